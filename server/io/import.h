@@ -1,0 +1,32 @@
+/* Format detection and one entry point that turns an uploaded file into an ag_mesh. */
+#ifndef AG_IMPORT_H
+#define AG_IMPORT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../core/mesh.h"
+#include "../core/status.h"
+#include "obj.h"
+
+typedef enum {
+    AG_FORMAT_UNKNOWN = 0,
+    AG_FORMAT_OBJ,
+} ag_format;
+
+/* "obj" → AG_FORMAT_OBJ; unknown names give AG_FORMAT_UNKNOWN. Case-insensitive. */
+ag_format ag_format_from_name(const char *name);
+const char *ag_format_name(ag_format f);
+/* Guess from content (and an optional file name's extension); AG_FORMAT_UNKNOWN when unsure. */
+ag_format ag_format_sniff(const uint8_t *data, size_t len, const char *filename);
+
+typedef struct {
+    ag_up_axis up;
+    int (*progress)(void *user, double fraction); /* non-zero return cancels */
+    void *user;
+} ag_import_options;
+
+ag_status ag_import_buffer(const uint8_t *data, size_t len, ag_format fmt,
+                           const ag_import_options *opt, ag_mesh **out, ag_error *err);
+
+#endif
