@@ -38,6 +38,9 @@ typedef struct {
 ag_mesh *ag_mesh_create(void);
 void ag_mesh_free(ag_mesh *m);
 
+/* Makes room for at least nverts vertices and ntris triangles (an optional speed-up). */
+ag_status ag_mesh_reserve(ag_mesh *m, size_t nverts, size_t ntris);
+
 /* Append; return AG_ERR_NOMEM on allocation failure. Indices are checked by the caller. */
 ag_status ag_mesh_add_vertex(ag_mesh *m, double x, double y, double z);
 ag_status ag_mesh_add_triangle(ag_mesh *m, uint32_t a, uint32_t b, uint32_t c, uint32_t component);

@@ -7,17 +7,27 @@
 const char *ag_status_name(ag_status s)
 {
     switch (s) {
-#define AG__STATUS_NAME(name, value, http, msg) case name: return #name;
+#define AG__STATUS_NAME(name, value, http, slug, msg) case name: return #name;
         AG_STATUS_LIST(AG__STATUS_NAME)
 #undef AG__STATUS_NAME
     }
     return "AG_ERR_INTERNAL";
 }
 
+const char *ag_status_slug(ag_status s)
+{
+    switch (s) {
+#define AG__STATUS_SLUG(name, value, http, slug, msg) case name: return slug;
+        AG_STATUS_LIST(AG__STATUS_SLUG)
+#undef AG__STATUS_SLUG
+    }
+    return "internal";
+}
+
 const char *ag_status_message(ag_status s)
 {
     switch (s) {
-#define AG__STATUS_MSG(name, value, http, msg) case name: return msg;
+#define AG__STATUS_MSG(name, value, http, slug, msg) case name: return msg;
         AG_STATUS_LIST(AG__STATUS_MSG)
 #undef AG__STATUS_MSG
     }
@@ -27,7 +37,7 @@ const char *ag_status_message(ag_status s)
 int ag_status_http(ag_status s)
 {
     switch (s) {
-#define AG__STATUS_HTTP(name, value, http, msg) case name: return http;
+#define AG__STATUS_HTTP(name, value, http, slug, msg) case name: return http;
         AG_STATUS_LIST(AG__STATUS_HTTP)
 #undef AG__STATUS_HTTP
     }

@@ -8,28 +8,29 @@
 
 #include <stddef.h>
 
-/*        name               value  http  message */
+/*  name                           value http slug (problem type)      message */
 #define AG_STATUS_LIST(X)                                                        \
-    X(AG_OK,                   0,   200, "ok")                                   \
-    X(AG_ERR_NOMEM,           -1,   503, "out of memory")                        \
-    X(AG_ERR_IO,              -2,   500, "input/output error")                   \
-    X(AG_ERR_PARSE,           -3,   422, "the input could not be parsed")        \
-    X(AG_ERR_INVALID,         -4,   400, "invalid argument")                     \
-    X(AG_ERR_NOT_FOUND,       -5,   404, "not found")                            \
-    X(AG_ERR_CONFLICT,        -6,   409, "conflict")                             \
-    X(AG_ERR_STALE,           -7,   412, "the version is stale")                 \
-    X(AG_ERR_PRECONDITION,    -8,   428, "a precondition is required")          \
-    X(AG_ERR_TOO_LARGE,       -9,   413, "the input is too large")               \
-    X(AG_ERR_UNSUPPORTED,    -10,   415, "unsupported format")                   \
-    X(AG_ERR_CANCELLED,      -11,   409, "the work was cancelled")               \
-    X(AG_ERR_DB,             -12,   500, "database error")                       \
-    X(AG_ERR_DB_TOO_NEW,     -13,   500, "the database is newer than this build") \
-    X(AG_ERR_BUSY,           -14,   503, "the server is busy")                   \
-    X(AG_ERR_EMPTY,          -15,   422, "the input holds no geometry")          \
-    X(AG_ERR_INTERNAL,       -16,   500, "internal error")
+    X(AG_OK,                         0,   200, "ok",                    "ok")                        \
+    X(AG_ERR_NOMEM,                  -1,  503, "out-of-memory",         "out of memory")             \
+    X(AG_ERR_IO,                     -2,  500, "io",                    "input/output error")        \
+    X(AG_ERR_PARSE,                  -3,  422, "parse",                 "the input could not be parsed") \
+    X(AG_ERR_INVALID,                -4,  400, "invalid",               "invalid argument")          \
+    X(AG_ERR_NOT_FOUND,              -5,  404, "not-found",             "not found")                 \
+    X(AG_ERR_CONFLICT,               -6,  409, "conflict",              "conflict")                  \
+    X(AG_ERR_STALE,                  -7,  412, "stale",                 "the version is stale")      \
+    X(AG_ERR_PRECONDITION_REQUIRED,  -8,  428, "precondition-required", "a precondition is required") \
+    X(AG_ERR_TOO_LARGE,              -9,  413, "too-large",             "the input is too large")    \
+    X(AG_ERR_UNSUPPORTED,            -10, 415, "unsupported",           "unsupported format")        \
+    X(AG_ERR_CANCELLED,              -11, 409, "cancelled",             "the work was cancelled")    \
+    X(AG_ERR_DB,                     -12, 500, "database",              "database error")            \
+    X(AG_ERR_DB_TOO_NEW,             -13, 500, "database-too-new",      "the database is newer than this build") \
+    X(AG_ERR_BUSY,                   -14, 503, "busy",                  "the server is busy")        \
+    X(AG_ERR_EMPTY,                  -15, 422, "empty",                 "the input holds no geometry") \
+    X(AG_ERR_INTERNAL,               -16, 500, "internal",              "internal error")            \
+    X(AG_ERR_METHOD_NOT_ALLOWED,     -17, 405, "method-not-allowed",    "method not allowed")       
 
 typedef enum {
-#define AG__STATUS_ENUM(name, value, http, msg) name = value,
+#define AG__STATUS_ENUM(name, value, http, slug, msg) name = value,
     AG_STATUS_LIST(AG__STATUS_ENUM)
 #undef AG__STATUS_ENUM
 } ag_status;
@@ -46,6 +47,8 @@ typedef struct {
 /* "AG_ERR_PARSE" → "parse" style stable slug used in problem type URIs. */
 const char *ag_status_name(ag_status s);
 const char *ag_status_message(ag_status s);
+/* "not-found" for AG_ERR_NOT_FOUND: the stable part of a problem type URI. */
+const char *ag_status_slug(ag_status s);
 int ag_status_http(ag_status s);
 
 /* Records code, element and a printf-formatted text into err (if non-NULL); returns code

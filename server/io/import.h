@@ -12,6 +12,13 @@
 typedef enum {
     AG_FORMAT_UNKNOWN = 0,
     AG_FORMAT_OBJ,
+    /* Recognised so a message can name them; importing them is not supported yet. */
+    AG_FORMAT_PLY,
+    AG_FORMAT_STL,
+    AG_FORMAT_GLTF,
+    AG_FORMAT_GLB,
+    AG_FORMAT_FBX,
+    AG_FORMAT_DAE,
 } ag_format;
 
 /* "obj" → AG_FORMAT_OBJ; unknown names give AG_FORMAT_UNKNOWN. Case-insensitive. */
@@ -26,6 +33,8 @@ typedef struct {
     void *user;
 } ag_import_options;
 
+/* OBJ is read by the built-in reader; the other recognised formats give
+ * AG_ERR_UNSUPPORTED naming the format, AG_FORMAT_UNKNOWN is sniffed from the content. */
 ag_status ag_import_buffer(const uint8_t *data, size_t len, ag_format fmt,
                            const ag_import_options *opt, ag_mesh **out, ag_error *err);
 

@@ -6,8 +6,8 @@
 
 #include "../core/mesh.h"
 
-/* {"vertices", "triangles", "components", "groups", "bounds": {"min":[3], "max":[3]},
- *  "diagonal"} — a new reference. */
+/* {"vertices", "triangles", "components", "groups" (counts), "group_names": [...],
+ *  "bounds": {"min":[3], "max":[3]} (null for an empty mesh), "diagonal"} — a new reference. */
 json_t *ag_meshjson_summary(const ag_mesh *m);
 
 #endif

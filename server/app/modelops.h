@@ -1,0 +1,28 @@
+/* Edits to a model as ops: validated, sequenced (one version per op), logged and published.
+ * The same path serves websocket ops, REST PATCH and POST …/ops. */
+#ifndef AG_MODELOPS_H
+#define AG_MODELOPS_H
+
+#include <jansson.h>
+#include <stdint.h>
+
+#include "app.h"
+
+/* Checks an op's shape: {"kind": "rename", "name"} or {"kind": "note", "text"}. */
+ag_status ag_modelops_validate(const json_t *op, ag_error *err);
+
+/* Applies op to model if base is its current version: *version gets the new version.
+ * A (author, cid) pair seen before on this model is not applied again: *duplicate = 1 and
+ * *version is the version it got then. AG_ERR_STALE carries the current version in
+ * err->element. origin is passed on to the published event (0 = none). */
+ag_status ag_modelops_apply(ag_app *app, int64_t model, int64_t base, const char *author,
+                            const char *cid, const json_t *op, uint64_t origin,
+                            int64_t *version, int *duplicate, ag_error *err);
+
+/* Deletes a model at the given version (AG_ERR_STALE otherwise) and publishes its end. */
+ag_status ag_modelops_delete(ag_app *app, int64_t model, int64_t version, ag_error *err);
+
+/* Checks a client-supplied identifier (cid, author): 1..100 printable ASCII characters. */
+ag_status ag_modelops_check_token(const char *what, const char *value, ag_error *err);
+
+#endif

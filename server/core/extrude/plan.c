@@ -1,0 +1,395 @@
+#include "plan.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "predicates.h"
+#include "tolerance.h"
+
+ag_plan *ag_plan_create(void)
+{
+    return calloc(1, sizeof(ag_plan));
+}
+
+void ag_plan_free(ag_plan *p)
+{
+    if (!p)
+        return;
+    for (size_t i = 0; i < p->nloops; i++) {
+        free(p->loops[i].xy);
+        free(p->loops[i].profile);
+    }
+    for (size_t i = 0; i < p->nprofiles; i++) {
+        free(p->profiles[i].name);
+        free(p->profiles[i].points);
+        free(p->profiles[i].tag);
+    }
+    free(p->loops);
+    free(p->profiles);
+    free(p);
+}
+
+void ag_plan_fixes_free(ag_plan_fixes *f)
+{
+    if (!f)
+        return;
+    free(f->fixes);
+    f->fixes = NULL;
+    f->n = f->cap = 0;
+}
+
+static char *dupstr(const char *s)
+{
+    if (!s)
+        return NULL;
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d)
+        memcpy(d, s, n);
+    return d;
+}
+
+ag_status ag_plan_add_profile(ag_plan *p, const char *name, const ag_profile_point *pts,
+                              size_t n, const char *tag, size_t *index, ag_error *err)
+{
+    long idx = (long)p->nprofiles;
+    if (n < 2)
+        return ag_error_set(err, AG_ERR_INVALID, idx + 1,
+                            "profile %s: needs at least two points", name ? name : "");
+    for (size_t i = 0; i < n; i++) {
+        if (!isfinite(pts[i].w) || !isfinite(pts[i].z))
+            return ag_error_set(err, AG_ERR_INVALID, idx + 1,
+                                "profile %s: point %zu is not finite", name ? name : "", i);
+        if (i > 0 && pts[i].z < pts[i - 1].z)
+            return ag_error_set(err, AG_ERR_INVALID, idx + 1,
+                                "profile %s: point %zu is lower than point %zu (profiles must "
+                                "be monotone in z)", name ? name : "", i, i - 1);
+    }
+    if (pts[0].w != 0.0 || pts[0].z != 0.0)
+        return ag_error_set(err, AG_ERR_INVALID, idx + 1,
+                            "profile %s: must start at (0, 0)", name ? name : "");
+    if (pts[n - 1].z <= pts[n - 2].z)
+        return ag_error_set(err, AG_ERR_INVALID, idx + 1,
+                            "profile %s: the last segment must rise (it continues upwards)",
+                            name ? name : "");
+    for (size_t i = 1; i + 1 < n; i++)
+        if (pts[i + 1].z - pts[i].z <= 0.0)
+            return ag_error_set(err, AG_ERR_UNSUPPORTED, idx + 1,
+                                "profile %s: horizontal segment %zu is not supported yet; "
+                                "use a steep segment instead", name ? name : "", i);
+    if (p->nprofiles == p->cap_profiles) {
+        size_t cap = p->cap_profiles ? 2 * p->cap_profiles : 4;
+        ag_profile *np = realloc(p->profiles, cap * sizeof *np);
+        if (!np)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        p->profiles = np;
+        p->cap_profiles = cap;
+    }
+    ag_profile *pr = &p->profiles[p->nprofiles];
+    memset(pr, 0, sizeof *pr);
+    pr->points = malloc(n * sizeof *pr->points);
+    pr->name = dupstr(name ? name : "");
+    pr->tag = dupstr(tag);
+    if (!pr->points || !pr->name || (tag && !pr->tag)) {
+        free(pr->points);
+        free(pr->name);
+        free(pr->tag);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    memcpy(pr->points, pts, n * sizeof *pts);
+    pr->npoints = n;
+    if (index)
+        *index = p->nprofiles;
+    p->nprofiles++;
+    return AG_OK;
+}
+
+ag_status ag_plan_add_loop(ag_plan *p, const double *xy, size_t n, const int32_t *profiles,
+                           ag_error *err)
+{
+    if (p->nloops == p->cap_loops) {
+        size_t cap = p->cap_loops ? 2 * p->cap_loops : 4;
+        ag_plan_loop *nl = realloc(p->loops, cap * sizeof *nl);
+        if (!nl)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        p->loops = nl;
+        p->cap_loops = cap;
+    }
+    ag_plan_loop *l = &p->loops[p->nloops];
+    l->n = n;
+    l->xy = malloc((n ? n : 1) * 2 * sizeof(double));
+    l->profile = malloc((n ? n : 1) * sizeof(int32_t));
+    if (!l->xy || !l->profile) {
+        free(l->xy);
+        free(l->profile);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    if (n)
+        memcpy(l->xy, xy, n * 2 * sizeof(double));
+    for (size_t i = 0; i < n; i++)
+        l->profile[i] = profiles ? profiles[i] : 0;
+    p->nloops++;
+    return AG_OK;
+}
+
+int32_t ag_plan_find_profile(const ag_plan *p, const char *name)
+{
+    for (size_t i = 0; i < p->nprofiles; i++)
+        if (p->profiles[i].name && strcmp(p->profiles[i].name, name) == 0)
+            return (int32_t)i;
+    return -1;
+}
+
+double ag_plan_loop_area(const ag_plan_loop *l)
+{
+    long double a = 0;
+    for (size_t i = 0, j = l->n - 1; i < l->n; j = i++)
+        a += (long double)l->xy[2 * j] * l->xy[2 * i + 1] -
+             (long double)l->xy[2 * i] * l->xy[2 * j + 1];
+    return (double)(a / 2);
+}
+
+static void add_fix(ag_plan_fixes *f, ag_plan_fix_kind kind, long loop, long corner,
+                    const char *reason)
+{
+    if (!f)
+        return;
+    if (f->n == f->cap) {
+        size_t cap = f->cap ? 2 * f->cap : 8;
+        ag_plan_fix *nf = realloc(f->fixes, cap * sizeof *nf);
+        if (!nf)
+            return; /* the record is informative; losing it under memory pressure is fine */
+        f->fixes = nf;
+        f->cap = cap;
+    }
+    ag_plan_fix *x = &f->fixes[f->n++];
+    x->kind = kind;
+    x->loop = loop;
+    x->corner = corner;
+    snprintf(x->reason, sizeof x->reason, "%s", reason);
+}
+
+/* Removes duplicate, collinear and spike corners of one loop; `orig` maps the kept
+ * corners back to input indices for the messages. */
+static void clean_loop(ag_plan_loop *l, long li, long *orig, double d2, ag_plan_fixes *fx)
+{
+    int changed = 1;
+    while (changed && l->n >= 3) {
+        changed = 0;
+        for (size_t i = 0; i < l->n && l->n >= 3; i++) {
+            size_t pi = (i + l->n - 1) % l->n, ni = (i + 1) % l->n;
+            const double *a = &l->xy[2 * pi], *b = &l->xy[2 * i], *c = &l->xy[2 * ni];
+            double abx = b[0] - a[0], aby = b[1] - a[1], bcx = c[0] - b[0], bcy = c[1] - b[1];
+            double lab = hypot(abx, aby), lbc = hypot(bcx, bcy);
+            ag_plan_fix_kind kind = 0;
+            const char *why = NULL;
+            if (lab <= d2) {
+                kind = AG_PLAN_FIX_DUPLICATE;
+                why = "duplicate corner (same position as the previous one) removed";
+            } else if (lbc > d2) {
+                double cr = abx * bcy - aby * bcx, dt = abx * bcx + aby * bcy;
+                /* distance of b from the line ac, relative to the shorter edge */
+                double h = fabs(cr) / (lab > lbc ? lab : lbc);
+                if (h <= d2 && dt < 0) {
+                    kind = AG_PLAN_FIX_SPIKE;
+                    why = "spike (the boundary turns back on itself) removed";
+                } else if (h <= d2 && l->profile[pi] == l->profile[i]) {
+                    kind = AG_PLAN_FIX_COLLINEAR;
+                    why = "collinear corner with the same profile on both edges removed";
+                }
+            }
+            if (!kind)
+                continue;
+            add_fix(fx, kind, li, orig[i], why);
+            /* drop corner i; the edge i (from i to i+1) goes, edge pi now reaches i+1 */
+            memmove(&l->xy[2 * i], &l->xy[2 * (i + 1)], (l->n - i - 1) * 2 * sizeof(double));
+            memmove(&l->profile[i], &l->profile[i + 1], (l->n - i - 1) * sizeof(int32_t));
+            memmove(&orig[i], &orig[i + 1], (l->n - i - 1) * sizeof(long));
+            l->n--;
+            changed = 1;
+            i = i > 0 ? i - 1 : 0;
+        }
+    }
+}
+
+typedef struct {
+    double xmin, xmax;
+    uint32_t loop, idx;
+} seg_box;
+
+static int cmp_seg(const void *a, const void *b)
+{
+    const seg_box *x = a, *y = b;
+    return x->xmin < y->xmin ? -1 : x->xmin > y->xmin;
+}
+
+static ag_status check_crossings(const ag_plan *p, long **orig, double eps, ag_error *err)
+{
+    size_t total = 0;
+    for (size_t i = 0; i < p->nloops; i++)
+        total += p->loops[i].n;
+    seg_box *s = malloc((total ? total : 1) * sizeof *s);
+    if (!s)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    size_t k = 0;
+    for (size_t i = 0; i < p->nloops; i++) {
+        const ag_plan_loop *l = &p->loops[i];
+        for (size_t j = 0; j < l->n; j++) {
+            double x0 = l->xy[2 * j], x1 = l->xy[2 * ((j + 1) % l->n)];
+            s[k].xmin = x0 < x1 ? x0 : x1;
+            s[k].xmax = x0 < x1 ? x1 : x0;
+            s[k].loop = (uint32_t)i;
+            s[k].idx = (uint32_t)j;
+            k++;
+        }
+    }
+    qsort(s, total, sizeof *s, cmp_seg);
+    ag_status st = AG_OK;
+    for (size_t i = 0; i < total && st == AG_OK; i++) {
+        const ag_plan_loop *la = &p->loops[s[i].loop];
+        size_t a0 = s[i].idx, a1 = (a0 + 1) % la->n;
+        for (size_t j = i + 1; j < total && s[j].xmin <= s[i].xmax; j++) {
+            const ag_plan_loop *lb = &p->loops[s[j].loop];
+            size_t b0 = s[j].idx, b1 = (b0 + 1) % lb->n;
+            if (s[i].loop == s[j].loop && (a1 == b0 || b1 == a0))
+                continue; /* neighbours share a corner */
+            if (ag_pred_segments_touch(&la->xy[2 * a0], &la->xy[2 * a1], &lb->xy[2 * b0],
+                                       &lb->xy[2 * b1], eps)) {
+                st = ag_error_set(err, AG_ERR_INVALID, (long)s[i].loop + 1,
+                                  "loop %u edge %ld (from corner %ld) crosses or touches "
+                                  "loop %u edge %ld (from corner %ld)",
+                                  s[i].loop, orig[s[i].loop][a0], orig[s[i].loop][a0],
+                                  s[j].loop, orig[s[j].loop][b0], orig[s[j].loop][b0]);
+                break;
+            }
+        }
+    }
+    free(s);
+    return st;
+}
+
+static void reverse_loop(ag_plan_loop *l, long *orig)
+{
+    /* corners reversed; edge i (i -> i+1) becomes the edge from i+1 to i */
+    size_t n = l->n;
+    for (size_t i = 0; i < n / 2; i++) {
+        size_t j = n - 1 - i;
+        double tx = l->xy[2 * i], ty = l->xy[2 * i + 1];
+        l->xy[2 * i] = l->xy[2 * j];
+        l->xy[2 * i + 1] = l->xy[2 * j + 1];
+        l->xy[2 * j] = tx;
+        l->xy[2 * j + 1] = ty;
+        long to = orig[i];
+        orig[i] = orig[j];
+        orig[j] = to;
+    }
+    /* new edge i runs from new corner i (old n-1-i) to old n-2-i: old edge n-2-i */
+    int32_t *np = malloc(n * sizeof *np);
+    if (!np)
+        return;
+    for (size_t i = 0; i < n; i++)
+        np[i] = l->profile[(2 * n - 2 - i) % n];
+    memcpy(l->profile, np, n * sizeof *np);
+    free(np);
+}
+
+ag_status ag_plan_validate(ag_plan *p, ag_plan_fixes *fixes, double *extent, ag_error *err)
+{
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (size_t i = 0; i < p->nloops; i++) {
+        ag_plan_loop *l = &p->loops[i];
+        for (size_t j = 0; j < l->n; j++) {
+            double x = l->xy[2 * j], y = l->xy[2 * j + 1];
+            if (!isfinite(x) || !isfinite(y))
+                return ag_error_set(err, AG_ERR_INVALID, (long)i + 1,
+                                    "loop %zu corner %zu is not finite", i, j);
+            if (l->profile[j] < 0 || (size_t)l->profile[j] >= p->nprofiles)
+                return ag_error_set(err, AG_ERR_INVALID, (long)i + 1,
+                                    "loop %zu edge %zu has no valid profile (%d of %zu)", i, j,
+                                    (int)l->profile[j], p->nprofiles);
+            lo[0] = fmin(lo[0], x);
+            lo[1] = fmin(lo[1], y);
+            hi[0] = fmax(hi[0], x);
+            hi[1] = fmax(hi[1], y);
+        }
+    }
+    if (p->nloops == 0 || !(hi[0] >= lo[0]))
+        return ag_error_set(err, AG_ERR_EMPTY, 0, "the plan has no corners");
+    double ext = hypot(hi[0] - lo[0], hi[1] - lo[1]);
+    if (extent)
+        *extent = ext;
+    double scale = ag_extrude_scale(ext);
+    double d2 = AG_EXTRUDE_DELTA2 * scale;
+
+    long **orig = calloc(p->nloops, sizeof *orig);
+    if (!orig)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    ag_status st = AG_OK;
+    size_t kept = 0;
+    for (size_t i = 0; i < p->nloops; i++) {
+        ag_plan_loop *l = &p->loops[i];
+        orig[i] = malloc((l->n ? l->n : 1) * sizeof(long));
+        if (!orig[i]) {
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            goto done;
+        }
+        for (size_t j = 0; j < l->n; j++)
+            orig[i][j] = (long)j;
+        clean_loop(l, (long)i, orig[i], d2, fixes);
+        if (l->n < 3 || fabs(ag_plan_loop_area(l)) <= d2 * ext) {
+            add_fix(fixes, AG_PLAN_FIX_DROPPED, (long)i, -1,
+                    "loop with fewer than 3 corners or no area removed");
+            l->n = 0;
+        } else {
+            kept++;
+        }
+    }
+    if (!kept) {
+        st = ag_error_set(err, AG_ERR_EMPTY, 0, "no loop of the plan has an area");
+        goto done;
+    }
+    /* compact the loops (keeping orig aligned) */
+    size_t w = 0;
+    for (size_t i = 0; i < p->nloops; i++) {
+        if (p->loops[i].n == 0) {
+            free(p->loops[i].xy);
+            free(p->loops[i].profile);
+            free(orig[i]);
+            continue;
+        }
+        p->loops[w] = p->loops[i];
+        orig[w] = orig[i];
+        w++;
+    }
+    for (size_t i = w; i < p->nloops; i++)
+        orig[i] = NULL;
+    p->nloops = w;
+
+    st = check_crossings(p, orig, d2 * d2, err);
+    if (st != AG_OK)
+        goto done;
+    /* orientation by nesting depth: even depth = outer (CCW), odd = hole (CW) */
+    for (size_t i = 0; i < p->nloops; i++) {
+        ag_plan_loop *l = &p->loops[i];
+        int depth = 0;
+        for (size_t j = 0; j < p->nloops; j++)
+            if (j != i && ag_pred_point_in_polygon(p->loops[j].xy, p->loops[j].n, l->xy[0],
+                                                  l->xy[1]))
+                depth++;
+        double a = ag_plan_loop_area(l);
+        int want_ccw = depth % 2 == 0;
+        if ((a > 0) != want_ccw) {
+            reverse_loop(l, orig[i]);
+            add_fix(fixes, AG_PLAN_FIX_REVERSED, (long)i, -1,
+                    want_ccw ? "outer loop was clockwise: reversed"
+                             : "hole was counter-clockwise: reversed");
+        }
+    }
+done:
+    for (size_t i = 0; i < p->nloops; i++)
+        free(orig[i]);
+    free(orig);
+    return st;
+}

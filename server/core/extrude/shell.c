@@ -1,0 +1,745 @@
+#include "shell.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "predicates.h"
+
+#define NONE UINT32_MAX
+
+ag_shell *ag_shell_create(void)
+{
+    return calloc(1, sizeof(ag_shell));
+}
+
+void ag_shell_free(ag_shell *s)
+{
+    if (!s)
+        return;
+    free(s->pos);
+    free(s->faces);
+    free(s->loop_start);
+    free(s->idx);
+    free(s->he_twin);
+    free(s->he_next);
+    free(s->he_face);
+    free(s->segs);
+    free(s);
+}
+
+static int grow(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap)
+        return 1;
+    size_t c = *cap ? *cap : 16;
+    while (c < need)
+        c *= 2;
+    void *n = realloc(*p, c * elem);
+    if (!n)
+        return 0;
+    *p = n;
+    *cap = c;
+    return 1;
+}
+
+ag_status ag_shell_add_vertex(ag_shell *s, double x, double y, double z, uint32_t *id)
+{
+    if (!grow((void **)&s->pos, &s->cap_verts, s->nverts + 1, 3 * sizeof(double)))
+        return AG_ERR_NOMEM;
+    double *p = &s->pos[3 * s->nverts];
+    p[0] = x;
+    p[1] = y;
+    p[2] = z;
+    *id = (uint32_t)s->nverts++;
+    return AG_OK;
+}
+
+ag_status ag_shell_add_face(ag_shell *s, const ag_shell_face *f, uint32_t *id)
+{
+    if (!grow((void **)&s->faces, &s->cap_faces, s->nfaces + 1, sizeof(ag_shell_face)))
+        return AG_ERR_NOMEM;
+    s->faces[s->nfaces] = *f;
+    s->faces[s->nfaces].first_loop = 0;
+    s->faces[s->nfaces].nloops = 0;
+    *id = (uint32_t)s->nfaces++;
+    return AG_OK;
+}
+
+ag_status ag_shell_add_segment(ag_shell *s, uint32_t face, uint32_t from, uint32_t to)
+{
+    if (from == to)
+        return AG_OK;
+    if (!grow((void **)&s->segs, &s->cap_segs, s->nsegs + 1, 3 * sizeof(uint32_t)))
+        return AG_ERR_NOMEM;
+    uint32_t *g = &s->segs[3 * s->nsegs++];
+    g[0] = face;
+    g[1] = from;
+    g[2] = to;
+    return AG_OK;
+}
+
+/* --- welding --------------------------------------------------------------------------- */
+
+static const double *g_sort_pos;
+static int cmp_by_x(const void *a, const void *b)
+{
+    double x = g_sort_pos[3 * *(const uint32_t *)a], y = g_sort_pos[3 * *(const uint32_t *)b];
+    return x < y ? -1 : x > y;
+}
+
+static uint32_t find(uint32_t *par, uint32_t x)
+{
+    while (par[x] != x) {
+        par[x] = par[par[x]];
+        x = par[x];
+    }
+    return x;
+}
+
+static ag_status weld(ag_shell *s, double tol, uint32_t *map)
+{
+    size_t n = s->nverts;
+    uint32_t *order = malloc((n ? n : 1) * sizeof *order);
+    uint32_t *par = malloc((n ? n : 1) * sizeof *par);
+    if (!order || !par) {
+        free(order);
+        free(par);
+        return AG_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n; i++)
+        order[i] = par[i] = (uint32_t)i;
+    g_sort_pos = s->pos;
+    qsort(order, n, sizeof *order, cmp_by_x);
+    double t2 = tol * tol;
+    for (size_t i = 0; i < n; i++) {
+        const double *a = &s->pos[3 * order[i]];
+        for (size_t j = i + 1; j < n; j++) {
+            const double *b = &s->pos[3 * order[j]];
+            if (b[0] - a[0] > tol)
+                break;
+            double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
+            if (dx * dx + dy * dy + dz * dz <= t2) {
+                uint32_t ra = find(par, order[i]), rb = find(par, order[j]);
+                if (ra != rb)
+                    par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
+            }
+        }
+    }
+    for (size_t i = 0; i < n; i++)
+        map[i] = find(par, (uint32_t)i);
+    free(order);
+    free(par);
+    return AG_OK;
+}
+
+/* --- linking ---------------------------------------------------------------------------- */
+
+typedef struct {
+    uint64_t key; /* from << 32 | to */
+    uint32_t seg;
+} seg_key;
+
+static int cmp_key(const void *a, const void *b)
+{
+    uint64_t x = ((const seg_key *)a)->key, y = ((const seg_key *)b)->key;
+    return x < y ? -1 : x > y;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+ag_status ag_shell_finish(ag_shell *s, double weld_tol)
+{
+    uint32_t *map = malloc((s->nverts ? s->nverts : 1) * sizeof *map);
+    if (!map)
+        return AG_ERR_NOMEM;
+    ag_status st = weld(s, weld_tol, map);
+    if (st != AG_OK) {
+        free(map);
+        return st;
+    }
+    size_t ns = s->nsegs;
+    uint32_t *g = s->segs;
+    for (size_t i = 0; i < ns; i++) {
+        g[3 * i + 1] = map[g[3 * i + 1]];
+        g[3 * i + 2] = map[g[3 * i + 2]];
+    }
+    free(map);
+    /* sort segments by face, then cancel zero-length and in-face opposite pairs */
+    uint32_t *ord = malloc((ns ? ns : 1) * sizeof *ord);
+    uint8_t *dead = calloc(ns ? ns : 1, 1);
+    seg_key *keys = malloc((ns ? ns : 1) * sizeof *keys);
+    uint32_t *fstart = calloc(s->nfaces + 1, sizeof *fstart);
+    if (!ord || !dead || !keys || !fstart) {
+        st = AG_ERR_NOMEM;
+        goto out;
+    }
+    for (size_t i = 0; i < ns; i++)
+        fstart[g[3 * i] + 1]++;
+    for (size_t f = 0; f < s->nfaces; f++)
+        fstart[f + 1] += fstart[f];
+    {
+        uint32_t *fill = malloc((s->nfaces + 1) * sizeof *fill);
+        if (!fill) {
+            st = AG_ERR_NOMEM;
+            goto out;
+        }
+        memcpy(fill, fstart, (s->nfaces + 1) * sizeof *fill);
+        for (size_t i = 0; i < ns; i++)
+            ord[fill[g[3 * i]]++] = (uint32_t)i;
+        free(fill);
+    }
+    for (size_t i = 0; i < ns; i++)
+        if (g[3 * i + 1] == g[3 * i + 2])
+            dead[i] = 1;
+    free(s->loop_start);
+    free(s->idx);
+    s->loop_start = malloc((ns + s->nfaces + 1) * sizeof(uint32_t));
+    s->idx = malloc((ns ? ns : 1) * sizeof(uint32_t));
+    if (!s->loop_start || !s->idx) {
+        st = AG_ERR_NOMEM;
+        goto out;
+    }
+    s->nloops = 0;
+    s->open_segments = 0;
+    size_t nidx = 0;
+    for (size_t f = 0; f < s->nfaces; f++) {
+        uint32_t a = fstart[f], b = fstart[f + 1], k = b - a;
+        for (uint32_t i = 0; i < k; i++) {
+            uint32_t sg = ord[a + i];
+            keys[i].key = (uint64_t)g[3 * sg + 1] << 32 | g[3 * sg + 2];
+            keys[i].seg = sg;
+        }
+        qsort(keys, k, sizeof *keys, cmp_key);
+        /* cancel u->v against v->u within the face (zero-width slits) */
+        for (uint32_t i = 0; i < k; i++) {
+            uint32_t sg = keys[i].seg;
+            if (dead[sg])
+                continue;
+            uint64_t rev = (uint64_t)g[3 * sg + 2] << 32 | g[3 * sg + 1];
+            uint32_t lo = 0, hi = k;
+            while (lo < hi) {
+                uint32_t mid = (lo + hi) / 2;
+                if (keys[mid].key < rev)
+                    lo = mid + 1;
+                else
+                    hi = mid;
+            }
+            for (uint32_t j = lo; j < k && keys[j].key == rev; j++)
+                if (!dead[keys[j].seg]) {
+                    dead[keys[j].seg] = 1;
+                    dead[sg] = 1;
+                    break;
+                }
+        }
+        /* link: keys sorted by from-vertex; walk from each unused segment */
+        s->faces[f].first_loop = (uint32_t)s->nloops;
+        for (uint32_t i = 0; i < k; i++) {
+            uint32_t sg = keys[i].seg;
+            if (dead[sg])
+                continue;
+            uint32_t start = g[3 * sg + 1], cur = sg;
+            size_t begin = nidx;
+            int closed = 0;
+            for (;;) {
+                dead[cur] = 1;
+                s->idx[nidx++] = g[3 * cur + 1];
+                uint32_t to = g[3 * cur + 2];
+                if (to == start) {
+                    closed = 1;
+                    break;
+                }
+                uint64_t want = (uint64_t)to << 32;
+                uint32_t lo = 0, hi = k;
+                while (lo < hi) {
+                    uint32_t mid = (lo + hi) / 2;
+                    if (keys[mid].key < want)
+                        lo = mid + 1;
+                    else
+                        hi = mid;
+                }
+                uint32_t next = NONE;
+                for (uint32_t j = lo; j < k && (keys[j].key >> 32) == to; j++)
+                    if (!dead[keys[j].seg]) {
+                        next = keys[j].seg;
+                        break;
+                    }
+                if (next == NONE)
+                    break;
+                cur = next;
+            }
+            if (closed && nidx - begin >= 3) {
+                s->loop_start[s->nloops++] = (uint32_t)begin;
+            } else {
+                s->open_segments += nidx - begin;
+                nidx = begin;
+                s->faces[f].nloops |= 0x80000000u; /* mark: open boundary */
+            }
+        }
+        uint32_t open = s->faces[f].nloops & 0x80000000u;
+        s->faces[f].nloops = (uint32_t)(s->nloops - s->faces[f].first_loop) | open;
+    }
+    s->loop_start[s->nloops] = (uint32_t)nidx;
+    /* half-edges */
+    s->nhalf = nidx;
+    free(s->he_twin);
+    free(s->he_next);
+    free(s->he_face);
+    s->he_twin = malloc((nidx ? nidx : 1) * sizeof(uint32_t));
+    s->he_next = malloc((nidx ? nidx : 1) * sizeof(uint32_t));
+    s->he_face = malloc((nidx ? nidx : 1) * sizeof(uint32_t));
+    seg_key *hk = malloc((nidx ? nidx : 1) * sizeof *hk);
+    if (!s->he_twin || !s->he_next || !s->he_face || !hk) {
+        free(hk);
+        st = AG_ERR_NOMEM;
+        goto out;
+    }
+    for (size_t f = 0; f < s->nfaces; f++) {
+        uint32_t nl = s->faces[f].nloops & 0x7fffffffu;
+        for (uint32_t l = s->faces[f].first_loop; l < s->faces[f].first_loop + nl; l++) {
+            uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
+            for (uint32_t i = a; i < b; i++) {
+                s->he_next[i] = i + 1 < b ? i + 1 : a;
+                s->he_face[i] = (uint32_t)f;
+                s->he_twin[i] = NONE;
+            }
+        }
+    }
+    for (size_t i = 0; i < nidx; i++) {
+        hk[i].key = (uint64_t)s->idx[i] << 32 | s->idx[s->he_next[i]];
+        hk[i].seg = (uint32_t)i;
+    }
+    qsort(hk, nidx, sizeof *hk, cmp_key);
+    for (size_t i = 0; i < nidx; i++) {
+        uint32_t h = (uint32_t)i;
+        uint64_t rev = (uint64_t)s->idx[s->he_next[h]] << 32 | s->idx[h];
+        size_t lo = 0, hi = nidx;
+        while (lo < hi) {
+            size_t mid = (lo + hi) / 2;
+            if (hk[mid].key < rev)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        /* exactly one opposite half-edge: twin; more than one stays unpaired (reported) */
+        if (lo < nidx && hk[lo].key == rev && (lo + 1 >= nidx || hk[lo + 1].key != rev))
+            s->he_twin[h] = hk[lo].seg;
+    }
+    free(hk);
+out:
+    (void)cmp_u32;
+    free(ord);
+    free(dead);
+    free(keys);
+    free(fstart);
+    return st;
+}
+
+size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max)
+{
+    size_t nbad = 0;
+    /* duplicate directed edges */
+    seg_key *hk = malloc((s->nhalf ? s->nhalf : 1) * sizeof *hk);
+    uint8_t *dup = calloc(s->nhalf ? s->nhalf : 1, 1);
+    if (hk && dup) {
+        for (size_t i = 0; i < s->nhalf; i++) {
+            hk[i].key = (uint64_t)s->idx[i] << 32 | s->idx[s->he_next[i]];
+            hk[i].seg = (uint32_t)i;
+        }
+        qsort(hk, s->nhalf, sizeof *hk, cmp_key);
+        for (size_t i = 1; i < s->nhalf; i++)
+            if (hk[i].key == hk[i - 1].key)
+                dup[hk[i].seg] = dup[hk[i - 1].seg] = 1;
+    }
+    for (size_t f = 0; f < s->nfaces; f++) {
+        const ag_shell_face *fc = &s->faces[f];
+        char why[112] = "";
+        if (fc->nloops & 0x80000000u)
+            snprintf(why, sizeof why, "face boundary does not close into a loop");
+        uint32_t nl = fc->nloops & 0x7fffffffu;
+        for (uint32_t l = fc->first_loop; l < fc->first_loop + nl && !why[0]; l++)
+            for (uint32_t h = s->loop_start[l]; h < s->loop_start[l + 1]; h++) {
+                uint32_t u = s->idx[h], v = s->idx[s->he_next[h]];
+                if (dup && dup[h]) {
+                    snprintf(why, sizeof why,
+                             "edge %u-%u is used twice in the same direction (not 2-manifold)",
+                             u, v);
+                    break;
+                }
+                if (s->he_twin[h] == NONE) {
+                    snprintf(why, sizeof why,
+                             "edge %u-%u has no opposite edge (the shell is open there)", u, v);
+                    break;
+                }
+            }
+        if (why[0]) {
+            if (nbad < max) {
+                out[nbad].face = (int32_t)f;
+                memcpy(out[nbad].reason, why, sizeof why);
+            }
+            nbad++;
+        }
+    }
+    free(hk);
+    free(dup);
+    return nbad;
+}
+
+double ag_shell_volume(const ag_shell *s)
+{
+    /* divergence theorem over fan triangles of every loop */
+    long double v = 0;
+    for (size_t l = 0; l < s->nloops; l++) {
+        uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
+        const double *p0 = &s->pos[3 * s->idx[a]];
+        for (uint32_t i = a + 1; i + 1 < b; i++) {
+            const double *p1 = &s->pos[3 * s->idx[i]], *p2 = &s->pos[3 * s->idx[i + 1]];
+            v += (long double)p0[0] * (p1[1] * p2[2] - p1[2] * p2[1]) -
+                 (long double)p0[1] * (p1[0] * p2[2] - p1[2] * p2[0]) +
+                 (long double)p0[2] * (p1[0] * p2[1] - p1[1] * p2[0]);
+        }
+    }
+    return (double)(v / 6);
+}
+
+/* --- triangulation ---------------------------------------------------------------------- */
+
+typedef struct {
+    double x, y;
+    uint32_t v; /* shell vertex */
+} tri_pt;
+
+static double cross3(const tri_pt *a, const tri_pt *b, const tri_pt *c)
+{
+    return (b->x - a->x) * (c->y - a->y) - (b->y - a->y) * (c->x - a->x);
+}
+
+static double loop_area(const tri_pt *p, size_t n)
+{
+    double a = 0;
+    for (size_t i = 0, j = n - 1; i < n; j = i++)
+        a += p[j].x * p[i].y - p[i].x * p[j].y;
+    return a / 2;
+}
+
+static int seg_cross(const tri_pt *a, const tri_pt *b, const tri_pt *c, const tri_pt *d)
+{
+    double p1[2] = {a->x, a->y}, p2[2] = {b->x, b->y}, p3[2] = {c->x, c->y}, p4[2] = {d->x, d->y};
+    return ag_pred_segments_touch(p1, p2, p3, p4, 0.0);
+}
+
+/* Ear clipping of one simple polygon (CCW). Emits triangles through the callback
+ * arrays. Falls back to clipping the most convex corner when no clean ear is found,
+ * so it always terminates. */
+static ag_status ear_clip(tri_pt *p, size_t n, ag_mesh *m, uint32_t base, uint32_t comp,
+                          size_t *ntris)
+{
+    if (n < 3)
+        return AG_OK;
+    uint32_t *prev = malloc(n * sizeof *prev), *next = malloc(n * sizeof *next);
+    if (!prev || !next) {
+        free(prev);
+        free(next);
+        return AG_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n; i++) {
+        prev[i] = (uint32_t)(i ? i - 1 : n - 1);
+        next[i] = (uint32_t)(i + 1 < n ? i + 1 : 0);
+    }
+    double ext = 0;
+    for (size_t i = 0; i < n; i++)
+        ext = fmax(ext, fmax(fabs(p[i].x - p[0].x), fabs(p[i].y - p[0].y)));
+    double eps = 1e-14 * ext * ext;
+    size_t left = n;
+    uint32_t cur = 0;
+    size_t misses = 0;
+    ag_status st = AG_OK;
+    while (left > 3) {
+        uint32_t a = prev[cur], b = cur, c = next[cur];
+        double cr = cross3(&p[a], &p[b], &p[c]);
+        int ear = cr > eps;
+        if (ear) {
+            for (uint32_t k = next[c]; k != a; k = next[k]) {
+                if (p[k].v == p[a].v || p[k].v == p[b].v || p[k].v == p[c].v)
+                    continue;
+                /* only reflex or flat corners can lie inside an ear */
+                if (cross3(&p[prev[k]], &p[k], &p[next[k]]) > eps)
+                    continue;
+                if (cross3(&p[a], &p[b], &p[k]) >= -eps && cross3(&p[b], &p[c], &p[k]) >= -eps &&
+                    cross3(&p[c], &p[a], &p[k]) >= -eps) {
+                    ear = 0;
+                    break;
+                }
+            }
+        }
+        if (!ear && misses > left) {
+            /* no clean ear: take the most convex corner to guarantee progress */
+            uint32_t best = cur;
+            double bc = -INFINITY;
+            uint32_t k = cur;
+            for (size_t i = 0; i < left; i++, k = next[k]) {
+                double v = cross3(&p[prev[k]], &p[k], &p[next[k]]);
+                if (v > bc) {
+                    bc = v;
+                    best = k;
+                }
+            }
+            cur = best;
+            a = prev[cur];
+            b = cur;
+            c = next[cur];
+            ear = 1;
+        }
+        if (ear) {
+            st = ag_mesh_add_triangle(m, base + p[a].v, base + p[b].v, base + p[c].v, comp);
+            if (st != AG_OK)
+                break;
+            (*ntris)++;
+            next[a] = c;
+            prev[c] = a;
+            left--;
+            cur = c;
+            misses = 0;
+        } else {
+            cur = next[cur];
+            misses++;
+        }
+    }
+    if (st == AG_OK && left == 3) {
+        uint32_t a = prev[cur], b = cur, c = next[cur];
+        st = ag_mesh_add_triangle(m, base + p[a].v, base + p[b].v, base + p[c].v, comp);
+        if (st == AG_OK)
+            (*ntris)++;
+    }
+    free(prev);
+    free(next);
+    return st;
+}
+
+/* Appends hole h into polygon *poly (size *n) through a bridge to a visible corner. */
+static ag_status bridge_hole(tri_pt **poly, size_t *n, const tri_pt *h, size_t hn,
+                             const tri_pt *all, const size_t *all_n, size_t nall_loops,
+                             const tri_pt *const *loops)
+{
+    (void)all;
+    size_t mi = 0;
+    for (size_t i = 1; i < hn; i++)
+        if (h[i].x > h[mi].x)
+            mi = i;
+    const tri_pt *M = &h[mi];
+    tri_pt *P = *poly;
+    /* candidates by distance; first whose bridge crosses nothing */
+    size_t best = SIZE_MAX;
+    double bestd = INFINITY;
+    for (int pass = 0; pass < 2 && best == SIZE_MAX; pass++) {
+        for (size_t i = 0; i < *n; i++) {
+            double d = (P[i].x - M->x) * (P[i].x - M->x) + (P[i].y - M->y) * (P[i].y - M->y);
+            if (d >= bestd)
+                continue;
+            if (pass == 0) {
+                int ok = 1;
+                for (size_t j = 0; j < *n && ok; j++) {
+                    size_t j2 = (j + 1) % *n;
+                    if (P[j].v == P[i].v || P[j2].v == P[i].v)
+                        continue;
+                    if (seg_cross(M, &P[i], &P[j], &P[j2]))
+                        ok = 0;
+                }
+                for (size_t L = 0; L < nall_loops && ok; L++)
+                    for (size_t j = 0; j < all_n[L] && ok; j++) {
+                        const tri_pt *q = loops[L];
+                        size_t j2 = (j + 1) % all_n[L];
+                        if (q[j].v == M->v || q[j2].v == M->v || q[j].v == P[i].v ||
+                            q[j2].v == P[i].v)
+                            continue;
+                        if (seg_cross(M, &P[i], &q[j], &q[j2]))
+                            ok = 0;
+                    }
+                if (!ok)
+                    continue;
+            }
+            bestd = d;
+            best = i;
+        }
+    }
+    tri_pt *np = malloc((*n + hn + 2) * sizeof *np);
+    if (!np)
+        return AG_ERR_NOMEM;
+    size_t k = 0;
+    for (size_t i = 0; i <= best; i++)
+        np[k++] = P[i];
+    for (size_t i = 0; i <= hn; i++)
+        np[k++] = h[(mi + i) % hn];
+    for (size_t i = best; i < *n; i++)
+        np[k++] = P[i];
+    free(P);
+    *poly = np;
+    *n = k;
+    return AG_OK;
+}
+
+static int cmp_hole_x(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x > y ? -1 : x < y;
+}
+
+static ag_status triangulate_face(const ag_shell *s, size_t f, ag_mesh *m, uint32_t base,
+                                  uint32_t comp, size_t *ntris)
+{
+    const ag_shell_face *fc = &s->faces[f];
+    uint32_t nl = fc->nloops & 0x7fffffffu;
+    if (!nl)
+        return AG_OK;
+    /* Newell normal over all loops */
+    double nx = 0, ny = 0, nz = 0;
+    for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++) {
+        uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
+        for (uint32_t i = a; i < b; i++) {
+            const double *p = &s->pos[3 * s->idx[i]];
+            const double *q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
+            nx += (p[1] - q[1]) * (p[2] + q[2]);
+            ny += (p[2] - q[2]) * (p[0] + q[0]);
+            nz += (p[0] - q[0]) * (p[1] + q[1]);
+        }
+    }
+    double len = sqrt(nx * nx + ny * ny + nz * nz);
+    if (!(len > 1e-18))
+        return AG_OK; /* no area */
+    nx /= len;
+    ny /= len;
+    nz /= len;
+    double ux, uy, uz;
+    if (fabs(nx) < 0.9) {
+        ux = 0;
+        uy = -nz;
+        uz = ny; /* n x (1,0,0) */
+    } else {
+        ux = nz;
+        uy = 0;
+        uz = -nx; /* n x (0,1,0) */
+    }
+    double ul = sqrt(ux * ux + uy * uy + uz * uz);
+    ux /= ul;
+    uy /= ul;
+    uz /= ul;
+    double vx = ny * uz - nz * uy, vy = nz * ux - nx * uz, vz = nx * uy - ny * ux;
+    tri_pt **loops = calloc(nl, sizeof *loops);
+    size_t *ln = calloc(nl, sizeof *ln);
+    double *areas = calloc(nl, sizeof *areas);
+    ag_status st = AG_OK;
+    if (!loops || !ln || !areas) {
+        st = AG_ERR_NOMEM;
+        goto out;
+    }
+    for (uint32_t i = 0; i < nl; i++) {
+        uint32_t l = fc->first_loop + i, a = s->loop_start[l], b = s->loop_start[l + 1];
+        ln[i] = b - a;
+        loops[i] = malloc(ln[i] * sizeof(tri_pt));
+        if (!loops[i]) {
+            st = AG_ERR_NOMEM;
+            goto out;
+        }
+        for (uint32_t k = a; k < b; k++) {
+            const double *p = &s->pos[3 * s->idx[k]];
+            /* u, v basis with u x v = n: loops CCW about n have positive area */
+            loops[i][k - a].x = p[0] * ux + p[1] * uy + p[2] * uz;
+            loops[i][k - a].y = p[0] * vx + p[1] * vy + p[2] * vz;
+            loops[i][k - a].v = s->idx[k];
+        }
+        areas[i] = loop_area(loops[i], ln[i]);
+    }
+    for (uint32_t i = 0; i < nl; i++) {
+        if (areas[i] <= 0)
+            continue;
+        size_t n = ln[i];
+        tri_pt *poly = malloc(n * sizeof *poly);
+        if (!poly) {
+            st = AG_ERR_NOMEM;
+            goto out;
+        }
+        memcpy(poly, loops[i], n * sizeof *poly);
+        /* holes inside this outer loop, right-most first */
+        double *hx = malloc(2 * nl * sizeof(double));
+        size_t nh = 0;
+        if (!hx) {
+            free(poly);
+            st = AG_ERR_NOMEM;
+            goto out;
+        }
+        double *oxy = malloc(2 * n * sizeof(double));
+        if (!oxy) {
+            free(hx);
+            free(poly);
+            st = AG_ERR_NOMEM;
+            goto out;
+        }
+        for (size_t k = 0; k < n; k++) {
+            oxy[2 * k] = loops[i][k].x;
+            oxy[2 * k + 1] = loops[i][k].y;
+        }
+        for (uint32_t j = 0; j < nl; j++) {
+            if (areas[j] >= 0)
+                continue;
+            /* test a hole corner that is not on the outer loop */
+            int inside = 0;
+            for (size_t k = 0; k < ln[j]; k++) {
+                inside = ag_pred_point_in_polygon(oxy, n, loops[j][k].x, loops[j][k].y);
+                if (inside)
+                    break;
+            }
+            if (!inside)
+                continue;
+            double mx = -INFINITY;
+            for (size_t k = 0; k < ln[j]; k++)
+                mx = fmax(mx, loops[j][k].x);
+            hx[2 * nh] = mx;
+            hx[2 * nh + 1] = j;
+            nh++;
+        }
+        free(oxy);
+        qsort(hx, nh, 2 * sizeof(double), cmp_hole_x);
+        for (size_t h = 0; h < nh && st == AG_OK; h++) {
+            uint32_t j = (uint32_t)hx[2 * h + 1];
+            st = bridge_hole(&poly, &n, loops[j], ln[j], NULL, ln, nl, (const tri_pt *const *)loops);
+        }
+        free(hx);
+        if (st == AG_OK)
+            st = ear_clip(poly, n, m, base, comp, ntris);
+        free(poly);
+        if (st != AG_OK)
+            goto out;
+    }
+out:
+    if (loops)
+        for (uint32_t i = 0; i < nl; i++)
+            free(loops[i]);
+    free(loops);
+    free(ln);
+    free(areas);
+    return st;
+}
+
+ag_status ag_shell_to_mesh(const ag_shell *s, ag_mesh *m, uint32_t component, size_t *ntris)
+{
+    size_t count = 0;
+    uint32_t base = (uint32_t)m->nverts;
+    for (size_t i = 0; i < s->nverts; i++) {
+        ag_status st = ag_mesh_add_vertex(m, s->pos[3 * i], s->pos[3 * i + 1], s->pos[3 * i + 2]);
+        if (st != AG_OK)
+            return st;
+    }
+    for (size_t f = 0; f < s->nfaces; f++) {
+        ag_status st = triangulate_face(s, f, m, base, component, &count);
+        if (st != AG_OK)
+            return st;
+    }
+    if (ntris)
+        *ntris = count;
+    return AG_OK;
+}

@@ -1,0 +1,39 @@
+/* The sweep-plane weighted straight skeleton that turns a validated plan with per-edge
+ * profiles into an architectural shell.
+ *
+ * A plane rises from z = 0; every active plan edge moves inwards by its profile
+ * segment's slope per metre of height. Events are kept in a heap: edge events (an
+ * edge shrinks to nothing), split events (a corner reaches another edge) and profile
+ * direction events (a profile changes slope). Intersection events within delta1 in
+ * height and delta2 in plan are handled together as one generalized intersection: the
+ * corners that arrive are retired, edges passing through the point are split, and the
+ * edges leaving the point are paired around it into new corners. Neighbouring edges
+ * that become collinear are resolved by the plan's priority scheme (the winner's plane
+ * takes over), antiparallel neighbours (a ridge) are zipped. */
+#ifndef AG_EXTRUDE_SKELETON_H
+#define AG_EXTRUDE_SKELETON_H
+
+#include <stddef.h>
+
+#include "../status.h"
+#include "plan.h"
+#include "shell.h"
+
+typedef struct {
+    size_t max_events; /* 0 = a bound proportional to the plan size */
+} ag_skeleton_options;
+
+typedef struct {
+    size_t intersections; /* generalized intersection events handled */
+    size_t directions;    /* profile direction events handled */
+    size_t zips, merges;  /* ridge zips and collinear merges */
+    int capped;           /* the top was closed flat */
+    double top;           /* highest height reached */
+} ag_skeleton_stats;
+
+/* plan must have passed ag_plan_validate (extent from it). The shell's faces are tagged
+ * with loop/edge/profile/segment; it has been through ag_shell_finish. */
+ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleton_options *opt,
+                            ag_shell **out, ag_skeleton_stats *stats, ag_error *err);
+
+#endif

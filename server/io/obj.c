@@ -1,0 +1,773 @@
+#include "obj.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define DEFAULT_MAX_VERTICES 100000000u
+#define DEFAULT_MAX_TRIANGLES 200000000u
+#define PROGRESS_STEP (1u << 20)
+#define NAME_SHOWN 40 /* characters of a bad token quoted in a message */
+
+/* ---- numbers --------------------------------------------------------------------------- */
+
+static inline int is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+static inline int is_digit(char c)
+{
+    return (unsigned char)(c - '0') < 10;
+}
+
+static const double pow10_tab[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+/* Parses a decimal number at *p (< e) that must end at whitespace or e. Returns 0 and
+ * advances *p; -1 when the token is not a number; -2 when it is not finite. The fast path
+ * (at most 19 digits, mantissa ≤ 2^53, |exponent| ≤ 22) is exact because both the
+ * mantissa and the power of ten are exact doubles and one IEEE operation rounds once;
+ * anything else goes through strtod on a bounded copy. */
+static int parse_double(const char **pp, const char *e, double *out)
+{
+    const char *p = *pp, *s = p;
+    int neg = 0;
+    if (p < e && (*p == '-' || *p == '+')) {
+        neg = *p == '-';
+        p++;
+    }
+    uint64_t mant = 0;
+    int ndig = 0, sig = 0, exp10 = 0, overflow = 0;
+    while (p < e && is_digit(*p)) {
+        if (sig < 19) {
+            mant = mant * 10 + (uint64_t)(*p - '0');
+            if (mant)
+                sig++;
+        } else {
+            overflow = 1;
+            exp10++;
+        }
+        ndig++;
+        p++;
+    }
+    if (p < e && *p == '.') {
+        p++;
+        while (p < e && is_digit(*p)) {
+            if (sig < 19) {
+                mant = mant * 10 + (uint64_t)(*p - '0');
+                if (mant)
+                    sig++;
+                exp10--;
+            } else {
+                overflow = 1;
+            }
+            ndig++;
+            p++;
+        }
+    }
+    if (ndig == 0)
+        goto slow;
+    if (p < e && (*p == 'e' || *p == 'E')) {
+        const char *q = p + 1;
+        int eneg = 0;
+        if (q < e && (*q == '-' || *q == '+')) {
+            eneg = *q == '-';
+            q++;
+        }
+        if (q >= e || !is_digit(*q))
+            return -1;
+        int ev = 0;
+        while (q < e && is_digit(*q)) {
+            if (ev < 100000)
+                ev = ev * 10 + (*q - '0');
+            q++;
+        }
+        exp10 += eneg ? -ev : ev;
+        p = q;
+    }
+    if (p < e && !is_space(*p))
+        goto slow;
+    if (!overflow && mant <= (1ull << 53) && exp10 >= -22 && exp10 <= 22) {
+        double v = (double)mant;
+        v = exp10 < 0 ? v / pow10_tab[-exp10] : v * pow10_tab[exp10];
+        *out = neg ? -v : v;
+        *pp = p;
+        return 0;
+    }
+slow:;
+    /* Find the token's end, then let strtod judge it on a terminated copy. */
+    const char *t = s;
+    while (t < e && !is_space(*t))
+        t++;
+    char buf[512];
+    size_t n = (size_t)(t - s);
+    if (n == 0 || n >= sizeof buf)
+        return -1;
+    memcpy(buf, s, n);
+    buf[n] = '\0';
+    char *end;
+    double v = strtod(buf, &end);
+    if (end != buf + n)
+        return -1;
+    if (!isfinite(v))
+        return -2;
+    *out = v;
+    *pp = t;
+    return 0;
+}
+
+/* Parses an optionally signed decimal integer; 0 on success. Values beyond ±2^62 are
+ * clamped (they are out of range for any mesh anyway). */
+static int parse_long(const char **pp, const char *e, long long *out)
+{
+    const char *p = *pp;
+    int neg = 0;
+    if (p < e && (*p == '-' || *p == '+')) {
+        neg = *p == '-';
+        p++;
+    }
+    if (p >= e || !is_digit(*p))
+        return -1;
+    long long v = 0;
+    while (p < e && is_digit(*p)) {
+        if (v < (1ll << 58))
+            v = v * 10 + (*p - '0');
+        p++;
+    }
+    *out = neg ? -v : v;
+    *pp = p;
+    return 0;
+}
+
+/* ---- group names → components ------------------------------------------------------------ */
+
+typedef struct {
+    uint64_t *hash;
+    uint32_t *group; /* group index + 1; 0 = empty slot */
+    size_t cap, n;
+} name_map;
+
+static uint64_t hash_bytes(const char *s, size_t n)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ (unsigned char)s[i]) * 1099511628211ull;
+    return h;
+}
+
+static void map_free(name_map *mp)
+{
+    free(mp->hash);
+    free(mp->group);
+}
+
+/* Finds name; returns the group index or -1. */
+static long map_find(const name_map *mp, const ag_mesh *m, const char *name, size_t len,
+                     uint64_t h)
+{
+    if (!mp->cap)
+        return -1;
+    for (size_t i = h & (mp->cap - 1);; i = (i + 1) & (mp->cap - 1)) {
+        if (!mp->group[i])
+            return -1;
+        uint32_t g = mp->group[i] - 1;
+        if (mp->hash[i] == h && strlen(m->group_names[g]) == len &&
+            memcmp(m->group_names[g], name, len) == 0)
+            return g;
+    }
+}
+
+static int map_insert(name_map *mp, uint64_t h, uint32_t g)
+{
+    if (2 * (mp->n + 1) > mp->cap) {
+        size_t ncap = mp->cap ? mp->cap * 2 : 64;
+        uint64_t *nh = calloc(ncap, sizeof *nh);
+        uint32_t *ng = calloc(ncap, sizeof *ng);
+        if (!nh || !ng) {
+            free(nh);
+            free(ng);
+            return -1;
+        }
+        for (size_t i = 0; i < mp->cap; i++)
+            if (mp->group[i]) {
+                size_t j = mp->hash[i] & (ncap - 1);
+                while (ng[j])
+                    j = (j + 1) & (ncap - 1);
+                nh[j] = mp->hash[i];
+                ng[j] = mp->group[i];
+            }
+        map_free(mp);
+        mp->hash = nh;
+        mp->group = ng;
+        mp->cap = ncap;
+    }
+    size_t j = h & (mp->cap - 1);
+    while (mp->group[j])
+        j = (j + 1) & (mp->cap - 1);
+    mp->hash[j] = h;
+    mp->group[j] = g + 1;
+    mp->n++;
+    return 0;
+}
+
+/* ---- the reader ------------------------------------------------------------------------- */
+
+typedef struct {
+    ag_mesh *m;
+    ag_error *err;
+    int yup;
+    size_t max_v, max_t;
+    long line;
+    size_t nvt, nvn;
+    /* The group named by the last g/o line, resolved to a component at the first face. */
+    const char *pend;
+    size_t pend_len;
+    int have_pend;
+    long cur_comp;  /* component that faces go to, or -1 when not resolved yet */
+    long nogroup_comp; /* the component of faces before any g/o, or -1 */
+    uint32_t *comp_of_group;
+    size_t cap_cg;
+    name_map map;
+    uint32_t *poly;
+    size_t cap_poly;
+    char *joined; /* scratch for lines with '\' continuations */
+    size_t cap_joined;
+} reader;
+
+static ag_status perr(reader *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static ag_status perr(reader *r, const char *fmt, ...)
+{
+    if (r->err) {
+        char msg[AG_ERROR_TEXT];
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, sizeof msg, fmt, ap);
+        va_end(ap);
+        ag_error_set(r->err, AG_ERR_PARSE, r->line, "line %ld: %s", r->line, msg);
+    }
+    return AG_ERR_PARSE;
+}
+
+static ag_status nomem(reader *r)
+{
+    return ag_error_set(r->err, AG_ERR_NOMEM, r->line, "line %ld: out of memory", r->line);
+}
+
+/* Quotes the token at p for a message (bounded, non-printable bytes escaped). */
+static const char *quote(const char *p, const char *e, char *buf, size_t cap)
+{
+    size_t k = 0;
+    while (p < e && !is_space(*p) && k + 5 < cap && k < NAME_SHOWN) {
+        unsigned char c = (unsigned char)*p++;
+        if (c < 0x20 || c == 0x7f)
+            k += (size_t)snprintf(buf + k, cap - k, "\\x%02x", c);
+        else
+            buf[k++] = (char)c;
+    }
+    buf[k] = '\0';
+    return buf;
+}
+
+static ag_status read_vertex(reader *r, const char *p, const char *e)
+{
+    double c[3];
+    for (int k = 0; k < 3; k++) {
+        while (p < e && is_space(*p))
+            p++;
+        if (p >= e)
+            return perr(r, "vertex needs 3 coordinates, found %d", k);
+        const char *s = p;
+        int rc = parse_double(&p, e, &c[k]);
+        if (rc) {
+            char q[64];
+            return perr(r, rc == -2 ? "coordinate '%s' is not a finite number"
+                                    : "cannot parse coordinate '%s'",
+                        quote(s, e, q, sizeof q));
+        }
+    }
+    /* Anything after x y z (w, or a vertex colour) is ignored. */
+    if (r->m->nverts >= r->max_v)
+        return perr(r, "more than %zu vertices", r->max_v);
+    ag_status st = r->yup ? ag_mesh_add_vertex(r->m, c[0], -c[2], c[1])
+                          : ag_mesh_add_vertex(r->m, c[0], c[1], c[2]);
+    if (st == AG_ERR_TOO_LARGE)
+        return perr(r, "more than %u vertices", (unsigned)UINT32_MAX);
+    return st == AG_OK ? AG_OK : nomem(r);
+}
+
+/* Resolves a 1-based or negative (relative) index against count defined elements. */
+static int resolve(long long idx, size_t count, size_t *out)
+{
+    if (idx > 0) {
+        if ((unsigned long long)idx > count)
+            return -1;
+        *out = (size_t)idx - 1;
+        return 0;
+    }
+    if (idx < 0 && (unsigned long long)(-idx) <= count) {
+        *out = count - (size_t)(-idx);
+        return 0;
+    }
+    return -1;
+}
+
+static ag_status current_component(reader *r, uint32_t *comp)
+{
+    if (r->cur_comp >= 0) {
+        *comp = (uint32_t)r->cur_comp;
+        return AG_OK;
+    }
+    ag_mesh *m = r->m;
+    size_t c;
+    if (!r->have_pend) {
+        if (r->nogroup_comp < 0) {
+            if (ag_mesh_add_component(m, -1, &c) != AG_OK)
+                return nomem(r);
+            r->nogroup_comp = (long)c;
+        }
+        r->cur_comp = r->nogroup_comp;
+    } else {
+        uint64_t h = hash_bytes(r->pend, r->pend_len);
+        long g = map_find(&r->map, m, r->pend, r->pend_len, h);
+        if (g >= 0) {
+            r->cur_comp = r->comp_of_group[g];
+        } else {
+            char *name = strndup(r->pend, r->pend_len);
+            size_t gi;
+            if (!name)
+                return nomem(r);
+            ag_status st = ag_mesh_add_group(m, name, &gi);
+            free(name);
+            if (st != AG_OK || ag_mesh_add_component(m, (int32_t)gi, &c) != AG_OK)
+                return nomem(r);
+            if (gi >= r->cap_cg) {
+                size_t ncap = r->cap_cg ? 2 * r->cap_cg : 64;
+                uint32_t *p = realloc(r->comp_of_group, ncap * sizeof *p);
+                if (!p)
+                    return nomem(r);
+                r->comp_of_group = p;
+                r->cap_cg = ncap;
+            }
+            r->comp_of_group[gi] = (uint32_t)c;
+            if (map_insert(&r->map, h, (uint32_t)gi))
+                return nomem(r);
+            r->cur_comp = (long)c;
+        }
+    }
+    *comp = (uint32_t)r->cur_comp;
+    return AG_OK;
+}
+
+static ag_status read_face(reader *r, const char *p, const char *e)
+{
+    size_t n = 0;
+    size_t nv = r->m->nverts;
+    for (;;) {
+        while (p < e && is_space(*p))
+            p++;
+        if (p >= e)
+            break;
+        const char *s = p;
+        long long idx;
+        char q[64];
+        if (parse_long(&p, e, &idx))
+            return perr(r, "bad face vertex '%s'", quote(s, e, q, sizeof q));
+        size_t v;
+        if (idx == 0)
+            return perr(r, "face index 0 is invalid (OBJ indices start at 1)");
+        if (resolve(idx, nv, &v))
+            return perr(r, "face index %lld out of range (file has %zu vertices so far)", idx,
+                        nv);
+        /* Optional /vt and /vn parts: checked, then ignored. */
+        for (int part = 0; part < 2 && p < e && *p == '/'; part++) {
+            p++;
+            if (p < e && (is_digit(*p) || *p == '-' || *p == '+')) {
+                long long j;
+                size_t dummy, count = part == 0 ? r->nvt : r->nvn;
+                if (parse_long(&p, e, &j))
+                    return perr(r, "bad face vertex '%s'", quote(s, e, q, sizeof q));
+                if (resolve(j, count, &dummy))
+                    return perr(r, "face %s index %lld out of range (file has %zu so far)",
+                                part == 0 ? "texture" : "normal", j, count);
+            }
+        }
+        if (p < e && !is_space(*p))
+            return perr(r, "bad face vertex '%s'", quote(s, e, q, sizeof q));
+        if (n == r->cap_poly) {
+            size_t ncap = r->cap_poly ? 2 * r->cap_poly : 64;
+            uint32_t *np = realloc(r->poly, ncap * sizeof *np);
+            if (!np)
+                return nomem(r);
+            r->poly = np;
+            r->cap_poly = ncap;
+        }
+        r->poly[n++] = (uint32_t)v;
+    }
+    if (n < 3)
+        return perr(r, "face needs at least 3 vertices, found %zu", n);
+    uint32_t comp = 0;
+    ag_status st = current_component(r, &comp);
+    if (st)
+        return st;
+    const uint32_t *f = r->poly;
+    for (size_t i = 1; i + 1 < n; i++) {
+        /* A repeated index makes no triangle; geometrically flat ones are kept. */
+        if (f[0] == f[i] || f[0] == f[i + 1] || f[i] == f[i + 1])
+            continue;
+        if (r->m->ntris >= r->max_t)
+            return perr(r, "more than %zu triangles", r->max_t);
+        if (ag_mesh_add_triangle(r->m, f[0], f[i], f[i + 1], comp) != AG_OK)
+            return nomem(r);
+    }
+    return AG_OK;
+}
+
+static void set_group(reader *r, const char *p, const char *e)
+{
+    while (p < e && is_space(*p))
+        p++;
+    while (e > p && is_space(e[-1]))
+        e--;
+    if (p == e) { /* `g` alone: OBJ's default group */
+        p = "default";
+        e = p + 7;
+    }
+    r->pend = p;
+    r->pend_len = (size_t)(e - p);
+    r->have_pend = 1;
+    r->cur_comp = -1;
+}
+
+/* One logical line [p, e) (no newline). */
+static ag_status read_line(reader *r, const char *p, const char *e)
+{
+    while (p < e && is_space(*p))
+        p++;
+    if (p >= e || *p == '#')
+        return AG_OK;
+    const char *k = p;
+    while (p < e && !is_space(*p))
+        p++;
+    size_t kl = (size_t)(p - k);
+    if (kl == 1) {
+        switch (k[0]) {
+        case 'v':
+            return read_vertex(r, p, e);
+        case 'f':
+            return read_face(r, p, e);
+        case 'g':
+        case 'o':
+            /* Resolved lazily at the next face; the name points into the input (or into
+             * a copy the caller keeps for continued lines). */
+            set_group(r, p, e);
+            return AG_OK;
+        default:
+            break;
+        }
+    } else if (kl == 2 && k[0] == 'v' && k[1] == 't') {
+        r->nvt++;
+        return AG_OK;
+    } else if (kl == 2 && k[0] == 'v' && k[1] == 'n') {
+        r->nvn++;
+        return AG_OK;
+    }
+    /* Other keywords (usemtl, mtllib, s, l, p, vp, curves...) are accepted and ignored,
+     * but a keyword must look like one: binary data does not. */
+    for (const char *c = k; c < k + kl; c++) {
+        unsigned char u = (unsigned char)*c;
+        if (!((u >= 'a' && u <= 'z') || (u >= 'A' && u <= 'Z') || (u >= '0' && u <= '9') ||
+              u == '_' || u == '-' || u == '.')) {
+            char q[64];
+            return perr(r, "unexpected data '%s' (not an OBJ statement)",
+                        quote(k, k + kl, q, sizeof q));
+        }
+    }
+    return AG_OK;
+}
+
+ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_options *opt,
+                             ag_mesh **out, ag_error *err)
+{
+    static const ag_obj_read_options defaults;
+    if (!opt)
+        opt = &defaults;
+    *out = NULL;
+    ag_error_clear(err);
+
+    /* NUL never occurs in an OBJ file; finding one early rejects binary input cheaply. */
+    const char *nul = len ? memchr(data, '\0', len) : NULL;
+    if (nul) {
+        long line = 1;
+        for (const char *c = data; c < nul; c++)
+            line += *c == '\n';
+        return ag_error_set(err, AG_ERR_PARSE, line, "line %ld: NUL byte (binary data, not an OBJ file)",
+                            line);
+    }
+
+    reader r = {0};
+    r.err = err;
+    r.yup = opt->up != AG_UP_Z;
+    r.max_v = opt->max_vertices ? opt->max_vertices : DEFAULT_MAX_VERTICES;
+    r.max_t = opt->max_triangles ? opt->max_triangles : DEFAULT_MAX_TRIANGLES;
+    r.cur_comp = -1;
+    r.nogroup_comp = -1;
+    r.m = ag_mesh_create();
+    if (!r.m)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    /* A typical OBJ line is ~30 bytes, so len/60 leaves room for a balanced file. */
+    {
+        size_t guess_v = len / 60, guess_t = len / 60;
+        if (guess_v > r.max_v)
+            guess_v = r.max_v;
+        if (guess_t > r.max_t)
+            guess_t = r.max_t;
+        if (guess_v > (1u << 24))
+            guess_v = 1u << 24;
+        if (guess_t > (1u << 24))
+            guess_t = 1u << 24;
+        (void)ag_mesh_reserve(r.m, guess_v, guess_t);
+    }
+
+    ag_status st = AG_OK;
+    const char *p = data, *end = data + len;
+    if (len >= 3 && (unsigned char)p[0] == 0xEF && (unsigned char)p[1] == 0xBB &&
+        (unsigned char)p[2] == 0xBF)
+        p += 3; /* UTF-8 byte order mark */
+    size_t next_progress = PROGRESS_STEP;
+    long line = 0;
+    /* Group names point into the input; a name from a continued line is copied here. */
+    char *held_name = NULL;
+    while (p < end) {
+        const char *nl = memchr(p, '\n', (size_t)(end - p));
+        const char *le = nl ? nl : end;
+        line++;
+        r.line = line;
+        const char *q = le;
+        while (q > p && (q[-1] == '\r' || q[-1] == ' ' || q[-1] == '\t'))
+            q--;
+        if (q > p && q[-1] == '\\' && nl) {
+            /* Continuation: join the physical lines (backslash-newline → space). */
+            size_t n = 0;
+            const char *s = p;
+            for (;;) {
+                const char *ne = memchr(s, '\n', (size_t)(end - s));
+                const char *se = ne ? ne : end;
+                const char *t = se;
+                while (t > s && (t[-1] == '\r' || t[-1] == ' ' || t[-1] == '\t'))
+                    t--;
+                int cont = ne && t > s && t[-1] == '\\';
+                size_t piece = (size_t)((cont ? t - 1 : se) - s);
+                if (n + piece + 1 > r.cap_joined) {
+                    size_t ncap = (n + piece + 1) * 2;
+                    char *nj = realloc(r.joined, ncap);
+                    if (!nj) {
+                        st = nomem(&r);
+                        goto done;
+                    }
+                    r.joined = nj;
+                    r.cap_joined = ncap;
+                }
+                memcpy(r.joined + n, s, piece);
+                n += piece;
+                r.joined[n++] = ' ';
+                s = ne ? ne + 1 : end;
+                if (!cont)
+                    break;
+                line++;
+            }
+            p = s;
+            const char *js = r.joined, *je = r.joined + n;
+            const char *ks = js;
+            while (ks < je && is_space(*ks))
+                ks++;
+            if (je - ks >= 2 && (ks[0] == 'g' || ks[0] == 'o') && is_space(ks[1])) {
+                /* The scratch buffer is reused: keep the group name elsewhere. */
+                char *copy = malloc(n);
+                if (!copy) {
+                    st = nomem(&r);
+                    goto done;
+                }
+                memcpy(copy, js, n);
+                free(held_name);
+                held_name = copy;
+                js = copy;
+                je = copy + n;
+            }
+            st = read_line(&r, js, je);
+        } else {
+            st = read_line(&r, p, le);
+            p = nl ? nl + 1 : end;
+        }
+        if (st != AG_OK)
+            goto done;
+        if ((size_t)(p - data) >= next_progress) {
+            next_progress = (size_t)(p - data) + PROGRESS_STEP;
+            if (opt->progress && opt->progress(opt->user, (double)(p - data) / (double)len)) {
+                st = ag_error_set(err, AG_ERR_CANCELLED, line, "cancelled at line %ld", line);
+                goto done;
+            }
+        }
+    }
+    if (opt->progress && opt->progress(opt->user, 1.0)) {
+        st = ag_error_set(err, AG_ERR_CANCELLED, line, "cancelled at line %ld", line);
+        goto done;
+    }
+    if (r.m->ntris == 0) {
+        st = ag_error_set(err, AG_ERR_EMPTY, 0,
+                          r.m->nverts ? "no faces (the file has %zu vertices and no triangle)"
+                                      : "no geometry (%zu vertices, no faces)",
+                          r.m->nverts);
+        goto done;
+    }
+    /* Without any group the connected pieces are the components; groups holding several
+     * loose pieces are kept whole here (the proceduralization stage decides). */
+    if (r.m->ngroups == 0 && (st = ag_mesh_split_connected(r.m)) != AG_OK) {
+        st = ag_error_set(err, st, 0, "out of memory");
+        goto done;
+    }
+done:
+    free(held_name);
+    free(r.comp_of_group);
+    free(r.poly);
+    free(r.joined);
+    map_free(&r.map);
+    if (st != AG_OK) {
+        ag_mesh_free(r.m);
+        return st;
+    }
+    *out = r.m;
+    return AG_OK;
+}
+
+ag_status ag_obj_read_file(const char *path, const ag_obj_read_options *opt, ag_mesh **out,
+                           ag_error *err)
+{
+    *out = NULL;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return ag_error_set(err, AG_ERR_IO, 0, "cannot open %s: %s", path, strerror(errno));
+    struct stat sb;
+    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        close(fd);
+        return ag_error_set(err, AG_ERR_IO, 0, "%s: not a regular file", path);
+    }
+    size_t len = (size_t)sb.st_size;
+    if (len == 0) {
+        close(fd);
+        return ag_error_set(err, AG_ERR_EMPTY, 0, "%s: empty file", path);
+    }
+    void *map = mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (map != MAP_FAILED) {
+        close(fd);
+        madvise(map, len, MADV_SEQUENTIAL);
+        ag_status st = ag_obj_read_buffer(map, len, opt, out, err);
+        munmap(map, len);
+        return st;
+    }
+    /* Some file systems cannot map: read it all. */
+    char *buf = malloc(len);
+    if (!buf) {
+        close(fd);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "%s: out of memory", path);
+    }
+    size_t got = 0;
+    while (got < len) {
+        ssize_t k = read(fd, buf + got, len - got);
+        if (k < 0 && errno == EINTR)
+            continue;
+        if (k <= 0) {
+            int e = k < 0 ? errno : EIO;
+            free(buf);
+            close(fd);
+            return ag_error_set(err, AG_ERR_IO, 0, "cannot read %s: %s", path, strerror(e));
+        }
+        got += (size_t)k;
+    }
+    close(fd);
+    ag_status st = ag_obj_read_buffer(buf, len, opt, out, err);
+    free(buf);
+    return st;
+}
+
+/* ---- writer ----------------------------------------------------------------------------- */
+
+static void put_name(FILE *f, const char *name)
+{
+    for (const char *c = name; *c; c++)
+        fputc(*c == '\n' || *c == '\r' || *c == '\\' ? '_' : *c, f);
+}
+
+ag_status ag_obj_write_file(const ag_mesh *m, ag_up_axis up, const char *path, ag_error *err)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", path, strerror(errno));
+    setvbuf(f, NULL, _IOFBF, 1 << 16);
+    int yup = up != AG_UP_Z;
+    fprintf(f, "# archgram: %zu vertices, %zu triangles, %zu components; %s up\n", m->nverts,
+            m->ntris, m->ncomponents, yup ? "y" : "z");
+    for (size_t i = 0; i < m->nverts; i++) {
+        const double *p = m->pos + 3 * i;
+        if (yup) /* inverse of the reader's (x, y, z) → (x, -z, y) */
+            fprintf(f, "v %.17g %.17g %.17g\n", p[0], p[2], -p[1]);
+        else
+            fprintf(f, "v %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+    }
+    /* Triangles grouped by component, in file order within each. */
+    size_t nc = m->ncomponents;
+    size_t *start = calloc(nc + 1, sizeof *start);
+    uint32_t *order = malloc((m->ntris ? m->ntris : 1) * sizeof *order);
+    if (!start || !order) {
+        free(start);
+        free(order);
+        fclose(f);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t t = 0; t < m->ntris; t++)
+        start[m->tri_component[t] + 1]++;
+    for (size_t c = 0; c < nc; c++)
+        start[c + 1] += start[c];
+    for (size_t t = 0; t < m->ntris; t++)
+        order[start[m->tri_component[t]]++] = (uint32_t)t;
+    for (size_t c = nc; c > 0; c--) /* start[c] now holds the end of c; shift back */
+        start[c] = start[c - 1];
+    start[0] = 0;
+    /* A mesh with no groups at all is written without g lines: reading it back splits it
+     * into its connected pieces again. Components sharing a group merge when read back. */
+    int named = m->ngroups > 0;
+    for (size_t c = 0; c < nc; c++) {
+        if (start[c] == start[c + 1])
+            continue;
+        int32_t g = m->component_group[c];
+        /* A group-less first component is written before any g line, where the reader
+         * puts group-less faces. */
+        if (named && !(c == 0 && g < 0)) {
+            fputs("g ", f);
+            if (g >= 0 && (size_t)g < m->ngroups && m->group_names[g][0])
+                put_name(f, m->group_names[g]);
+            else
+                fprintf(f, "component_%zu", c);
+            fputc('\n', f);
+        }
+        for (size_t i = start[c]; i < start[c + 1]; i++) {
+            const uint32_t *t = m->tri + 3 * (size_t)order[i];
+            fprintf(f, "f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
+        }
+    }
+    free(start);
+    free(order);
+    int bad = ferror(f);
+    if (fclose(f) != 0 || bad)
+        return ag_error_set(err, AG_ERR_IO, 0, "cannot write %s: %s", path, strerror(errno));
+    return AG_OK;
+}

@@ -1,0 +1,222 @@
+#include "http.h"
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <microhttpd.h>
+#include <netinet/in.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "request.h"
+#include "routes.h"
+#include "static_files.h"
+#include "upload.h"
+
+#define AG_MAX_JSON_BODY (1u << 20)
+
+struct ag_http {
+    struct MHD_Daemon *daemon;
+    ag_http_config cfg;
+    char *web_dir;
+};
+
+static ag_request *request_new(ag_http *http, struct MHD_Connection *conn, const char *url,
+                               const char *method)
+{
+    ag_request *r = calloc(1, sizeof *r);
+    if (!r)
+        return NULL;
+    r->cfg = &http->cfg;
+    r->conn = conn;
+    r->url = url;
+    r->method = method;
+    return r;
+}
+
+static void request_free(ag_request *r)
+{
+    if (!r)
+        return;
+    free(r->body);
+    ag_upload_free(r->upload);
+    free(r);
+}
+
+static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
+                         enum MHD_RequestTerminationCode toe)
+{
+    (void)cls, (void)conn, (void)toe;
+    request_free(*con_cls);
+    *con_cls = NULL;
+}
+
+static ag_status append_body(ag_request *r, const char *data, size_t len, ag_error *err)
+{
+    if (r->body_len + len > r->cfg->max_json)
+        return ag_error_set(err, AG_ERR_TOO_LARGE, 0, "the request body is larger than %zu bytes",
+                            r->cfg->max_json);
+    if (r->body_len + len + 1 > r->body_cap) {
+        size_t cap = r->body_cap ? r->body_cap : 1024;
+        while (cap < r->body_len + len + 1)
+            cap *= 2;
+        char *grown = realloc(r->body, cap);
+        if (!grown)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory reading the body");
+        r->body = grown;
+        r->body_cap = cap;
+    }
+    memcpy(r->body + r->body_len, data, len);
+    r->body_len += len;
+    r->body[r->body_len] = '\0';
+    return AG_OK;
+}
+
+/* First call for a request: route it and check what can be checked before the body. */
+static enum MHD_Result begin(ag_http *http, struct MHD_Connection *conn, const char *url,
+                             const char *method, void **con_cls)
+{
+    ag_request *r = request_new(http, conn, url, method);
+    if (!r)
+        return MHD_NO;
+    *con_cls = r;
+    if (strncmp(url, "/api/", 5) != 0)
+        return MHD_YES; /* static files: answered once the (empty) body is in */
+
+    char allow[64];
+    ag_match m = ag_routes_match(method, url, &r->route, r->ids, allow, sizeof allow);
+    ag_error err;
+    ag_error_clear(&err);
+    if (m == AG_MATCH_NONE) {
+        ag_error_set(&err, AG_ERR_NOT_FOUND, 0, "no resource at %s", url);
+        return ag_reply_problem(r, AG_ERR_NOT_FOUND, &err);
+    }
+    if (m == AG_MATCH_PATH_ONLY) {
+        ag_reply_header(r, MHD_HTTP_HEADER_ALLOW, allow);
+        ag_error_set(&err, AG_ERR_METHOD_NOT_ALLOWED, 0, "%s does not accept %s; it accepts %s",
+                     url, method, allow);
+        return ag_reply_problem(r, AG_ERR_METHOD_NOT_ALLOWED, &err);
+    }
+    const char *length = ag_request_header(r, MHD_HTTP_HEADER_CONTENT_LENGTH);
+    size_t limit = r->route->body == AG_BODY_UPLOAD ? http->cfg.max_body : http->cfg.max_json;
+    if (length && strtoull(length, NULL, 10) > limit) {
+        ag_error_set(&err, AG_ERR_TOO_LARGE, 0,
+                     "the body has %s bytes; this server accepts at most %zu here", length, limit);
+        return ag_reply_problem(r, AG_ERR_TOO_LARGE, &err);
+    }
+    if (r->route->body == AG_BODY_UPLOAD) {
+        ag_status s = ag_upload_begin(r, &r->upload, &err);
+        if (s != AG_OK)
+            return ag_reply_problem(r, s, &err);
+    }
+    return MHD_YES;
+}
+
+static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const char *url,
+                                  const char *method, const char *version,
+                                  const char *upload_data, size_t *upload_data_size,
+                                  void **con_cls)
+{
+    (void)version;
+    ag_http *http = cls;
+    if (!*con_cls)
+        return begin(http, conn, url, method, con_cls);
+    ag_request *r = *con_cls;
+
+    if (*upload_data_size) {
+        size_t n = *upload_data_size;
+        *upload_data_size = 0;
+        if (r->body_status != AG_OK || !r->route)
+            return MHD_YES; /* already failed or no body expected: drop the rest */
+        ag_status s;
+        if (r->route->body == AG_BODY_UPLOAD)
+            s = ag_upload_feed(r->upload, upload_data, n, &r->body_err);
+        else if (r->route->body == AG_BODY_JSON)
+            s = append_body(r, upload_data, n, &r->body_err);
+        else
+            s = AG_OK; /* a body where none is used is ignored */
+        if (s != AG_OK) {
+            r->body_status = s;
+            /* Answer now: the client learns of a too-large body without sending it all;
+             * libmicrohttpd closes the connection after this reply. */
+            return ag_reply_problem(r, s, &r->body_err);
+        }
+        return MHD_YES;
+    }
+
+    /* The whole body is in. */
+    if (strncmp(url, "/api/", 5) != 0)
+        return ag_static_serve(r, http->cfg.web_dir);
+    if (r->body_status != AG_OK)
+        return ag_reply_problem(r, r->body_status, &r->body_err);
+    if (r->upload) {
+        ag_status s = ag_upload_end(r->upload, &r->body_err);
+        if (s != AG_OK)
+            return ag_reply_problem(r, s, &r->body_err);
+    }
+    return r->route->handler(r);
+}
+
+static void log_mhd(void *cls, const char *fmt, va_list ap)
+{
+    (void)cls;
+    fputs("archgramd: http: ", stderr);
+    vfprintf(stderr, fmt, ap);
+}
+
+ag_status ag_http_start(ag_app *app, const ag_http_options *opt, ag_http **out, ag_error *err)
+{
+    *out = NULL;
+    ag_http *http = calloc(1, sizeof *http);
+    if (!http)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    http->cfg.app = app;
+    http->cfg.max_body = opt->max_body ? opt->max_body : (size_t)512 << 20;
+    http->cfg.max_json = AG_MAX_JSON_BODY;
+    http->cfg.ws_port = opt->ws_port;
+    if (opt->web_dir) {
+        http->web_dir = strdup(opt->web_dir);
+        http->cfg.web_dir = http->web_dir;
+    }
+    struct sockaddr_in addr = {.sin_family = AF_INET, .sin_port = htons((uint16_t)opt->port)};
+    if (inet_pton(AF_INET, opt->bind ? opt->bind : "127.0.0.1", &addr.sin_addr) != 1) {
+        free(http->web_dir);
+        free(http);
+        return ag_error_set(err, AG_ERR_INVALID, 0, "--bind %s is not an IPv4 address",
+                            opt->bind);
+    }
+    int threads = opt->threads;
+    if (threads <= 0) {
+        long cores = sysconf(_SC_NPROCESSORS_ONLN);
+        threads = cores > 0 ? (int)cores * 2 : 4;
+        if (threads < 4)
+            threads = 4;
+    }
+    http->daemon = MHD_start_daemon(
+        MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL | MHD_USE_ERROR_LOG, (uint16_t)opt->port,
+        NULL, NULL, on_request, http, MHD_OPTION_EXTERNAL_LOGGER, log_mhd, NULL,
+        MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
+        MHD_OPTION_THREAD_POOL_SIZE, (unsigned)threads, MHD_OPTION_NOTIFY_COMPLETED, on_completed,
+        http, MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)120, MHD_OPTION_LISTENING_ADDRESS_REUSE,
+        (unsigned)1, MHD_OPTION_END);
+    if (!http->daemon) {
+        int e = errno;
+        free(http->web_dir);
+        free(http);
+        return ag_error_set(err, AG_ERR_IO, 0, "cannot listen on %s:%d: %s",
+                            opt->bind ? opt->bind : "127.0.0.1", opt->port,
+                            e ? strerror(e) : "the port may be in use");
+    }
+    *out = http;
+    return AG_OK;
+}
+
+void ag_http_stop(ag_http *http)
+{
+    if (!http)
+        return;
+    MHD_stop_daemon(http->daemon);
+    free(http->web_dir);
+    free(http);
+}

@@ -1,0 +1,19 @@
+/* The live layer: websocket rooms per model on their own port (libwebsockets), fed by the
+ * app's event bus. The protocol is documented in schema/websocket.md. */
+#ifndef AG_LIVE_H
+#define AG_LIVE_H
+
+#include "../app/app.h"
+
+typedef struct ag_live ag_live;
+
+typedef struct {
+    const char *bind; /* NULL = 127.0.0.1 */
+    int port;
+} ag_live_options;
+
+ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, ag_error *err);
+/* Closes every connection and stops the service thread. */
+void ag_live_stop(ag_live *live);
+
+#endif

@@ -1,0 +1,131 @@
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../app/views.h"
+#include "request.h"
+
+
+void ag_reply_header(ag_request *r, const char *name, const char *value)
+{
+    int n = r->nheaders;
+    if (n >= (int)(sizeof r->headers / sizeof r->headers[0]))
+        return;
+    snprintf(r->headers[n].name, sizeof r->headers[n].name, "%s", name);
+    snprintf(r->headers[n].value, sizeof r->headers[n].value, "%s", value);
+    r->nheaders++;
+}
+
+static enum MHD_Result queue(ag_request *r, unsigned status, struct MHD_Response *resp,
+                            const char *content_type, const char *etag)
+{
+    if (!resp)
+        return MHD_NO;
+    if (content_type)
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, content_type);
+    if (etag) {
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_ETAG, etag);
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
+    } else if (strncmp(r->url, "/api/", 5) == 0) {
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    }
+    for (int i = 0; i < r->nheaders; i++)
+        MHD_add_response_header(resp, r->headers[i].name, r->headers[i].value);
+    r->nheaders = 0;
+    enum MHD_Result rc = MHD_queue_response(r->conn, status, resp);
+    MHD_destroy_response(resp);
+    return rc;
+}
+
+enum MHD_Result ag_reply_bytes(ag_request *r, unsigned status, const char *content_type,
+                               void *data, size_t len, const char *etag)
+{
+    struct MHD_Response *resp =
+        MHD_create_response_from_buffer(len, data ? data : (void *)"", data ? MHD_RESPMEM_MUST_FREE
+                                                                            : MHD_RESPMEM_PERSISTENT);
+    return queue(r, status, resp, content_type, etag);
+}
+
+enum MHD_Result ag_reply_json(ag_request *r, unsigned status, json_t *body, const char *etag)
+{
+    char *text = body ? json_dumps(body, JSON_COMPACT) : NULL;
+    json_decref(body);
+    if (!text) {
+        ag_error e;
+        ag_error_set(&e, AG_ERR_NOMEM, 0, "out of memory writing the answer");
+        return ag_reply_problem(r, AG_ERR_NOMEM, &e);
+    }
+    return ag_reply_bytes(r, status, "application/json", text, strlen(text), etag);
+}
+
+enum MHD_Result ag_reply_problem(ag_request *r, ag_status s, const ag_error *err)
+{
+    char *text = ag_view_problem_text(s, err);
+    if (!text)
+        return MHD_NO;
+    return ag_reply_bytes(r, (unsigned)ag_status_http(s), "application/problem+json", text,
+                          strlen(text), NULL);
+}
+
+enum MHD_Result ag_reply_empty(ag_request *r, unsigned status, const char *etag)
+{
+    struct MHD_Response *resp = MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
+    return queue(r, status, resp, NULL, etag);
+}
+
+const char *ag_request_query(ag_request *r, const char *name)
+{
+    return MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, name);
+}
+
+const char *ag_request_header(ag_request *r, const char *name)
+{
+    return MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, name);
+}
+
+ag_status ag_request_json(ag_request *r, json_t **out, ag_error *err)
+{
+    *out = NULL;
+    if (!r->body || r->body_len == 0)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "a JSON body is required");
+    json_error_t je;
+    json_t *v = json_loadb(r->body, r->body_len, 0, &je);
+    if (!v)
+        return ag_error_set(err, AG_ERR_INVALID, je.line, "the body is not valid JSON: %s (line %d, column %d)",
+                            je.text, je.line, je.column);
+    if (!json_is_object(v)) {
+        json_decref(v);
+        return ag_error_set(err, AG_ERR_INVALID, 0, "the body must be a JSON object");
+    }
+    *out = v;
+    return AG_OK;
+}
+
+ag_status ag_request_if_match(ag_request *r, int64_t *version, ag_error *err)
+{
+    const char *h = ag_request_header(r, MHD_HTTP_HEADER_IF_MATCH);
+    if (!h)
+        return ag_error_set(err, AG_ERR_PRECONDITION_REQUIRED, 0,
+                            "send If-Match with the model's ETag (its version) to change it");
+    while (*h == ' ')
+        h++;
+    if (h[0] == '*' && (h[1] == '\0' || h[1] == ' ')) {
+        *version = -1;
+        return AG_OK;
+    }
+    const char *p = h;
+    int quoted = *p == '"';
+    if (quoted)
+        p++;
+    char *end;
+    long long v = strtoll(p, &end, 10);
+    if (end == p || v < 1 || (quoted && *end++ != '"'))
+        return ag_error_set(err, AG_ERR_INVALID, 0, "If-Match must be an ETag such as \"3\"");
+    while (*end == ' ')
+        end++;
+    if (*end != '\0')
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "If-Match must hold one ETag, the model's current version");
+    *version = v;
+    return AG_OK;
+}

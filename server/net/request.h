@@ -1,0 +1,67 @@
+/* One HTTP request as the REST handlers see it, and the ways to answer it. */
+#ifndef AG_REQUEST_H
+#define AG_REQUEST_H
+
+#include <jansson.h>
+#include <microhttpd.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../app/app.h"
+#include "../core/status.h"
+
+struct ag_route;
+struct ag_upload;
+
+typedef struct {
+    ag_app *app;
+    size_t max_body;     /* uploads */
+    size_t max_json;     /* JSON request bodies */
+    int ws_port;
+    const char *web_dir; /* NULL: no client served */
+} ag_http_config;
+
+typedef struct ag_request {
+    const ag_http_config *cfg;
+    struct MHD_Connection *conn;
+    const struct ag_route *route;
+    const char *method;
+    const char *url;
+    int64_t ids[2];          /* the {id} segments of the matched route, in order */
+    /* body */
+    char *body;              /* small bodies (JSON), NUL-terminated */
+    size_t body_len, body_cap;
+    struct ag_upload *upload; /* spooled uploads */
+    ag_status body_status;   /* set when receiving the body failed */
+    ag_error body_err;
+    /* headers for the reply, added by handlers */
+    struct {
+        char name[32];
+        char value[256];
+    } headers[4];
+    int nheaders;
+} ag_request;
+
+typedef enum MHD_Result (*ag_handler)(ag_request *r);
+
+/* Answers; each takes ownership of nothing it is given unless said. */
+enum MHD_Result ag_reply_json(ag_request *r, unsigned status, json_t *body /* stolen */,
+                              const char *etag);
+enum MHD_Result ag_reply_problem(ag_request *r, ag_status s, const ag_error *err);
+enum MHD_Result ag_reply_bytes(ag_request *r, unsigned status, const char *content_type,
+                               void *data /* stolen, malloc'd */, size_t len, const char *etag);
+enum MHD_Result ag_reply_empty(ag_request *r, unsigned status, const char *etag);
+/* Adds a header to the next reply of this request (Location, Allow …); copied. */
+void ag_reply_header(ag_request *r, const char *name, const char *value);
+
+/* Query parameter or NULL. */
+const char *ag_request_query(ag_request *r, const char *name);
+const char *ag_request_header(ag_request *r, const char *name);
+/* The body parsed as a JSON object; AG_ERR_INVALID with the parse position otherwise. */
+ag_status ag_request_json(ag_request *r, json_t **out, ag_error *err);
+
+/* Preconditions: parses If-Match into *version (quoted or bare digits; "*" gives -1).
+ * AG_ERR_PRECONDITION_REQUIRED when the header is absent, AG_ERR_INVALID when malformed. */
+ag_status ag_request_if_match(ag_request *r, int64_t *version, ag_error *err);
+
+#endif

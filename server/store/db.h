@@ -1,0 +1,40 @@
+/* One SQLite connection with archgram's settings: WAL, foreign keys, a busy timeout, and the
+ * schema brought up to date from the embedded migrations when it is opened.
+ *
+ * A connection belongs to one thread at a time. Every write goes through
+ * ag_db_begin (BEGIN IMMEDIATE: a deferred transaction that later writes fails with
+ * SQLITE_BUSY_SNAPSHOT under WAL and ignores the busy timeout). */
+#ifndef AG_DB_H
+#define AG_DB_H
+
+#include <sqlite3.h>
+
+#include "../core/status.h"
+
+typedef struct ag_db ag_db;
+
+typedef struct {
+    int busy_timeout_ms; /* 0 = 10000 */
+    int no_migrate;      /* 1: open an existing schema as it is (still refuses a newer one) */
+} ag_db_options;
+
+ag_status ag_db_open(const char *path, const ag_db_options *opt, ag_db **out, ag_error *err);
+void ag_db_close(ag_db *db);
+
+sqlite3 *ag_db_handle(ag_db *db);
+const char *ag_db_path(const ag_db *db);
+int ag_db_schema_version(ag_db *db);
+
+ag_status ag_db_begin(ag_db *db, ag_error *err);
+ag_status ag_db_commit(ag_db *db, ag_error *err);
+void ag_db_rollback(ag_db *db);
+
+/* Turns the connection's last SQLite error into AG_ERR_DB (or AG_ERR_BUSY for a lock
+ * timeout) with the message and what was being done. */
+ag_status ag_db_fail(ag_db *db, ag_error *err, const char *doing);
+
+/* Prepares (and caches per connection) a statement; NULL with err filled on failure.
+ * The statement is reset and its bindings cleared before it is returned. */
+sqlite3_stmt *ag_db_prepare(ag_db *db, const char *sql, ag_error *err);
+
+#endif

@@ -1,0 +1,153 @@
+// The web client against a real archgramd in Debian's chromium: import and draw a model,
+// pick a component, and two people editing the same model live.
+import assert from 'node:assert/strict';
+import { readFile, writeFile } from 'node:fs/promises';
+import path from 'node:path';
+import { after, before, test } from 'node:test';
+import { startDaemon, ROOT } from './daemon.js';
+import { launchBrowser, openPage } from './browser.js';
+import { readCanvas } from './pixels.js';
+
+const FIXTURE = path.join(ROOT, 'tests', 'data', 'web', 'two_boxes.obj');
+const WAIT = { timeout: 20000 };
+
+let daemon;
+let browser;
+const pages = [];
+
+before(async () => {
+  daemon = await startDaemon();
+  browser = await launchBrowser();
+});
+
+after(async () => {
+  if (browser) await browser.close();
+  if (daemon) await daemon.stop();
+});
+
+async function newPage(opts) {
+  const page = await openPage(browser, opts);
+  pages.push(page);
+  return page;
+}
+
+function assertNoProblems(...list) {
+  for (const page of list) assert.deepEqual(page.problems, [], 'the page reported errors');
+}
+
+// Imports the fixture over REST and returns the new model id.
+async function importOverRest(name) {
+  const body = await readFile(FIXTURE);
+  const res = await fetch(`${daemon.url}api/v1/models?name=${encodeURIComponent(name)}&format=obj`, {
+    method: 'POST',
+    body,
+  });
+  assert.equal(res.status, 202, await res.clone().text());
+  let job = await res.json();
+  const deadline = Date.now() + 20000;
+  while (!['succeeded', 'failed', 'cancelled'].includes(job.status)) {
+    assert.ok(Date.now() < deadline, 'import job did not finish');
+    await new Promise((r) => setTimeout(r, 100));
+    job = await (await fetch(`${daemon.url}api/v1/jobs/${job.id}`)).json();
+  }
+  assert.equal(job.status, 'succeeded', JSON.stringify(job.error));
+  return job.result.model;
+}
+
+const textOf = (page, testid) => page.getByTestId(testid).textContent();
+const versionOf = async (page) => Number((await textOf(page, 'model-version')).replace(/\D/g, ''));
+
+test('import through the page, draw the model and pick a component', async () => {
+  const page = await newPage({ user: 'tester' });
+  await page.goto(daemon.url);
+  await page.getByTestId('upload-input').setInputFiles(FIXTURE);
+
+  await page.locator('[data-testid="job"][data-status="succeeded"]').waitFor(WAIT);
+  await page.locator('[data-testid="model-item"]', { hasText: 'two_boxes' }).waitFor(WAIT);
+  await page.waitForFunction(() => document.getElementById('viewport').dataset.model, null, WAIT);
+  assert.equal((await textOf(page, 'model-name')).trim(), 'two_boxes');
+  assert.ok((await versionOf(page)) >= 1);
+  const view = await readCanvas(page);
+  assert.ok(view.width > 200 && view.height > 200, `canvas is ${view.width}x${view.height}`);
+  const pct = (view.fraction * 100).toFixed(2);
+  assert.ok(view.fraction > 0.02, `only ${pct}% of the canvas shows the model`);
+  assert.ok(view.fraction < 0.9, `${pct}% of the canvas differs from the background`);
+  assert.ok(view.inside, 'no pixel well inside the model');
+  assert.ok(view.outside, 'no background pixel');
+
+  await view.canvas.click({ position: view.inside });
+  const picked = page.getByTestId('picked-component');
+  await page.waitForFunction(() => /component \d+/.test(document.querySelector('[data-testid="picked-component"]').textContent), null, WAIT);
+  const match = /component (\d+) · group (\S+)/.exec(await picked.textContent());
+  assert.ok(match, await picked.textContent());
+  assert.ok(['block', 'annex'].includes(match[2]), `group ${match[2]}`);
+
+  // Clicking empty space (a background pixel) clears the pick.
+  await view.canvas.click({ position: view.outside });
+  await page.waitForFunction(() => !/component \d+/.test(document.querySelector('[data-testid="picked-component"]').textContent), null, WAIT);
+  assertNoProblems(page);
+});
+
+test('a failed import is shown to the person', async () => {
+  const page = await newPage({ user: 'tester' });
+  await page.goto(daemon.url);
+  const bad = path.join(daemon.dir, 'broken.obj');
+  await writeFile(bad, 'v 0 0 0\nv 1 0 0\nf 1 2 9\n');
+  await page.getByTestId('upload-input').setInputFiles(bad);
+  const banner = page.getByTestId('error');
+  await banner.waitFor({ state: 'visible', ...WAIT });
+  assert.match(await banner.textContent(), /line 3/);
+  await page.locator('[data-testid="job"][data-status="failed"]').waitFor(WAIT);
+  // the page's own warning about the problem is expected; anything else is not
+  assertNoProblems(page);
+});
+
+test('two people in one model: presence and a live rename', async () => {
+  const id = await importOverRest('Shared hall');
+  const alice = await newPage({ user: 'alice' });
+  const bob = await newPage({ user: 'bob' });
+  await alice.goto(`${daemon.url}#model=${id}`);
+  await alice.getByTestId('model-name').filter({ hasText: 'Shared hall' }).waitFor(WAIT);
+  await bob.goto(`${daemon.url}#model=${id}`);
+  await bob.getByTestId('model-name').filter({ hasText: 'Shared hall' }).waitFor(WAIT);
+
+  await bob.getByTestId('peers').filter({ hasText: 'alice' }).waitFor(WAIT);
+  await alice.getByTestId('peers').filter({ hasText: 'bob' }).waitFor(WAIT);
+  const before1 = await versionOf(alice);
+  const before2 = await versionOf(bob);
+  assert.equal(before1, before2);
+
+  const title = alice.getByTestId('model-name');
+  await title.click();
+  await title.fill('Hall 7');
+  await title.press('Enter');
+
+  await bob.getByTestId('model-name').filter({ hasText: /^Hall 7$/ }).waitFor(WAIT);
+  await bob.locator('[data-testid="model-item"]', { hasText: 'Hall 7' }).waitFor(WAIT);
+  await alice.waitForFunction((v) => Number(document.querySelector('[data-testid="model-version"]').textContent.replace(/\D/g, '')) > v, before1, WAIT);
+  await bob.waitForFunction((v) => Number(document.querySelector('[data-testid="model-version"]').textContent.replace(/\D/g, '')) > v, before2, WAIT);
+  assert.equal(await versionOf(alice), await versionOf(bob));
+  await bob.getByTestId('history').filter({ hasText: 'alice' }).waitFor(WAIT);
+
+  // A note from bob reaches alice's history; both move on to the same version.
+  await bob.getByTestId('note-input').fill('check the annex roof');
+  await bob.getByTestId('note-send').click();
+  await alice.getByTestId('history').filter({ hasText: 'check the annex roof' }).waitFor(WAIT);
+  await alice.waitForFunction((v) => Number(document.querySelector('[data-testid="model-version"]').textContent.replace(/\D/g, '')) === v, before1 + 2, WAIT);
+  assert.equal(await versionOf(bob), before1 + 2);
+
+  // The rename is stored: a fresh read of the model has it.
+  const model = await (await fetch(`${daemon.url}api/v1/models/${id}`)).json();
+  assert.equal(model.name, 'Hall 7');
+  assert.equal(model.version, before1 + 2);
+
+  // Bob sees what alice picks.
+  await alice.waitForFunction(() => document.getElementById('viewport').dataset.model, null, WAIT);
+  const view = await readCanvas(alice);
+  assert.ok(view.inside, 'no pixel well inside the model');
+  await view.canvas.click({ position: view.inside });
+  await alice.waitForFunction(() => /component \d+/.test(document.querySelector('[data-testid="picked-component"]').textContent), null, WAIT);
+  const component = /component (\d+)/.exec(await textOf(alice, 'picked-component'))[1];
+  await bob.getByTestId('peers').filter({ hasText: `component ${component}` }).waitFor(WAIT);
+  assertNoProblems(alice, bob);
+});

@@ -1,0 +1,157 @@
+// REST client for /api/v1. Every failure becomes an ApiError carrying an RFC 9457 problem
+// ({type, title, status, detail, line?, element?}), whether the server sent one or not.
+const BASE = '/api/v1';
+
+export class ApiError extends Error {
+  constructor(problem) {
+    super(problem.detail ? `${problem.title}: ${problem.detail}` : problem.title);
+    this.name = 'ApiError';
+    this.problem = problem;
+    this.status = problem.status ?? 0;
+  }
+}
+
+async function problemFrom(res) {
+  const type = res.headers.get('Content-Type') || '';
+  let text = '';
+  try {
+    text = await res.text();
+  } catch {
+    // body unreadable: fall back to the status line
+  }
+  if (type.includes('json') && text) {
+    try {
+      const body = JSON.parse(text);
+      if (body && typeof body === 'object' && body.title) return { status: res.status, ...body };
+    } catch {
+      // not JSON after all
+    }
+  }
+  return {
+    type: 'about:blank',
+    title: res.statusText || `HTTP ${res.status}`,
+    status: res.status,
+    detail: text.slice(0, 300) || undefined,
+  };
+}
+
+function networkProblem(err, what) {
+  return { type: 'urn:archgram:problem:network', title: 'Network error', status: 0, detail: `${what}: ${err.message}` };
+}
+
+export class Api {
+  constructor(user = () => 'api') {
+    this.user = user; // named in X-Archgram-User so REST edits carry an author
+    this.health = null;
+  }
+
+  async request(method, path, { body, headers = {}, raw = false } = {}) {
+    const init = { method, headers: { Accept: 'application/json', ...headers } };
+    if (body !== undefined) {
+      if (body instanceof Blob || body instanceof ArrayBuffer || typeof body === 'string') {
+        init.body = body;
+      } else {
+        init.body = JSON.stringify(body);
+        init.headers['Content-Type'] = 'application/json';
+      }
+    }
+    if (method !== 'GET') init.headers['X-Archgram-User'] = this.user();
+    let res;
+    try {
+      res = await fetch(BASE + path, init);
+    } catch (err) {
+      throw new ApiError(networkProblem(err, `${method} ${path}`));
+    }
+    if (!res.ok) throw new ApiError(await problemFrom(res));
+    if (raw) return res;
+    if (res.status === 204) return null;
+    const text = await res.text();
+    try {
+      return text ? JSON.parse(text) : null;
+    } catch {
+      throw new ApiError({ title: 'Bad response', status: res.status, detail: `${method} ${path} did not return JSON` });
+    }
+  }
+
+  async getHealth() {
+    if (!this.health) this.health = await this.request('GET', '/health');
+    return this.health;
+  }
+
+  listModels(pageToken = null, pageSize = 50) {
+    const q = new URLSearchParams({ page_size: String(pageSize) });
+    if (pageToken) q.set('page_token', pageToken);
+    return this.request('GET', `/models?${q}`);
+  }
+
+  getModel(id) {
+    return this.request('GET', `/models/${id}`);
+  }
+
+  getOps(id, since = 0) {
+    return this.request('GET', `/models/${id}/ops?since=${since}`);
+  }
+
+  getJob(id) {
+    return this.request('GET', `/jobs/${id}`);
+  }
+
+  cancelJob(id) {
+    return this.request('DELETE', `/jobs/${id}`);
+  }
+
+  // The model's GLB as an ArrayBuffer (through request() so errors arrive as problems).
+  async meshBuffer(model) {
+    const path = (model.mesh || `${BASE}/models/${model.id}/mesh.glb`).replace(BASE, '');
+    const res = await this.request('GET', path, { raw: true, headers: { Accept: 'model/gltf-binary' } });
+    return res.arrayBuffer();
+  }
+
+  // REST fallbacks for edits when the live connection is down.
+  rename(id, version, name) {
+    return this.request('PATCH', `/models/${id}`, { body: { name }, headers: { 'If-Match': `"${version}"` } });
+  }
+
+  postOp(id, version, cid, op) {
+    return this.request('POST', `/models/${id}/ops`, { body: { cid, op }, headers: { 'If-Match': `"${version}"` } });
+  }
+
+  // Uploads a file as the raw request body; XMLHttpRequest because fetch reports no upload
+  // progress. Resolves with the job object of the 202 answer.
+  uploadModel(file, { name, format, up } = {}, onProgress = () => {}) {
+    const q = new URLSearchParams({ name: name ?? file.name, format });
+    if (up) q.set('up', up);
+    const path = `/models?${q}`;
+    return new Promise((resolve, reject) => {
+      const xhr = new XMLHttpRequest();
+      xhr.open('POST', BASE + path);
+      xhr.setRequestHeader('Content-Type', 'application/octet-stream');
+      xhr.setRequestHeader('Accept', 'application/json');
+      xhr.setRequestHeader('X-Archgram-User', this.user());
+      xhr.upload.onprogress = (e) => {
+        if (e.lengthComputable) onProgress(e.loaded / e.total);
+      };
+      xhr.onerror = () => reject(new ApiError(networkProblem(new Error('upload failed'), `POST ${path}`)));
+      xhr.onload = () => {
+        const headers = new Headers({ 'Content-Type': xhr.getResponseHeader('Content-Type') || '' });
+        const res = new Response(xhr.status === 204 ? null : xhr.responseText, {
+          status: xhr.status,
+          statusText: xhr.statusText,
+          headers,
+        });
+        if (!res.ok) {
+          problemFrom(res).then((p) => reject(new ApiError(p)));
+          return;
+        }
+        res.text().then((text) => {
+          try {
+            resolve(JSON.parse(text));
+          } catch {
+            reject(new ApiError({ title: 'Bad response', status: xhr.status, detail: 'the upload answer was not JSON' }));
+          }
+        });
+      };
+      xhr.send(file);
+    });
+  }
+}

@@ -1,0 +1,210 @@
+// The editor: all client state plus the signals that announce its changes.
+// Panels and the viewport read state here and listen to signals; they never talk to each other.
+import { Signal } from './signal.js';
+
+const USER_KEY = 'archgram.user';
+
+function defaultUser() {
+  const chars = 'abcdefghijklmnopqrstuvwxyz0123456789';
+  let s = '';
+  for (let i = 0; i < 4; i++) s += chars[Math.floor(Math.random() * chars.length)];
+  return `guest-${s}`;
+}
+
+function loadUser() {
+  try {
+    const saved = localStorage.getItem(USER_KEY);
+    if (saved && saved.trim()) return saved.trim();
+    const user = defaultUser();
+    localStorage.setItem(USER_KEY, user);
+    return user;
+  } catch {
+    return defaultUser(); // storage disabled: a fresh name per visit
+  }
+}
+
+export class Editor {
+  constructor() {
+    this.signals = {
+      modelsChanged: new Signal(),     // the list (models, nextPageToken)
+      modelOpened: new Signal(),       // model (or null when closed)
+      modelChanged: new Signal(),      // name or version of the open model
+      selectionChanged: new Signal(),  // selection (or null)
+      peersChanged: new Signal(),
+      historyChanged: new Signal(),
+      jobChanged: new Signal(),        // job (or null when the panel should clear)
+      connectionChanged: new Signal(), // 'offline' | 'connecting' | 'online' | 'lost'
+      userChanged: new Signal(),
+      cameraChanged: new Signal(),     // {position, target} from the viewport
+      problem: new Signal(),           // {title, detail, ...}: shown to the person
+      notice: new Signal(),            // short informational message
+    };
+
+    this.models = [];
+    this.nextPageToken = null;
+
+    this.model = null;      // the open model object, name/version kept current by ops
+    this.selection = null;  // {component, group} or null
+    this.peers = new Map(); // peer id -> {peer, user, state}
+    this.ops = new Map();   // version -> op entry of the open model
+    this.job = null;
+    this.connection = 'offline';
+    this.user = loadUser();
+    this.camera = null;
+  }
+
+  // --- model list ---------------------------------------------------------------------------
+  setModels(items, nextPageToken, append = false) {
+    this.models = append ? mergeById(this.models, items) : items.slice();
+    this.nextPageToken = nextPageToken ?? null;
+    this.signals.modelsChanged.dispatch(this.models);
+  }
+
+  upsertModel(model) {
+    this.models = mergeById(this.models, [model]);
+    this.signals.modelsChanged.dispatch(this.models);
+  }
+
+  // --- the open model -----------------------------------------------------------------------
+  openModel(model) {
+    this.model = model ? { ...model } : null;
+    this.selection = null;
+    this.peers.clear();
+    this.ops.clear();
+    this.signals.modelOpened.dispatch(this.model);
+    this.signals.selectionChanged.dispatch(null);
+    this.signals.peersChanged.dispatch(this.peers);
+    this.signals.historyChanged.dispatch(this.history());
+  }
+
+  get version() {
+    return this.model ? this.model.version : null;
+  }
+
+  // Op entries {version, author, cid, op, at}, possibly overlapping what we already have.
+  addHistory(entries) {
+    let changed = false;
+    for (const e of entries) {
+      if (!this.ops.has(e.version)) {
+        this.ops.set(e.version, e);
+        changed = true;
+      }
+    }
+    if (changed) this.signals.historyChanged.dispatch(this.history());
+  }
+
+  history() {
+    return [...this.ops.values()].sort((a, b) => a.version - b.version);
+  }
+
+  // Applies one sequenced op to the open model; entries at or below the current version are
+  // already part of it and only join the history.
+  applyOp(entry) {
+    if (!this.model) return;
+    this.addHistory([entry]);
+    if (entry.version <= this.model.version) return;
+    this.model.version = entry.version;
+    const op = entry.op || {};
+    if (op.kind === 'rename' && typeof op.name === 'string') this.model.name = op.name;
+    const listed = this.models.find((m) => m.id === this.model.id);
+    if (listed) {
+      listed.name = this.model.name;
+      listed.version = entry.version;
+      this.signals.modelsChanged.dispatch(this.models);
+    }
+    this.signals.modelChanged.dispatch(this.model);
+  }
+
+  // The server told us the current version (welcome) without ops to carry us there.
+  setVersion(version) {
+    if (!this.model || version <= this.model.version) return;
+    this.model.version = version;
+    this.signals.modelChanged.dispatch(this.model);
+  }
+
+  // Re-announces the model so views drop unconfirmed edits (e.g. a title typed but refused).
+  refreshModel() {
+    if (this.model) this.signals.modelChanged.dispatch(this.model);
+  }
+
+  // --- selection, camera --------------------------------------------------------------------
+  select(selection) {
+    const same = (this.selection?.component ?? null) === (selection?.component ?? null);
+    this.selection = selection;
+    if (!same) this.signals.selectionChanged.dispatch(selection);
+  }
+
+  setCamera(camera) {
+    this.camera = camera;
+    this.signals.cameraChanged.dispatch(camera);
+  }
+
+  // --- peers --------------------------------------------------------------------------------
+  setPeers(list) {
+    this.peers.clear();
+    for (const p of list || []) this.peers.set(p.peer, { peer: p.peer, user: p.user, state: p.state ?? null });
+    this.signals.peersChanged.dispatch(this.peers);
+  }
+
+  updatePeer(peer, fields) {
+    const prev = this.peers.get(peer) || { peer, user: fields.user ?? peer, state: null };
+    this.peers.set(peer, { ...prev, ...fields });
+    this.signals.peersChanged.dispatch(this.peers);
+  }
+
+  removePeer(peer) {
+    if (this.peers.delete(peer)) this.signals.peersChanged.dispatch(this.peers);
+  }
+
+  // --- misc ---------------------------------------------------------------------------------
+  setUser(name) {
+    const user = String(name).trim();
+    if (!user || user === this.user) return;
+    this.user = user;
+    try {
+      localStorage.setItem(USER_KEY, user);
+    } catch {
+      // storage disabled: the name lasts for this visit
+    }
+    this.signals.userChanged.dispatch(user);
+  }
+
+  setJob(job) {
+    this.job = job;
+    this.signals.jobChanged.dispatch(job);
+  }
+
+  setConnection(state) {
+    if (state === this.connection) return;
+    this.connection = state;
+    this.signals.connectionChanged.dispatch(state);
+  }
+
+  // Every failure the person should know about goes through here.
+  fail(problem) {
+    const p = toProblem(problem);
+    console.warn(`archgram: ${p.title}${p.detail ? `: ${p.detail}` : ''}`);
+    this.signals.problem.dispatch(p);
+  }
+
+  notify(text) {
+    this.signals.notice.dispatch(text);
+  }
+}
+
+function mergeById(list, items) {
+  const out = list.slice();
+  for (const item of items) {
+    const i = out.findIndex((m) => m.id === item.id);
+    if (i >= 0) out[i] = item;
+    else out.push(item);
+  }
+  return out.sort((a, b) => a.id - b.id);
+}
+
+export function toProblem(x) {
+  if (x && x.problem) return x.problem; // ApiError
+  if (x instanceof Error) return { title: 'Unexpected error', detail: x.message };
+  if (x && typeof x === 'object') return { title: x.title || 'Error', ...x };
+  return { title: String(x) };
+}

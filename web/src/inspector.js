@@ -1,0 +1,50 @@
+// The inspector: the picked component and the open model's figures.
+import { el } from './dom.js';
+
+export class Inspector {
+  constructor(editor, container) {
+    this.editor = editor;
+    this.picked = el('div.picked', { 'data-testid': 'picked-component' });
+    this.stats = el('dl.stats');
+    container.append(el('h2', {}, 'Inspector'), this.picked, this.stats);
+    editor.signals.selectionChanged.add(() => this.renderPick());
+    editor.signals.modelOpened.add(() => this.render());
+    this.render();
+  }
+
+  render() {
+    this.renderPick();
+    const m = this.editor.model;
+    const st = m?.stats;
+    if (!st) {
+      this.stats.replaceChildren();
+      return;
+    }
+    const fmt = (n) => (typeof n === 'number' ? n.toLocaleString() : '–');
+    const size = st.bounds
+      ? st.bounds.max.map((v, i) => (v - st.bounds.min[i]).toFixed(2)).join(' × ') + ' m'
+      : '–';
+    const rows = [
+      ['vertices', fmt(st.vertices)],
+      ['triangles', fmt(st.triangles)],
+      ['components', fmt(st.components)],
+      ['groups', fmt(st.groups)],
+      ['size', size],
+    ];
+    this.stats.replaceChildren(...rows.flatMap(([k, v]) => [el('dt', {}, k), el('dd', {}, v)]));
+  }
+
+  renderPick() {
+    const sel = this.editor.selection;
+    if (!this.editor.model) {
+      this.picked.textContent = '';
+      this.picked.classList.add('none');
+    } else if (!sel) {
+      this.picked.textContent = 'Click the model to pick a component';
+      this.picked.classList.add('none');
+    } else {
+      this.picked.textContent = `component ${sel.component} · group ${sel.group ?? '—'}`;
+      this.picked.classList.remove('none');
+    }
+  }
+}

@@ -1,0 +1,49 @@
+// Wires the archgram client together: one editor, its services, its views.
+import { Editor } from './editor.js';
+import { Api } from './api.js';
+import { Live } from './live.js';
+import { Session } from './session.js';
+import { Upload } from './upload.js';
+import { Viewport } from './viewport.js';
+import { Toolbar } from './toolbar.js';
+import { ModelsPanel } from './models.js';
+import { Inspector } from './inspector.js';
+import { PeersPanel } from './peers.js';
+import { HistoryPanel } from './history.js';
+import { Toast } from './toast.js';
+
+const editor = new Editor();
+const api = new Api(() => editor.user);
+const live = new Live(editor, api);
+const session = new Session(editor, api, live);
+const upload = new Upload(editor, api, live, session);
+
+const $ = (id) => document.getElementById(id);
+new Toast(editor, $('toasts'));
+new Toolbar(editor, session, $('toolbar'));
+new ModelsPanel(editor, session, upload, $('models'));
+new Viewport(editor, api, $('viewport'));
+new Inspector(editor, $('inspector'));
+new PeersPanel(editor, $('peers'));
+new HistoryPanel(editor, session, $('history'));
+
+window.addEventListener('unhandledrejection', (e) => {
+  editor.fail(e.reason);
+});
+
+window.archgram = editor; // for poking at state from the console
+
+function modelFromHash() {
+  const m = /^#model=(\d+)$/.exec(location.hash);
+  return m ? Number(m[1]) : null;
+}
+
+window.addEventListener('hashchange', () => {
+  const id = modelFromHash();
+  if (id !== null) session.open(id);
+});
+
+editor.openModel(null);
+await session.loadModels();
+const initial = modelFromHash();
+if (initial !== null) await session.open(initial);

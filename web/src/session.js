@@ -1,0 +1,76 @@
+// What a person does to a model (open, rename, add a note), carried out over REST and the
+// live connection; the results land in the editor, which tells the views.
+export class Session {
+  constructor(editor, api, live) {
+    this.editor = editor;
+    this.api = api;
+    this.live = live;
+    editor.signals.selectionChanged.add(() => live.presence());
+    editor.signals.cameraChanged.add(() => live.presence());
+    editor.signals.userChanged.add(() => live.hello()); // re-introduce ourselves under the new name
+  }
+
+  async loadModels(more = false) {
+    const ed = this.editor;
+    try {
+      const page = await this.api.listModels(more ? ed.nextPageToken : null);
+      ed.setModels(page.items || [], page.next_page_token, more);
+    } catch (err) {
+      ed.fail(err);
+    }
+  }
+
+  async open(id) {
+    const ed = this.editor;
+    if (ed.model && ed.model.id === id) return;
+    try {
+      const model = await this.api.getModel(id);
+      ed.upsertModel(model);
+      ed.openModel(model);
+      if (location.hash !== `#model=${id}`) history.replaceState(null, '', `#model=${id}`);
+      const [ops] = await Promise.all([
+        this.api.getOps(id, 0).catch((err) => {
+          ed.fail(err);
+          return { items: [] };
+        }),
+        this.live.join(id).catch((err) => ed.fail({ title: 'Live connection unavailable', detail: err.message })),
+      ]);
+      if (ed.model && ed.model.id === id) {
+        const items = ops.items || [];
+        ed.addHistory(items);
+        // Ops logged after the model was read: apply them (the room catches up the same way).
+        for (const entry of items) if (entry.version > ed.model.version) this.live.applyOps([entry]);
+      }
+    } catch (err) {
+      ed.fail(err);
+    }
+  }
+
+  async rename(name) {
+    const ed = this.editor;
+    const clean = name.trim();
+    if (!ed.model || !clean || clean === ed.model.name) {
+      ed.refreshModel();
+      return;
+    }
+    try {
+      await this.live.sendOp({ kind: 'rename', name: clean });
+    } catch (err) {
+      if (!err.problem || !this.live.open) ed.fail(err); // a nack was already shown
+      ed.refreshModel();
+    }
+  }
+
+  async note(text) {
+    const ed = this.editor;
+    const clean = text.trim();
+    if (!ed.model || !clean) return false;
+    try {
+      await this.live.sendOp({ kind: 'note', text: clean });
+      return true;
+    } catch (err) {
+      if (!err.problem || !this.live.open) ed.fail(err);
+      return false;
+    }
+  }
+}

@@ -1,0 +1,47 @@
+// Problems and notices shown to the person: one banner for the latest problem (kept until
+// dismissed or replaced by the next) and a
+// short-lived notice line.
+import { el } from './dom.js';
+
+const NOTICE_MS = 4000;
+
+export class Toast {
+  constructor(editor, container) {
+    this.count = 0;
+    this.text = el('div.toast-text');
+    this.close = el('button.toast-close', { type: 'button', title: 'Dismiss', 'aria-label': 'Dismiss' }, '×');
+    this.banner = el('div.toast.error', { role: 'alert', 'data-testid': 'error', hidden: true }, this.text, this.close);
+    this.close.addEventListener('click', () => {
+      this.banner.hidden = true;
+    });
+    this.notice = el('div.toast.notice', { role: 'status', 'data-testid': 'notice', hidden: true });
+    container.append(this.banner, this.notice);
+    editor.signals.problem.add((p) => this.showProblem(p));
+    editor.signals.notice.add((t) => this.showNotice(t));
+  }
+
+  showProblem(p) {
+    this.count += 1;
+    let where = p.line ? ` (line ${p.line})` : p.element !== undefined && p.element !== null ? ` (element ${p.element})` : '';
+    if (p.detail && where && p.detail.includes(where.slice(2, -1))) where = ''; // already said
+    this.text.replaceChildren(
+      el('strong', {}, p.title || 'Error'),
+      p.status ? el('span.status', {}, ` ${p.status}`) : '',
+      p.detail ? el('div.detail', {}, `${p.detail}${where}`) : where ? el('div.detail', {}, where) : '',
+    );
+    this.banner.title = p.type || '';
+    this.banner.hidden = false;
+    this.banner.classList.remove('flash');
+    void this.banner.offsetWidth; // restart the animation for a repeated problem
+    this.banner.classList.add('flash');
+  }
+
+  showNotice(text) {
+    this.notice.textContent = text;
+    this.notice.hidden = false;
+    clearTimeout(this.timer);
+    this.timer = setTimeout(() => {
+      this.notice.hidden = true;
+    }, NOTICE_MS);
+  }
+}

@@ -1,0 +1,264 @@
+// The 3D view: loads a model's GLB, frames it, renders on demand and turns clicks into
+// component selections. It only reacts to editor signals and reports picks/camera moves back.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+
+// Flat, light background; model colours are mid-tones kept well away from it so the model
+// always stands out (and the grid stays close to it so it never does).
+export const BACKGROUND = 0xdde3ea;
+const GRID_CENTER = 0xbcc4cd;
+const GRID_LINES = 0xccd3da;
+const PALETTE = [0xc4683f, 0x4f7cac, 0x6a994e, 0x9a6fa8, 0x3d8a8a, 0x8a6d5a, 0xa84f62, 0x5b6b7d];
+// A picked component turns bright yellow, a colour the palette never uses.
+const HIGHLIGHT = new THREE.Color(0xffc820);
+const HIGHLIGHT_GLOW = new THREE.Color(0x3a2a00);
+const CLICK_SLOP_PX = 5;
+
+export class Viewport {
+  constructor(editor, api, container) {
+    this.editor = editor;
+    this.api = api;
+    this.container = container;
+
+    this.renderer = new THREE.WebGLRenderer({ antialias: true });
+    this.renderer.setPixelRatio(window.devicePixelRatio || 1);
+    this.renderer.domElement.setAttribute('data-testid', 'viewport-canvas');
+    container.appendChild(this.renderer.domElement);
+
+    this.scene = new THREE.Scene();
+    this.scene.background = new THREE.Color(BACKGROUND);
+    const hemi = new THREE.HemisphereLight(0xffffff, 0x8d8475, 1.0);
+    this.scene.add(hemi);
+    const sun = new THREE.DirectionalLight(0xffffff, 1.3);
+    sun.position.set(0.6, 1.0, 0.45);
+    this.scene.add(sun);
+    this.scene.add(sun.target);
+
+    this.grid = null;
+    this.root = null;           // the loaded model
+    this.byComponent = new Map(); // component -> meshes
+    this.loadToken = 0;
+
+    this.camera = new THREE.PerspectiveCamera(45, 1, 0.1, 1000);
+    this.camera.position.set(12, 9, 14);
+    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls.addEventListener('change', () => {
+      this.requestRender();
+      this.reportCamera();
+    });
+
+    this.raycaster = new THREE.Raycaster();
+    this.pointerDown = null;
+    const el = this.renderer.domElement;
+    el.addEventListener('pointerdown', (e) => {
+      if (e.button === 0) this.pointerDown = { x: e.clientX, y: e.clientY };
+    });
+    el.addEventListener('pointerup', (e) => {
+      const d = this.pointerDown;
+      this.pointerDown = null;
+      if (e.button !== 0 || !d) return;
+      if (Math.hypot(e.clientX - d.x, e.clientY - d.y) > CLICK_SLOP_PX) return; // an orbit drag
+      this.pick(e.clientX, e.clientY);
+    });
+
+    this.status = document.createElement('div');
+    this.status.className = 'viewport-status';
+    container.appendChild(this.status);
+
+    this.frame = 0;
+    new ResizeObserver(() => this.resize()).observe(container);
+    window.addEventListener('resize', () => this.resize());
+    this.resize();
+    this.makeGrid(10);
+
+    const s = editor.signals;
+    s.modelOpened.add((model) => this.load(model));
+    s.selectionChanged.add((sel) => this.highlight(sel));
+  }
+
+  requestRender() {
+    if (this.frame) return;
+    this.frame = requestAnimationFrame(() => {
+      this.frame = 0;
+      this.renderer.render(this.scene, this.camera);
+    });
+  }
+
+  resize() {
+    const w = Math.max(1, this.container.clientWidth);
+    const h = Math.max(1, this.container.clientHeight);
+    this.renderer.setSize(w, h, true);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.requestRender();
+  }
+
+  setStatus(text) {
+    this.status.textContent = text || '';
+    this.status.hidden = !text;
+  }
+
+  // --- loading ------------------------------------------------------------------------------
+  async load(model) {
+    const token = ++this.loadToken;
+    delete this.container.dataset.model;
+    this.clear();
+    if (!model) {
+      this.setStatus('Open or import a model');
+      return;
+    }
+    this.setStatus('Loading mesh…');
+    try {
+      const buffer = await this.api.meshBuffer(model);
+      if (token !== this.loadToken) return;
+      const gltf = await new GLTFLoader().parseAsync(buffer, '');
+      if (token !== this.loadToken) return;
+      this.show(gltf.scene);
+      this.setStatus('');
+      this.container.dataset.model = String(model.id); // which model is on screen
+    } catch (err) {
+      if (token !== this.loadToken) return;
+      this.setStatus('The mesh could not be shown');
+      this.editor.fail(err.problem || { title: 'Cannot show the mesh', detail: err.message });
+    }
+  }
+
+  clear() {
+    if (this.root) {
+      this.scene.remove(this.root);
+      this.root.traverse((o) => {
+        if (o.isMesh) {
+          o.geometry.dispose();
+          for (const m of [].concat(o.material)) m.dispose();
+        }
+      });
+    }
+    this.root = null;
+    this.byComponent.clear();
+    this.requestRender();
+  }
+
+  show(root) {
+    const groupColour = new Map();
+    root.traverse((o) => {
+      if (!o.isMesh) return;
+      const owner = componentOwner(o);
+      const component = owner ? owner.userData.component : -1;
+      const group = owner ? owner.userData.group ?? null : null;
+      // One palette colour per group (or per component when ungrouped), own material per
+      // mesh so a highlight touches only the picked component.
+      const key = group !== null ? `g:${group}` : `c:${component}`;
+      if (!groupColour.has(key)) groupColour.set(key, PALETTE[groupColour.size % PALETTE.length]);
+      for (const m of [].concat(o.material)) m.dispose();
+      o.material = new THREE.MeshStandardMaterial({
+        color: groupColour.get(key),
+        roughness: 0.85,
+        metalness: 0,
+        side: THREE.DoubleSide,
+        polygonOffset: true,
+        polygonOffsetFactor: 1,
+        polygonOffsetUnits: 1,
+      });
+      o.userData.baseColour = o.material.color.clone();
+      if (!this.byComponent.has(component)) this.byComponent.set(component, []);
+      this.byComponent.get(component).push(o);
+    });
+    this.root = root;
+    this.scene.add(root);
+    this.frameModel();
+    this.highlight(this.editor.selection);
+  }
+
+  // Places the camera so the whole model fits, and the grid under it.
+  frameModel() {
+    const box = new THREE.Box3().setFromObject(this.root);
+    if (box.isEmpty()) return;
+    const sphere = box.getBoundingSphere(new THREE.Sphere());
+    const r = Math.max(sphere.radius, 1e-3);
+    const fov = THREE.MathUtils.degToRad(this.camera.fov);
+    const fit = Math.min(fov, 2 * Math.atan(Math.tan(fov / 2) * this.camera.aspect));
+    const dist = (r / Math.sin(fit / 2)) * 1.15;
+    const dir = new THREE.Vector3(1, 0.75, 1.25).normalize();
+    this.camera.position.copy(sphere.center).addScaledVector(dir, dist);
+    this.camera.near = dist / 200;
+    this.camera.far = dist * 50;
+    this.camera.updateProjectionMatrix();
+    this.controls.target.copy(sphere.center);
+    this.controls.update();
+
+    const size = box.getSize(new THREE.Vector3());
+    this.makeGrid(niceSize(Math.max(size.x, size.z) * 3));
+    this.grid.position.set(sphere.center.x, box.min.y - r * 1e-3, sphere.center.z);
+    this.sun().position.copy(sphere.center).addScaledVector(new THREE.Vector3(0.6, 1.0, 0.45), dist);
+    this.sun().target.position.copy(sphere.center);
+    this.requestRender();
+    this.reportCamera();
+  }
+
+  sun() {
+    return this.scene.children.find((o) => o.isDirectionalLight);
+  }
+
+  makeGrid(size) {
+    if (this.grid) {
+      this.scene.remove(this.grid);
+      this.grid.geometry.dispose();
+      this.grid.material.dispose();
+    }
+    this.grid = new THREE.GridHelper(size, 20, GRID_CENTER, GRID_LINES);
+    this.scene.add(this.grid);
+    this.requestRender();
+  }
+
+  // --- picking ------------------------------------------------------------------------------
+  pick(clientX, clientY) {
+    if (!this.root) return;
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    const ndc = new THREE.Vector2(
+      ((clientX - rect.left) / rect.width) * 2 - 1,
+      -((clientY - rect.top) / rect.height) * 2 + 1,
+    );
+    this.raycaster.setFromCamera(ndc, this.camera);
+    const hit = this.raycaster.intersectObject(this.root, true).find((h) => h.object.isMesh);
+    const owner = hit ? componentOwner(hit.object) : null;
+    if (!owner) {
+      this.editor.select(null);
+      return;
+    }
+    this.editor.select({ component: owner.userData.component, group: owner.userData.group ?? null });
+  }
+
+  highlight(sel) {
+    for (const [component, meshes] of this.byComponent) {
+      const on = sel && sel.component === component;
+      for (const mesh of meshes) {
+        mesh.material.color.copy(on ? HIGHLIGHT : mesh.userData.baseColour);
+        mesh.material.emissive.copy(on ? HIGHLIGHT_GLOW : BLACK);
+      }
+    }
+    this.requestRender();
+  }
+
+  reportCamera() {
+    const round = (v) => [v.x, v.y, v.z].map((n) => Math.round(n * 1000) / 1000);
+    this.editor.setCamera({ position: round(this.camera.position), target: round(this.controls.target) });
+  }
+}
+
+const BLACK = new THREE.Color(0x000000);
+
+// The nearest object (itself or an ancestor) that the GLB marked with a component id.
+function componentOwner(o) {
+  for (let x = o; x; x = x.parent) {
+    if (typeof x.userData?.component === 'number') return x;
+  }
+  return null;
+}
+
+function niceSize(x) {
+  if (!(x > 0)) return 10;
+  const p = 10 ** Math.floor(Math.log10(x));
+  for (const m of [1, 2, 5, 10]) if (m * p >= x) return m * p;
+  return 10 * p;
+}
