@@ -7,4 +7,17 @@
 int ag_cli_info(int argc, char **argv);
 int ag_cli_convert(int argc, char **argv);
 
+/* Shared by the subcommands (defined in server/cli.c). */
+#include "../core/mesh.h"
+#include "../core/status.h"
+#include "../io/obj.h"
+
+/* Prints `archgram: FILE:LINE: message` (or `archgram: FILE: message`) to stderr. */
+void ag_cli_report(const char *file, const ag_error *err);
+/* "--up y|z" value → axis; returns 0, or -1 on a bad value. */
+int ag_cli_parse_up(const char *value, ag_up_axis *up);
+/* Reads a mesh file of any importable format; on failure reports it and returns 1.
+ * *bytes receives the file size. */
+int ag_cli_load_mesh(const char *path, ag_up_axis up, ag_mesh **out, size_t *bytes);
+
 #endif

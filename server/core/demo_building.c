@@ -112,7 +112,7 @@ static void row_house(builder *b)
     prism(b, part(b, "roof_back"), back, 4, up);
 
     /* 6 × 2 identical windows, symmetric about the door in the middle. */
-    const double ww = 0.9, wh = 1.2, pitch = 1.9, x0 = W / 2 - 2.5 * pitch - ww / 2;
+    const double ww = 0.9, wh = 1.2, pitch = 2.0, x0 = W / 2 - 2.5 * pitch - ww / 2;
     const double rows[2] = {1.0, 3.6};
     for (int r = 0; r < 2; r++)
         for (int c = 0; c < 6; c++) {
@@ -121,8 +121,8 @@ static void row_house(builder *b)
             window_frame(b, part(b, name), x0 + c * pitch, rows[r], ww, wh, -0.1, 0.02);
         }
     uint32_t door = part(b, "door");
-    window_frame(b, door, W / 2 - 0.4, 0.08, 0.8, 2.1, -0.1, 0.02);
-    box(b, door, W / 2 - 0.4, -0.04, 0.08, W / 2 + 0.4, -0.02, 2.18); /* leaf */
+    window_frame(b, door, W / 2 - 0.35, 0.08, 0.7, 2.1, -0.1, 0.02);
+    box(b, door, W / 2 - 0.35, -0.04, 0.08, W / 2 + 0.35, -0.02, 2.18); /* leaf */
 }
 
 static void octagon(double r, double z, double (*out)[3])

@@ -2,9 +2,13 @@
  *
  * One node with one mesh/primitive per component, so a picked primitive maps back to a
  * component: node.name = "component <i>", node.extras = {"component": i, "group": name|null}.
- * glTF is y-up, archgram is z-up: positions are written as (x, z, -y). Flat normals are
- * emitted (vertices are split per triangle only where needed is not attempted: every
- * primitive gets its own vertex copy so components stay independent). */
+ * mesh.extras holds the same. glTF is y-up, archgram is z-up: positions are written as
+ * (x, z, -y). Vertices are not shared: each triangle gets its own three vertices with its
+ * flat normal, and no index buffer. Positions are stored relative to the centre of the
+ * mesh bounds and every node's `translation` is that centre, so geo-referenced (UTM)
+ * coordinates keep their precision in float32. Components without triangles get no node;
+ * an empty mesh gives a valid GLB with an empty scene and no BIN chunk. One default
+ * material (light grey, doubleSided). */
 #ifndef AG_GLB_H
 #define AG_GLB_H
 

@@ -481,14 +481,13 @@ static ag_status read_line(reader *r, const char *p, const char *e)
         r->nvn++;
         return AG_OK;
     }
-    /* Other keywords (usemtl, mtllib, s, l, p, vp, curves...) are accepted and ignored,
-     * but a keyword must look like one: binary data does not. */
-    for (const char *c = k; c < k + kl; c++) {
+    /* Other statements (usemtl, mtllib, s, l, p, vp, curves...) are accepted and ignored,
+     * but control characters mark binary data, not text. */
+    for (const char *c = k; c < e; c++) {
         unsigned char u = (unsigned char)*c;
-        if (!((u >= 'a' && u <= 'z') || (u >= 'A' && u <= 'Z') || (u >= '0' && u <= '9') ||
-              u == '_' || u == '-' || u == '.')) {
+        if ((u < 0x20 && !is_space((char)u)) || u == 0x7f) {
             char q[64];
-            return perr(r, "unexpected data '%s' (not an OBJ statement)",
+            return perr(r, "unexpected data '%s' (binary, not an OBJ statement)",
                         quote(k, k + kl, q, sizeof q));
         }
     }

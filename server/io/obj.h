@@ -1,12 +1,31 @@
 /* Wavefront OBJ ↔ ag_mesh.
  *
- * Reading: `v`, `f` (polygons fan-triangulated; v, v/vt, v//vn, v/vt/vn; negative
- * indices relative), `g` and `o` start a group (one component per group), `usemtl`,
- * `mtllib`, `vt`, `vn`, `s`, `l`, `p` and comments are accepted. Malformed input — a bad or
- * out-of-range index, NaN/inf coordinates, a truncated line, a face with fewer than three
- * vertices, counts past the limits — fails with AG_ERR_PARSE and the 1-based line in
- * err->element and a message naming the problem. A file with no triangle fails with
- * AG_ERR_EMPTY. Files without groups get one component per connected piece. */
+ * Reading: `v x y z [w | r g b]` (extras ignored), `f` (polygons fan-triangulated from
+ * their first vertex; v, v/vt, v//vn, v/vt/vn; negative indices relative to the vertices
+ * defined so far), `g` and `o` start a group, `usemtl`, `mtllib`, `vt`, `vn`, `s`, `l`,
+ * `p`, `#` comments, CRLF, blank lines, trailing blanks and `\` line continuations are
+ * accepted; other statement keywords are ignored.
+ *
+ * Groups and components: one component per group, in the order of the groups' first faces.
+ * Of consecutive g/o lines with no face between them the last wins; a group that never
+ * gets a face does not exist; a group named again later continues the same group (and
+ * component); a bare `g` is the group "default"; the name is the rest of the line.
+ * Faces before any g/o form a group-less component (group -1). A file with no group at
+ * all gets one component per connected piece (ag_mesh_split_connected). A group made of
+ * several loose pieces stays one component here: the proceduralization stage decides.
+ *
+ * Degenerate faces: a triangle of the fan that repeats a vertex index is dropped silently;
+ * geometrically flat (zero-area) triangles are kept for later stages to judge.
+ *
+ * Errors: malformed input — a zero, unparsable or out-of-range index (including one
+ * that refers to a vertex defined further down: OBJ requires definition first), a
+ * NaN/inf/unparsable coordinate, a truncated `v` line, a face with fewer than three
+ * vertices, counts past max_vertices/max_triangles, a NUL byte or other binary data —
+ * fails with AG_ERR_PARSE, the 1-based line in err->element and err->text like
+ * "line 12: face index 57 out of range (file has 40 vertices so far)". A file without
+ * any triangle fails with AG_ERR_EMPTY. On failure *out is NULL.
+ *
+ * Axes: the mesh is always z-up; a y-up file (the default) maps (x, y, z) → (x, -z, y). */
 #ifndef AG_OBJ_H
 #define AG_OBJ_H
 
@@ -36,8 +55,11 @@ ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_opt
 ag_status ag_obj_read_file(const char *path, const ag_obj_read_options *opt, ag_mesh **out,
                            ag_error *err);
 
-/* Writes z-up geometry back in the given up axis (AG_UP_DEFAULT = y), one `g` per
- * component named after its group (or `component_<i>`). */
+/* Writes z-up geometry back in the given up axis (AG_UP_DEFAULT = y): every vertex
+ * (%.17g, so reading it back is exact), then per component a `g` line named after its
+ * group (or `component_<i>`) and its triangles, 1-based. A mesh without groups is written
+ * without g lines, and a group-less component 0 before the first g line, so that reading
+ * the file back reproduces the components; components sharing one group merge. */
 ag_status ag_obj_write_file(const ag_mesh *m, ag_up_axis up, const char *path, ag_error *err);
 
 #endif

@@ -15,6 +15,8 @@
 #include "upload.h"
 
 #define AG_MAX_JSON_BODY (1u << 20)
+/* How much of a rejected body is read and dropped before the connection is cut. */
+#define AG_DISCARD_LIMIT ((size_t)64 << 20)
 
 struct ag_http {
     struct MHD_Daemon *daemon;
@@ -127,8 +129,15 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
     if (*upload_data_size) {
         size_t n = *upload_data_size;
         *upload_data_size = 0;
-        if (r->body_status != AG_OK || !r->route)
-            return MHD_YES; /* already failed or no body expected: drop the rest */
+        if (!r->route)
+            return MHD_YES; /* a static file request with a body: ignore it */
+        if (r->body_status != AG_OK) {
+            /* libmicrohttpd cannot answer while body data is being delivered, so the rest of
+             * a rejected body is read and dropped (never stored) and the problem is sent when
+             * it ends; a client that keeps sending far past the limit is disconnected. */
+            r->discarded += n;
+            return r->discarded > AG_DISCARD_LIMIT ? MHD_NO : MHD_YES;
+        }
         ag_status s;
         if (r->route->body == AG_BODY_UPLOAD)
             s = ag_upload_feed(r->upload, upload_data, n, &r->body_err);
@@ -138,9 +147,8 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
             s = AG_OK; /* a body where none is used is ignored */
         if (s != AG_OK) {
             r->body_status = s;
-            /* Answer now: the client learns of a too-large body without sending it all;
-             * libmicrohttpd closes the connection after this reply. */
-            return ag_reply_problem(r, s, &r->body_err);
+            ag_upload_free(r->upload); /* the spooled part goes at once */
+            r->upload = NULL;
         }
         return MHD_YES;
     }

@@ -34,6 +34,7 @@ typedef struct ag_request {
     struct ag_upload *upload; /* spooled uploads */
     ag_status body_status;   /* set when receiving the body failed */
     ag_error body_err;
+    size_t discarded;        /* bytes of a rejected body dropped so far */
     /* headers for the reply, added by handlers */
     struct {
         char name[32];

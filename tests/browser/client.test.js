@@ -1,5 +1,6 @@
 // The web client against a real archgramd in Debian's chromium: import and draw a model,
-// pick a component, and two people editing the same model live.
+// pick a component, import errors, two people editing one model live, a lost connection,
+// and the paged model list.
 import assert from 'node:assert/strict';
 import { readFile, writeFile } from 'node:fs/promises';
 import path from 'node:path';
@@ -13,7 +14,6 @@ const WAIT = { timeout: 20000 };
 
 let daemon;
 let browser;
-const pages = [];
 
 before(async () => {
   daemon = await startDaemon();
@@ -25,11 +25,7 @@ after(async () => {
   if (daemon) await daemon.stop();
 });
 
-async function newPage(opts) {
-  const page = await openPage(browser, opts);
-  pages.push(page);
-  return page;
-}
+const newPage = (opts) => openPage(browser, opts); // contexts close with the browser
 
 function assertNoProblems(...list) {
   for (const page of list) assert.deepEqual(page.problems, [], 'the page reported errors');
@@ -81,10 +77,17 @@ test('import through the page, draw the model and pick a component', async () =>
   const match = /component (\d+) · group (\S+)/.exec(await picked.textContent());
   assert.ok(match, await picked.textContent());
   assert.ok(['block', 'annex'].includes(match[2]), `group ${match[2]}`);
+  // The picked component is drawn highlighted.
+  const colourDistance = (a, b) => Math.max(...a.map((v, i) => Math.abs(v - b[i])));
+  const before = view.pixel(view.inside);
+  const highlighted = (await readCanvas(page)).pixel(view.inside);
+  assert.ok(colourDistance(before, highlighted) > 40, `pick did not recolour: ${before} → ${highlighted}`);
 
   // Clicking empty space (a background pixel) clears the pick.
   await view.canvas.click({ position: view.outside });
   await page.waitForFunction(() => !/component \d+/.test(document.querySelector('[data-testid="picked-component"]').textContent), null, WAIT);
+  const restored = (await readCanvas(page)).pixel(view.inside);
+  assert.ok(colourDistance(before, restored) <= 2, `colour not restored: ${before} → ${restored}`);
   assertNoProblems(page);
 });
 
@@ -150,4 +153,56 @@ test('two people in one model: presence and a live rename', async () => {
   const component = /component (\d+)/.exec(await textOf(alice, 'picked-component'))[1];
   await bob.getByTestId('peers').filter({ hasText: `component ${component}` }).waitFor(WAIT);
   assertNoProblems(alice, bob);
+});
+
+test('a lost connection is shown, and the page resumes and catches up', async () => {
+  const id = await importOverRest('Depot');
+  const page = await newPage({ user: 'carol' });
+  await page.goto(`${daemon.url}#model=${id}`);
+  await page.getByTestId('model-name').filter({ hasText: 'Depot' }).waitFor(WAIT);
+  await page.getByTestId('connection').filter({ hasText: 'live' }).waitFor(WAIT);
+  const v0 = await versionOf(page);
+
+  await daemon.stopProcess();
+  const banner = page.getByTestId('error');
+  await banner.filter({ hasText: 'connection lost' }).waitFor({ state: 'visible', ...WAIT });
+  await daemon.restart();
+
+  // An edit made over REST while the page is away (or just back) reaches it.
+  const res = await fetch(`${daemon.url}api/v1/models/${id}`, {
+    method: 'PATCH',
+    headers: { 'Content-Type': 'application/json', 'If-Match': `"${v0}"`, 'X-Archgram-User': 'dave' },
+    body: JSON.stringify({ name: 'Depot East' }),
+  });
+  assert.equal(res.status, 200, await res.clone().text());
+  await page.getByTestId('connection').filter({ hasText: 'live' }).waitFor(WAIT);
+  await page.getByTestId('model-name').filter({ hasText: 'Depot East' }).waitFor(WAIT);
+  assert.equal(await versionOf(page), v0 + 1);
+  await page.getByTestId('history').filter({ hasText: 'dave' }).waitFor(WAIT);
+  // A failed reconnect attempt logs a websocket error in the console; nothing else may.
+  const rest = page.problems.filter((p) => !/WebSocket connection to .* failed|ERR_CONNECTION_REFUSED/.test(p));
+  assert.deepEqual(rest, [], 'the page reported errors');
+});
+
+test('the model list pages: load more fetches the rest', async () => {
+  const listed = async () => (await (await fetch(`${daemon.url}api/v1/models?page_size=200`)).json()).items.length;
+  // The page shows 50 at a time; make sure there are more than that.
+  const have = await listed();
+  const names = Array.from({ length: Math.max(0, 53 - have) }, (_, i) => `Block ${i + 1}`);
+  for (let i = 0; i < names.length; i += 8) await Promise.all(names.slice(i, i + 8).map(importOverRest));
+  const total = await listed();
+  assert.ok(total > 50);
+
+  const page = await newPage({ user: 'erin' });
+  await page.goto(daemon.url);
+  const items = page.getByTestId('model-item');
+  await page.getByTestId('load-more').waitFor({ state: 'visible', ...WAIT });
+  assert.equal(await items.count(), 50);
+  await page.getByTestId('load-more').click();
+  await page.getByTestId('load-more').waitFor({ state: 'hidden', ...WAIT });
+  assert.equal(await items.count(), total);
+  // Ids ascend down the list, no model twice.
+  const ids = await items.evaluateAll((els) => els.map((e) => Number(e.dataset.id)));
+  assert.deepEqual(ids, [...new Set(ids)].sort((a, b) => a - b));
+  assertNoProblems(page);
 });

@@ -68,6 +68,47 @@ function launch(port, db) {
   });
 }
 
+// A handle on a running daemon; restart() brings it back on the same ports and database.
+function handle(port, dir, first) {
+  let r = first;
+  const stopProcess = async () => {
+    const { child } = r;
+    if (child.exitCode === null && child.signalCode === null) {
+      const exited = new Promise((resolve) => child.once('exit', resolve));
+      child.kill('SIGTERM');
+      const killer = setTimeout(() => child.kill('SIGKILL'), 5000);
+      await exited;
+      clearTimeout(killer);
+    }
+  };
+  return {
+    url: `http://127.0.0.1:${port}/`,
+    port,
+    dir,
+    log: () => r.log(),
+    stopProcess,
+    async restart() {
+      await stopProcess();
+      let last = '';
+      for (let attempt = 0; attempt < 20; attempt++) {
+        const next = await launch(port, path.join(dir, 't.db'));
+        if (next.ok) {
+          r = next;
+          return;
+        }
+        last = next.reason;
+        if (!next.inUse) break;
+        await new Promise((res) => setTimeout(res, 250));
+      }
+      throw new Error(`archgramd did not restart: ${last}`);
+    },
+    async stop() {
+      await stopProcess();
+      await rm(dir, { recursive: true, force: true });
+    },
+  };
+}
+
 export async function startDaemon() {
   if (!existsSync(BINARY)) throw new Error(`${BINARY} is missing: run \`make build/archgramd web\``);
   if (!existsSync(path.join(WEB, 'app.js'))) throw new Error(`${WEB}/app.js is missing: run \`make web\``);
@@ -76,25 +117,7 @@ export async function startDaemon() {
   for (let attempt = 0; attempt < 5; attempt++) {
     const port = await freePortPair();
     const r = await launch(port, path.join(dir, 't.db'));
-    if (r.ok) {
-      const { child } = r;
-      const exited = new Promise((resolve) => child.once('exit', resolve));
-      return {
-        url: `http://127.0.0.1:${port}/`,
-        port,
-        dir,
-        log: r.log,
-        async stop() {
-          if (child.exitCode === null && child.signalCode === null) {
-            child.kill('SIGTERM');
-            const killer = setTimeout(() => child.kill('SIGKILL'), 5000);
-            await exited;
-            clearTimeout(killer);
-          }
-          await rm(dir, { recursive: true, force: true });
-        },
-      };
-    }
+    if (r.ok) return handle(port, dir, r);
     last = r.reason;
     if (!r.inUse) break;
   }

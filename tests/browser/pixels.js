@@ -56,8 +56,13 @@ export async function readCanvas(page) {
       }
     }
   }
+  const pixel = ({ x, y }) => {
+    const o = (y * width + x) * 4;
+    return [data[o], data[o + 1], data[o + 2]];
+  };
   return {
     canvas,
+    pixel,
     width,
     height,
     background: bg,

@@ -11,7 +11,8 @@ import { fileURLToPath } from 'node:url';
 import WebSocket from 'ws';
 
 export const REPO = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
-export const DAEMON = path.join(REPO, 'build', 'archgramd');
+// ARCHGRAMD overrides the binary (e.g. a sanitizer build kept outside the checkout).
+export const DAEMON = process.env.ARCHGRAMD ? path.resolve(process.env.ARCHGRAMD) : path.join(REPO, 'build', 'archgramd');
 export const DATA = path.join(REPO, 'tests', 'data', 'http');
 export const PROBLEM = 'urn:archgram:problem:';
 
@@ -137,6 +138,9 @@ class Daemon {
     }
     assert.equal(r.signal, null, `archgramd killed by ${r.signal}\nstderr:\n${this.err}`);
     assert.equal(r.code, 0, `archgramd exit code ${r.code}\nstderr:\n${this.err}`);
+    // A sanitizer build (ARCHGRAMD=...) reports undefined behaviour without failing the exit.
+    assert.doesNotMatch(this.err, /runtime error:|(ERROR|WARNING): (Address|Leak|Thread)Sanitizer/,
+      `sanitizer report from archgramd:\n${this.err}`);
     return { ...r, ms: Date.now() - t0 };
   }
 

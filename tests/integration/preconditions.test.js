@@ -39,6 +39,19 @@ describe('ETag and If-Match', () => {
     m = g.json;
   });
 
+  it('concurrent PATCHes on the same version: exactly one wins', async () => {
+    const v = m.version;
+    const rs = await Promise.all([...Array(10).keys()].map((i) =>
+      http(d, 'PATCH', m.href, { body: { name: `racer ${i}` }, headers: { 'If-Match': `"${v}"` } })));
+    const ok = rs.filter((r) => r.status === 200);
+    assert.equal(ok.length, 1, rs.map((r) => r.status).join(' '));
+    assert.ok(rs.every((r) => r.status === 200 || r.status === 412), rs.map((r) => r.status).join(' '));
+    const g = await http(d, 'GET', m.href);
+    assert.equal(g.json.version, v + 1);
+    assert.equal(g.json.name, ok[0].json.name);
+    m = g.json;
+  });
+
   it('PATCH with an invalid name is 400 and changes nothing', async () => {
     for (const body of [{ name: '' }, { name: 'x'.repeat(201) }, { name: 5 }, {}]) {
       assertProblem(await http(d, 'PATCH', m.href, { body, headers: { 'If-Match': `"${m.version}"` } }),

@@ -55,9 +55,30 @@ function checkGlb(buf, m, glbMin, glbMax) {
       const count = prim.indices !== undefined ? j.accessors[prim.indices].count : pos.count;
       assert.equal(count % 3, 0);
       t += count / 3;
+      // The BIN chunk's floats must agree with the accessor's declared min/max.
+      assert.equal(pos.componentType, 5126, 'float positions');
+      const view = j.bufferViews[pos.bufferView];
+      const at = (view.byteOffset ?? 0) + (pos.byteOffset ?? 0);
+      const stride = view.byteStride ?? 12;
+      const lo = [Infinity, Infinity, Infinity];
+      const hi = [-Infinity, -Infinity, -Infinity];
+      for (let v = 0; v < pos.count; v++) {
+        for (let k = 0; k < 3; k++) {
+          const x = g.bin.readFloatLE(at + v * stride + 4 * k);
+          lo[k] = Math.min(lo[k], x);
+          hi[k] = Math.max(hi[k], x);
+        }
+      }
+      near(lo, pos.min, 'POSITION min vs BIN data');
+      near(hi, pos.max, 'POSITION max vs BIN data');
+      // Nodes may carry a translation (positions stored relative to a centre).
+      const tr = n.translation ?? [0, 0, 0];
+      assert.equal(n.rotation, undefined, 'no node rotation expected');
+      assert.equal(n.scale, undefined, 'no node scale expected');
+      assert.equal(n.matrix, undefined, 'no node matrix expected');
       for (let k = 0; k < 3; k++) {
-        min[k] = Math.min(min[k], pos.min[k]);
-        max[k] = Math.max(max[k], pos.max[k]);
+        min[k] = Math.min(min[k], pos.min[k] + tr[k]);
+        max[k] = Math.max(max[k], pos.max[k] + tr[k]);
       }
     }
     triangles += t;
@@ -96,13 +117,13 @@ describe('upload and read back', () => {
     checkModel(m, done.result.model, 'block z');
     // z up: the file's coordinates are kept.
     near(m.stats.bounds.min, [0, 0, 0], 'bounds.min');
-    near(m.stats.bounds.max, [4, 3, 6], 'bounds.max');
+    near(m.stats.bounds.max, [4, 5, 6], 'bounds.max');
     assert.equal(r.headers.get('etag'), `"${m.version}"`);
 
     const g = await http(d, 'GET', m.mesh);
     assert.equal(g.status, 200);
     assert.match(g.headers.get('content-type'), /^model\/gltf-binary/);
-    checkGlb(g.body, m, [0, 0, -3], [4, 6, 0]);
+    checkGlb(g.body, m, [0, 0, -5], [4, 6, 0]);
     const etag = g.headers.get('etag');
     assert.ok(etag, 'mesh.glb has an ETag');
 

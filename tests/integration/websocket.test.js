@@ -96,6 +96,20 @@ describe('websocket rooms and ops', () => {
     assert.equal(m.version, version);
   });
 
+  it('two ops on the same base at once: one ack, one stale nack', async () => {
+    A.send({ type: 'op', base: version, cid: 'race-a', op: { kind: 'note', text: 'a' } });
+    B.send({ type: 'op', base: version, cid: 'race-b', op: { kind: 'note', text: 'b' } });
+    const ra = await A.next((m) => (m.type === 'ack' || m.type === 'nack') && m.cid === 'race-a');
+    const rb = await B.next((m) => (m.type === 'ack' || m.type === 'nack') && m.cid === 'race-b');
+    assert.deepEqual([ra.type, rb.type].sort(), ['ack', 'nack'], JSON.stringify([ra, rb]));
+    const [win, lose, other] = ra.type === 'ack' ? [ra, rb, B] : [rb, ra, A];
+    assert.equal(win.version, version + 1);
+    assert.equal(lose.version, version + 1);
+    assert.equal(lose.problem.type, `${PROBLEM}stale`);
+    await other.next(isOp(win.cid));
+    version += 1;
+  });
+
   it('an invalid op is nacked', async () => {
     B.send({ type: 'op', base: version, cid: 'b-2', op: { kind: 'rename', name: '' } });
     const nack = await B.next(isNack('b-2'));
@@ -196,7 +210,7 @@ describe('websocket rooms and ops', () => {
       headers: { 'If-Match': `"${version}"` },
     });
     assert.equal(n.status, 200, n.text);
-    assert.deepEqual(n.json, { version: version + 1 });
+    assert.equal(n.json.version, version + 1, n.text);
     version += 1;
     for (const c of [A, B]) {
       const op = await c.next(isOp('rest-1'));

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "core/mesh.h"
+#include "io/import.h"
 #include "io/obj.h"
 
 static ag_status parse_opt(const char *text, const ag_obj_read_options *o, ag_mesh **m,
@@ -169,6 +170,7 @@ static void test_lexical_variety(void **state)
                        "usemtl red\n"
                        "s off\n"
                        "l 1 2\np 3\nvp 0.5\ncstype bezier\n" /* unknown/ignored statements */
+                       "Größe 12 m\n"
                        "f 1 2 \\\n 3\n"
                        "f 1 3 4   \t\n"
                        "# the end without newline\nf 2 3 4";
@@ -241,6 +243,7 @@ static void test_errors(void **state)
     assert_int_equal(e.element, 2);
     assert_non_null(strstr(e.text, "NUL"));
     expect_error("v 0 0 0\n\x89PNG\x1a\x02\n", AG_ERR_PARSE, 2, "not an OBJ statement");
+    expect_error("v 0 0 0\nusemtl a\x01" "b\n", AG_ERR_PARSE, 2, "binary");
     /* No geometry */
     expect_error("", AG_ERR_EMPTY, -1, NULL);
     expect_error("# only a comment\n\n", AG_ERR_EMPTY, -1, NULL);
@@ -460,6 +463,90 @@ static void test_shared_ingolstadt_counts(void **state)
     assert_true(n > 0);
 }
 
+/* The 0 A.D. meshes: one `o` each, so one component; splitting gives the connected
+ * piece counts listed in the data set's README table. */
+static void test_shared_0ad_connected_pieces(void **state)
+{
+    const char *dir = AG_REPO_DIR "/../shared/data/meshes_0ad";
+    char path[1024];
+    snprintf(path, sizeof path, "%s/README.md", dir);
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        printf("skipping: %s is absent\n", path);
+        skip();
+    }
+    char line[512];
+    int n = 0;
+    while (fgets(line, sizeof line, f)) {
+        char file[128];
+        size_t nv, nt, nc;
+        if (sscanf(line, "| %127[^ |] | %zu | %zu | %zu |", file, &nv, &nt, &nc) != 4)
+            continue;
+        snprintf(path, sizeof path, "%s/%s", dir, file);
+        ag_mesh *m = NULL;
+        ag_error e;
+        ag_status st = ag_obj_read_file(path, NULL, &m, &e);
+        if (st)
+            print_error("%s: %s\n", path, e.text);
+        assert_int_equal(st, AG_OK);
+        assert_int_equal(m->nverts, nv);
+        assert_int_equal(m->ntris, nt);
+        assert_int_equal(m->ncomponents, 1);
+        assert_int_equal(ag_mesh_split_connected(m), AG_OK);
+        assert_int_equal(m->ncomponents, nc);
+        assert_int_equal(m->component_group[nc - 1], 0);
+        ag_mesh_free(m);
+        n++;
+    }
+    fclose(f);
+    assert_true(n > 0);
+}
+
+/* OBJ detection and the import entry point (import.h). */
+static void test_sniff_and_import(void **state)
+{
+    const char *obj = "# exported\n\nmtllib x.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    const uint8_t *d = (const uint8_t *)obj;
+    size_t n = strlen(obj);
+    assert_int_equal(ag_format_sniff(d, n, NULL), AG_FORMAT_OBJ);
+    assert_int_equal(ag_format_sniff(d, n, "x.bin"), AG_FORMAT_OBJ);
+    assert_int_equal(ag_format_sniff((const uint8_t *)"hello world\n", 12, NULL),
+                     AG_FORMAT_UNKNOWN);
+    assert_int_equal(ag_format_sniff((const uint8_t *)"hello world\n", 12, "a/B.OBJ"),
+                     AG_FORMAT_OBJ);
+    assert_int_equal(ag_format_sniff((const uint8_t *)"ply\nformat ascii 1.0\n", 21, "x.obj"),
+                     AG_FORMAT_PLY);
+    assert_int_equal(ag_format_sniff((const uint8_t *)"glTF\2\0\0\0", 8, NULL), AG_FORMAT_GLB);
+    assert_int_equal(ag_format_sniff(NULL, 0, "dir.obj/file"), AG_FORMAT_UNKNOWN);
+    assert_int_equal(ag_format_from_name("OBJ"), AG_FORMAT_OBJ);
+    assert_int_equal(ag_format_from_name(".obj"), AG_FORMAT_OBJ);
+    assert_int_equal(ag_format_from_name("xyz"), AG_FORMAT_UNKNOWN);
+    assert_string_equal(ag_format_name(AG_FORMAT_OBJ), "obj");
+
+    ag_mesh *m = NULL;
+    ag_error e;
+    ag_import_options o = {.up = AG_UP_Z};
+    assert_int_equal(ag_import_buffer(d, n, AG_FORMAT_UNKNOWN, &o, &m, &e), AG_OK);
+    assert_int_equal(m->ntris, 1);
+    assert_true(m->pos[7] == 1); /* z-up kept: (0, 1, 0) */
+    ag_mesh_free(m);
+    assert_int_equal(ag_import_buffer(d, n, AG_FORMAT_OBJ, NULL, &m, &e), AG_OK);
+    assert_true(m->pos[8] == 1); /* default y-up: (0, 1, 0) → (0, 0, 1) */
+    ag_mesh_free(m);
+    m = (ag_mesh *)1;
+    assert_int_equal(ag_import_buffer(d, n, AG_FORMAT_PLY, NULL, &m, &e), AG_ERR_UNSUPPORTED);
+    assert_null(m);
+    assert_non_null(strstr(e.text, "ply"));
+    assert_int_equal(
+        ag_import_buffer((const uint8_t *)"\x01\x02", 2, AG_FORMAT_UNKNOWN, NULL, &m, &e),
+        AG_ERR_UNSUPPORTED);
+    /* A parse error passes through with its line. */
+    assert_int_equal(ag_import_buffer((const uint8_t *)"v 0 0 0\nf 1 2 3\n", 16, AG_FORMAT_OBJ,
+                                      NULL, &m, &e),
+                     AG_ERR_PARSE);
+    assert_int_equal(e.element, 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -479,6 +566,8 @@ int main(void)
         cmocka_unit_test(test_write_read_round_trip),
         cmocka_unit_test(test_fixture_files),
         cmocka_unit_test(test_shared_ingolstadt_counts),
+        cmocka_unit_test(test_shared_0ad_connected_pieces),
+        cmocka_unit_test(test_sniff_and_import),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

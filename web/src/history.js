@@ -1,6 +1,8 @@
 // The open model's op log, newest first, and the note box.
 import { el, timeAgo } from './dom.js';
 
+const SHOWN = 200; // newest entries listed; older ones stay in the log
+
 function summary(op) {
   switch (op?.kind) {
     case 'rename':
@@ -41,7 +43,8 @@ export class HistoryPanel {
   render() {
     const ed = this.editor;
     this.form.hidden = !ed.model;
-    const ops = ed.history().reverse();
+    const all = ed.history();
+    const ops = all.slice(-SHOWN).reverse();
     if (!ed.model) {
       this.list.replaceChildren();
       return;
@@ -50,6 +53,7 @@ export class HistoryPanel {
       this.list.replaceChildren(el('li.empty', {}, 'No edits yet'));
       return;
     }
+    const older = all.length - ops.length;
     this.list.replaceChildren(
       ...ops.map((e) =>
         el(
@@ -62,6 +66,7 @@ export class HistoryPanel {
           el('span.op-time', {}, e.at ? timeAgo(e.at) : ''),
         ),
       ),
+      older > 0 ? el('li.empty', {}, `${older} older edits not shown`) : '',
     );
   }
 }

@@ -25,7 +25,6 @@ export class Live {
     this.presenceTimer = null;
     this.presenceDue = false;
     this.lastPresence = 0;
-    this.closedOnPurpose = false;
   }
 
   get open() {
@@ -44,8 +43,13 @@ export class Live {
 
   async openSocket() {
     clearTimeout(this.retryTimer);
-    this.closedOnPurpose = false;
-    const health = await this.api.getHealth();
+    let health;
+    try {
+      health = await this.api.getHealth();
+    } catch (err) {
+      this.lost(); // the server itself is away: keep retrying
+      throw err;
+    }
     const port = health.ws_port;
     if (!port) throw new Error('the server announced no websocket port');
     const scheme = location.protocol === 'https:' ? 'wss' : 'ws';
@@ -84,10 +88,10 @@ export class Live {
 
   // After a loss: tell the person once, then retry with growing pauses.
   lost() {
-    if (this.closedOnPurpose) return;
     const first = this.attempt === 0;
     const delay = BACKOFF_MS[Math.min(this.attempt, BACKOFF_MS.length - 1)];
     this.attempt += 1;
+    this.api.health = null; // a restarted server may announce another websocket port
     this.editor.setConnection('lost');
     if (first) {
       this.editor.fail({
@@ -111,14 +115,6 @@ export class Live {
     }, delay);
   }
 
-  close() {
-    this.closedOnPurpose = true;
-    clearTimeout(this.retryTimer);
-    if (this.ws) this.ws.close();
-    this.ws = null;
-    this.editor.setConnection('offline');
-  }
-
   // Re-enters the room and re-subscribes to jobs after (re)connecting.
   resume() {
     if (this.room !== null) this.hello();
@@ -134,13 +130,9 @@ export class Live {
   // --- room ---------------------------------------------------------------------------------
   async join(modelId) {
     this.room = modelId;
-    await this.connect();
-    // connect() says hello through resume() when the socket was new; say it again otherwise.
-    this.hello();
-  }
-
-  leave() {
-    this.room = null;
+    // A socket being opened says hello itself once open (resume()).
+    if (this.open) this.hello();
+    else await this.connect();
   }
 
   hello() {
@@ -221,9 +213,11 @@ export class Live {
     switch (msg.type) {
       case 'welcome':
         if (!inRoom || msg.model !== ed.model.id) return;
-        this.applyOps(msg.ops || []);
-        ed.setVersion(msg.version);
         ed.setPeers(msg.peers);
+        this.applyOps(msg.ops || []);
+        // A long absence is replayed in slices: ask for the next one from where we are now.
+        if (msg.more) this.hello();
+        else ed.setVersion(msg.version);
         this.presence();
         break;
       case 'join':

@@ -105,7 +105,7 @@ export class ModelsPanel {
     }
     this.job.hidden = false;
     const p = Math.max(0, Math.min(1, job.progress ?? 0));
-    const done = job.status === 'succeeded';
+    const done = ['succeeded', 'failed', 'cancelled'].includes(job.status);
     this.bar.style.width = `${Math.round((done ? 1 : p) * 100)}%`;
     this.job.className = `job ${job.status}`;
     this.job.dataset.status = job.status;

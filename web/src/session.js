@@ -23,13 +23,15 @@ export class Session {
   async open(id) {
     const ed = this.editor;
     if (ed.model && ed.model.id === id) return;
+    this.wanted = id; // the latest click wins over slower earlier ones
     try {
       const model = await this.api.getModel(id);
+      if (this.wanted !== id) return;
       ed.upsertModel(model);
       ed.openModel(model);
       if (location.hash !== `#model=${id}`) history.replaceState(null, '', `#model=${id}`);
       const [ops] = await Promise.all([
-        this.api.getOps(id, 0).catch((err) => {
+        this.loadOps(id, model.version).catch((err) => {
           ed.fail(err);
           return { items: [] };
         }),
@@ -44,6 +46,20 @@ export class Session {
     } catch (err) {
       ed.fail(err);
     }
+  }
+
+  // The op log up to at least `version`, read in as many slices as the server cuts it into.
+  async loadOps(id, version) {
+    const items = [];
+    let since = 0;
+    for (;;) {
+      const page = (await this.api.getOps(id, since)).items || [];
+      items.push(...page);
+      const last = page.length ? page[page.length - 1].version : since;
+      if (!page.length || last >= version || last <= since) break;
+      since = last;
+    }
+    return { items };
   }
 
   async rename(name) {

@@ -18,6 +18,10 @@ export class Toast {
     container.append(this.banner, this.notice);
     editor.signals.problem.add((p) => this.showProblem(p));
     editor.signals.notice.add((t) => this.showNotice(t));
+    editor.signals.connectionChanged.add((state) => {
+      // a lost connection that came back is no longer a problem
+      if (state === 'online' && this.problemType === 'urn:archgram:problem:connection') this.banner.hidden = true;
+    });
   }
 
   showProblem(p) {
@@ -29,6 +33,7 @@ export class Toast {
       p.status ? el('span.status', {}, ` ${p.status}`) : '',
       p.detail ? el('div.detail', {}, `${p.detail}${where}`) : where ? el('div.detail', {}, where) : '',
     );
+    this.problemType = p.type;
     this.banner.title = p.type || '';
     this.banner.hidden = false;
     this.banner.classList.remove('flash');

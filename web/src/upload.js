@@ -2,7 +2,6 @@
 // when the live connection is unavailable), then list and open the new model.
 const POLL_MS = 300;
 const POLL_BACKSTOP_MS = 2000; // also poll, slowly, while the websocket reports
-const FORMATS = new Set(['obj', 'ply', 'glb', 'gltf', 'fbx', 'dae', 'stl', '3ds', 'las', 'laz']);
 
 export function formatOf(fileName) {
   const dot = fileName.lastIndexOf('.');
@@ -24,7 +23,6 @@ export class Upload {
       ed.fail({ title: 'Unknown file type', detail: `${file.name} has no extension to tell its format` });
       return;
     }
-    if (!FORMATS.has(format)) console.info(`archgram: letting the server judge format "${format}"`);
     const name = file.name.replace(/\.[^.]*$/, '') || file.name;
     ed.setJob({ status: 'uploading', progress: 0, stage: 'upload', name: file.name });
     let job;

@@ -146,9 +146,10 @@ export class Viewport {
       const owner = componentOwner(o);
       const component = owner ? owner.userData.component : -1;
       const group = owner ? owner.userData.group ?? null : null;
-      // One palette colour per group (or per component when ungrouped), own material per
-      // mesh so a highlight touches only the picked component.
-      const key = group !== null ? `g:${group}` : `c:${component}`;
+      // One palette colour per kind of group ("window_3" and "window_7" are both windows),
+      // or per component when ungrouped; own material per mesh so a highlight touches only
+      // the picked component.
+      const key = group !== null ? `g:${groupKind(group)}` : `c:${component}`;
       if (!groupColour.has(key)) groupColour.set(key, PALETTE[groupColour.size % PALETTE.length]);
       for (const m of [].concat(o.material)) m.dispose();
       o.material = new THREE.MeshStandardMaterial({
@@ -254,6 +255,11 @@ function componentOwner(o) {
     if (typeof x.userData?.component === 'number') return x;
   }
   return null;
+}
+
+function groupKind(name) {
+  const m = /^[A-Za-z]+/.exec(String(name));
+  return m ? m[0].toLowerCase() : String(name);
 }
 
 function niceSize(x) {

@@ -1,0 +1,126 @@
+/* archgram — the command-line tool: one dispatcher, one file per subcommand. */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli/commands.h"
+#include "io/import.h"
+
+#define ARCHGRAM_VERSION "0.1.0"
+
+static const struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *usage;
+} commands[] = {
+    {"info", ag_cli_info, "info FILE [--up y|z] [--json]   counts, groups and bounds of a mesh"},
+    {"convert", ag_cli_convert, "convert IN OUT [--up y|z]       convert a mesh (OUT: .obj or .glb)"},
+};
+
+#define NCOMMANDS (sizeof commands / sizeof commands[0])
+
+static void usage(FILE *f)
+{
+    fputs("usage: archgram COMMAND [ARGS...]\n"
+          "       archgram --help | --version\n\ncommands:\n",
+          f);
+    for (size_t i = 0; i < NCOMMANDS; i++)
+        fprintf(f, "  %s\n", commands[i].usage);
+    fputs("\n--up names the input's up axis (default y, OBJ's convention); archgram works "
+          "z-up.\n",
+          f);
+}
+
+void ag_cli_report(const char *file, const ag_error *err)
+{
+    const char *text = err->text[0] ? err->text : ag_status_message(err->code);
+    if (err->code == AG_ERR_PARSE && err->element > 0) {
+        /* GCC style file:line: — drop the reader's own "line N: " prefix. */
+        char prefix[32];
+        int n = snprintf(prefix, sizeof prefix, "line %ld: ", err->element);
+        if (n > 0 && strncmp(text, prefix, (size_t)n) == 0)
+            text += n;
+        fprintf(stderr, "archgram: %s:%ld: %s\n", file, err->element, text);
+    } else {
+        fprintf(stderr, "archgram: %s: %s\n", file, text);
+    }
+}
+
+int ag_cli_parse_up(const char *value, ag_up_axis *up)
+{
+    if (value && (!strcmp(value, "y") || !strcmp(value, "Y")))
+        *up = AG_UP_Y;
+    else if (value && (!strcmp(value, "z") || !strcmp(value, "Z")))
+        *up = AG_UP_Z;
+    else
+        return -1;
+    return 0;
+}
+
+int ag_cli_load_mesh(const char *path, ag_up_axis up, ag_mesh **out, size_t *bytes)
+{
+    ag_error err;
+    ag_error_clear(&err);
+    *out = NULL;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    struct stat sb;
+    if (fd < 0 || fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        int e = errno;
+        if (fd >= 0)
+            close(fd);
+        fprintf(stderr, "archgram: %s: %s\n", path,
+                fd < 0 || e ? strerror(e) : "not a regular file");
+        return 1;
+    }
+    *bytes = (size_t)sb.st_size;
+    const uint8_t *data = (const uint8_t *)"";
+    void *map = NULL;
+    if (sb.st_size > 0) {
+        map = mmap(NULL, (size_t)sb.st_size, PROT_READ, MAP_PRIVATE, fd, 0);
+        if (map == MAP_FAILED) {
+            fprintf(stderr, "archgram: %s: %s\n", path, strerror(errno));
+            close(fd);
+            return 1;
+        }
+        data = map;
+    }
+    close(fd);
+    ag_format fmt = ag_format_sniff(data, *bytes, path);
+    ag_import_options opt = {.up = up};
+    ag_status st = fmt == AG_FORMAT_UNKNOWN && *bytes == 0
+                       ? ag_error_set(&err, AG_ERR_EMPTY, 0, "empty file")
+                       : ag_import_buffer(data, *bytes, fmt, &opt, out, &err);
+    if (map)
+        munmap(map, (size_t)sb.st_size);
+    if (st != AG_OK) {
+        ag_cli_report(path, &err);
+        return 1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        puts("archgram " ARCHGRAM_VERSION);
+        return 0;
+    }
+    for (size_t i = 0; i < NCOMMANDS; i++)
+        if (!strcmp(argv[1], commands[i].name))
+            return commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "archgram: unknown command '%s' (see archgram --help)\n", argv[1]);
+    return 2;
+}

@@ -1,0 +1,1049 @@
+#include "skeleton.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "eventq.h"
+#include "tolerance.h"
+
+#define NONE UINT32_MAX
+
+typedef struct {
+    double nx, ny; /* inward unit normal; direction is (ny, -nx) */
+    double c, s;   /* the edge's line at height z: n . p = c + s z */
+    uint32_t start, end;
+    uint32_t face;
+    int32_t loop, edge, profile, seg;
+    uint32_t ver;
+    uint8_t alive;
+} sk_edge;
+
+typedef struct {
+    double x, y, z; /* where the corner was made */
+    double vx, vy;  /* plan velocity per metre of height */
+    uint32_t in, out;
+    uint32_t vert; /* shell vertex where it was made */
+    uint32_t stamp;
+    uint8_t alive, settled;
+} sk_corner;
+
+typedef struct {
+    const ag_plan *plan;
+    ag_shell *shell;
+    ag_eventq q;
+    sk_edge *e;
+    size_t ne, cap_e;
+    sk_corner *c;
+    size_t nc, cap_c;
+    uint32_t *live_c; /* corners that may still split edges (lazily compacted) */
+    size_t nlive_c, cap_live_c;
+    uint32_t *live_e;
+    size_t nlive_e, cap_live_e;
+    uint32_t *touched; /* corners made while handling one event */
+    size_t ntouched, cap_touched;
+    uint32_t stamp;
+    double ox, oy; /* local origin */
+    double d1, d2, d3;
+    double zcur;
+    ag_status st;
+    ag_error *err;
+    ag_skeleton_stats stats;
+} sk;
+
+static int grow(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap)
+        return 1;
+    size_t c = *cap ? *cap : 64;
+    while (c < need)
+        c *= 2;
+    void *n = realloc(*p, c * elem);
+    if (!n)
+        return 0;
+    *p = n;
+    *cap = c;
+    return 1;
+}
+
+static void fail(sk *S, ag_status st)
+{
+    if (S->st == AG_OK)
+        S->st = st;
+}
+
+static inline double edx(const sk_edge *e) { return e->ny; }
+static inline double edy(const sk_edge *e) { return -e->nx; }
+
+static inline void cpos(const sk_corner *c, double z, double *x, double *y)
+{
+    *x = c->x + c->vx * (z - c->z);
+    *y = c->y + c->vy * (z - c->z);
+}
+
+static uint32_t vertex(sk *S, double x, double y, double z)
+{
+    uint32_t id = 0;
+    if (ag_shell_add_vertex(S->shell, x + S->ox, y + S->oy, z, &id) != AG_OK)
+        fail(S, AG_ERR_NOMEM);
+    return id;
+}
+
+static void seg(sk *S, uint32_t face, uint32_t a, uint32_t b)
+{
+    if (ag_shell_add_segment(S->shell, face, a, b) != AG_OK)
+        fail(S, AG_ERR_NOMEM);
+}
+
+static uint32_t new_face(sk *S, const sk_edge *e)
+{
+    ag_shell_face f = {AG_SHELL_FACE_SIDE, e->loop, e->edge, e->profile, e->seg, 0, 0};
+    uint32_t id = 0;
+    if (ag_shell_add_face(S->shell, &f, &id) != AG_OK)
+        fail(S, AG_ERR_NOMEM);
+    return id;
+}
+
+static uint32_t add_edge(sk *S)
+{
+    if (!grow((void **)&S->e, &S->cap_e, S->ne + 1, sizeof(sk_edge)) ||
+        !grow((void **)&S->live_e, &S->cap_live_e, S->nlive_e + 1, sizeof(uint32_t))) {
+        fail(S, AG_ERR_NOMEM);
+        return NONE;
+    }
+    memset(&S->e[S->ne], 0, sizeof(sk_edge));
+    S->e[S->ne].alive = 1;
+    S->e[S->ne].start = S->e[S->ne].end = NONE;
+    S->live_e[S->nlive_e++] = (uint32_t)S->ne;
+    return (uint32_t)S->ne++;
+}
+
+/* A corner joining edge `in` to edge `out` at (x, y, z); velocity is set by settle(). */
+static uint32_t add_corner(sk *S, uint32_t in, uint32_t out, double x, double y, double z,
+                           uint32_t vert)
+{
+    if (!grow((void **)&S->c, &S->cap_c, S->nc + 1, sizeof(sk_corner)) ||
+        !grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1, sizeof(uint32_t)) ||
+        !grow((void **)&S->live_c, &S->cap_live_c, S->nlive_c + 1, sizeof(uint32_t))) {
+        fail(S, AG_ERR_NOMEM);
+        return NONE;
+    }
+    uint32_t k = (uint32_t)S->nc++;
+    sk_corner *c = &S->c[k];
+    memset(c, 0, sizeof *c);
+    c->x = x;
+    c->y = y;
+    c->z = z;
+    c->in = in;
+    c->out = out;
+    c->vert = vert;
+    c->alive = 1;
+    S->e[in].end = k;
+    S->e[in].ver++;
+    S->e[out].start = k;
+    S->e[out].ver++;
+    S->touched[S->ntouched++] = k;
+    S->live_c[S->nlive_c++] = k;
+    return k;
+}
+
+/* The corner stops at vertex v: its arc closes the faces on both sides. */
+static void retire(sk *S, uint32_t k, uint32_t v)
+{
+    sk_corner *c = &S->c[k];
+    if (!c->alive)
+        return;
+    seg(S, S->e[c->in].face, c->vert, v);
+    seg(S, S->e[c->out].face, v, c->vert);
+    c->alive = 0;
+}
+
+static void kill_edge(sk *S, uint32_t e)
+{
+    S->e[e].alive = 0;
+    S->e[e].ver++;
+}
+
+/* --- event computation ------------------------------------------------------------------- */
+
+static void push(sk *S, const ag_event *ev)
+{
+    if (ag_eventq_push(&S->q, ev) != AG_OK)
+        fail(S, AG_ERR_NOMEM);
+}
+
+static void edge_event(sk *S, uint32_t ei)
+{
+    const sk_edge *e = &S->e[ei];
+    if (!e->alive || e->start == NONE || e->end == NONE)
+        return;
+    const sk_corner *a = &S->c[e->start], *b = &S->c[e->end];
+    if (!a->settled || !b->settled || !a->alive || !b->alive)
+        return;
+    double z0 = fmax(fmax(a->z, b->z), S->zcur);
+    double ax, ay, bx, by;
+    cpos(a, z0, &ax, &ay);
+    cpos(b, z0, &bx, &by);
+    double dx = edx(e), dy = edy(e);
+    double len = dx * (bx - ax) + dy * (by - ay);
+    double rate = dx * (b->vx - a->vx) + dy * (b->vy - a->vy);
+    if (!(rate < -1e-12))
+        return;
+    double dz = len / -rate;
+    if (dz < 0)
+        dz = 0;
+    ag_event ev = {0};
+    ev.type = AG_EVENT_EDGE;
+    ev.z = z0 + dz;
+    cpos(a, ev.z, &ax, &ay);
+    cpos(b, ev.z, &bx, &by);
+    ev.x = (ax + bx) / 2;
+    ev.y = (ay + by) / 2;
+    ev.a = ei;
+    ev.ver = e->ver;
+    if (isfinite(ev.z))
+        push(S, &ev);
+}
+
+static void split_event(sk *S, uint32_t k, uint32_t fi)
+{
+    const sk_corner *c = &S->c[k];
+    const sk_edge *f = &S->e[fi];
+    if (!c->alive || !c->settled || !f->alive || fi == c->in || fi == c->out)
+        return;
+    if (f->start == NONE || f->end == NONE)
+        return;
+    const sk_corner *fa = &S->c[f->start], *fb = &S->c[f->end];
+    if (!fa->settled || !fb->settled)
+        return;
+    double z0 = fmax(c->z, S->zcur), px, py;
+    cpos(c, z0, &px, &py);
+    double dist = f->nx * px + f->ny * py - (f->c + f->s * z0);
+    double closing = f->s - (f->nx * c->vx + f->ny * c->vy);
+    if (!(closing > 1e-12) || dist < -S->d2)
+        return;
+    double dz = dist > 0 ? dist / closing : 0;
+    double z = z0 + dz;
+    if (!isfinite(z))
+        return;
+    double x, y, ax, ay, bx, by;
+    cpos(c, z, &x, &y);
+    cpos(fa, z, &ax, &ay);
+    cpos(fb, z, &bx, &by);
+    double dx = edx(f), dy = edy(f);
+    double len = dx * (bx - ax) + dy * (by - ay);
+    double t = dx * (x - ax) + dy * (y - ay);
+    if (len < -S->d3 || t < -S->d3 || t > len + S->d3)
+        return;
+    ag_event ev = {0};
+    ev.type = AG_EVENT_SPLIT;
+    ev.z = z;
+    ev.x = x;
+    ev.y = y;
+    ev.a = k;
+    ev.b = fi;
+    ev.ver = f->ver;
+    push(S, &ev);
+}
+
+/* --- corner settling: velocity, collinear merge, ridge zip ------------------------------- */
+
+static void settle(sk *S, uint32_t k);
+
+static int velocity(sk *S, sk_corner *c)
+{
+    const sk_edge *a = &S->e[c->in], *b = &S->e[c->out];
+    double det = a->nx * b->ny - a->ny * b->nx;
+    if (fabs(det) <= AG_EXTRUDE_PARALLEL)
+        return 0;
+    c->vx = (a->s * b->ny - b->s * a->ny) / det;
+    c->vy = (a->nx * b->s - b->nx * a->s) / det;
+    return 1;
+}
+
+static void merge(sk *S, uint32_t k)
+{
+    sk_corner *c = &S->c[k];
+    uint32_t ein = c->in, eout = c->out;
+    int min_vol = S->plan->priority == AG_PRIORITY_MIN_VOLUME;
+    double sin_ = S->e[ein].s, sout = S->e[eout].s;
+    int in_wins = min_vol ? sin_ > sout : sin_ < sout;
+    double z = c->z, l_x = c->x, l_y = c->y;
+    uint32_t vl = c->vert;
+    S->stats.merges++;
+    c->alive = 0; /* made and retired at the same point: no arc */
+    if (in_wins) {
+        uint32_t loser = eout, m = S->e[loser].end;
+        uint32_t x_out = S->c[m].out;
+        double px, py;
+        cpos(&S->c[m], z, &px, &py);
+        uint32_t vm = vertex(S, px, py, z);
+        retire(S, m, vm);
+        seg(S, S->e[loser].face, vm, vl);
+        seg(S, S->e[ein].face, vl, vm);
+        kill_edge(S, loser);
+        if (x_out == loser || x_out == ein) {
+            kill_edge(S, ein); /* the loop was only these two edges */
+            return;
+        }
+        uint32_t k2 = add_corner(S, ein, x_out, px, py, z, vm);
+        if (k2 != NONE)
+            settle(S, k2);
+    } else {
+        uint32_t loser = ein, m = S->e[loser].start;
+        uint32_t y_in = S->c[m].in;
+        double px, py;
+        cpos(&S->c[m], z, &px, &py);
+        uint32_t vm = vertex(S, px, py, z);
+        retire(S, m, vm);
+        seg(S, S->e[loser].face, vl, vm);
+        seg(S, S->e[eout].face, vm, vl);
+        kill_edge(S, loser);
+        if (y_in == loser || y_in == eout) {
+            kill_edge(S, eout);
+            return;
+        }
+        uint32_t k2 = add_corner(S, y_in, eout, px, py, z, vm);
+        if (k2 != NONE)
+            settle(S, k2);
+    }
+    (void)l_x;
+    (void)l_y;
+}
+
+static void zip(sk *S, uint32_t k)
+{
+    sk_corner *c = &S->c[k];
+    uint32_t B = c->in, A = c->out;
+    uint32_t cA = S->e[A].end, cB = S->e[B].start;
+    double z = c->z;
+    uint32_t vl = c->vert;
+    S->stats.zips++;
+    c->alive = 0;
+    double pax, pay, pbx, pby;
+    cpos(&S->c[cA], z, &pax, &pay);
+    cpos(&S->c[cB], z, &pbx, &pby);
+    if (cA == cB) {
+        uint32_t vp = vertex(S, pax, pay, z);
+        retire(S, cA, vp);
+        seg(S, S->e[A].face, vp, vl);
+        seg(S, S->e[B].face, vl, vp);
+        kill_edge(S, A);
+        kill_edge(S, B);
+        return;
+    }
+    double dx = edx(&S->e[A]), dy = edy(&S->e[A]);
+    double lenA = dx * (pax - c->x) + dy * (pay - c->y);
+    double lenB = dx * (pbx - c->x) + dy * (pby - c->y);
+    if (fabs(lenA - lenB) <= S->d2 * 10) {
+        double px = (pax + pbx) / 2, py = (pay + pby) / 2;
+        uint32_t vp = vertex(S, px, py, z);
+        uint32_t yin = S->c[cB].in, xout = S->c[cA].out;
+        retire(S, cA, vp);
+        retire(S, cB, vp);
+        seg(S, S->e[A].face, vp, vl);
+        seg(S, S->e[B].face, vl, vp);
+        kill_edge(S, A);
+        kill_edge(S, B);
+        if (yin == xout) {
+            /* a single edge is left between the two: it has shrunk to this point */
+            kill_edge(S, yin);
+            return;
+        }
+        uint32_t k2 = add_corner(S, yin, xout, px, py, z, vp);
+        if (k2 != NONE)
+            settle(S, k2);
+    } else if (lenA < lenB) {
+        uint32_t vp = vertex(S, pax, pay, z);
+        uint32_t xout = S->c[cA].out;
+        retire(S, cA, vp);
+        seg(S, S->e[A].face, vp, vl);
+        seg(S, S->e[B].face, vl, vp);
+        kill_edge(S, A);
+        uint32_t k2 = add_corner(S, B, xout, pax, pay, z, vp);
+        if (k2 != NONE)
+            settle(S, k2);
+    } else {
+        uint32_t vp = vertex(S, pbx, pby, z);
+        uint32_t yin = S->c[cB].in;
+        retire(S, cB, vp);
+        seg(S, S->e[A].face, vp, vl);
+        seg(S, S->e[B].face, vl, vp);
+        kill_edge(S, B);
+        uint32_t k2 = add_corner(S, yin, A, pbx, pby, z, vp);
+        if (k2 != NONE)
+            settle(S, k2);
+    }
+}
+
+static void settle(sk *S, uint32_t k)
+{
+    if (S->st != AG_OK)
+        return;
+    sk_corner *c = &S->c[k];
+    if (!c->alive)
+        return;
+    if (c->in == c->out) {
+        /* a loop of one edge: it has closed */
+        kill_edge(S, c->in);
+        c->alive = 0;
+        return;
+    }
+    if (velocity(S, c)) {
+        c->settled = 1;
+        return;
+    }
+    const sk_edge *a = &S->e[c->in], *b = &S->e[c->out];
+    double dot = a->nx * b->nx + a->ny * b->ny;
+    if (dot > 0) {
+        if (fabs(a->s - b->s) <= AG_EXTRUDE_SAME_SLOPE) {
+            /* collinear, same slope: the corner moves with the common plane */
+            double nx = a->nx + b->nx, ny = a->ny + b->ny, l = hypot(nx, ny);
+            c->vx = a->s * nx / l;
+            c->vy = a->s * ny / l;
+            c->settled = 1;
+            return;
+        }
+        merge(S, k);
+    } else {
+        zip(S, k);
+    }
+}
+
+/* --- after an event: schedule new events ------------------------------------------------- */
+
+static void compact_live(sk *S)
+{
+    size_t w = 0;
+    for (size_t i = 0; i < S->nlive_c; i++)
+        if (S->c[S->live_c[i]].alive)
+            S->live_c[w++] = S->live_c[i];
+    S->nlive_c = w;
+    w = 0;
+    for (size_t i = 0; i < S->nlive_e; i++)
+        if (S->e[S->live_e[i]].alive)
+            S->live_e[w++] = S->live_e[i];
+    S->nlive_e = w;
+}
+
+static void schedule_touched(sk *S)
+{
+    if (S->st != AG_OK)
+        return;
+    compact_live(S);
+    S->stamp++;
+    for (size_t i = 0; i < S->ntouched; i++) {
+        sk_corner *c = &S->c[S->touched[i]];
+        if (!c->alive)
+            continue;
+        uint32_t es[2] = {c->in, c->out};
+        for (int j = 0; j < 2; j++) {
+            sk_edge *e = &S->e[es[j]];
+            if (!e->alive)
+                continue;
+            /* the edge changed: its collapse and every corner's hit on it are new */
+            edge_event(S, es[j]);
+            for (size_t q = 0; q < S->nlive_c; q++)
+                split_event(S, S->live_c[q], es[j]);
+        }
+        for (size_t q = 0; q < S->nlive_e; q++)
+            split_event(S, S->touched[i], S->live_e[q]);
+    }
+    S->ntouched = 0;
+}
+
+/* --- generalized intersection event ------------------------------------------------------ */
+
+typedef struct {
+    double ang;
+    uint32_t edge;
+    int out;
+} ray;
+
+static int cmp_ray(const void *a, const void *b)
+{
+    const ray *x = a, *y = b;
+    if (x->ang != y->ang)
+        return x->ang < y->ang ? -1 : 1;
+    return y->out - x->out; /* outgoing first on ties */
+}
+
+typedef struct {
+    uint32_t *arr;
+    size_t n, cap;
+} u32vec;
+
+static int vpush(u32vec *v, uint32_t x)
+{
+    if (!grow((void **)&v->arr, &v->cap, v->n + 1, sizeof(uint32_t)))
+        return 0;
+    v->arr[v->n++] = x;
+    return 1;
+}
+
+typedef struct {
+    u32vec C, E, splits;
+    ray *rays;
+    size_t cap_rays;
+} scratch;
+
+static int near_l(sk *S, uint32_t k, double z, double lx, double ly, double spread)
+{
+    const sk_corner *c = &S->c[k];
+    double x, y;
+    cpos(c, z, &x, &y);
+    /* a fast corner (nearly parallel edges) may drift by |v| * spread: bounded so that
+     * unrelated corners are not pulled in */
+    double drift = hypot(c->vx, c->vy) * spread;
+    double tol = 2 * S->d2 + (drift < 100 * S->d3 ? drift : 100 * S->d3);
+    return hypot(x - lx, y - ly) <= tol;
+}
+
+static void intersection(sk *S, ag_event *evs, size_t n, scratch *W)
+{
+    S->stamp++;
+    uint32_t mark = S->stamp;
+    W->C.n = W->E.n = W->splits.n = 0;
+    double z = 0, lx = 0, ly = 0, zmin = INFINITY, zmax = -INFINITY;
+    size_t used = 0;
+    for (size_t i = 0; i < n; i++) {
+        ag_event *ev = &evs[i];
+        if (ev->type == AG_EVENT_EDGE) {
+            sk_edge *e = &S->e[ev->a];
+            if (!e->alive || e->ver != ev->ver)
+                continue;
+            uint32_t ks[2] = {e->start, e->end};
+            for (int j = 0; j < 2; j++)
+                if (S->c[ks[j]].stamp != mark) {
+                    S->c[ks[j]].stamp = mark;
+                    vpush(&W->C, ks[j]);
+                }
+        } else {
+            sk_corner *c = &S->c[ev->a];
+            sk_edge *f = &S->e[ev->b];
+            if (!c->alive || !f->alive || f->ver != ev->ver)
+                continue;
+            if (c->stamp != mark) {
+                c->stamp = mark;
+                vpush(&W->C, ev->a);
+            }
+            vpush(&W->splits, ev->b);
+        }
+        z += ev->z;
+        lx += ev->x;
+        ly += ev->y;
+        zmin = fmin(zmin, ev->z);
+        zmax = fmax(zmax, ev->z);
+        used++;
+    }
+    if (!used || !W->C.n)
+        return;
+    z /= used;
+    lx /= used;
+    ly /= used;
+    if (z < S->zcur)
+        z = S->zcur;
+    double spread = zmax - zmin + 1e-3 * S->d1;
+    /* split edges whose end is at the point: the corner there arrives instead */
+    for (size_t i = 0; i < W->splits.n; i++) {
+        sk_edge *f = &S->e[W->splits.arr[i]];
+        uint32_t ks[2] = {f->start, f->end};
+        for (int j = 0; j < 2; j++)
+            if (S->c[ks[j]].stamp != mark && near_l(S, ks[j], z, lx, ly, spread)) {
+                S->c[ks[j]].stamp = mark;
+                vpush(&W->C, ks[j]);
+            }
+    }
+    /* chains: neighbours of arriving corners that are at the point too */
+    for (size_t i = 0; i < W->C.n; i++) {
+        sk_corner *c = &S->c[W->C.arr[i]];
+        uint32_t ks[2] = {S->e[c->in].start, S->e[c->out].end};
+        for (int j = 0; j < 2; j++)
+            if (S->c[ks[j]].stamp != mark && S->c[ks[j]].alive &&
+                near_l(S, ks[j], z, lx, ly, spread)) {
+                S->c[ks[j]].stamp = mark;
+                vpush(&W->C, ks[j]);
+            }
+    }
+    S->stats.intersections++;
+    uint32_t vl = vertex(S, lx, ly, z);
+    /* edges at the point */
+    for (size_t i = 0; i < W->C.n; i++) {
+        sk_corner *c = &S->c[W->C.arr[i]];
+        uint32_t es[2] = {c->in, c->out};
+        for (int j = 0; j < 2; j++)
+            {
+                int seen = 0;
+                for (size_t q = 0; q < W->E.n; q++)
+                    if (W->E.arr[q] == es[j])
+                        seen = 1;
+                if (!seen)
+                    vpush(&W->E, es[j]);
+            }
+    }
+    size_t nrays = 0;
+    size_t need = 2 * (W->E.n + W->splits.n) + 2;
+    if (!grow((void **)&W->rays, &W->cap_rays, need, sizeof(ray))) {
+        fail(S, AG_ERR_NOMEM);
+        return;
+    }
+    for (size_t i = 0; i < W->E.n; i++) {
+        sk_edge *e = &S->e[W->E.arr[i]];
+        int st = S->c[e->start].stamp == mark, en = S->c[e->end].stamp == mark;
+        double a = atan2(edy(e), edx(e));
+        if (st && en) {
+            kill_edge(S, W->E.arr[i]);
+        } else if (st) {
+            W->rays[nrays++] = (ray){a, W->E.arr[i], 1};
+        } else if (en) {
+            W->rays[nrays++] = (ray){a > 0 ? a - M_PI : a + M_PI, W->E.arr[i], 0};
+        }
+    }
+    for (size_t i = 0; i < W->splits.n; i++) {
+        uint32_t fi = W->splits.arr[i];
+        sk_edge *f = &S->e[fi];
+        if (!f->alive || f->start == NONE || f->end == NONE ||
+            S->c[f->start].stamp == mark || S->c[f->end].stamp == mark)
+            continue;
+        int dup = 0;
+        for (size_t q = 0; q < nrays; q++)
+            if (W->rays[q].edge == fi)
+                dup = 1;
+        if (dup)
+            continue;
+        /* still crossing the point? */
+        double ax, ay, bx, by;
+        cpos(&S->c[f->start], z, &ax, &ay);
+        cpos(&S->c[f->end], z, &bx, &by);
+        double dx = edx(f), dy = edy(f);
+        double t = dx * (lx - ax) + dy * (ly - ay), len = dx * (bx - ax) + dy * (by - ay);
+        double off = fabs(f->nx * lx + f->ny * ly - (f->c + f->s * z));
+        if (t < -S->d3 || t > len + S->d3 || off > S->d3 + spread * (1 + fabs(f->s)))
+            continue;
+        uint32_t f2 = add_edge(S);
+        if (f2 == NONE)
+            return;
+        f = &S->e[fi];
+        sk_edge *g = &S->e[f2];
+        *g = *f;
+        g->ver = 0;
+        g->alive = 1;
+        g->start = NONE;
+        g->end = f->end;
+        S->c[f->end].in = f2;
+        f->end = NONE;
+        f->ver++;
+        double a = atan2(dy, dx);
+        W->rays[nrays++] = (ray){a > 0 ? a - M_PI : a + M_PI, fi, 0};
+        W->rays[nrays++] = (ray){a, f2, 1};
+    }
+    for (size_t i = 0; i < W->C.n; i++)
+        retire(S, W->C.arr[i], vl);
+    if (!nrays)
+        return;
+    qsort(W->rays, nrays, sizeof(ray), cmp_ray);
+    /* near-ties: an outgoing ray goes before an incoming one (a ridge, zipped later) */
+    for (size_t i = 0; i + 1 < nrays; i++)
+        if (!W->rays[i].out && W->rays[i + 1].out && W->rays[i + 1].ang - W->rays[i].ang < 1e-9) {
+            ray t = W->rays[i];
+            W->rays[i] = W->rays[i + 1];
+            W->rays[i + 1] = t;
+        }
+    if (nrays >= 2 && !W->rays[nrays - 1].out && W->rays[0].out &&
+        W->rays[0].ang + 2 * M_PI - W->rays[nrays - 1].ang < 1e-9) {
+        /* wrap-around tie: rotate the last (incoming) ray behind the first */
+        ray t = W->rays[nrays - 1];
+        memmove(&W->rays[1], &W->rays[0], (nrays - 1) * sizeof(ray));
+        W->rays[0] = t;
+        W->rays[0].ang -= 2 * M_PI;
+        t = W->rays[0];
+        W->rays[0] = W->rays[1];
+        W->rays[1] = t;
+    }
+    /* pair each outgoing ray with the next incoming one counter-clockwise */
+    long bal = 0, minbal = 0;
+    size_t start = 0;
+    int nout = 0;
+    for (size_t i = 0; i < nrays; i++) {
+        bal += W->rays[i].out ? 1 : -1;
+        nout += W->rays[i].out;
+        if (bal < minbal) {
+            minbal = bal;
+            start = i + 1;
+        }
+    }
+    if (bal != 0) {
+        ag_error_set(S->err, AG_ERR_INTERNAL, 0,
+                     "inconsistent intersection at (%.6f, %.6f, %.6f): %d edges leave, %d arrive",
+                     lx + S->ox, ly + S->oy, z, nout, (int)nrays - nout);
+        fail(S, AG_ERR_INTERNAL);
+        return;
+    }
+    uint32_t *stack = malloc(nrays * sizeof *stack);
+    if (!stack) {
+        fail(S, AG_ERR_NOMEM);
+        return;
+    }
+    size_t sp = 0;
+    size_t first_new = S->ntouched;
+    for (size_t j = 0; j < nrays; j++) {
+        ray *r = &W->rays[(start + j) % nrays];
+        if (r->out) {
+            stack[sp++] = r->edge;
+        } else if (sp) {
+            uint32_t out = stack[--sp];
+            add_corner(S, r->edge, out, lx, ly, z, vl);
+        }
+    }
+    free(stack);
+    size_t last_new = S->ntouched;
+    for (size_t i = first_new; i < last_new && S->st == AG_OK; i++)
+        settle(S, S->touched[i]);
+}
+
+/* --- profile direction events ------------------------------------------------------------ */
+
+static double seg_slope(const ag_profile *p, int32_t seg)
+{
+    const ag_profile_point *a = &p->points[seg], *b = &p->points[seg + 1];
+    return (b->w - a->w) / (b->z - a->z);
+}
+
+static void direction(sk *S, ag_event *evs, size_t n)
+{
+    double z = evs[0].z;
+    S->stamp++;
+    uint32_t mark = S->stamp;
+    S->stats.directions++;
+    compact_live(S);
+    /* edges that change */
+    u32vec ch = {0}, ks = {0};
+    for (size_t i = 0; i < S->nlive_e; i++) {
+        uint32_t ei = S->live_e[i];
+        sk_edge *e = &S->e[ei];
+        for (size_t j = 0; j < n; j++)
+            if ((uint32_t)e->profile == evs[j].a && (uint32_t)e->seg + 1 == evs[j].b) {
+                if (!vpush(&ch, ei))
+                    fail(S, AG_ERR_NOMEM);
+                break;
+            }
+    }
+    for (size_t i = 0; i < ch.n; i++) {
+        sk_edge *e = &S->e[ch.arr[i]];
+        uint32_t cs[2] = {e->start, e->end};
+        for (int j = 0; j < 2; j++)
+            if (S->c[cs[j]].stamp != mark) {
+                S->c[cs[j]].stamp = mark;
+                if (!vpush(&ks, cs[j]))
+                    fail(S, AG_ERR_NOMEM);
+            }
+    }
+    /* retire the corners there, remembering their vertex at this height */
+    uint32_t *verts = malloc((ks.n ? ks.n : 1) * sizeof *verts);
+    double *xy = malloc((ks.n ? ks.n : 1) * 2 * sizeof *xy);
+    if (!verts || !xy) {
+        fail(S, AG_ERR_NOMEM);
+        goto out;
+    }
+    for (size_t i = 0; i < ks.n; i++) {
+        sk_corner *c = &S->c[ks.arr[i]];
+        cpos(c, z, &xy[2 * i], &xy[2 * i + 1]);
+        verts[i] = vertex(S, xy[2 * i], xy[2 * i + 1], z);
+        retire(S, ks.arr[i], verts[i]);
+        c->stamp = (uint32_t)i; /* index into verts until re-made */
+    }
+    for (size_t i = 0; i < ch.n; i++) {
+        sk_edge *e = &S->e[ch.arr[i]];
+        uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
+        seg(S, e->face, ve, vs);
+        const ag_profile *p = &S->plan->profiles[e->profile];
+        double s_new = seg_slope(p, e->seg + 1);
+        e->c += (e->s - s_new) * z;
+        e->s = s_new;
+        e->seg++;
+        e->face = new_face(S, e);
+        seg(S, e->face, vs, ve);
+        e->ver++;
+    }
+    size_t first_new = S->ntouched;
+    for (size_t i = 0; i < ks.n; i++) {
+        sk_corner *c = &S->c[ks.arr[i]];
+        c->stamp = 0;
+        add_corner(S, c->in, c->out, xy[2 * i], xy[2 * i + 1], z, verts[i]);
+    }
+    size_t last_new = S->ntouched;
+    for (size_t i = first_new; i < last_new && S->st == AG_OK; i++)
+        settle(S, S->touched[i]);
+out:
+    free(verts);
+    free(xy);
+    free(ch.arr);
+    free(ks.arr);
+}
+
+/* --- the cap ----------------------------------------------------------------------------- */
+
+static void cap(sk *S, double z)
+{
+    compact_live(S);
+    if (!S->nlive_e)
+        return;
+    S->stats.capped = 1;
+    ag_shell_face f = {AG_SHELL_FACE_CAP, -1, -1, -1, -1, 0, 0};
+    uint32_t face = 0;
+    if (ag_shell_add_face(S->shell, &f, &face) != AG_OK) {
+        fail(S, AG_ERR_NOMEM);
+        return;
+    }
+    uint32_t *verts = malloc(S->nc * sizeof *verts);
+    if (!verts) {
+        fail(S, AG_ERR_NOMEM);
+        return;
+    }
+    for (size_t i = 0; i < S->nlive_c; i++) {
+        uint32_t k = S->live_c[i];
+        double x, y;
+        cpos(&S->c[k], z, &x, &y);
+        verts[k] = vertex(S, x, y, z);
+        retire(S, k, verts[k]);
+    }
+    for (size_t i = 0; i < S->nlive_e; i++) {
+        sk_edge *e = &S->e[S->live_e[i]];
+        seg(S, e->face, verts[e->end], verts[e->start]);
+        seg(S, face, verts[e->start], verts[e->end]);
+        e->alive = 0;
+    }
+    free(verts);
+}
+
+/* --- driver ------------------------------------------------------------------------------ */
+
+static int cmp_event_x(const void *a, const void *b)
+{
+    double x = ((const ag_event *)a)->x, y = ((const ag_event *)b)->x;
+    return x < y ? -1 : x > y;
+}
+
+static uint32_t uf_find(uint32_t *p, uint32_t x)
+{
+    while (p[x] != x) {
+        p[x] = p[p[x]];
+        x = p[x];
+    }
+    return x;
+}
+
+static int event_valid(sk *S, const ag_event *ev)
+{
+    if (ev->type == AG_EVENT_EDGE)
+        return S->e[ev->a].alive && S->e[ev->a].ver == ev->ver;
+    if (ev->type == AG_EVENT_SPLIT)
+        return S->c[ev->a].alive && S->e[ev->b].alive && S->e[ev->b].ver == ev->ver;
+    return 1;
+}
+
+ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleton_options *opt,
+                            ag_shell **out, ag_skeleton_stats *stats, ag_error *err)
+{
+    *out = NULL;
+    sk S;
+    memset(&S, 0, sizeof S);
+    S.plan = plan;
+    S.err = err;
+    double scale = ag_extrude_scale(extent);
+    S.d1 = AG_EXTRUDE_DELTA1 * scale;
+    S.d2 = AG_EXTRUDE_DELTA2 * scale;
+    S.d3 = AG_EXTRUDE_DELTA3 * scale;
+    S.shell = ag_shell_create();
+    if (!S.shell)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    /* local origin: the first corner */
+    S.ox = plan->loops[0].xy[0];
+    S.oy = plan->loops[0].xy[1];
+    size_t ncorners = 0;
+    ag_shell_face ff = {AG_SHELL_FACE_FLOOR, -1, -1, -1, -1, 0, 0};
+    uint32_t floor_face = 0;
+    if (ag_shell_add_face(S.shell, &ff, &floor_face) != AG_OK)
+        fail(&S, AG_ERR_NOMEM);
+    double top_profile = 0;
+    for (size_t i = 0; i < plan->nprofiles; i++) {
+        const ag_profile *p = &plan->profiles[i];
+        top_profile = fmax(top_profile, p->points[p->npoints - 1].z);
+        for (size_t j = 1; j + 1 < p->npoints; j++) {
+            ag_event ev = {0};
+            ev.type = AG_EVENT_DIRECTION;
+            ev.z = p->points[j].z;
+            ev.a = (uint32_t)i;
+            ev.b = (uint32_t)j;
+            push(&S, &ev);
+        }
+    }
+    for (size_t L = 0; L < plan->nloops && S.st == AG_OK; L++) {
+        const ag_plan_loop *lp = &plan->loops[L];
+        size_t n = lp->n;
+        ncorners += n;
+        uint32_t e0 = (uint32_t)S.ne;
+        uint32_t v0 = (uint32_t)S.shell->nverts;
+        for (size_t i = 0; i < n; i++)
+            vertex(&S, lp->xy[2 * i] - S.ox, lp->xy[2 * i + 1] - S.oy, 0);
+        for (size_t i = 0; i < n; i++) {
+            uint32_t ei = add_edge(&S);
+            if (ei == NONE)
+                break;
+            sk_edge *e = &S.e[ei];
+            size_t j = (i + 1) % n;
+            double dx = lp->xy[2 * j] - lp->xy[2 * i], dy = lp->xy[2 * j + 1] - lp->xy[2 * i + 1];
+            double len = hypot(dx, dy);
+            e->nx = -dy / len;
+            e->ny = dx / len;
+            const ag_profile *p = &plan->profiles[lp->profile[i]];
+            e->s = seg_slope(p, 0);
+            e->c = e->nx * (lp->xy[2 * i] - S.ox) + e->ny * (lp->xy[2 * i + 1] - S.oy);
+            e->loop = (int32_t)L;
+            e->edge = (int32_t)i;
+            e->profile = lp->profile[i];
+            e->seg = 0;
+            e->face = new_face(&S, e);
+            seg(&S, e->face, v0 + (uint32_t)i, v0 + (uint32_t)j);
+            seg(&S, floor_face, v0 + (uint32_t)j, v0 + (uint32_t)i);
+        }
+        for (size_t i = 0; i < n && S.st == AG_OK; i++)
+            add_corner(&S, e0 + (uint32_t)((i + n - 1) % n), e0 + (uint32_t)i,
+                       lp->xy[2 * i] - S.ox, lp->xy[2 * i + 1] - S.oy, 0, v0 + (uint32_t)i);
+    }
+    for (size_t i = 0; i < S.ntouched && S.st == AG_OK; i++)
+        settle(&S, S.touched[i]);
+    schedule_touched(&S);
+
+    size_t max_events = opt && opt->max_events ? opt->max_events : 64 * ncorners + 10000;
+    size_t handled = 0;
+    double limit = plan->cap_height > 0 ? plan->cap_height : INFINITY;
+    scratch W;
+    memset(&W, 0, sizeof W);
+    ag_event *batch = NULL;
+    size_t cap_batch = 0;
+    uint32_t *uf = NULL;
+    size_t cap_uf = 0;
+    while (S.st == AG_OK) {
+        ag_event ev;
+        if (!ag_eventq_pop(&S.q, &ev))
+            break;
+        if (!event_valid(&S, &ev))
+            continue;
+        if (ev.z > limit)
+            break;
+        if (++handled > max_events) {
+            ag_error_set(err, AG_ERR_INTERNAL, 0,
+                         "the sweep did not finish after %zu events (height %.4f)", max_events,
+                         S.zcur);
+            fail(&S, AG_ERR_INTERNAL);
+            break;
+        }
+        if (ev.z > S.zcur)
+            S.zcur = ev.z;
+        size_t nb = 0;
+        if (!grow((void **)&batch, &cap_batch, 1, sizeof *batch)) {
+            fail(&S, AG_ERR_NOMEM);
+            break;
+        }
+        batch[nb++] = ev;
+        const ag_event *top;
+        int is_dir = ev.type == AG_EVENT_DIRECTION;
+        while ((top = ag_eventq_peek(&S.q)) && top->z <= ev.z + S.d1 &&
+               (top->type == AG_EVENT_DIRECTION) == is_dir) {
+            ag_event nx;
+            ag_eventq_pop(&S.q, &nx);
+            if (!event_valid(&S, &nx))
+                continue;
+            if (!grow((void **)&batch, &cap_batch, nb + 1, sizeof *batch)) {
+                fail(&S, AG_ERR_NOMEM);
+                break;
+            }
+            batch[nb++] = nx;
+        }
+        if (is_dir) {
+            direction(&S, batch, nb);
+            schedule_touched(&S);
+            continue;
+        }
+        /* cluster in plan: union of events closer than delta2 (sorted by x) */
+        qsort(batch, nb, sizeof *batch, cmp_event_x);
+        if (!grow((void **)&uf, &cap_uf, nb, sizeof *uf)) {
+            fail(&S, AG_ERR_NOMEM);
+            break;
+        }
+        for (size_t i = 0; i < nb; i++)
+            uf[i] = (uint32_t)i;
+        double r = 10 * S.d2;
+        for (size_t i = 0; i < nb; i++)
+            for (size_t j = i + 1; j < nb && batch[j].x - batch[i].x <= r; j++)
+                if (fabs(batch[j].y - batch[i].y) <= r &&
+                    hypot(batch[j].x - batch[i].x, batch[j].y - batch[i].y) <= r) {
+                    uint32_t a = uf_find(uf, (uint32_t)i), b = uf_find(uf, (uint32_t)j);
+                    if (a != b)
+                        uf[a > b ? a : b] = a < b ? a : b;
+                }
+        /* handle groups lowest first; group members are gathered in place */
+        ag_event *grp = malloc(nb * sizeof *grp);
+        uint8_t *done = calloc(nb, 1);
+        if (!grp || !done) {
+            free(grp);
+            free(done);
+            fail(&S, AG_ERR_NOMEM);
+            break;
+        }
+        for (;;) {
+            size_t best = SIZE_MAX;
+            for (size_t i = 0; i < nb; i++)
+                if (!done[i] && (best == SIZE_MAX || batch[i].z < batch[best].z))
+                    best = i;
+            if (best == SIZE_MAX)
+                break;
+            uint32_t root = uf_find(uf, (uint32_t)best);
+            size_t ng = 0;
+            for (size_t i = 0; i < nb; i++)
+                if (!done[i] && uf_find(uf, (uint32_t)i) == root) {
+                    done[i] = 1;
+                    grp[ng++] = batch[i];
+                }
+            intersection(&S, grp, ng, &W);
+            if (S.st != AG_OK)
+                break;
+        }
+        free(grp);
+        free(done);
+        schedule_touched(&S);
+    }
+    if (S.st == AG_OK) {
+        double zc = plan->cap_height > 0 ? plan->cap_height : fmax(S.zcur, top_profile);
+        compact_live(&S);
+        if (S.nlive_e)
+            cap(&S, zc);
+        S.stats.top = S.nlive_e ? zc : S.zcur;
+    }
+    free(batch);
+    free(uf);
+    free(W.C.arr);
+    free(W.E.arr);
+    free(W.splits.arr);
+    free(W.rays);
+    ag_status st = S.st;
+    if (st == AG_OK)
+        st = ag_shell_finish(S.shell, S.d1);
+    ag_eventq_free(&S.q);
+    free(S.e);
+    free(S.c);
+    free(S.live_c);
+    free(S.live_e);
+    free(S.touched);
+    if (stats)
+        *stats = S.stats;
+    if (st != AG_OK) {
+        ag_shell_free(S.shell);
+        if (!err || err->code == AG_OK)
+            ag_error_set(err, st, 0, "%s", st == AG_ERR_NOMEM ? "out of memory" : "extrusion failed");
+        return st;
+    }
+    *out = S.shell;
+    return AG_OK;
+}

@@ -1,0 +1,328 @@
+#include "label.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "weld.h"
+
+void ag_label_rotate(int k, double *x, double *y)
+{
+    double a = *x, b = *y;
+    switch (k & 3) {
+    case 1: *x = -b; *y = a; break;
+    case 2: *x = -a; *y = -b; break;
+    case 3: *x = b; *y = -a; break;
+    default: break;
+    }
+}
+
+typedef struct {
+    uint64_t h;
+    uint32_t i;
+} hidx;
+
+static int cmp_hidx(const void *a, const void *b)
+{
+    const hidx *x = a, *y = b;
+    if (x->h != y->h)
+        return x->h < y->h ? -1 : 1;
+    return x->i < y->i ? -1 : x->i > y->i;
+}
+
+static void centroid(const double *t, double c[3])
+{
+    for (int a = 0; a < 3; a++)
+        c[a] = (t[a] + t[3 + a] + t[6 + a]) / 3.0;
+}
+
+static double tri_dist(const double *x, const double *y, int shift)
+{
+    double m = 0;
+    for (int v = 0; v < 3; v++) {
+        const double *p = x + 3 * v, *q = y + 3 * ((v + shift) % 3);
+        double d = (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                   (p[2] - q[2]) * (p[2] - q[2]);
+        if (d > m)
+            m = d;
+    }
+    return sqrt(m);
+}
+
+double ag_label_match_triangles(const double *a, size_t na, const double *b, size_t nb,
+                                double tol, size_t *unmatched)
+{
+    size_t miss = 0;
+    double worst = 0;
+    if (tol <= 0)
+        tol = 1e-300;
+    double cell = 2 * tol;
+    hidx *ha = malloc((na + 1) * sizeof *ha);
+    uint8_t *used = calloc(na + 1, 1);
+    if (!ha || !used) {
+        free(ha);
+        free(used);
+        return -1;
+    }
+    for (size_t i = 0; i < na; i++) {
+        double c[3];
+        centroid(a + 9 * i, c);
+        ha[i].h = ag__cell_hash((int64_t)floor(c[0] / cell), (int64_t)floor(c[1] / cell),
+                                (int64_t)floor(c[2] / cell));
+        ha[i].i = (uint32_t)i;
+    }
+    qsort(ha, na, sizeof *ha, cmp_hidx);
+    for (size_t j = 0; j < nb; j++) {
+        const double *tb = b + 9 * j;
+        double c[3];
+        centroid(tb, c);
+        int64_t k0 = (int64_t)floor(c[0] / cell), k1 = (int64_t)floor(c[1] / cell),
+                k2 = (int64_t)floor(c[2] / cell);
+        double best = INFINITY;
+        size_t besti = SIZE_MAX;
+        for (int dx = -1; dx <= 1; dx++)
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dz = -1; dz <= 1; dz++) {
+                    uint64_t h = ag__cell_hash(k0 + dx, k1 + dy, k2 + dz);
+                    size_t lo = 0, hi = na;
+                    while (lo < hi) {
+                        size_t mid = (lo + hi) / 2;
+                        if (ha[mid].h < h)
+                            lo = mid + 1;
+                        else
+                            hi = mid;
+                    }
+                    for (size_t s = lo; s < na && ha[s].h == h; s++) {
+                        uint32_t i = ha[s].i;
+                        if (used[i])
+                            continue;
+                        for (int sh = 0; sh < 3; sh++) {
+                            double d = tri_dist(tb, a + 9 * (size_t)i, sh);
+                            if (d <= tol && d < best) {
+                                best = d;
+                                besti = i;
+                            }
+                        }
+                    }
+                }
+        if (besti == SIZE_MAX) {
+            miss++;
+            continue;
+        }
+        used[besti] = 1;
+        if (best > worst)
+            worst = best;
+    }
+    free(ha);
+    free(used);
+    if (unmatched)
+        *unmatched = miss;
+    return worst;
+}
+
+void ag_labels_free(ag_labels *l)
+{
+    if (!l)
+        return;
+    free(l->box);
+    free(l->ntris);
+    free(l->label);
+    free(l->rot);
+    free(l->tri_start);
+    free(l->tris);
+    free(l->exemplar);
+    free(l->count);
+    free(l);
+}
+
+/* Triangle soup of component c, centred on its box centre, rotated by k. */
+static void soup(const ag_mesh *m, const ag_labels *L, uint32_t c, int k, double *out)
+{
+    const ag_box *b = &L->box[c];
+    double ctr[3];
+    for (int a = 0; a < 3; a++)
+        ctr[a] = 0.5 * (b->min[a] + b->max[a]);
+    size_t o = 0;
+    for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++) {
+        uint32_t t = L->tris[s];
+        for (int v = 0; v < 3; v++) {
+            const double *p = m->pos + 3 * m->tri[3 * t + v];
+            double x = p[0] - ctr[0], y = p[1] - ctr[1];
+            ag_label_rotate(k, &x, &y);
+            out[o++] = x;
+            out[o++] = y;
+            out[o++] = p[2] - ctr[2];
+        }
+    }
+}
+
+static int dims_match(const ag_box *e, const ag_box *c, int k, double tol)
+{
+    double de[3], dc[3];
+    for (int a = 0; a < 3; a++) {
+        de[a] = e->max[a] - e->min[a];
+        dc[a] = c->max[a] - c->min[a];
+    }
+    if (k & 1) {
+        double s = de[0];
+        de[0] = de[1];
+        de[1] = s;
+    }
+    for (int a = 0; a < 3; a++)
+        if (fabs(de[a] - dc[a]) > tol)
+            return 0;
+    return 1;
+}
+
+typedef struct {
+    uint64_t key;
+    int32_t head; /* first label in the bucket */
+} bucket;
+
+ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_labels **out,
+                              ag_error *err)
+{
+    ag_label_options o = opt ? *opt : (ag_label_options){0};
+    if (o.tolerance <= 0)
+        o.tolerance = 1e-6;
+    *out = NULL;
+    size_t nc = m->ncomponents;
+    ag_labels *L = calloc(1, sizeof *L);
+    if (!L)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling");
+    L->ncomponents = nc;
+    L->box = malloc((nc + 1) * sizeof *L->box);
+    L->ntris = calloc(nc + 1, sizeof *L->ntris);
+    L->label = malloc((nc + 1) * sizeof *L->label);
+    L->rot = calloc(nc + 1, 1);
+    L->tri_start = calloc(nc + 2, sizeof *L->tri_start);
+    L->tris = malloc((m->ntris + 1) * sizeof *L->tris);
+    L->exemplar = malloc((nc + 1) * sizeof *L->exemplar);
+    L->count = calloc(nc + 1, sizeof *L->count);
+    int32_t *next_in_bucket = malloc((nc + 1) * sizeof *next_in_bucket);
+    size_t cap = 16;
+    while (cap < 2 * nc + 16)
+        cap <<= 1;
+    bucket *bk = calloc(cap, sizeof *bk);
+    double *sa = NULL, *sb = NULL;
+    size_t maxt = 0;
+    ag_status st = AG_ERR_NOMEM;
+    if (!L->box || !L->ntris || !L->label || !L->rot || !L->tri_start || !L->tris ||
+        !L->exemplar || !L->count || !next_in_bucket || !bk)
+        goto fail;
+    for (size_t i = 0; i < cap; i++)
+        bk[i].head = -1;
+
+    ag_box all = ag_mesh_bounds(m);
+    L->diagonal = ag_box_diagonal(&all);
+    if (!(L->diagonal > 0))
+        L->diagonal = 0;
+    L->tol = o.tolerance * (L->diagonal > 0 ? L->diagonal : 1.0);
+
+    for (size_t c = 0; c < nc; c++)
+        for (int a = 0; a < 3; a++) {
+            L->box[c].min[a] = INFINITY;
+            L->box[c].max[a] = -INFINITY;
+        }
+    for (size_t t = 0; t < m->ntris; t++) {
+        uint32_t c = m->tri_component[t];
+        L->ntris[c]++;
+        for (int v = 0; v < 3; v++) {
+            const double *p = m->pos + 3 * m->tri[3 * t + v];
+            for (int a = 0; a < 3; a++) {
+                if (p[a] < L->box[c].min[a])
+                    L->box[c].min[a] = p[a];
+                if (p[a] > L->box[c].max[a])
+                    L->box[c].max[a] = p[a];
+            }
+        }
+    }
+    for (size_t c = 0; c < nc; c++) {
+        L->tri_start[c + 1] = L->tri_start[c] + L->ntris[c];
+        if (L->ntris[c] > maxt)
+            maxt = L->ntris[c];
+    }
+    {
+        uint32_t *fill = malloc((nc + 1) * sizeof *fill);
+        if (!fill)
+            goto fail;
+        memcpy(fill, L->tri_start, nc * sizeof *fill);
+        for (size_t t = 0; t < m->ntris; t++)
+            L->tris[fill[m->tri_component[t]]++] = (uint32_t)t;
+        free(fill);
+    }
+    sa = malloc((9 * maxt + 1) * sizeof *sa);
+    sb = malloc((9 * maxt + 1) * sizeof *sb);
+    if (!sa || !sb)
+        goto fail;
+
+    double zq = 100 * L->tol;
+    for (size_t c = 0; c < nc; c++) {
+        L->label[c] = -1;
+        if (!L->ntris[c])
+            continue;
+        double dz = L->box[c].max[2] - L->box[c].min[2];
+        int64_t zb = (int64_t)floor(dz / zq);
+        int found = -1, fk = 0;
+        for (int64_t d = -1; d <= 1 && found < 0; d++) {
+            uint64_t key = ag__mix64(L->ntris[c] * 0x9E3779B97F4A7C15ULL ^ (uint64_t)(zb + d));
+            size_t i = key & (cap - 1);
+            while (bk[i].head >= 0 && bk[i].key != key)
+                i = (i + 1) & (cap - 1);
+            for (int32_t l = bk[i].head; l >= 0 && found < 0; l = next_in_bucket[l]) {
+                uint32_t e = L->exemplar[l];
+                if (L->ntris[e] != L->ntris[c])
+                    continue;
+                int have_cb = 0;
+                for (int k = 0; k < (o.no_rotation ? 1 : 4) && found < 0; k++) {
+                    if (!dims_match(&L->box[e], &L->box[c], k, L->tol))
+                        continue;
+                    if (!have_cb) {
+                        soup(m, L, (uint32_t)c, 0, sb);
+                        have_cb = 1;
+                    }
+                    soup(m, L, e, k, sa);
+                    size_t miss = 0;
+                    double w = ag_label_match_triangles(sa, L->ntris[e], sb, L->ntris[c], L->tol,
+                                                        &miss);
+                    if (w < 0)
+                        goto fail;
+                    if (miss == 0) {
+                        found = l;
+                        fk = k;
+                    }
+                }
+            }
+        }
+        if (found >= 0) {
+            L->label[c] = found;
+            L->rot[c] = (uint8_t)fk;
+            L->count[found]++;
+            continue;
+        }
+        int32_t l = (int32_t)L->nlabels++;
+        L->exemplar[l] = (uint32_t)c;
+        L->count[l] = 1;
+        L->label[c] = l;
+        uint64_t key = ag__mix64(L->ntris[c] * 0x9E3779B97F4A7C15ULL ^ (uint64_t)zb);
+        size_t i = key & (cap - 1);
+        while (bk[i].head >= 0 && bk[i].key != key)
+            i = (i + 1) & (cap - 1);
+        bk[i].key = key;
+        next_in_bucket[l] = bk[i].head;
+        bk[i].head = l;
+    }
+    free(sa);
+    free(sb);
+    free(bk);
+    free(next_in_bucket);
+    *out = L;
+    return AG_OK;
+fail:
+    free(sa);
+    free(sb);
+    free(bk);
+    free(next_in_bucket);
+    ag_labels_free(L);
+    return ag_error_set(err, st, 0, "out of memory while labeling");
+}

@@ -1,0 +1,147 @@
+#include "rules.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Box of child e relative to the centre of node v, rotated by k quarter turns. */
+static void rel_box(const ag_splittree *t, int32_t v, int32_t e, int k, double lo[3], double hi[3])
+{
+    const ag_box *pb = &t->nodes[v].box, *cb = &t->nodes[e].box;
+    double c[3];
+    for (int a = 0; a < 3; a++)
+        c[a] = 0.5 * (pb->min[a] + pb->max[a]);
+    double x0 = cb->min[0] - c[0], y0 = cb->min[1] - c[1];
+    double x1 = cb->max[0] - c[0], y1 = cb->max[1] - c[1];
+    ag_label_rotate(k, &x0, &y0);
+    ag_label_rotate(k, &x1, &y1);
+    lo[0] = fmin(x0, x1);
+    hi[0] = fmax(x0, x1);
+    lo[1] = fmin(y0, y1);
+    hi[1] = fmax(y0, y1);
+    lo[2] = cb->min[2] - c[2];
+    hi[2] = cb->max[2] - c[2];
+}
+
+static size_t children(const ag_splittree *t, int32_t v, int32_t *buf, size_t cap)
+{
+    size_t n = 0;
+    for (int32_t s = t->nodes[v].first_child; s >= 0; s = t->nodes[s].next_sibling) {
+        int32_t e = ag_splittree_chain_end(t, s);
+        if (e >= 0) {
+            if (n < cap)
+                buf[n] = e;
+            n++;
+        }
+    }
+    return n;
+}
+
+/* Does b match rep a with b = rotate(a, k)? */
+static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca, int32_t *cb,
+                uint8_t *used, size_t n)
+{
+    children(t, a, ca, n);
+    children(t, b, cb, n);
+    memset(used, 0, n);
+    double tol = t->tol;
+    for (size_t j = 0; j < n; j++) {
+        const ag_tnode *y = &t->nodes[cb[j]];
+        double blo[3], bhi[3];
+        rel_box(t, b, cb[j], 0, blo, bhi);
+        int ok = 0;
+        for (size_t i = 0; i < n && !ok; i++) {
+            if (used[i])
+                continue;
+            const ag_tnode *x = &t->nodes[ca[i]];
+            if (x->rule != y->rule || x->kind != y->kind || ((x->rule_rot + k) & 3) != y->rule_rot)
+                continue;
+            double alo[3], ahi[3];
+            rel_box(t, a, ca[i], k, alo, ahi);
+            int fit = 1;
+            for (int d = 0; d < 3 && fit; d++)
+                fit = fabs(alo[d] - blo[d]) <= tol && fabs(ahi[d] - bhi[d]) <= tol;
+            if (fit) {
+                used[i] = 1;
+                ok = 1;
+            }
+        }
+        if (!ok)
+            return 0;
+    }
+    return 1;
+}
+
+size_t ag_rules_max_count(const ag_splittree *t)
+{
+    size_t m = 0;
+    for (size_t r = 0; r < t->nrules; r++)
+        if (t->rule_count[r] > m)
+            m = t->rule_count[r];
+    return m;
+}
+
+ag_status ag_rules_label(ag_splittree *t, ag_error *err)
+{
+    size_t N = t->nnodes;
+    /* per label: list of rules whose representative has that label */
+    int32_t maxlabel = -1;
+    for (size_t i = 0; i < N; i++)
+        if (t->nodes[i].label > maxlabel)
+            maxlabel = t->nodes[i].label;
+    int32_t *lhead = malloc(((size_t)maxlabel + 2) * sizeof *lhead);
+    int32_t *rnext = malloc((N + 1) * sizeof *rnext);
+    int32_t *ca = malloc((N + 1) * sizeof *ca), *cb = malloc((N + 1) * sizeof *cb);
+    uint8_t *used = malloc(N + 1);
+    free(t->rule_count);
+    free(t->rule_rep);
+    t->rule_count = malloc((N + 1) * sizeof *t->rule_count);
+    t->rule_rep = malloc((N + 1) * sizeof *t->rule_rep);
+    t->nrules = 0;
+    if (!lhead || !rnext || !ca || !cb || !used || !t->rule_count || !t->rule_rep) {
+        free(lhead);
+        free(rnext);
+        free(ca);
+        free(cb);
+        free(used);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
+    }
+    for (int32_t l = 0; l <= maxlabel; l++)
+        lhead[l] = -1;
+    /* parents are created before their children: reverse order visits children first */
+    for (size_t ii = N; ii-- > 0;) {
+        ag_tnode *b = &t->nodes[ii];
+        if (b->kind != AG_NODE_COMPONENT)
+            continue;
+        size_t nb = children(t, (int32_t)ii, NULL, 0);
+        int32_t found = -1;
+        int fk = 0;
+        for (int32_t r = lhead[b->label]; r >= 0 && found < 0; r = rnext[r]) {
+            int32_t a = t->rule_rep[r];
+            if (children(t, a, NULL, 0) != nb)
+                continue;
+            int k = (b->rot - t->nodes[a].rot) & 3;
+            if (same(t, a, (int32_t)ii, k, ca, cb, used, nb)) {
+                found = r;
+                fk = k;
+            }
+        }
+        if (found < 0) {
+            found = (int32_t)t->nrules++;
+            t->rule_rep[found] = (int32_t)ii;
+            t->rule_count[found] = 0;
+            rnext[found] = lhead[b->label];
+            lhead[b->label] = found;
+            fk = 0;
+        }
+        b->rule = found;
+        b->rule_rot = (uint8_t)fk;
+        t->rule_count[found]++;
+    }
+    free(lhead);
+    free(rnext);
+    free(ca);
+    free(cb);
+    free(used);
+    return AG_OK;
+}

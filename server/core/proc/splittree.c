@@ -1,0 +1,345 @@
+#include "splittree.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void ag_splittree_free(ag_splittree *t)
+{
+    if (!t)
+        return;
+    free(t->nodes);
+    free(t->comp_node);
+    free(t->adj);
+    free(t->rule_count);
+    free(t->rule_rep);
+    free(t->patterns);
+    free(t);
+}
+
+ag_box ag_splittree_child_box(const ag_box *p, const double pivot[3], int octant)
+{
+    ag_box b;
+    int q = octant - 1;
+    for (int a = 0; a < 3; a++) {
+        double v = p->min[a] + pivot[a];
+        if (q >> a & 1) {
+            b.min[a] = v;
+            b.max[a] = p->max[a];
+        } else {
+            b.min[a] = p->min[a];
+            b.max[a] = v;
+        }
+    }
+    return b;
+}
+
+int32_t ag_splittree_chain_end(const ag_splittree *t, int32_t n)
+{
+    while (n >= 0 && t->nodes[n].kind == AG_NODE_SPLIT)
+        n = t->nodes[n].first_child;
+    return n;
+}
+
+static int32_t new_node(ag_splittree *t, int kind)
+{
+    if (t->nnodes == t->cap) {
+        size_t nc = t->cap ? 2 * t->cap : 64;
+        ag_tnode *nn = realloc(t->nodes, nc * sizeof *nn);
+        if (!nn)
+            return -1;
+        t->nodes = nn;
+        t->cap = nc;
+    }
+    int32_t i = (int32_t)t->nnodes++;
+    ag_tnode *n = &t->nodes[i];
+    memset(n, 0, sizeof *n);
+    n->parent = n->first_child = n->last_child = n->next_sibling = -1;
+    n->component = n->label = n->rule = n->pattern = -1;
+    n->kind = (uint8_t)kind;
+    return i;
+}
+
+void ag_splittree_attach(ag_splittree *t, int32_t parent, int32_t child)
+{
+    ag_tnode *p = &t->nodes[parent];
+    t->nodes[child].parent = parent;
+    t->nodes[child].next_sibling = -1;
+    if (p->last_child >= 0)
+        t->nodes[p->last_child].next_sibling = child;
+    else
+        p->first_child = child;
+    p->last_child = child;
+}
+
+int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *c, int kind)
+{
+    const ag_box P = t->nodes[parent].box;
+    double eps = t->eps;
+    int done[3], single = 1;
+    double piv[3];
+    int q = 0;
+    for (int a = 0; a < 3; a++) {
+        int lo = fabs(c->min[a] - P.min[a]) <= eps, hi = fabs(c->max[a] - P.max[a]) <= eps;
+        done[a] = 1;
+        if (lo) {
+            piv[a] = c->max[a] - P.min[a];
+        } else if (hi) {
+            piv[a] = c->min[a] - P.min[a];
+            q |= 1 << a;
+        } else {
+            piv[a] = c->min[a] - P.min[a];
+            q |= 1 << a;
+            done[a] = 0;
+            single = 0;
+        }
+        double size = P.max[a] - P.min[a];
+        if (piv[a] < 0)
+            piv[a] = 0;
+        if (piv[a] > size)
+            piv[a] = size;
+    }
+    int32_t n = new_node(t, single ? kind : AG_NODE_SPLIT);
+    if (n < 0)
+        return -1;
+    memcpy(t->nodes[n].pivot, piv, sizeof piv);
+    t->nodes[n].octant = (uint8_t)(q + 1);
+    t->nodes[n].box = ag_splittree_child_box(&t->nodes[parent].box, piv, q + 1);
+    ag_splittree_attach(t, parent, n);
+    if (single)
+        return n;
+    const ag_box I = t->nodes[n].box;
+    q = 0;
+    for (int a = 0; a < 3; a++) {
+        if (done[a]) {
+            piv[a] = 0;
+            q |= 1 << a;
+        } else {
+            piv[a] = c->max[a] - I.min[a];
+            double size = I.max[a] - I.min[a];
+            if (piv[a] < 0)
+                piv[a] = 0;
+            if (piv[a] > size)
+                piv[a] = size;
+        }
+    }
+    int32_t m = new_node(t, kind);
+    if (m < 0)
+        return -1;
+    memcpy(t->nodes[m].pivot, piv, sizeof piv);
+    t->nodes[m].octant = (uint8_t)(q + 1);
+    t->nodes[m].box = ag_splittree_child_box(&t->nodes[n].box, piv, q + 1);
+    ag_splittree_attach(t, n, m);
+    return m;
+}
+
+typedef struct {
+    double vol;
+    uint32_t c;
+} volc;
+
+static int cmp_volc(const void *a, const void *b)
+{
+    const volc *x = a, *y = b;
+    if (x->vol != y->vol)
+        return x->vol > y->vol ? -1 : 1;
+    return x->c < y->c ? -1 : x->c > y->c;
+}
+
+static double fvol(const ag_box *b, double floor_)
+{
+    double v = 1;
+    for (int a = 0; a < 3; a++) {
+        double d = b->max[a] - b->min[a];
+        v *= d > floor_ ? d : floor_;
+    }
+    return v;
+}
+
+static int encloses(const ag_box *o, const ag_box *i, double eps)
+{
+    for (int a = 0; a < 3; a++)
+        if (i->min[a] < o->min[a] - eps || i->max[a] > o->max[a] + eps)
+            return 0;
+    return 1;
+}
+
+typedef struct {
+    double x;
+    uint32_t n;
+} xn;
+
+static int cmp_xn(const void *a, const void *b)
+{
+    const xn *p = a, *q = b;
+    if (p->x != q->x)
+        return p->x < q->x ? -1 : 1;
+    return p->n < q->n ? -1 : p->n > q->n;
+}
+
+static ag_status adjacency(ag_splittree *t)
+{
+    size_t nv = 0;
+    for (size_t i = 0; i < t->nnodes; i++)
+        nv += t->nodes[i].kind == AG_NODE_COMPONENT;
+    xn *s = malloc((nv + 1) * sizeof *s);
+    if (!s)
+        return AG_ERR_NOMEM;
+    size_t k = 0;
+    for (size_t i = 0; i < t->nnodes; i++)
+        if (t->nodes[i].kind == AG_NODE_COMPONENT) {
+            s[k].x = t->nodes[i].box.min[0];
+            s[k++].n = (uint32_t)i;
+        }
+    qsort(s, nv, sizeof *s, cmp_xn);
+    size_t cap = 0;
+    double tol = t->tol;
+    for (size_t i = 0; i < nv; i++) {
+        const ag_box *a = &t->nodes[s[i].n].box;
+        for (size_t j = i + 1; j < nv && s[j].x <= a->max[0] + tol; j++) {
+            const ag_box *b = &t->nodes[s[j].n].box;
+            if (b->min[1] > a->max[1] + tol || a->min[1] > b->max[1] + tol ||
+                b->min[2] > a->max[2] + tol || a->min[2] > b->max[2] + tol)
+                continue;
+            if (t->nadj == cap) {
+                size_t nc = cap ? 2 * cap : 256;
+                uint32_t *na = realloc(t->adj, 2 * nc * sizeof *na);
+                if (!na) {
+                    free(s);
+                    return AG_ERR_NOMEM;
+                }
+                t->adj = na;
+                cap = nc;
+            }
+            uint32_t x = s[i].n, y = s[j].n;
+            t->adj[2 * t->nadj] = x < y ? x : y;
+            t->adj[2 * t->nadj + 1] = x < y ? y : x;
+            t->nadj++;
+        }
+    }
+    free(s);
+    return AG_OK;
+}
+
+ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree **out,
+                             ag_error *err)
+{
+    *out = NULL;
+    ag_splittree *t = calloc(1, sizeof *t);
+    size_t nc = L->ncomponents;
+    volc *order = malloc((nc + 1) * sizeof *order);
+    if (!t || !order)
+        goto nomem;
+    t->ncomponents = nc;
+    t->comp_node = malloc((nc + 1) * sizeof *t->comp_node);
+    if (!t->comp_node)
+        goto nomem;
+    double diag = L->diagonal > 0 ? L->diagonal : 1.0;
+    t->tol = L->tol;
+    t->eps = 1e-9 * diag;
+    int32_t root = new_node(t, AG_NODE_ROOT);
+    if (root < 0)
+        goto nomem;
+    ag_box all = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    size_t n = 0;
+    for (size_t c = 0; c < nc; c++) {
+        t->comp_node[c] = -1;
+        if (!L->ntris[c])
+            continue;
+        for (int a = 0; a < 3; a++) {
+            if (L->box[c].min[a] < all.min[a])
+                all.min[a] = L->box[c].min[a];
+            if (L->box[c].max[a] > all.max[a])
+                all.max[a] = L->box[c].max[a];
+        }
+        order[n].vol = fvol(&L->box[c], 1e-3 * diag);
+        order[n++].c = (uint32_t)c;
+    }
+    if (n == 0) {
+        ag_splittree_free(t);
+        free(order);
+        return ag_error_set(err, AG_ERR_EMPTY, 0, "no component has triangles");
+    }
+    t->nodes[root].box = all;
+    qsort(order, n, sizeof *order, cmp_volc);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t c = order[i].c;
+        const ag_box *cb = &L->box[c];
+        int32_t P = root;
+        for (;;) {
+            int32_t best = -1;
+            double bv = INFINITY;
+            for (int32_t s = t->nodes[P].first_child; s >= 0; s = t->nodes[s].next_sibling) {
+                int32_t e = ag_splittree_chain_end(t, s);
+                if (e < 0 || t->nodes[e].kind != AG_NODE_COMPONENT)
+                    continue;
+                if (!encloses(&t->nodes[e].box, cb, t->eps))
+                    continue;
+                double v = fvol(&t->nodes[e].box, 1e-3 * diag);
+                if (v < bv) {
+                    bv = v;
+                    best = e;
+                }
+            }
+            if (best < 0)
+                break;
+            P = best;
+        }
+        int32_t k = ag_splittree_insert(t, P, cb, AG_NODE_COMPONENT);
+        if (k < 0)
+            goto nomem;
+        t->nodes[k].component = (int32_t)c;
+        t->nodes[k].label = L->label[c];
+        t->nodes[k].rot = L->rot[c];
+        t->comp_node[c] = k;
+    }
+    free(order);
+    order = NULL;
+    if (adjacency(t))
+        goto nomem;
+    *out = t;
+    return AG_OK;
+nomem:
+    free(order);
+    ag_splittree_free(t);
+    return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while building the split tree");
+}
+
+ag_splittree_stats ag_splittree_stats_of(const ag_splittree *t)
+{
+    ag_splittree_stats s = {0};
+    /* patterns re-parent nodes to later nodes, so depths are memoised walking up */
+    int32_t *depth = malloc((t->nnodes + 1) * sizeof *depth);
+    if (depth)
+        for (size_t i = 0; i < t->nnodes; i++)
+            depth[i] = -1;
+    for (size_t i = 0; i < t->nnodes; i++) {
+        const ag_tnode *n = &t->nodes[i];
+        if (n->kind == AG_NODE_DEAD)
+            continue;
+        s.nodes++;
+        if (n->kind == AG_NODE_COMPONENT)
+            s.visible++;
+        else
+            s.invisible++;
+        if (!depth)
+            continue;
+        int32_t d = 0, j = (int32_t)i;
+        while (j >= 0 && depth[j] < 0) {
+            j = t->nodes[j].parent;
+            d++;
+        }
+        int32_t base = j >= 0 ? depth[j] : -1;
+        /* second walk fills the memo */
+        j = (int32_t)i;
+        int32_t k = base + d;
+        while (j >= 0 && depth[j] < 0) {
+            depth[j] = k--;
+            j = t->nodes[j].parent;
+        }
+        if ((size_t)depth[i] > s.depth)
+            s.depth = (size_t)depth[i];
+    }
+    free(depth);
+    return s;
+}
