@@ -22,7 +22,7 @@ DB      ?= var/archgram.db
 
 # Debian packages: to build and run, and in addition to test.
 DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libwebsockets-dev \
-             libsqlite3-dev libsuitesparse-dev libassimp-dev nodejs npm
+             libsqlite3-dev libsuitesparse-dev libassimp-dev
 DEB_TEST  := libcmocka-dev chromium curl
 DEB_BENCH := wrk
 
@@ -61,6 +61,14 @@ endef
 
 deps:
 	$(call install_missing,$(DEB_BUILD))
+	@# Node may come from Debian (nodejs + npm) or from a nodejs build that bundles npm and
+	@# conflicts with Debian's npm package: ask for the commands, not the packages.
+	@if ! command -v node >/dev/null || ! command -v npm >/dev/null; then \
+	  echo "archgram: installing Node.js and npm"; \
+	  SUDO=; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+	  $$SUDO apt-get update -q && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y --no-install-recommends nodejs npm; \
+	fi
 	@$(MAKE) --no-print-directory npm
 
 deps-test: deps
@@ -132,7 +140,7 @@ test: deps-test all
 test-unit: $(UNIT_BIN)
 	@pass=0; fail=0; for t in $(UNIT_BIN); do \
 	  if $$t; then pass=$$((pass+1)); else fail=$$((fail+1)); echo "FAILED: $$t"; fi; \
-	done; echo "unit suites: $$pass passed, $$fail failed"; [ $$fail = 0 ]
+	done; echo "unit: $$pass passed, $$fail failed"; [ $$fail = 0 ]
 
 test-integration: $(BUILD)/archgramd $(BUILD)/archgram
 	node --test --test-concurrency=1 tests/integration/
@@ -143,6 +151,7 @@ test-browser: $(BUILD)/archgramd web
 # --- benchmarks ---------------------------------------------------------------------------
 bench: deps-bench all
 	@for b in bench/*.sh; do [ -f "$$b" ] && sh "$$b"; done; true
+	@for b in bench/*.js; do [ -f "$$b" ] && node "$$b"; done; true
 	@for b in $(BENCH_BIN); do $$b; done
 
 clean:

@@ -628,9 +628,12 @@ ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_opt
                           r.m->nverts);
         goto done;
     }
-    /* Without any group the connected pieces are the components; groups holding several
-     * loose pieces are kept whole here (the proceduralization stage decides). */
-    if (r.m->ngroups == 0 && (st = ag_mesh_split_connected(r.m)) != AG_OK) {
+    /* Without any group the connected pieces are the components, and so they are when one
+     * group (typically a lone `o`) holds the whole file: it carries no segmentation. Files
+     * with several groups keep them whole, even with loose pieces inside (the
+     * proceduralization stage decides). */
+    if ((r.m->ngroups == 0 || (r.m->ngroups == 1 && r.m->ncomponents == 1)) &&
+        (st = ag_mesh_split_connected(r.m)) != AG_OK) {
         st = ag_error_set(err, st, 0, "out of memory");
         goto done;
     }

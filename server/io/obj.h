@@ -11,8 +11,10 @@
  * gets a face does not exist; a group named again later continues the same group (and
  * component); a bare `g` is the group "default"; the name is the rest of the line.
  * Faces before any g/o form a group-less component (group -1). A file with no group at
- * all gets one component per connected piece (ag_mesh_split_connected). A group made of
- * several loose pieces stays one component here: the proceduralization stage decides.
+ * all, or whose only group holds every face (a lone `o`, which segments nothing), gets one
+ * component per connected piece (ag_mesh_split_connected), keeping that group. In files with
+ * several groups, a group made of loose pieces stays one component: the proceduralization
+ * stage decides.
  *
  * Degenerate faces: a triangle of the fan that repeats a vertex index is dropped silently;
  * geometrically flat (zero-area) triangles are kept for later stages to judge.

@@ -151,10 +151,26 @@ static void test_no_groups_splits_connected(void **state)
 
 static void test_group_loose_pieces_not_split(void **state)
 {
+    /* Two groups: the loose pieces inside "columns" stay one component. */
     ag_mesh *m = parse_ok("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 0 0\nv 6 0 0\nv 5 1 0\n"
-                          "o columns\nf 1 2 3\nf 4 5 6\n",
+                          "v 9 0 0\nv 9 1 0\n"
+                          "o columns\nf 1 2 3\nf 4 5 6\no wall\nf 5 7 8\n",
                           AG_UP_Z);
-    assert_int_equal(m->ncomponents, 1);
+    assert_int_equal(m->ngroups, 2);
+    assert_int_equal(m->ncomponents, 2);
+    ag_mesh_free(m);
+}
+
+static void test_lone_object_splits_connected(void **state)
+{
+    /* One `o` around everything segments nothing: its pieces become the components. */
+    ag_mesh *m = parse_ok("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 0 0\nv 6 0 0\nv 5 1 0\n"
+                          "o temple\nf 1 2 3\nf 4 5 6\n",
+                          AG_UP_Z);
+    assert_int_equal(m->ngroups, 1);
+    assert_int_equal(m->ncomponents, 2);
+    assert_int_equal(m->component_group[0], 0);
+    assert_int_equal(m->component_group[1], 0);
     ag_mesh_free(m);
 }
 
@@ -491,8 +507,7 @@ static void test_shared_0ad_connected_pieces(void **state)
         assert_int_equal(st, AG_OK);
         assert_int_equal(m->nverts, nv);
         assert_int_equal(m->ntris, nt);
-        assert_int_equal(m->ncomponents, 1);
-        assert_int_equal(ag_mesh_split_connected(m), AG_OK);
+        /* A lone `o`: the reader already splits it into the loose parts the README counts. */
         assert_int_equal(m->ncomponents, nc);
         assert_int_equal(m->component_group[nc - 1], 0);
         ag_mesh_free(m);
@@ -557,6 +572,7 @@ int main(void)
         cmocka_unit_test(test_groups_to_components),
         cmocka_unit_test(test_no_groups_splits_connected),
         cmocka_unit_test(test_group_loose_pieces_not_split),
+        cmocka_unit_test(test_lone_object_splits_connected),
         cmocka_unit_test(test_lexical_variety),
         cmocka_unit_test(test_continued_group_name),
         cmocka_unit_test(test_repeated_index_dropped_flat_kept),
