@@ -20,6 +20,10 @@ static const struct {
 } commands[] = {
     {"info", ag_cli_info, "info FILE [--up y|z] [--json]   counts, groups and bounds of a mesh"},
     {"convert", ag_cli_convert, "convert IN OUT [--up y|z]       convert a mesh (OUT: .obj or .glb)"},
+    {"proceduralize", ag_cli_proceduralize,
+     "proceduralize IN --out DIR [--up y|z]  split grammar + terminals + summary.json"},
+    {"derive", ag_cli_derive, "derive GRAMMAR --out FILE.obj|FILE.glb  derive a grammar into a mesh"},
+    {"fmt", ag_cli_fmt, "fmt GRAMMAR                     print a grammar in canonical form"},
 };
 
 #define NCOMMANDS (sizeof commands / sizeof commands[0])

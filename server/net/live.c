@@ -31,6 +31,7 @@ typedef struct session {
     struct lws *wsi;
     uint64_t id;
     int64_t model; /* 0: in no room */
+    int64_t seen;  /* the newest model version this session has been told of */
     char user[801];
     char *presence; /* last state, JSON text */
     char *rx;
@@ -40,6 +41,7 @@ typedef struct session {
     size_t out_count;
     int closing;
     int64_t watch[AG_LIVE_MAX_WATCH];
+    double watch_progress[AG_LIVE_MAX_WATCH]; /* the last progress sent for that job */
     int nwatch;
     struct session *prev, *next;
 } session;
@@ -203,6 +205,7 @@ static void on_hello(ag_live *live, session *s, json_t *msg)
 
     leave_room(live, s);
     s->model = model;
+    s->seen = version;
     snprintf(s->user, sizeof s->user, "%s", user);
 
     json_t *peers = json_array();
@@ -325,17 +328,23 @@ static void on_watch(ag_live *live, session *s, json_t *msg)
         return send_problem(s, st, &err);
     json_t *view = ag_view_job(&row);
     int done = job_finished(row.status);
+    double progress = row.progress;
     ag_jobs_row_clear(&row);
     if (!done) {
-        int known = 0;
+        int slot = -1;
         for (int i = 0; i < s->nwatch; i++)
-            known |= s->watch[i] == id;
-        if (!known && s->nwatch >= AG_LIVE_MAX_WATCH) {
+            if (s->watch[i] == id)
+                slot = i;
+        if (slot < 0 && s->nwatch >= AG_LIVE_MAX_WATCH) {
             json_decref(view);
             return send_error(s, AG_ERR_BUSY, "a connection watches at most 16 jobs at once%s", "");
         }
-        if (!known)
-            s->watch[s->nwatch++] = id;
+        if (slot < 0) {
+            slot = s->nwatch++;
+            s->watch[slot] = id;
+        }
+        /* Events queued before this snapshot may still arrive: older progress is dropped. */
+        s->watch_progress[slot] = progress;
     }
     send_json(s, job_message(view));
     json_decref(view);
@@ -409,22 +418,34 @@ static void deliver(ag_live *live, pending *p)
                                 "cid", p->cid ? p->cid : "", "op", op ? op : json_null());
         char *text = msg ? json_dumps(msg, JSON_COMPACT) : NULL;
         json_decref(msg);
-        for (session *s = live->sessions; text && s; s = s->next)
-            if (s->model == p->model && s->id != p->origin)
+        /* A session that joined after the op was committed has it in its welcome already. */
+        for (session *s = live->sessions; text && s; s = s->next) {
+            if (s->model != p->model || p->version <= s->seen)
+                continue;
+            s->seen = p->version;
+            if (s->id != p->origin)
                 send_text(s, text);
+        }
         free(text);
     } else if (p->kind == AG_EVENT_JOB) {
         json_t *job = p->json ? json_loads(p->json, 0, NULL) : NULL;
         json_t *msg = job ? job_message(job) : NULL;
         char *text = msg ? json_dumps(msg, JSON_COMPACT) : NULL;
         int done = job && job_finished(json_string_value(json_object_get(job, "status")) ?: "");
+        double progress = json_number_value(json_object_get(job, "progress"));
         for (session *s = live->sessions; text && s; s = s->next) {
             for (int i = 0; i < s->nwatch; i++) {
                 if (s->watch[i] != p->job)
                     continue;
-                send_text(s, text);
-                if (done)
-                    s->watch[i] = s->watch[--s->nwatch];
+                if (done) {
+                    send_text(s, text);
+                    s->nwatch--;
+                    s->watch[i] = s->watch[s->nwatch];
+                    s->watch_progress[i] = s->watch_progress[s->nwatch];
+                } else if (progress > s->watch_progress[i]) {
+                    send_text(s, text);
+                    s->watch_progress[i] = progress;
+                }
                 break;
             }
         }

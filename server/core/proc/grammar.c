@@ -306,6 +306,7 @@ typedef struct {
     uint32_t *apps;      /* per class */
     int32_t *exemplar;   /* per class: node */
     uint8_t *visited;    /* per class */
+    uint8_t *in_pattern; /* per class: used by a subdivide */
     int32_t *rule_of;    /* per class: grammar rule */
     int32_t *term_of;    /* per label: terminal */
     uint32_t *vmap;      /* scratch: vertex → terminal vertex */
@@ -322,6 +323,9 @@ static int is_rule(exctx *x, int32_t cls)
         return 0;
     if (x->pass == 1)
         return x->t->rule_count[cls] >= 2;
+    /* a repeated lone terminal is placed directly unless a pattern needs it as a rule */
+    if (x->t->nodes[x->exemplar[cls]].first_child < 0 && !x->in_pattern[cls])
+        return 0;
     return x->apps[cls] >= 2;
 }
 
@@ -378,6 +382,8 @@ static int32_t use_rule(exctx *x, int32_t cls, int32_t node, int weight)
 {
     if (x->pass == 1) {
         x->apps[cls] += (uint32_t)weight;
+        if (weight > 1)
+            x->in_pattern[cls] = 1;
         if (!x->visited[cls]) {
             x->visited[cls] = 1;
             x->exemplar[cls] = node;
@@ -486,13 +492,14 @@ ag_status ag_grammar_export(const ag_mesh *m, const ag_labels *L, const ag_split
     x.apps = calloc(nc + 1, sizeof *x.apps);
     x.exemplar = malloc((nc + 1) * sizeof *x.exemplar);
     x.visited = calloc(nc + 1, 1);
+    x.in_pattern = calloc(nc + 1, 1);
     x.rule_of = malloc((nc + 1) * sizeof *x.rule_of);
     x.term_of = malloc((L->nlabels + 1) * sizeof *x.term_of);
     x.vmap = malloc((m->nverts + 1) * sizeof *x.vmap);
     x.tpos = malloc((9 * maxt + 3) * sizeof *x.tpos);
     x.ttri = malloc((3 * maxt + 3) * sizeof *x.ttri);
     ag_status st = AG_ERR_NOMEM;
-    if (!x.g || !x.apps || !x.exemplar || !x.visited || !x.rule_of || !x.term_of || !x.vmap ||
+    if (!x.g || !x.apps || !x.exemplar || !x.visited || !x.in_pattern || !x.rule_of || !x.term_of || !x.vmap ||
         !x.tpos || !x.ttri)
         goto done;
     for (size_t i = 0; i < nc; i++)
@@ -539,6 +546,7 @@ done:
     free(x.apps);
     free(x.exemplar);
     free(x.visited);
+    free(x.in_pattern);
     free(x.rule_of);
     free(x.term_of);
     free(x.vmap);

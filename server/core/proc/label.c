@@ -184,7 +184,7 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
 {
     ag_label_options o = opt ? *opt : (ag_label_options){0};
     if (o.tolerance <= 0)
-        o.tolerance = 1e-6;
+        o.tolerance = 1e-5;
     *out = NULL;
     size_t nc = m->ncomponents;
     ag_labels *L = calloc(1, sizeof *L);

@@ -16,7 +16,7 @@
 #include "../status.h"
 
 typedef struct {
-    double tolerance; /* relative to the model diagonal; 0 = 1e-6 */
+    double tolerance; /* relative to the model diagonal; 0 = 1e-5 */
     int no_rotation;  /* non-zero: do not match quarter turns */
 } ag_label_options;
 

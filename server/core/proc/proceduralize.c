@@ -69,7 +69,7 @@ ag_status ag_proceduralize_run(const ag_mesh *in, const ag_proceduralize_options
         t0 = now();
         st = ag_grammar_derive(r->grammar, NULL, &d, err);
         if (!st)
-            st = ag_grammar_fidelity(r->mesh, d, 0, &r->fidelity, err);
+            st = ag_grammar_fidelity(r->mesh, d, 10 * r->labels->tol, &r->fidelity, err);
         ag_mesh_free(d);
         r->seconds[AG_STAGE_VERIFY] = now() - t0;
         if (st)

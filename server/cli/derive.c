@@ -1,0 +1,177 @@
+/* archgram derive GRAMMAR --out FILE.obj|FILE.glb [--compare MESH [--up y|z]] */
+#include <errno.h>
+#include <libgen.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/proc/proceduralize.h"
+#include "../io/glb.h"
+#include "../io/grammar_text.h"
+#include "../io/terminals.h"
+#include "commands.h"
+
+static int usage(void)
+{
+    fputs("usage: archgram derive GRAMMAR --out FILE.obj|FILE.glb [--compare MESH [--up y|z]]\n",
+          stderr);
+    return 2;
+}
+
+static int ends_with(const char *s, const char *suf)
+{
+    size_t a = strlen(s), b = strlen(suf);
+    return a >= b && !strcasecmp(s + a - b, suf);
+}
+
+/* OBJ + MTL: one `usemtl` material per terminal (label), colours spread over the hue circle. */
+static int write_obj_mtl(const ag_mesh *m, const char *path)
+{
+    char mtl[4096];
+    snprintf(mtl, sizeof mtl, "%s", path);
+    size_t n = strlen(mtl);
+    if (n >= 4)
+        mtl[n - 4] = 0;
+    strncat(mtl, ".mtl", sizeof mtl - strlen(mtl) - 1);
+    FILE *fm = fopen(mtl, "w");
+    FILE *f = fopen(path, "w");
+    if (!f || !fm) {
+        fprintf(stderr, "archgram: cannot write %s: %s\n", !f ? path : mtl, strerror(errno));
+        if (f)
+            fclose(f);
+        if (fm)
+            fclose(fm);
+        return 1;
+    }
+    for (size_t g = 0; g < m->ngroups; g++) {
+        double h = g * 0.618033988749895, r, gg, b;
+        h -= (long)h;
+        double x = h * 6;
+        int i = (int)x;
+        double fr = x - i;
+        double v = 0.85, s = 0.55, p = v * (1 - s), q = v * (1 - s * fr), t = v * (1 - s * (1 - fr));
+        switch (i % 6) {
+        case 0: r = v, gg = t, b = p; break;
+        case 1: r = q, gg = v, b = p; break;
+        case 2: r = p, gg = v, b = t; break;
+        case 3: r = p, gg = q, b = v; break;
+        case 4: r = t, gg = p, b = v; break;
+        default: r = v, gg = p, b = q; break;
+        }
+        fprintf(fm, "newmtl %s\nKd %.3f %.3f %.3f\n\n", m->group_names[g], r, gg, b);
+    }
+    const char *base = strrchr(mtl, '/');
+    fprintf(f, "# derived by archgram from a split grammar; z up\nmtllib %s\n",
+            base ? base + 1 : mtl);
+    for (size_t v = 0; v < m->nverts; v++)
+        fprintf(f, "v %.10g %.10g %.10g\n", m->pos[3 * v], m->pos[3 * v + 1], m->pos[3 * v + 2]);
+    size_t t = 0;
+    for (size_t c = 0; c < m->ncomponents; c++) {
+        int32_t g = m->component_group[c];
+        const char *name = g >= 0 ? m->group_names[g] : "none";
+        fprintf(f, "g %s_%zu\nusemtl %s\n", name, c, name);
+        /* derivation emits components in order, each with consecutive triangles */
+        while (t < m->ntris && m->tri_component[t] == c) {
+            fprintf(f, "f %u %u %u\n", m->tri[3 * t] + 1, m->tri[3 * t + 1] + 1,
+                    m->tri[3 * t + 2] + 1);
+            t++;
+        }
+    }
+    int bad = ferror(f) | ferror(fm);
+    bad |= fclose(f) != 0;
+    bad |= fclose(fm) != 0;
+    if (bad) {
+        fprintf(stderr, "archgram: cannot write %s\n", path);
+        return 1;
+    }
+    return 0;
+}
+
+int ag_cli_derive(int argc, char **argv)
+{
+    const char *gpath = NULL, *out = NULL, *cmp = NULL;
+    ag_up_axis up = AG_UP_DEFAULT;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--out")) {
+            if (++i >= argc)
+                return usage();
+            out = argv[i];
+        } else if (!strcmp(argv[i], "--compare")) {
+            if (++i >= argc)
+                return usage();
+            cmp = argv[i];
+        } else if (!strcmp(argv[i], "--up")) {
+            if (++i >= argc || ag_cli_parse_up(argv[i], &up))
+                return usage();
+        } else if (!strcmp(argv[i], "--help")) {
+            fputs("usage: archgram derive GRAMMAR --out FILE.obj|FILE.glb "
+                  "[--compare MESH [--up y|z]]\n",
+                  stdout);
+            return 0;
+        } else if (argv[i][0] == '-' && argv[i][1]) {
+            fprintf(stderr, "archgram: derive: unknown option %s\n", argv[i]);
+            return usage();
+        } else if (!gpath) {
+            gpath = argv[i];
+        } else {
+            return usage();
+        }
+    }
+    if (!gpath || !out || !(ends_with(out, ".obj") || ends_with(out, ".glb")))
+        return usage();
+    ag_error err;
+    ag_error_clear(&err);
+    ag_grammar *g = NULL;
+    long col = 0;
+    ag_status st = ag_grammar_text_read_file(gpath, &g, &err, &col);
+    if (st) {
+        if (st == AG_ERR_PARSE)
+            fprintf(stderr, "%s:%ld:%ld: %s\n", gpath, err.element, col, err.text);
+        else
+            ag_cli_report(gpath, &err);
+        return 1;
+    }
+    char *dcopy = strdup(gpath);
+    int rc = 1;
+    ag_mesh *m = NULL, *input = NULL;
+    if (!dcopy)
+        goto done;
+    if (ag_terminals_load(g, dirname(dcopy), &err) || ag_grammar_derive(g, NULL, &m, &err)) {
+        ag_cli_report(gpath, &err);
+        goto done;
+    }
+    if (ends_with(out, ".glb")) {
+        if (ag_glb_write_file(m, out, &err)) {
+            ag_cli_report(out, &err);
+            goto done;
+        }
+    } else if (write_obj_mtl(m, out)) {
+        goto done;
+    }
+    printf("%s: %zu triangles, %zu vertices, %zu placed terminals\n", out, m->ntris, m->nverts,
+           m->ncomponents);
+    rc = 0;
+    if (cmp) {
+        size_t bytes;
+        if (ag_cli_load_mesh(cmp, up, &input, &bytes)) {
+            rc = 1;
+            goto done;
+        }
+        ag_fidelity f;
+        if (ag_grammar_fidelity(input, m, 0, &f, &err)) {
+            ag_cli_report(cmp, &err);
+            rc = 1;
+            goto done;
+        }
+        printf("compared with %s: max error %.3g (%.3g of the diagonal), %zu of %zu input "
+               "triangles unmatched\n",
+               cmp, f.max_error, f.relative, f.unmatched, f.input_triangles);
+        rc = f.unmatched ? 1 : 0;
+    }
+done:
+    free(dcopy);
+    ag_mesh_free(m);
+    ag_mesh_free(input);
+    ag_grammar_free(g);
+    return rc;
+}

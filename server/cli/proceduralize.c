@@ -1,0 +1,282 @@
+/* archgram proceduralize IN --out DIR [--up y|z] [--tolerance REL] [--keep-groups] */
+#include <errno.h>
+#include <jansson.h>
+#include <libgen.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "../core/proc/proceduralize.h"
+#include "../io/grammar_text.h"
+#include "../io/terminals.h"
+#include "commands.h"
+
+static int usage(void)
+{
+    fputs("usage: archgram proceduralize IN --out DIR [--up y|z] [--tolerance REL] "
+          "[--keep-groups]\n",
+          stderr);
+    return 2;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static json_t *vec3(const double *v)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < 3; i++)
+        json_array_append_new(a, json_real(v[i]));
+    return a;
+}
+
+/* mkdir -p */
+static int make_dirs(const char *dir)
+{
+    char p[4096];
+    snprintf(p, sizeof p, "%s", dir);
+    for (char *s = p + 1; *s; s++)
+        if (*s == '/') {
+            *s = 0;
+            if (mkdir(p, 0777) && errno != EEXIST)
+                return -1;
+            *s = '/';
+        }
+    return mkdir(p, 0777) && errno != EEXIST ? -1 : 0;
+}
+
+static int write_file(const char *path, const char *data, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    int ok = f && fwrite(data, 1, len, f) == len;
+    if (f && fclose(f))
+        ok = 0;
+    if (!ok)
+        fprintf(stderr, "archgram: cannot write %s: %s\n", path, strerror(errno));
+    return ok ? 0 : 1;
+}
+
+int ag_cli_proceduralize(int argc, char **argv)
+{
+    const char *in = NULL, *dir = NULL;
+    ag_up_axis up = AG_UP_DEFAULT;
+    ag_proceduralize_options po = {0};
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--out")) {
+            if (++i >= argc)
+                return usage();
+            dir = argv[i];
+        } else if (!strcmp(argv[i], "--up")) {
+            if (++i >= argc || ag_cli_parse_up(argv[i], &up)) {
+                fputs("archgram: --up takes y or z\n", stderr);
+                return 2;
+            }
+        } else if (!strcmp(argv[i], "--tolerance")) {
+            char *e;
+            if (++i >= argc || (po.label.tolerance = strtod(argv[i], &e), *e) ||
+                !(po.label.tolerance > 0 && po.label.tolerance < 0.1)) {
+                fputs("archgram: --tolerance takes a number in (0, 0.1)\n", stderr);
+                return 2;
+            }
+        } else if (!strcmp(argv[i], "--keep-groups")) {
+            po.segment.keep_groups = 1;
+        } else if (!strcmp(argv[i], "--help")) {
+            fputs("usage: archgram proceduralize IN --out DIR [--up y|z] [--tolerance REL] "
+                  "[--keep-groups]\n",
+                  stdout);
+            return 0;
+        } else if (argv[i][0] == '-' && argv[i][1]) {
+            fprintf(stderr, "archgram: proceduralize: unknown option %s\n", argv[i]);
+            return usage();
+        } else if (!in) {
+            in = argv[i];
+        } else {
+            return usage();
+        }
+    }
+    if (!in || !dir)
+        return usage();
+
+    double t_all = now(), t0 = now();
+    ag_mesh *m = NULL;
+    size_t bytes = 0;
+    if (ag_cli_load_mesh(in, up, &m, &bytes))
+        return 1;
+    double t_import = now() - t0;
+
+    ag_error err;
+    ag_error_clear(&err);
+    ag_proceduralize_result *r = NULL;
+    if (ag_proceduralize_run(m, &po, &r, &err)) {
+        ag_cli_report(in, &err);
+        ag_mesh_free(m);
+        return 1;
+    }
+    int rc = 1;
+    char *text = NULL;
+    size_t tlen = 0, term_bytes = 0;
+    char path[4096];
+    ag_grammar *back = NULL;
+    ag_mesh *derived = NULL;
+    json_t *j = NULL;
+
+    t0 = now();
+    if (make_dirs(dir)) {
+        fprintf(stderr, "archgram: cannot create %s: %s\n", dir, strerror(errno));
+        goto done;
+    }
+    if (ag_terminals_write(r->grammar, dir, &term_bytes, &err) ||
+        ag_grammar_text_print(r->grammar, &text, &tlen, &err)) {
+        ag_cli_report(dir, &err);
+        goto done;
+    }
+    snprintf(path, sizeof path, "%s/grammar.txt", dir);
+    if (write_file(path, text, tlen))
+        goto done;
+    double t_export = r->seconds[AG_STAGE_EXPORT] + (now() - t0);
+    double t_total = now() - t_all;
+
+    /* verify the files as written: parse, load terminals, derive, compare */
+    t0 = now();
+    long col = 0;
+    ag_fidelity fid = {0};
+    if (ag_grammar_text_read_file(path, &back, &err, &col)) {
+        fprintf(stderr, "archgram: %s:%ld:%ld: %s\n", path, err.element, col, err.text);
+        goto done;
+    }
+    if (ag_terminals_load(back, dir, &err) || ag_grammar_derive(back, NULL, &derived, &err) ||
+        ag_grammar_fidelity(r->mesh, derived, 10 * r->labels->tol, &fid, &err)) {
+        ag_cli_report(path, &err);
+        goto done;
+    }
+    double t_verify = now() - t0;
+
+    ag_splittree_stats ts = ag_splittree_stats_of(r->tree);
+    j = json_object();
+    json_t *ji = json_object();
+    json_object_set_new(ji, "file", json_string(in));
+    json_object_set_new(ji, "triangles", json_integer((json_int_t)m->ntris));
+    json_object_set_new(ji, "vertices", json_integer((json_int_t)m->nverts));
+    json_object_set_new(ji, "components", json_integer((json_int_t)r->mesh->ncomponents));
+    json_object_set_new(ji, "groups", json_integer((json_int_t)m->ngroups));
+    json_object_set_new(ji, "bytes", json_integer((json_int_t)bytes));
+    json_object_set_new(ji, "up", json_string(up == AG_UP_Z ? "z" : "y"));
+    json_object_set_new(ji, "normalization",
+                        json_string(up == AG_UP_Z ? "input is z-up; units taken as metres"
+                                                  : "y-up input turned to z-up (x, -z, y); "
+                                                    "units taken as metres"));
+    json_object_set_new(ji, "groups_split", json_integer((json_int_t)r->segment.groups_split));
+    json_object_set_new(ji, "planar_fallback", json_boolean(r->segment.planar_fallback));
+    json_object_set_new(j, "input", ji);
+
+    const ag_labels *L = r->labels;
+    json_t *jl = json_array();
+    for (size_t l = 0; l < L->nlabels; l++) {
+        json_t *o = json_object();
+        uint32_t ex = L->exemplar[l];
+        double size[3];
+        for (int a = 0; a < 3; a++)
+            size[a] = L->box[ex].max[a] - L->box[ex].min[a];
+        int32_t ti = r->info.terminal_of_label ? r->info.terminal_of_label[l] : -1;
+        json_object_set_new(o, "label", json_integer((json_int_t)l));
+        json_object_set_new(o, "terminal",
+                            ti >= 0 ? json_string(r->grammar->terminals[ti].name) : json_null());
+        json_object_set_new(o, "count", json_integer(L->count[l]));
+        json_object_set_new(o, "triangles", json_integer(L->ntris[ex]));
+        json_object_set_new(o, "size", vec3(size));
+        json_array_append_new(jl, o);
+    }
+    json_object_set_new(j, "labels", jl);
+
+    json_t *jc = json_array();
+    for (size_t c = 0; c < r->mesh->ncomponents; c++) {
+        json_t *o = json_object();
+        int32_t g = r->mesh->component_group[c];
+        json_object_set_new(o, "index", json_integer((json_int_t)c));
+        json_object_set_new(o, "group", g >= 0 ? json_string(r->mesh->group_names[g]) : json_null());
+        json_object_set_new(o, "label", L->label[c] >= 0 ? json_integer(L->label[c]) : json_null());
+        json_object_set_new(o, "rot", json_integer(90 * L->rot[c]));
+        json_object_set_new(o, "node", r->tree->comp_node[c] >= 0
+                                           ? json_integer(r->tree->comp_node[c])
+                                           : json_null());
+        json_array_append_new(jc, o);
+    }
+    json_object_set_new(j, "components", jc);
+
+    json_t *jt = json_object();
+    json_object_set_new(jt, "nodes", json_integer((json_int_t)ts.nodes));
+    json_object_set_new(jt, "visible", json_integer((json_int_t)ts.visible));
+    json_object_set_new(jt, "invisible", json_integer((json_int_t)ts.invisible));
+    json_object_set_new(jt, "depth", json_integer((json_int_t)ts.depth));
+    json_object_set_new(jt, "adjacent_pairs", json_integer((json_int_t)r->tree->nadj));
+    json_object_set_new(j, "tree", jt);
+    json_object_set_new(j, "rules", json_integer((json_int_t)r->grammar->nrules));
+    json_object_set_new(j, "terminals", json_integer((json_int_t)r->grammar->nterminals));
+
+    json_t *jp = json_array();
+    for (size_t p = 0; p < r->tree->npatterns; p++) {
+        const ag_pattern *pt = &r->tree->patterns[p];
+        int32_t ri = r->info.rule_of_class ? r->info.rule_of_class[pt->rule] : -1;
+        json_t *o = json_object();
+        json_object_set_new(o, "rule", ri >= 0 ? json_string(r->grammar->rules[ri].name) : json_null());
+        json_t *cnt = json_array();
+        for (int a = 0; a < 3; a++)
+            json_array_append_new(cnt, json_integer(pt->counts[a]));
+        json_object_set_new(o, "counts", cnt);
+        json_object_set_new(o, "step", vec3(pt->step));
+        json_object_set_new(o, "rot", json_integer(90 * pt->rot));
+        json_object_set_new(o, "instances",
+                            json_integer((json_int_t)pt->counts[0] * pt->counts[1] * pt->counts[2]));
+        json_array_append_new(jp, o);
+    }
+    json_object_set_new(j, "patterns", jp);
+    json_object_set_new(j, "grammar_bytes", json_integer((json_int_t)tlen));
+    json_object_set_new(j, "terminal_bytes", json_integer((json_int_t)term_bytes));
+    json_t *jf = json_object();
+    json_object_set_new(jf, "max_error", json_real(fid.max_error));
+    json_object_set_new(jf, "relative", json_real(fid.relative));
+    json_object_set_new(jf, "unmatched", json_integer((json_int_t)fid.unmatched));
+    json_object_set_new(jf, "derived_triangles", json_integer((json_int_t)fid.derived_triangles));
+    json_object_set_new(j, "fidelity", jf);
+    json_t *js = json_object();
+    json_object_set_new(js, "import", json_real(t_import));
+    json_object_set_new(js, "segment", json_real(r->seconds[AG_STAGE_SEGMENT]));
+    json_object_set_new(js, "label", json_real(r->seconds[AG_STAGE_LABEL]));
+    json_object_set_new(js, "tree", json_real(r->seconds[AG_STAGE_TREE]));
+    json_object_set_new(js, "rules", json_real(r->seconds[AG_STAGE_RULES]));
+    json_object_set_new(js, "patterns", json_real(r->seconds[AG_STAGE_PATTERNS]));
+    json_object_set_new(js, "export", json_real(t_export));
+    json_object_set_new(js, "total", json_real(t_total));
+    json_object_set_new(js, "verify", json_real(t_verify));
+    json_object_set_new(j, "seconds", js);
+
+    snprintf(path, sizeof path, "%s/summary.json", dir);
+    if (json_dump_file(j, path, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10))) {
+        fprintf(stderr, "archgram: cannot write %s\n", path);
+        goto done;
+    }
+    printf("%s: %zu triangles, %zu components, %zu labels, %zu rules, %zu patterns, "
+           "%zu terminals; grammar %zu + terminals %zu bytes (input %zu); "
+           "max error %.3g (%.3g of the diagonal), %zu unmatched; %.3f s\n",
+           in, m->ntris, r->mesh->ncomponents, L->nlabels, r->grammar->nrules,
+           r->tree->npatterns, r->grammar->nterminals, tlen, term_bytes, bytes, fid.max_error,
+           fid.relative, fid.unmatched, t_total);
+    rc = fid.unmatched ? 1 : 0;
+    if (fid.unmatched)
+        fprintf(stderr, "archgram: %s: the grammar does not reproduce %zu input triangles\n", in,
+                fid.unmatched);
+done:
+    json_decref(j);
+    ag_mesh_free(derived);
+    ag_grammar_free(back);
+    free(text);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+    return rc;
+}
