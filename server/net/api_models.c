@@ -205,6 +205,27 @@ static ag_status precondition(ag_request *r, ag_db *db, int64_t *version, ag_err
     return AG_OK;
 }
 
+/* What every change needs: a connection, the JSON body and the If-Match version. Returns 0
+ * after answering the request itself when one is missing. */
+static int change_request(ag_request *r, ag_db **db, json_t **body, int64_t *base,
+                          enum MHD_Result *rc)
+{
+    ag_error err;
+    *body = NULL;
+    if (!(*db = db_or_reply(r, rc)))
+        return 0;
+    ag_status s = ag_request_json(r, body, &err);
+    if (s == AG_OK && (s = precondition(r, *db, base, &err)) != AG_OK) {
+        json_decref(*body);
+        *body = NULL;
+    }
+    if (s != AG_OK) {
+        *rc = ag_reply_problem(r, s, &err);
+        return 0;
+    }
+    return 1;
+}
+
 static const char *rest_author(ag_request *r)
 {
     const char *user = ag_request_header(r, "X-Archgram-User");
@@ -226,18 +247,12 @@ enum MHD_Result ag_api_model_patch(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
-    if (!db)
-        return rc;
+    ag_db *db;
     json_t *body;
-    ag_status s = ag_request_json(r, &body, &err);
-    if (s != AG_OK)
-        return ag_reply_problem(r, s, &err);
     int64_t base;
-    if ((s = precondition(r, db, &base, &err)) != AG_OK) {
-        json_decref(body);
-        return ag_reply_problem(r, s, &err);
-    }
+    if (!change_request(r, &db, &body, &base, &rc))
+        return rc;
+    ag_status s;
     const char *key;
     json_t *value;
     json_object_foreach(body, key, value) {
@@ -366,18 +381,12 @@ enum MHD_Result ag_api_model_ops_create(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
-    if (!db)
-        return rc;
+    ag_db *db;
     json_t *body;
-    ag_status s = ag_request_json(r, &body, &err);
-    if (s != AG_OK)
-        return ag_reply_problem(r, s, &err);
     int64_t base;
-    if ((s = precondition(r, db, &base, &err)) != AG_OK) {
-        json_decref(body);
-        return ag_reply_problem(r, s, &err);
-    }
+    if (!change_request(r, &db, &body, &base, &rc))
+        return rc;
+    ag_status s;
     char generated[64];
     const char *cid = json_string_value(json_object_get(body, "cid"));
     if (!cid) {

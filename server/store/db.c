@@ -147,3 +147,22 @@ sqlite3_stmt *ag_db_prepare(ag_db *db, const char *sql, ag_error *err)
     }
     return st;
 }
+
+ag_status ag_db_step_done(ag_db *db, sqlite3_stmt *st, const char *doing, ag_error *err)
+{
+    int rc = sqlite3_step(st);
+    ag_status s = rc == SQLITE_DONE ? AG_OK : ag_db_fail(db, err, doing);
+    sqlite3_reset(st);
+    return s;
+}
+
+void ag_db_column_copy(sqlite3_stmt *st, int col, char *dst, size_t cap)
+{
+    const unsigned char *src = sqlite3_column_text(st, col);
+    size_t n = src ? strlen((const char *)src) : 0;
+    if (n >= cap)
+        n = cap - 1;
+    if (n)
+        memcpy(dst, src, n);
+    dst[n] = '\0';
+}

@@ -37,4 +37,11 @@ ag_status ag_db_fail(ag_db *db, ag_error *err, const char *doing);
  * The statement is reset and its bindings cleared before it is returned. */
 sqlite3_stmt *ag_db_prepare(ag_db *db, const char *sql, ag_error *err);
 
+/* Steps a statement that returns no row and resets it; AG_OK or the failure, described as
+ * what was being done. */
+ag_status ag_db_step_done(ag_db *db, sqlite3_stmt *st, const char *doing, ag_error *err);
+
+/* Copies a text column into a fixed buffer (truncating; "" for NULL). */
+void ag_db_column_copy(sqlite3_stmt *st, int col, char *dst, size_t cap);
+
 #endif

@@ -3,16 +3,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void copy_text(char *dst, size_t cap, const unsigned char *src)
-{
-    size_t n = src ? strlen((const char *)src) : 0;
-    if (n >= cap)
-        n = cap - 1;
-    if (n)
-        memcpy(dst, src, n);
-    dst[n] = '\0';
-}
-
 static char *dup_or_null(const unsigned char *s)
 {
     return s ? strdup((const char *)s) : NULL;
@@ -36,10 +26,9 @@ ag_status ag_jobs_insert(ag_db *db, const char *kind, const char *params_json, i
         return err ? err->code : AG_ERR_DB;
     sqlite3_bind_text(st, 1, kind, -1, SQLITE_STATIC);
     sqlite3_bind_text(st, 2, params_json ? params_json : "{}", -1, SQLITE_STATIC);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    if (rc != SQLITE_DONE)
-        return ag_db_fail(db, err, "creating a job");
+    ag_status done = ag_db_step_done(db, st, "creating a job", err);
+    if (done != AG_OK)
+        return done;
     *id = sqlite3_last_insert_rowid(ag_db_handle(db));
     return AG_OK;
 }
@@ -59,16 +48,16 @@ ag_status ag_jobs_get(ag_db *db, int64_t id, ag_job_row *row, ag_error *err)
     ag_status s = AG_OK;
     if (rc == SQLITE_ROW) {
         row->id = sqlite3_column_int64(st, 0);
-        copy_text(row->kind, sizeof row->kind, sqlite3_column_text(st, 1));
-        copy_text(row->status, sizeof row->status, sqlite3_column_text(st, 2));
+        ag_db_column_copy(st, 1, row->kind, sizeof row->kind);
+        ag_db_column_copy(st, 2, row->status, sizeof row->status);
         row->progress = sqlite3_column_double(st, 3);
-        copy_text(row->stage, sizeof row->stage, sqlite3_column_text(st, 4));
+        ag_db_column_copy(st, 4, row->stage, sizeof row->stage);
         row->params_json = dup_or_null(sqlite3_column_text(st, 5));
         row->result_json = dup_or_null(sqlite3_column_text(st, 6));
         row->error_json = dup_or_null(sqlite3_column_text(st, 7));
         row->model = sqlite3_column_int64(st, 8);
-        copy_text(row->created_at, sizeof row->created_at, sqlite3_column_text(st, 9));
-        copy_text(row->updated_at, sizeof row->updated_at, sqlite3_column_text(st, 10));
+        ag_db_column_copy(st, 9, row->created_at, sizeof row->created_at);
+        ag_db_column_copy(st, 10, row->updated_at, sizeof row->updated_at);
     } else if (rc == SQLITE_DONE) {
         s = ag_error_set(err, AG_ERR_NOT_FOUND, 0, "there is no job %lld", (long long)id);
     } else {
@@ -96,9 +85,7 @@ ag_status ag_jobs_update(ag_db *db, int64_t id, const char *status, double progr
     else
         sqlite3_bind_null(st, 3);
     sqlite3_bind_int64(st, 4, id);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    return rc == SQLITE_DONE ? AG_OK : ag_db_fail(db, err, "updating a job");
+    return ag_db_step_done(db, st, "updating a job", err);
 }
 
 ag_status ag_jobs_finish(ag_db *db, int64_t id, const char *status, const char *result_json,
@@ -128,9 +115,7 @@ ag_status ag_jobs_finish(ag_db *db, int64_t id, const char *status, const char *
         sqlite3_bind_null(st, 4);
     sqlite3_bind_text(st, 5, status, -1, SQLITE_STATIC);
     sqlite3_bind_int64(st, 6, id);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    return rc == SQLITE_DONE ? AG_OK : ag_db_fail(db, err, "finishing a job");
+    return ag_db_step_done(db, st, "finishing a job", err);
 }
 
 ag_status ag_jobs_cancel_unfinished(ag_db *db, const char *error_json, int *count, ag_error *err)
@@ -144,10 +129,9 @@ ag_status ag_jobs_cancel_unfinished(ag_db *db, const char *error_json, int *coun
     if (!st)
         return err ? err->code : AG_ERR_DB;
     sqlite3_bind_text(st, 1, error_json, -1, SQLITE_STATIC);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    if (rc != SQLITE_DONE)
-        return ag_db_fail(db, err, "cancelling unfinished jobs");
+    ag_status done = ag_db_step_done(db, st, "cancelling unfinished jobs", err);
+    if (done != AG_OK)
+        return done;
     if (count)
         *count = sqlite3_changes(ag_db_handle(db));
     return AG_OK;

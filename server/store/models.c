@@ -3,19 +3,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void copy_text(char *dst, size_t cap, const unsigned char *src)
-{
-    if (!src) {
-        dst[0] = '\0';
-        return;
-    }
-    size_t n = strlen((const char *)src);
-    if (n >= cap)
-        n = cap - 1;
-    memcpy(dst, src, n);
-    dst[n] = '\0';
-}
-
 void ag_models_row_clear(ag_model_row *row)
 {
     if (row) {
@@ -67,10 +54,9 @@ static ag_status insert_blob(ag_db *db, const char *media, const void *data, siz
     sqlite3_bind_text(st, 1, media ? media : "application/octet-stream", -1, SQLITE_STATIC);
     sqlite3_bind_int64(st, 2, (sqlite3_int64)len);
     sqlite3_bind_blob64(st, 3, len ? data : "", len, SQLITE_STATIC);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    if (rc != SQLITE_DONE)
-        return ag_db_fail(db, err, "storing a file");
+    ag_status done = ag_db_step_done(db, st, "storing a file", err);
+    if (done != AG_OK)
+        return done;
     *id = sqlite3_last_insert_rowid(ag_db_handle(db));
     return AG_OK;
 }
@@ -105,10 +91,9 @@ ag_status ag_models_insert(ag_db *db, const ag_model_new *m, int64_t *id, ag_err
     else
         sqlite3_bind_null(st, 5);
     sqlite3_bind_text(st, 6, m->stats_json ? m->stats_json : "{}", -1, SQLITE_STATIC);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    if (rc != SQLITE_DONE)
-        return ag_db_fail(db, err, "storing the model");
+    ag_status done = ag_db_step_done(db, st, "storing the model", err);
+    if (done != AG_OK)
+        return done;
     *id = sqlite3_last_insert_rowid(ag_db_handle(db));
     return AG_OK;
 }
@@ -121,14 +106,14 @@ static ag_status read_row(sqlite3_stmt *st, ag_model_row *row)
 {
     memset(row, 0, sizeof *row);
     row->id = sqlite3_column_int64(st, 0);
-    copy_text(row->name, sizeof row->name, sqlite3_column_text(st, 1));
-    copy_text(row->kind, sizeof row->kind, sqlite3_column_text(st, 2));
+    ag_db_column_copy(st, 1, row->name, sizeof row->name);
+    ag_db_column_copy(st, 2, row->kind, sizeof row->kind);
     row->version = sqlite3_column_int64(st, 3);
     row->mesh_blob = sqlite3_column_int64(st, 4);
     row->source_blob = sqlite3_column_int64(st, 5);
-    copy_text(row->source_format, sizeof row->source_format, sqlite3_column_text(st, 6));
-    copy_text(row->created_at, sizeof row->created_at, sqlite3_column_text(st, 7));
-    copy_text(row->updated_at, sizeof row->updated_at, sqlite3_column_text(st, 8));
+    ag_db_column_copy(st, 6, row->source_format, sizeof row->source_format);
+    ag_db_column_copy(st, 7, row->created_at, sizeof row->created_at);
+    ag_db_column_copy(st, 8, row->updated_at, sizeof row->updated_at);
     const unsigned char *stats = sqlite3_column_text(st, 9);
     row->stats_json = strdup(stats ? (const char *)stats : "{}");
     return row->stats_json ? AG_OK : AG_ERR_NOMEM;
@@ -217,17 +202,25 @@ static ag_status current_version(ag_db *db, int64_t id, int64_t *version, ag_err
     return s;
 }
 
+/* AG_OK when the model is at `expected`; AG_ERR_STALE with the current version in
+ * err->element otherwise. */
+static ag_status expect_version(ag_db *db, int64_t id, int64_t expected, int64_t *current,
+                                ag_error *err)
+{
+    ag_status s = current_version(db, id, current, err);
+    if (s == AG_OK && *current != expected)
+        s = ag_error_set(err, AG_ERR_STALE, (long)*current, "model %lld is at version %lld, not %lld",
+                         (long long)id, (long long)*current, (long long)expected);
+    return s;
+}
+
 ag_status ag_models_bump_version(ag_db *db, int64_t id, int64_t base, int64_t *new_version,
                                  ag_error *err)
 {
     int64_t v;
-    ag_status s = current_version(db, id, &v, err);
+    ag_status s = expect_version(db, id, base, &v, err);
     if (s != AG_OK)
         return s;
-    if (v != base)
-        return ag_error_set(err, AG_ERR_STALE, (long)v,
-                            "model %lld is at version %lld, not %lld", (long long)id,
-                            (long long)v, (long long)base);
     sqlite3_stmt *st = ag_db_prepare(
         db,
         "UPDATE models SET version = version + 1, "
@@ -236,10 +229,9 @@ ag_status ag_models_bump_version(ag_db *db, int64_t id, int64_t base, int64_t *n
     if (!st)
         return err ? err->code : AG_ERR_DB;
     sqlite3_bind_int64(st, 1, id);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    if (rc != SQLITE_DONE)
-        return ag_db_fail(db, err, "raising a model's version");
+    ag_status done = ag_db_step_done(db, st, "raising a model's version", err);
+    if (done != AG_OK)
+        return done;
     *new_version = v + 1;
     return AG_OK;
 }
@@ -254,32 +246,20 @@ ag_status ag_models_set_name(ag_db *db, int64_t id, const char *name, ag_error *
         return err ? err->code : AG_ERR_DB;
     sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
     sqlite3_bind_int64(st, 2, id);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    if (rc != SQLITE_DONE)
-        return ag_db_fail(db, err, "renaming a model");
-    return AG_OK;
+    return ag_db_step_done(db, st, "renaming a model", err);
 }
 
 ag_status ag_models_delete(ag_db *db, int64_t id, int64_t version, ag_error *err)
 {
     int64_t v;
-    ag_status s = current_version(db, id, &v, err);
+    ag_status s = expect_version(db, id, version, &v, err);
     if (s != AG_OK)
         return s;
-    if (v != version)
-        return ag_error_set(err, AG_ERR_STALE, (long)v,
-                            "model %lld is at version %lld, not %lld", (long long)id,
-                            (long long)v, (long long)version);
     sqlite3_stmt *st = ag_db_prepare(db, "DELETE FROM models WHERE id = ?", err);
     if (!st)
         return err ? err->code : AG_ERR_DB;
     sqlite3_bind_int64(st, 1, id);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    if (rc != SQLITE_DONE)
-        return ag_db_fail(db, err, "deleting a model");
-    return AG_OK;
+    return ag_db_step_done(db, st, "deleting a model", err);
 }
 
 ag_status ag_blobs_get(ag_db *db, int64_t id, void **data, size_t *len, ag_error *err)

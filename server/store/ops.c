@@ -13,11 +13,7 @@ ag_status ag_ops_insert(ag_db *db, const ag_op_row *op, ag_error *err)
     sqlite3_bind_text(st, 4, op->cid, -1, SQLITE_STATIC);
     sqlite3_bind_text(st, 5, op->kind, -1, SQLITE_STATIC);
     sqlite3_bind_text(st, 6, op->body_json, -1, SQLITE_STATIC);
-    int rc = sqlite3_step(st);
-    sqlite3_reset(st);
-    if (rc != SQLITE_DONE)
-        return ag_db_fail(db, err, "writing the op log");
-    return AG_OK;
+    return ag_db_step_done(db, st, "writing the op log", err);
 }
 
 ag_status ag_ops_find_cid(ag_db *db, int64_t model, const char *author, const char *cid,

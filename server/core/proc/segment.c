@@ -355,7 +355,10 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
         free(first);
         free(cfirst);
 
-        if (next == 1 && n > 1) {
+        int one_piece = 1;
+        for (size_t t = 1; t < n && one_piece; t++)
+            one_piece = piece[t] == piece[0];
+        if (next == 1 && n > 1 && one_piece) {
             size_t nr = 0;
             double cosmax = cos(o.planar_degrees * M_PI / 180.0);
             st = planar_regions(in, wid, cosmax, 1e-4 * (diag > 0 ? diag : 1.0), newc, &nr);
