@@ -324,9 +324,9 @@ static int is_rule(exctx *x, int32_t cls)
     if (x->pass == 1)
         return x->t->rule_count[cls] >= 2;
     /* a repeated lone terminal is placed directly unless a pattern needs it as a rule */
-    if (x->t->nodes[x->exemplar[cls]].first_child < 0 && !x->in_pattern[cls])
+    if (x->apps[cls] < 2)
         return 0;
-    return x->apps[cls] >= 2;
+    return x->t->nodes[x->exemplar[cls]].first_child >= 0 || x->in_pattern[cls];
 }
 
 static void emit_content(exctx *x, ag_grule *r, int32_t v, const char *vname, unsigned *counter);
