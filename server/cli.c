@@ -24,6 +24,7 @@ static const struct {
      "proceduralize IN --out DIR [--up y|z]  split grammar + terminals + summary.json"},
     {"derive", ag_cli_derive, "derive GRAMMAR --out FILE.obj|FILE.glb  derive a grammar into a mesh"},
     {"fmt", ag_cli_fmt, "fmt GRAMMAR                     print a grammar in canonical form"},
+    {"extrude", ag_cli_extrude, "extrude --plan PLAN.json | FOOTPRINTS.geojson --style S --out OUT  roofs and shells"},
 };
 
 #define NCOMMANDS (sizeof commands / sizeof commands[0])

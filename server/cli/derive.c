@@ -24,7 +24,7 @@ static int ends_with(const char *s, const char *suf)
     return a >= b && !strcasecmp(s + a - b, suf);
 }
 
-/* OBJ + MTL: one `usemtl` material per terminal (label), colours spread over the hue circle. */
+/* OBJ + MTL: one `usemtl` material per label, colours spread over the hue circle. */
 static int write_obj_mtl(const ag_mesh *m, const char *path)
 {
     char mtl[4096];
@@ -61,10 +61,13 @@ static int write_obj_mtl(const ag_mesh *m, const char *path)
         fprintf(fm, "newmtl %s\nKd %.3f %.3f %.3f\n\n", m->group_names[g], r, gg, b);
     }
     const char *base = strrchr(mtl, '/');
-    fprintf(f, "# derived by archgram from a split grammar; z up\nmtllib %s\n",
+    /* OBJ's convention is y up: archgram's (x, y, z) is written as (x, z, -y) */
+    fprintf(f, "# derived by archgram from a split grammar; y up\nmtllib %s\n",
             base ? base + 1 : mtl);
-    for (size_t v = 0; v < m->nverts; v++)
-        fprintf(f, "v %.10g %.10g %.10g\n", m->pos[3 * v], m->pos[3 * v + 1], m->pos[3 * v + 2]);
+    for (size_t v = 0; v < m->nverts; v++) {
+        double y = -m->pos[3 * v + 1];
+        fprintf(f, "v %.10g %.10g %.10g\n", m->pos[3 * v], m->pos[3 * v + 2], y == 0 ? 0 : y);
+    }
     size_t t = 0;
     for (size_t c = 0; c < m->ncomponents; c++) {
         int32_t g = m->component_group[c];

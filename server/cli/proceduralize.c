@@ -10,13 +10,14 @@
 
 #include "../core/proc/proceduralize.h"
 #include "../io/grammar_text.h"
+#include "../io/import.h"
 #include "../io/terminals.h"
 #include "commands.h"
 
 static int usage(void)
 {
     fputs("usage: archgram proceduralize IN --out DIR [--up y|z] [--tolerance REL] "
-          "[--keep-groups]\n",
+          "[--exact REL] [--keep-groups]\n",
           stderr);
     return 2;
 }
@@ -82,6 +83,13 @@ int ag_cli_proceduralize(int argc, char **argv)
             if (++i >= argc || (po.label.tolerance = strtod(argv[i], &e), *e) ||
                 !(po.label.tolerance > 0 && po.label.tolerance < 0.1)) {
                 fputs("archgram: --tolerance takes a number in (0, 0.1)\n", stderr);
+                return 2;
+            }
+        } else if (!strcmp(argv[i], "--exact")) {
+            char *e;
+            if (++i >= argc || (po.label.exact = strtod(argv[i], &e), *e) ||
+                !(po.label.exact > 0 && po.label.exact < 0.1)) {
+                fputs("archgram: --exact takes a number in (0, 0.1)\n", stderr);
                 return 2;
             }
         } else if (!strcmp(argv[i], "--keep-groups")) {
@@ -166,11 +174,18 @@ int ag_cli_proceduralize(int argc, char **argv)
     json_object_set_new(ji, "components", json_integer((json_int_t)r->mesh->ncomponents));
     json_object_set_new(ji, "groups", json_integer((json_int_t)m->ngroups));
     json_object_set_new(ji, "bytes", json_integer((json_int_t)bytes));
-    json_object_set_new(ji, "up", json_string(up == AG_UP_Z ? "z" : "y"));
-    json_object_set_new(ji, "normalization",
-                        json_string(up == AG_UP_Z ? "input is z-up; units taken as metres"
-                                                  : "y-up input turned to z-up (x, -z, y); "
-                                                    "units taken as metres"));
+    /* what import did to reach z-up metres (see io/import.h and io/assimp_import.h) */
+    ag_format fmt = ag_format_sniff(NULL, 0, in);
+    int zup = up == AG_UP_Z ||
+              (up == AG_UP_DEFAULT && (fmt == AG_FORMAT_PLY || fmt == AG_FORMAT_STL));
+    char norm[160];
+    snprintf(norm, sizeof norm, "%s; %s", zup ? "input taken as z-up, kept" :
+             "y-up input turned to z-up: (x, y, z) -> (x, -z, y)",
+             fmt == AG_FORMAT_FBX ? "FBX units (UnitScaleFactor) converted to metres"
+                                  : "units taken as metres");
+    json_object_set_new(ji, "format", json_string(ag_format_name(fmt)));
+    json_object_set_new(ji, "up", json_string(zup ? "z" : "y"));
+    json_object_set_new(ji, "normalization", json_string(norm));
     json_object_set_new(ji, "groups_split", json_integer((json_int_t)r->segment.groups_split));
     json_object_set_new(ji, "planar_fallback", json_boolean(r->segment.planar_fallback));
     json_object_set_new(j, "input", ji);
@@ -183,10 +198,14 @@ int ag_cli_proceduralize(int argc, char **argv)
         double size[3];
         for (int a = 0; a < 3; a++)
             size[a] = L->box[ex].max[a] - L->box[ex].min[a];
-        int32_t ti = r->info.terminal_of_label ? r->info.terminal_of_label[l] : -1;
         json_object_set_new(o, "label", json_integer((json_int_t)l));
-        json_object_set_new(o, "terminal",
-                            ti >= 0 ? json_string(r->grammar->terminals[ti].name) : json_null());
+        json_t *tv = json_array();
+        for (size_t v = 0; v < L->nvariants; v++) {
+            int32_t ti = r->info.terminal_of_variant ? r->info.terminal_of_variant[v] : -1;
+            if (L->variant_label[v] == (int32_t)l && ti >= 0)
+                json_array_append_new(tv, json_string(r->grammar->terminals[ti].name));
+        }
+        json_object_set_new(o, "terminals", tv);
         json_object_set_new(o, "count", json_integer(L->count[l]));
         json_object_set_new(o, "triangles", json_integer(L->ntris[ex]));
         json_object_set_new(o, "size", vec3(size));
@@ -201,6 +220,8 @@ int ag_cli_proceduralize(int argc, char **argv)
         json_object_set_new(o, "index", json_integer((json_int_t)c));
         json_object_set_new(o, "group", g >= 0 ? json_string(r->mesh->group_names[g]) : json_null());
         json_object_set_new(o, "label", L->label[c] >= 0 ? json_integer(L->label[c]) : json_null());
+        json_object_set_new(o, "variant",
+                            L->variant[c] >= 0 ? json_integer(L->variant[c]) : json_null());
         json_object_set_new(o, "rot", json_integer(90 * L->rot[c]));
         json_object_set_new(o, "node", r->tree->comp_node[c] >= 0
                                            ? json_integer(r->tree->comp_node[c])
@@ -230,6 +251,13 @@ int ag_cli_proceduralize(int argc, char **argv)
             json_array_append_new(cnt, json_integer(pt->counts[a]));
         json_object_set_new(o, "counts", cnt);
         json_object_set_new(o, "step", vec3(pt->step));
+        json_object_set_new(o, "kind", json_string(pt->nvec ? "repeat" : "subdivide"));
+        if (pt->nvec) {
+            json_t *vs = json_array();
+            for (int k = 0; k < pt->nvec; k++)
+                json_array_append_new(vs, vec3(pt->vec[k]));
+            json_object_set_new(o, "vectors", vs);
+        }
         json_object_set_new(o, "rot", json_integer(90 * pt->rot));
         json_object_set_new(o, "instances",
                             json_integer((json_int_t)pt->counts[0] * pt->counts[1] * pt->counts[2]));
@@ -261,10 +289,10 @@ int ag_cli_proceduralize(int argc, char **argv)
         fprintf(stderr, "archgram: cannot write %s\n", path);
         goto done;
     }
-    printf("%s: %zu triangles, %zu components, %zu labels, %zu rules, %zu patterns, "
+    printf("%s: %zu triangles, %zu components, %zu labels (%zu variants), %zu rules, %zu patterns, "
            "%zu terminals; grammar %zu + terminals %zu bytes (input %zu); "
            "max error %.3g (%.3g of the diagonal), %zu unmatched; %.3f s\n",
-           in, m->ntris, r->mesh->ncomponents, L->nlabels, r->grammar->nrules,
+           in, m->ntris, r->mesh->ncomponents, L->nlabels, L->nvariants, r->grammar->nrules,
            r->tree->npatterns, r->grammar->nterminals, tlen, term_bytes, bytes, fid.max_error,
            fid.relative, fid.unmatched, t_total);
     rc = fid.unmatched ? 1 : 0;

@@ -74,6 +74,16 @@ static void put_body(sbuf *s, const ag_grule *r)
             sput(s, "  %s = split(%s, ", t->node, t->parent);
             put_nums(s, t->v, 3, ", ");
             sput(s, ", %d)\n", t->octant);
+        } else if (t->subdivide == 2) {
+            sput(s, "  %s(repeat(%s", t->callee, t->node);
+            for (int k = 0; k < t->nvec; k++) {
+                sput(s, ", %u, ", t->counts[k]);
+                put_nums(s, t->vec[k], 3, ", ");
+            }
+            sput(s, "))");
+            if (t->rot)
+                sput(s, " rot %d", 90 * t->rot);
+            sput(s, "\n");
         } else if (t->subdivide) {
             sput(s, "  %s(subdivide(%s, %u, %u, %u, ", t->callee, t->node, t->counts[0],
                  t->counts[1], t->counts[2]);
@@ -102,6 +112,8 @@ ag_status ag_grammar_text_print(const ag_grammar *g, char **out, size_t *len, ag
         const ag_gterminal *t = &g->terminals[i];
         sput(&s, "terminal %s \"%s\" size ", t->name, t->path ? t->path : "");
         put_nums(&s, t->size, 3, " ");
+        if (t->label_name)
+            sput(&s, " label %s", t->label_name);
         sput(&s, "\n");
     }
     for (size_t i = 0; i < g->nrules; i++) {
@@ -372,6 +384,43 @@ static int parse_body(lexer *L, ag_grule *r)
             for (int k = 0; k < 3; k++)
                 counts[k] = (uint32_t)c[k];
             sub = 1;
+        } else if (is_kw(L, "repeat")) {
+            next(L);
+            long c[3];
+            double vec[3][3];
+            int nvec = 0;
+            if (expect_punct(L, '(') || ident(L, b, sizeof b, "the node to repeat in"))
+                return -1;
+            while (nvec < 3 && is_punct(L, ',')) {
+                next(L);
+                if (integer(L, 1, 10000000, &c[nvec], "a count") || comma(L) ||
+                    number(L, &vec[nvec][0]) || comma(L) || number(L, &vec[nvec][1]) ||
+                    comma(L) || number(L, &vec[nvec][2]))
+                    return -1;
+                nvec++;
+            }
+            if (!nvec)
+                return lerr(L, L->tline, L->tcol, "repeat needs a count and a vector"), -1;
+            if (expect_punct(L, ')'))
+                return -1;
+            for (int k = 0; k < 3; k++)
+                counts[k] = k < nvec ? (uint32_t)c[k] : 1;
+            sub = 2;
+            if (expect_punct(L, ')'))
+                return -1;
+            int rot = 0;
+            if (is_kw(L, "rot")) {
+                next(L);
+                long rl = L->tline, rc = L->tcol, deg;
+                if (integer(L, 0, 270, &deg, "rot"))
+                    return -1;
+                if (deg % 90)
+                    return lerr(L, rl, rc, "rot must be 0, 90, 180 or 270"), -1;
+                rot = (int)(deg / 90);
+            }
+            if (ag_grammar_add_repeat(r, a, b, rot, nvec, counts, vec, line, col))
+                return lerr(L, line, col, "out of memory"), -1;
+            continue;
         } else if (ident(L, b, sizeof b, "a node name")) {
             return -1;
         }
@@ -464,6 +513,16 @@ ag_status ag_grammar_text_parse(const char *text, size_t len, ag_grammar **out, 
                 break;
             }
             g->terminals[ti].path = path;
+            if (is_kw(&L, "label")) {
+                next(&L);
+                char lab[NAME_MAX_LEN];
+                if (ident(&L, lab, sizeof lab, "a label name"))
+                    break;
+                if (!(g->terminals[ti].label_name = strdup(lab))) {
+                    lerr(&L, line, c, "out of memory");
+                    break;
+                }
+            }
         }
         while (!L.st && is_kw(&L, "rule")) {
             long line = L.tline, c = L.tcol;

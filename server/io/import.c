@@ -1,5 +1,7 @@
 #include "import.h"
 
+#include "assimp_import.h"
+
 #include <string.h>
 #include <strings.h>
 
@@ -127,12 +129,21 @@ ag_status ag_import_buffer(const uint8_t *data, size_t len, ag_format fmt,
         }
         return ag_obj_read_buffer((const char *)data, len, &o, out, err);
     }
+    case AG_FORMAT_PLY:
+    case AG_FORMAT_STL:
+    case AG_FORMAT_GLTF:
+    case AG_FORMAT_GLB:
+    case AG_FORMAT_FBX:
+    case AG_FORMAT_DAE:
+        return ag_assimp_import_buffer(data, len, fmt, opt, out, NULL, err);
     case AG_FORMAT_UNKNOWN:
         return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
-                            "unrecognised file format (supported: obj)");
+                            "unrecognised file format (archgram reads obj, ply, stl, gltf, "
+                            "glb, fbx and dae; name it with the file's extension or format)");
     default:
         return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
-                            "%s files cannot be imported yet (supported: obj)",
+                            "%s files cannot be imported (archgram reads obj, ply, stl, gltf, "
+                            "glb, fbx and dae)",
                             ag_format_name(fmt));
     }
 }

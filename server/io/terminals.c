@@ -16,7 +16,6 @@ ag_status ag_terminals_format(const ag_gterminal *t, char **out, size_t *len, ag
     FILE *f = open_memstream(&buf, &n);
     if (!f)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    fprintf(f, "# archgram terminal: local coordinates in metres, z up\n");
     for (size_t v = 0; v < t->nverts; v++) {
         const double *p = t->pos + 3 * v;
         double x = p[0] == 0 ? 0 : p[0], y = p[1] == 0 ? 0 : p[1], z = p[2] == 0 ? 0 : p[2];
@@ -113,6 +112,21 @@ static int safe_path(const char *p)
         s = e + 1;
     }
     return 1;
+}
+
+ag_status ag_terminals_load_buffer(ag_gterminal *t, const char *data, size_t len, ag_error *err)
+{
+    ag_obj_read_options o = {.up = AG_UP_Z};
+    ag_mesh *m = NULL;
+    ag_error e = {0};
+    ag_status st = ag_obj_read_buffer(data, len, &o, &m, &e);
+    if (st)
+        return ag_error_set(err, st, e.element, "terminal '%s': %s", t->name, e.text);
+    st = ag_grammar_set_terminal_geometry(t, m->pos, m->nverts, m->tri, m->ntris);
+    ag_mesh_free(m);
+    if (st)
+        return ag_error_set(err, st, 0, "out of memory");
+    return AG_OK;
 }
 
 ag_status ag_terminals_load(ag_grammar *g, const char *dir, ag_error *err)

@@ -127,7 +127,8 @@ enum MHD_Result ag_api_models_create(ag_request *r)
         return ag_reply_problem(r, s, &err);
     const char *format = ag_request_query(r, "format");
     if (format && ag_format_from_name(format) == AG_FORMAT_UNKNOWN) {
-        ag_error_set(&err, AG_ERR_UNSUPPORTED, 0, "unknown format \"%s\"; archgram reads: obj",
+        ag_error_set(&err, AG_ERR_UNSUPPORTED, 0, "unknown format \"%s\"; archgram reads obj, ply, stl, gltf, glb, "
+                     "fbx and dae",
                      format);
         return ag_reply_problem(r, AG_ERR_UNSUPPORTED, &err);
     }

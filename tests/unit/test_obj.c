@@ -548,10 +548,10 @@ static void test_sniff_and_import(void **state)
     assert_int_equal(ag_import_buffer(d, n, AG_FORMAT_OBJ, NULL, &m, &e), AG_OK);
     assert_true(m->pos[8] == 1); /* default y-up: (0, 1, 0) → (0, 0, 1) */
     ag_mesh_free(m);
+    /* OBJ text declared as PLY goes to the PLY reader, which refuses it. */
     m = (ag_mesh *)1;
-    assert_int_equal(ag_import_buffer(d, n, AG_FORMAT_PLY, NULL, &m, &e), AG_ERR_UNSUPPORTED);
+    assert_int_not_equal(ag_import_buffer(d, n, AG_FORMAT_PLY, NULL, &m, &e), AG_OK);
     assert_null(m);
-    assert_non_null(strstr(e.text, "ply"));
     assert_int_equal(
         ag_import_buffer((const uint8_t *)"\x01\x02", 2, AG_FORMAT_UNKNOWN, NULL, &m, &e),
         AG_ERR_UNSUPPORTED);

@@ -4,6 +4,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <cmocka.h>
@@ -164,6 +165,55 @@ static void test_derivation_limits_and_turns(void **state)
     ag_grammar_free(g);
 }
 
+static void test_deep_nesting_and_rule_chains(void **state)
+{
+    (void)state;
+    /* 3000 nested shells: nesting is bounded, nothing recurses that deep */
+    ag_mesh *m = ag_mesh_create();
+    for (int i = 0; i < 3000; i++) {
+        size_t c;
+        ag_mesh_add_component(m, -1, &c);
+        double r = 3000 - i;
+        uint32_t b = (uint32_t)m->nverts;
+        ag_mesh_add_vertex(m, -r, -r, -r);
+        ag_mesh_add_vertex(m, r, -r, -r);
+        ag_mesh_add_vertex(m, 0, r, r);
+        ag_mesh_add_triangle(m, b, b + 1, b + 2, (uint32_t)c);
+    }
+    ag_proceduralize_result *r = run(m, AG_OK, NULL);
+    assert_int_equal(r->fidelity.unmatched, 0);
+    ag_splittree_stats s = ag_splittree_stats_of(r->tree);
+    assert_true(s.depth <= 2 * AG_SPLITTREE_MAX_NESTING + 2);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+
+    /* a chain of 2000 rules each applying the previous one is refused, not overflowed */
+    ag_grammar *g = ag_grammar_create();
+    double one[3] = {1, 1, 1};
+    size_t ti, ri;
+    ag_grammar_add_terminal(g, "T", one, &ti);
+    double pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 1};
+    uint32_t tri[3] = {0, 1, 2};
+    ag_grammar_set_terminal_geometry(&g->terminals[ti], pos, 3, tri, 1);
+    char name[32], prev[32] = "T";
+    for (int i = 0; i < 2000; i++) {
+        snprintf(name, sizeof name, "R%d", i);
+        ag_grammar_add_rule(g, name, one, &ri);
+        ag_grammar_add_apply(&g->rules[ri], prev, "p", 0, NULL, NULL, 0, 0);
+        snprintf(prev, sizeof prev, "%s", name);
+    }
+    g->has_axiom = 1;
+    g->axiom.box = (ag_box){{0, 0, 0}, {1, 1, 1}};
+    ag_grammar_add_apply(&g->axiom, prev, "p", 0, NULL, NULL, 0, 0);
+    long col;
+    assert_int_equal(ag_grammar_resolve(g, NULL, &col), AG_OK);
+    ag_mesh *d = NULL;
+    ag_error err = {0};
+    assert_int_equal(ag_grammar_derive(g, NULL, &d, &err), AG_ERR_TOO_LARGE);
+    assert_null(d);
+    ag_grammar_free(g);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -171,6 +221,7 @@ int main(void)
         cmocka_unit_test(test_malformed_input_is_refused),
         cmocka_unit_test(test_one_triangle_and_degenerate_triangles),
         cmocka_unit_test(test_derivation_limits_and_turns),
+        cmocka_unit_test(test_deep_nesting_and_rule_chains),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

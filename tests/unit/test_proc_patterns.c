@@ -90,14 +90,14 @@ static void test_window_grid_is_one_rule_subdivided(void **state)
     assert_int_equal((rot_side - rot_front) & 3, 1);
     /* the rule places the window terminal; the annex terminal is placed once, directly */
     assert_int_equal(g->rules[0].nstmts, 1);
-    int32_t annex_label = -1;
+    size_t annex_c = SIZE_MAX;
     for (size_t c = 0; c < r->mesh->ncomponents; c++) {
         int32_t gi = r->mesh->component_group[c];
         if (gi >= 0 && !strcmp(r->mesh->group_names[gi], "annex"))
-            annex_label = r->labels->label[c];
+            annex_c = c;
     }
-    assert_true(annex_label >= 0);
-    int32_t at = r->info.terminal_of_label[annex_label];
+    assert_true(annex_c != SIZE_MAX);
+    int32_t at = r->info.terminal_of_variant[r->labels->variant[annex_c]];
     assert_int_equal(applications(&g->axiom, g->terminals[at].name, NULL), 1);
     assert_int_equal(r->tree->npatterns, 2);
     ag_proceduralize_result_free(r);
@@ -162,22 +162,75 @@ static void test_irregular_rows_and_odd_subtree(void **state)
         if (applications(&g->axiom, g->rules[i].name, NULL) >= 2)
             rule = g->rules[i].name;
     assert_non_null(rule);
-    size_t rows = 0, singles = 0;
+    size_t rows = 0, singles = 0, lens[8] = {0};
     for (size_t i = 0; i < g->axiom.nstmts; i++) {
         const ag_gstmt *s = &g->axiom.stmts[i];
         if (s->kind != AG_GSTMT_APPLY || strcmp(s->callee, rule))
             continue;
         if (s->subdivide) {
-            assert_int_equal(s->counts[0], 4);
+            assert_int_equal(s->subdivide, 1); /* axis-aligned rows stay subdivides */
             assert_int_equal(s->counts[1] * s->counts[2], 1);
+            assert_true(fabs(s->step[0] - 2.5) < 1e-9);
+            if (rows < 8)
+                lens[rows] = s->counts[0];
             rows++;
         } else {
             singles++;
         }
     }
-    /* rows 0 and 2 are complete; row 1 has a gap where the odd frame is */
-    assert_int_equal(rows, 2);
-    assert_int_equal(singles, 3);
+    /* rows 0 and 2 are complete; row 1 keeps the run before the odd frame, the frame after
+     * it is a single application */
+    assert_int_equal(rows, 3);
+    assert_int_equal(lens[0] + lens[1] + lens[2], 10);
+    assert_true((lens[0] == 2) + (lens[1] == 2) + (lens[2] == 2) == 1);
+    assert_int_equal(singles, 1);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+}
+
+/* A facade turned 30 degrees about z: windows repeat along an oblique direction. */
+static void test_oblique_facade_is_a_lattice(void **state)
+{
+    (void)state;
+    ag_mesh *m = ag_mesh_create();
+    const double c = cos(M_PI / 6), s = sin(M_PI / 6);
+    char name[32];
+    size_t comp = 0;
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 5; i++) {
+            /* a small wedge (not a box, so the turn matters), placed along the facade */
+            size_t g;
+            snprintf(name, sizeof name, "window_%d_%d", i, j);
+            ag_mesh_add_group(m, name, &g);
+            ag_mesh_add_component(m, (int32_t)g, &comp);
+            double ox = 3.0 * i * c, oy = 3.0 * i * s, oz = 4.0 * j;
+            uint32_t b = (uint32_t)m->nverts;
+            const double lp[4][3] = {{0, 0, 0}, {1.2, 0, 0}, {0, 0.3, 0}, {0, 0, 1.8}};
+            for (int k = 0; k < 4; k++)
+                ag_mesh_add_vertex(m, ox + lp[k][0], oy + lp[k][1], oz + lp[k][2]);
+            ag_mesh_add_triangle(m, b, b + 2, b + 1, (uint32_t)comp);
+            ag_mesh_add_triangle(m, b, b + 1, b + 3, (uint32_t)comp);
+            ag_mesh_add_triangle(m, b, b + 3, b + 2, (uint32_t)comp);
+            ag_mesh_add_triangle(m, b + 1, b + 2, b + 3, (uint32_t)comp);
+        }
+    ag_proceduralize_result *r = run(m);
+    const ag_grammar *g = r->grammar;
+    assert_int_equal(g->nrules, 1);
+    const ag_gstmt *st = NULL;
+    assert_int_equal(applications(&g->axiom, g->rules[0].name, &st), 1);
+    assert_int_equal(st->subdivide, 2);
+    assert_int_equal(st->nvec, 2);
+    assert_int_equal(st->counts[0] * st->counts[1], 15);
+    /* one vector is the oblique step (3 cos 30, 3 sin 30, 0), the other (0, 0, 4) */
+    int oblique = 0, up = 0;
+    for (int k = 0; k < 2; k++) {
+        const double *v = st->vec[k];
+        if (fabs(v[0] - 3 * c) < 1e-9 && fabs(v[1] - 3 * s) < 1e-9 && fabs(v[2]) < 1e-9)
+            oblique = st->counts[k] == 5;
+        if (fabs(v[0]) < 1e-9 && fabs(v[1]) < 1e-9 && fabs(v[2] - 4) < 1e-9)
+            up = st->counts[k] == 3;
+    }
+    assert_true(oblique && up);
     ag_proceduralize_result_free(r);
     ag_mesh_free(m);
 }
@@ -202,6 +255,7 @@ int main(void)
         cmocka_unit_test(test_window_grid_is_one_rule_subdivided),
         cmocka_unit_test(test_nested_subtree_becomes_the_rule),
         cmocka_unit_test(test_irregular_rows_and_odd_subtree),
+        cmocka_unit_test(test_oblique_facade_is_a_lattice),
         cmocka_unit_test(test_no_repetition_gives_no_rule),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -12,6 +12,7 @@ typedef enum {
     AG_EVENT_EDGE = 0,      /* an edge shrinks to zero length: a = edge */
     AG_EVENT_SPLIT = 1,     /* a corner reaches an edge: a = corner, b = edge */
     AG_EVENT_DIRECTION = 2, /* profile a switches to its segment b */
+    AG_EVENT_ANCHOR = 3,    /* anchor b is located on the active plan */
 } ag_event_type;
 
 typedef struct {

@@ -19,7 +19,8 @@ ag_status ag_extrude_plan(ag_plan *plan, ag_mesh *m, int32_t group, ag_extrude_r
     if (st != AG_OK)
         return st;
     ag_shell *sh = NULL;
-    st = ag_skeleton_build(plan, extent, NULL, &sh, &res->stats, err);
+    ag_skeleton_options so = {0, plan->anchors};
+    st = ag_skeleton_build(plan, extent, &so, &sh, &res->stats, err);
     if (st != AG_OK)
         return st;
     res->failing_faces = ag_shell_check(sh, res->problems, AG_EXTRUDE_MAX_PROBLEMS);

@@ -25,7 +25,7 @@ typedef struct {
 } ag_extrude_result;
 
 /* Validates (and cleans) plan, extrudes it and appends the triangles to m as one new
- * component of `group` (-1 for none). A plan that fails validation or the sweep leaves
+ * component of `group` (-1 for none); the plan's anchors are located (found, pos, ...). A plan that fails validation or the sweep leaves
  * m unchanged and returns the error. A shell that is not watertight is still added:
  * its failing faces are listed in res. `keep_shell` (may be NULL) receives the shell. */
 ag_status ag_extrude_plan(ag_plan *plan, ag_mesh *m, int32_t group, ag_extrude_result *res,

@@ -28,6 +28,8 @@ void ag_plan_free(ag_plan *p)
     }
     free(p->loops);
     free(p->profiles);
+    free(p->anchors);
+    free(p->steps);
     free(p);
 }
 
@@ -74,11 +76,11 @@ ag_status ag_plan_add_profile(ag_plan *p, const char *name, const ag_profile_poi
         return ag_error_set(err, AG_ERR_INVALID, idx + 1,
                             "profile %s: the last segment must rise (it continues upwards)",
                             name ? name : "");
-    for (size_t i = 1; i + 1 < n; i++)
-        if (pts[i + 1].z - pts[i].z <= 0.0)
-            return ag_error_set(err, AG_ERR_UNSUPPORTED, idx + 1,
-                                "profile %s: horizontal segment %zu is not supported yet; "
-                                "use a steep segment instead", name ? name : "", i);
+    for (size_t i = 0; i + 2 < n; i++)
+        if (pts[i + 1].z == pts[i].z && pts[i + 2].z == pts[i + 1].z)
+            return ag_error_set(err, AG_ERR_INVALID, idx + 1,
+                                "profile %s: segments %zu and %zu are both horizontal (join them)",
+                                name ? name : "", i, i + 1);
     if (p->nprofiles == p->cap_profiles) {
         size_t cap = p->cap_profiles ? 2 * p->cap_profiles : 4;
         ag_profile *np = realloc(p->profiles, cap * sizeof *np);
@@ -131,6 +133,62 @@ ag_status ag_plan_add_loop(ag_plan *p, const double *xy, size_t n, const int32_t
     for (size_t i = 0; i < n; i++)
         l->profile[i] = profiles ? profiles[i] : 0;
     p->nloops++;
+    return AG_OK;
+}
+
+ag_status ag_plan_add_anchor(ag_plan *p, const ag_anchor *a, ag_error *err)
+{
+    if (!isfinite(a->along) || !isfinite(a->z) || a->z < 0 || (!a->absolute && (a->along < 0 || a->along > 1)))
+        return ag_error_set(err, AG_ERR_INVALID, (long)p->nanchors + 1,
+                            "anchor %zu: height must be >= 0 and a relative position in [0, 1]",
+                            p->nanchors);
+    if (p->nanchors == p->cap_anchors) {
+        size_t cap = p->cap_anchors ? 2 * p->cap_anchors : 4;
+        ag_anchor *na = realloc(p->anchors, cap * sizeof *na);
+        if (!na)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        p->anchors = na;
+        p->cap_anchors = cap;
+    }
+    ag_anchor *d = &p->anchors[p->nanchors++];
+    *d = *a;
+    d->name[sizeof d->name - 1] = 0;
+    d->found = 0;
+    d->face = -1;
+    return AG_OK;
+}
+
+ag_status ag_plan_add_step(ag_plan *p, const ag_plan_step *s, ag_error *err)
+{
+    long idx = (long)p->nsteps + 1;
+    if (!(s->width >= 2e-3) || !(fabs(s->depth) >= 2e-3) || !isfinite(s->width) ||
+        !isfinite(s->depth))
+        return ag_error_set(err, AG_ERR_INVALID, idx,
+                            "step %zu: width and |depth| must be at least 2 mm", p->nsteps);
+    if (s->profile < 0 || (size_t)s->profile >= p->nprofiles)
+        return ag_error_set(err, AG_ERR_INVALID, idx, "step %zu: unknown profile %d", p->nsteps,
+                            (int)s->profile);
+    const ag_profile *pr = &p->profiles[s->profile];
+    if (pr->points[1].z <= 0)
+        return ag_error_set(err, AG_ERR_INVALID, idx,
+                            "step %zu: the step's profile must rise from its first point",
+                            p->nsteps);
+    if (!isfinite(s->at.z) || s->at.z <= 0 || !isfinite(s->at.along) ||
+        (!s->at.absolute && (s->at.along < 0 || s->at.along > 1)))
+        return ag_error_set(err, AG_ERR_INVALID, idx,
+                            "step %zu: height must be > 0 and a relative position in [0, 1]",
+                            p->nsteps);
+    if (p->nsteps == p->cap_steps) {
+        size_t cap = p->cap_steps ? 2 * p->cap_steps : 4;
+        ag_plan_step *ns = realloc(p->steps, cap * sizeof *ns);
+        if (!ns)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        p->steps = ns;
+        p->cap_steps = cap;
+    }
+    p->steps[p->nsteps] = *s;
+    p->steps[p->nsteps].name[sizeof s->name - 1] = 0;
+    p->nsteps++;
     return AG_OK;
 }
 

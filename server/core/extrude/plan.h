@@ -4,8 +4,11 @@
  * A profile is a polyline (w, z) monotone in z, starting at (0, 0): w is the horizontal
  * offset towards the inside of the plan, z the height above the plan. Each segment is
  * a direction plane through the edge; its slope is dw/dz (0 = vertical wall, 1 = 45°,
- * negative = leaning outwards). The last segment continues upwards until the roof
- * closes or the plan's cap height is reached, where what is left is closed flat. */
+ * negative = leaning outwards). A horizontal segment (equal z) offsets its edges by its
+ * width at that height, making flat faces (a soffit when outwards, a terrace when
+ * inwards) while the edges of other profiles wait. The last segment must rise; it
+ * continues upwards until the roof closes or the plan's cap height is reached, where
+ * what is left is closed flat. */
 #ifndef AG_EXTRUDE_PLAN_H
 #define AG_EXTRUDE_PLAN_H
 
@@ -24,6 +27,9 @@ typedef struct {
     ag_profile_point *points;
     /* Copied onto the faces the profile makes (e.g. "roof", "wall"); may be NULL. */
     char *tag;
+    /* Ambiguity priority tag: when collinear neighbours with different slopes must
+     * merge, the higher priority wins; equal priorities fall back to the plan's scheme. */
+    int32_t priority;
 } ag_profile;
 
 typedef struct {
@@ -31,6 +37,36 @@ typedef struct {
     double *xy;        /* 2 * n corner coordinates */
     int32_t *profile;  /* n: profile of the edge from corner i to corner i+1 */
 } ag_plan_loop;
+
+/* An anchor (a point to attach a mesh or a feature to): on plan edge `edge` of loop
+ * `loop` (indices of the validated plan) at height z above the plan. Relative: at
+ * fraction `along` of the edge as it is in the active plan at that height. Absolute: on
+ * the plane perpendicular to the input edge at `along` metres from its first corner,
+ * wherever the active edge is at that height (it may lie beyond the input edge's ends).
+ * Not instanced when the edge no longer exists there or the point falls off it. */
+typedef struct {
+    char name[32];
+    int32_t loop, edge;
+    int absolute;
+    double along, z;
+    /* result of the extrusion */
+    int found;
+    double pos[3];
+    double normal[3]; /* outward normal of the face there */
+    int32_t face;     /* shell face holding the point */
+} ag_anchor;
+
+/* A plan edit made as a natural step: at anchor `at` (its height is the step's height)
+ * a rectangle `width` wide and `depth` deep is added to the active plan (depth > 0:
+ * protruding outwards, e.g. a dormer or a bay; depth < 0: a recess). Its new edges take
+ * `profile`, whose heights count from the step's height. It grows from a tiny seed so it
+ * meets the rest of the plan through ordinary events (never self-intersecting). */
+typedef struct {
+    char name[32];
+    ag_anchor at;
+    double width, depth;
+    int32_t profile;
+} ag_plan_step;
 
 typedef enum {
     AG_PRIORITY_MAX_VOLUME = 0, /* ambiguous collinear edges: the shallowest slope wins */
@@ -44,19 +80,29 @@ typedef struct {
     ag_profile *profiles;
     double cap_height; /* > 0: close the shell flat at this height */
     ag_priority priority;
-    size_t cap_loops, cap_profiles; /* private */
+    size_t nanchors;
+    ag_anchor *anchors; /* located by the extrusion (found, pos, normal, face) */
+    size_t nsteps;
+    ag_plan_step *steps;
+    size_t cap_loops, cap_profiles, cap_anchors, cap_steps; /* private */
 } ag_plan;
 
 ag_plan *ag_plan_create(void);
 void ag_plan_free(ag_plan *p);
 
 /* Adds a profile (points copied); fails with AG_ERR_INVALID when the points are not
- * monotone in z, do not start at (0, 0), hold NaN/inf or are fewer than two. */
+ * monotone in z, do not start at (0, 0), hold NaN/inf, are fewer than two, end with a
+ * segment that does not rise or hold two horizontal segments in a row. */
 ag_status ag_plan_add_profile(ag_plan *p, const char *name, const ag_profile_point *pts,
                               size_t n, const char *tag, size_t *index, ag_error *err);
 /* Adds a loop of n corners (xy copied); profiles may be NULL (all edges profile 0). */
 ag_status ag_plan_add_loop(ag_plan *p, const double *xy, size_t n, const int32_t *profiles,
                            ag_error *err);
+/* Adds an anchor (copied; name may be NULL). */
+ag_status ag_plan_add_anchor(ag_plan *p, const ag_anchor *a, ag_error *err);
+/* Adds a natural step; fails with AG_ERR_INVALID for a width or depth below 2 mm, a bad
+ * anchor or an unknown profile (add the profile first). */
+ag_status ag_plan_add_step(ag_plan *p, const ag_plan_step *s, ag_error *err);
 /* Index of the profile with this name, or -1. */
 int32_t ag_plan_find_profile(const ag_plan *p, const char *name);
 

@@ -377,6 +377,42 @@ size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max)
                     break;
                 }
             }
+        if (!why[0] && nl) {
+            /* planarity: distance of every corner from the face's Newell plane */
+            double nx = 0, ny = 0, nz = 0, cx = 0, cy = 0, cz = 0, cnt = 0, lo = INFINITY, hi = -INFINITY;
+            for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++) {
+                uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
+                for (uint32_t i = a; i < b; i++) {
+                    const double *p = &s->pos[3 * s->idx[i]];
+                    const double *q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
+                    nx += (p[1] - q[1]) * (p[2] + q[2]);
+                    ny += (p[2] - q[2]) * (p[0] + q[0]);
+                    nz += (p[0] - q[0]) * (p[1] + q[1]);
+                    cx += p[0];
+                    cy += p[1];
+                    cz += p[2];
+                    cnt++;
+                }
+            }
+            double len = sqrt(nx * nx + ny * ny + nz * nz);
+            if (len > 0) {
+                cx /= cnt;
+                cy /= cnt;
+                cz /= cnt;
+                double size = 0;
+                for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++)
+                    for (uint32_t i = s->loop_start[l]; i < s->loop_start[l + 1]; i++) {
+                        const double *p = &s->pos[3 * s->idx[i]];
+                        double d = ((p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz) / len;
+                        lo = fmin(lo, d);
+                        hi = fmax(hi, d);
+                        size = fmax(size, fabs(p[0] - cx) + fabs(p[1] - cy) + fabs(p[2] - cz));
+                    }
+                if (hi - lo > 1e-6 * (1 + size))
+                    snprintf(why, sizeof why, "face is not planar (corners %.3g m off its plane)",
+                             hi - lo);
+            }
+        }
         if (why[0]) {
             if (nbad < max) {
                 out[nbad].face = (int32_t)f;

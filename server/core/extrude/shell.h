@@ -63,8 +63,9 @@ typedef struct {
     char reason[112];
 } ag_shell_problem;
 
-/* Checks that every half-edge has exactly one opposite half-edge (closed, edge-manifold)
- * and that every face boundary closed into loops. Writes up to max problems (one per
+/* Checks that every half-edge has exactly one opposite half-edge (closed, edge-manifold),
+ * that every face boundary closed into loops and that every face is planar (within
+ * 1e-6 of its size). Writes up to max problems (one per
  * failing face) and returns how many faces fail in total: 0 = watertight 2-manifold. */
 size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max);
 

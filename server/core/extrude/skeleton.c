@@ -17,6 +17,9 @@ typedef struct {
     int32_t loop, edge, profile, seg;
     uint32_t ver;
     uint8_t alive;
+    uint8_t paused;  /* held still while other edges make a horizontal face */
+    uint8_t growing; /* a plan edit's edge, growing to its size in a flat interval */
+    int32_t step;    /* 0: from the plan; k + 1: made by plan edit k */
 } sk_edge;
 
 typedef struct {
@@ -46,6 +49,12 @@ typedef struct {
     double ox, oy; /* local origin */
     double d1, d2, d3;
     double zcur;
+    /* Horizontal profile segments: the sweep runs in a virtual height in which each
+     * height H with a horizontal segment is stretched to an interval [vs, vs + 1] of
+     * the same real height; edges with the horizontal segment move by its width over
+     * that interval, all others are held still. */
+    size_t nflat;
+    double *flat_h; /* real heights, ascending */
     ag_status st;
     ag_error *err;
     ag_skeleton_stats stats;
@@ -81,8 +90,31 @@ static inline void cpos(const sk_corner *c, double z, double *x, double *y)
     *y = c->y + c->vy * (z - c->z);
 }
 
+/* Real height of virtual height v. */
+static double real_z(const sk *S, double v)
+{
+    for (size_t k = 0; k < S->nflat; k++) {
+        double vs = S->flat_h[k] + (double)k;
+        if (v < vs)
+            return v - (double)k;
+        if (v <= vs + 1)
+            return S->flat_h[k];
+    }
+    return v - (double)S->nflat;
+}
+
+/* Virtual height of real height z: `after` places z behind a flat interval at z. */
+static double virtual_z(const sk *S, double z, int after)
+{
+    size_t k = 0;
+    while (k < S->nflat && (S->flat_h[k] < z || (after && S->flat_h[k] == z)))
+        k++;
+    return z + (double)k;
+}
+
 static uint32_t vertex(sk *S, double x, double y, double z)
 {
+    z = real_z(S, z);
     uint32_t id = 0;
     if (ag_shell_add_vertex(S->shell, x + S->ox, y + S->oy, z, &id) != AG_OK)
         fail(S, AG_ERR_NOMEM);
@@ -98,6 +130,8 @@ static void seg(sk *S, uint32_t face, uint32_t a, uint32_t b)
 static uint32_t new_face(sk *S, const sk_edge *e)
 {
     ag_shell_face f = {AG_SHELL_FACE_SIDE, e->loop, e->edge, e->profile, e->seg, 0, 0};
+    if (e->growing)
+        f.segment = -1; /* the flat growth of a plan edit */
     uint32_t id = 0;
     if (ag_shell_add_face(S->shell, &f, &id) != AG_OK)
         fail(S, AG_ERR_NOMEM);
@@ -233,7 +267,8 @@ static void split_event(sk *S, uint32_t k, uint32_t fi)
     double dx = edx(f), dy = edy(f);
     double len = dx * (bx - ax) + dy * (by - ay);
     double t = dx * (x - ax) + dy * (y - ay);
-    if (len < -S->d3 || t < -S->d3 || t > len + S->d3)
+    /* an edge that has shrunk to a point by then is handled by its edge event */
+    if (len <= S->d3 || t < -S->d3 || t > len + S->d3)
         return;
     ag_event ev = {0};
     ev.type = AG_EVENT_SPLIT;
@@ -267,7 +302,9 @@ static void merge(sk *S, uint32_t k)
     uint32_t ein = c->in, eout = c->out;
     int min_vol = S->plan->priority == AG_PRIORITY_MIN_VOLUME;
     double sin_ = S->e[ein].s, sout = S->e[eout].s;
-    int in_wins = min_vol ? sin_ > sout : sin_ < sout;
+    int32_t pin = S->plan->profiles[S->e[ein].profile].priority;
+    int32_t pout = S->plan->profiles[S->e[eout].profile].priority;
+    int in_wins = pin != pout ? pin > pout : min_vol ? sin_ > sout : sin_ < sout;
     double z = c->z, l_x = c->x, l_y = c->y;
     uint32_t vl = c->vert;
     S->stats.merges++;
@@ -637,10 +674,11 @@ static void intersection(sk *S, ag_event *evs, size_t n, scratch *W)
         W->rays[nrays++] = (ray){a > 0 ? a - M_PI : a + M_PI, fi, 0};
         W->rays[nrays++] = (ray){a, f2, 1};
     }
-    for (size_t i = 0; i < W->C.n; i++)
-        retire(S, W->C.arr[i], vl);
-    if (!nrays)
+    if (!nrays) {
+        for (size_t i = 0; i < W->C.n; i++)
+            retire(S, W->C.arr[i], vl);
         return;
+    }
     qsort(W->rays, nrays, sizeof(ray), cmp_ray);
     /* near-ties: an outgoing ray goes before an incoming one (a ridge, zipped later) */
     for (size_t i = 0; i + 1 < nrays; i++)
@@ -680,22 +718,52 @@ static void intersection(sk *S, ag_event *evs, size_t n, scratch *W)
         return;
     }
     uint32_t *stack = malloc(nrays * sizeof *stack);
-    if (!stack) {
+    uint32_t *pairs = malloc(nrays * sizeof *pairs);
+    uint8_t *keep = calloc(W->C.n + 1, 1);
+    if (!stack || !pairs || !keep) {
+        free(stack);
+        free(pairs);
+        free(keep);
         fail(S, AG_ERR_NOMEM);
         return;
     }
-    size_t sp = 0;
-    size_t first_new = S->ntouched;
+    size_t sp = 0, np = 0;
+    int nested = 0;
     for (size_t j = 0; j < nrays; j++) {
         ray *r = &W->rays[(start + j) % nrays];
         if (r->out) {
+            if (sp)
+                nested = 1;
             stack[sp++] = r->edge;
         } else if (sp) {
-            uint32_t out = stack[--sp];
-            add_corner(S, r->edge, out, lx, ly, z, vl);
+            pairs[2 * np] = r->edge;
+            pairs[2 * np + 1] = stack[--sp];
+            np++;
         }
     }
+    if (nested)
+        S->stats.irregular++;
+    /* a corner that is paired again with the same two edges only touched the others:
+     * it carries on unchanged (re-making it would find the same touch again) */
+    for (size_t p = 0; p < np; p++)
+        for (size_t i = 0; i < W->C.n; i++) {
+            sk_corner *c = &S->c[W->C.arr[i]];
+            if (!keep[i] && c->in == pairs[2 * p] && c->out == pairs[2 * p + 1]) {
+                keep[i] = 1;
+                pairs[2 * p] = NONE;
+                break;
+            }
+        }
+    for (size_t i = 0; i < W->C.n; i++)
+        if (!keep[i])
+            retire(S, W->C.arr[i], vl);
+    size_t first_new = S->ntouched;
+    for (size_t p = 0; p < np; p++)
+        if (pairs[2 * p] != NONE)
+            add_corner(S, pairs[2 * p], pairs[2 * p + 1], lx, ly, z, vl);
     free(stack);
+    free(pairs);
+    free(keep);
     size_t last_new = S->ntouched;
     for (size_t i = first_new; i < last_new && S->st == AG_OK; i++)
         settle(S, S->touched[i]);
@@ -703,11 +771,21 @@ static void intersection(sk *S, ag_event *evs, size_t n, scratch *W)
 
 /* --- profile direction events ------------------------------------------------------------ */
 
+/* Slope per unit of virtual height: a horizontal segment covers its width in one unit. */
 static double seg_slope(const ag_profile *p, int32_t seg)
 {
     const ag_profile_point *a = &p->points[seg], *b = &p->points[seg + 1];
+    if (b->z == a->z)
+        return b->w - a->w;
     return (b->w - a->w) / (b->z - a->z);
 }
+
+static int seg_flat(const ag_profile *p, int32_t seg)
+{
+    return p->points[seg + 1].z == p->points[seg].z;
+}
+
+#define FLAT_MARK UINT32_MAX
 
 static void direction(sk *S, ag_event *evs, size_t n)
 {
@@ -716,17 +794,38 @@ static void direction(sk *S, ag_event *evs, size_t n)
     uint32_t mark = S->stamp;
     S->stats.directions++;
     compact_live(S);
-    /* edges that change */
+    /* edges that change: a profile switching segment (new face), or an edge held
+     * still for / released after a flat interval (same face) */
     u32vec ch = {0}, ks = {0};
+    int flat_start = 0, flat_end = 0;
+    for (size_t j = 0; j < n; j++)
+        if (evs[j].a == FLAT_MARK) {
+            flat_start |= evs[j].b == 0;
+            flat_end |= evs[j].b == 1;
+        }
+    uint8_t *newface = malloc(S->nlive_e ? S->nlive_e : 1);
+    if (!newface) {
+        fail(S, AG_ERR_NOMEM);
+        return;
+    }
     for (size_t i = 0; i < S->nlive_e; i++) {
         uint32_t ei = S->live_e[i];
         sk_edge *e = &S->e[ei];
-        for (size_t j = 0; j < n; j++)
-            if ((uint32_t)e->profile == evs[j].a && (uint32_t)e->seg + 1 == evs[j].b) {
-                if (!vpush(&ch, ei))
-                    fail(S, AG_ERR_NOMEM);
-                break;
-            }
+        int hit = 0;
+        for (size_t j = 0; j < n && !hit; j++)
+            if (evs[j].a != FLAT_MARK && (uint32_t)e->profile == evs[j].a &&
+                (uint32_t)e->seg + 1 == evs[j].b && (uint32_t)e->step == evs[j].ver)
+                hit = 1;
+        const ag_profile *p = &S->plan->profiles[e->profile];
+        int next_flat = hit ? seg_flat(p, e->seg + 1) : seg_flat(p, e->seg);
+        int grown = flat_end && e->growing;
+        int pause = !hit && !e->growing && flat_start && !next_flat && !e->paused;
+        int release = !hit && flat_end && e->paused;
+        if (!hit && !pause && !release && !grown)
+            continue;
+        newface[ch.n] = (uint8_t)(grown ? 2 : hit);
+        if (!vpush(&ch, ei))
+            fail(S, AG_ERR_NOMEM);
     }
     for (size_t i = 0; i < ch.n; i++) {
         sk_edge *e = &S->e[ch.arr[i]];
@@ -754,15 +853,27 @@ static void direction(sk *S, ag_event *evs, size_t n)
     }
     for (size_t i = 0; i < ch.n; i++) {
         sk_edge *e = &S->e[ch.arr[i]];
-        uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
-        seg(S, e->face, ve, vs);
         const ag_profile *p = &S->plan->profiles[e->profile];
-        double s_new = seg_slope(p, e->seg + 1);
+        double s_new;
+        if (newface[i]) {
+            uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
+            seg(S, e->face, ve, vs);
+            if (newface[i] == 1)
+                e->seg++; /* a grown plan edit keeps its profile's first segment */
+            s_new = seg_slope(p, e->seg);
+            e->face = new_face(S, e);
+            seg(S, e->face, vs, ve);
+            e->paused = 0;
+            e->growing = 0;
+        } else if (e->paused) {
+            s_new = seg_slope(p, e->seg);
+            e->paused = 0;
+        } else {
+            s_new = 0;
+            e->paused = 1;
+        }
         e->c += (e->s - s_new) * z;
         e->s = s_new;
-        e->seg++;
-        e->face = new_face(S, e);
-        seg(S, e->face, vs, ve);
         e->ver++;
     }
     size_t first_new = S->ntouched;
@@ -775,10 +886,188 @@ static void direction(sk *S, ag_event *evs, size_t n)
     for (size_t i = first_new; i < last_new && S->st == AG_OK; i++)
         settle(S, S->touched[i]);
 out:
+    free(newface);
     free(verts);
     free(xy);
     free(ch.arr);
     free(ks.arr);
+}
+
+/* --- plan edits (natural steps) ----------------------------------------------------------- */
+
+/* Finds the active piece of an anchor's edge at height z and the point on it (local
+ * coordinates); returns the edge or NONE. */
+static uint32_t anchor_point(sk *S, const ag_anchor *a, double z, double *px, double *py);
+
+#define STEP_SEED 1e-3 /* side of the protrusion a natural step grows from */
+
+static uint32_t make_edge(sk *S, double ax, double ay, double bx, double by, double slope, double z,
+                          int32_t step, int32_t profile)
+{
+    uint32_t id = add_edge(S);
+    if (id == NONE)
+        return NONE;
+    sk_edge *e = &S->e[id];
+    double len = hypot(bx - ax, by - ay);
+    e->nx = -(by - ay) / len;
+    e->ny = (bx - ax) / len;
+    e->s = slope;
+    e->c = e->nx * ax + e->ny * ay - slope * z;
+    e->loop = -1;
+    e->edge = step - 1;
+    e->profile = profile;
+    e->seg = 0;
+    e->step = step;
+    e->growing = 1;
+    e->face = new_face(S, e);
+    return id;
+}
+
+/* At the start of a flat interval: a tiny protrusion (or recess) is put into the active
+ * edge at each natural step's anchor; during the interval it grows to the step's width
+ * and depth while the other edges wait, so it meets the rest of the plan through the
+ * ordinary events and cannot make the plan self-intersect. */
+static void insert_steps(sk *S, double v)
+{
+    const ag_plan *P = S->plan;
+    for (size_t k = 0; k < P->nsteps && S->st == AG_OK; k++) {
+        const ag_plan_step *st = &P->steps[k];
+        size_t fk = 0;
+        while (fk < S->nflat && S->flat_h[fk] != st->at.z)
+            fk++;
+        if (fk == S->nflat || fabs(S->flat_h[fk] + (double)fk - v) > 1e-9)
+            continue;
+        compact_live(S);
+        double x, y;
+        uint32_t ei = anchor_point(S, &st->at, v, &x, &y);
+        if (ei == NONE) {
+            S->stats.steps_skipped++;
+            continue;
+        }
+        sk_edge *e = &S->e[ei];
+        double dx = edx(e), dy = edy(e), h = STEP_SEED / 2;
+        double sx, sy, ex, ey;
+        cpos(&S->c[e->start], v, &sx, &sy);
+        cpos(&S->c[e->end], v, &ex, &ey);
+        double t = dx * (x - sx) + dy * (y - sy), len = dx * (ex - sx) + dy * (ey - sy);
+        if (t - h < 10 * S->d3 || t + h > len - 10 * S->d3) {
+            S->stats.steps_skipped++;
+            continue;
+        }
+        double out = st->depth > 0 ? -1 : 1; /* protrusion: outwards (-n) */
+        double ax = x - h * dx, ay = y - h * dy, bx = x + h * dx, by = y + h * dy;
+        double a2x = ax + out * STEP_SEED * e->nx, a2y = ay + out * STEP_SEED * e->ny;
+        double b2x = bx + out * STEP_SEED * e->nx, b2y = by + out * STEP_SEED * e->ny;
+        /* growth over the unit interval: sides to the width, front to the depth; a
+         * protrusion's edges move outwards (negative slope), a recess's inwards */
+        double side = (st->width / 2 - h) * (st->depth > 0 ? -1 : 1);
+        double front = (fabs(st->depth) - STEP_SEED) * (st->depth > 0 ? -1 : 1);
+        int32_t sid = (int32_t)k + 1;
+        uint32_t e2 = add_edge(S);
+        uint32_t s1 = make_edge(S, ax, ay, a2x, a2y, side, v, sid, st->profile);
+        uint32_t f = make_edge(S, a2x, a2y, b2x, b2y, front, v, sid, st->profile);
+        uint32_t s2 = make_edge(S, b2x, b2y, bx, by, side, v, sid, st->profile);
+        if (e2 == NONE || s1 == NONE || f == NONE || s2 == NONE)
+            return;
+        e = &S->e[ei];
+        sk_edge *g = &S->e[e2];
+        *g = *e;
+        g->ver = 0;
+        g->alive = 1;
+        g->end = e->end;
+        S->c[e->end].in = e2;
+        uint32_t va = vertex(S, ax, ay, v), va2 = vertex(S, a2x, a2y, v);
+        uint32_t vb2 = vertex(S, b2x, b2y, v), vb = vertex(S, bx, by, v);
+        ag_shell_face ff = {AG_SHELL_FACE_FLOOR, -1, (int32_t)k, st->profile, -1, 0, 0};
+        uint32_t floor = 0;
+        if (ag_shell_add_face(S->shell, &ff, &floor) != AG_OK) {
+            fail(S, AG_ERR_NOMEM);
+            return;
+        }
+        seg(S, e->face, vb, va); /* the piece of the edge the step replaces */
+        seg(S, floor, va, vb);
+        seg(S, floor, vb, vb2);
+        seg(S, floor, vb2, va2);
+        seg(S, floor, va2, va);
+        seg(S, S->e[s1].face, va, va2);
+        seg(S, S->e[f].face, va2, vb2);
+        seg(S, S->e[s2].face, vb2, vb);
+        size_t first = S->ntouched;
+        add_corner(S, ei, s1, ax, ay, v, va);
+        add_corner(S, s1, f, a2x, a2y, v, va2);
+        add_corner(S, f, s2, b2x, b2y, v, vb2);
+        add_corner(S, s2, e2, bx, by, v, vb);
+        size_t last = S->ntouched;
+        for (size_t i = first; i < last && S->st == AG_OK; i++)
+            settle(S, S->touched[i]);
+        S->stats.steps++;
+    }
+}
+
+/* --- anchors ----------------------------------------------------------------------------- */
+
+static uint32_t anchor_point(sk *S, const ag_anchor *a, double z, double *px, double *py)
+{
+    if (a->loop < 0 || (size_t)a->loop >= S->plan->nloops || a->edge < 0 ||
+        (size_t)a->edge >= S->plan->loops[a->loop].n)
+        return NONE;
+    const ag_plan_loop *lp = &S->plan->loops[a->loop];
+    size_t i = (size_t)a->edge, j = (i + 1) % lp->n;
+    double bx = lp->xy[2 * i] - S->ox, by = lp->xy[2 * i + 1] - S->oy;
+    double ex = lp->xy[2 * j] - S->ox, ey = lp->xy[2 * j + 1] - S->oy;
+    double len = hypot(ex - bx, ey - by), dx = (ex - bx) / len, dy = (ey - by) / len;
+    /* the pieces of this edge in the active plan, as parameters along its direction */
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t q = 0; q < S->nlive_e; q++) {
+        const sk_edge *e = &S->e[S->live_e[q]];
+        if (!e->alive || e->step || e->loop != a->loop || e->edge != a->edge)
+            continue;
+        double ax, ay, cx, cy;
+        cpos(&S->c[e->start], z, &ax, &ay);
+        cpos(&S->c[e->end], z, &cx, &cy);
+        lo = fmin(lo, dx * (ax - bx) + dy * (ay - by));
+        hi = fmax(hi, dx * (cx - bx) + dy * (cy - by));
+    }
+    if (!(hi > lo))
+        return NONE;
+    double t = a->absolute ? a->along : lo + a->along * (hi - lo);
+    for (size_t q = 0; q < S->nlive_e; q++) {
+        uint32_t id = S->live_e[q];
+        const sk_edge *e = &S->e[id];
+        if (!e->alive || e->step || e->loop != a->loop || e->edge != a->edge)
+            continue;
+        double ax, ay, cx, cy;
+        cpos(&S->c[e->start], z, &ax, &ay);
+        cpos(&S->c[e->end], z, &cx, &cy);
+        double t0 = dx * (ax - bx) + dy * (ay - by), t1 = dx * (cx - bx) + dy * (cy - by);
+        if (t < t0 - S->d3 || t > t1 + S->d3)
+            continue;
+        /* the point on the edge's line at this height */
+        double off = e->c + e->s * z - (e->nx * bx + e->ny * by);
+        *px = bx + t * dx + off * e->nx;
+        *py = by + t * dy + off * e->ny;
+        return id;
+    }
+    return NONE;
+}
+
+static void locate_anchor(sk *S, ag_anchor *a, double z)
+{
+    double x, y;
+    uint32_t id = anchor_point(S, a, z, &x, &y);
+    if (id == NONE)
+        return;
+    const sk_edge *e = &S->e[id];
+    a->found = 1;
+    a->pos[0] = x + S->ox;
+    a->pos[1] = y + S->oy;
+    a->pos[2] = real_z(S, z);
+    /* the face's outward normal: the plane n.p - s z = c, pointing away from inside */
+    double nl = sqrt(1 + e->s * e->s);
+    a->normal[0] = -e->nx / nl;
+    a->normal[1] = -e->ny / nl;
+    a->normal[2] = e->s / nl;
+    a->face = (int32_t)e->face;
 }
 
 /* --- the cap ----------------------------------------------------------------------------- */
@@ -795,7 +1084,7 @@ static void cap(sk *S, double z)
         fail(S, AG_ERR_NOMEM);
         return;
     }
-    uint32_t *verts = malloc(S->nc * sizeof *verts);
+    uint32_t *verts = calloc(S->nc ? S->nc : 1, sizeof *verts);
     if (!verts) {
         fail(S, AG_ERR_NOMEM);
         return;
@@ -822,6 +1111,21 @@ static int cmp_event_x(const void *a, const void *b)
 {
     double x = ((const ag_event *)a)->x, y = ((const ag_event *)b)->x;
     return x < y ? -1 : x > y;
+}
+
+typedef struct {
+    double z;
+    uint32_t root, i;
+} gsort;
+
+static int cmp_gsort(const void *a, const void *b)
+{
+    const gsort *x = a, *y = b;
+    if (x->z != y->z)
+        return x->z < y->z ? -1 : 1;
+    if (x->root != y->root)
+        return x->root < y->root ? -1 : 1;
+    return x->i < y->i ? -1 : x->i > y->i;
 }
 
 static uint32_t uf_find(uint32_t *p, uint32_t x)
@@ -865,18 +1169,98 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     uint32_t floor_face = 0;
     if (ag_shell_add_face(S.shell, &ff, &floor_face) != AG_OK)
         fail(&S, AG_ERR_NOMEM);
-    double top_profile = 0;
-    for (size_t i = 0; i < plan->nprofiles; i++) {
+    /* heights with a horizontal segment, ascending and distinct */
+    size_t maxflat = 0;
+    for (size_t i = 0; i < plan->nprofiles; i++)
+        maxflat += plan->profiles[i].npoints;
+    S.flat_h = malloc((maxflat ? maxflat : 1) * sizeof *S.flat_h);
+    if (!S.flat_h)
+        fail(&S, AG_ERR_NOMEM);
+    for (size_t i = 0; i < plan->nprofiles && S.flat_h; i++) {
         const ag_profile *p = &plan->profiles[i];
-        top_profile = fmax(top_profile, p->points[p->npoints - 1].z);
+        for (size_t j = 0; j + 1 < p->npoints; j++) {
+            if (!seg_flat(p, (int32_t)j))
+                continue;
+            double h = p->points[j].z;
+            size_t k = 0;
+            while (k < S.nflat && S.flat_h[k] < h)
+                k++;
+            if (k < S.nflat && S.flat_h[k] == h)
+                continue;
+            memmove(&S.flat_h[k + 1], &S.flat_h[k], (S.nflat - k) * sizeof *S.flat_h);
+            S.flat_h[k] = h;
+            S.nflat++;
+        }
+    }
+    for (size_t k = 0; k < plan->nsteps && S.flat_h; k++) {
+        double h = plan->steps[k].at.z;
+        size_t q = 0;
+        while (q < S.nflat && S.flat_h[q] < h)
+            q++;
+        if (q < S.nflat && S.flat_h[q] == h)
+            continue;
+        double *nf = realloc(S.flat_h, (S.nflat + 1 + maxflat) * sizeof *nf);
+        if (!nf) {
+            fail(&S, AG_ERR_NOMEM);
+            break;
+        }
+        S.flat_h = nf;
+        memmove(&S.flat_h[q + 1], &S.flat_h[q], (S.nflat - q) * sizeof *S.flat_h);
+        S.flat_h[q] = h;
+        S.nflat++;
+    }
+    for (size_t k = 0; k < plan->nsteps; k++) {
+        const ag_plan_step *st = &plan->steps[k];
+        const ag_profile *p = &plan->profiles[st->profile];
         for (size_t j = 1; j + 1 < p->npoints; j++) {
             ag_event ev = {0};
             ev.type = AG_EVENT_DIRECTION;
-            ev.z = p->points[j].z;
+            ev.z = virtual_z(&S, st->at.z + p->points[j].z, 1);
+            ev.a = (uint32_t)st->profile;
+            ev.b = (uint32_t)j;
+            ev.ver = (uint32_t)k + 1;
+            push(&S, &ev);
+        }
+    }
+    for (size_t k = 0; k < S.nflat; k++) {
+        ag_event ev = {0};
+        ev.type = AG_EVENT_DIRECTION;
+        ev.a = FLAT_MARK;
+        ev.b = 0;
+        ev.z = S.flat_h[k] + (double)k;
+        push(&S, &ev);
+        ev.b = 1;
+        ev.z += 1;
+        push(&S, &ev);
+    }
+    double top_profile = 0;
+    for (size_t i = 0; i < plan->nprofiles; i++) {
+        const ag_profile *p = &plan->profiles[i];
+        top_profile = fmax(top_profile, virtual_z(&S, p->points[p->npoints - 1].z, 1));
+        for (size_t j = 1; j + 1 < p->npoints; j++) {
+            ag_event ev = {0};
+            ev.type = AG_EVENT_DIRECTION;
+            double z = p->points[j].z;
+            if (seg_flat(p, (int32_t)j))
+                ev.z = virtual_z(&S, z, 0); /* the flat interval starts */
+            else if (seg_flat(p, (int32_t)j - 1))
+                ev.z = virtual_z(&S, z, 0) + 1; /* it ends */
+            else
+                ev.z = virtual_z(&S, z, 1);
             ev.a = (uint32_t)i;
             ev.b = (uint32_t)j;
             push(&S, &ev);
         }
+    }
+    ag_anchor *anchors = opt ? opt->anchors : NULL;
+    for (size_t i = 0; anchors && i < plan->nanchors; i++) {
+        ag_event ev = {0};
+        ev.type = AG_EVENT_ANCHOR;
+        ev.z = virtual_z(&S, anchors[i].z, 0);
+        ev.b = (uint32_t)i;
+        anchors[i].found = 0;
+        anchors[i].face = -1;
+        push(&S, &ev);
     }
     for (size_t L = 0; L < plan->nloops && S.st == AG_OK; L++) {
         const ag_plan_loop *lp = &plan->loops[L];
@@ -917,7 +1301,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
 
     size_t max_events = opt && opt->max_events ? opt->max_events : 64 * ncorners + 10000;
     size_t handled = 0;
-    double limit = plan->cap_height > 0 ? plan->cap_height : INFINITY;
+    double limit = plan->cap_height > 0 ? virtual_z(&S, plan->cap_height, 0) : INFINITY;
     scratch W;
     memset(&W, 0, sizeof W);
     ag_event *batch = NULL;
@@ -939,6 +1323,12 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             fail(&S, AG_ERR_INTERNAL);
             break;
         }
+        if (ev.type == AG_EVENT_ANCHOR) {
+            /* only observes: the sweep height stays where the last event left it */
+            compact_live(&S);
+            locate_anchor(&S, &anchors[ev.b], ev.z);
+            continue;
+        }
         if (ev.z > S.zcur)
             S.zcur = ev.z;
         size_t nb = 0;
@@ -950,7 +1340,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         const ag_event *top;
         int is_dir = ev.type == AG_EVENT_DIRECTION;
         while ((top = ag_eventq_peek(&S.q)) && top->z <= ev.z + S.d1 &&
-               (top->type == AG_EVENT_DIRECTION) == is_dir) {
+               top->type != AG_EVENT_ANCHOR && (top->type == AG_EVENT_DIRECTION) == is_dir) {
             ag_event nx;
             ag_eventq_pop(&S.q, &nx);
             if (!event_valid(&S, &nx))
@@ -963,6 +1353,9 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         }
         if (is_dir) {
             direction(&S, batch, nb);
+            for (size_t i = 0; i < nb; i++)
+                if (batch[i].a == FLAT_MARK && batch[i].b == 0)
+                    insert_steps(&S, batch[i].z);
             schedule_touched(&S);
             continue;
         }
@@ -975,51 +1368,57 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         for (size_t i = 0; i < nb; i++)
             uf[i] = (uint32_t)i;
         double r = 10 * S.d2;
+        /* a window of 64 suffices: points of one cluster chain each other */
         for (size_t i = 0; i < nb; i++)
-            for (size_t j = i + 1; j < nb && batch[j].x - batch[i].x <= r; j++)
+            for (size_t j = i + 1; j < nb && j < i + 64 && batch[j].x - batch[i].x <= r; j++)
                 if (fabs(batch[j].y - batch[i].y) <= r &&
                     hypot(batch[j].x - batch[i].x, batch[j].y - batch[i].y) <= r) {
                     uint32_t a = uf_find(uf, (uint32_t)i), b = uf_find(uf, (uint32_t)j);
                     if (a != b)
                         uf[a > b ? a : b] = a < b ? a : b;
                 }
-        /* handle groups lowest first; group members are gathered in place */
+        /* handle groups lowest first: order events by (group's lowest z, group) */
+        gsort *gs = malloc(nb * sizeof *gs);
+        double *gz = malloc(nb * sizeof *gz);
         ag_event *grp = malloc(nb * sizeof *grp);
-        uint8_t *done = calloc(nb, 1);
-        if (!grp || !done) {
+        if (!gs || !gz || !grp) {
+            free(gs);
+            free(gz);
             free(grp);
-            free(done);
             fail(&S, AG_ERR_NOMEM);
             break;
         }
-        for (;;) {
-            size_t best = SIZE_MAX;
-            for (size_t i = 0; i < nb; i++)
-                if (!done[i] && (best == SIZE_MAX || batch[i].z < batch[best].z))
-                    best = i;
-            if (best == SIZE_MAX)
-                break;
-            uint32_t root = uf_find(uf, (uint32_t)best);
-            size_t ng = 0;
-            for (size_t i = 0; i < nb; i++)
-                if (!done[i] && uf_find(uf, (uint32_t)i) == root) {
-                    done[i] = 1;
-                    grp[ng++] = batch[i];
-                }
-            intersection(&S, grp, ng, &W);
-            if (S.st != AG_OK)
-                break;
+        for (size_t i = 0; i < nb; i++)
+            gz[i] = INFINITY;
+        for (size_t i = 0; i < nb; i++) {
+            uint32_t rt = uf_find(uf, (uint32_t)i);
+            if (batch[i].z < gz[rt])
+                gz[rt] = batch[i].z;
         }
+        for (size_t i = 0; i < nb; i++) {
+            gs[i].root = uf_find(uf, (uint32_t)i);
+            gs[i].z = gz[gs[i].root];
+            gs[i].i = (uint32_t)i;
+        }
+        qsort(gs, nb, sizeof *gs, cmp_gsort);
+        for (size_t i = 0; i < nb && S.st == AG_OK;) {
+            size_t j = i, ng = 0;
+            while (j < nb && gs[j].root == gs[i].root)
+                grp[ng++] = batch[gs[j++].i];
+            intersection(&S, grp, ng, &W);
+            i = j;
+        }
+        free(gs);
+        free(gz);
         free(grp);
-        free(done);
         schedule_touched(&S);
     }
     if (S.st == AG_OK) {
-        double zc = plan->cap_height > 0 ? plan->cap_height : fmax(S.zcur, top_profile);
+        double zc = plan->cap_height > 0 ? limit : fmax(S.zcur, top_profile);
         compact_live(&S);
         if (S.nlive_e)
             cap(&S, zc);
-        S.stats.top = S.nlive_e ? zc : S.zcur;
+        S.stats.top = real_z(&S, S.nlive_e ? zc : S.zcur);
     }
     free(batch);
     free(uf);
@@ -1036,6 +1435,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     free(S.live_c);
     free(S.live_e);
     free(S.touched);
+    free(S.flat_h);
     if (stats)
         *stats = S.stats;
     if (st != AG_OK) {

@@ -21,12 +21,19 @@
 
 typedef struct {
     size_t max_events; /* 0 = a bound proportional to the plan size */
+    /* plan->nanchors entries to locate (usually plan->anchors), or NULL */
+    ag_anchor *anchors;
 } ag_skeleton_options;
 
 typedef struct {
     size_t intersections; /* generalized intersection events handled */
     size_t directions;    /* profile direction events handled */
     size_t zips, merges;  /* ridge zips and collinear merges */
+    /* intersections whose edges did not alternate in and out around the point (nested
+     * chains, §4.4's non-connected class): resolved by nesting the pairs, but the shape
+     * there may be undesirable */
+    size_t irregular;
+    size_t steps, steps_skipped; /* plan edits made / not made (anchor not on the plan) */
     int capped;           /* the top was closed flat */
     double top;           /* highest height reached */
 } ag_skeleton_stats;

@@ -30,6 +30,7 @@ void ag_grammar_free(ag_grammar *g)
     for (size_t i = 0; i < g->nterminals; i++) {
         free(g->terminals[i].name);
         free(g->terminals[i].path);
+        free(g->terminals[i].label_name);
         free(g->terminals[i].pos);
         free(g->terminals[i].tri);
     }
@@ -137,6 +138,24 @@ ag_status ag_grammar_add_apply(ag_grule *r, const char *callee, const char *node
     return s->callee && s->node ? AG_OK : AG_ERR_NOMEM;
 }
 
+ag_status ag_grammar_add_repeat(ag_grule *r, const char *callee, const char *node, int rot,
+                                int nvec, const uint32_t *counts, const double vec[][3],
+                                long line, long col)
+{
+    ag_status st = ag_grammar_add_apply(r, callee, node, rot, NULL, NULL, line, col);
+    if (st)
+        return st;
+    ag_gstmt *s = &r->stmts[r->nstmts - 1];
+    s->subdivide = 2;
+    s->nvec = nvec < 1 ? 1 : nvec > 3 ? 3 : nvec;
+    for (int k = 0; k < 3; k++) {
+        s->counts[k] = k < s->nvec ? counts[k] : 1;
+        for (int a = 0; a < 3; a++)
+            s->vec[k][a] = k < s->nvec ? vec[k][a] : 0;
+    }
+    return AG_OK;
+}
+
 ag_status ag_grammar_set_terminal_geometry(ag_gterminal *t, const double *pos, size_t nverts,
                                            const uint32_t *tri, size_t ntris)
 {
@@ -167,32 +186,83 @@ static ag_status rerr(ag_error *err, long *col, long line, long c, const char *f
     return ag_error_set(err, AG_ERR_PARSE, line, fmt, a ? a : "");
 }
 
-static int find_node(char **names, size_t n, const char *s)
+/* Node names of one body: an open-addressing table over string hashes. */
+typedef struct {
+    char **names;
+    int32_t *slot; /* index into names, -1 empty */
+    size_t n, cap;
+} nametab;
+
+static uint64_t str_hash(const char *s)
 {
-    for (size_t i = n; i-- > 0;)
-        if (!strcmp(names[i], s))
-            return (int)i;
+    uint64_t h = 0xcbf29ce484222325ULL;
+    while (*s)
+        h = (h ^ (unsigned char)*s++) * 0x100000001b3ULL;
+    return h;
+}
+
+static int find_node(const nametab *t, const char *s)
+{
+    size_t i = str_hash(s) & (t->cap - 1);
+    while (t->slot[i] >= 0) {
+        if (!strcmp(t->names[t->slot[i]], s))
+            return t->slot[i];
+        i = (i + 1) & (t->cap - 1);
+    }
     return -1;
 }
 
-static ag_status resolve_rule(ag_grammar *g, ag_grule *r, size_t nrules_before, ag_error *err,
-                              long *col)
+static void add_node(nametab *t, char *s)
 {
-    char **names = malloc((r->nstmts + 1) * sizeof *names);
-    if (!names)
+    size_t i = str_hash(s) & (t->cap - 1);
+    while (t->slot[i] >= 0)
+        i = (i + 1) & (t->cap - 1);
+    t->slot[i] = (int32_t)t->n;
+    t->names[t->n++] = s;
+}
+
+/* Terminal and rule names: index by hash as well, rules only up to `limit`. */
+static int find_callee(const ag_grammar *g, const nametab *rt, const nametab *tt, const char *s,
+                       size_t limit, int *is_rule)
+{
+    int k = find_node(rt, s);
+    if (k >= 0 && (size_t)k < limit) {
+        *is_rule = 1;
+        return k;
+    }
+    k = find_node(tt, s);
+    *is_rule = 0;
+    (void)g;
+    return k;
+}
+
+static ag_status resolve_rule(ag_grammar *g, ag_grule *r, size_t nrules_before, const nametab *rt,
+                              const nametab *tt, ag_error *err, long *col)
+{
+    nametab nt = {0};
+    nt.cap = 16;
+    while (nt.cap < 2 * (r->nstmts + 1))
+        nt.cap <<= 1;
+    nt.names = malloc((r->nstmts + 1) * sizeof *nt.names);
+    nt.slot = malloc(nt.cap * sizeof *nt.slot);
+    if (!nt.names || !nt.slot) {
+        free(nt.names);
+        free(nt.slot);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    size_t n = 0;
-    names[n++] = "p";
+    }
+    for (size_t i = 0; i < nt.cap; i++)
+        nt.slot[i] = -1;
+    add_node(&nt, "p");
     ag_status st = AG_OK;
     for (size_t i = 0; i < r->nstmts && !st; i++) {
         ag_gstmt *s = &r->stmts[i];
         if (s->kind == AG_GSTMT_SPLIT) {
-            int p = find_node(names, n, s->parent);
+            int p = find_node(&nt, s->parent);
             if (p < 0) {
                 st = rerr(err, col, s->line, s->col, "node '%s' is not defined", s->parent);
                 break;
             }
-            if (find_node(names, n, s->node) >= 0) {
+            if (find_node(&nt, s->node) >= 0) {
                 st = rerr(err, col, s->line, s->col, "node '%s' is defined twice", s->node);
                 break;
             }
@@ -208,31 +278,20 @@ static ag_status resolve_rule(ag_grammar *g, ag_grule *r, size_t nrules_before, 
             if (st)
                 break;
             s->parent_ix = p;
-            s->node_ix = (int32_t)n;
-            names[n++] = s->node;
+            s->node_ix = (int32_t)nt.n;
+            add_node(&nt, s->node);
         } else {
-            int p = find_node(names, n, s->node);
+            int p = find_node(&nt, s->node);
             if (p < 0) {
                 st = rerr(err, col, s->line, s->col, "node '%s' is not defined", s->node);
                 break;
             }
             s->node_ix = p;
-            s->callee_ix = -1;
-            for (size_t k = 0; k < nrules_before; k++)
-                if (!strcmp(g->rules[k].name, s->callee)) {
-                    s->callee_ix = (int32_t)k;
-                    s->callee_is_rule = 1;
-                }
-            if (s->callee_ix < 0)
-                for (size_t k = 0; k < g->nterminals; k++)
-                    if (!strcmp(g->terminals[k].name, s->callee)) {
-                        s->callee_ix = (int32_t)k;
-                        s->callee_is_rule = 0;
-                    }
+            int is_rule = 0;
+            s->callee_ix = find_callee(g, rt, tt, s->callee, nrules_before, &is_rule);
+            s->callee_is_rule = is_rule;
             if (s->callee_ix < 0) {
-                int later = 0;
-                for (size_t k = nrules_before; k < g->nrules; k++)
-                    later |= !strcmp(g->rules[k].name, s->callee);
+                int later = find_node(rt, s->callee) >= 0;
                 st = rerr(err, col, s->line, s->col,
                           later ? "rule '%s' is used before it is declared"
                                 : "'%s' is neither a terminal nor a rule",
@@ -246,9 +305,13 @@ static ag_status resolve_rule(ag_grammar *g, ag_grule *r, size_t nrules_before, 
             if (s->subdivide) {
                 double cells = 1;
                 for (int a = 0; a < 3; a++) {
-                    if (s->counts[a] < 1 || !isfinite(s->step[a])) {
+                    int bad = s->counts[a] < 1 || !isfinite(s->step[a]);
+                    for (int b = 0; b < 3; b++)
+                        bad |= !isfinite(s->vec[a][b]);
+                    if (bad) {
                         st = rerr(err, col, s->line, s->col,
-                                  "subdivide needs counts >= 1 and finite steps%s", "");
+                                  "%s needs counts >= 1 and finite steps",
+                                  s->subdivide == 2 ? "repeat" : "subdivide");
                         break;
                     }
                     cells *= s->counts[a];
@@ -258,41 +321,80 @@ static ag_status resolve_rule(ag_grammar *g, ag_grule *r, size_t nrules_before, 
             }
         }
     }
-    r->nnodes = n;
-    free(names);
+    r->nnodes = nt.n;
+    free(nt.names);
+    free(nt.slot);
     return st;
+}
+
+static int tab_init(nametab *t, size_t n)
+{
+    t->n = 0;
+    t->cap = 16;
+    while (t->cap < 2 * (n + 1))
+        t->cap <<= 1;
+    t->names = malloc((n + 1) * sizeof *t->names);
+    t->slot = malloc(t->cap * sizeof *t->slot);
+    if (!t->names || !t->slot)
+        return -1;
+    for (size_t i = 0; i < t->cap; i++)
+        t->slot[i] = -1;
+    return 0;
 }
 
 ag_status ag_grammar_resolve(ag_grammar *g, ag_error *err, long *col)
 {
     if (col)
         *col = 0;
-    for (size_t i = 0; i < g->nterminals; i++) {
-        for (size_t k = 0; k < i; k++)
-            if (!strcmp(g->terminals[k].name, g->terminals[i].name))
-                return rerr(err, col, 0, 0, "terminal '%s' is declared twice", g->terminals[i].name);
-        for (int a = 0; a < 3; a++)
-            if (!(g->terminals[i].size[a] >= 0) || !isfinite(g->terminals[i].size[a]))
-                return rerr(err, col, 0, 0, "terminal '%s' has a bad size", g->terminals[i].name);
+    nametab rt = {0}, tt = {0};
+    ag_status st = AG_OK;
+    if (tab_init(&rt, g->nrules) || tab_init(&tt, g->nterminals)) {
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        goto done;
     }
-    for (size_t i = 0; i < g->nrules; i++) {
+    for (size_t i = 0; i < g->nterminals && !st; i++) {
+        ag_gterminal *t = &g->terminals[i];
+        if (find_node(&tt, t->name) >= 0) {
+            st = rerr(err, col, 0, 0, "terminal '%s' is declared twice", t->name);
+            break;
+        }
+        add_node(&tt, t->name);
+        for (int a = 0; a < 3; a++)
+            if (!(t->size[a] >= 0) || !isfinite(t->size[a])) {
+                st = rerr(err, col, 0, 0, "terminal '%s' has a bad size", t->name);
+                break;
+            }
+    }
+    for (size_t i = 0; i < g->nrules && !st; i++) {
         ag_grule *r = &g->rules[i];
-        for (size_t k = 0; k < i; k++)
-            if (!strcmp(g->rules[k].name, r->name))
-                return rerr(err, col, r->line, r->col, "rule '%s' is declared twice", r->name);
-        for (size_t k = 0; k < g->nterminals; k++)
-            if (!strcmp(g->terminals[k].name, r->name))
-                return rerr(err, col, r->line, r->col, "'%s' names a terminal and a rule", r->name);
+        if (find_node(&rt, r->name) >= 0) {
+            st = rerr(err, col, r->line, r->col, "rule '%s' is declared twice", r->name);
+            break;
+        }
+        if (find_node(&tt, r->name) >= 0) {
+            st = rerr(err, col, r->line, r->col, "'%s' names a terminal and a rule", r->name);
+            break;
+        }
+        add_node(&rt, r->name);
         for (int a = 0; a < 3; a++)
-            if (!(r->size[a] >= 0) || !isfinite(r->size[a]))
-                return rerr(err, col, r->line, r->col, "rule '%s' has a bad size", r->name);
-        ag_status st = resolve_rule(g, r, i, err, col);
-        if (st)
-            return st;
+            if (!(r->size[a] >= 0) || !isfinite(r->size[a])) {
+                st = rerr(err, col, r->line, r->col, "rule '%s' has a bad size", r->name);
+                break;
+            }
     }
-    if (!g->has_axiom)
-        return rerr(err, col, 0, 0, "the grammar has no axiom%s", "");
-    return resolve_rule(g, &g->axiom, g->nrules, err, col);
+    /* bodies: a rule may call only the rules before it */
+    for (size_t i = 0; i < g->nrules && !st; i++)
+        st = resolve_rule(g, &g->rules[i], i, &rt, &tt, err, col);
+    if (!st && !g->has_axiom)
+        st = rerr(err, col, 0, 0, "the grammar has no axiom%s", "");
+    if (!st)
+        st = resolve_rule(g, &g->axiom, g->nrules, &rt, &tt, err, col);
+done:
+    free(rt.names);
+    free(rt.slot);
+    free(tt.names);
+    free(tt.slot);
+    return st;
 }
 
 /* ---- export ----------------------------------------------------------------------------- */
@@ -308,7 +410,7 @@ typedef struct {
     uint8_t *visited;    /* per class */
     uint8_t *in_pattern; /* per class: used by a subdivide */
     int32_t *rule_of;    /* per class: grammar rule */
-    int32_t *term_of;    /* per label: terminal */
+    int32_t *term_of;    /* per variant: terminal */
     uint32_t *vmap;      /* scratch: vertex → terminal vertex */
     double *tpos;
     uint32_t *ttri;
@@ -331,12 +433,12 @@ static int is_rule(exctx *x, int32_t cls)
 
 static void emit_content(exctx *x, ag_grule *r, int32_t v, const char *vname, unsigned *counter);
 
-static int32_t terminal_for(exctx *x, int32_t label)
+static int32_t terminal_for(exctx *x, int32_t variant)
 {
-    if (x->term_of[label] >= 0)
-        return x->term_of[label];
+    if (x->term_of[variant] >= 0)
+        return x->term_of[variant];
     const ag_labels *L = x->L;
-    uint32_t c = L->exemplar[label];
+    uint32_t c = L->variant_exemplar[variant];
     const ag_box *nb = &x->t->nodes[x->t->comp_node[c]].box;
     double size[3];
     for (int a = 0; a < 3; a++)
@@ -346,7 +448,12 @@ static int32_t terminal_for(exctx *x, int32_t label)
     size_t ti;
     if ((x->st = ag_grammar_add_terminal(x->g, name, size, &ti)))
         return 0;
-    x->g->terminals[ti].label = label;
+    x->g->terminals[ti].label = L->variant_label[variant];
+    snprintf(name, sizeof name, "L%d", L->variant_label[variant] + 1);
+    if (!(x->g->terminals[ti].label_name = strdup(name))) {
+        x->st = AG_ERR_NOMEM;
+        return 0;
+    }
     size_t nv = 0, nt = 0;
     for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++) {
         uint32_t tr = L->tris[s];
@@ -367,7 +474,7 @@ static int32_t terminal_for(exctx *x, int32_t label)
             x->vmap[x->m->tri[3 * L->tris[s] + k]] = UINT32_MAX;
     if ((x->st = ag_grammar_set_terminal_geometry(&x->g->terminals[ti], x->tpos, nv, x->ttri, nt)))
         return 0;
-    x->term_of[label] = (int32_t)ti;
+    x->term_of[variant] = (int32_t)ti;
     return (int32_t)ti;
 }
 
@@ -429,7 +536,7 @@ static void emit_content(exctx *x, ag_grule *r, int32_t v, const char *vname, un
     if (x->st)
         return;
     if (n->kind == AG_NODE_COMPONENT && emit) {
-        int32_t ti = terminal_for(x, n->label);
+        int32_t ti = terminal_for(x, n->variant);
         if (x->st)
             return;
         x->st = ag_grammar_add_apply(r, x->g->terminals[ti].name, vname, n->rot, NULL, NULL, 0, 0);
@@ -454,8 +561,12 @@ static void emit_content(exctx *x, ag_grule *r, int32_t v, const char *vname, un
             int32_t ri = use_rule(x, p->rule, e->first_child, 2);
             if (emit && !x->st) {
                 int rot = (p->rot - t->nodes[x->exemplar[p->rule]].rule_rot) & 3;
-                x->st = ag_grammar_add_apply(r, x->g->rules[ri].name, cur, rot, p->counts,
-                                             p->step, 0, 0);
+                if (p->nvec)
+                    x->st = ag_grammar_add_repeat(r, x->g->rules[ri].name, cur, rot, p->nvec,
+                                                  p->counts, p->vec, 0, 0);
+                else
+                    x->st = ag_grammar_add_apply(r, x->g->rules[ri].name, cur, rot, p->counts,
+                                                 p->step, 0, 0);
             }
         } else if (e->kind == AG_NODE_COMPONENT && is_rule(x, e->rule)) {
             int32_t ri = use_rule(x, e->rule, k, 1);
@@ -474,7 +585,7 @@ void ag_grammar_export_info_free(ag_grammar_export_info *info)
     if (!info)
         return;
     free(info->rule_of_class);
-    free(info->terminal_of_label);
+    free(info->terminal_of_variant);
     memset(info, 0, sizeof *info);
 }
 
@@ -494,7 +605,7 @@ ag_status ag_grammar_export(const ag_mesh *m, const ag_labels *L, const ag_split
     x.visited = calloc(nc + 1, 1);
     x.in_pattern = calloc(nc + 1, 1);
     x.rule_of = malloc((nc + 1) * sizeof *x.rule_of);
-    x.term_of = malloc((L->nlabels + 1) * sizeof *x.term_of);
+    x.term_of = malloc((L->nvariants + 1) * sizeof *x.term_of);
     x.vmap = malloc((m->nverts + 1) * sizeof *x.vmap);
     x.tpos = malloc((9 * maxt + 3) * sizeof *x.tpos);
     x.ttri = malloc((3 * maxt + 3) * sizeof *x.ttri);
@@ -504,7 +615,7 @@ ag_status ag_grammar_export(const ag_mesh *m, const ag_labels *L, const ag_split
         goto done;
     for (size_t i = 0; i < nc; i++)
         x.rule_of[i] = -1;
-    for (size_t i = 0; i < L->nlabels; i++)
+    for (size_t i = 0; i < L->nvariants; i++)
         x.term_of[i] = -1;
     for (size_t i = 0; i < m->nverts; i++)
         x.vmap[i] = UINT32_MAX;
@@ -530,9 +641,9 @@ ag_status ag_grammar_export(const ag_mesh *m, const ag_labels *L, const ag_split
     }
     if (info) {
         info->rule_of_class = x.rule_of;
-        info->terminal_of_label = x.term_of;
+        info->terminal_of_variant = x.term_of;
         info->nclasses = nc;
-        info->nlabels = L->nlabels;
+        info->nvariants = L->nvariants;
         x.rule_of = NULL;
         x.term_of = NULL;
     }
@@ -566,6 +677,7 @@ typedef struct {
     const ag_grammar *g;
     ag_mesh *out;
     size_t max_tris;
+    int32_t *tgroup; /* per terminal: group of the derived mesh */
     ag_status st;
     ag_error *err;
 } dctx;
@@ -641,7 +753,7 @@ static void apply_one(dctx *d, const ag_gstmt *s, const ag_box *B, const frame *
     frame G = place(F, T->size, s->rot, B);
     ag_mesh *m = d->out;
     size_t base = m->nverts, comp;
-    if ((d->st = ag_mesh_add_component(m, s->callee_ix, &comp)))
+    if ((d->st = ag_mesh_add_component(m, d->tgroup[s->callee_ix], &comp)))
         return;
     for (size_t v = 0; v < T->nverts; v++) {
         double y[3];
@@ -666,6 +778,11 @@ static void derive_body(dctx *d, const ag_grule *r, const ag_box *p, const frame
 {
     if (d->st)
         return;
+    if (depth > 512) {
+        d->st = ag_error_set(d->err, AG_ERR_TOO_LARGE, r->line,
+                             "rules are nested more than 512 deep");
+        return;
+    }
     ag_box stackb[64];
     ag_box *b = r->nnodes <= 64 ? stackb : malloc(r->nnodes * sizeof *b);
     if (!b) {
@@ -684,16 +801,26 @@ static void derive_body(dctx *d, const ag_grule *r, const ag_box *p, const frame
             apply_one(d, s, B, F, depth);
             continue;
         }
-        double w[3];
+        /* cells at offsets i v0 + j v1 + k v2 (axis-aligned vectors for subdivide) */
+        double v[3][3] = {{0}};
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++)
+                v[k][a] = s->subdivide == 2 ? s->vec[k][a] : (k == a ? s->step[a] : 0);
+        double omin[3] = {0, 0, 0}, omax[3] = {0, 0, 0}, w[3];
+        for (int k = 0; k < 3; k++)
+            for (int a = 0; a < 3; a++) {
+                double e = (double)(s->counts[k] - 1) * v[k][a];
+                omin[a] += e < 0 ? e : 0;
+                omax[a] += e > 0 ? e : 0;
+            }
         for (int a = 0; a < 3; a++)
-            w[a] = (B->max[a] - B->min[a]) - (double)(s->counts[a] - 1) * s->step[a];
+            w[a] = (B->max[a] - B->min[a]) - (omax[a] - omin[a]);
         for (uint32_t k = 0; k < s->counts[2] && !d->st; k++)
             for (uint32_t j = 0; j < s->counts[1] && !d->st; j++)
                 for (uint32_t i2 = 0; i2 < s->counts[0] && !d->st; i2++) {
-                    uint32_t idx[3] = {i2, j, k};
                     ag_box c;
                     for (int a = 0; a < 3; a++) {
-                        c.min[a] = B->min[a] + idx[a] * s->step[a];
+                        c.min[a] = B->min[a] - omin[a] + i2 * v[0][a] + j * v[1][a] + k * v[2][a];
                         c.max[a] = c.min[a] + w[a];
                     }
                     apply_one(d, s, &c, F, depth);
@@ -714,11 +841,23 @@ ag_status ag_grammar_derive(const ag_grammar *g, const ag_grammar_derive_options
     d.out = ag_mesh_create();
     if (!d.out)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    for (size_t i = 0; i < g->nterminals && !d.st; i++)
-        d.st = ag_mesh_add_group(d.out, g->terminals[i].name, NULL);
+    d.tgroup = malloc((g->nterminals + 1) * sizeof *d.tgroup);
+    if (!d.tgroup)
+        d.st = AG_ERR_NOMEM;
+    for (size_t i = 0; i < g->nterminals && !d.st; i++) {
+        const char *gn = g->terminals[i].label_name ? g->terminals[i].label_name
+                                                    : g->terminals[i].name;
+        size_t k = 0;
+        while (k < d.out->ngroups && strcmp(d.out->group_names[k], gn))
+            k++;
+        if (k == d.out->ngroups)
+            d.st = ag_mesh_add_group(d.out, gn, &k);
+        d.tgroup[i] = (int32_t)k;
+    }
     frame I = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
     if (!d.st)
         derive_body(&d, &g->axiom, &g->axiom.box, &I, 0);
+    free(d.tgroup);
     if (d.st) {
         ag_mesh_free(d.out);
         if (d.st == AG_ERR_NOMEM)

@@ -8,6 +8,9 @@
  *   APPLY  Rule(subdivide(node, sx, sy, sz, dx, dy, dz)) [rot]
  *          node's box holds sx*sy*sz cells of equal size spaced by (dx, dy, dz); the cell
  *          size per axis is size - (s - 1) * d; the rule is applied to every cell.
+ *   APPLY  Rule(repeat(node, c1, a1, a2, a3 [, c2, b1, b2, b3 [, c3, ...]])) [rot]
+ *          a translation lattice in any direction (oblique facades): cell (i, j, k) is offset
+ *          by i a + j b + k c; cells are as large as node's box less the lattice's extent.
  * Applying X (size S) with r quarter turns to a box B: X's local box, turned by r about its
  * centre and scaled per axis to B's size, is placed on B. The text form is in
  * schema/grammar.md; parsing and printing live in server/io/grammar_text.c. */
@@ -30,6 +33,7 @@ typedef struct {
     double *pos;     /* local coordinates, in [0, size]; NULL until loaded */
     uint32_t *tri;
     int32_t label;   /* the label it stands for when exported, else -1 */
+    char *label_name; /* label shared by near-equal terminals ("L3"); NULL when none */
 } ag_gterminal;
 
 typedef enum { AG_GSTMT_SPLIT = 1, AG_GSTMT_APPLY = 2 } ag_gstmt_kind;
@@ -42,9 +46,11 @@ typedef struct {
     int octant;       /* SPLIT: 1..8 */
     char *callee;     /* APPLY */
     int rot;          /* APPLY: quarter turns 0..3 */
-    int subdivide;    /* APPLY */
-    uint32_t counts[3];
-    double step[3];
+    int subdivide;    /* APPLY: 0 single, 1 subdivide (axis-aligned), 2 repeat (lattice) */
+    uint32_t counts[3]; /* subdivide: per axis; repeat: per vector (nvec used) */
+    double step[3];   /* subdivide */
+    int nvec;         /* repeat: 1..3 vectors */
+    double vec[3][3]; /* repeat: translation vectors */
     long line, col;   /* source position when parsed */
     /* filled by ag_grammar_resolve */
     int32_t node_ix, parent_ix, callee_ix;
@@ -82,6 +88,9 @@ ag_status ag_grammar_add_split(ag_grule *r, const char *node, const char *parent
                                const double v[3], int octant, long line, long col);
 ag_status ag_grammar_add_apply(ag_grule *r, const char *callee, const char *node, int rot,
                                const uint32_t *counts, const double *step, long line, long col);
+ag_status ag_grammar_add_repeat(ag_grule *r, const char *callee, const char *node, int rot,
+                                int nvec, const uint32_t *counts, const double vec[][3],
+                                long line, long col);
 /* Sets a terminal's geometry (copied). */
 ag_status ag_grammar_set_terminal_geometry(ag_gterminal *t, const double *pos, size_t nverts,
                                            const uint32_t *tri, size_t ntris);
@@ -93,8 +102,8 @@ ag_status ag_grammar_resolve(ag_grammar *g, ag_error *err, long *col);
 
 typedef struct {
     int32_t *rule_of_class;    /* per split-tree rule: grammar rule index or -1 (inlined) */
-    int32_t *terminal_of_label;/* per label: terminal index */
-    size_t nclasses, nlabels;
+    int32_t *terminal_of_variant; /* per label variant: terminal index, -1 if unused */
+    size_t nclasses, nvariants;
 } ag_grammar_export_info;
 
 /* Grammar of a labelled split tree (after rules and patterns). Terminals carry geometry. */
@@ -106,8 +115,8 @@ typedef struct {
     size_t max_triangles; /* 0 = 50 million */
 } ag_grammar_derive_options;
 
-/* Derives the mesh: one component per placed terminal, grouped by terminal (the group names
- * are the terminal names). Every terminal needs its geometry. */
+/* Derives the mesh: one component per placed terminal, grouped by label (the terminal's
+ * label name, or its own name when it has none). Every terminal needs its geometry. */
 ag_status ag_grammar_derive(const ag_grammar *g, const ag_grammar_derive_options *opt,
                             ag_mesh **out, ag_error *err);
 

@@ -132,6 +132,11 @@ void ag_labels_free(ag_labels *l)
     free(l->tris);
     free(l->exemplar);
     free(l->count);
+    free(l->variant);
+    free(l->vrot);
+    free(l->variant_exemplar);
+    free(l->variant_count);
+    free(l->variant_label);
     free(l);
 }
 
@@ -176,15 +181,108 @@ static int dims_match(const ag_box *e, const ag_box *c, int k, double tol)
 
 typedef struct {
     uint64_t key;
-    int32_t head; /* first label in the bucket */
+    int32_t head; /* first class in the bucket */
 } bucket;
+
+/* Classifies the components in `comps` (in order) with tolerance tol: cls[c] and rot[c] for
+ * each, exemplar[k] and count[k] for each class; returns the number of classes, or -1 when
+ * out of memory. */
+static long classify(const ag_mesh *m, const ag_labels *L, const uint32_t *comps, size_t n,
+                     double tol, int no_rotation, int32_t *cls, uint8_t *rot, uint32_t *exemplar,
+                     uint32_t *count, double *sa, double *sb)
+{
+    size_t cap = 16;
+    while (cap < 2 * n + 16)
+        cap <<= 1;
+    bucket *bk = calloc(cap, sizeof *bk);
+    int32_t *next_in_bucket = malloc((n + 1) * sizeof *next_in_bucket);
+    if (!bk || !next_in_bucket) {
+        free(bk);
+        free(next_in_bucket);
+        return -1;
+    }
+    for (size_t i = 0; i < cap; i++)
+        bk[i].head = -1;
+    long ncls = 0;
+    /* buckets: triangle count and the box's height and sorted plan sizes in cells of 4 tol,
+     * so a match within tol is always in a neighbouring cell */
+    double q = 4 * tol > 0 ? 4 * tol : 1e-300;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t c = comps[i];
+        double dx = L->box[c].max[0] - L->box[c].min[0], dy = L->box[c].max[1] - L->box[c].min[1];
+        double dz = L->box[c].max[2] - L->box[c].min[2];
+        int64_t kb[3] = {(int64_t)floor(dz / q), (int64_t)floor(fmin(dx, dy) / q),
+                         (int64_t)floor(fmax(dx, dy) / q)};
+        int found = -1, fk = 0;
+        for (int nb = 0; nb < 27 && found < 0; nb++) {
+            int64_t k0 = kb[0] + nb % 3 - 1, k1 = kb[1] + nb / 3 % 3 - 1, k2 = kb[2] + nb / 9 - 1;
+            uint64_t key = ag__mix64(L->ntris[c] * 0x9E3779B97F4A7C15ULL ^ ag__cell_hash(k0, k1, k2));
+            size_t h = key & (cap - 1);
+            while (bk[h].head >= 0 && bk[h].key != key)
+                h = (h + 1) & (cap - 1);
+            for (int32_t l = bk[h].head; l >= 0 && found < 0; l = next_in_bucket[l]) {
+                uint32_t e = exemplar[l];
+                if (L->ntris[e] != L->ntris[c])
+                    continue;
+                int have_cb = 0;
+                for (int k = 0; k < (no_rotation ? 1 : 4) && found < 0; k++) {
+                    if (!dims_match(&L->box[e], &L->box[c], k, tol))
+                        continue;
+                    if (!have_cb) {
+                        soup(m, L, c, 0, sb);
+                        have_cb = 1;
+                    }
+                    soup(m, L, e, k, sa);
+                    size_t miss = 0;
+                    double w = ag_label_match_triangles(sa, L->ntris[e], sb, L->ntris[c], tol,
+                                                        &miss);
+                    if (w < 0) {
+                        free(bk);
+                        free(next_in_bucket);
+                        return -1;
+                    }
+                    if (miss == 0) {
+                        found = l;
+                        fk = k;
+                    }
+                }
+            }
+        }
+        if (found >= 0) {
+            cls[c] = found;
+            rot[c] = (uint8_t)fk;
+            count[found]++;
+            continue;
+        }
+        int32_t l = (int32_t)ncls++;
+        exemplar[l] = c;
+        count[l] = 1;
+        cls[c] = l;
+        rot[c] = 0;
+        uint64_t key = ag__mix64(L->ntris[c] * 0x9E3779B97F4A7C15ULL ^
+                                 ag__cell_hash(kb[0], kb[1], kb[2]));
+        size_t h = key & (cap - 1);
+        while (bk[h].head >= 0 && bk[h].key != key)
+            h = (h + 1) & (cap - 1);
+        bk[h].key = key;
+        next_in_bucket[l] = bk[h].head;
+        bk[h].head = l;
+    }
+    free(bk);
+    free(next_in_bucket);
+    return ncls;
+}
 
 ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_labels **out,
                               ag_error *err)
 {
     ag_label_options o = opt ? *opt : (ag_label_options){0};
     if (o.tolerance <= 0)
-        o.tolerance = 1e-5;
+        o.tolerance = 1e-4;
+    if (o.exact <= 0)
+        o.exact = 1e-7;
+    if (o.exact > o.tolerance)
+        o.exact = o.tolerance;
     *out = NULL;
     size_t nc = m->ncomponents;
     ag_labels *L = calloc(1, sizeof *L);
@@ -199,25 +297,25 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
     L->tris = malloc((m->ntris + 1) * sizeof *L->tris);
     L->exemplar = malloc((nc + 1) * sizeof *L->exemplar);
     L->count = calloc(nc + 1, sizeof *L->count);
-    int32_t *next_in_bucket = malloc((nc + 1) * sizeof *next_in_bucket);
-    size_t cap = 16;
-    while (cap < 2 * nc + 16)
-        cap <<= 1;
-    bucket *bk = calloc(cap, sizeof *bk);
+    L->variant = malloc((nc + 1) * sizeof *L->variant);
+    L->vrot = calloc(nc + 1, 1);
+    L->variant_exemplar = malloc((nc + 1) * sizeof *L->variant_exemplar);
+    L->variant_count = calloc(nc + 1, sizeof *L->variant_count);
+    L->variant_label = malloc((nc + 1) * sizeof *L->variant_label);
     double *sa = NULL, *sb = NULL;
     size_t maxt = 0;
     ag_status st = AG_ERR_NOMEM;
     if (!L->box || !L->ntris || !L->label || !L->rot || !L->tri_start || !L->tris ||
-        !L->exemplar || !L->count || !next_in_bucket || !bk)
+        !L->exemplar || !L->count || !L->variant || !L->vrot || !L->variant_exemplar ||
+        !L->variant_count || !L->variant_label)
         goto fail;
-    for (size_t i = 0; i < cap; i++)
-        bk[i].head = -1;
 
     ag_box all = ag_mesh_bounds(m);
     L->diagonal = ag_box_diagonal(&all);
     if (!(L->diagonal > 0))
         L->diagonal = 0;
     L->tol = o.tolerance * (L->diagonal > 0 ? L->diagonal : 1.0);
+    L->exact = o.exact * (L->diagonal > 0 ? L->diagonal : 1.0);
 
     for (size_t c = 0; c < nc; c++)
         for (int a = 0; a < 3; a++) {
@@ -256,73 +354,57 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
     if (!sa || !sb)
         goto fail;
 
-    double zq = 100 * L->tol;
-    for (size_t c = 0; c < nc; c++) {
-        L->label[c] = -1;
-        if (!L->ntris[c])
-            continue;
-        double dz = L->box[c].max[2] - L->box[c].min[2];
-        int64_t zb = (int64_t)floor(dz / zq);
-        int found = -1, fk = 0;
-        for (int64_t d = -1; d <= 1 && found < 0; d++) {
-            uint64_t key = ag__mix64(L->ntris[c] * 0x9E3779B97F4A7C15ULL ^ (uint64_t)(zb + d));
-            size_t i = key & (cap - 1);
-            while (bk[i].head >= 0 && bk[i].key != key)
-                i = (i + 1) & (cap - 1);
-            for (int32_t l = bk[i].head; l >= 0 && found < 0; l = next_in_bucket[l]) {
-                uint32_t e = L->exemplar[l];
-                if (L->ntris[e] != L->ntris[c])
-                    continue;
-                int have_cb = 0;
-                for (int k = 0; k < (o.no_rotation ? 1 : 4) && found < 0; k++) {
-                    if (!dims_match(&L->box[e], &L->box[c], k, L->tol))
-                        continue;
-                    if (!have_cb) {
-                        soup(m, L, (uint32_t)c, 0, sb);
-                        have_cb = 1;
-                    }
-                    soup(m, L, e, k, sa);
-                    size_t miss = 0;
-                    double w = ag_label_match_triangles(sa, L->ntris[e], sb, L->ntris[c], L->tol,
-                                                        &miss);
-                    if (w < 0)
-                        goto fail;
-                    if (miss == 0) {
-                        found = l;
-                        fk = k;
-                    }
-                }
-            }
+    {
+        uint32_t *list = malloc((nc + 1) * sizeof *list);
+        int32_t *vl = malloc((nc + 1) * sizeof *vl);
+        uint8_t *vr = calloc(nc + 1, 1);
+        if (!list || !vl || !vr) {
+            free(list);
+            free(vl);
+            free(vr);
+            goto fail;
         }
-        if (found >= 0) {
-            L->label[c] = found;
-            L->rot[c] = (uint8_t)fk;
-            L->count[found]++;
-            continue;
+        size_t n = 0;
+        for (size_t c = 0; c < nc; c++) {
+            L->label[c] = L->variant[c] = -1;
+            if (L->ntris[c])
+                list[n++] = (uint32_t)c;
         }
-        int32_t l = (int32_t)L->nlabels++;
-        L->exemplar[l] = (uint32_t)c;
-        L->count[l] = 1;
-        L->label[c] = l;
-        uint64_t key = ag__mix64(L->ntris[c] * 0x9E3779B97F4A7C15ULL ^ (uint64_t)zb);
-        size_t i = key & (cap - 1);
-        while (bk[i].head >= 0 && bk[i].key != key)
-            i = (i + 1) & (cap - 1);
-        bk[i].key = key;
-        next_in_bucket[l] = bk[i].head;
-        bk[i].head = l;
+        long nv = classify(m, L, list, n, L->exact, o.no_rotation, L->variant, L->vrot,
+                           L->variant_exemplar, L->variant_count, sa, sb);
+        long nl = nv < 0 ? -1
+                         : classify(m, L, L->variant_exemplar, (size_t)nv, L->tol, o.no_rotation,
+                                    vl, vr, L->exemplar, L->count, sa, sb);
+        if (nl < 0) {
+            free(list);
+            free(vl);
+            free(vr);
+            goto fail;
+        }
+        L->nvariants = (size_t)nv;
+        L->nlabels = (size_t)nl;
+        for (long k = 0; k < nl; k++)
+            L->count[k] = 0;
+        for (long v = 0; v < nv; v++)
+            L->variant_label[v] = vl[L->variant_exemplar[v]];
+        for (size_t i = 0; i < n; i++) {
+            uint32_t c = list[i];
+            uint32_t e = L->variant_exemplar[L->variant[c]];
+            L->label[c] = vl[e];
+            L->rot[c] = (uint8_t)((L->vrot[c] + vr[e]) & 3);
+            L->count[L->label[c]]++;
+        }
+        free(list);
+        free(vl);
+        free(vr);
     }
     free(sa);
     free(sb);
-    free(bk);
-    free(next_in_bucket);
     *out = L;
     return AG_OK;
 fail:
     free(sa);
     free(sb);
-    free(bk);
-    free(next_in_bucket);
     ag_labels_free(L);
     return ag_error_set(err, st, 0, "out of memory while labeling");
 }

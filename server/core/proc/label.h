@@ -5,7 +5,12 @@
  * (x/y swapped for odd quarter turns) and finally by their whole geometry: every triangle of
  * one must land on a triangle of the other within the tolerance after the rotation about the
  * box centre. That full comparison is stricter than a convex-hull comparison, and it is what
- * lets every component of a label be derived from one terminal. */
+ * lets every component of a label be derived from one terminal.
+ *
+ * Two tolerances: components equal within `exact` are one variant (one terminal, and what
+ * rules and patterns compare); variants equal within `tolerance` are one label (near-exact
+ * copies, e.g. windows modelled by hand a millimetre apart). Derivation is then exact to
+ * `exact` while labels still group what a person sees as the same element. */
 #ifndef AG_LABEL_H
 #define AG_LABEL_H
 
@@ -16,7 +21,8 @@
 #include "../status.h"
 
 typedef struct {
-    double tolerance; /* relative to the model diagonal; 0 = 1e-5 */
+    double tolerance; /* labels: relative to the model diagonal; 0 = 1e-4 */
+    double exact;     /* variants: relative to the model diagonal; 0 = 1e-7 */
     int no_rotation;  /* non-zero: do not match quarter turns */
 } ag_label_options;
 
@@ -26,6 +32,8 @@ typedef struct {
     uint32_t *ntris;     /* per component */
     int32_t *label;      /* per component (components without triangles: -1) */
     uint8_t *rot;        /* per component: quarter turns about +z from its label's exemplar */
+    int32_t *variant;    /* per component: exact class (-1 without triangles) */
+    uint8_t *vrot;       /* per component: quarter turns from its variant's exemplar */
     uint32_t *tri_start; /* ncomponents + 1 offsets into tris */
     uint32_t *tris;      /* triangles grouped by component, input order */
 
@@ -33,8 +41,14 @@ typedef struct {
     uint32_t *exemplar;  /* per label: the first component with the label */
     uint32_t *count;     /* per label: components */
 
+    size_t nvariants;
+    uint32_t *variant_exemplar; /* per variant: the first component */
+    uint32_t *variant_count;    /* per variant: components */
+    int32_t *variant_label;     /* per variant: its label */
+
     double diagonal;     /* of the model */
-    double tol;          /* absolute tolerance used */
+    double tol;          /* absolute label tolerance */
+    double exact;        /* absolute variant tolerance */
 } ag_labels;
 
 ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_labels **out,

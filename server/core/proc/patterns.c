@@ -79,28 +79,66 @@ static int grid_fit(const ag_splittree *t, const inst *g, size_t n, double tol, 
     return 1;
 }
 
-static ag_status make_pattern(ag_splittree *t, int32_t parent, const inst *g, size_t n,
-                              const uint32_t counts[3], const double step[3], uint8_t *moved)
+/* A pattern found under one parent, applied after all of the parent's groups are done. */
+typedef struct {
+    size_t first, n; /* members in `members`, in cell order */
+    uint32_t counts[3];
+    double step[3];
+    int nvec;        /* 0 = axis-aligned grid */
+    double vec[3][3];
+} found;
+
+typedef struct {
+    inst *members;
+    size_t nmembers, capm;
+    found *list;
+    size_t n, cap;
+} foundset;
+
+static int add_found(foundset *f, const inst *m, size_t n, const uint32_t counts[3],
+                     const double step[3], int nvec, const double vec[][3])
 {
-    ag_box b = t->nodes[g[0].node].box;
-    for (size_t i = 1; i < n; i++)
-        for (int a = 0; a < 3; a++) {
-            const ag_box *c = &t->nodes[g[i].node].box;
-            if (c->min[a] < b.min[a])
-                b.min[a] = c->min[a];
-            if (c->max[a] > b.max[a])
-                b.max[a] = c->max[a];
-        }
-    ag_pattern *np = realloc(t->patterns, (t->npatterns + 1) * sizeof *np);
-    if (!np)
-        return AG_ERR_NOMEM;
-    t->patterns = np;
-    /* detach the instances' slots from the parent */
-    for (size_t i = 0; i < n; i++)
-        moved[g[i].slot] = 1;
+    if (f->nmembers + n > f->capm) {
+        size_t nc = f->capm ? f->capm : 256;
+        while (nc < f->nmembers + n)
+            nc *= 2;
+        inst *nm = realloc(f->members, nc * sizeof *nm);
+        if (!nm)
+            return -1;
+        f->members = nm;
+        f->capm = nc;
+    }
+    if (f->n == f->cap) {
+        size_t nc = f->cap ? 2 * f->cap : 16;
+        found *nl = realloc(f->list, nc * sizeof *nl);
+        if (!nl)
+            return -1;
+        f->list = nl;
+        f->cap = nc;
+    }
+    memcpy(f->members + f->nmembers, m, n * sizeof *m);
+    found *x = &f->list[f->n++];
+    x->first = f->nmembers;
+    x->n = n;
+    memcpy(x->counts, counts, sizeof x->counts);
+    memcpy(x->step, step, sizeof x->step);
+    x->nvec = nvec;
+    memset(x->vec, 0, sizeof x->vec);
+    for (int k = 0; k < nvec; k++)
+        memcpy(x->vec[k], vec[k], sizeof x->vec[k]);
+    f->nmembers += n;
+    return 0;
+}
+
+/* Detaches every member's slot from the parent in one pass, then adds the pattern nodes. */
+static ag_status apply_found(ag_splittree *t, int32_t parent, foundset *f, uint8_t *moved)
+{
+    if (!f->n)
+        return AG_OK;
+    for (size_t i = 0; i < f->nmembers; i++)
+        moved[f->members[i].slot] = 1;
     int32_t prev = -1;
-    ag_tnode *P = &t->nodes[parent];
-    for (int32_t s = P->first_child, nx; s >= 0; s = nx) {
+    for (int32_t s = t->nodes[parent].first_child, nx; s >= 0; s = nx) {
         nx = t->nodes[s].next_sibling;
         if (moved[s]) {
             if (prev >= 0)
@@ -119,25 +157,320 @@ static ag_status make_pattern(ag_splittree *t, int32_t parent, const inst *g, si
             prev = s;
         }
     }
-    int32_t pn = ag_splittree_insert(t, parent, &b, AG_NODE_PATTERN);
-    if (pn < 0)
-        return AG_ERR_NOMEM;
-    ag_pattern *p = &t->patterns[t->npatterns];
-    p->rule = g[0].rule;
-    p->rot = g[0].rot;
-    memcpy(p->counts, counts, sizeof p->counts);
-    memcpy(p->step, step, sizeof p->step);
-    p->node = pn;
-    t->nodes[pn].pattern = (int32_t)t->npatterns++;
-    t->nodes[pn].first_child = t->nodes[pn].last_child = -1;
-    /* members in cell order (x fastest) so the pattern's cells map to them in order */
-    for (size_t i = 0; i < n; i++) {
-        int32_t v = g[i].node;
-        t->nodes[v].octant = 0;
-        memset(t->nodes[v].pivot, 0, sizeof t->nodes[v].pivot);
-        ag_splittree_attach(t, pn, v);
+    for (size_t p = 0; p < f->n; p++) {
+        const found *x = &f->list[p];
+        const inst *g = f->members + x->first;
+        ag_box b = t->nodes[g[0].node].box;
+        for (size_t i = 1; i < x->n; i++)
+            for (int a = 0; a < 3; a++) {
+                const ag_box *c = &t->nodes[g[i].node].box;
+                if (c->min[a] < b.min[a])
+                    b.min[a] = c->min[a];
+                if (c->max[a] > b.max[a])
+                    b.max[a] = c->max[a];
+            }
+        ag_pattern *np = realloc(t->patterns, (t->npatterns + 1) * sizeof *np);
+        if (!np)
+            return AG_ERR_NOMEM;
+        t->patterns = np;
+        int32_t pn = ag_splittree_insert(t, parent, &b, AG_NODE_PATTERN);
+        if (pn < 0)
+            return AG_ERR_NOMEM;
+        ag_pattern *pt = &t->patterns[t->npatterns];
+        pt->rule = g[0].rule;
+        pt->rot = g[0].rot;
+        memcpy(pt->counts, x->counts, sizeof pt->counts);
+        memcpy(pt->step, x->step, sizeof pt->step);
+        pt->nvec = (uint8_t)x->nvec;
+        memcpy(pt->vec, x->vec, sizeof pt->vec);
+        pt->node = pn;
+        t->nodes[pn].pattern = (int32_t)t->npatterns++;
+        t->nodes[pn].first_child = t->nodes[pn].last_child = -1;
+        for (size_t i = 0; i < x->n; i++) {
+            int32_t v = g[i].node;
+            t->nodes[v].octant = 0;
+            memset(t->nodes[v].pivot, 0, sizeof t->nodes[v].pivot);
+            ag_splittree_attach(t, pn, v);
+        }
     }
+    f->n = 0;
+    f->nmembers = 0;
     return AG_OK;
+}
+
+#define OFF_LATTICE INT64_MIN
+
+/* Points a vector so that its largest component is positive (a canonical direction). */
+static void flip_positive(double v[3])
+{
+    int m = 0;
+    for (int a = 1; a < 3; a++)
+        if (fabs(v[a]) > fabs(v[m]))
+            m = a;
+    if (v[m] < 0)
+        for (int a = 0; a < 3; a++)
+            v[a] = -v[a];
+}
+
+/* Lattice fit of the instances' min corners: o + i a (+ j b) for vectors a, b in any
+ * direction (the shortest offset between two instances, then the shortest one off a's
+ * line). On success ij[2k], ij[2k+1] hold instance k's indices (from 0) and counts the
+ * extent; *complete tells whether every lattice cell holds an instance. */
+static int lattice_fit(const ag_splittree *t, const inst *g, size_t n, double tol, int *nvec,
+                       double vec[2][3], uint32_t counts[2], int64_t *ij, int *complete)
+{
+    if (n < 2 || n > 4096)
+        return 0;
+    const ag_box *B0 = &t->nodes[g[0].node].box;
+    double best = INFINITY, a[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++)
+        for (size_t k = i + 1; k < n; k++) {
+            const ag_box *x = &t->nodes[g[i].node].box, *y = &t->nodes[g[k].node].box;
+            double d[3] = {y->min[0] - x->min[0], y->min[1] - x->min[1], y->min[2] - x->min[2]};
+            double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            if (l > tol && l < best - tol) {
+                best = l;
+                memcpy(a, d, sizeof a);
+            }
+        }
+    if (!isfinite(best))
+        return 0;
+    flip_positive(a);
+    double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+    /* b: the shortest offset farther than tol from a's line */
+    double bestb = INFINITY, b[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++)
+        for (size_t k = i + 1; k < n; k++) {
+            const ag_box *x = &t->nodes[g[i].node].box, *y = &t->nodes[g[k].node].box;
+            double d[3] = {y->min[0] - x->min[0], y->min[1] - x->min[1], y->min[2] - x->min[2]};
+            double s = (d[0] * a[0] + d[1] * a[1] + d[2] * a[2]) / aa;
+            double r[3] = {d[0] - s * a[0], d[1] - s * a[1], d[2] - s * a[2]};
+            double off = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+            double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            if (off > 4 * tol && l < bestb - tol) {
+                bestb = l;
+                memcpy(b, d, sizeof b);
+            }
+        }
+    int nv = isfinite(bestb) ? 2 : 1;
+    flip_positive(b);
+    double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2], bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+    double det = aa * bb - ab * ab;
+    if (nv == 2 && !(fabs(det) > 0))
+        return 0;
+    int64_t lo[2] = {INT64_MAX, INT64_MAX}, hi[2] = {INT64_MIN, INT64_MIN};
+    size_t fitted = 0;
+    for (size_t k = 0; k < n; k++) {
+        const ag_box *x = &t->nodes[g[k].node].box;
+        double d[3] = {x->min[0] - B0->min[0], x->min[1] - B0->min[1], x->min[2] - B0->min[2]};
+        double da = d[0] * a[0] + d[1] * a[1] + d[2] * a[2];
+        double c[2];
+        if (nv == 1) {
+            c[0] = da / aa;
+            c[1] = 0;
+        } else {
+            double db = d[0] * b[0] + d[1] * b[1] + d[2] * b[2];
+            c[0] = (bb * da - ab * db) / det;
+            c[1] = (aa * db - ab * da) / det;
+        }
+        int64_t r0 = (int64_t)floor(c[0] + 0.5), r1 = (int64_t)floor(c[1] + 0.5);
+        int off = llabs(r0) > 1000000 || llabs(r1) > 1000000;
+        for (int q = 0; q < 3 && !off; q++)
+            off = fabs(d[q] - r0 * a[q] - r1 * b[q]) > tol;
+        if (off) { /* not on the lattice: left out of its runs */
+            ij[2 * k] = ij[2 * k + 1] = OFF_LATTICE;
+            continue;
+        }
+        fitted++;
+        ij[2 * k] = r0;
+        ij[2 * k + 1] = r1;
+        for (int q = 0; q < 2; q++) {
+            if (ij[2 * k + q] < lo[q])
+                lo[q] = ij[2 * k + q];
+            if (ij[2 * k + q] > hi[q])
+                hi[q] = ij[2 * k + q];
+        }
+    }
+    if (fitted < 2)
+        return 0;
+    for (size_t k = 0; k < n; k++)
+        if (ij[2 * k] != OFF_LATTICE)
+            for (int q = 0; q < 2; q++)
+                ij[2 * k + q] -= lo[q];
+    counts[0] = (uint32_t)(hi[0] - lo[0] + 1);
+    counts[1] = (uint32_t)(hi[1] - lo[1] + 1);
+    *nvec = nv;
+    memcpy(vec[0], a, sizeof a);
+    memcpy(vec[1], b, sizeof b);
+    *complete = fitted == n && (size_t)counts[0] * counts[1] == n;
+    if (*complete) {
+        /* distinct cells */
+        uint8_t *seen = calloc(n, 1);
+        if (!seen)
+            return 0;
+        for (size_t k = 0; k < n && *complete; k++) {
+            size_t c = (size_t)ij[2 * k + 1] * counts[0] + (size_t)ij[2 * k];
+            if (c >= n || seen[c])
+                *complete = 0;
+            else
+                seen[c] = 1;
+        }
+        free(seen);
+    }
+    return 1;
+}
+
+/* A lattice whose vectors each lie along a distinct axis is an axis-aligned grid. */
+static int as_grid(int nvec, const double vec[][3], const uint32_t lc[], double tol,
+                   uint32_t counts[3], double step[3], int axis_of[2])
+{
+    counts[0] = counts[1] = counts[2] = 1;
+    step[0] = step[1] = step[2] = 0;
+    int used = 0;
+    for (int k = 0; k < nvec; k++) {
+        int ax = -1;
+        for (int a = 0; a < 3; a++) {
+            int other = 0;
+            for (int b2 = 0; b2 < 3; b2++)
+                if (b2 != a && fabs(vec[k][b2]) > tol)
+                    other = 1;
+            if (!other && vec[k][a] > tol)
+                ax = a;
+        }
+        if (ax < 0 || (used >> ax & 1))
+            return 0;
+        used |= 1 << ax;
+        counts[ax] = lc[k];
+        step[ax] = vec[k][ax];
+        axis_of[k] = ax;
+    }
+    return 1;
+}
+
+/* Emits the instances (with lattice indices ij) as a pattern, in cell order. */
+static int emit_lattice(foundset *f, const inst *g, size_t n, const int64_t *ij, int nvec,
+                        double vec[2][3], const uint32_t lc[2], double tol, inst *sorted)
+{
+    uint32_t counts[3];
+    double step[3];
+    int axis_of[2] = {0, 0};
+    if (as_grid(nvec, vec, lc, tol, counts, step, axis_of)) {
+        for (size_t k = 0; k < n; k++) {
+            size_t idx[3] = {0, 0, 0};
+            for (int q = 0; q < nvec; q++)
+                idx[axis_of[q]] = (size_t)ij[2 * k + q];
+            sorted[(idx[2] * counts[1] + idx[1]) * counts[0] + idx[0]] = g[k];
+        }
+        return add_found(f, sorted, n, counts, step, 0, NULL);
+    }
+    for (size_t k = 0; k < n; k++)
+        sorted[(size_t)ij[2 * k + 1] * lc[0] + (size_t)ij[2 * k]] = g[k];
+    counts[0] = lc[0];
+    counts[1] = nvec > 1 ? lc[1] : 1;
+    counts[2] = 1;
+    step[0] = step[1] = step[2] = 0;
+    return add_found(f, sorted, n, counts, step, nvec, vec);
+}
+
+typedef struct {
+    int64_t j, i;
+    size_t k;
+} runkey;
+
+static int cmp_runkey(const void *p, const void *q)
+{
+    const runkey *x = p, *y = q;
+    if (x->j != y->j)
+        return x->j < y->j ? -1 : 1;
+    return x->i < y->i ? -1 : x->i > y->i;
+}
+
+/* Sorting instances by their min corner on two axes (rows along the third). */
+static const ag_splittree *sort_tree;
+static int sort_b1, sort_b2, sort_a;
+
+static int cmp_row(const void *p, const void *q)
+{
+    const ag_box *x = &sort_tree->nodes[((const inst *)p)->node].box;
+    const ag_box *y = &sort_tree->nodes[((const inst *)q)->node].box;
+    int ax[3] = {sort_b1, sort_b2, sort_a};
+    for (int k = 0; k < 3; k++)
+        if (x->min[ax[k]] != y->min[ax[k]])
+            return x->min[ax[k]] < y->min[ax[k]] ? -1 : 1;
+    return 0;
+}
+
+/* Rows along axis a: runs of instances (sorted) sharing the other two coordinates. Calls
+ * back with each run; returns the number of instances in runs of at least minn. */
+static size_t rows(const ag_splittree *t, inst *g, size_t n, int a, size_t minn, double tol,
+                   int (*cb)(void *, inst *, size_t), void *user, int *fail)
+{
+    sort_tree = t;
+    sort_a = a;
+    sort_b1 = (a + 1) % 3;
+    sort_b2 = (a + 2) % 3;
+    qsort(g, n, sizeof *g, cmp_row);
+    size_t cover = 0;
+    for (size_t i = 0, j; i < n; i = j) {
+        const ag_box *x = &t->nodes[g[i].node].box;
+        for (j = i + 1; j < n; j++) {
+            const ag_box *y = &t->nodes[g[j].node].box;
+            if (fabs(x->min[sort_b1] - y->min[sort_b1]) > tol ||
+                fabs(x->min[sort_b2] - y->min[sort_b2]) > tol)
+                break;
+        }
+        if (j - i >= minn) {
+            cover += j - i;
+            if (cb && cb(user, g + i, j - i)) {
+                *fail = 1;
+                return cover;
+            }
+        }
+    }
+    return cover;
+}
+
+typedef struct {
+    const ag_splittree *t;
+    foundset *f;
+    int axis;
+    uint32_t *idx;
+    double *tmp;
+    uint8_t *seen;
+    inst *sorted;
+} rowctx;
+
+static int take_row(void *user, inst *r, size_t n)
+{
+    rowctx *c = user;
+    uint32_t counts[3];
+    double step[3], origin[3];
+    if (!grid_fit(c->t, r, n, c->t->tol, counts, step, origin, c->idx, c->tmp, c->seen))
+        return 0;
+    for (size_t q = 0; q < n; q++)
+        c->sorted[c->idx[3 * q + c->axis]] = r[q];
+    return add_found(c->f, c->sorted, n, counts, step, 0, NULL);
+}
+
+/* Complete rows along one axis (instances sharing the other two coordinates); returns
+ * non-zero when out of memory. */
+static int axis_rows(const ag_splittree *t, inst *g, size_t n, size_t minn, foundset *fs,
+                     uint32_t *idx, double *tmp, uint8_t *seen, inst *sorted)
+{
+    int best = -1, fail = 0;
+    size_t best_cover = 0;
+    for (int a = 0; a < 3; a++) {
+        size_t cover = rows(t, g, n, a, minn, t->tol, NULL, NULL, &fail);
+        if (cover > best_cover) {
+            best_cover = cover;
+            best = a;
+        }
+    }
+    if (best < 0)
+        return 0;
+    rowctx rc = {t, fs, best, idx, tmp, seen, sorted};
+    rows(t, g, n, best, minn, t->tol, take_row, &rc, &fail);
+    return fail;
 }
 
 ag_status ag_patterns_find(ag_splittree *t, const ag_patterns_options *opt, ag_error *err)
@@ -151,9 +484,13 @@ ag_status ag_patterns_find(ag_splittree *t, const ag_patterns_options *opt, ag_e
     uint32_t *idx = malloc((3 * N0 + 3) * sizeof *idx);
     double *tmp = malloc((N0 + 1) * sizeof *tmp);
     uint8_t *seen = malloc(N0 + 1);
-    uint8_t *moved = calloc(2 * N0 + 16, 1); /* indexed by node; new nodes are added at the end */
+    uint8_t *moved = calloc(N0 + 1, 1);
+    int64_t *ij = malloc((2 * N0 + 2) * sizeof *ij), *ij2 = malloc((2 * N0 + 2) * sizeof *ij2);
+    runkey *rk = malloc((N0 + 1) * sizeof *rk);
+    inst *run = malloc((N0 + 1) * sizeof *run);
+    foundset fs = {0};
     ag_status st = AG_ERR_NOMEM;
-    if (!buf || !row || !idx || !tmp || !seen || !moved)
+    if (!buf || !row || !idx || !tmp || !seen || !moved || !ij || !ij2 || !rk || !run)
         goto done;
     for (size_t pi = 0; pi < N0; pi++) {
         int kind = t->nodes[pi].kind;
@@ -183,85 +520,61 @@ ag_status ag_patterns_find(ag_splittree *t, const ag_patterns_options *opt, ag_e
             uint32_t counts[3];
             double step[3], origin[3];
             if (grid_fit(t, buf + i, g, t->tol, counts, step, origin, idx, tmp, seen)) {
-                /* order members by cell */
-                inst *sorted = row;
                 for (size_t k = 0; k < g; k++) {
                     size_t c = (idx[3 * k + 2] * (size_t)counts[1] + idx[3 * k + 1]) * counts[0] +
                                idx[3 * k];
-                    sorted[c] = buf[i + k];
+                    row[c] = buf[i + k];
                 }
-                if ((st = make_pattern(t, (int32_t)pi, sorted, g, counts, step, moved)))
+                if (add_found(&fs, row, g, counts, step, 0, NULL))
                     goto done;
                 continue;
             }
-            /* rows: for each axis, instances sharing the other two coordinates */
-            int best_axis = -1;
-            size_t best_cover = 0;
-            for (int a = 0; a < 3; a++) {
-                size_t cover = 0;
-                uint8_t *taken = seen;
-                memset(taken, 0, g);
-                for (size_t k = 0; k < g; k++) {
-                    if (taken[k])
-                        continue;
-                    size_t r = 0;
-                    for (size_t l = k; l < g; l++) {
-                        const ag_box *x = &t->nodes[buf[i + k].node].box,
-                                     *y = &t->nodes[buf[i + l].node].box;
-                        int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
-                        if (!taken[l] && fabs(x->min[b1] - y->min[b1]) <= t->tol &&
-                            fabs(x->min[b2] - y->min[b2]) <= t->tol) {
-                            taken[l] = 1;
-                            r++;
-                        }
-                    }
-                    if (r >= minn)
-                        cover += r;
-                }
-                if (cover > best_cover) {
-                    best_cover = cover;
-                    best_axis = a;
-                }
-            }
-            if (best_axis < 0)
+            /* any translation lattice (oblique facades); else its complete runs along a */
+            int nvec, complete = 0;
+            double vec[2][3];
+            uint32_t lc[2];
+            size_t before = fs.n;
+            if (!lattice_fit(t, buf + i, g, t->tol, &nvec, vec, lc, ij, &complete)) {
+                if (axis_rows(t, buf + i, g, minn, &fs, idx, tmp, seen, row))
+                    goto done;
                 continue;
-            int a = best_axis, b1 = (a + 1) % 3, b2 = (a + 2) % 3;
-            uint8_t *taken = calloc(g, 1);
-            if (!taken)
-                goto done;
+            }
+            if (complete) {
+                if (emit_lattice(&fs, buf + i, g, ij, nvec, vec, lc, t->tol, row))
+                    goto done;
+                continue;
+            }
+            size_t nk = 0;
             for (size_t k = 0; k < g; k++) {
-                if (taken[k])
+                if (ij[2 * k] == OFF_LATTICE)
                     continue;
-                size_t r = 0;
-                for (size_t l = k; l < g; l++) {
-                    const ag_box *x = &t->nodes[buf[i + k].node].box,
-                                 *y = &t->nodes[buf[i + l].node].box;
-                    if (!taken[l] && fabs(x->min[b1] - y->min[b1]) <= t->tol &&
-                        fabs(x->min[b2] - y->min[b2]) <= t->tol) {
-                        taken[l] = 1;
-                        row[r++] = buf[i + l];
-                    }
-                }
-                if (r < minn)
-                    continue;
-                if (!grid_fit(t, row, r, t->tol, counts, step, origin, idx, tmp, seen))
-                    continue;
-                inst *sorted = malloc(r * sizeof *sorted);
-                if (!sorted) {
-                    free(taken);
-                    goto done;
-                }
-                for (size_t q = 0; q < r; q++)
-                    sorted[idx[3 * q + a]] = row[q];
-                st = make_pattern(t, (int32_t)pi, sorted, r, counts, step, moved);
-                free(sorted);
-                if (st) {
-                    free(taken);
-                    goto done;
-                }
+                rk[nk].i = ij[2 * k];
+                rk[nk].j = ij[2 * k + 1];
+                rk[nk++].k = k;
             }
-            free(taken);
+            qsort(rk, nk, sizeof *rk, cmp_runkey);
+            for (size_t u = 0, w; u < nk; u = w) {
+                for (w = u + 1; w < nk && rk[w].j == rk[u].j && rk[w].i == rk[w - 1].i + 1; w++)
+                    ;
+                size_t rn = w - u;
+                if (rn < minn)
+                    continue;
+                for (size_t q = 0; q < rn; q++) {
+                    run[q] = buf[i + rk[u + q].k];
+                    ij2[2 * q] = (int64_t)q;
+                    ij2[2 * q + 1] = 0;
+                }
+                uint32_t rc[2] = {(uint32_t)rn, 1};
+                if (emit_lattice(&fs, run, rn, ij2, 1, vec, rc, t->tol, row))
+                    goto done;
+            }
+            /* nothing on a lattice: complete rows along the axis that covers most */
+            if (fs.n == before && axis_rows(t, buf + i, g, minn, &fs, idx, tmp, seen, row))
+                goto done;
         }
+        if ((st = apply_found(t, (int32_t)pi, &fs, moved)))
+            goto done;
+        st = AG_ERR_NOMEM;
     }
     st = AG_OK;
 done:
@@ -271,6 +584,12 @@ done:
     free(tmp);
     free(seen);
     free(moved);
+    free(ij);
+    free(ij2);
+    free(rk);
+    free(run);
+    free(fs.members);
+    free(fs.list);
     if (st)
         return ag_error_set(err, st, 0, "out of memory while finding patterns");
     return AG_OK;

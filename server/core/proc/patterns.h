@@ -1,12 +1,14 @@
 /* Pattern discovery by transformation-space analysis.
  *
  * Among the children of one node, the roots of one rule with one turn are compared by their
- * pairwise offsets along x, y and z: per axis, the smallest offset that divides all others
- * (within the tolerance) is the step. When the roots fill a complete grid of
- * counts[0] x counts[1] x counts[2] cells at that step (k <= 3 translation groups), they are
- * moved under a new PATTERN node whose box spans them, emitted as `subdivide`. When they do
- * not, rows along one axis that are complete are tried; the rest stay separate applications
- * of the rule (irregular or rotated repetitions). */
+ * offsets. Per axis, the smallest offset that divides all others (within the tolerance) is
+ * the step; when the roots fill a complete grid of counts[0] x counts[1] x counts[2] cells at
+ * those steps (k <= 3 translation groups) they become one axis-aligned pattern (`subdivide`).
+ * Otherwise the offsets are fitted to a lattice in any direction (the shortest offset, then
+ * the shortest one off its line): a complete lattice is one pattern (`repeat`, e.g. windows
+ * of a facade at an angle); an incomplete one gives its unbroken runs along the first vector.
+ * Instances left over stay separate applications of the rule (irregular or rotated
+ * repetitions). Each pattern's roots move under a new PATTERN node spanning them. */
 #ifndef AG_PATTERNS_H
 #define AG_PATTERNS_H
 

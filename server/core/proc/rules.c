@@ -84,11 +84,11 @@ size_t ag_rules_max_count(const ag_splittree *t)
 ag_status ag_rules_label(ag_splittree *t, ag_error *err)
 {
     size_t N = t->nnodes;
-    /* per label: list of rules whose representative has that label */
+    /* per variant: list of rules whose representative has that variant */
     int32_t maxlabel = -1;
     for (size_t i = 0; i < N; i++)
-        if (t->nodes[i].label > maxlabel)
-            maxlabel = t->nodes[i].label;
+        if (t->nodes[i].variant > maxlabel)
+            maxlabel = t->nodes[i].variant;
     int32_t *lhead = malloc(((size_t)maxlabel + 2) * sizeof *lhead);
     int32_t *rnext = malloc((N + 1) * sizeof *rnext);
     int32_t *ca = malloc((N + 1) * sizeof *ca), *cb = malloc((N + 1) * sizeof *cb);
@@ -116,7 +116,7 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
         size_t nb = children(t, (int32_t)ii, NULL, 0);
         int32_t found = -1;
         int fk = 0;
-        for (int32_t r = lhead[b->label]; r >= 0 && found < 0; r = rnext[r]) {
+        for (int32_t r = lhead[b->variant]; r >= 0 && found < 0; r = rnext[r]) {
             int32_t a = t->rule_rep[r];
             if (children(t, a, NULL, 0) != nb)
                 continue;
@@ -130,8 +130,8 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
             found = (int32_t)t->nrules++;
             t->rule_rep[found] = (int32_t)ii;
             t->rule_count[found] = 0;
-            rnext[found] = lhead[b->label];
-            lhead[b->label] = found;
+            rnext[found] = lhead[b->variant];
+            lhead[b->variant] = found;
             fk = 0;
         }
         b->rule = found;

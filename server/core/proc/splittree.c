@@ -55,7 +55,7 @@ static int32_t new_node(ag_splittree *t, int kind)
     ag_tnode *n = &t->nodes[i];
     memset(n, 0, sizeof *n);
     n->parent = n->first_child = n->last_child = n->next_sibling = -1;
-    n->component = n->label = n->rule = n->pattern = -1;
+    n->component = n->label = n->variant = n->rule = n->pattern = -1;
     n->kind = (uint8_t)kind;
     return i;
 }
@@ -221,13 +221,137 @@ static ag_status adjacency(ag_splittree *t)
     return AG_OK;
 }
 
+/* Spatial index of visible nodes for the parent search: a box is registered in the cells it
+ * covers on the finest of three grid levels where it covers at most 64 cells (boxes larger
+ * than that are kept in a short list). A query looks at the cell holding the centre of the
+ * new box on each level: every node enclosing the box is found without scanning siblings. */
+#define GI_LEVELS 3
+typedef struct {
+    uint64_t key;
+    int32_t head; /* -1 = empty slot */
+} gcell;
+
+typedef struct {
+    int32_t node, next;
+} gentry;
+
+typedef struct {
+    double h[GI_LEVELS], o[3];
+    gcell *cells;
+    size_t cap, used;
+    gentry *ent;
+    size_t nent, capent;
+    int32_t *large;
+    size_t nlarge, caplarge;
+} gindex;
+
+static uint64_t gkey(int level, int64_t x, int64_t y, int64_t z)
+{
+    uint64_t h = (uint64_t)level * 0x9E3779B97F4A7C15ULL;
+    h ^= (uint64_t)x * 0xBF58476D1CE4E5B9ULL;
+    h = (h ^ (h >> 31)) * 0x94D049BB133111EBULL;
+    h ^= (uint64_t)y * 0xD6E8FEB86659FD93ULL;
+    h = (h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ULL;
+    h ^= (uint64_t)z * 0x94D049BB133111EBULL;
+    return h ^ (h >> 32);
+}
+
+static gcell *gi_slot(gindex *g, uint64_t key)
+{
+    size_t i = key & (g->cap - 1);
+    while (g->cells[i].head >= 0 && g->cells[i].key != key)
+        i = (i + 1) & (g->cap - 1);
+    return &g->cells[i];
+}
+
+static int gi_grow(gindex *g)
+{
+    size_t nc = g->cap ? 2 * g->cap : 1024;
+    gcell *old = g->cells;
+    size_t oc = g->cap;
+    g->cells = malloc(nc * sizeof *g->cells);
+    if (!g->cells) {
+        g->cells = old;
+        return -1;
+    }
+    g->cap = nc;
+    for (size_t i = 0; i < nc; i++)
+        g->cells[i].head = -1;
+    for (size_t i = 0; i < oc; i++)
+        if (old[i].head >= 0)
+            *gi_slot(g, old[i].key) = old[i];
+    free(old);
+    return 0;
+}
+
+static int gi_add(gindex *g, const ag_box *b, int32_t node)
+{
+    for (int l = GI_LEVELS - 1; l >= 0; l--) {
+        int64_t lo[3], hi[3];
+        double cells = 1;
+        for (int a = 0; a < 3; a++) {
+            lo[a] = (int64_t)floor((b->min[a] - g->o[a]) / g->h[l]);
+            hi[a] = (int64_t)floor((b->max[a] - g->o[a]) / g->h[l]);
+            cells *= (double)(hi[a] - lo[a] + 1);
+        }
+        if (cells > 64 && l > 0)
+            continue;
+        if (cells > 64)
+            break;
+        for (int64_t x = lo[0]; x <= hi[0]; x++)
+            for (int64_t y = lo[1]; y <= hi[1]; y++)
+                for (int64_t z = lo[2]; z <= hi[2]; z++) {
+                    if (2 * (g->used + 1) > g->cap && gi_grow(g))
+                        return -1;
+                    if (g->nent == g->capent) {
+                        size_t nc = g->capent ? 2 * g->capent : 1024;
+                        gentry *ne = realloc(g->ent, nc * sizeof *ne);
+                        if (!ne)
+                            return -1;
+                        g->ent = ne;
+                        g->capent = nc;
+                    }
+                    uint64_t key = gkey(l, x, y, z);
+                    gcell *c = gi_slot(g, key);
+                    if (c->head < 0) {
+                        c->key = key;
+                        g->used++;
+                    }
+                    g->ent[g->nent].node = node;
+                    g->ent[g->nent].next = c->head;
+                    c->head = (int32_t)g->nent++;
+                }
+        return 0;
+    }
+    if (g->nlarge == g->caplarge) {
+        size_t nc = g->caplarge ? 2 * g->caplarge : 64;
+        int32_t *nl = realloc(g->large, nc * sizeof *nl);
+        if (!nl)
+            return -1;
+        g->large = nl;
+        g->caplarge = nc;
+    }
+    g->large[g->nlarge++] = node;
+    return 0;
+}
+
+static void gi_free(gindex *g)
+{
+    free(g->cells);
+    free(g->ent);
+    free(g->large);
+}
+
 ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree **out,
                              ag_error *err)
 {
     *out = NULL;
+    gindex gi = {0};
     ag_splittree *t = calloc(1, sizeof *t);
     size_t nc = L->ncomponents;
     volc *order = malloc((nc + 1) * sizeof *order);
+    /* visible nesting level per node (indexed by node; grown with the tree) */
+    uint32_t *depth = NULL;
     if (!t || !order)
         goto nomem;
     t->ncomponents = nc;
@@ -235,7 +359,7 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
     if (!t->comp_node)
         goto nomem;
     double diag = L->diagonal > 0 ? L->diagonal : 1.0;
-    t->tol = L->tol;
+    t->tol = L->exact;
     t->eps = 1e-9 * diag;
     int32_t root = new_node(t, AG_NODE_ROOT);
     if (root < 0)
@@ -256,50 +380,86 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
         order[n++].c = (uint32_t)c;
     }
     if (n == 0) {
+        gi_free(&gi);
+        free(depth);
         ag_splittree_free(t);
         free(order);
         return ag_error_set(err, AG_ERR_EMPTY, 0, "no component has triangles");
     }
     t->nodes[root].box = all;
     qsort(order, n, sizeof *order, cmp_volc);
+    depth = calloc(3 * n + 8, sizeof *depth); /* at most two splits per component */
+    if (!depth)
+        goto nomem;
+    for (int l = 0; l < GI_LEVELS; l++)
+        gi.h[l] = diag / (8.0 * (1 << (2 * l)));
+    for (int a = 0; a < 3; a++)
+        gi.o[a] = all.min[a];
     for (size_t i = 0; i < n; i++) {
         uint32_t c = order[i].c;
         const ag_box *cb = &L->box[c];
+        /* the tightest enclosing visible node; on equal volume the later (deeper) one */
         int32_t P = root;
-        for (;;) {
-            int32_t best = -1;
-            double bv = INFINITY;
-            for (int32_t s = t->nodes[P].first_child; s >= 0; s = t->nodes[s].next_sibling) {
-                int32_t e = ag_splittree_chain_end(t, s);
-                if (e < 0 || t->nodes[e].kind != AG_NODE_COMPONENT)
+        double bv = INFINITY, ctr[3];
+        for (int a = 0; a < 3; a++)
+            ctr[a] = 0.5 * (cb->min[a] + cb->max[a]);
+        for (int l = 0; l <= GI_LEVELS; l++) {
+            if (l < GI_LEVELS) {
+                if (!gi.cap)
                     continue;
+                uint64_t key = gkey(l, (int64_t)floor((ctr[0] - gi.o[0]) / gi.h[l]),
+                                    (int64_t)floor((ctr[1] - gi.o[1]) / gi.h[l]),
+                                    (int64_t)floor((ctr[2] - gi.o[2]) / gi.h[l]));
+                gcell *cell = gi_slot(&gi, key);
+                for (int32_t en = cell->head; en >= 0; en = gi.ent[en].next) {
+                    int32_t e = gi.ent[en].node;
+                    if (!encloses(&t->nodes[e].box, cb, t->eps))
+                        continue;
+                    double v = fvol(&t->nodes[e].box, 1e-3 * diag);
+                    if (v < bv || (v == bv && e > P)) {
+                        bv = v;
+                        P = e;
+                    }
+                }
+                continue;
+            }
+            for (size_t q = 0; q < gi.nlarge; q++) {
+                int32_t e = gi.large[q];
                 if (!encloses(&t->nodes[e].box, cb, t->eps))
                     continue;
                 double v = fvol(&t->nodes[e].box, 1e-3 * diag);
-                if (v < bv) {
+                if (v < bv || (v == bv && e > P)) {
                     bv = v;
-                    best = e;
+                    P = e;
                 }
             }
-            if (best < 0)
-                break;
-            P = best;
         }
+        /* bound the nesting (export and derivation recurse along it) */
+        if (P != root && depth[P] >= AG_SPLITTREE_MAX_NESTING)
+            P = root;
         int32_t k = ag_splittree_insert(t, P, cb, AG_NODE_COMPONENT);
-        if (k < 0)
+        if (k < 0 || gi_add(&gi, &t->nodes[k].box, k))
             goto nomem;
+        depth[k] = P == root ? 1 : depth[P] + 1;
         t->nodes[k].component = (int32_t)c;
         t->nodes[k].label = L->label[c];
-        t->nodes[k].rot = L->rot[c];
+        t->nodes[k].variant = L->variant[c];
+        t->nodes[k].rot = L->vrot[c];
         t->comp_node[c] = k;
     }
     free(order);
     order = NULL;
+    gi_free(&gi);
+    gi = (gindex){0};
+    free(depth);
+    depth = NULL;
     if (adjacency(t))
         goto nomem;
     *out = t;
     return AG_OK;
 nomem:
+    gi_free(&gi);
+    free(depth);
     free(order);
     ag_splittree_free(t);
     return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while building the split tree");

@@ -31,7 +31,8 @@ typedef struct {
     int32_t parent, first_child, last_child, next_sibling;
     int32_t component; /* visible nodes, else -1 */
     int32_t label;     /* label of the component, else -1 */
-    uint8_t rot;       /* label rotation (quarter turns) */
+    int32_t variant;   /* variant (exact class) of the component, else -1 */
+    uint8_t rot;       /* quarter turns from the variant's exemplar */
     uint8_t kind;      /* ag_node_kind */
     uint8_t octant;    /* 1..8; 0 for the root and for members of a pattern */
     uint8_t rule_rot;  /* quarter turns from the rule's representative */
@@ -43,9 +44,11 @@ typedef struct {
 typedef struct {
     int32_t rule;
     uint8_t rot;
-    uint32_t counts[3];
-    double step[3];
-    int32_t node; /* the PATTERN node */
+    uint8_t nvec;       /* 0: axis-aligned grid (counts, step per axis); 1..3: a lattice */
+    uint32_t counts[3]; /* per axis, or per lattice vector */
+    double step[3];     /* axis-aligned grid: the step per axis */
+    double vec[3][3];   /* lattice: the translation vectors (need not be axis-aligned) */
+    int32_t node;       /* the PATTERN node */
 } ag_pattern;
 
 typedef struct {
@@ -60,13 +63,16 @@ typedef struct {
     int32_t *rule_rep;    /* per rule: its representative node */
     size_t npatterns;
     ag_pattern *patterns;
-    double tol; /* absolute matching tolerance (labels) */
+    double tol; /* absolute matching tolerance (the labels' exact tolerance) */
     double eps; /* absolute coincidence tolerance for faces */
 } ag_splittree;
 
 typedef struct {
     size_t nodes, visible, invisible, depth;
 } ag_splittree_stats;
+
+/* Components nest at most this deep (deeper ones are inserted under the root). */
+#define AG_SPLITTREE_MAX_NESTING 256
 
 /* The labels must come from the same mesh. */
 ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *labels, ag_splittree **out,

@@ -1,0 +1,209 @@
+/* archgram extrude: one plan (building description JSON) or a GeoJSON batch with a style
+ * into an OBJ or GLB shell, with a JSON report for batches. */
+#include <jansson.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+
+#include "commands.h"
+#include "../core/extrude/extrude.h"
+#include "../core/extrude/style.h"
+#include "../core/mesh.h"
+#include "../io/footprints.h"
+#include "../io/glb.h"
+#include "../io/obj.h"
+#include "../io/plan_json.h"
+
+static void usage(void)
+{
+    fprintf(stderr,
+            "usage: archgram extrude --plan PLAN.json --out OUT.obj|OUT.glb\n"
+            "       archgram extrude FOOTPRINTS.geojson --style STYLE.json|flat|hip|gable|mansard|overhang\n"
+            "                        --out OUT.obj|OUT.glb [--report R.json] [--height-property NAME]\n"
+            "                        [--seed N] [--lonlat|--metres]\n");
+}
+
+static int ends_with(const char *s, const char *suffix)
+{
+    size_t a = strlen(s), b = strlen(suffix);
+    return a >= b && strcasecmp(s + a - b, suffix) == 0;
+}
+
+static ag_status write_mesh(const ag_mesh *m, const char *out, ag_error *err)
+{
+    if (ends_with(out, ".glb"))
+        return ag_glb_write_file(m, out, err);
+    return ag_obj_write_file(m, AG_UP_DEFAULT, out, err);
+}
+
+static double seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static int run_plan(const char *plan_path, const char *out)
+{
+    ag_error err = {0};
+    ag_plan *plan = NULL;
+    if (ag_plan_json_read_file(plan_path, &plan, &err) != AG_OK) {
+        fprintf(stderr, "archgram extrude: %s: %s\n", plan_path, err.text);
+        return 1;
+    }
+    ag_mesh *m = ag_mesh_create();
+    size_t g = 0;
+    const char *base = strrchr(plan_path, '/');
+    base = base ? base + 1 : plan_path;
+    ag_extrude_result r;
+    ag_status st = m ? ag_mesh_add_group(m, base, &g) : AG_ERR_NOMEM;
+    if (st == AG_OK)
+        st = ag_extrude_plan(plan, m, (int32_t)g, &r, NULL, &err);
+    for (size_t i = 0; st == AG_OK && i < plan->nanchors; i++) {
+        const ag_anchor *a = &plan->anchors[i];
+        if (a->found)
+            printf("anchor %s: (%.4f, %.4f, %.4f) normal (%.3f, %.3f, %.3f) face %d\n", a->name,
+                   a->pos[0], a->pos[1], a->pos[2], a->normal[0], a->normal[1], a->normal[2],
+                   (int)a->face);
+        else
+            printf("anchor %s: not instanced (the edge is gone or too short there)\n", a->name);
+    }
+    ag_plan_free(plan);
+    if (st != AG_OK) {
+        fprintf(stderr, "archgram extrude: %s: %s\n", plan_path, err.text[0] ? err.text : ag_status_message(st));
+        ag_mesh_free(m);
+        return 1;
+    }
+    if (r.stats.steps || r.stats.steps_skipped)
+        printf("plan edits: %zu made, %zu skipped (anchor not on the plan at its height)\n",
+               r.stats.steps, r.stats.steps_skipped);
+    if (r.stats.irregular)
+        fprintf(stderr, "archgram extrude: warning: %zu intersection(s) with nested chains; the "
+                        "roof may look odd there\n", r.stats.irregular);
+    for (size_t i = 0; i < r.failing_faces && i < AG_EXTRUDE_MAX_PROBLEMS; i++)
+        fprintf(stderr, "archgram extrude: face %d: %s\n", (int)r.problems[i].face,
+                r.problems[i].reason);
+    st = write_mesh(m, out, &err);
+    ag_mesh_free(m);
+    if (st != AG_OK) {
+        fprintf(stderr, "archgram extrude: %s: %s\n", out, err.text);
+        return 1;
+    }
+    printf("%s: %zu faces, %zu triangles, height %.3f m, %s\n", out, r.faces, r.triangles, r.top,
+           r.failing_faces ? "NOT watertight" : "watertight");
+    return r.failing_faces ? 1 : 0;
+}
+
+static json_t *issues_json(const ag_footprint_issue *v, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; i++)
+        json_array_append_new(a, json_pack("{s:s,s:s}", "id", v[i].id, "reason", v[i].reason));
+    return a;
+}
+
+static int run_batch(const char *in, const char *style_arg, const char *out, const char *report,
+                     const char *height_prop, long seed, int lonlat)
+{
+    ag_error err = {0};
+    ag_style style;
+    if (ag_style_builtin(style_arg, &style, NULL) != AG_OK &&
+        ag_plan_json_read_style_file(style_arg, &style, &err) != AG_OK) {
+        fprintf(stderr, "archgram extrude: style %s: %s\n", style_arg,
+                err.text[0] ? err.text : "not a built-in style name nor a readable style file");
+        return 2;
+    }
+    if (seed >= 0)
+        style.seed = (uint64_t)seed;
+    ag_footprints_options fo = {height_prop, lonlat};
+    ag_footprints *f = NULL;
+    double t0 = seconds();
+    if (ag_footprints_read_file(in, &fo, &f, &err) != AG_OK) {
+        fprintf(stderr, "archgram extrude: %s: %s\n", in, err.text);
+        return 1;
+    }
+    ag_mesh *m = ag_mesh_create();
+    ag_footprints_report r;
+    ag_status st = m ? ag_footprints_extrude(f, &style, m, &r, &err) : AG_ERR_NOMEM;
+    double dt = seconds() - t0;
+    if (st != AG_OK) {
+        fprintf(stderr, "archgram extrude: %s\n", err.text);
+        ag_mesh_free(m);
+        ag_footprints_free(f);
+        return 1;
+    }
+    st = write_mesh(m, out, &err);
+    int rc = st == AG_OK ? 0 : 1;
+    if (st != AG_OK)
+        fprintf(stderr, "archgram extrude: %s: %s\n", out, err.text);
+    if (report) {
+        json_t *j = json_pack("{s:I,s:I,s:o,s:I,s:o,s:I,s:f,s:s,s:b,s:[f,f],s:I}",
+                              "footprints", (json_int_t)r.footprints,
+                              "succeeded", (json_int_t)r.succeeded,
+                              "failed", issues_json(r.failed, r.nfailed),
+                              "not_watertight", (json_int_t)r.nnot_watertight,
+                              "not_watertight_items", issues_json(r.not_watertight, r.nnot_watertight),
+                              "triangles", (json_int_t)r.triangles,
+                              "seconds", dt,
+                              "style", style.name,
+                              "lonlat", f->lonlat,
+                              "origin", f->origin[0], f->origin[1],
+                              "skipped_features", (json_int_t)f->skipped);
+        if (!j || json_dump_file(j, report, JSON_INDENT(2)) != 0) {
+            fprintf(stderr, "archgram extrude: cannot write %s\n", report);
+            rc = 1;
+        }
+        json_decref(j);
+    }
+    printf("%s: %zu footprints, %zu succeeded, %zu failed, %zu not watertight, %zu triangles, "
+           "%.3f s\n", out, r.footprints, r.succeeded, r.nfailed, r.nnot_watertight, r.triangles, dt);
+    for (size_t i = 0; i < r.nfailed; i++)
+        fprintf(stderr, "  failed %s: %s\n", r.failed[i].id, r.failed[i].reason);
+    ag_footprints_report_free(&r);
+    ag_mesh_free(m);
+    ag_footprints_free(f);
+    return rc;
+}
+
+int ag_cli_extrude(int argc, char **argv)
+{
+    const char *plan = NULL, *out = NULL, *style = NULL, *report = NULL, *input = NULL;
+    const char *height_prop = NULL;
+    long seed = -1;
+    int lonlat = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        int more = i + 1 < argc;
+        if (strcmp(a, "--plan") == 0 && more)
+            plan = argv[++i];
+        else if (strcmp(a, "--out") == 0 && more)
+            out = argv[++i];
+        else if (strcmp(a, "--style") == 0 && more)
+            style = argv[++i];
+        else if (strcmp(a, "--report") == 0 && more)
+            report = argv[++i];
+        else if (strcmp(a, "--height-property") == 0 && more)
+            height_prop = argv[++i];
+        else if (strcmp(a, "--seed") == 0 && more)
+            seed = strtol(argv[++i], NULL, 10);
+        else if (strcmp(a, "--lonlat") == 0)
+            lonlat = 1;
+        else if (strcmp(a, "--metres") == 0 || strcmp(a, "--meters") == 0)
+            lonlat = -1;
+        else if (a[0] != '-' && !input)
+            input = a;
+        else {
+            usage();
+            return 2;
+        }
+    }
+    if (!out || (!plan && !input) || (plan && input)) {
+        usage();
+        return 2;
+    }
+    if (plan)
+        return run_plan(plan, out);
+    return run_batch(input, style ? style : "hip", out, report, height_prop, seed, lonlat);
+}

@@ -1,0 +1,497 @@
+#include "plan_json.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static ag_status read_points(json_t *arr, const char *what, ag_profile_point **out, size_t *n,
+                             ag_error *err)
+{
+    *out = NULL;
+    *n = 0;
+    if (!json_is_array(arr) || json_array_size(arr) == 0)
+        return ag_error_set(err, AG_ERR_PARSE, 0, "%s: expected a non-empty array of [x, y] pairs",
+                            what);
+    size_t k = json_array_size(arr);
+    ag_profile_point *p = malloc(k * sizeof *p);
+    if (!p)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    for (size_t i = 0; i < k; i++) {
+        json_t *pt = json_array_get(arr, i);
+        if (!json_is_array(pt) || json_array_size(pt) != 2 ||
+            !json_is_number(json_array_get(pt, 0)) || !json_is_number(json_array_get(pt, 1))) {
+            free(p);
+            return ag_error_set(err, AG_ERR_PARSE, (long)i + 1,
+                                "%s: point %zu is not a pair of numbers", what, i);
+        }
+        p[i].w = json_number_value(json_array_get(pt, 0));
+        p[i].z = json_number_value(json_array_get(pt, 1));
+    }
+    *out = p;
+    *n = k;
+    return AG_OK;
+}
+
+static ag_status read_anchor(json_t *av, const char *what, size_t ai, ag_anchor *a, ag_error *err)
+{
+    memset(a, 0, sizeof *a);
+    json_t *rel = json_object_get(av, "relative"), *abs_ = json_object_get(av, "absolute");
+    json_t *lo = json_object_get(av, "loop"), *ed = json_object_get(av, "edge");
+    json_t *h = json_object_get(av, "height");
+    if (!json_is_object(av) || !json_is_integer(ed) || (lo && !json_is_integer(lo)) ||
+        !json_is_number(h) || (!rel == !abs_) || (rel && !json_is_number(rel)) ||
+        (abs_ && !json_is_number(abs_)))
+        return ag_error_set(err, AG_ERR_PARSE, (long)ai + 1,
+                            "plan: %s[%zu] needs \"edge\", \"height\" and one of \"relative\" "
+                            "or \"absolute\" (numbers)", what, ai);
+    const char *nm = json_string_value(json_object_get(av, "name"));
+    snprintf(a->name, sizeof a->name, "%s", nm ? nm : "");
+    a->loop = lo ? (int32_t)json_integer_value(lo) : 0;
+    a->edge = (int32_t)json_integer_value(ed);
+    a->absolute = abs_ != NULL;
+    a->along = json_number_value(abs_ ? abs_ : rel);
+    a->z = json_number_value(h);
+    return AG_OK;
+}
+
+static ag_status parse_plan(json_t *root, ag_plan **out, ag_error *err)
+{
+    if (!json_is_object(root))
+        return ag_error_set(err, AG_ERR_PARSE, 0, "plan: the document must be a JSON object");
+    ag_plan *p = ag_plan_create();
+    if (!p)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    ag_status st = AG_OK;
+    json_t *profiles = json_object_get(root, "profiles");
+    if (!json_is_object(profiles) || json_object_size(profiles) == 0) {
+        st = ag_error_set(err, AG_ERR_PARSE, 0,
+                          "plan: \"profiles\" must be an object of named profiles");
+        goto fail;
+    }
+    const char *name;
+    json_t *pv;
+    json_object_foreach(profiles, name, pv)
+    {
+        json_t *pts = json_is_object(pv) ? json_object_get(pv, "points") : pv;
+        json_t *tag = json_is_object(pv) ? json_object_get(pv, "tag") : NULL;
+        if (tag && !json_is_string(tag)) {
+            st = ag_error_set(err, AG_ERR_PARSE, 0, "plan: profiles.%s.tag must be a string", name);
+            goto fail;
+        }
+        char what[96];
+        snprintf(what, sizeof what, "plan: profiles.%s.points", name);
+        ag_profile_point *pp = NULL;
+        size_t n = 0;
+        st = read_points(pts, what, &pp, &n, err);
+        if (st != AG_OK)
+            goto fail;
+        size_t idx = 0;
+        st = ag_plan_add_profile(p, name, pp, n, tag ? json_string_value(tag) : NULL, &idx, err);
+        free(pp);
+        if (st != AG_OK)
+            goto fail;
+        json_t *prio = json_is_object(pv) ? json_object_get(pv, "priority") : NULL;
+        if (prio && !json_is_integer(prio)) {
+            st = ag_error_set(err, AG_ERR_PARSE, 0, "plan: profiles.%s.priority must be an integer",
+                              name);
+            goto fail;
+        }
+        if (prio)
+            p->profiles[idx].priority = (int32_t)json_integer_value(prio);
+    }
+    int32_t def = 0;
+    json_t *dp = json_object_get(root, "default_profile");
+    if (dp) {
+        if (!json_is_string(dp) || (def = ag_plan_find_profile(p, json_string_value(dp))) < 0) {
+            st = ag_error_set(err, AG_ERR_PARSE, 0,
+                              "plan: \"default_profile\" must name one of the profiles");
+            goto fail;
+        }
+    }
+    json_t *loops = json_object_get(root, "loops");
+    if (!json_is_array(loops) || json_array_size(loops) == 0) {
+        st = ag_error_set(err, AG_ERR_PARSE, 0, "plan: \"loops\" must be a non-empty array");
+        goto fail;
+    }
+    size_t li;
+    json_t *lv;
+    json_array_foreach(loops, li, lv)
+    {
+        json_t *pts = json_is_object(lv) ? json_object_get(lv, "points") : lv;
+        char what[64];
+        snprintf(what, sizeof what, "plan: loops[%zu].points", li);
+        ag_profile_point *pp = NULL;
+        size_t n = 0;
+        st = read_points(pts, what, &pp, &n, err);
+        if (st != AG_OK)
+            goto fail;
+        int32_t *prof = malloc(n * sizeof *prof);
+        double *xy = malloc(2 * n * sizeof *xy);
+        if (!prof || !xy) {
+            free(pp);
+            free(prof);
+            free(xy);
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            goto fail;
+        }
+        for (size_t i = 0; i < n; i++) {
+            xy[2 * i] = pp[i].w;
+            xy[2 * i + 1] = pp[i].z;
+            prof[i] = def;
+        }
+        free(pp);
+        json_t *lp = json_is_object(lv) ? json_object_get(lv, "profiles") : NULL;
+        if (lp && (!json_is_array(lp) || json_array_size(lp) != n)) {
+            st = ag_error_set(err, AG_ERR_PARSE, (long)li + 1,
+                              "plan: loops[%zu].profiles must hold one profile name per edge (%zu)",
+                              li, n);
+        } else if (lp) {
+            for (size_t i = 0; i < n && st == AG_OK; i++) {
+                json_t *nm = json_array_get(lp, i);
+                int32_t k = json_is_string(nm) ? ag_plan_find_profile(p, json_string_value(nm)) : -1;
+                if (json_is_null(nm))
+                    k = def;
+                if (k < 0)
+                    st = ag_error_set(err, AG_ERR_PARSE, (long)li + 1,
+                                      "plan: loops[%zu].profiles[%zu] names no profile", li, i);
+                else
+                    prof[i] = k;
+            }
+        }
+        if (st == AG_OK)
+            st = ag_plan_add_loop(p, xy, n, prof, err);
+        free(prof);
+        free(xy);
+        if (st != AG_OK)
+            goto fail;
+    }
+    json_t *anchors = json_object_get(root, "anchors");
+    if (anchors && !json_is_array(anchors)) {
+        st = ag_error_set(err, AG_ERR_PARSE, 0, "plan: \"anchors\" must be an array");
+        goto fail;
+    }
+    size_t ai;
+    json_t *av;
+    json_array_foreach(anchors, ai, av)
+    {
+        ag_anchor a;
+        st = read_anchor(av, "anchors", ai, &a, err);
+        if (st == AG_OK)
+            st = ag_plan_add_anchor(p, &a, err);
+        if (st != AG_OK)
+            goto fail;
+    }
+    json_t *steps = json_object_get(root, "steps");
+    if (steps && !json_is_array(steps)) {
+        st = ag_error_set(err, AG_ERR_PARSE, 0, "plan: \"steps\" must be an array");
+        goto fail;
+    }
+    json_array_foreach(steps, ai, av)
+    {
+        ag_plan_step sp;
+        memset(&sp, 0, sizeof sp);
+        st = read_anchor(av, "steps", ai, &sp.at, err);
+        if (st != AG_OK)
+            goto fail;
+        memcpy(sp.name, sp.at.name, sizeof sp.name);
+        json_t *w = json_object_get(av, "width"), *d = json_object_get(av, "depth");
+        json_t *pn = json_object_get(av, "profile");
+        sp.profile = json_is_string(pn) ? ag_plan_find_profile(p, json_string_value(pn)) : -1;
+        if (!json_is_number(w) || !json_is_number(d) || sp.profile < 0) {
+            st = ag_error_set(err, AG_ERR_PARSE, (long)ai + 1,
+                              "plan: steps[%zu] needs \"width\", \"depth\" (numbers) and "
+                              "\"profile\" (a profile name)", ai);
+            goto fail;
+        }
+        sp.width = json_number_value(w);
+        sp.depth = json_number_value(d);
+        st = ag_plan_add_step(p, &sp, err);
+        if (st != AG_OK)
+            goto fail;
+    }
+    json_t *cap = json_object_get(root, "cap_height");
+    if (cap) {
+        if (!json_is_number(cap) || !(json_number_value(cap) >= 0)) {
+            st = ag_error_set(err, AG_ERR_PARSE, 0, "plan: \"cap_height\" must be a number >= 0");
+            goto fail;
+        }
+        p->cap_height = json_number_value(cap);
+    }
+    json_t *pr = json_object_get(root, "priority");
+    if (pr) {
+        const char *s = json_string_value(pr);
+        if (s && strcmp(s, "max_volume") == 0)
+            p->priority = AG_PRIORITY_MAX_VOLUME;
+        else if (s && strcmp(s, "min_volume") == 0)
+            p->priority = AG_PRIORITY_MIN_VOLUME;
+        else {
+            st = ag_error_set(err, AG_ERR_PARSE, 0,
+                              "plan: \"priority\" must be \"max_volume\" or \"min_volume\"");
+            goto fail;
+        }
+    }
+    *out = p;
+    return AG_OK;
+fail:
+    ag_plan_free(p);
+    return st;
+}
+
+static char *slurp(const char *path, size_t *len, ag_error *err, ag_status *st)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        *st = ag_error_set(err, AG_ERR_IO, 0, "cannot open %s", path);
+        return NULL;
+    }
+    char *buf = NULL;
+    size_t n = 0, cap = 0;
+    for (;;) {
+        if (n + 4096 > cap) {
+            cap = cap ? 2 * cap : 65536;
+            char *nb = realloc(buf, cap);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                *st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+                return NULL;
+            }
+            buf = nb;
+        }
+        size_t r = fread(buf + n, 1, cap - n, f);
+        n += r;
+        if (!r)
+            break;
+    }
+    fclose(f);
+    *len = n;
+    *st = AG_OK;
+    return buf;
+}
+
+ag_status ag_plan_json_read_buffer(const char *data, size_t len, ag_plan **out, ag_error *err)
+{
+    *out = NULL;
+    json_error_t je;
+    json_t *root = json_loadb(data, len, 0, &je);
+    if (!root)
+        return ag_error_set(err, AG_ERR_PARSE, je.line, "plan: %s (line %d, column %d)", je.text,
+                            je.line, je.column);
+    ag_status st = parse_plan(root, out, err);
+    json_decref(root);
+    return st;
+}
+
+ag_status ag_plan_json_read_file(const char *path, ag_plan **out, ag_error *err)
+{
+    *out = NULL;
+    size_t len = 0;
+    ag_status st;
+    char *buf = slurp(path, &len, err, &st);
+    if (!buf)
+        return st;
+    st = ag_plan_json_read_buffer(buf, len, out, err);
+    free(buf);
+    return st;
+}
+
+/* --- styles ------------------------------------------------------------------------------ */
+
+static int label_bits(json_t *v, const char *const *names, const uint32_t *bits, uint32_t any,
+                      uint32_t *out)
+{
+    if (!v) {
+        *out = any;
+        return 1;
+    }
+    json_t *one = NULL;
+    if (json_is_string(v)) {
+        one = json_array();
+        json_array_append(one, v);
+        v = one;
+    }
+    if (!json_is_array(v)) {
+        return 0;
+    }
+    uint32_t b = 0;
+    size_t i;
+    json_t *s;
+    int ok = 1;
+    json_array_foreach(v, i, s)
+    {
+        const char *t = json_string_value(s);
+        int found = 0;
+        if (t && strcmp(t, "any") == 0) {
+            b |= any;
+            found = 1;
+        }
+        for (int k = 0; t && names[k]; k++)
+            if (strcmp(t, names[k]) == 0) {
+                b |= bits[k];
+                found = 1;
+            }
+        if (!found)
+            ok = 0;
+    }
+    if (one)
+        json_decref(one);
+    *out = b;
+    return ok;
+}
+
+static ag_status parse_style(json_t *root, ag_style *s, ag_error *err)
+{
+    if (!json_is_object(root))
+        return ag_error_set(err, AG_ERR_PARSE, 0, "style: the document must be a JSON object");
+    ag_style_builtin("hip", s, NULL); /* defaults */
+    s->nprofiles = 0;
+    s->nrules = 0;
+    const char *nm = json_string_value(json_object_get(root, "name"));
+    snprintf(s->name, sizeof s->name, "%s", nm ? nm : "custom");
+    json_t *v;
+    if ((v = json_object_get(root, "height"))) {
+        if (!json_is_number(v) || !(json_number_value(v) > 0))
+            return ag_error_set(err, AG_ERR_PARSE, 0, "style: \"height\" must be a number > 0");
+        s->height = json_number_value(v);
+    }
+    if ((v = json_object_get(root, "cap")))
+        s->cap = json_is_true(v);
+    if ((v = json_object_get(root, "seed")))
+        s->seed = (uint64_t)json_integer_value(v);
+    if ((v = json_object_get(root, "short_below")) && json_is_number(v))
+        s->short_below = json_number_value(v);
+    if ((v = json_object_get(root, "long_above")) && json_is_number(v))
+        s->long_above = json_number_value(v);
+    if ((v = json_object_get(root, "street"))) {
+        if (!json_is_array(v) || json_array_size(v) != 2)
+            return ag_error_set(err, AG_ERR_PARSE, 0, "style: \"street\" must be [dx, dy]");
+        double dx = json_number_value(json_array_get(v, 0)), dy = json_number_value(json_array_get(v, 1));
+        double l = hypot(dx, dy);
+        if (!(l > 0))
+            return ag_error_set(err, AG_ERR_PARSE, 0, "style: \"street\" must not be zero");
+        s->has_street = 1;
+        s->street_dir[0] = dx / l;
+        s->street_dir[1] = dy / l;
+    }
+    json_t *profiles = json_object_get(root, "profiles");
+    if (!json_is_object(profiles) || !json_object_size(profiles))
+        return ag_error_set(err, AG_ERR_PARSE, 0, "style: \"profiles\" must be a non-empty object");
+    const char *name;
+    json_object_foreach(profiles, name, v)
+    {
+        if (s->nprofiles == AG_STYLE_MAX_PROFILES)
+            return ag_error_set(err, AG_ERR_TOO_LARGE, 0, "style: at most %d profiles",
+                                AG_STYLE_MAX_PROFILES);
+        char what[96];
+        snprintf(what, sizeof what, "style: profiles.%s", name);
+        ag_profile_point *pp = NULL;
+        size_t n = 0;
+        ag_status st = read_points(v, what, &pp, &n, err);
+        if (st != AG_OK)
+            return st;
+        if (n > AG_STYLE_MAX_POINTS) {
+            free(pp);
+            return ag_error_set(err, AG_ERR_TOO_LARGE, 0, "%s: at most %d points", what,
+                                AG_STYLE_MAX_POINTS);
+        }
+        ag_style_profile *sp = &s->profiles[s->nprofiles++];
+        snprintf(sp->name, sizeof sp->name, "%s", name);
+        sp->npoints = n;
+        memcpy(sp->points, pp, n * sizeof *pp);
+        free(pp);
+    }
+    json_t *rules = json_object_get(root, "rules");
+    if (!json_is_array(rules) || !json_array_size(rules))
+        return ag_error_set(err, AG_ERR_PARSE, 0, "style: \"rules\" must be a non-empty array");
+    static const char *const ln[] = {"short", "medium", "long", NULL};
+    static const uint32_t lb[] = {AG_LABEL_SHORT, AG_LABEL_MEDIUM, AG_LABEL_LONG};
+    static const char *const on[] = {"north", "east", "south", "west", "street", "side", "back", NULL};
+    static const uint32_t ob[] = {AG_LABEL_NORTH, AG_LABEL_EAST, AG_LABEL_SOUTH, AG_LABEL_WEST,
+                                  AG_LABEL_STREET, AG_LABEL_SIDE, AG_LABEL_BACK};
+    static const char *const an[] = {"along", "across", NULL};
+    static const uint32_t ab[] = {AG_LABEL_ALONG, AG_LABEL_ACROSS};
+    size_t ri;
+    json_t *r;
+    json_array_foreach(rules, ri, r)
+    {
+        if (s->nrules == AG_STYLE_MAX_RULES)
+            return ag_error_set(err, AG_ERR_TOO_LARGE, (long)ri + 1, "style: at most %d rules",
+                                AG_STYLE_MAX_RULES);
+        ag_style_rule *ru = &s->rules[s->nrules];
+        memset(ru, 0, sizeof *ru);
+        uint32_t a, b, c;
+        if (!json_is_object(r) ||
+            !label_bits(json_object_get(r, "length"), ln, lb, AG_LABEL_ANY_LENGTH, &a) ||
+            !label_bits(json_object_get(r, "orientation"), on, ob, AG_LABEL_ANY_ORIENTATION, &b) ||
+            !label_bits(json_object_get(r, "axis"), an, ab, AG_LABEL_ANY_AXIS, &c))
+            return ag_error_set(err, AG_ERR_PARSE, (long)ri + 1,
+                                "style: rules[%zu] has an unknown label (length: short/medium/"
+                                "long, orientation: north/east/south/west/street/side/back, "
+                                "axis: along/across, or any)", ri);
+        ru->labels = a | b | c;
+        json_t *choice = json_object_get(r, "profiles");
+        if (json_is_string(choice)) {
+            json_t *o = json_object();
+            json_object_set_new(o, json_string_value(choice), json_real(1));
+            choice = o;
+        } else {
+            json_incref(choice);
+        }
+        if (!json_is_object(choice) || !json_object_size(choice)) {
+            json_decref(choice);
+            return ag_error_set(err, AG_ERR_PARSE, (long)ri + 1,
+                                "style: rules[%zu].profiles must map profile names to weights", ri);
+        }
+        const char *pn;
+        json_t *w;
+        ag_status st = AG_OK;
+        json_object_foreach(choice, pn, w)
+        {
+            size_t k = 0;
+            while (k < s->nprofiles && strcmp(s->profiles[k].name, pn) != 0)
+                k++;
+            if (k == s->nprofiles || !json_is_number(w) || json_number_value(w) < 0 ||
+                ru->nchoices == AG_STYLE_MAX_PROFILES) {
+                st = ag_error_set(err, AG_ERR_PARSE, (long)ri + 1,
+                                  "style: rules[%zu].profiles.%s: unknown profile or bad weight",
+                                  ri, pn);
+                break;
+            }
+            ru->profile[ru->nchoices] = (uint32_t)k;
+            ru->weight[ru->nchoices] = json_number_value(w);
+            ru->nchoices++;
+        }
+        json_decref(choice);
+        if (st != AG_OK)
+            return st;
+        s->nrules++;
+    }
+    return AG_OK;
+}
+
+ag_status ag_plan_json_read_style_buffer(const char *data, size_t len, ag_style *out,
+                                         ag_error *err)
+{
+    json_error_t je;
+    json_t *root = json_loadb(data, len, 0, &je);
+    if (!root)
+        return ag_error_set(err, AG_ERR_PARSE, je.line, "style: %s (line %d, column %d)", je.text,
+                            je.line, je.column);
+    ag_status st = parse_style(root, out, err);
+    json_decref(root);
+    return st;
+}
+
+ag_status ag_plan_json_read_style_file(const char *path, ag_style *out, ag_error *err)
+{
+    size_t len = 0;
+    ag_status st;
+    char *buf = slurp(path, &len, err, &st);
+    if (!buf)
+        return st;
+    st = ag_plan_json_read_style_buffer(buf, len, out, err);
+    free(buf);
+    return st;
+}

@@ -1,0 +1,196 @@
+/* Plan validation: cleaning with reasons, orientation by nesting, rejected input. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <string.h>
+
+#include "core/extrude/plan.h"
+
+static const ag_profile_point R45[] = {{0, 0}, {1, 1}};
+
+static ag_plan *one_loop(const double *xy, size_t n)
+{
+    ag_plan *p = ag_plan_create();
+    assert_int_equal(ag_plan_add_profile(p, "r", R45, 2, NULL, NULL, NULL), AG_OK);
+    assert_int_equal(ag_plan_add_loop(p, xy, n, NULL, NULL), AG_OK);
+    return p;
+}
+
+static int has_fix(const ag_plan_fixes *f, ag_plan_fix_kind k, long corner)
+{
+    for (size_t i = 0; i < f->n; i++)
+        if (f->fixes[i].kind == k && (corner < -1 || f->fixes[i].corner == corner))
+            return 1;
+    return 0;
+}
+
+static void test_cleaning(void **state)
+{
+    (void)state;
+    /* corner 1 duplicates corner 0, corner 3 sits on the bottom edge, corner 6 is a spike */
+    const double xy[] = {0, 0, 0, 0, 4, 0, 10, 0, 10, 6, 5, 6, 5, 9, 5, 6, 0, 6};
+    ag_plan *p = one_loop(xy, 9);
+    ag_plan_fixes fx = {0};
+    ag_error err = {0};
+    double ext = 0;
+    assert_int_equal(ag_plan_validate(p, &fx, &ext, &err), AG_OK);
+    assert_true(has_fix(&fx, AG_PLAN_FIX_DUPLICATE, 1));
+    assert_true(has_fix(&fx, AG_PLAN_FIX_COLLINEAR, 2));
+    assert_true(has_fix(&fx, AG_PLAN_FIX_SPIKE, 6));
+    for (size_t i = 0; i < fx.n; i++)
+        assert_true(strlen(fx.fixes[i].reason) > 10);
+    assert_int_equal(p->loops[0].n, 4);
+    assert_true(fabs(ag_plan_loop_area(&p->loops[0]) - 60) < 1e-12);
+    assert_true(fabs(ext - hypot(10, 9)) < 1e-12);
+    ag_plan_fixes_free(&fx);
+    ag_plan_free(p);
+}
+
+static void test_collinear_kept_with_other_profile(void **state)
+{
+    (void)state;
+    const double xy[] = {0, 0, 4, 0, 10, 0, 10, 6, 0, 6};
+    const int32_t prof[] = {0, 1, 0, 0, 0};
+    ag_plan *p = ag_plan_create();
+    ag_plan_add_profile(p, "a", R45, 2, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "b", R45, 2, NULL, NULL, NULL);
+    ag_plan_add_loop(p, xy, 5, prof, NULL);
+    ag_plan_fixes fx = {0};
+    assert_int_equal(ag_plan_validate(p, &fx, NULL, NULL), AG_OK);
+    assert_int_equal(p->loops[0].n, 5); /* the sweep resolves it by priority */
+    assert_int_equal(fx.n, 0);
+    ag_plan_fixes_free(&fx);
+    ag_plan_free(p);
+}
+
+static void test_orientation(void **state)
+{
+    (void)state;
+    /* outer given clockwise, hole given counter-clockwise, island in the hole CW */
+    const double outer[] = {0, 0, 0, 20, 20, 20, 20, 0};
+    const double hole[] = {5, 5, 15, 5, 15, 15, 5, 15};
+    const double island[] = {8, 8, 8, 12, 12, 12, 12, 8};
+    ag_plan *p = ag_plan_create();
+    ag_plan_add_profile(p, "r", R45, 2, NULL, NULL, NULL);
+    const int32_t prof[] = {0, 0, 0, 0};
+    ag_plan_add_loop(p, outer, 4, prof, NULL);
+    ag_plan_add_loop(p, hole, 4, prof, NULL);
+    ag_plan_add_loop(p, island, 4, prof, NULL);
+    ag_plan_fixes fx = {0};
+    assert_int_equal(ag_plan_validate(p, &fx, NULL, NULL), AG_OK);
+    assert_true(ag_plan_loop_area(&p->loops[0]) > 0);
+    assert_true(ag_plan_loop_area(&p->loops[1]) < 0);
+    assert_true(ag_plan_loop_area(&p->loops[2]) > 0);
+    assert_int_equal(fx.n, 3);
+    assert_true(has_fix(&fx, AG_PLAN_FIX_REVERSED, -1));
+    ag_plan_fixes_free(&fx);
+    ag_plan_free(p);
+}
+
+static void test_reversal_keeps_edge_profiles(void **state)
+{
+    (void)state;
+    /* clockwise square whose edge from (0,0) to (0,4) has profile 1 */
+    const double xy[] = {0, 0, 0, 4, 4, 4, 4, 0};
+    const int32_t prof[] = {1, 0, 0, 0};
+    ag_plan *p = ag_plan_create();
+    ag_plan_add_profile(p, "a", R45, 2, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "b", R45, 2, NULL, NULL, NULL);
+    ag_plan_add_loop(p, xy, 4, prof, NULL);
+    assert_int_equal(ag_plan_validate(p, NULL, NULL, NULL), AG_OK);
+    const ag_plan_loop *l = &p->loops[0];
+    int found = 0;
+    for (size_t i = 0; i < 4; i++) {
+        size_t j = (i + 1) % 4;
+        if (l->profile[i] == 1) {
+            /* the same segment, now running from (0,4) to (0,0) */
+            assert_true(l->xy[2 * i] == 0 && l->xy[2 * i + 1] == 4);
+            assert_true(l->xy[2 * j] == 0 && l->xy[2 * j + 1] == 0);
+            found++;
+        }
+    }
+    assert_int_equal(found, 1);
+    ag_plan_free(p);
+}
+
+static void test_rejects(void **state)
+{
+    (void)state;
+    ag_error err = {0};
+    /* bow tie */
+    const double bow[] = {0, 0, 10, 10, 10, 0, 0, 6};
+    ag_plan *p = one_loop(bow, 4);
+    assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "crosses"));
+    ag_plan_free(p);
+    /* a hole touching the outer ring */
+    const double outer[] = {0, 0, 10, 0, 10, 10, 0, 10};
+    const double hole[] = {0, 5, 5, 4, 5, 6};
+    p = one_loop(outer, 4);
+    ag_plan_add_loop(p, hole, 3, NULL, NULL);
+    assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
+    ag_plan_free(p);
+    /* NaN */
+    const double bad[] = {0, 0, NAN, 0, 1, 1};
+    p = one_loop(bad, 3);
+    assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
+    assert_int_equal(err.element, 1);
+    ag_plan_free(p);
+    /* degenerate: everything on a line */
+    const double line[] = {0, 0, 1, 0, 2, 0};
+    p = one_loop(line, 3);
+    assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_EMPTY);
+    ag_plan_free(p);
+    /* profile index out of range */
+    const int32_t prof[] = {0, 3, 0, 0};
+    p = ag_plan_create();
+    ag_plan_add_profile(p, "r", R45, 2, NULL, NULL, NULL);
+    ag_plan_add_loop(p, outer, 4, prof, NULL);
+    assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "profile"));
+    ag_plan_free(p);
+}
+
+static void test_profiles_checked(void **state)
+{
+    (void)state;
+    ag_plan *p = ag_plan_create();
+    ag_error err = {0};
+    const ag_profile_point down[] = {{0, 0}, {0, 3}, {1, 2}};
+    assert_int_equal(ag_plan_add_profile(p, "down", down, 3, NULL, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "monotone"));
+    const ag_profile_point off[] = {{1, 0}, {1, 3}};
+    assert_int_equal(ag_plan_add_profile(p, "off", off, 2, NULL, NULL, &err), AG_ERR_INVALID);
+    const ag_profile_point flat_end[] = {{0, 0}, {0, 3}, {1, 3}};
+    assert_int_equal(ag_plan_add_profile(p, "flat", flat_end, 3, NULL, NULL, &err), AG_ERR_INVALID);
+    const ag_profile_point two_flat[] = {{0, 0}, {0, 3}, {1, 3}, {2, 3}, {2, 4}};
+    assert_int_equal(ag_plan_add_profile(p, "two", two_flat, 5, NULL, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "horizontal"));
+    const ag_profile_point one[] = {{0, 0}};
+    assert_int_equal(ag_plan_add_profile(p, "one", one, 1, NULL, NULL, &err), AG_ERR_INVALID);
+    const ag_profile_point ok[] = {{0, 0}, {0, 3}, {-0.5, 3.2}, {0.5, 4.2}};
+    size_t idx = 99;
+    assert_int_equal(ag_plan_add_profile(p, "ok", ok, 4, "roof", &idx, &err), AG_OK);
+    assert_int_equal(idx, 0);
+    assert_int_equal(ag_plan_find_profile(p, "ok"), 0);
+    assert_int_equal(ag_plan_find_profile(p, "nope"), -1);
+    assert_string_equal(p->profiles[0].tag, "roof");
+    ag_plan_free(p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cleaning),
+        cmocka_unit_test(test_collinear_kept_with_other_profile),
+        cmocka_unit_test(test_orientation),
+        cmocka_unit_test(test_reversal_keeps_edge_profiles),
+        cmocka_unit_test(test_rejects),
+        cmocka_unit_test(test_profiles_checked),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

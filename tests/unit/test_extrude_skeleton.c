@@ -1,0 +1,495 @@
+/* The sweep-plane skeleton: closed-form and brute-force references for uniform 45°
+ * roofs, profiles (walls, gables, outward eaves), ambiguity priorities, the named hard
+ * cases in tests/data/extrude, and the shell check itself. */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/extrude/extrude.h"
+#include "core/extrude/predicates.h"
+#include "io/plan_json.h"
+
+static ag_plan *plan_with(const ag_profile_point *pts, size_t np, const double *xy, size_t n)
+{
+    ag_plan *p = ag_plan_create();
+    assert_non_null(p);
+    assert_int_equal(ag_plan_add_profile(p, "p", pts, np, NULL, NULL, NULL), AG_OK);
+    assert_int_equal(ag_plan_add_loop(p, xy, n, NULL, NULL), AG_OK);
+    return p;
+}
+
+static ag_shell *extrude(ag_plan *p, ag_extrude_result *r)
+{
+    ag_mesh *m = ag_mesh_create();
+    ag_shell *sh = NULL;
+    ag_error err = {0};
+    ag_status st = ag_extrude_plan(p, m, -1, r, &sh, &err);
+    if (st != AG_OK)
+        print_error("extrude failed: %s\n", err.text);
+    assert_int_equal(st, AG_OK);
+    /* every triangle index is a valid vertex and the component exists */
+    for (size_t i = 0; i < 3 * m->ntris; i++)
+        assert_true(m->tri[i] < m->nverts);
+    assert_int_equal(m->ncomponents, 1);
+    assert_int_equal(r->triangles, m->ntris);
+    ag_mesh_free(m);
+    return sh;
+}
+
+static const ag_profile_point R45[] = {{0, 0}, {1, 1}};
+
+/* Height of the 45° roof over a convex polygon at (x, y): the distance to the nearest
+ * supporting line, computed directly from the input corners. */
+static double convex_height(const double *xy, size_t n, double x, double y)
+{
+    double h = INFINITY;
+    for (size_t i = 0; i < n; i++) {
+        size_t j = (i + 1) % n;
+        double dx = xy[2 * j] - xy[2 * i], dy = xy[2 * j + 1] - xy[2 * i + 1];
+        double d = (dx * (y - xy[2 * i + 1]) - dy * (x - xy[2 * i])) / hypot(dx, dy);
+        h = fmin(h, d);
+    }
+    return h;
+}
+
+static void check_convex(const double *xy, size_t n)
+{
+    ag_plan *p = plan_with(R45, 2, xy, n);
+    ag_extrude_result r;
+    ag_shell *sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    double top = 0;
+    for (size_t v = 0; v < sh->nverts; v++) {
+        const double *q = &sh->pos[3 * v];
+        double ref = convex_height(xy, n, q[0], q[1]);
+        if (fabs(q[2] - ref) > 1e-6)
+            print_error("vertex %zu at (%g, %g): z %.9f, reference %.9f\n", v, q[0], q[1], q[2], ref);
+        assert_true(fabs(q[2] - ref) <= 1e-6);
+        top = fmax(top, q[2]);
+    }
+    assert_true(fabs(r.top - top) <= 1e-6);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+}
+
+static void test_rectangle_closed_form(void **state)
+{
+    (void)state;
+    const double W = 10, H = 6;
+    const double xy[] = {0, 0, W, 0, W, H, 0, H};
+    ag_plan *p = plan_with(R45, 2, xy, 4);
+    ag_extrude_result r;
+    ag_shell *sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.faces, 5);
+    /* a hip roof: ridge from (H/2, H/2) to (W - H/2, H/2) at height H/2 */
+    int ridge = 0;
+    for (size_t v = 0; v < sh->nverts; v++) {
+        const double *q = &sh->pos[3 * v];
+        if (q[2] == 0)
+            continue;
+        assert_true(fabs(q[2] - H / 2) < 1e-9);
+        assert_true(fabs(q[1] - H / 2) < 1e-9);
+        assert_true(fabs(q[0] - H / 2) < 1e-9 || fabs(q[0] - (W - H / 2)) < 1e-9);
+        ridge++;
+    }
+    assert_true(ridge >= 2);
+    /* volume of a hip roof: H/2 * H * (3W - H) / 6 */
+    assert_true(fabs(r.volume - H / 2 * H * (3 * W - H) / 6) < 1e-6);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+}
+
+static void test_convex_brute_force(void **state)
+{
+    (void)state;
+    const double tri[] = {0, 0, 10, 0, 3, 7};
+    check_convex(tri, 3);
+    const double quad[] = {0, 0, 9, 1, 11, 7, 2, 5};
+    check_convex(quad, 4);
+    /* random convex polygons: sorted angles on an ellipse with jitter */
+    srand(7);
+    for (int t = 0; t < 20; t++) {
+        size_t n = 3 + (size_t)(rand() % 12);
+        double xy[64];
+        double a0 = 0;
+        for (size_t i = 0; i < n; i++) {
+            double a = a0 + 2 * M_PI * (i + 0.8 * rand() / (double)RAND_MAX) / n;
+            xy[2 * i] = 12 * cos(a);
+            xy[2 * i + 1] = 7 * sin(a);
+        }
+        check_convex(xy, n);
+    }
+    /* regular 200-gon: all faces meet at the centre */
+    double big[400];
+    for (int i = 0; i < 200; i++) {
+        big[2 * i] = 20 * cos(2 * M_PI * i / 200);
+        big[2 * i + 1] = 20 * sin(2 * M_PI * i / 200);
+    }
+    check_convex(big, 200);
+}
+
+/* Every roof vertex lies on the plane of every face that holds it, and no roof point is
+ * higher than its distance to the plan boundary (a straight-skeleton property). */
+static void test_nonconvex_planes(void **state)
+{
+    (void)state;
+    const double L[] = {0, 0, 10, 0, 10, 4, 4, 4, 4, 10, 0, 10};
+    const double U[] = {0, 0, 12, 0, 12, 10, 8, 10, 8, 4, 4, 4, 4, 10, 0, 10};
+    const double *shapes[] = {L, U};
+    size_t sizes[] = {6, 8};
+    for (int s = 0; s < 2; s++) {
+        const double *xy = shapes[s];
+        size_t n = sizes[s];
+        ag_plan *p = plan_with(R45, 2, xy, n);
+        ag_extrude_result r;
+        ag_shell *sh = extrude(p, &r);
+        assert_int_equal(r.failing_faces, 0);
+        assert_int_equal(r.faces, n + 1);
+        for (size_t f = 0; f < sh->nfaces; f++) {
+            const ag_shell_face *fc = &sh->faces[f];
+            if (fc->kind != AG_SHELL_FACE_SIDE)
+                continue;
+            size_t i = (size_t)fc->edge, j = (i + 1) % n;
+            double dx = xy[2 * j] - xy[2 * i], dy = xy[2 * j + 1] - xy[2 * i + 1], len = hypot(dx, dy);
+            for (uint32_t l = fc->first_loop; l < fc->first_loop + (fc->nloops & 0x7fffffffu); l++)
+                for (uint32_t k = sh->loop_start[l]; k < sh->loop_start[l + 1]; k++) {
+                    const double *q = &sh->pos[3 * sh->idx[k]];
+                    double d = (dx * (q[1] - xy[2 * i + 1]) - dy * (q[0] - xy[2 * i])) / len;
+                    assert_true(fabs(d - q[2]) < 1e-6);
+                    /* distance to the boundary segments */
+                    double best = INFINITY;
+                    for (size_t a = 0; a < n; a++) {
+                        size_t b = (a + 1) % n;
+                        double ex = xy[2 * b] - xy[2 * a], ey = xy[2 * b + 1] - xy[2 * a + 1];
+                        double t = ((q[0] - xy[2 * a]) * ex + (q[1] - xy[2 * a + 1]) * ey) / (ex * ex + ey * ey);
+                        t = fmax(0, fmin(1, t));
+                        best = fmin(best, hypot(q[0] - xy[2 * a] - t * ex, q[1] - xy[2 * a + 1] - t * ey));
+                    }
+                    assert_true(q[2] <= best + 1e-6);
+                    assert_true(ag_pred_point_in_polygon(xy, n, q[0], q[1]) || best < 1e-6);
+                }
+        }
+        ag_shell_free(sh);
+        ag_plan_free(p);
+    }
+}
+
+static void test_profiles(void **state)
+{
+    (void)state;
+    const double xy[] = {0, 0, 10, 0, 10, 6, 0, 6};
+    /* walls to 3 then 45°: every wall vertex at x/y of the plan up to z = 3 */
+    const ag_profile_point hip[] = {{0, 0}, {0, 3}, {1, 4}};
+    ag_plan *p = plan_with(hip, 3, xy, 4);
+    ag_extrude_result r;
+    ag_shell *sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.faces, 9);
+    assert_true(fabs(r.top - 6) < 1e-9);
+    assert_true(fabs(r.volume - (180 + 72)) < 1e-6);
+    int walltops = 0;
+    for (size_t f = 0; f < sh->nfaces; f++)
+        if (sh->faces[f].kind == AG_SHELL_FACE_SIDE)
+            assert_true(sh->faces[f].segment == 0 || sh->faces[f].segment == 1);
+    for (size_t v = 0; v < sh->nverts; v++)
+        if (fabs(sh->pos[3 * v + 2] - 3) < 1e-12)
+            walltops++;
+    assert_int_equal(walltops, 4);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* flat: vertical walls capped at 4 m */
+    const ag_profile_point wall[] = {{0, 0}, {0, 1}};
+    p = plan_with(wall, 2, xy, 4);
+    p->cap_height = 4;
+    sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.faces, 6);
+    assert_true(r.stats.capped);
+    assert_true(fabs(r.volume - 240) < 1e-6);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* mansard: two slopes; volume of the frustum + hip on top, by slices */
+    const ag_profile_point mans[] = {{0, 0}, {0, 2}, {1, 4}, {3, 5}};
+    p = plan_with(mans, 4, xy, 4);
+    sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    /* at z = 4 the plan is 8 x 4; the last slope 2 m/m closes it at 4 + 2/2 */
+    assert_true(fabs(r.top - 5) < 1e-9);
+    double frustum = 0;
+    for (int k = 0; k < 2000; k++) {
+        double z = (k + 0.5) * 2.0 / 2000, o = z / 2;
+        frustum += (10 - 2 * o) * (6 - 2 * o) * 2.0 / 2000;
+    }
+    double expect = 10 * 6 * 2 + frustum + 1 * 4 * (3 * 8 - 4) / 6.0 * 1; /* hip of 8x4, h = 1 */
+    assert_true(fabs(r.volume - expect) < 1e-3);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+}
+
+static void test_priority(void **state)
+{
+    (void)state;
+    /* the bottom edge is two collinear edges with different slopes */
+    const double xy[] = {0, 0, 5, 0, 10, 0, 10, 6, 0, 6};
+    const ag_profile_point steep[] = {{0, 0}, {0.5, 1}};
+    const int32_t prof[] = {1, 0, 0, 0, 0};
+    for (int pr = 0; pr < 2; pr++) {
+        ag_plan *p = ag_plan_create();
+        ag_plan_add_profile(p, "r45", R45, 2, NULL, NULL, NULL);
+        ag_plan_add_profile(p, "steep", steep, 2, NULL, NULL, NULL);
+        ag_plan_add_loop(p, xy, 5, prof, NULL);
+        p->priority = pr ? AG_PRIORITY_MIN_VOLUME : AG_PRIORITY_MAX_VOLUME;
+        ag_extrude_result r;
+        ag_shell *sh = extrude(p, &r);
+        assert_int_equal(r.failing_faces, 0);
+        assert_int_equal(r.stats.merges, 1);
+        /* max volume: the steep plane (0.5 m/m) takes the whole bottom edge */
+        assert_true(fabs(r.top - (pr ? 3.0 : 4.0)) < 1e-9);
+        ag_shell_free(sh);
+        ag_plan_free(p);
+    }
+    /* a priority tag overrides the scheme: the 45° profile is tagged higher */
+    ag_plan *p = ag_plan_create();
+    ag_plan_add_profile(p, "r45", R45, 2, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "steep", steep, 2, NULL, NULL, NULL);
+    p->profiles[0].priority = 1;
+    ag_plan_add_loop(p, xy, 5, prof, NULL);
+    ag_extrude_result r;
+    ag_shell *sh = extrude(p, &r);
+    assert_true(fabs(r.top - 3.0) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+}
+
+static void test_fixtures(void **state)
+{
+    (void)state;
+    const char *names[] = {"rectangle_hip", "l_shape", "u_shape", "cross", "hole",
+                           "hole_on_skeleton", "fig11_four_at_point", "fig12_five_at_point",
+                           "fig12_shared_ridge", "fig15_many_edges", "fig21_ambiguous_max",
+                           "fig21_ambiguous_min", "fig22_two_bays", "parallel_collinear",
+                           "nearly_parallel_different_angles", "wheel16", "gable_vertical",
+                           "overhang_outward", "polygon_1000", "overhang_soffit",
+                           "terrace_setback", "overhang_disabled_on_gables"};
+    for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
+        char path[512];
+        snprintf(path, sizeof path, AG_REPO_DIR "/tests/data/extrude/%s.json", names[i]);
+        ag_plan *p = NULL;
+        ag_error err = {0};
+        if (ag_plan_json_read_file(path, &p, &err) != AG_OK)
+            fail_msg("%s: %s", names[i], err.text);
+        json_t *doc = json_load_file(path, 0, NULL);
+        assert_non_null(doc);
+        json_t *ex = json_object_get(doc, "expect");
+        ag_extrude_result r;
+        ag_shell *sh = extrude(p, &r);
+        if (json_is_true(json_object_get(ex, "watertight")) && r.failing_faces)
+            fail_msg("%s: %zu failing faces, first: %s", names[i], r.failing_faces,
+                     r.problems[0].reason);
+        json_t *v;
+        if ((v = json_object_get(ex, "faces")) && (size_t)json_integer_value(v) != r.faces)
+            fail_msg("%s: %zu faces, expected %lld", names[i], r.faces, json_integer_value(v));
+        if ((v = json_object_get(ex, "top")) && fabs(json_number_value(v) - r.top) > 1e-6)
+            fail_msg("%s: top %.9f, expected %.9f", names[i], r.top, json_number_value(v));
+        if ((v = json_object_get(ex, "volume")) && fabs(json_number_value(v) - r.volume) > 1e-6)
+            fail_msg("%s: volume %.9f, expected %.9f", names[i], r.volume, json_number_value(v));
+        assert_true(r.volume > 0);
+        json_decref(doc);
+        ag_shell_free(sh);
+        ag_plan_free(p);
+    }
+}
+
+/* The check reports a missing face by id and reason instead of passing silently. */
+static void test_check_reports_open_faces(void **state)
+{
+    (void)state;
+    ag_shell *s = ag_shell_create();
+    uint32_t v[4], f[4];
+    const double P[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int i = 0; i < 4; i++)
+        ag_shell_add_vertex(s, P[i][0], P[i][1], P[i][2], &v[i]);
+    const int T[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
+    for (int i = 0; i < 3; i++) { /* the fourth face is left out */
+        ag_shell_face fc = {AG_SHELL_FACE_SIDE, 0, i, 0, 0, 0, 0};
+        ag_shell_add_face(s, &fc, &f[i]);
+        for (int k = 0; k < 3; k++)
+            ag_shell_add_segment(s, f[i], v[T[i][k]], v[T[i][(k + 1) % 3]]);
+    }
+    assert_int_equal(ag_shell_finish(s, 1e-9), AG_OK);
+    ag_shell_problem pr[4];
+    size_t n = ag_shell_check(s, pr, 4);
+    assert_int_equal(n, 3); /* each face borders the hole */
+    assert_non_null(strstr(pr[0].reason, "no opposite edge"));
+    /* with the fourth face it closes */
+    ag_shell_free(s);
+    s = ag_shell_create();
+    for (int i = 0; i < 4; i++)
+        ag_shell_add_vertex(s, P[i][0], P[i][1], P[i][2], &v[i]);
+    for (int i = 0; i < 4; i++) {
+        ag_shell_face fc = {AG_SHELL_FACE_SIDE, 0, i, 0, 0, 0, 0};
+        ag_shell_add_face(s, &fc, &f[i]);
+        for (int k = 0; k < 3; k++)
+            ag_shell_add_segment(s, f[i], v[T[i][k]], v[T[i][(k + 1) % 3]]);
+    }
+    assert_int_equal(ag_shell_finish(s, 1e-9), AG_OK);
+    assert_int_equal(ag_shell_check(s, pr, 4), 0);
+    assert_true(fabs(ag_shell_volume(s) - 1.0 / 6) < 1e-12);
+    ag_shell_free(s);
+}
+
+static void test_anchors(void **state)
+{
+    (void)state;
+    const double xy[] = {0, 0, 10, 0, 10, 6, 0, 6};
+    const ag_profile_point hip[] = {{0, 0}, {0, 3}, {1, 4}};
+    ag_plan *p = plan_with(hip, 3, xy, 4);
+    ag_anchor a[5];
+    memset(a, 0, sizeof a);
+    const struct {
+        int32_t edge;
+        int absolute;
+        double along, z;
+    } spec[5] = {
+        {0, 0, 0.5, 1}, /* wall, relative */
+        {0, 0, 0.5, 4}, /* roof: the edge spans x 1..9 at z 4 */
+        {0, 1, 2.0, 4}, /* absolute, 2 m from the corner */
+        {0, 1, 0.5, 4}, /* falls off the shrunken edge */
+        {1, 0, 0.5, 7}, /* above the ridge */
+    };
+    for (int i = 0; i < 5; i++) {
+        a[i].edge = spec[i].edge;
+        a[i].absolute = spec[i].absolute;
+        a[i].along = spec[i].along;
+        a[i].z = spec[i].z;
+    }
+    for (int i = 0; i < 5; i++)
+        assert_int_equal(ag_plan_add_anchor(p, &a[i], NULL), AG_OK);
+    ag_extrude_result r;
+    ag_shell *sh = extrude(p, &r);
+    const ag_anchor *h = p->anchors;
+    assert_true(h[0].found);
+    assert_true(fabs(h[0].pos[0] - 5) < 1e-9 && fabs(h[0].pos[1]) < 1e-9 && fabs(h[0].pos[2] - 1) < 1e-9);
+    assert_true(fabs(h[0].normal[1] + 1) < 1e-9);
+    assert_true(h[1].found);
+    assert_true(fabs(h[1].pos[0] - 5) < 1e-9 && fabs(h[1].pos[1] - 1) < 1e-9 && fabs(h[1].pos[2] - 4) < 1e-9);
+    assert_true(fabs(h[1].normal[1] + sqrt(0.5)) < 1e-9 && fabs(h[1].normal[2] - sqrt(0.5)) < 1e-9);
+    assert_int_equal(sh->faces[h[1].face].edge, 0);
+    assert_int_equal(sh->faces[h[1].face].segment, 1);
+    assert_true(h[2].found && fabs(h[2].pos[0] - 2) < 1e-9 && fabs(h[2].pos[1] - 1) < 1e-9);
+    assert_false(h[3].found);
+    assert_false(h[4].found);
+    assert_true(fabs(r.top - 6) < 1e-9); /* an anchor above the roof does not raise it */
+    ag_shell_free(sh);
+    ag_plan_free(p);
+}
+
+/* Area of the horizontal faces at height z made by plan edits (loop -1), signed by
+ * facing: up positive. */
+static double edit_floor_area(const ag_shell *sh, double z)
+{
+    double area = 0;
+    for (size_t f = 0; f < sh->nfaces; f++) {
+        const ag_shell_face *fc = &sh->faces[f];
+        if (fc->loop != -1)
+            continue;
+        for (uint32_t l = fc->first_loop; l < fc->first_loop + (fc->nloops & 0x7fffffffu); l++) {
+            double a = 0;
+            int flat = 1;
+            uint32_t b0 = sh->loop_start[l], b1 = sh->loop_start[l + 1];
+            for (uint32_t k = b0; k < b1; k++) {
+                const double *p = &sh->pos[3 * sh->idx[k]];
+                const double *q = &sh->pos[3 * sh->idx[k + 1 < b1 ? k + 1 : b0]];
+                a += p[0] * q[1] - q[0] * p[1];
+                if (fabs(p[2] - z) > 1e-9)
+                    flat = 0;
+            }
+            if (flat)
+                area += a / 2;
+        }
+    }
+    return area;
+}
+
+static void test_natural_steps(void **state)
+{
+    (void)state;
+    const double xy[] = {0, 0, 10, 0, 10, 6, 0, 6};
+    const ag_profile_point hip[] = {{0, 0}, {0, 3}, {1, 4}};
+    const ag_profile_point dormer[] = {{0, 0}, {0, 1.2}, {1, 2.2}};
+    for (int recess = 0; recess < 2; recess++) {
+        ag_plan *p = plan_with(hip, 3, xy, 4);
+        size_t dp = 0;
+        assert_int_equal(ag_plan_add_profile(p, "dormer", dormer, 3, NULL, &dp, NULL), AG_OK);
+        ag_plan_step st;
+        memset(&st, 0, sizeof st);
+        st.at.edge = 0;
+        st.at.along = 0.5;
+        st.at.z = 3.5;
+        st.width = 2;
+        st.depth = recess ? -0.8 : 1.2;
+        st.profile = (int32_t)dp;
+        assert_int_equal(ag_plan_add_step(p, &st, NULL), AG_OK);
+        ag_extrude_result r;
+        ag_shell *sh = extrude(p, &r);
+        if (r.failing_faces)
+            fail_msg("%s: %s", recess ? "recess" : "dormer", r.problems[0].reason);
+        assert_int_equal(r.stats.steps, 1);
+        /* the step's floor: width x depth at its height, facing down for a protrusion
+         * and up for a recess */
+        double a = edit_floor_area(sh, 3.5);
+        assert_true(fabs(a - (recess ? 2 * 0.8 : -2 * 1.2)) < 1e-6);
+        /* without the step: 252 m³; the dormer adds at least the part of its box that
+         * stands in front of the roof plane */
+        if (!recess)
+            assert_true(r.volume > 252 + 2 * 1.2 * 1.2 * 0.5);
+        ag_shell_free(sh);
+        ag_plan_free(p);
+    }
+    /* an anchor above the roof: the step is not made, and said so */
+    ag_plan *p = plan_with(hip, 3, xy, 4);
+    size_t dp = 0;
+    ag_plan_add_profile(p, "dormer", dormer, 3, NULL, &dp, NULL);
+    ag_plan_step st;
+    memset(&st, 0, sizeof st);
+    st.at.edge = 1;
+    st.at.along = 0.5;
+    st.at.z = 9;
+    st.width = 1;
+    st.depth = 1;
+    st.profile = (int32_t)dp;
+    ag_plan_add_step(p, &st, NULL);
+    ag_extrude_result r;
+    ag_shell *sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.stats.steps, 0);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rectangle_closed_form),
+        cmocka_unit_test(test_convex_brute_force),
+        cmocka_unit_test(test_nonconvex_planes),
+        cmocka_unit_test(test_profiles),
+        cmocka_unit_test(test_priority),
+        cmocka_unit_test(test_fixtures),
+        cmocka_unit_test(test_check_reports_open_faces),
+        cmocka_unit_test(test_anchors),
+        cmocka_unit_test(test_natural_steps),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
