@@ -147,12 +147,6 @@ static int cmp_key(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-static int cmp_u32(const void *a, const void *b)
-{
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return x < y ? -1 : x > y;
-}
-
 ag_status ag_shell_finish(ag_shell *s, double weld_tol)
 {
     uint32_t *map = malloc((s->nverts ? s->nverts : 1) * sizeof *map);
@@ -332,7 +326,6 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
     }
     free(hk);
 out:
-    (void)cmp_u32;
     free(ord);
     free(dead);
     free(keys);
@@ -469,8 +462,7 @@ static int seg_cross(const tri_pt *a, const tri_pt *b, const tri_pt *c, const tr
     return ag_pred_segments_touch(p1, p2, p3, p4, 0.0);
 }
 
-/* Ear clipping of one simple polygon (CCW). Emits triangles through the callback
- * arrays. Falls back to clipping the most convex corner when no clean ear is found,
+/* Ear clipping of one simple polygon (CCW) into m. Falls back to clipping the most convex corner when no clean ear is found,
  * so it always terminates. */
 static ag_status ear_clip(tri_pt *p, size_t n, ag_mesh *m, uint32_t base, uint32_t comp,
                           size_t *ntris)
@@ -559,10 +551,8 @@ static ag_status ear_clip(tri_pt *p, size_t n, ag_mesh *m, uint32_t base, uint32
 
 /* Appends hole h into polygon *poly (size *n) through a bridge to a visible corner. */
 static ag_status bridge_hole(tri_pt **poly, size_t *n, const tri_pt *h, size_t hn,
-                             const tri_pt *all, const size_t *all_n, size_t nall_loops,
-                             const tri_pt *const *loops)
+                             const size_t *all_n, size_t nall_loops, const tri_pt *const *loops)
 {
-    (void)all;
     size_t mi = 0;
     for (size_t i = 1; i < hn; i++)
         if (h[i].x > h[mi].x)
@@ -742,7 +732,7 @@ static ag_status triangulate_face(const ag_shell *s, size_t f, ag_mesh *m, uint3
         qsort(hx, nh, 2 * sizeof(double), cmp_hole_x);
         for (size_t h = 0; h < nh && st == AG_OK; h++) {
             uint32_t j = (uint32_t)hx[2 * h + 1];
-            st = bridge_hole(&poly, &n, loops[j], ln[j], NULL, ln, nl, (const tri_pt *const *)loops);
+            st = bridge_hole(&poly, &n, loops[j], ln[j], ln, nl, (const tri_pt *const *)loops);
         }
         free(hx);
         if (st == AG_OK)

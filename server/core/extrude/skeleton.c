@@ -305,7 +305,7 @@ static void merge(sk *S, uint32_t k)
     int32_t pin = S->plan->profiles[S->e[ein].profile].priority;
     int32_t pout = S->plan->profiles[S->e[eout].profile].priority;
     int in_wins = pin != pout ? pin > pout : min_vol ? sin_ > sout : sin_ < sout;
-    double z = c->z, l_x = c->x, l_y = c->y;
+    double z = c->z;
     uint32_t vl = c->vert;
     S->stats.merges++;
     c->alive = 0; /* made and retired at the same point: no arc */
@@ -344,8 +344,6 @@ static void merge(sk *S, uint32_t k)
         if (k2 != NONE)
             settle(S, k2);
     }
-    (void)l_x;
-    (void)l_y;
 }
 
 static void zip(sk *S, uint32_t k)
