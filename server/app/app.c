@@ -11,8 +11,10 @@
 
 #include "../store/jobs.h"
 #include "demo.h"
+#include "extrude_job.h"
 #include "import_job.h"
 #include "jobqueue.h"
+#include "proceduralize_job.h"
 
 struct ag_app {
     char *db_path;
@@ -159,6 +161,8 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "cannot start the worker threads");
     }
     ag_jobqueue_register(app->jobs, &ag_import_job_kind);
+    ag_jobqueue_register(app->jobs, &ag_extrude_job_kind);
+    ag_jobqueue_register(app->jobs, &ag_proceduralize_job_kind);
     *out = app;
     return AG_OK;
 }

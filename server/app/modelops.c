@@ -5,6 +5,7 @@
 
 #include "../store/models.h"
 #include "../store/ops.h"
+#include "plan_edit.h"
 
 #define AG_NOTE_MAX 4000
 
@@ -56,6 +57,16 @@ ag_status ag_modelops_validate(const json_t *op, ag_error *err)
                                 AG_NOTE_MAX);
         return only_members(op, allowed, err);
     }
+    if (ag_plan_edit_handles(kind))
+        return ag_plan_edit_validate(op, err);
+    if (strcmp(kind, "proceduralize") == 0)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "\"proceduralize\" ops are made by the server: POST "
+                            "/api/v1/models/{id}/proceduralize");
+    if (strcmp(kind, "grammar") == 0)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "\"grammar\" ops are made by the server: PUT "
+                            "/api/v1/models/{id}/grammar");
     return ag_error_set(err, AG_ERR_INVALID, 0, "unknown op kind \"%s\"", kind);
 }
 
@@ -78,6 +89,8 @@ static ag_status apply_effect(ag_db *db, int64_t model, const json_t *op, ag_err
     const char *kind = json_string_value(json_object_get(op, "kind"));
     if (strcmp(kind, "rename") == 0)
         return ag_models_set_name(db, model, json_string_value(json_object_get(op, "name")), err);
+    if (ag_plan_edit_handles(kind))
+        return ag_plan_edit_apply(db, model, op, err); /* re-extrudes what the op touches */
     return AG_OK; /* a note only lives in the log */
 }
 
@@ -156,5 +169,68 @@ ag_status ag_modelops_delete(ag_app *app, int64_t model, int64_t version, ag_err
         ag_events_publish(ag_app_events(app), &ev);
     }
     ag__app_unlock_ops(app);
+    return s;
+}
+
+ag_status ag_modelops_server_begin(ag_app *app, int64_t model, int64_t base, ag_modelops_txn *t,
+                                   ag_error *err)
+{
+    memset(t, 0, sizeof *t);
+    ag_db *db = ag_app_db(app, err);
+    if (!db)
+        return err ? err->code : AG_ERR_DB;
+    ag__app_lock_ops(app);
+    ag_status s = ag_db_begin(db, err);
+    if (s == AG_OK && (s = ag_models_bump_version(db, model, base, &t->version, err)) != AG_OK)
+        ag_db_rollback(db);
+    if (s != AG_OK) {
+        ag__app_unlock_ops(app);
+        return s;
+    }
+    t->app = app;
+    t->db = db;
+    t->model = model;
+    return AG_OK;
+}
+
+void ag_modelops_server_abort(ag_modelops_txn *t)
+{
+    if (!t->app)
+        return;
+    ag_db_rollback(t->db);
+    ag__app_unlock_ops(t->app);
+    t->app = NULL;
+}
+
+ag_status ag_modelops_server_commit(ag_modelops_txn *t, const char *author, const char *cid,
+                                   const json_t *op, ag_error *err)
+{
+    if (!t->app)
+        return ag_error_set(err, AG_ERR_INTERNAL, 0, "no server op under way");
+    char *body = json_dumps(op, JSON_COMPACT | JSON_SORT_KEYS);
+    ag_status s = body ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    const char *kind = json_string_value(json_object_get(op, "kind"));
+    if (s == AG_OK) {
+        ag_op_row row = {.model = t->model,
+                         .version = t->version,
+                         .author = author,
+                         .cid = cid,
+                         .kind = kind ? kind : "",
+                         .body_json = body};
+        s = ag_ops_insert(t->db, &row, err);
+    }
+    s = s == AG_OK ? ag_db_commit(t->db, err) : (ag_db_rollback(t->db), s);
+    if (s == AG_OK) {
+        ag_event ev = {.kind = AG_EVENT_OP,
+                       .model = t->model,
+                       .version = t->version,
+                       .author = author,
+                       .cid = cid,
+                       .json = body};
+        ag_events_publish(ag_app_events(t->app), &ev);
+    }
+    ag__app_unlock_ops(t->app);
+    t->app = NULL;
+    free(body);
     return s;
 }

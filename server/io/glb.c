@@ -43,16 +43,31 @@ static json_t *vec3(const double *v)
     return json_pack("[f,f,f]", v[0], v[1], v[2]);
 }
 
-static json_t *extras(size_t c, const ag_mesh *m)
+static json_t *extras(size_t c, const ag_mesh *m, const ag_glb_component_meta *meta,
+                      size_t nmeta)
 {
     int32_t g = m->component_group[c];
     json_t *name = g >= 0 && (size_t)g < m->ngroups ? json_string(m->group_names[g]) : json_null();
     if (!name) /* a group name that is not UTF-8 */
         name = json_null();
-    return json_pack("{s:I,s:o}", "component", (json_int_t)c, "group", name);
+    json_t *e = json_pack("{s:I,s:o}", "component", (json_int_t)c, "group", name);
+    if (e && meta && c < nmeta) {
+        json_t *label = meta[c].label ? json_string(meta[c].label) : NULL;
+        if (label)
+            json_object_set_new(e, "label", label);
+        if (meta[c].node >= 0)
+            json_object_set_new(e, "node", json_integer((json_int_t)meta[c].node));
+    }
+    return e;
 }
 
 ag_status ag_glb_write(const ag_mesh *m, uint8_t **out, size_t *len, ag_error *err)
+{
+    return ag_glb_write_meta(m, NULL, 0, out, len, err);
+}
+
+ag_status ag_glb_write_meta(const ag_mesh *m, const ag_glb_component_meta *meta, size_t nmeta,
+                            uint8_t **out, size_t *len, ag_error *err)
 {
     *out = NULL;
     *len = 0;
@@ -190,11 +205,11 @@ ag_status ag_glb_write(const ag_mesh *m, uint8_t **out, size_t *len, ag_error *e
             meshes, json_pack("{s:s,s:[{s:{s:I,s:I},s:i,s:i}],s:o}", "name", name, "primitives",
                               "attributes", "POSITION", (json_int_t)acc, "NORMAL",
                               (json_int_t)(acc + 1), "material", 0, "mode", MODE_TRIANGLES,
-                              "extras", extras(c, m)));
+                              "extras", extras(c, m, meta, nmeta)));
         json_array_append_new(scene_nodes, json_integer((json_int_t)json_array_size(nodes)));
         json_array_append_new(nodes, json_pack("{s:s,s:I,s:o,s:o}", "name", name, "mesh",
                                                (json_int_t)mesh, "translation", vec3(centre),
-                                               "extras", extras(c, m)));
+                                               "extras", extras(c, m, meta, nmeta)));
         off = nrm_off + nvert * 12;
     }
     json_t *scene = json_object();

@@ -20,6 +20,17 @@
 
 /* *out is malloc'd; the caller frees it. */
 ag_status ag_glb_write(const ag_mesh *m, uint8_t **out, size_t *len, ag_error *err);
+/* Per-component additions to the extras, e.g. from a split tree: "label" when label is not
+ * NULL, "node" when node >= 0. */
+typedef struct {
+    const char *label;
+    int64_t node;
+} ag_glb_component_meta;
+
+/* Like ag_glb_write, with meta[c] added to component c's extras for c < nmeta (meta may be
+ * NULL). */
+ag_status ag_glb_write_meta(const ag_mesh *m, const ag_glb_component_meta *meta, size_t nmeta,
+                            uint8_t **out, size_t *len, ag_error *err);
 ag_status ag_glb_write_file(const ag_mesh *m, const char *path, ag_error *err);
 
 #endif

@@ -84,8 +84,11 @@ enum MHD_Result ag_api_models_list(ag_request *r)
         return ag_reply_problem(r, s, &err);
     json_t *items = json_array();
     size_t shown = n > (size_t)size ? (size_t)size : n;
-    for (size_t i = 0; i < shown; i++)
-        json_array_append_new(items, ag_view_model(&rows[i]));
+    for (size_t i = 0; i < shown; i++) {
+        json_t *m = ag_view_model(&rows[i]);
+        ag_api_grammar_decorate_model(db, m, &rows[i]);
+        json_array_append_new(items, m);
+    }
     json_t *next = json_null();
     if (n > (size_t)size) {
         char buf[32];
@@ -181,6 +184,7 @@ static enum MHD_Result reply_model(ag_request *r, ag_db *db, int64_t id, unsigne
     char etag[32];
     version_etag(etag, sizeof etag, row.version);
     json_t *body = ag_view_model(&row);
+    ag_api_grammar_decorate_model(db, body, &row);
     ag_models_row_clear(&row);
     return ag_reply_json(r, status, body, etag);
 }

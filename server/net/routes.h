@@ -5,6 +5,7 @@
 
 #include <stddef.h>
 
+#include "../store/models.h"
 #include "request.h"
 
 typedef enum {
@@ -41,7 +42,17 @@ enum MHD_Result ag_api_model_delete(ag_request *r);
 enum MHD_Result ag_api_model_mesh(ag_request *r);
 enum MHD_Result ag_api_model_ops_list(ag_request *r);
 enum MHD_Result ag_api_model_ops_create(ag_request *r);
+enum MHD_Result ag_api_model_mesh_glb(ag_request *r);
+enum MHD_Result ag_api_model_proceduralize(ag_request *r);
+enum MHD_Result ag_api_model_tree(ag_request *r);
+enum MHD_Result ag_api_model_grammar_get(ag_request *r);
+enum MHD_Result ag_api_model_grammar_put(ag_request *r);
+enum MHD_Result ag_api_extrusions_create(ag_request *r);
+enum MHD_Result ag_api_model_plan(ag_request *r);
 enum MHD_Result ag_api_job_get(ag_request *r);
 enum MHD_Result ag_api_job_cancel(ag_request *r);
+
+/* Adds "proceduralized" (a grammar describes the model's current mesh) to a model's JSON. */
+void ag_api_grammar_decorate_model(ag_db *db, json_t *model, const ag_model_row *row);
 
 #endif

@@ -71,3 +71,68 @@ export async function readCanvas(page) {
     outside,
   };
 }
+
+// How many pixels of a view pass test([r, g, b]).
+export function countWhere(view, test) {
+  let n = 0;
+  for (let y = 0; y < view.height; y++) for (let x = 0; x < view.width; x++) if (test(view.pixel({ x, y }))) n++;
+  return n;
+}
+
+// How many pixels differ by more than `margin` in some channel between two views of one size.
+export function countChanged(a, b, margin = 40) {
+  let n = 0;
+  for (let y = 0; y < a.height; y++) {
+    for (let x = 0; x < a.width; x++) {
+      const p = a.pixel({ x, y });
+      const q = b.pixel({ x, y });
+      if (Math.max(Math.abs(p[0] - q[0]), Math.abs(p[1] - q[1]), Math.abs(p[2] - q[2])) > margin) n++;
+    }
+  }
+  return n;
+}
+
+// A spot whose pixels within r all pass test, nearest to the middle of all passing pixels.
+export function spotWhere(view, test, r = 3) {
+  let n = 0;
+  let cx = 0;
+  let cy = 0;
+  for (let y = 0; y < view.height; y++) {
+    for (let x = 0; x < view.width; x++) {
+      if (test(view.pixel({ x, y }))) {
+        n++;
+        cx += x;
+        cy += y;
+      }
+    }
+  }
+  if (!n) return null;
+  cx /= n;
+  cy /= n;
+  let best = null;
+  for (let y = r; y < view.height - r; y++) {
+    for (let x = r; x < view.width - r; x++) {
+      if (!test(view.pixel({ x, y }))) continue;
+      let all = true;
+      for (let dy = -r; dy <= r && all; dy++) for (let dx = -r; dx <= r && all; dx++) all = test(view.pixel({ x: x + dx, y: y + dy }));
+      if (!all) continue;
+      const d = (x - cx) ** 2 + (y - cy) ** 2;
+      if (!best || d < best.d) best = { x, y, d };
+    }
+  }
+  return best && { x: best.x, y: best.y };
+}
+
+// Hue in degrees and saturation of an [r, g, b] colour.
+export function hueOf([r, g, b]) {
+  const max = Math.max(r, g, b);
+  const min = Math.min(r, g, b);
+  const d = max - min;
+  const s = max ? d / max : 0;
+  if (!d) return { h: 0, s };
+  let h;
+  if (max === r) h = ((g - b) / d) % 6;
+  else if (max === g) h = (b - r) / d + 2;
+  else h = (r - g) / d + 4;
+  return { h: (h * 60 + 360) % 360, s };
+}

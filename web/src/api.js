@@ -116,6 +116,33 @@ export class Api {
     return this.request('POST', `/models/${id}/ops`, { body: { cid, op }, headers: { 'If-Match': `"${version}"` } });
   }
 
+  // --- proceduralization ----------------------------------------------------------------------
+  // Starts the job against the version the person sees (412 if the model moved on).
+  proceduralize(id, version) {
+    const headers = version != null ? { 'If-Match': `"${version}"` } : {};
+    return this.request('POST', `/models/${id}/proceduralize`, { body: {}, headers });
+  }
+
+  getTree(id) {
+    return this.request('GET', `/models/${id}/tree`);
+  }
+
+  // The grammar text and the model version it belongs to (its ETag).
+  async getGrammar(id) {
+    const res = await this.request('GET', `/models/${id}/grammar`, { raw: true, headers: { Accept: 'text/plain' } });
+    const text = await res.text();
+    const version = Number(/\d+/.exec(res.headers.get('ETag') || '')?.[0] ?? NaN);
+    return { text, version: Number.isFinite(version) ? version : null };
+  }
+
+  // Replaces the grammar; resolves with the model JSON of the new version.
+  putGrammar(id, version, text) {
+    return this.request('PUT', `/models/${id}/grammar`, {
+      body: new Blob([text], { type: 'text/plain; charset=utf-8' }),
+      headers: { 'If-Match': `"${version}"` },
+    });
+  }
+
   // Uploads a file as the raw request body; XMLHttpRequest because fetch reports no upload
   // progress. Resolves with the job object of the 202 answer.
   uploadModel(file, { name, format, up } = {}, onProgress = () => {}) {

@@ -33,6 +33,10 @@ export class Editor {
       peersChanged: new Signal(),
       historyChanged: new Signal(),
       jobChanged: new Signal(),        // job (or null when the panel should clear)
+      meshChanged: new Signal(),       // model: its mesh was replaced (proceduralize, grammar edit)
+      treeChanged: new Signal(),       // split tree (SplitTree or null)
+      grammarChanged: new Signal(),    // grammar {text, version} (or null)
+      procJobChanged: new Signal(),    // proceduralize job of the open model (or null)
       connectionChanged: new Signal(), // 'offline' | 'connecting' | 'online' | 'lost'
       userChanged: new Signal(),
       cameraChanged: new Signal(),     // {position, target} from the viewport
@@ -44,7 +48,10 @@ export class Editor {
     this.nextPageToken = null;
 
     this.model = null;      // the open model object, name/version kept current by ops
-    this.selection = null;  // {component, group} or null
+    this.selection = null;  // {component, group, node?, components?} or null
+    this.tree = null;       // SplitTree of the open model once proceduralized
+    this.grammar = null;    // {text, version} of the open model once proceduralized
+    this.procJob = null;
     this.peers = new Map(); // peer id -> {peer, user, state}
     this.ops = new Map();   // version -> op entry of the open model
     this.job = null;
@@ -69,9 +76,15 @@ export class Editor {
   openModel(model) {
     this.model = model ? { ...model } : null;
     this.selection = null;
+    this.tree = null;
+    this.grammar = null;
+    this.procJob = null;
     this.peers.clear();
     this.ops.clear();
     this.signals.modelOpened.dispatch(this.model);
+    this.signals.treeChanged.dispatch(null);
+    this.signals.grammarChanged.dispatch(null);
+    this.signals.procJobChanged.dispatch(null);
     this.signals.selectionChanged.dispatch(null);
     this.signals.peersChanged.dispatch(this.peers);
     this.signals.historyChanged.dispatch(this.history());
@@ -106,12 +119,27 @@ export class Editor {
     this.model.version = entry.version;
     const op = entry.op || {};
     if (op.kind === 'rename' && typeof op.name === 'string') this.model.name = op.name;
+    const remeshed = MESH_OPS.has(op.kind);
+    if (remeshed) this.model.proceduralized = true;
     const listed = this.models.find((m) => m.id === this.model.id);
     if (listed) {
       listed.name = this.model.name;
       listed.version = entry.version;
+      if (remeshed) listed.proceduralized = true;
       this.signals.modelsChanged.dispatch(this.models);
     }
+    this.signals.modelChanged.dispatch(this.model);
+    if (remeshed) {
+      // Component numbers refer to the old mesh: drop the pick before the views reload.
+      this.select(null);
+      this.signals.meshChanged.dispatch(this.model);
+    }
+  }
+
+  // Fresh figures of the open model (e.g. re-read after its mesh changed).
+  updateModel(model) {
+    if (!this.model || model.id !== this.model.id || model.version < this.model.version) return;
+    this.model = { ...this.model, stats: model.stats, proceduralized: model.proceduralized };
     this.signals.modelChanged.dispatch(this.model);
   }
 
@@ -128,10 +156,40 @@ export class Editor {
   }
 
   // --- selection, camera --------------------------------------------------------------------
+  // A picked component also selects its split-tree node once the model has a tree.
   select(selection) {
-    const same = (this.selection?.component ?? null) === (selection?.component ?? null);
-    this.selection = selection;
-    if (!same) this.signals.selectionChanged.dispatch(selection);
+    let sel = selection;
+    if (sel && sel.node == null && this.tree && typeof sel.component === 'number') {
+      const node = this.tree.nodeOfComponent(sel.component);
+      if (node !== null) sel = { ...sel, node };
+    }
+    const same = selectionKey(this.selection) === selectionKey(sel);
+    this.selection = sel;
+    if (!same) this.signals.selectionChanged.dispatch(sel);
+  }
+
+  // Selects a split-tree node: all components of its visible descendants light up.
+  selectNode(id) {
+    const n = this.tree?.node(id);
+    if (!n) {
+      this.select(null);
+      return;
+    }
+    const components = this.tree.componentsUnder(id);
+    this.select({
+      node: id,
+      component: typeof n.component === 'number' ? n.component : null,
+      group: n.label ?? null,
+      components,
+    });
+  }
+
+  // The components a selection covers.
+  selectedComponents() {
+    const sel = this.selection;
+    if (!sel) return [];
+    if (Array.isArray(sel.components)) return sel.components;
+    return typeof sel.component === 'number' ? [sel.component] : [];
   }
 
   setCamera(camera) {
@@ -174,6 +232,29 @@ export class Editor {
     this.signals.jobChanged.dispatch(job);
   }
 
+  setProcJob(job) {
+    this.procJob = job;
+    this.signals.procJobChanged.dispatch(job);
+  }
+
+  // --- proceduralization --------------------------------------------------------------------
+  setTree(tree) {
+    this.tree = tree;
+    this.signals.treeChanged.dispatch(tree);
+    // The pick's node belongs to the previous tree: keep a picked component, drop a node pick.
+    const sel = this.selection;
+    if (sel) {
+      this.selection = null;
+      if (typeof sel.component === 'number' && !sel.components) this.select({ component: sel.component, group: sel.group });
+      else this.signals.selectionChanged.dispatch(null);
+    }
+  }
+
+  setGrammar(grammar) {
+    this.grammar = grammar;
+    this.signals.grammarChanged.dispatch(grammar);
+  }
+
   setConnection(state) {
     if (state === this.connection) return;
     this.connection = state;
@@ -190,6 +271,14 @@ export class Editor {
   notify(text) {
     this.signals.notice.dispatch(text);
   }
+}
+
+// Ops after which the model's mesh, tree and grammar must be read again.
+const MESH_OPS = new Set(['proceduralize', 'grammar']);
+
+function selectionKey(sel) {
+  if (!sel) return '';
+  return `${sel.component ?? ''}|${sel.node ?? ''}|${Array.isArray(sel.components) ? sel.components.join(',') : ''}`;
 }
 
 function mergeById(list, items) {

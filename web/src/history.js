@@ -9,9 +9,18 @@ function summary(op) {
       return `→ “${op.name}”`;
     case 'note':
       return op.text.length > 80 ? `${op.text.slice(0, 79)}…` : op.text;
+    case 'proceduralize':
+      return `${count(op.rules, 'rule')} · ${count(op.terminals, 'terminal')} · ${count(op.patterns, 'pattern')}`;
+    case 'grammar':
+      return typeof op.bytes === 'number' ? `grammar edited (${count(op.bytes, 'byte')})` : 'grammar edited';
     default:
       return '';
   }
+}
+
+function count(n, what) {
+  if (typeof n !== 'number') return `? ${what}s`;
+  return `${n.toLocaleString()} ${what}${n === 1 ? '' : 's'}`;
 }
 
 export class HistoryPanel {

@@ -9,6 +9,8 @@ export class Inspector {
     container.append(el('h2', {}, 'Inspector'), this.picked, this.stats);
     editor.signals.selectionChanged.add(() => this.renderPick());
     editor.signals.modelOpened.add(() => this.render());
+    editor.signals.modelChanged.add(() => this.render());
+    editor.signals.treeChanged.add(() => this.renderPick());
     this.render();
   }
 
@@ -42,8 +44,16 @@ export class Inspector {
     } else if (!sel) {
       this.picked.textContent = 'Click the model to pick a component';
       this.picked.classList.add('none');
+    } else if (Array.isArray(sel.components)) {
+      // a split-tree node: its visible descendants
+      const n = this.editor.tree?.node(sel.node);
+      const what = n ? [n.kind, n.rule].filter(Boolean).join(' ') : 'node';
+      const k = sel.components.length;
+      this.picked.textContent = `node ${sel.node} · ${what} · ${k} component${k === 1 ? '' : 's'}`;
+      this.picked.classList.remove('none');
     } else {
-      this.picked.textContent = `component ${sel.component} · group ${sel.group ?? '—'}`;
+      const node = sel.node != null ? ` · node ${sel.node}` : '';
+      this.picked.textContent = `component ${sel.component} · group ${sel.group ?? '—'}${node}`;
       this.picked.classList.remove('none');
     }
   }

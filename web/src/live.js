@@ -3,6 +3,7 @@
 // resumes the room with hello {since} so no op is missed.
 
 const PRESENCE_INTERVAL_MS = 100; // at most 10 presence messages a second
+const PRESENCE_MAX_SELECTION = 1000; // keeps a presence state well under the server's 16 KiB
 const BACKOFF_MS = [500, 1000, 2000, 4000, 8000, 15000];
 
 let cidCounter = 0;
@@ -182,7 +183,7 @@ export class Live {
         type: 'presence',
         state: {
           name: ed.user,
-          selection: ed.selection ? [ed.selection.component] : [],
+          selection: ed.selectedComponents().slice(0, PRESENCE_MAX_SELECTION),
           camera: ed.camera,
         },
       });

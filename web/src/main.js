@@ -11,12 +11,17 @@ import { Inspector } from './inspector.js';
 import { PeersPanel } from './peers.js';
 import { HistoryPanel } from './history.js';
 import { Toast } from './toast.js';
+import { Procedural } from './procedural.js';
+import { SplitTreePanel } from './treepanel.js';
+import { GrammarPanel } from './grammarpanel.js';
+import { collapsible } from './collapse.js';
 
 const editor = new Editor();
 const api = new Api(() => editor.user);
 const live = new Live(editor, api);
 const session = new Session(editor, api, live);
 const upload = new Upload(editor, api, live, session);
+const procedural = new Procedural(editor, api, live);
 
 const $ = (id) => document.getElementById(id);
 new Toast(editor, $('toasts'));
@@ -26,6 +31,9 @@ new Viewport(editor, api, $('viewport'));
 new Inspector(editor, $('inspector'));
 new PeersPanel(editor, $('peers'));
 new HistoryPanel(editor, session, $('history'));
+new SplitTreePanel(editor, procedural, $('tree'));
+new GrammarPanel(editor, procedural, $('grammar'));
+collapsible(document.querySelectorAll('section[id]'));
 
 window.addEventListener('unhandledrejection', (e) => {
   editor.fail(e.reason);

@@ -34,7 +34,9 @@ export class PeersPanel {
       ...peers.map((p) => {
         const name = p.state?.name || p.user || p.peer;
         const sel = p.state?.selection;
-        const what = Array.isArray(sel) && sel.length ? `component ${sel.join(', ')}` : 'no selection';
+        const what = !Array.isArray(sel) || !sel.length
+          ? 'no selection'
+          : sel.length <= 3 ? `component ${sel.join(', ')}` : `${sel.length} components`;
         return el(
           'li.peer',
           { dataset: { peer: p.peer } },

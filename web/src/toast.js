@@ -28,10 +28,22 @@ export class Toast {
     this.count += 1;
     let where = p.line ? ` (line ${p.line})` : p.element !== undefined && p.element !== null ? ` (element ${p.element})` : '';
     if (p.detail && where && p.detail.includes(where.slice(2, -1))) where = ''; // already said
+    // A problem may offer one way out (e.g. reload what someone else changed).
+    const action = p.action && typeof p.action.run === 'function'
+      ? el('button.toast-action', {
+        type: 'button',
+        'data-testid': 'error-action',
+        onclick: () => {
+          this.banner.hidden = true;
+          p.action.run();
+        },
+      }, p.action.label || 'Retry')
+      : '';
     this.text.replaceChildren(
       el('strong', {}, p.title || 'Error'),
       p.status ? el('span.status', {}, ` ${p.status}`) : '',
       p.detail ? el('div.detail', {}, `${p.detail}${where}`) : where ? el('div.detail', {}, where) : '',
+      action,
     );
     this.problemType = p.type;
     this.banner.title = p.type || '';

@@ -1,5 +1,6 @@
 // The 3D view: loads a model's GLB, frames it, renders on demand and turns clicks into
 // component selections. It only reacts to editor signals and reports picks/camera moves back.
+// Once the model is proceduralized its components are coloured by label (the tree's colours).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
@@ -74,7 +75,9 @@ export class Viewport {
 
     const s = editor.signals;
     s.modelOpened.add((model) => this.load(model));
-    s.selectionChanged.add((sel) => this.highlight(sel));
+    s.meshChanged.add((model) => this.load(model, { keepCamera: true }));
+    s.treeChanged.add(() => this.colourize());
+    s.selectionChanged.add(() => this.highlight());
   }
 
   requestRender() {
@@ -100,23 +103,29 @@ export class Viewport {
   }
 
   // --- loading ------------------------------------------------------------------------------
-  async load(model) {
+  // keepCamera: the same model with a new mesh (it stays where the person was looking).
+  async load(model, { keepCamera = false } = {}) {
     const token = ++this.loadToken;
+    const reframe = !(keepCamera && this.root);
     delete this.container.dataset.model;
-    this.clear();
+    delete this.container.dataset.version;
+    if (reframe) this.clear();
     if (!model) {
       this.setStatus('Open or import a model');
       return;
     }
-    this.setStatus('Loading mesh…');
+    const version = model.version;
+    if (reframe) this.setStatus('Loading mesh…');
     try {
       const buffer = await this.api.meshBuffer(model);
       if (token !== this.loadToken) return;
       const gltf = await new GLTFLoader().parseAsync(buffer, '');
       if (token !== this.loadToken) return;
-      this.show(gltf.scene);
+      this.clear();
+      this.show(gltf.scene, reframe);
       this.setStatus('');
       this.container.dataset.model = String(model.id); // which model is on screen
+      this.container.dataset.version = String(version); // and which version of its mesh
     } catch (err) {
       if (token !== this.loadToken) return;
       this.setStatus('The mesh could not be shown');
@@ -139,21 +148,17 @@ export class Viewport {
     this.requestRender();
   }
 
-  show(root) {
-    const groupColour = new Map();
+  show(root, reframe = true) {
     root.traverse((o) => {
       if (!o.isMesh) return;
       const owner = componentOwner(o);
       const component = owner ? owner.userData.component : -1;
-      const group = owner ? owner.userData.group ?? null : null;
-      // One palette colour per kind of group ("window_3" and "window_7" are both windows),
-      // or per component when ungrouped; own material per mesh so a highlight touches only
-      // the picked component.
-      const key = group !== null ? `g:${groupKind(group)}` : `c:${component}`;
-      if (!groupColour.has(key)) groupColour.set(key, PALETTE[groupColour.size % PALETTE.length]);
+      o.userData.componentId = component;
+      o.userData.groupName = owner ? owner.userData.group ?? null : null;
+      o.userData.label = owner && typeof owner.userData.label === 'string' ? owner.userData.label : null;
+      // Own material per mesh so a highlight touches only the picked component.
       for (const m of [].concat(o.material)) m.dispose();
       o.material = new THREE.MeshStandardMaterial({
-        color: groupColour.get(key),
         roughness: 0.85,
         metalness: 0,
         side: THREE.DoubleSide,
@@ -161,14 +166,37 @@ export class Viewport {
         polygonOffsetFactor: 1,
         polygonOffsetUnits: 1,
       });
-      o.userData.baseColour = o.material.color.clone();
       if (!this.byComponent.has(component)) this.byComponent.set(component, []);
       this.byComponent.get(component).push(o);
     });
     this.root = root;
     this.scene.add(root);
-    this.frameModel();
-    this.highlight(this.editor.selection);
+    if (reframe) this.frameModel();
+    this.colourize();
+  }
+
+  // Base colours: by label with the tree's colours once the model is proceduralized;
+  // otherwise one palette colour per kind of group ("window_3" and "window_7" are both
+  // windows), or per component when ungrouped.
+  colourize() {
+    const tree = this.editor.tree;
+    const groupColour = new Map();
+    for (const meshes of this.byComponent.values()) {
+      for (const o of meshes) {
+        const byLabel = tree && o.userData.label !== null ? tree.colourOf(o.userData.label) : null;
+        let colour;
+        if (byLabel) {
+          colour = new THREE.Color(byLabel);
+        } else {
+          const group = o.userData.groupName;
+          const key = group !== null ? `g:${groupKind(group)}` : `c:${o.userData.componentId}`;
+          if (!groupColour.has(key)) groupColour.set(key, PALETTE[groupColour.size % PALETTE.length]);
+          colour = new THREE.Color(groupColour.get(key));
+        }
+        o.userData.baseColour = colour;
+      }
+    }
+    this.highlight();
   }
 
   // Places the camera so the whole model fits, and the grid under it.
@@ -230,12 +258,13 @@ export class Viewport {
     this.editor.select({ component: owner.userData.component, group: owner.userData.group ?? null });
   }
 
-  highlight(sel) {
+  highlight() {
+    const on = new Set(this.editor.selectedComponents());
     for (const [component, meshes] of this.byComponent) {
-      const on = sel && sel.component === component;
+      const lit = on.has(component);
       for (const mesh of meshes) {
-        mesh.material.color.copy(on ? HIGHLIGHT : mesh.userData.baseColour);
-        mesh.material.emissive.copy(on ? HIGHLIGHT_GLOW : BLACK);
+        mesh.material.color.copy(lit ? HIGHLIGHT : mesh.userData.baseColour);
+        mesh.material.emissive.copy(lit ? HIGHLIGHT_GLOW : BLACK);
       }
     }
     this.requestRender();

@@ -1,0 +1,32 @@
+/* Plan and profile edits of extrusion models, as ops (validated and applied by
+ * app/modelops.c like every op, inside the transaction that raises the version):
+ *
+ *   {"kind": "plan", "building": i, "plan": {...}}   replaces building i's description
+ *   {"kind": "profile", "name": "...", "profile": [[w, z], ...] | {"points", "tag", "priority"}}
+ *                                                    replaces that profile in every building
+ *                                                    whose description has it
+ *
+ * Only the buildings an op touches are extruded again; the model's mesh is re-assembled from
+ * the stored buildings. A description that does not parse or validate, or a building that
+ * fails to extrude, refuses the whole op (AG_ERR_PARSE, 422, naming the building and the
+ * reason) and nothing is stored. */
+#ifndef AG_PLAN_EDIT_H
+#define AG_PLAN_EDIT_H
+
+#include <jansson.h>
+#include <stdint.h>
+
+#include "../core/status.h"
+#include "../store/db.h"
+
+/* Non-zero for the op kinds this file handles ("plan", "profile"). */
+int ag_plan_edit_handles(const char *kind);
+
+/* The op's shape and its description or profile (parsed and validated without a model). */
+ag_status ag_plan_edit_validate(const json_t *op, ag_error *err);
+
+/* Applies a validated op to the model inside the caller's transaction. AG_ERR_INVALID when
+ * the model is not an extrusion, has no such building or no building uses the profile. */
+ag_status ag_plan_edit_apply(ag_db *db, int64_t model, const json_t *op, ag_error *err);
+
+#endif
