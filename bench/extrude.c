@@ -1,5 +1,6 @@
 /* Extrusion benchmark: real Den Haag footprints with built-in styles, generated batches
- * with per-edge profiles, and single large footprints. Prints seconds, failures (each
+ * with per-edge profiles, an adversarial integer-grid stress batch, and single large
+ * footprints. Prints seconds, failures (each
  * with id and reason) and peak memory. */
 #include <math.h>
 #include <stdio.h>
@@ -223,6 +224,194 @@ static void big_polygon(size_t n, const char *prof_kind)
     free(pr);
 }
 
+
+/* --- adversarial integer-grid stress ------------------------------------------------------- */
+
+/* Shapes on an integer grid with profiles whose heights and widths are whole metres: many
+ * events fall at exactly the same height and point (ties, coincident and collinear edges,
+ * flat intervals that end exactly where edges meet). Plans that validation rejects
+ * (polyominoes pinched at a corner) are counted apart. */
+static uint64_t srng = 0x9E3779B97F4A7C15ULL;
+static double srnd(void)
+{
+    srng ^= srng << 13;
+    srng ^= srng >> 7;
+    srng ^= srng << 17;
+    return (double)(srng >> 11) / 9007199254740992.0;
+}
+
+/* A polyomino grown on a G x G grid of cells `cell` metres wide; its boundary as loops.
+ * Returns the number of loops written (xy: all corners, starts[]: loop starts). */
+static size_t grid_shape(double cell, int G, double *xy, size_t *starts, size_t *nloops_out)
+{
+    unsigned char in[16][16] = {{0}};
+    int cnt = 1 + (int)(srnd() * (G * G * 0.6));
+    in[G / 2][G / 2] = 1;
+    for (int k = 1; k < cnt; k++) {
+        for (int tries = 0; tries < 100; tries++) {
+            int x = (int)(srnd() * G), y = (int)(srnd() * G);
+            if (in[x][y])
+                continue;
+            int nb = (x > 0 && in[x - 1][y]) || (x + 1 < G && in[x + 1][y]) ||
+                     (y > 0 && in[x][y - 1]) || (y + 1 < G && in[x][y + 1]);
+            if (nb) {
+                in[x][y] = 1;
+                break;
+            }
+        }
+    }
+    /* directed boundary edges, interior on the left: unit steps */
+    int ex[4 * 256][4];
+    int ne = 0;
+    for (int x = 0; x < G; x++)
+        for (int y = 0; y < G; y++) {
+            if (!in[x][y])
+                continue;
+            if (y == 0 || !in[x][y - 1]) { ex[ne][0] = x; ex[ne][1] = y; ex[ne][2] = x + 1; ex[ne][3] = y; ne++; }
+            if (x == G - 1 || !in[x + 1][y]) { ex[ne][0] = x + 1; ex[ne][1] = y; ex[ne][2] = x + 1; ex[ne][3] = y + 1; ne++; }
+            if (y == G - 1 || !in[x][y + 1]) { ex[ne][0] = x + 1; ex[ne][1] = y + 1; ex[ne][2] = x; ex[ne][3] = y + 1; ne++; }
+            if (x == 0 || !in[x - 1][y]) { ex[ne][0] = x; ex[ne][1] = y + 1; ex[ne][2] = x; ex[ne][3] = y; ne++; }
+        }
+    unsigned char used[4 * 256] = {0};
+    size_t n = 0, nl = 0;
+    for (int s = 0; s < ne; s++) {
+        if (used[s])
+            continue;
+        starts[nl++] = n;
+        int cur = s;
+        while (!used[cur]) {
+            used[cur] = 1;
+            xy[2 * n] = ex[cur][0] * cell;
+            xy[2 * n + 1] = ex[cur][1] * cell;
+            n++;
+            /* next: an unused edge starting at this end; prefer the left turn at pinches */
+            int best = -1, bestturn = 99;
+            for (int t = 0; t < ne; t++)
+                if (!used[t] && ex[t][0] == ex[cur][2] && ex[t][1] == ex[cur][3]) {
+                    int dx1 = ex[cur][2] - ex[cur][0], dy1 = ex[cur][3] - ex[cur][1];
+                    int dx2 = ex[t][2] - ex[t][0], dy2 = ex[t][3] - ex[t][1];
+                    int cr = dx1 * dy2 - dy1 * dx2;
+                    int turn = cr > 0 ? 0 : cr == 0 ? 1 : 2;
+                    if (turn < bestturn) {
+                        bestturn = turn;
+                        best = t;
+                    }
+                }
+            if (best < 0)
+                break;
+            cur = best;
+        }
+    }
+    starts[nl] = n;
+    *nloops_out = nl;
+    return n;
+}
+
+/* A star-shaped polygon through integer points around a centre. */
+static size_t star_shape(double cell, double *xy)
+{
+    int k = 5 + (int)(srnd() * 12);
+    double pts[64][3];
+    int n = 0;
+    for (int i = 0; i < k; i++) {
+        int x = (int)(srnd() * 13) - 6, y = (int)(srnd() * 13) - 6;
+        if (x == 0 && y == 0)
+            continue;
+        double a = atan2(y - 0.31, x - 0.17);
+        int dup = 0;
+        for (int j = 0; j < n; j++)
+            if (fabs(pts[j][2] - a) < 1e-12)
+                dup = 1;
+        if (dup)
+            continue;
+        pts[n][0] = x * cell;
+        pts[n][1] = y * cell;
+        pts[n][2] = a;
+        n++;
+    }
+    for (int i = 1; i < n; i++)
+        for (int j = i; j > 0 && pts[j][2] < pts[j - 1][2]; j--)
+            for (int c = 0; c < 3; c++) {
+                double t = pts[j][c];
+                pts[j][c] = pts[j - 1][c];
+                pts[j - 1][c] = t;
+            }
+    for (int i = 0; i < n; i++) {
+        xy[2 * i] = pts[i][0];
+        xy[2 * i + 1] = pts[i][1];
+    }
+    return (size_t)n;
+}
+
+static void grid_profiles(ag_plan *p, double h)
+{
+    ag_profile_point hip[] = {{0, 0}, {0, h}, {1, h + 1}};
+    ag_profile_point steep[] = {{0, 0}, {0, h}, {0.5, h + 1}};
+    ag_profile_point wall[] = {{0, 0}, {0, h + 1}};
+    ag_profile_point r2[] = {{0, 0}, {0, h}, {2, h + 1}};
+    ag_profile_point over[] = {{0, 0}, {0, h}, {-1, h + 1}, {1, h + 2}};
+    ag_profile_point soffit[] = {{0, 0}, {0, h}, {-1, h}, {1, h + 2}};
+    ag_profile_point r45[] = {{0, 0}, {1, 1}};
+    ag_profile_point terrace[] = {{0, 0}, {0, h}, {1, h}, {1, h + 1}, {2, h + 2}};
+    ag_plan_add_profile(p, "hip", hip, 3, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "steep", steep, 3, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "wall", wall, 2, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "r2", r2, 3, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "over", over, 4, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "soffit", soffit, 4, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "r45", r45, 2, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "terrace", terrace, 5, NULL, NULL, NULL);
+}
+
+static void grid_stress(size_t count)
+{
+    size_t failed = 0, leaky = 0, rejected = 0;
+    static double xy[2 * 1200];
+    size_t starts[300];
+    static int32_t prof[1200];
+    double t0 = now();
+    for (size_t i = 0; i < count; i++) {
+        size_t n, nl = 1;
+        int kind = (int)(srnd() * 2);
+        if (kind == 0) {
+            n = grid_shape(1 + (int)(srnd() * 3), 4 + (int)(srnd() * 5), xy, starts, &nl);
+        } else {
+            n = star_shape(1 + (int)(srnd() * 2), xy);
+            starts[0] = 0;
+            starts[1] = n;
+        }
+        ag_plan *p = ag_plan_create();
+        grid_profiles(p, 1 + (int)(srnd() * 3));
+        int mode = (int)(srnd() * 3), base = (int)(srnd() * 8);
+        for (size_t k = 0; k < n; k++)
+            prof[k] = mode == 0 ? 6 : mode == 1 ? base : (int)(srnd() * 8);
+        for (size_t l = 0; l < nl; l++)
+            ag_plan_add_loop(p, xy + 2 * starts[l], starts[l + 1] - starts[l], prof + starts[l], NULL);
+        ag_mesh *m = ag_mesh_create();
+        ag_extrude_result r;
+        ag_error err = {0};
+        ag_status st = ag_extrude_plan(p, m, -1, &r, NULL, &err);
+        if (st == AG_ERR_INVALID || st == AG_ERR_EMPTY) {
+            rejected++;
+        } else if (st != AG_OK) {
+            failed++;
+            printf("    failed grid%zu: %s\n", i, err.text);
+        } else if (r.failing_faces) {
+            leaky++;
+            printf("    not watertight grid%zu: face %d: %s\n", i, (int)r.problems[0].face,
+                   r.problems[0].reason);
+        }
+        ag_mesh_free(m);
+        ag_plan_free(p);
+    }
+    double dt = now() - t0;
+    size_t valid = count - rejected;
+    printf("  %-22s %5zu plans  %.3f s  rejected by validation %zu  failed %zu  not watertight %zu "
+           "(%.3f%% of %zu valid)\n",
+           "integer-grid stress", count, dt, rejected, failed, leaky,
+           100.0 * (failed + leaky) / (valid ? valid : 1), valid);
+}
+
 int main(void)
 {
     const char *path = AG_REPO_DIR "/../shared/data/footprints_denhaag_lod2/denhaag_tile01_footprints.geojson";
@@ -251,6 +440,7 @@ int main(void)
         }
     }
     generated_batch(3000);
+    grid_stress(20000);
     big_polygon(1000, "hip");
     big_polygon(1000, "mixed");
     big_polygon(2000, "hip");

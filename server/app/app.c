@@ -11,6 +11,7 @@
 
 #include "../store/jobs.h"
 #include "demo.h"
+#include "edit_session.h"
 #include "extrude_job.h"
 #include "import_job.h"
 #include "jobqueue.h"
@@ -22,6 +23,7 @@ struct ag_app {
     int workers;
     ag_events *events;
     ag_jobqueue *jobs;
+    ag_edit_sessions *edit_sessions;
     pthread_key_t db_key;
     pthread_mutex_t ops_lock;
     pthread_mutex_t conns_lock;
@@ -94,6 +96,7 @@ int ag_app_workers(const ag_app *app) { return app->workers; }
 void ag__app_lock_ops(ag_app *app) { pthread_mutex_lock(&app->ops_lock); }
 void ag__app_unlock_ops(ag_app *app) { pthread_mutex_unlock(&app->ops_lock); }
 struct ag_jobqueue *ag__app_jobqueue(ag_app *app) { return app->jobs; }
+struct ag_edit_sessions *ag__app_edit_sessions(ag_app *app) { return app->edit_sessions; }
 
 ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
 {
@@ -110,7 +113,8 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
     else if (asprintf(&app->upload_dir, "%s.uploads", opt->db_path) < 0)
         app->upload_dir = NULL;
     app->events = ag_events_create();
-    if (!app->db_path || !app->upload_dir || !app->events) {
+    app->edit_sessions = ag_edit_sessions_create();
+    if (!app->db_path || !app->upload_dir || !app->events || !app->edit_sessions) {
         ag_app_free(app);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
@@ -178,6 +182,7 @@ void ag_app_free(ag_app *app)
     if (!app)
         return;
     ag_jobqueue_free(app->jobs);
+    ag_edit_sessions_free(app->edit_sessions);
     close_all_connections(app);
     ag_events_free(app->events);
     pthread_key_delete(app->db_key);

@@ -38,5 +38,7 @@ int ag_app_workers(const ag_app *app);
 void ag__app_lock_ops(ag_app *app);
 void ag__app_unlock_ops(ag_app *app);
 struct ag_jobqueue *ag__app_jobqueue(ag_app *app);
+/* The in-memory edit states of models (app/edit_session.h). */
+struct ag_edit_sessions *ag__app_edit_sessions(ag_app *app);
 
 #endif

@@ -5,6 +5,7 @@
 
 #include "../store/models.h"
 #include "../store/ops.h"
+#include "edit_ops.h"
 #include "plan_edit.h"
 
 #define AG_NOTE_MAX 4000
@@ -59,6 +60,8 @@ ag_status ag_modelops_validate(const json_t *op, ag_error *err)
     }
     if (ag_plan_edit_handles(kind))
         return ag_plan_edit_validate(op, err);
+    if (ag_edit_ops_handles(kind))
+        return ag_edit_ops_validate(op, err);
     if (strcmp(kind, "proceduralize") == 0)
         return ag_error_set(err, AG_ERR_INVALID, 0,
                             "\"proceduralize\" ops are made by the server: POST "
@@ -105,6 +108,10 @@ ag_status ag_modelops_apply(ag_app *app, int64_t model, int64_t base, const char
         (s = ag_models_check_name(author, err)) != AG_OK ||
         (s = ag_modelops_validate(op, err)) != AG_OK)
         return s;
+    /* structural edits, undo, redo, restore: computed off the op lock, then a server op */
+    if (ag_edit_ops_handles(json_string_value(json_object_get(op, "kind"))))
+        return ag_edit_ops_apply(app, model, base, author, cid, op, origin, version, duplicate,
+                                 err);
     ag_db *db = ag_app_db(app, err);
     if (!db)
         return err ? err->code : AG_ERR_DB;
@@ -226,7 +233,8 @@ ag_status ag_modelops_server_commit(ag_modelops_txn *t, const char *author, cons
                        .version = t->version,
                        .author = author,
                        .cid = cid,
-                       .json = body};
+                       .json = body,
+                       .origin = t->origin};
         ag_events_publish(ag_app_events(t->app), &ev);
     }
     ag__app_unlock_ops(t->app);

@@ -9,7 +9,8 @@
 #include "app.h"
 
 /* Checks an op's shape: {"kind": "rename", "name"} or {"kind": "note", "text"}; "plan" and
- * "profile" ops of extrusion models are checked by app/plan_edit.h. The kinds
+ * "profile" ops of extrusion models are checked by app/plan_edit.h, structural edits, "undo",
+ * "redo" and "restore" by app/edit_ops.h (which also applies them). The kinds
  * the server makes itself ("proceduralize", "grammar") are refused with a message naming the
  * REST call that makes them. */
 ag_status ag_modelops_validate(const json_t *op, ag_error *err);
@@ -39,6 +40,7 @@ typedef struct {
     ag_db *db;
     int64_t model;
     int64_t version; /* the version the change gets */
+    uint64_t origin; /* the live session the op came from, set after begin (0 = none) */
 } ag_modelops_txn;
 
 ag_status ag_modelops_server_begin(ag_app *app, int64_t model, int64_t base, ag_modelops_txn *t,

@@ -118,9 +118,11 @@ static void update_clear(update *u)
     ag_extrusion_built_clear(&u->built);
 }
 
-/* Extrudes doc as building b (footprint id given); failure → AG_ERR_PARSE naming both. */
-static ag_status rebuild(const json_t *doc, int64_t b, const char *footprint, update *u,
-                         ag_error *err)
+/* Extrudes doc as building b (footprint id given); failure → AG_ERR_PARSE naming both,
+ * unless may_fail: a building that already failed before the op (a batch's bad footprint)
+ * is kept as failed with its new reason rather than refusing an op that did not cause it. */
+static ag_status rebuild(const json_t *doc, int64_t b, const char *footprint, int may_fail,
+                         update *u, ag_error *err)
 {
     memset(u, 0, sizeof *u);
     u->building = b;
@@ -133,7 +135,7 @@ static ag_status rebuild(const json_t *doc, int64_t b, const char *footprint, up
     if (s == AG_OK)
         s = ag_extrusion_build(plan, footprint, NULL, &u->built, err);
     ag_plan_free(plan);
-    if (s == AG_OK && strcmp(u->built.status, "failed") == 0)
+    if (s == AG_OK && strcmp(u->built.status, "failed") == 0 && !may_fail)
         s = ag_error_set(err, AG_ERR_PARSE, 0, "%sthe plan cannot be extruded: %s", what,
                          u->built.reason);
     return s;
@@ -171,7 +173,7 @@ static ag_status apply_plan(ag_db *db, int64_t model, size_t buildings, const js
     if (s != AG_OK)
         return s;
     update u;
-    s = rebuild(json_object_get(op, "plan"), bi, row.footprint, &u, err);
+    s = rebuild(json_object_get(op, "plan"), bi, row.footprint, 0, &u, err);
     ag_extrusions_building_clear(&row);
     if (s == AG_OK)
         s = store(db, model, &u, 1, err);
@@ -207,7 +209,8 @@ static ag_status visit(void *user, ag_extrusion_building *b)
         pe->u = g;
         pe->cap = cap;
     }
-    ag_status s = rebuild(doc, b->building, b->footprint, &pe->u[pe->n], pe->err);
+    ag_status s = rebuild(doc, b->building, b->footprint, strcmp(b->status, "failed") == 0,
+                          &pe->u[pe->n], pe->err);
     pe->n++; /* cleared by the caller whatever happened */
     json_decref(doc);
     return s;

@@ -9,7 +9,8 @@
  * Only the buildings an op touches are extruded again; the model's mesh is re-assembled from
  * the stored buildings. A description that does not parse or validate, or a building that
  * fails to extrude, refuses the whole op (AG_ERR_PARSE, 422, naming the building and the
- * reason) and nothing is stored. */
+ * reason) and nothing is stored; only a building that had already failed before a profile op
+ * (a batch's bad footprint) may stay failed. */
 #ifndef AG_PLAN_EDIT_H
 #define AG_PLAN_EDIT_H
 

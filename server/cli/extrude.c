@@ -64,12 +64,18 @@ static int run_plan(const char *plan_path, const char *out)
     for (size_t i = 0; st == AG_OK && i < plan->nanchors; i++) {
         const ag_anchor *a = &plan->anchors[i];
         if (a->found)
-            printf("anchor %s: (%.4f, %.4f, %.4f) normal (%.3f, %.3f, %.3f) face %d\n", a->name,
+            printf("anchor %s: (%.4f, %.4f, %.4f) normal (%.3f, %.3f, %.3f) face %d%s%s\n", a->name,
                    a->pos[0], a->pos[1], a->pos[2], a->normal[0], a->normal[1], a->normal[2],
-                   (int)a->face);
+                   (int)a->face, a->mesh > 0 ? " mesh " : "",
+                   a->mesh > 0 ? plan->meshes[a->mesh - 1].name : "");
         else
             printf("anchor %s: not instanced (the edge is gone or too short there)\n", a->name);
     }
+    size_t placed = 0;
+    if (st == AG_OK)
+        st = ag_extrude_place_meshes(plan, m, (int32_t)g, &placed, &err);
+    if (st == AG_OK && placed)
+        printf("meshes placed at anchors: %zu\n", placed);
     ag_plan_free(plan);
     if (st != AG_OK) {
         fprintf(stderr, "archgram extrude: %s: %s\n", plan_path, err.text[0] ? err.text : ag_status_message(st));

@@ -9,6 +9,8 @@
 #include <time.h>
 
 #include "../core/proc/proceduralize.h"
+#include "../core/edit/edit.h"
+#include "../io/edit_tree_json.h"
 #include "../io/grammar_text.h"
 #include "../io/import.h"
 #include "../io/terminals.h"
@@ -164,6 +166,27 @@ int ag_cli_proceduralize(int argc, char **argv)
         goto done;
     }
     double t_verify = now() - t0;
+
+    /* tree.json: the tree `archgram edit` reads this folder as (the grammar derived and
+     * proceduralized again, as ag_edit_model_from_grammar does), so its ids are the ones
+     * edit ops name */
+    {
+        ag_edit_model *em = NULL;
+        if (ag_edit_model_from_grammar(back, NULL, &em, &err)) {
+            ag_cli_report(path, &err);
+            goto done;
+        }
+        char tpath[4096];
+        snprintf(tpath, sizeof tpath, "%s/tree.json", dir);
+        json_t *tj = ag_edit_tree_json(em->proc);
+        int bad = !tj || json_dump_file(tj, tpath, JSON_INDENT(1) | JSON_REAL_PRECISION(12));
+        json_decref(tj);
+        ag_edit_model_free(em);
+        if (bad) {
+            fprintf(stderr, "archgram: cannot write %s\n", tpath);
+            goto done;
+        }
+    }
 
     ag_splittree_stats ts = ag_splittree_stats_of(r->tree);
     j = json_object();

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "obj.h"
+
 static ag_status read_points(json_t *arr, const char *what, ag_profile_point **out, size_t *n,
                              ag_error *err)
 {
@@ -34,7 +36,8 @@ static ag_status read_points(json_t *arr, const char *what, ag_profile_point **o
     return AG_OK;
 }
 
-static ag_status read_anchor(json_t *av, const char *what, size_t ai, ag_anchor *a, ag_error *err)
+static ag_status read_anchor_mesh(json_t *av, const char *what, size_t ai, ag_anchor *a,
+                                  const ag_plan *p, ag_error *err)
 {
     memset(a, 0, sizeof *a);
     json_t *rel = json_object_get(av, "relative"), *abs_ = json_object_get(av, "absolute");
@@ -53,10 +56,136 @@ static ag_status read_anchor(json_t *av, const char *what, size_t ai, ag_anchor 
     a->absolute = abs_ != NULL;
     a->along = json_number_value(abs_ ? abs_ : rel);
     a->z = json_number_value(h);
+    json_t *mesh = json_object_get(av, "mesh");
+    if (mesh) {
+        int32_t k = p && json_is_string(mesh) ? ag_plan_find_mesh(p, json_string_value(mesh)) : -1;
+        if (k < 0)
+            return ag_error_set(err, AG_ERR_PARSE, (long)ai + 1,
+                                "plan: %s[%zu].mesh must name one of \"meshes\"", what, ai);
+        a->mesh = k + 1;
+    }
     return AG_OK;
 }
 
-static ag_status parse_plan(json_t *root, ag_plan **out, ag_error *err)
+static ag_status read_anchor(json_t *av, const char *what, size_t ai, ag_anchor *a, ag_error *err)
+{
+    return read_anchor_mesh(av, what, ai, a, NULL, err);
+}
+
+/* "meshes": {name: "file.obj" | {"path": "file.obj", "up": "y" | "z"}}, paths relative
+ * to base (the plan file's folder; NULL: as given). */
+static ag_status read_meshes(json_t *root, const char *base, ag_plan *p, ag_error *err)
+{
+    json_t *ms = json_object_get(root, "meshes");
+    if (!ms)
+        return AG_OK;
+    if (!json_is_object(ms))
+        return ag_error_set(err, AG_ERR_PARSE, 0, "plan: \"meshes\" must map names to OBJ files");
+    const char *name;
+    json_t *mv;
+    json_object_foreach(ms, name, mv)
+    {
+        json_t *pv = json_is_object(mv) ? json_object_get(mv, "path") : mv;
+        json_t *up = json_is_object(mv) ? json_object_get(mv, "up") : NULL;
+        const char *path = json_string_value(pv), *ups = up ? json_string_value(up) : "y";
+        if (!path || !ups || (strcmp(ups, "y") != 0 && strcmp(ups, "z") != 0))
+            return ag_error_set(err, AG_ERR_PARSE, 0,
+                                "plan: meshes.%s must be a file name or {\"path\", \"up\": "
+                                "\"y\"|\"z\"}", name);
+        if (strlen(name) >= sizeof p->meshes[0].name)
+            return ag_error_set(err, AG_ERR_PARSE, 0, "plan: mesh name %s is too long (max %zu)",
+                                name, sizeof p->meshes[0].name - 1);
+        char full[4096];
+        if (base && path[0] != '/')
+            snprintf(full, sizeof full, "%s/%s", base, path);
+        else
+            snprintf(full, sizeof full, "%s", path);
+        ag_obj_read_options o = {0};
+        o.up = ups[0] == 'z' ? AG_UP_Z : AG_UP_Y;
+        ag_mesh *m = NULL;
+        ag_error e2 = {0};
+        if (ag_obj_read_file(full, &o, &m, &e2) != AG_OK)
+            return ag_error_set(err, e2.code ? e2.code : AG_ERR_IO, 0, "plan: meshes.%s: %s", name,
+                                e2.text);
+        ag_status st = ag_plan_add_mesh(p, name, m, NULL, err);
+        if (st != AG_OK)
+            return st;
+    }
+    return AG_OK;
+}
+
+/* "offsets": [{"height", "outside", "profile", "side", "edges": [{"loop", "edge",
+ * "disabled", "outside", "profile"}]}] */
+static int32_t opt_profile(json_t *v, const ag_plan *p, int *bad)
+{
+    if (!v || json_is_null(v))
+        return -1;
+    int32_t k = json_is_string(v) ? ag_plan_find_profile(p, json_string_value(v)) : -1;
+    if (k < 0)
+        *bad = 1;
+    return k;
+}
+
+static ag_status read_offsets(json_t *root, ag_plan *p, ag_error *err)
+{
+    json_t *offs = json_object_get(root, "offsets");
+    if (!offs)
+        return AG_OK;
+    if (!json_is_array(offs))
+        return ag_error_set(err, AG_ERR_PARSE, 0, "plan: \"offsets\" must be an array");
+    size_t oi;
+    json_t *ov;
+    json_array_foreach(offs, oi, ov)
+    {
+        json_t *h = json_object_get(ov, "height"), *w = json_object_get(ov, "outside");
+        json_t *edges = json_object_get(ov, "edges");
+        int bad = 0;
+        ag_plan_offset o;
+        memset(&o, 0, sizeof o);
+        o.profile = opt_profile(json_object_get(ov, "profile"), p, &bad);
+        o.side = opt_profile(json_object_get(ov, "side"), p, &bad);
+        if (!json_is_object(ov) || !json_is_number(h) || !json_is_number(w) || bad ||
+            (edges && !json_is_array(edges)))
+            return ag_error_set(err, AG_ERR_PARSE, (long)oi + 1,
+                                "plan: offsets[%zu] needs \"height\" and \"outside\" (numbers); "
+                                "\"profile\" and \"side\" must name profiles, \"edges\" be an "
+                                "array", oi);
+        o.z = json_number_value(h);
+        o.outside = json_number_value(w);
+        o.nedges = edges ? json_array_size(edges) : 0;
+        o.edges = calloc(o.nedges ? o.nedges : 1, sizeof *o.edges);
+        if (!o.edges)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        size_t ei;
+        json_t *ev;
+        json_array_foreach(edges, ei, ev)
+        {
+            ag_offset_edge *x = &o.edges[ei];
+            json_t *lo = json_object_get(ev, "loop"), *ed = json_object_get(ev, "edge");
+            json_t *dis = json_object_get(ev, "disabled"), *xw = json_object_get(ev, "outside");
+            x->profile = opt_profile(json_object_get(ev, "profile"), p, &bad);
+            if (!json_is_object(ev) || !json_is_integer(ed) || (lo && !json_is_integer(lo)) ||
+                (dis && !json_is_boolean(dis)) || (xw && !json_is_number(xw)) || bad) {
+                free(o.edges);
+                return ag_error_set(err, AG_ERR_PARSE, (long)oi + 1,
+                                    "plan: offsets[%zu].edges[%zu] needs \"edge\" (and may have "
+                                    "\"loop\", \"disabled\", \"outside\", \"profile\")", oi, ei);
+            }
+            x->loop = lo ? (int32_t)json_integer_value(lo) : 0;
+            x->edge = (int32_t)json_integer_value(ed);
+            x->disabled = json_is_true(dis);
+            x->has_outside = xw != NULL;
+            x->outside = xw ? json_number_value(xw) : 0;
+        }
+        ag_status st = ag_plan_add_offset(p, &o, err);
+        free(o.edges);
+        if (st != AG_OK)
+            return st;
+    }
+    return AG_OK;
+}
+
+static ag_status parse_plan(json_t *root, const char *base, ag_plan **out, ag_error *err)
 {
     if (!json_is_object(root))
         return ag_error_set(err, AG_ERR_PARSE, 0, "plan: the document must be a JSON object");
@@ -100,6 +229,27 @@ static ag_status parse_plan(json_t *root, ag_plan **out, ag_error *err)
         }
         if (prio)
             p->profiles[idx].priority = (int32_t)json_integer_value(prio);
+        json_t *sp = json_is_object(pv) ? json_object_get(pv, "segment_priority") : NULL;
+        if (sp && (!json_is_array(sp) || json_array_size(sp) != n - 1)) {
+            st = ag_error_set(err, AG_ERR_PARSE, 0,
+                              "plan: profiles.%s.segment_priority must hold one integer per "
+                              "segment (%zu)", name, n - 1);
+            goto fail;
+        }
+        for (size_t k = 0; sp && k + 1 < n; k++) {
+            json_t *v = json_array_get(sp, k);
+            if (!json_is_integer(v) && !json_is_null(v)) {
+                st = ag_error_set(err, AG_ERR_PARSE, 0,
+                                  "plan: profiles.%s.segment_priority[%zu] must be an integer "
+                                  "(or null for the profile's priority)", name, k);
+                goto fail;
+            }
+            st = ag_plan_set_segment_priority(
+                p, idx, k, json_is_null(v) ? p->profiles[idx].priority : (int32_t)json_integer_value(v),
+                err);
+            if (st != AG_OK)
+                goto fail;
+        }
     }
     int32_t def = 0;
     json_t *dp = json_object_get(root, "default_profile");
@@ -167,6 +317,9 @@ static ag_status parse_plan(json_t *root, ag_plan **out, ag_error *err)
         if (st != AG_OK)
             goto fail;
     }
+    st = read_meshes(root, base, p, err);
+    if (st != AG_OK)
+        goto fail;
     json_t *anchors = json_object_get(root, "anchors");
     if (anchors && !json_is_array(anchors)) {
         st = ag_error_set(err, AG_ERR_PARSE, 0, "plan: \"anchors\" must be an array");
@@ -177,7 +330,7 @@ static ag_status parse_plan(json_t *root, ag_plan **out, ag_error *err)
     json_array_foreach(anchors, ai, av)
     {
         ag_anchor a;
-        st = read_anchor(av, "anchors", ai, &a, err);
+        st = read_anchor_mesh(av, "anchors", ai, &a, p, err);
         if (st == AG_OK)
             st = ag_plan_add_anchor(p, &a, err);
         if (st != AG_OK)
@@ -192,13 +345,61 @@ static ag_status parse_plan(json_t *root, ag_plan **out, ag_error *err)
     {
         ag_plan_step sp;
         memset(&sp, 0, sizeof sp);
+        json_t *fpts = json_object_get(av, "points");
+        json_t *pn = json_object_get(av, "profile");
+        sp.profile = json_is_string(pn) ? ag_plan_find_profile(p, json_string_value(pn)) : -1;
+        if (fpts) {
+            /* a forced step: a polygon in the anchor's frame, or in plan coordinates
+             * when no edge is given */
+            char what[64];
+            snprintf(what, sizeof what, "plan: steps[%zu].points", ai);
+            ag_profile_point *pp = NULL;
+            size_t n = 0;
+            json_t *h = json_object_get(av, "height");
+            if (json_object_get(av, "edge")) {
+                st = read_anchor(av, "steps", ai, &sp.at, err);
+            } else if (!json_is_number(h)) {
+                st = ag_error_set(err, AG_ERR_PARSE, (long)ai + 1,
+                                  "plan: steps[%zu] needs \"height\" (a number)", ai);
+            } else {
+                const char *nm = json_string_value(json_object_get(av, "name"));
+                snprintf(sp.at.name, sizeof sp.at.name, "%s", nm ? nm : "");
+                sp.at.edge = -1;
+                sp.at.z = json_number_value(h);
+                sp.plan_frame = 1;
+            }
+            if (st == AG_OK && sp.profile < 0)
+                st = ag_error_set(err, AG_ERR_PARSE, (long)ai + 1,
+                                  "plan: steps[%zu] needs \"profile\" (a profile name)", ai);
+            if (st == AG_OK)
+                st = read_points(fpts, what, &pp, &n, err);
+            if (st != AG_OK)
+                goto fail;
+            memcpy(sp.name, sp.at.name, sizeof sp.name);
+            double *xy = malloc(2 * n * sizeof *xy);
+            if (!xy) {
+                free(pp);
+                st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+                goto fail;
+            }
+            for (size_t i = 0; i < n; i++) {
+                xy[2 * i] = pp[i].w;
+                xy[2 * i + 1] = pp[i].z;
+            }
+            free(pp);
+            sp.npoints = n;
+            sp.points = xy;
+            st = ag_plan_add_step(p, &sp, err);
+            free(xy);
+            if (st != AG_OK)
+                goto fail;
+            continue;
+        }
         st = read_anchor(av, "steps", ai, &sp.at, err);
         if (st != AG_OK)
             goto fail;
         memcpy(sp.name, sp.at.name, sizeof sp.name);
         json_t *w = json_object_get(av, "width"), *d = json_object_get(av, "depth");
-        json_t *pn = json_object_get(av, "profile");
-        sp.profile = json_is_string(pn) ? ag_plan_find_profile(p, json_string_value(pn)) : -1;
         if (!json_is_number(w) || !json_is_number(d) || sp.profile < 0) {
             st = ag_error_set(err, AG_ERR_PARSE, (long)ai + 1,
                               "plan: steps[%zu] needs \"width\", \"depth\" (numbers) and "
@@ -211,6 +412,9 @@ static ag_status parse_plan(json_t *root, ag_plan **out, ag_error *err)
         if (st != AG_OK)
             goto fail;
     }
+    st = read_offsets(root, p, err);
+    if (st != AG_OK)
+        goto fail;
     json_t *cap = json_object_get(root, "cap_height");
     if (cap) {
         if (!json_is_number(cap) || !(json_number_value(cap) >= 0)) {
@@ -271,7 +475,8 @@ static char *slurp(const char *path, size_t *len, ag_error *err, ag_status *st)
     return buf;
 }
 
-ag_status ag_plan_json_read_buffer(const char *data, size_t len, ag_plan **out, ag_error *err)
+static ag_status read_buffer(const char *data, size_t len, const char *base, ag_plan **out,
+                             ag_error *err)
 {
     *out = NULL;
     json_error_t je;
@@ -279,9 +484,14 @@ ag_status ag_plan_json_read_buffer(const char *data, size_t len, ag_plan **out, 
     if (!root)
         return ag_error_set(err, AG_ERR_PARSE, je.line, "plan: %s (line %d, column %d)", je.text,
                             je.line, je.column);
-    ag_status st = parse_plan(root, out, err);
+    ag_status st = parse_plan(root, base, out, err);
     json_decref(root);
     return st;
+}
+
+ag_status ag_plan_json_read_buffer(const char *data, size_t len, ag_plan **out, ag_error *err)
+{
+    return read_buffer(data, len, NULL, out, err);
 }
 
 ag_status ag_plan_json_read_file(const char *path, ag_plan **out, ag_error *err)
@@ -292,7 +502,12 @@ ag_status ag_plan_json_read_file(const char *path, ag_plan **out, ag_error *err)
     char *buf = slurp(path, &len, err, &st);
     if (!buf)
         return st;
-    st = ag_plan_json_read_buffer(buf, len, out, err);
+    /* mesh files are found next to the plan */
+    char base[4096];
+    const char *slash = strrchr(path, '/');
+    if (slash)
+        snprintf(base, sizeof base, "%.*s", (int)(slash - path), path);
+    st = read_buffer(buf, len, slash ? (slash == path ? "/" : base) : NULL, out, err);
     free(buf);
     return st;
 }

@@ -7,7 +7,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
+#include "../app/edit_ops.h"
 #include "../app/events.h"
 #include "../app/modelops.h"
 #include "../app/views.h"
@@ -20,6 +22,11 @@
 #define AG_LIVE_MAX_OUTBOX 4096
 #define AG_LIVE_MAX_WATCH 16
 #define AG_LIVE_WELCOME_OPS 5000
+/* Live drag previews solved per connection per second at most; extra ones wait, the newest
+ * replacing the one waiting. */
+#define AG_LIVE_PREVIEW_HZ 30
+/* Edits and previews waiting for the worker, over all connections. */
+#define AG_LIVE_MAX_WORK 256
 
 typedef struct outmsg {
     struct outmsg *next;
@@ -43,6 +50,8 @@ typedef struct session {
     int64_t watch[AG_LIVE_MAX_WATCH];
     double watch_progress[AG_LIVE_MAX_WATCH]; /* the last progress sent for that job */
     int nwatch;
+    double preview_at;      /* when the last preview was solved (ms, monotonic) */
+    json_t *preview_next;   /* the newest preview waiting for its turn */
     struct session *prev, *next;
 } session;
 
@@ -54,6 +63,22 @@ typedef struct pending {
     char *author, *cid, *json;
 } pending;
 
+/* Structural edits and drag previews can take a while (a model is proceduralized when it is
+ * first edited), so one worker thread computes them, in arrival order, off the service thread;
+ * its replies come back through the pending list. */
+typedef struct work {
+    struct work *next;
+    uint64_t session;
+    int64_t model;
+    char *user, *peer;
+    json_t *msg; /* the op or preview message */
+    int preview;
+} work;
+
+/* Pending kinds of the live layer itself, beside the app's events. */
+#define LIVE_TO_SESSION ((ag_event_kind)100) /* json to the session `origin` */
+#define LIVE_TO_ROOM ((ag_event_kind)101)    /* json to everyone in the room `model` */
+
 struct ag_live {
     ag_app *app;
     struct lws_context *context;
@@ -63,6 +88,13 @@ struct ag_live {
     pending *head, *tail;
     session *sessions;    /* service thread only */
     uint64_t next_id;
+    pthread_t worker;
+    int worker_started;
+    pthread_mutex_t work_lock;
+    pthread_cond_t work_cond;
+    work *work_head, *work_tail;
+    size_t work_count;    /* guarded by work_lock */
+    int work_stop;        /* guarded by work_lock */
 };
 
 /* --- sending ------------------------------------------------------------------------------ */
@@ -148,6 +180,8 @@ static void leave_room(ag_live *live, session *s)
     s->model = 0;
     free(s->presence);
     s->presence = NULL;
+    json_decref(s->preview_next);
+    s->preview_next = NULL;
     broadcast_json(live, model, s, json_pack("{s:s, s:s}", "type", "leave", "peer", peer));
 }
 
@@ -250,12 +284,12 @@ static void on_presence(ag_live *live, session *s, json_t *msg)
                              s->user, "state", state));
 }
 
-static void on_op(ag_live *live, session *s, json_t *msg)
+/* The ack or nack of an op (any thread). */
+static json_t *op_reply(ag_app *app, int64_t model, const char *user, uint64_t origin,
+                        json_t *msg)
 {
     json_t *jcid = json_object_get(msg, "cid");
     const char *cid = json_string_value(jcid);
-    if (!s->model)
-        return send_error(s, AG_ERR_INVALID, "send hello before ops%s", "");
     json_t *jbase = json_object_get(msg, "base");
     ag_error err;
     ag_error_clear(&err);
@@ -267,28 +301,149 @@ static void on_op(ag_live *live, session *s, json_t *msg)
     int64_t version = 0;
     int dup = 0;
     if (st == AG_OK)
-        st = ag_modelops_apply(live->app, s->model, json_integer_value(jbase), s->user, cid,
-                               json_object_get(msg, "op"), s->id, &version, &dup, &err);
-    if (st == AG_OK) {
-        send_json(s, json_pack("{s:s, s:s, s:I, s:b}", "type", "ack", "cid", cid, "version",
-                               (json_int_t)version, "duplicate", dup));
-        return;
-    }
+        st = ag_modelops_apply(app, model, json_integer_value(jbase), user, cid,
+                               json_object_get(msg, "op"), origin, &version, &dup, &err);
+    if (st == AG_OK)
+        return json_pack("{s:s, s:s, s:I, s:b}", "type", "ack", "cid", cid, "version",
+                         (json_int_t)version, "duplicate", dup);
     int64_t current = 0;
     if (st == AG_ERR_STALE) {
         current = err.element;
         err.element = 0;
     } else {
-        ag_db *db = ag_app_db(live->app, NULL);
+        ag_db *db = ag_app_db(app, NULL);
         ag_model_row row;
-        if (db && ag_models_get(db, s->model, &row, NULL) == AG_OK) {
+        if (db && ag_models_get(db, model, &row, NULL) == AG_OK) {
             current = row.version;
             ag_models_row_clear(&row);
         }
     }
-    send_json(s, json_pack("{s:s, s:o, s:I, s:o}", "type", "nack", "cid",
-                           cid ? json_string(cid) : json_null(), "version", (json_int_t)current,
-                           "problem", ag_view_problem(st, &err)));
+    return json_pack("{s:s, s:o, s:I, s:o}", "type", "nack", "cid",
+                     cid ? json_string(cid) : json_null(), "version", (json_int_t)current,
+                     "problem", ag_view_problem(st, &err));
+}
+
+static void enqueue_work(ag_live *live, session *s, json_t *msg, int preview)
+{
+    pthread_mutex_lock(&live->work_lock);
+    int full = live->work_count >= AG_LIVE_MAX_WORK;
+    pthread_mutex_unlock(&live->work_lock);
+    if (full && preview)
+        return; /* a preview is only worth its newest position: drop it */
+    if (full) {
+        ag_error err;
+        ag_error_set(&err, AG_ERR_BUSY, 0, "too many edits are waiting; send it again later");
+        json_t *cid = json_object_get(msg, "cid");
+        return send_json(s, json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid", cid,
+                                      "version", (json_int_t)0, "problem",
+                                      ag_view_problem(AG_ERR_BUSY, &err)));
+    }
+    work *w = calloc(1, sizeof *w);
+    char peer[32];
+    peer_name(s, peer, sizeof peer);
+    if (w && (!(w->user = strdup(s->user)) || !(w->peer = strdup(peer)))) {
+        free(w->user);
+        free(w);
+        w = NULL;
+    }
+    if (!w)
+        return send_error(s, AG_ERR_NOMEM, "out of memory%s", "");
+    w->session = s->id;
+    w->model = s->model;
+    w->msg = json_incref(msg);
+    w->preview = preview;
+    pthread_mutex_lock(&live->work_lock);
+    if (live->work_tail)
+        live->work_tail->next = w;
+    else
+        live->work_head = w;
+    live->work_tail = w;
+    live->work_count++;
+    pthread_cond_signal(&live->work_cond);
+    pthread_mutex_unlock(&live->work_lock);
+}
+
+static void on_op(ag_live *live, session *s, json_t *msg)
+{
+    if (!s->model)
+        return send_error(s, AG_ERR_INVALID, "send hello before ops%s", "");
+    const char *kind = json_string_value(json_object_get(json_object_get(msg, "op"), "kind"));
+    if (ag_edit_ops_handles(kind) && json_is_string(json_object_get(msg, "cid")))
+        return enqueue_work(live, s, msg, 0);
+    send_json(s, op_reply(live->app, s->model, s->user, s->id, msg));
+}
+
+static double mono_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* Solves a drag preview (any thread): the message for the whole room (the author too: the
+ * server's solve is what everyone sees), or with *to_room = 0 a problem for the author only.
+ * Nothing is stored. */
+static json_t *preview_message(ag_app *app, int64_t model, const char *user, const char *peer,
+                               json_t *msg, int *to_room)
+{
+    *to_room = 0;
+    json_t *jbase = json_object_get(msg, "base");
+    ag_error err;
+    ag_error_clear(&err);
+    json_t *boxes = NULL;
+    double solve_ms = 0;
+    ag_status st = json_is_integer(jbase)
+                       ? ag_edit_ops_preview(app, model, json_integer_value(jbase),
+                                             json_object_get(msg, "op"), &boxes, &solve_ms, &err)
+                       : ag_error_set(&err, AG_ERR_INVALID, 0,
+                                      "a preview needs \"base\", the version it was made on");
+    if (st != AG_OK) {
+        int64_t current = st == AG_ERR_STALE ? err.element : 0;
+        if (st == AG_ERR_STALE)
+            err.element = 0;
+        return json_pack("{s:s, s:O?, s:I, s:o}", "type", "preview.error", "base", jbase,
+                         "version", (json_int_t)current, "problem", ag_view_problem(st, &err));
+    }
+    *to_room = 1;
+    return json_pack("{s:s, s:s, s:s, s:O, s:o, s:f}", "type", "preview", "peer", peer, "author",
+                     user, "base", jbase, "boxes", boxes, "solve_ms", solve_ms);
+}
+
+static void run_preview(ag_live *live, session *s, json_t *msg)
+{
+    s->preview_at = mono_ms();
+    enqueue_work(live, s, msg, 1);
+}
+
+static void on_preview(ag_live *live, session *s, json_t *msg)
+{
+    if (!s->model)
+        return send_error(s, AG_ERR_INVALID, "send hello before previews%s", "");
+    json_t *jm = json_object_get(msg, "model");
+    if (jm && (!json_is_integer(jm) || json_integer_value(jm) != s->model))
+        return send_error(s, AG_ERR_INVALID,
+                          "a preview is for the model of the connection's room%s", "");
+    double wait = s->preview_at + 1000.0 / AG_LIVE_PREVIEW_HZ - mono_ms();
+    if (wait <= 0 && !s->preview_next)
+        return run_preview(live, s, msg);
+    /* too soon: keep the newest, solve it when its turn comes */
+    if (!s->preview_next)
+        lws_set_timer_usecs(s->wsi, wait > 0 ? (lws_usec_t)(wait * 1000) : 1);
+    json_decref(s->preview_next);
+    s->preview_next = json_incref(msg);
+}
+
+static void on_preview_end(ag_live *live, session *s)
+{
+    if (!s->model)
+        return;
+    json_decref(s->preview_next);
+    s->preview_next = NULL;
+    char peer[32];
+    peer_name(s, peer, sizeof peer);
+    broadcast_json(live, s->model, s,
+                   json_pack("{s:s, s:s, s:s}", "type", "preview.end", "peer", peer, "author",
+                             s->user));
 }
 
 static int job_finished(const char *status)
@@ -378,6 +533,10 @@ static void on_message(ag_live *live, session *s)
         on_presence(live, s, msg);
     else if (strcmp(type, "watch") == 0)
         on_watch(live, s, msg);
+    else if (strcmp(type, "preview") == 0)
+        on_preview(live, s, msg);
+    else if (strcmp(type, "preview.end") == 0)
+        on_preview_end(live, s);
     else
         send_error(s, AG_ERR_INVALID, "unknown message type \"%s\"", type);
     json_decref(msg);
@@ -411,7 +570,14 @@ static void on_event(void *user, const ag_event *ev)
 
 static void deliver(ag_live *live, pending *p)
 {
-    if (p->kind == AG_EVENT_OP) {
+    if (p->kind == LIVE_TO_SESSION) {
+        for (session *s = live->sessions; s; s = s->next)
+            if (s->id == p->origin && p->json)
+                send_text(s, p->json);
+    } else if (p->kind == LIVE_TO_ROOM) {
+        if (p->json)
+            broadcast(live, p->model, NULL, p->json);
+    } else if (p->kind == AG_EVENT_OP) {
         json_t *op = p->json ? json_loads(p->json, 0, NULL) : NULL;
         json_t *msg = json_pack("{s:s, s:I, s:s, s:s, s:o}", "type", "op", "version",
                                 (json_int_t)p->version, "author", p->author ? p->author : "",
@@ -460,6 +626,51 @@ static void deliver(ag_live *live, pending *p)
             send_json(s, json_pack("{s:s, s:I}", "type", "gone", "model", (json_int_t)p->model));
         }
     }
+}
+
+static void free_work(work *w)
+{
+    json_decref(w->msg);
+    free(w->user);
+    free(w->peer);
+    free(w);
+}
+
+static void *worker_main(void *arg)
+{
+    ag_live *live = arg;
+    for (;;) {
+        pthread_mutex_lock(&live->work_lock);
+        while (!live->work_head && !live->work_stop)
+            pthread_cond_wait(&live->work_cond, &live->work_lock);
+        work *w = live->work_head;
+        int stop = live->work_stop;
+        if (w && !(live->work_head = w->next))
+            live->work_tail = NULL;
+        if (w)
+            live->work_count--;
+        pthread_mutex_unlock(&live->work_lock);
+        if (!w)
+            break;
+        if (!stop) {
+            int to_room = 0;
+            json_t *reply = w->preview ? preview_message(live->app, w->model, w->user, w->peer,
+                                                         w->msg, &to_room)
+                                       : op_reply(live->app, w->model, w->user, w->session,
+                                                  w->msg);
+            char *text = reply ? json_dumps(reply, JSON_COMPACT) : NULL;
+            json_decref(reply);
+            ag_event ev = {.kind = to_room ? LIVE_TO_ROOM : LIVE_TO_SESSION,
+                           .model = w->model,
+                           .json = text,
+                           .origin = w->session};
+            if (text)
+                on_event(live, &ev);
+            free(text);
+        }
+        free_work(w);
+    }
+    return NULL;
 }
 
 static void drain_events(ag_live *live)
@@ -560,7 +771,17 @@ static int on_lws(struct lws *wsi, enum lws_callback_reasons reason, void *user,
         }
         free(s->rx);
         free(s->presence);
+        json_decref(s->preview_next);
         memset(s, 0, sizeof *s);
+        break;
+    case LWS_CALLBACK_TIMER:
+        if (s->preview_next) {
+            json_t *msg = s->preview_next;
+            s->preview_next = NULL;
+            if (s->model)
+                run_preview(live, s, msg);
+            json_decref(msg);
+        }
         break;
     case LWS_CALLBACK_EVENT_WAIT_CANCELLED:
         if (live)
@@ -586,6 +807,23 @@ static void *service_main(void *arg)
     return NULL;
 }
 
+/* Lets the worker finish what it is computing, drops what waits, joins it. */
+static void stop_worker(ag_live *live)
+{
+    pthread_mutex_lock(&live->work_lock);
+    live->work_stop = 1;
+    pthread_cond_signal(&live->work_cond);
+    pthread_mutex_unlock(&live->work_lock);
+    if (live->worker_started)
+        pthread_join(live->worker, NULL);
+    live->worker_started = 0;
+    for (work *w = live->work_head, *next; w; w = next) {
+        next = w->next;
+        free_work(w);
+    }
+    live->work_head = live->work_tail = NULL;
+}
+
 static void log_lws(int level, const char *line)
 {
     (void)level;
@@ -600,6 +838,8 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     live->app = app;
     pthread_mutex_init(&live->lock, NULL);
+    pthread_mutex_init(&live->work_lock, NULL);
+    pthread_cond_init(&live->work_cond, NULL);
     lws_set_log_level(LLL_ERR, log_lws);
     struct lws_context_creation_info info;
     memset(&info, 0, sizeof info);
@@ -613,18 +853,25 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
     live->context = lws_create_context(&info);
     if (!live->context) {
         pthread_mutex_destroy(&live->lock);
+        pthread_mutex_destroy(&live->work_lock);
+        pthread_cond_destroy(&live->work_cond);
         free(live);
         return ag_error_set(err, AG_ERR_IO, 0,
                             "cannot listen for websockets on %s:%d (is the port in use?)",
                             opt->bind ? opt->bind : "127.0.0.1", opt->port);
     }
     ag_events_subscribe(ag_app_events(app), on_event, live);
-    if (pthread_create(&live->thread, NULL, service_main, live) != 0) {
+    live->worker_started = pthread_create(&live->worker, NULL, worker_main, live) == 0;
+    if (!live->worker_started ||
+        pthread_create(&live->thread, NULL, service_main, live) != 0) {
+        stop_worker(live);
         ag_events_unsubscribe(ag_app_events(app), on_event, live);
         lws_context_destroy(live->context);
         pthread_mutex_destroy(&live->lock);
+        pthread_mutex_destroy(&live->work_lock);
+        pthread_cond_destroy(&live->work_cond);
         free(live);
-        return ag_error_set(err, AG_ERR_INTERNAL, 0, "cannot start the websocket thread");
+        return ag_error_set(err, AG_ERR_INTERNAL, 0, "cannot start the websocket threads");
     }
     *out = live;
     return AG_OK;
@@ -634,6 +881,7 @@ void ag_live_stop(ag_live *live)
 {
     if (!live)
         return;
+    stop_worker(live);
     ag_events_unsubscribe(ag_app_events(live->app), on_event, live);
     atomic_store(&live->stop, 1);
     lws_cancel_service(live->context);
@@ -649,5 +897,7 @@ void ag_live_stop(ag_live *live)
         p = next;
     }
     pthread_mutex_destroy(&live->lock);
+    pthread_mutex_destroy(&live->work_lock);
+    pthread_cond_destroy(&live->work_cond);
     free(live);
 }

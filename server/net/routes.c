@@ -23,6 +23,7 @@ const ag_route ag_routes[] = {
     {"PUT", "/api/v1/models/{id}/grammar", ag_api_model_grammar_put, AG_BODY_UPLOAD},
     /* a building description or GeoJSON footprints, spooled like model uploads */
     {"POST", "/api/v1/extrusions", ag_api_extrusions_create, AG_BODY_UPLOAD},
+    {"POST", "/api/v1/extrusions/preview", ag_api_extrusions_preview, AG_BODY_JSON},
     {"GET", "/api/v1/models/{id}/plan", ag_api_model_plan, AG_BODY_NONE},
     {"GET", "/api/v1/jobs/{id}", ag_api_job_get, AG_BODY_NONE},
     {"DELETE", "/api/v1/jobs/{id}", ag_api_job_cancel, AG_BODY_NONE},

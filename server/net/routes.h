@@ -48,6 +48,7 @@ enum MHD_Result ag_api_model_tree(ag_request *r);
 enum MHD_Result ag_api_model_grammar_get(ag_request *r);
 enum MHD_Result ag_api_model_grammar_put(ag_request *r);
 enum MHD_Result ag_api_extrusions_create(ag_request *r);
+enum MHD_Result ag_api_extrusions_preview(ag_request *r);
 enum MHD_Result ag_api_model_plan(ag_request *r);
 enum MHD_Result ag_api_job_get(ag_request *r);
 enum MHD_Result ag_api_job_cancel(ag_request *r);

@@ -272,6 +272,54 @@ static void test_priority(void **state)
     ag_plan_free(p);
 }
 
+/* Per-segment priority tags: the bottom edge is two collinear edges, both vertical walls
+ * to 2 m (the same plane: no merge), then 45° (A) and 0.5 m/m (B). At 2 m they must merge;
+ * the tags of the segments in effect there decide, not those of the walls. */
+static double segment_priority_top(int32_t a_wall, int32_t a_roof, int32_t b_roof)
+{
+    const double xy[] = {0, 0, 5, 0, 10, 0, 10, 6, 0, 6};
+    const ag_profile_point A[] = {{0, 0}, {0, 2}, {1, 3}};
+    const ag_profile_point B[] = {{0, 0}, {0, 2}, {0.5, 3}};
+    const int32_t prof[] = {0, 1, 0, 0, 0};
+    ag_plan *p = ag_plan_create();
+    assert_int_equal(ag_plan_add_profile(p, "A", A, 3, NULL, NULL, NULL), AG_OK);
+    assert_int_equal(ag_plan_add_profile(p, "B", B, 3, NULL, NULL, NULL), AG_OK);
+    assert_int_equal(ag_plan_add_loop(p, xy, 5, prof, NULL), AG_OK);
+    assert_int_equal(ag_plan_set_segment_priority(p, 0, 0, a_wall, NULL), AG_OK);
+    assert_int_equal(ag_plan_set_segment_priority(p, 0, 1, a_roof, NULL), AG_OK);
+    assert_int_equal(ag_plan_set_segment_priority(p, 1, 1, b_roof, NULL), AG_OK);
+    ag_extrude_result r;
+    ag_shell *sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.stats.merges, 1);
+    double top = r.top;
+    ag_shell_free(sh);
+    ag_plan_free(p);
+    return top;
+}
+
+static void test_segment_priority(void **state)
+{
+    (void)state;
+    /* equal tags: max volume, B's shallower plane takes the bottom edge; the ridge is
+     * where 0.5 t = 6 - t, t = 4 above the walls */
+    assert_true(fabs(segment_priority_top(0, 0, 0) - 6.0) < 1e-9);
+    /* A's roof segment tagged higher: 45° everywhere, ridge at 2 + 3 */
+    assert_true(fabs(segment_priority_top(0, 5, 0) - 5.0) < 1e-9);
+    /* a tag on A's wall segment is not in effect at the merge */
+    assert_true(fabs(segment_priority_top(9, 0, 0) - 6.0) < 1e-9);
+    /* B's roof tagged below A's untagged roof */
+    assert_true(fabs(segment_priority_top(0, 0, -1) - 5.0) < 1e-9);
+    /* bad segment indices are refused */
+    ag_plan *p = ag_plan_create();
+    ag_plan_add_profile(p, "r", R45, 2, NULL, NULL, NULL);
+    ag_error err = {0};
+    assert_int_equal(ag_plan_set_segment_priority(p, 0, 1, 1, &err), AG_ERR_INVALID);
+    assert_int_equal(ag_plan_set_segment_priority(p, 3, 0, 1, &err), AG_ERR_INVALID);
+    assert_int_equal(ag_profile_priority(&p->profiles[0], 0), 0);
+    ag_plan_free(p);
+}
+
 static void test_fixtures(void **state)
 {
     (void)state;
@@ -281,7 +329,11 @@ static void test_fixtures(void **state)
                            "fig21_ambiguous_min", "fig22_two_bays", "parallel_collinear",
                            "nearly_parallel_different_angles", "wheel16", "gable_vertical",
                            "overhang_outward", "polygon_1000", "overhang_soffit",
-                           "terrace_setback", "overhang_disabled_on_gables"};
+                           "terrace_setback", "overhang_disabled_on_gables",
+                           "segment_priority", "forced_chimney", "forced_dormer",
+                           "mesh_anchor", "offset_overhang", "offset_open_ended",
+                           "offset_disabled_extended", "grid_terrace_meets_soffit",
+                           "grid_coincident_rays"};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
         char path[512];
         snprintf(path, sizeof path, AG_REPO_DIR "/tests/data/extrude/%s.json", names[i]);
@@ -305,6 +357,47 @@ static void test_fixtures(void **state)
         if ((v = json_object_get(ex, "volume")) && fabs(json_number_value(v) - r.volume) > 1e-6)
             fail_msg("%s: volume %.9f, expected %.9f", names[i], r.volume, json_number_value(v));
         assert_true(r.volume > 0);
+        /* anchors: where they were instanced, or null for not at all */
+        const char *an;
+        json_object_foreach(json_object_get(ex, "anchors"), an, v)
+        {
+            const ag_anchor *a = NULL;
+            for (size_t k = 0; k < p->nanchors; k++)
+                if (strcmp(p->anchors[k].name, an) == 0)
+                    a = &p->anchors[k];
+            if (!a)
+                fail_msg("%s: no anchor %s", names[i], an);
+            if (json_is_null(v) ? a->found : !a->found)
+                fail_msg("%s: anchor %s %s", names[i], an, a->found ? "instanced" : "not instanced");
+            for (size_t k = 0; !json_is_null(v) && k < 3; k++)
+                if (fabs(a->pos[k] - json_number_value(json_array_get(v, k))) > 1e-6)
+                    fail_msg("%s: anchor %s at %.9f in %zu", names[i], an, a->pos[k], k);
+        }
+        /* placed meshes: one component each, with the expected bounding box */
+        json_t *boxes = json_object_get(ex, "mesh_boxes");
+        if (boxes) {
+            ag_mesh *mm = ag_mesh_create();
+            size_t placed = 0;
+            assert_int_equal(ag_extrude_place_meshes(p, mm, -1, &placed, NULL), AG_OK);
+            assert_int_equal(placed, json_array_size(boxes));
+            assert_int_equal(mm->ncomponents, placed);
+            for (size_t c = 0; c < placed; c++) {
+                double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+                for (size_t t = 0; t < mm->ntris; t++)
+                    for (int k = 0; mm->tri_component[t] == c && k < 3; k++)
+                        for (int d = 0; d < 3; d++) {
+                            double x = mm->pos[3 * mm->tri[3 * t + k] + d];
+                            lo[d] = fmin(lo[d], x);
+                            hi[d] = fmax(hi[d], x);
+                        }
+                json_t *b = json_array_get(boxes, c);
+                for (int d = 0; d < 3; d++)
+                    if (fabs(lo[d] - json_number_value(json_array_get(json_array_get(b, 0), d))) > 1e-6 ||
+                        fabs(hi[d] - json_number_value(json_array_get(json_array_get(b, 1), d))) > 1e-6)
+                        fail_msg("%s: mesh %zu spans %.9f..%.9f in %d", names[i], c, lo[d], hi[d], d);
+            }
+            ag_mesh_free(mm);
+        }
         json_decref(doc);
         ag_shell_free(sh);
         ag_plan_free(p);
@@ -346,6 +439,46 @@ static void test_check_reports_open_faces(void **state)
     assert_int_equal(ag_shell_finish(s, 1e-9), AG_OK);
     assert_int_equal(ag_shell_check(s, pr, 4), 0);
     assert_true(fabs(ag_shell_volume(s) - 1.0 / 6) < 1e-12);
+    ag_shell_free(s);
+}
+
+/* Two solids touching along one edge (as a terrace and a soffit can meet): the edge has
+ * two half-edges each way; each must be paired with the other face of its own solid. */
+static void test_check_edge_touching_solids(void **state)
+{
+    (void)state;
+    ag_shell *s = ag_shell_create();
+    /* cube A [0,1]^3 and cube B [1,2]x[1,2]x[0,1]: they share x = y = 1 */
+    static const int F[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    uint32_t faces[2][6];
+    for (int c = 0; c < 2; c++) {
+        uint32_t v[8];
+        for (int i = 0; i < 8; i++) {
+            double x = (i == 1 || i == 2 || i == 5 || i == 6) ? 1 : 0;
+            double y = (i == 2 || i == 3 || i == 6 || i == 7) ? 1 : 0;
+            ag_shell_add_vertex(s, x + c, y + c, i >= 4, &v[i]);
+        }
+        for (int f = 0; f < 6; f++) {
+            ag_shell_face fc = {AG_SHELL_FACE_SIDE, c, f, 0, 0, 0, 0};
+            ag_shell_add_face(s, &fc, &faces[c][f]);
+            for (int k = 0; k < 4; k++)
+                ag_shell_add_segment(s, faces[c][f], v[F[f][k]], v[F[f][(k + 1) % 4]]);
+        }
+    }
+    assert_int_equal(ag_shell_finish(s, 1e-9), AG_OK);
+    ag_shell_problem pr[4];
+    assert_int_equal(ag_shell_check(s, pr, 4), 0);
+    size_t shared = 0;
+    for (size_t h = 0; h < s->nhalf; h++) {
+        assert_true(s->he_twin[h] != UINT32_MAX);
+        /* every pair stays within one cube */
+        assert_int_equal(s->faces[s->he_face[h]].loop, s->faces[s->he_face[s->he_twin[h]]].loop);
+        const double *p = &s->pos[3 * s->idx[h]], *q = &s->pos[3 * s->idx[s->he_next[h]]];
+        shared += p[0] == 1 && p[1] == 1 && q[0] == 1 && q[1] == 1;
+    }
+    assert_int_equal(shared, 4);
+    assert_true(fabs(ag_shell_volume(s) - 2) < 1e-12);
     ag_shell_free(s);
 }
 
@@ -478,6 +611,304 @@ static void test_natural_steps(void **state)
     ag_plan_free(p);
 }
 
+static ag_plan *forced_plan(const double *poly, size_t n, double h, int plan_frame,
+                            ag_plan_step **out)
+{
+    const double xy[] = {0, 0, 10, 0, 10, 6, 0, 6};
+    const ag_profile_point hip[] = {{0, 0}, {0, 3}, {1, 4}};
+    const ag_profile_point box[] = {{0, 0}, {0, 1}, {1, 2}};
+    ag_plan *p = plan_with(hip, 3, xy, 4);
+    size_t bp = 0;
+    assert_int_equal(ag_plan_add_profile(p, "box", box, 3, NULL, &bp, NULL), AG_OK);
+    if (!poly)
+        return p;
+    ag_plan_step st;
+    memset(&st, 0, sizeof st);
+    st.at.edge = plan_frame ? -1 : 0;
+    st.at.along = 0.5;
+    st.at.z = h;
+    st.plan_frame = plan_frame;
+    st.npoints = n;
+    st.points = (double *)poly;
+    st.profile = (int32_t)bp;
+    assert_int_equal(ag_plan_add_step(p, &st, NULL), AG_OK);
+    if (out)
+        *out = &p->steps[0];
+    return p;
+}
+
+static void test_forced_steps(void **state)
+{
+    (void)state;
+    ag_extrude_result r0, r;
+    ag_plan *p = forced_plan(NULL, 0, 0, 0, NULL);
+    ag_shell *sh = extrude(p, &r0);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+    assert_true(fabs(r0.volume - 252) < 1e-6);
+
+    /* straddling the front slope at 3.5 m (anchor frame: 0.5 m behind the active edge,
+     * 1 m in front): the floor is the part in front, 2 x 1 m, facing down */
+    const double straddle[] = {-1, -0.5, 1, -0.5, 1, 1, -1, 1};
+    p = forced_plan(straddle, 4, 3.5, 0, NULL);
+    sh = extrude(p, &r);
+    if (r.failing_faces)
+        fail_msg("straddle: %s", r.problems[0].reason);
+    assert_int_equal(r.stats.steps, 1);
+    assert_true(fabs(edit_floor_area(sh, 3.5) + 2.0) < 1e-6);
+    assert_true(r.volume > r0.volume + 2.0 * 1.0); /* at least the 1 m walls in front */
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* the same, clockwise: oriented before use */
+    const double straddle_cw[] = {-1, 1, 1, 1, 1, -0.5, -1, -0.5};
+    p = forced_plan(straddle_cw, 4, 3.5, 0, NULL);
+    sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_true(fabs(edit_floor_area(sh, 3.5) + 2.0) < 1e-6);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* plan frame, wholly inside the active plan: nothing changes, counted as skipped */
+    const double inside[] = {4, 2, 6, 2, 6, 4, 4, 4};
+    p = forced_plan(inside, 4, 2, 1, NULL);
+    sh = extrude(p, &r);
+    assert_int_equal(r.stats.steps, 0);
+    assert_int_equal(r.stats.steps_skipped, 1);
+    assert_true(fabs(r.volume - r0.volume) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* disjoint, outside: a separate block from 2 m; its volume is that of the same
+     * square extruded on its own */
+    const double island[] = {12, 0, 14, 0, 14, 2, 12, 2};
+    p = forced_plan(island, 4, 2, 1, NULL);
+    sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.stats.steps, 1);
+    assert_true(fabs(edit_floor_area(sh, 2) + 4.0) < 1e-6);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+    const ag_profile_point box[] = {{0, 0}, {0, 1}, {1, 2}};
+    const double sq[] = {12, 0, 14, 0, 14, 2, 12, 2};
+    ag_plan *pb = plan_with(box, 3, sq, 4);
+    ag_extrude_result rb;
+    sh = extrude(pb, &rb);
+    ag_shell_free(sh);
+    ag_plan_free(pb);
+    assert_true(fabs(r.volume - (r0.volume + rb.volume)) < 1e-6);
+
+    /* swallowing the whole active plan at 3.5 m (9 x 5 there): the floor is the
+     * 12 x 8 polygon minus it; the roof above is the polygon's own */
+    const double big[] = {-1, -1, 11, -1, 11, 7, -1, 7};
+    p = forced_plan(big, 4, 3.5, 1, NULL);
+    sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_true(fabs(edit_floor_area(sh, 3.5) + (96.0 - 45.0)) < 1e-6);
+    assert_true(fabs(r.top - (3.5 + 1 + 4)) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* over a corner of the walls at 1 m: the corner ends inside, two edges are cut */
+    const double corner[] = {8, -2, 12, -2, 12, 2, 8, 2};
+    p = forced_plan(corner, 4, 1, 1, NULL);
+    sh = extrude(p, &r);
+    if (r.failing_faces)
+        fail_msg("corner: %s", r.problems[0].reason);
+    assert_int_equal(r.stats.steps, 1);
+    assert_true(fabs(edit_floor_area(sh, 1) + 12.0) < 1e-6);
+    assert_true(r.volume > r0.volume + 12.0);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* a corner exactly on the active boundary: refused, not guessed */
+    const double touch[] = {5, -1, 6, 0, 5, 0.5};
+    p = forced_plan(touch, 3, 1, 1, NULL);
+    sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.stats.steps_skipped, 1);
+    assert_true(fabs(r.volume - r0.volume) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* bad polygons are refused when added */
+    p = forced_plan(NULL, 0, 0, 0, NULL);
+    ag_plan_step st;
+    memset(&st, 0, sizeof st);
+    const double bow[] = {0, 0, 2, 2, 2, 0, 0, 1};
+    st.at.z = 1;
+    st.plan_frame = 1;
+    st.points = (double *)bow;
+    st.npoints = 4;
+    st.profile = 1;
+    ag_error err = {0};
+    assert_int_equal(ag_plan_add_step(p, &st, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "cross"));
+    st.npoints = 2;
+    assert_int_equal(ag_plan_add_step(p, &st, &err), AG_ERR_INVALID);
+    ag_plan_free(p);
+}
+
+/* Area of the horizontal faces at height z, signed by facing (up positive). */
+static double flat_area(const ag_shell *sh, double z)
+{
+    double area = 0;
+    for (size_t f = 0; f < sh->nfaces; f++) {
+        const ag_shell_face *fc = &sh->faces[f];
+        for (uint32_t l = fc->first_loop; l < fc->first_loop + (fc->nloops & 0x7fffffffu); l++) {
+            double a = 0;
+            int flat = 1;
+            uint32_t b0 = sh->loop_start[l], b1 = sh->loop_start[l + 1];
+            for (uint32_t k = b0; k < b1; k++) {
+                const double *p = &sh->pos[3 * sh->idx[k]];
+                const double *q = &sh->pos[3 * sh->idx[k + 1 < b1 ? k + 1 : b0]];
+                a += p[0] * q[1] - q[0] * p[1];
+                if (fabs(p[2] - z) > 1e-9)
+                    flat = 0;
+            }
+            if (flat)
+                area += a / 2;
+        }
+    }
+    return area;
+}
+
+static ag_plan *offset_plan(double outside, int disable_gables, int side, int32_t after)
+{
+    const double xy[] = {0, 0, 10, 0, 10, 6, 0, 6};
+    const ag_profile_point wall[] = {{0, 0}, {0, 1}}, roof[] = {{0, 0}, {1, 1}};
+    ag_plan *p = plan_with(wall, 2, xy, 4);
+    ag_plan_add_profile(p, "roof", roof, 2, NULL, NULL, NULL);
+    ag_plan_add_profile(p, "end", wall, 2, NULL, NULL, NULL);
+    ag_offset_edge ov[2] = {{0, 1, 1, 0, 0, -1}, {0, 3, 1, 0, 0, -1}};
+    ag_plan_offset o = {3, outside, after, side ? 2 : -1, disable_gables ? 2 : 0, ov};
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_OK);
+    return p;
+}
+
+static void test_offset_events(void **state)
+{
+    (void)state;
+    ag_extrude_result ra, rb;
+    /* the mitre cut adds, at each of the 4 corners, the roof over the triangle between
+     * the gable wall's line and the mitre: the integral of (y + 0.5) over it, 1/48 */
+    ag_plan *p = offset_plan(0.5, 1, 0, 1);
+    ag_shell *sh = extrude(p, &ra);
+    assert_int_equal(ra.stats.offsets, 1);
+    assert_int_equal(ra.stats.offset_sides, 0);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+    p = offset_plan(0.5, 1, 1, 1);
+    sh = extrude(p, &rb);
+    assert_int_equal(rb.failing_faces, 0);
+    assert_int_equal(rb.stats.offset_sides, 4);
+    assert_true(fabs(rb.volume - ra.volume - 4.0 / 48) < 1e-9);
+    /* the soffit: the two eaves' strips, mitred, facing down at 3 m: 2 * 0.5 * 10.5 */
+    assert_true(fabs(flat_area(sh, 3) + 10.5) < 1e-9);
+    /* faces: the soffits are flat growth (segment -1) of the roof profile, then segment 0 */
+    int soffits = 0, roofs = 0, sides = 0;
+    for (size_t f = 0; f < sh->nfaces; f++) {
+        const ag_shell_face *fc = &sh->faces[f];
+        if (!(fc->nloops & 0x7fffffffu) || fc->kind != AG_SHELL_FACE_SIDE)
+            continue;
+        soffits += fc->profile == 1 && fc->segment == -1;
+        roofs += fc->profile == 1 && fc->segment == 0;
+        sides += fc->profile == 2 && fc->segment == 0;
+    }
+    assert_int_equal(soffits, 2);
+    assert_int_equal(roofs, 2);
+    assert_int_equal(sides, 4);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* inwards, every edge, walls carrying on (no profile after) and a cap at 5 m: a 1 m
+     * terrace at 3 m, 60 - 32 m² facing up, and 8 x 4 above it */
+    p = offset_plan(-1, 0, 0, -1);
+    p->cap_height = 5;
+    sh = extrude(p, &ra);
+    assert_int_equal(ra.failing_faces, 0);
+    assert_true(fabs(flat_area(sh, 3) - 28) < 1e-9);
+    assert_true(fabs(ra.volume - (180 + 64)) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* per-edge distance and profile; anchors still find the input edge after the event */
+    p = offset_plan(0.5, 1, 0, 1);
+    p->offsets[0].edges[0] = (ag_offset_edge){0, 0, 0, 1, 1.0, 0};
+    p->offsets[0].nedges = 1;
+    ag_anchor a;
+    memset(&a, 0, sizeof a);
+    a.edge = 0;
+    a.along = 0.5;
+    a.z = 3.2;
+    ag_plan_add_anchor(p, &a, NULL);
+    sh = extrude(p, &ra);
+    assert_int_equal(ra.failing_faces, 0);
+    /* edge 0 moved 1 m out and keeps a vertical wall (profile 0): the anchor is on it */
+    assert_true(p->anchors[0].found);
+    assert_true(fabs(p->anchors[0].pos[1] + 1.0) < 1e-9 && fabs(p->anchors[0].pos[2] - 3.2) < 1e-9);
+    assert_true(fabs(p->anchors[0].normal[1] + 1) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* a forced step's profile heights count from the step and the offset interval is
+     * skipped over: an island from 1 m (walls 1.5 m, then 45°), moved 0.5 m out at 2 m,
+     * turns at 2.5 m and closes 1.5 m higher, at 4 m */
+    {
+        const double hxy[] = {0, 0, 10, 0, 10, 6, 0, 6};
+        const ag_profile_point hip2[] = {{0, 0}, {0, 2}, {1, 3}};
+        const ag_profile_point box[] = {{0, 0}, {0, 1.5}, {1, 2.5}};
+        const double island[] = {12, 0, 14, 0, 14, 2, 12, 2};
+        p = plan_with(hip2, 3, hxy, 4);
+        ag_plan_add_profile(p, "box", box, 3, NULL, NULL, NULL);
+        ag_plan_step st;
+        memset(&st, 0, sizeof st);
+        st.at.z = 1;
+        st.plan_frame = 1;
+        st.points = (double *)island;
+        st.npoints = 4;
+        st.profile = 1;
+        assert_int_equal(ag_plan_add_step(p, &st, NULL), AG_OK);
+        ag_plan_offset oo = {2, 0.5, -1, -1, 0, NULL};
+        assert_int_equal(ag_plan_add_offset(p, &oo, NULL), AG_OK);
+        sh = extrude(p, &ra);
+        assert_int_equal(ra.failing_faces, 0);
+        double itop = 0;
+        for (size_t f = 0; f < sh->nfaces; f++)
+            if (sh->faces[f].loop == -1)
+                for (uint32_t l = sh->faces[f].first_loop;
+                     l < sh->faces[f].first_loop + (sh->faces[f].nloops & 0x7fffffffu); l++)
+                    for (uint32_t k = sh->loop_start[l]; k < sh->loop_start[l + 1]; k++)
+                        itop = fmax(itop, sh->pos[3 * sh->idx[k] + 2]);
+        assert_true(fabs(itop - 4.0) < 1e-9);
+        assert_true(fabs(ra.top - 5.5) < 1e-9); /* the main roof from 11 x 7 at 2 m */
+        ag_shell_free(sh);
+        ag_plan_free(p);
+    }
+
+    /* an offset at the height of a horizontal profile segment is refused */
+    const double xy[] = {0, 0, 10, 0, 10, 6, 0, 6};
+    const ag_profile_point ov[] = {{0, 0}, {0, 3}, {-0.5, 3}, {0.5, 4}};
+    p = plan_with(ov, 4, xy, 4);
+    ag_plan_offset o = {3, 0.2, -1, -1, 0, NULL};
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_OK);
+    ag_mesh *m = ag_mesh_create();
+    ag_error err = {0};
+    assert_int_equal(ag_extrude_plan(p, m, -1, &ra, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "offset 0"));
+    assert_int_equal(m->ntris, 0);
+    ag_mesh_free(m);
+    /* bad offsets are refused when added */
+    o.profile = 1;
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_ERR_INVALID);
+    o.profile = 0; /* has a horizontal segment */
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_ERR_INVALID);
+    o.profile = -1;
+    o.z = 0;
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_ERR_INVALID);
+    ag_plan_free(p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -486,10 +917,14 @@ int main(void)
         cmocka_unit_test(test_nonconvex_planes),
         cmocka_unit_test(test_profiles),
         cmocka_unit_test(test_priority),
+        cmocka_unit_test(test_segment_priority),
         cmocka_unit_test(test_fixtures),
         cmocka_unit_test(test_check_reports_open_faces),
+        cmocka_unit_test(test_check_edge_touching_solids),
         cmocka_unit_test(test_anchors),
         cmocka_unit_test(test_natural_steps),
+        cmocka_unit_test(test_forced_steps),
+        cmocka_unit_test(test_offset_events),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -62,6 +62,137 @@ static void test_plan_ok(void **state)
     ag_plan_free(p);
 }
 
+static void test_plan_forced_and_tags(void **state)
+{
+    (void)state;
+    const char *doc =
+        "{\"profiles\": {\"roof\": {\"points\": [[0,0],[0,3],[1,4]], \"priority\": 2,"
+        "                          \"segment_priority\": [7, null]},"
+        "               \"box\": [[0,0],[0,1],[1,2]]},"
+        " \"loops\": [[[0,0],[10,0],[10,6],[0,6]]],"
+        " \"steps\": [{\"name\": \"chimney\", \"edge\": 0, \"relative\": 0.7, \"height\": 4,"
+        "             \"points\": [[-0.4,-0.4],[0.4,-0.4],[0.4,0.4],[-0.4,0.4]], \"profile\": \"box\"},"
+        "            {\"name\": \"annex\", \"height\": 2, \"profile\": \"box\","
+        "             \"points\": [[12,0],[14,0],[14,2]]}]}";
+    ag_plan *p = NULL;
+    ag_error err = {0};
+    if (parse(doc, &p, &err) != AG_OK)
+        fail_msg("%s", err.text);
+    int32_t roof = ag_plan_find_profile(p, "roof");
+    assert_int_equal(ag_profile_priority(&p->profiles[roof], 0), 7);
+    assert_int_equal(ag_profile_priority(&p->profiles[roof], 1), 2); /* null: the profile's */
+    assert_int_equal(p->nsteps, 2);
+    const ag_plan_step *c = &p->steps[0], *a = &p->steps[1];
+    assert_string_equal(c->name, "chimney");
+    assert_int_equal(c->npoints, 4);
+    assert_false(c->plan_frame);
+    assert_true(c->at.edge == 0 && c->at.along == 0.7 && c->at.z == 4);
+    assert_true(c->points[0] == -0.4 && c->points[5] == 0.4);
+    assert_string_equal(a->name, "annex");
+    assert_true(a->plan_frame && a->npoints == 3 && a->at.z == 2 && a->points[4] == 14);
+    ag_plan_free(p);
+    struct {
+        const char *doc, *needle;
+    } bad[] = {
+        {"{\"profiles\": {\"r\": {\"points\": [[0,0],[1,1]], \"segment_priority\": [1, 2]}},"
+         " \"loops\": [[[0,0],[1,0],[0,1]]]}", "one integer per segment"},
+        {"{\"profiles\": {\"r\": {\"points\": [[0,0],[1,1]], \"segment_priority\": [\"x\"]}},"
+         " \"loops\": [[[0,0],[1,0],[0,1]]]}", "segment_priority[0]"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"steps\": [{\"profile\": \"r\", \"points\": [[0,0],[1,0],[0,1]]}]}", "height"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"steps\": [{\"height\": 1, \"points\": [[0,0],[1,0],[0,1]]}]}", "profile"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"steps\": [{\"height\": 1, \"profile\": \"r\", \"points\": [[0,0],[1,0]]}]}",
+         "at least 3"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]], \"t\": [[0,0],[0,1],[1,1],[1,2]]},"
+         " \"loops\": [[[0,0],[1,0],[0,1]]], \"steps\": [{\"height\": 1, \"profile\": \"t\","
+         " \"points\": [[0,0],[1,0],[0,1]]}]}", "horizontal"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"anchors\": [{\"edge\": 0, \"relative\": 0.5, \"height\": 1, \"mesh\": \"w\"}]}",
+         "anchors[0].mesh"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"meshes\": {\"w\": \"/nonexistent/w.obj\"}}", "meshes.w"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"meshes\": {\"w\": {\"path\": \"w.obj\", \"up\": \"x\"}}}", "meshes.w"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        ag_plan *q = NULL;
+        ag_error e2 = {0};
+        ag_status st = parse(bad[i].doc, &q, &e2);
+        if (st == AG_OK || !strstr(e2.text, bad[i].needle))
+            fail_msg("bad %zu: status %d, message '%s' lacks '%s'", i, st, e2.text, bad[i].needle);
+        assert_null(q);
+    }
+}
+
+static void test_plan_offsets(void **state)
+{
+    (void)state;
+    const char *doc =
+        "{\"profiles\": {\"wall\": [[0,0],[0,1]], \"roof\": [[0,0],[1,1]], \"end\": [[0,0],[0,1]]},"
+        " \"loops\": [[[0,0],[10,0],[10,6],[0,6]]],"
+        " \"offsets\": [{\"height\": 3, \"outside\": 0.5, \"profile\": \"roof\", \"side\": \"end\","
+        "   \"edges\": [{\"edge\": 1, \"disabled\": true},"
+        "             {\"loop\": 0, \"edge\": 2, \"outside\": 0.8, \"profile\": \"wall\"}]}]}";
+    ag_plan *p = NULL;
+    ag_error err = {0};
+    if (parse(doc, &p, &err) != AG_OK)
+        fail_msg("%s", err.text);
+    assert_int_equal(p->noffsets, 1);
+    const ag_plan_offset *o = &p->offsets[0];
+    assert_true(o->z == 3 && o->outside == 0.5);
+    assert_int_equal(o->profile, ag_plan_find_profile(p, "roof"));
+    assert_int_equal(o->side, ag_plan_find_profile(p, "end"));
+    assert_int_equal(o->nedges, 2);
+    assert_true(o->edges[0].disabled && o->edges[0].edge == 1 && !o->edges[0].has_outside);
+    assert_int_equal(o->edges[0].profile, -1);
+    assert_true(!o->edges[1].disabled && o->edges[1].has_outside && o->edges[1].outside == 0.8);
+    assert_int_equal(o->edges[1].profile, ag_plan_find_profile(p, "wall"));
+    ag_plan_free(p);
+    const char *bad[][2] = {
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"offsets\": [{\"outside\": 1}]}", "offsets[0]"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"offsets\": [{\"height\": 1, \"outside\": 1, \"profile\": \"q\"}]}", "offsets[0]"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"offsets\": [{\"height\": 1, \"outside\": 1, \"edges\": [{\"edge\": 7}]}]}",
+         "names no edge"},
+        {"{\"profiles\": {\"r\": [[0,0],[1,1]]}, \"loops\": [[[0,0],[1,0],[0,1]]],"
+         " \"offsets\": [{\"height\": 1, \"outside\": 1, \"edges\": [{\"edge\": 0, \"disabled\": 1}]}]}",
+         "edges[0]"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        ag_plan *q = NULL;
+        ag_error e2 = {0};
+        ag_status st = parse(bad[i][0], &q, &e2);
+        if (st == AG_OK || !strstr(e2.text, bad[i][1]))
+            fail_msg("bad %zu: status %d, message '%s' lacks '%s'", i, st, e2.text, bad[i][1]);
+        assert_null(q);
+    }
+}
+
+static void test_plan_meshes(void **state)
+{
+    (void)state;
+    ag_plan *p = NULL;
+    ag_error err = {0};
+    if (ag_plan_json_read_file(AG_REPO_DIR "/tests/data/extrude/mesh_anchor.json", &p, &err) != AG_OK)
+        fail_msg("%s", err.text);
+    assert_int_equal(p->nmeshes, 1);
+    assert_string_equal(p->meshes[0].name, "window");
+    assert_int_equal(p->meshes[0].mesh->ntris, 12);
+    /* read z-up as asked: the box stands 1.2 m tall in z */
+    double zmax = 0;
+    for (size_t i = 0; i < p->meshes[0].mesh->nverts; i++)
+        zmax = fmax(zmax, p->meshes[0].mesh->pos[3 * i + 2]);
+    assert_true(fabs(zmax - 1.2) < 1e-12);
+    assert_int_equal(p->nanchors, 4);
+    for (size_t i = 0; i < 4; i++)
+        assert_int_equal(p->anchors[i].mesh, 1);
+    ag_plan_free(p);
+}
+
 static void test_plan_errors(void **state)
 {
     (void)state;
@@ -135,6 +266,9 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plan_ok),
+        cmocka_unit_test(test_plan_forced_and_tags),
+        cmocka_unit_test(test_plan_offsets),
+        cmocka_unit_test(test_plan_meshes),
         cmocka_unit_test(test_plan_errors),
         cmocka_unit_test(test_style),
     };

@@ -181,4 +181,23 @@ export class Api {
       xhr.send(file);
     });
   }
+
+  // --- extrusions -----------------------------------------------------------------------------
+  // GeoJSON footprints or a building description → the extrude job (202).
+  uploadExtrusion(file, { name, style } = {}) {
+    const q = new URLSearchParams({ name: name ?? file.name });
+    if (style) q.set('style', style);
+    return this.request('POST', `/extrusions?${q}`, { body: file });
+  }
+
+  // The stored description(s) of an extrusion model (a batch: {buildings: [...]}).
+  getPlan(id) {
+    return this.request('GET', `/models/${id}/plan`);
+  }
+
+  // One building description extruded without storing anything: the shell's GLB bytes.
+  async previewExtrusion(plan) {
+    const res = await this.request('POST', '/extrusions/preview', { body: plan, raw: true, headers: { Accept: 'model/gltf-binary' } });
+    return res.arrayBuffer();
+  }
 }

@@ -274,7 +274,7 @@ export class Editor {
 }
 
 // Ops after which the model's mesh, tree and grammar must be read again.
-const MESH_OPS = new Set(['proceduralize', 'grammar']);
+const MESH_OPS = new Set(['proceduralize', 'grammar', 'resize', 'split', 'join', 'paste', 'remove', 'undo', 'redo', 'restore']);
 
 function selectionKey(sel) {
   if (!sel) return '';

@@ -13,9 +13,44 @@ function summary(op) {
       return `${count(op.rules, 'rule')} · ${count(op.terminals, 'terminal')} · ${count(op.patterns, 'pattern')}`;
     case 'grammar':
       return typeof op.bytes === 'number' ? `grammar edited (${count(op.bytes, 'byte')})` : 'grammar edited';
+    case 'resize':
+      return `node ${op.node} ${op.scale ? `× ${op.scale.join(', ')}` : boxText(op.box)} · ${op.mode || 'global'}${reportText(op.report)}`;
+    case 'split':
+      return `node ${op.node} at ${op.axis} = ${Number(op.at).toFixed(2)} m${reportText(op.report)}`;
+    case 'join':
+    case 'remove':
+      return Array.isArray(op.nodes) ? `nodes ${op.nodes.join(', ')}` : '';
+    case 'paste':
+      return `${Array.isArray(op.source) ? op.source.join(', ') : '?'} → ${op.target} · ${op.placement || 'insert'}, ${op.fit || 'fill'}`;
+    case 'undo':
+    case 'redo':
+      return '';
+    case 'restore':
+      if (op.undoes != null) return `undo of v${op.undoes}`;
+      if (op.redoes != null) return `redo of v${op.redoes}`;
+      return `back to v${op.version}`;
+    case 'plan':
+      return `building ${op.building} · plan edited`;
+    case 'profile':
+      return `profile “${op.name}” edited`;
     default:
       return '';
   }
+}
+
+// What the server's solve did: splits and joins, and its time.
+function reportText(r) {
+  if (!r || typeof r !== 'object') return '';
+  const parts = [];
+  if (r.splits) parts.push(count(r.splits, 'split'));
+  if (r.joins) parts.push(count(r.joins, 'join'));
+  if (typeof r.solve_ms === 'number' && r.equations) parts.push(`${r.equations} eq. in ${r.solve_ms.toFixed(1)} ms`);
+  return parts.length ? ` · ${parts.join(', ')}` : '';
+}
+
+function boxText(box) {
+  if (!Array.isArray(box) || box.length !== 6) return '';
+  return `→ ${[0, 1, 2].map((i) => (box[i + 3] - box[i]).toFixed(2)).join(' × ')} m`;
 }
 
 function count(n, what) {
@@ -26,6 +61,7 @@ function count(n, what) {
 export class HistoryPanel {
   constructor(editor, session, container) {
     this.editor = editor;
+    this.session = session;
     this.list = el('ol.history', { 'data-testid': 'history' });
     this.input = el('input.note-input', {
       type: 'text',
@@ -46,7 +82,17 @@ export class HistoryPanel {
     container.append(el('h2', {}, 'History'), this.form, this.list);
     editor.signals.historyChanged.add(() => this.render());
     editor.signals.modelOpened.add(() => this.render());
+    editor.signals.modelChanged.add(() => this.render());
     this.render();
+  }
+
+  // Restoring an old version is an op too: it appends, so it can itself be undone.
+  async restore(version) {
+    try {
+      await this.session.live.sendOp({ kind: 'restore', version });
+    } catch (err) {
+      if (!err.problem || !this.session.live.open) this.editor.fail(err); // a nack was already shown
+    }
   }
 
   render() {
@@ -73,6 +119,14 @@ export class HistoryPanel {
           el('span.op-kind', {}, e.op?.kind || '?'),
           el('span.op-summary', {}, summary(e.op)),
           el('span.op-time', {}, e.at ? timeAgo(e.at) : ''),
+          e.version < ed.model.version && ed.model.proceduralized
+            ? el('button.op-restore', {
+              type: 'button',
+              title: `Make v${e.version} the current state again (a new edit)`,
+              'data-testid': 'restore',
+              onclick: () => this.restore(e.version),
+            }, 'restore')
+            : '',
         ),
       ),
       older > 0 ? el('li.empty', {}, `${older} older edits not shown`) : '',

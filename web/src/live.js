@@ -26,6 +26,12 @@ export class Live {
     this.presenceTimer = null;
     this.presenceDue = false;
     this.lastPresence = 0;
+    this.handlers = new Map(); // message type -> callback(msg, inRoom) for types added by tools
+  }
+
+  // Lets a tool (e.g. the live drag preview) receive a message type this class does not handle.
+  on(type, callback) {
+    this.handlers.set(type, callback);
   }
 
   get open() {
@@ -264,9 +270,12 @@ export class Live {
       case 'error':
         ed.fail(msg.problem || { title: 'Live connection error' });
         break;
-      default:
-        // newer servers may add types; nothing for us to do with them
+      default: {
+        // newer servers may add types; a registered tool may want them
+        const handler = this.handlers.get(msg.type);
+        if (handler) handler(msg, inRoom);
         break;
+      }
     }
   }
 

@@ -15,6 +15,14 @@ import { Procedural } from './procedural.js';
 import { SplitTreePanel } from './treepanel.js';
 import { GrammarPanel } from './grammarpanel.js';
 import { collapsible } from './collapse.js';
+import { Extrusion } from './extrusion.js';
+import { PlanEditor } from './planeditor.js';
+import { ProfileEditor } from './profileeditor.js';
+import { CityView, NewExtrusionPanel } from './cityview.js';
+import { PreviewLayer } from './previewlayer.js';
+import { EditTools } from './edittools.js';
+import { Handles } from './handles.js';
+import { Undo } from './undo.js';
 
 const editor = new Editor();
 const api = new Api(() => editor.user);
@@ -27,8 +35,17 @@ const $ = (id) => document.getElementById(id);
 new Toast(editor, $('toasts'));
 new Toolbar(editor, session, $('toolbar'));
 new ModelsPanel(editor, session, upload, $('models'));
-new Viewport(editor, api, $('viewport'));
+const viewport = new Viewport(editor, api, $('viewport'));
+const preview = new PreviewLayer(editor, viewport, live);
+const editTools = new EditTools(editor, live, api, viewport, $('edit'));
+const handles = new Handles(editor, viewport, live, preview, editTools);
+new Undo(editor, live, editTools.undoSlot);
 new Inspector(editor, $('inspector'));
+const extrusion = new Extrusion(editor, api, live, session, viewport);
+new NewExtrusionPanel(editor, extrusion, $('extrude-new'));
+new PlanEditor(editor, extrusion, $('plan-pane'));
+new ProfileEditor(editor, extrusion, $('profile-pane'));
+new CityView(editor, extrusion, viewport, $('city'));
 new PeersPanel(editor, $('peers'));
 new HistoryPanel(editor, session, $('history'));
 new SplitTreePanel(editor, procedural, $('tree'));
@@ -40,6 +57,7 @@ window.addEventListener('unhandledrejection', (e) => {
 });
 
 window.archgram = editor; // for poking at state from the console
+window.archgramTools = { viewport, preview, editTools, handles }; // and at the edit tools (tests drive handles)
 
 function modelFromHash() {
   const m = /^#model=(\d+)$/.exec(location.hash);

@@ -3,7 +3,8 @@ import { el } from './dom.js';
 
 const COLOURS = ['#e07a5f', '#3d85c6', '#81b29a', '#c38bd6', '#f2cc8f', '#5fb3b3', '#e06c9f'];
 
-function colourOf(name) {
+// A person's colour: their dot here and their selection in the viewport.
+export function colourOf(name) {
   let h = 0;
   for (const ch of name) h = (h * 31 + ch.codePointAt(0)) >>> 0;
   return COLOURS[h % COLOURS.length];
@@ -39,7 +40,7 @@ export class PeersPanel {
           : sel.length <= 3 ? `component ${sel.join(', ')}` : `${sel.length} components`;
         return el(
           'li.peer',
-          { dataset: { peer: p.peer } },
+          { dataset: { peer: p.peer, colour: colourOf(name) } },
           el('span.dot', { style: `background:${colourOf(name)}` }),
           el('span.peer-name', {}, name),
           el('span.peer-sel', {}, what),

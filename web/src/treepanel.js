@@ -3,6 +3,7 @@
 // geometry; a component picked in the viewport is revealed here (both through the editor).
 import { el } from './dom.js';
 import { boxSize, nodeTitle } from './splittree.js';
+import { selectedNodes, toggleNode } from './edittools.js';
 
 const STAGES = ['segment', 'label', 'tree', 'rules', 'patterns', 'export', 'verify'];
 const OPEN_DEPTH = 2; // levels shown expanded when a tree arrives
@@ -159,7 +160,8 @@ export class SplitTreePanel {
         dataset: { node: id, kind: n.kind },
         style: `padding-left:${depth * 12 + 2}px`,
         title: `node ${id}`,
-        onclick: () => this.editor.selectNode(id),
+        // Shift+click adds to the selection (join, copy, remove work on several nodes)
+        onclick: (e) => (e.shiftKey ? toggleNode(this.editor, id) : this.editor.selectNode(id)),
         onkeydown: (e) => this.key(e, id),
       },
       kids.length ? toggle : el('span.toggle-space'),
@@ -203,11 +205,11 @@ export class SplitTreePanel {
     return sel && sel.node !== undefined && sel.node !== null ? sel.node : null;
   }
 
-  // Marks the selected node's row.
+  // Marks the selected nodes' rows.
   mark() {
-    const id = this.selectedNode();
+    const ids = new Set(selectedNodes(this.editor));
     for (const [nid, row] of this.rows) {
-      const on = nid === id;
+      const on = ids.has(nid);
       row.classList.toggle('selected', on);
       row.setAttribute('aria-selected', on ? 'true' : 'false');
     }

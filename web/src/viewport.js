@@ -4,6 +4,8 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { toggleNode } from './edittools.js';
+import { colourOf } from './peers.js';
 
 // Flat, light background; model colours are mid-tones kept well away from it so the model
 // always stands out (and the grid stays close to it so it never does).
@@ -60,7 +62,7 @@ export class Viewport {
       this.pointerDown = null;
       if (e.button !== 0 || !d) return;
       if (Math.hypot(e.clientX - d.x, e.clientY - d.y) > CLICK_SLOP_PX) return; // an orbit drag
-      this.pick(e.clientX, e.clientY);
+      this.pick(e.clientX, e.clientY, e.shiftKey);
     });
 
     this.status = document.createElement('div');
@@ -78,6 +80,7 @@ export class Viewport {
     s.meshChanged.add((model) => this.load(model, { keepCamera: true }));
     s.treeChanged.add(() => this.colourize());
     s.selectionChanged.add(() => this.highlight());
+    s.peersChanged.add(() => this.highlight());
   }
 
   requestRender() {
@@ -193,7 +196,7 @@ export class Viewport {
           if (!groupColour.has(key)) groupColour.set(key, PALETTE[groupColour.size % PALETTE.length]);
           colour = new THREE.Color(groupColour.get(key));
         }
-        o.userData.baseColour = colour;
+        o.userData.baseColour = (this.tint && this.tint(o)) || colour; // e.g. the city view's height colours
       }
     }
     this.highlight();
@@ -241,7 +244,8 @@ export class Viewport {
   }
 
   // --- picking ------------------------------------------------------------------------------
-  pick(clientX, clientY) {
+  // Shift adds the component's split-tree node to the selection (or takes it out).
+  pick(clientX, clientY, extend = false) {
     if (!this.root) return;
     const rect = this.renderer.domElement.getBoundingClientRect();
     const ndc = new THREE.Vector2(
@@ -255,16 +259,30 @@ export class Viewport {
       this.editor.select(null);
       return;
     }
+    const node = this.editor.tree?.nodeOfComponent(owner.userData.component) ?? null;
+    if (extend && node !== null) {
+      toggleNode(this.editor, node);
+      return;
+    }
     this.editor.select({ component: owner.userData.component, group: owner.userData.group ?? null });
   }
 
+  // Our selection in yellow; what others have selected in their colours.
   highlight() {
     const on = new Set(this.editor.selectedComponents());
+    const theirs = new Map();
+    for (const p of this.editor.peers.values()) {
+      const sel = p.state?.selection;
+      if (!Array.isArray(sel)) continue;
+      const colour = new THREE.Color(colourOf(p.state?.name || p.user || p.peer));
+      for (const c of sel) if (!theirs.has(c)) theirs.set(c, colour);
+    }
     for (const [component, meshes] of this.byComponent) {
       const lit = on.has(component);
+      const peer = lit ? null : theirs.get(component);
       for (const mesh of meshes) {
-        mesh.material.color.copy(lit ? HIGHLIGHT : mesh.userData.baseColour);
-        mesh.material.emissive.copy(lit ? HIGHLIGHT_GLOW : BLACK);
+        mesh.material.color.copy(lit ? HIGHLIGHT : peer || mesh.userData.baseColour);
+        mesh.material.emissive.copy(lit ? HIGHLIGHT_GLOW : peer ? peer.clone().multiplyScalar(0.25) : BLACK);
       }
     }
     this.requestRender();

@@ -41,3 +41,40 @@ ag_status ag_extrude_plan(ag_plan *plan, ag_mesh *m, int32_t group, ag_extrude_r
         ag_shell_free(sh);
     return st;
 }
+
+ag_status ag_extrude_place_meshes(const ag_plan *plan, ag_mesh *m, int32_t group, size_t *placed,
+                                  ag_error *err)
+{
+    if (placed)
+        *placed = 0;
+    for (size_t i = 0; i < plan->nanchors; i++) {
+        const ag_anchor *a = &plan->anchors[i];
+        if (!a->found || a->mesh <= 0 || (size_t)a->mesh > plan->nmeshes)
+            continue;
+        const ag_mesh *src = plan->meshes[a->mesh - 1].mesh;
+        const double *t = a->tangent, *n = a->normal;
+        /* up = n x t: in the face's plane, perpendicular to the edge, rising */
+        double up[3] = {n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2],
+                        n[0] * t[1] - n[1] * t[0]};
+        size_t comp = 0;
+        uint32_t v0 = (uint32_t)m->nverts;
+        ag_status st = ag_mesh_add_component(m, group, &comp);
+        if (st == AG_OK)
+            st = ag_mesh_reserve(m, m->nverts + src->nverts, m->ntris + src->ntris);
+        for (size_t v = 0; v < src->nverts && st == AG_OK; v++) {
+            const double *p = &src->pos[3 * v];
+            double q[3];
+            for (int k = 0; k < 3; k++)
+                q[k] = a->pos[k] + p[0] * t[k] - p[1] * n[k] + p[2] * up[k];
+            st = ag_mesh_add_vertex(m, q[0], q[1], q[2]);
+        }
+        for (size_t f = 0; f < src->ntris && st == AG_OK; f++)
+            st = ag_mesh_add_triangle(m, v0 + src->tri[3 * f], v0 + src->tri[3 * f + 1],
+                                      v0 + src->tri[3 * f + 2], (uint32_t)comp);
+        if (st != AG_OK)
+            return ag_error_set(err, st, 0, "out of memory");
+        if (placed)
+            (*placed)++;
+    }
+    return AG_OK;
+}

@@ -31,4 +31,13 @@ typedef struct {
 ag_status ag_extrude_plan(ag_plan *plan, ag_mesh *m, int32_t group, ag_extrude_result *res,
                           ag_shell **keep_shell, ag_error *err);
 
+/* Places the mesh of every anchor that has one and was found (after ag_extrude_plan) into
+ * m, one new component of `group` each; *placed (may be NULL) gets how many. The mesh's
+ * own frame is mapped to the anchor's: x along the active edge, z up the face (in its
+ * plane, perpendicular to the edge), -y out of the face, origin at the anchor's point;
+ * so a mesh modelled z-up against the front (facing -y) of a wall along +x appears as
+ * modelled on every wall and tilts with a roof face. */
+ag_status ag_extrude_place_meshes(const ag_plan *plan, ag_mesh *m, int32_t group, size_t *placed,
+                                  ag_error *err);
+
 #endif

@@ -25,11 +25,20 @@ void ag_plan_free(ag_plan *p)
         free(p->profiles[i].name);
         free(p->profiles[i].points);
         free(p->profiles[i].tag);
+        free(p->profiles[i].seg_priority);
     }
     free(p->loops);
     free(p->profiles);
     free(p->anchors);
+    for (size_t i = 0; i < p->nsteps; i++)
+        free(p->steps[i].points);
     free(p->steps);
+    for (size_t i = 0; i < p->nmeshes; i++)
+        ag_mesh_free(p->meshes[i].mesh);
+    free(p->meshes);
+    for (size_t i = 0; i < p->noffsets; i++)
+        free(p->offsets[i].edges);
+    free(p->offsets);
     free(p);
 }
 
@@ -136,8 +145,99 @@ ag_status ag_plan_add_loop(ag_plan *p, const double *xy, size_t n, const int32_t
     return AG_OK;
 }
 
+static int profile_ok(const ag_plan *p, int32_t k, int allow_none)
+{
+    if (k < 0)
+        return allow_none && k == -1;
+    if ((size_t)k >= p->nprofiles)
+        return 0;
+    const ag_profile *pr = &p->profiles[k];
+    for (size_t i = 0; i + 1 < pr->npoints; i++)
+        if (pr->points[i].z == pr->points[i + 1].z)
+            return 0;
+    return 1;
+}
+
+ag_status ag_plan_add_offset(ag_plan *p, const ag_plan_offset *o, ag_error *err)
+{
+    long idx = (long)p->noffsets + 1;
+    if (!isfinite(o->z) || o->z <= 0 || !isfinite(o->outside))
+        return ag_error_set(err, AG_ERR_INVALID, idx,
+                            "offset %zu: height must be > 0 and the distance finite", p->noffsets);
+    if (!profile_ok(p, o->profile, 1) || !profile_ok(p, o->side, 1))
+        return ag_error_set(err, AG_ERR_INVALID, idx,
+                            "offset %zu: unknown profile, or one with a horizontal segment (its "
+                            "heights count from the event)", p->noffsets);
+    for (size_t i = 0; i < o->nedges; i++) {
+        const ag_offset_edge *e = &o->edges[i];
+        if (e->loop < 0 || (size_t)e->loop >= p->nloops || e->edge < 0 ||
+            (size_t)e->edge >= p->loops[e->loop].n)
+            return ag_error_set(err, AG_ERR_INVALID, idx, "offset %zu: edges[%zu] names no edge "
+                                "of the plan (loop %d, edge %d)", p->noffsets, i, (int)e->loop,
+                                (int)e->edge);
+        if ((e->has_outside && !isfinite(e->outside)) || !profile_ok(p, e->profile, 1))
+            return ag_error_set(err, AG_ERR_INVALID, idx, "offset %zu: edges[%zu] has a bad "
+                                "distance or profile", p->noffsets, i);
+    }
+    if (p->noffsets == p->cap_offsets) {
+        size_t cap = p->cap_offsets ? 2 * p->cap_offsets : 4;
+        ag_plan_offset *no = realloc(p->offsets, cap * sizeof *no);
+        if (!no)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        p->offsets = no;
+        p->cap_offsets = cap;
+    }
+    ag_plan_offset *d = &p->offsets[p->noffsets];
+    *d = *o;
+    d->edges = NULL;
+    if (o->nedges) {
+        d->edges = malloc(o->nedges * sizeof *d->edges);
+        if (!d->edges)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        memcpy(d->edges, o->edges, o->nedges * sizeof *d->edges);
+    }
+    p->noffsets++;
+    return AG_OK;
+}
+
+ag_status ag_plan_add_mesh(ag_plan *p, const char *name, ag_mesh *mesh, size_t *index,
+                           ag_error *err)
+{
+    if (!mesh)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "mesh %s: no mesh", name ? name : "");
+    if (p->nmeshes == p->cap_meshes) {
+        size_t cap = p->cap_meshes ? 2 * p->cap_meshes : 4;
+        ag_plan_mesh *nm = realloc(p->meshes, cap * sizeof *nm);
+        if (!nm) {
+            ag_mesh_free(mesh);
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        }
+        p->meshes = nm;
+        p->cap_meshes = cap;
+    }
+    ag_plan_mesh *d = &p->meshes[p->nmeshes];
+    snprintf(d->name, sizeof d->name, "%s", name ? name : "");
+    d->mesh = mesh;
+    if (index)
+        *index = p->nmeshes;
+    p->nmeshes++;
+    return AG_OK;
+}
+
+int32_t ag_plan_find_mesh(const ag_plan *p, const char *name)
+{
+    for (size_t i = 0; i < p->nmeshes; i++)
+        if (strcmp(p->meshes[i].name, name) == 0)
+            return (int32_t)i;
+    return -1;
+}
+
 ag_status ag_plan_add_anchor(ag_plan *p, const ag_anchor *a, ag_error *err)
 {
+    if (a->mesh < 0 || (size_t)a->mesh > p->nmeshes)
+        return ag_error_set(err, AG_ERR_INVALID, (long)p->nanchors + 1,
+                            "anchor %zu: mesh %d is not one of the plan's %zu meshes", p->nanchors,
+                            (int)a->mesh - 1, p->nmeshes);
     if (!isfinite(a->along) || !isfinite(a->z) || a->z < 0 || (!a->absolute && (a->along < 0 || a->along > 1)))
         return ag_error_set(err, AG_ERR_INVALID, (long)p->nanchors + 1,
                             "anchor %zu: height must be >= 0 and a relative position in [0, 1]",
@@ -158,10 +258,59 @@ ag_status ag_plan_add_anchor(ag_plan *p, const ag_anchor *a, ag_error *err)
     return AG_OK;
 }
 
+/* A forced step's polygon: enough finite corners, simple, with area; its profile
+ * without horizontal segments (their heights would not follow the step's). */
+static ag_status check_forced(const ag_plan *p, const ag_plan_step *s, ag_error *err)
+{
+    long idx = (long)p->nsteps + 1;
+    size_t n = s->npoints;
+    const double *q = s->points;
+    if (n < 3 || !q)
+        return ag_error_set(err, AG_ERR_INVALID, idx, "step %zu: a forced step needs at least 3 "
+                            "corners", p->nsteps);
+    for (size_t i = 0; i < 2 * n; i++)
+        if (!isfinite(q[i]))
+            return ag_error_set(err, AG_ERR_INVALID, idx, "step %zu: corner %zu is not finite",
+                                p->nsteps, i / 2);
+    double area = 0, ext = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t j = (i + 1) % n;
+        area += q[2 * i] * q[2 * j + 1] - q[2 * j] * q[2 * i + 1];
+        ext = fmax(ext, hypot(q[2 * j] - q[2 * i], q[2 * j + 1] - q[2 * i + 1]));
+    }
+    if (!(fabs(area) / 2 > 1e-6))
+        return ag_error_set(err, AG_ERR_INVALID, idx, "step %zu: the forced polygon has no area",
+                            p->nsteps);
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 1; j < n; j++) {
+            size_t i2 = (i + 1) % n, j2 = (j + 1) % n;
+            if (j == i2 || i == j2)
+                continue; /* neighbours share a corner */
+            if (ag_pred_segments_touch(&q[2 * i], &q[2 * i2], &q[2 * j], &q[2 * j2], 1e-12 * ext))
+                return ag_error_set(err, AG_ERR_INVALID, idx,
+                                    "step %zu: forced polygon edges %zu and %zu cross or touch",
+                                    p->nsteps, i, j);
+        }
+    if (s->profile >= 0 && (size_t)s->profile < p->nprofiles) {
+        const ag_profile *pr = &p->profiles[s->profile];
+        for (size_t k = 0; k + 1 < pr->npoints; k++)
+            if (pr->points[k].z == pr->points[k + 1].z)
+                return ag_error_set(err, AG_ERR_INVALID, idx,
+                                    "step %zu: a forced step's profile (%s) must not have "
+                                    "horizontal segments", p->nsteps, pr->name);
+    }
+    return AG_OK;
+}
+
 ag_status ag_plan_add_step(ag_plan *p, const ag_plan_step *s, ag_error *err)
 {
     long idx = (long)p->nsteps + 1;
-    if (!(s->width >= 2e-3) || !(fabs(s->depth) >= 2e-3) || !isfinite(s->width) ||
+    int forced = s->npoints > 0;
+    if (forced) {
+        ag_status fs = check_forced(p, s, err);
+        if (fs != AG_OK)
+            return fs;
+    } else if (!(s->width >= 2e-3) || !(fabs(s->depth) >= 2e-3) || !isfinite(s->width) ||
         !isfinite(s->depth))
         return ag_error_set(err, AG_ERR_INVALID, idx,
                             "step %zu: width and |depth| must be at least 2 mm", p->nsteps);
@@ -173,8 +322,9 @@ ag_status ag_plan_add_step(ag_plan *p, const ag_plan_step *s, ag_error *err)
         return ag_error_set(err, AG_ERR_INVALID, idx,
                             "step %zu: the step's profile must rise from its first point",
                             p->nsteps);
-    if (!isfinite(s->at.z) || s->at.z <= 0 || !isfinite(s->at.along) ||
-        (!s->at.absolute && (s->at.along < 0 || s->at.along > 1)))
+    if (!isfinite(s->at.z) || s->at.z <= 0 ||
+        (!(forced && s->plan_frame) &&
+         (!isfinite(s->at.along) || (!s->at.absolute && (s->at.along < 0 || s->at.along > 1)))))
         return ag_error_set(err, AG_ERR_INVALID, idx,
                             "step %zu: height must be > 0 and a relative position in [0, 1]",
                             p->nsteps);
@@ -186,10 +336,48 @@ ag_status ag_plan_add_step(ag_plan *p, const ag_plan_step *s, ag_error *err)
         p->steps = ns;
         p->cap_steps = cap;
     }
-    p->steps[p->nsteps] = *s;
-    p->steps[p->nsteps].name[sizeof s->name - 1] = 0;
+    ag_plan_step *d = &p->steps[p->nsteps];
+    *d = *s;
+    d->name[sizeof s->name - 1] = 0;
+    if (forced) {
+        d->points = malloc(2 * s->npoints * sizeof *d->points);
+        if (!d->points)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        memcpy(d->points, s->points, 2 * s->npoints * sizeof *d->points);
+    } else {
+        d->points = NULL;
+    }
     p->nsteps++;
     return AG_OK;
+}
+
+ag_status ag_plan_set_segment_priority(ag_plan *p, size_t profile, size_t segment,
+                                       int32_t priority, ag_error *err)
+{
+    if (profile >= p->nprofiles)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "segment priority: unknown profile %zu",
+                            profile);
+    ag_profile *pr = &p->profiles[profile];
+    if (segment + 1 >= pr->npoints)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "profile %s: segment %zu does not exist (it has %zu)", pr->name,
+                            segment, pr->npoints - 1);
+    if (!pr->seg_priority) {
+        pr->seg_priority = malloc((pr->npoints - 1) * sizeof *pr->seg_priority);
+        if (!pr->seg_priority)
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        for (size_t i = 0; i + 1 < pr->npoints; i++)
+            pr->seg_priority[i] = pr->priority;
+    }
+    pr->seg_priority[segment] = priority;
+    return AG_OK;
+}
+
+int32_t ag_profile_priority(const ag_profile *pr, int32_t segment)
+{
+    if (pr->seg_priority && segment >= 0 && (size_t)segment + 1 < pr->npoints)
+        return pr->seg_priority[segment];
+    return pr->priority;
 }
 
 int32_t ag_plan_find_profile(const ag_plan *p, const char *name)

@@ -15,6 +15,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "../mesh.h"
 #include "../status.h"
 
 typedef struct {
@@ -30,6 +31,9 @@ typedef struct {
     /* Ambiguity priority tag: when collinear neighbours with different slopes must
      * merge, the higher priority wins; equal priorities fall back to the plan's scheme. */
     int32_t priority;
+    /* Per-segment priority tags (npoints - 1 entries) or NULL: the segment an edge is on
+     * when the merge happens decides, overriding `priority`. */
+    int32_t *seg_priority;
 } ag_profile;
 
 typedef struct {
@@ -54,7 +58,17 @@ typedef struct {
     double pos[3];
     double normal[3]; /* outward normal of the face there */
     int32_t face;     /* shell face holding the point */
+    /* input: 1 + index into the plan's meshes of a mesh to place here, 0 = none */
+    int32_t mesh;
+    /* result: the active edge's direction there (horizontal, unit) */
+    double tangent[3];
 } ag_anchor;
+
+/* A named mesh (a window, a door, an ornament) that anchors place on the shell. */
+typedef struct {
+    char name[32];
+    ag_mesh *mesh; /* owned by the plan */
+} ag_plan_mesh;
 
 /* A plan edit made as a natural step: at anchor `at` (its height is the step's height)
  * a rectangle `width` wide and `depth` deep is added to the active plan (depth > 0:
@@ -66,7 +80,43 @@ typedef struct {
     ag_anchor at;
     double width, depth;
     int32_t profile;
+    /* A forced step when npoints > 0: the polygon `points` (2 * npoints) is united with
+     * the active plan at the step's height, as it is, without growing (width and depth
+     * are unused). Coordinates are in the anchor's frame (x along the active edge from
+     * the anchor's point, y outwards, away from the inside) or, when `plan_frame` is set,
+     * plan coordinates (then only at.z is used). The new boundary takes `profile`; the
+     * part of the polygon outside the active plan gets a floor face. A polygon that
+     * comes closer than 0.1 mm to the active boundary without crossing it cleanly, or
+     * lies wholly inside the active plan, is skipped and counted. */
+    size_t npoints;
+    double *points;
+    int plan_frame;
 } ag_plan_step;
+
+/* One edge's part in a profile offset event (§4.6's per-edge tuple). */
+typedef struct {
+    int32_t loop, edge; /* edge of the validated plan */
+    int disabled;       /* no offset region on this edge: it waits (a gable end) */
+    int has_outside;    /* use `outside` below instead of the event's */
+    double outside;
+    int32_t profile;    /* profile after the event, -1: the event's */
+} ag_offset_edge;
+
+/* A profile offset event: at height z every active edge moves `outside` metres outwards
+ * (negative: inwards) in one step, making a flat face (a soffit, a terrace), while the
+ * disabled edges wait; then the moved edges take `profile` (heights from z; -1: they carry
+ * on with their own profile). Where a moved edge meets a disabled one, the offset region
+ * is cut along the mitre between the two by a new `side` edge that then follows the side
+ * profile (-1: no side edge, the disabled edge's line is extended instead). Edges made by
+ * plan edits take the event's defaults. */
+typedef struct {
+    double z;
+    double outside;
+    int32_t profile;
+    int32_t side;
+    size_t nedges;
+    ag_offset_edge *edges; /* overrides, owned by the plan */
+} ag_plan_offset;
 
 typedef enum {
     AG_PRIORITY_MAX_VOLUME = 0, /* ambiguous collinear edges: the shallowest slope wins */
@@ -85,6 +135,12 @@ typedef struct {
     size_t nsteps;
     ag_plan_step *steps;
     size_t cap_loops, cap_profiles, cap_anchors, cap_steps; /* private */
+    size_t nmeshes;
+    ag_plan_mesh *meshes;
+    size_t cap_meshes; /* private */
+    size_t noffsets;
+    ag_plan_offset *offsets;
+    size_t cap_offsets; /* private */
 } ag_plan;
 
 ag_plan *ag_plan_create(void);
@@ -100,9 +156,27 @@ ag_status ag_plan_add_loop(ag_plan *p, const double *xy, size_t n, const int32_t
                            ag_error *err);
 /* Adds an anchor (copied; name may be NULL). */
 ag_status ag_plan_add_anchor(ag_plan *p, const ag_anchor *a, ag_error *err);
-/* Adds a natural step; fails with AG_ERR_INVALID for a width or depth below 2 mm, a bad
- * anchor or an unknown profile (add the profile first). */
+/* Adds a natural step (or a forced one, npoints > 0; the points are copied); fails with
+ * AG_ERR_INVALID for a width or depth below 2 mm, a bad anchor, an unknown profile (add
+ * the profile first), a forced polygon with fewer than 3 corners, non-finite or
+ * self-intersecting, or a forced step's profile with a horizontal segment. */
 ag_status ag_plan_add_step(ag_plan *p, const ag_plan_step *s, ag_error *err);
+/* Tags segment `segment` of profile `profile` with an ambiguity priority (§4.8's
+ * user-defined scheme); fails with AG_ERR_INVALID for an unknown profile or segment. */
+ag_status ag_plan_set_segment_priority(ag_plan *p, size_t profile, size_t segment,
+                                       int32_t priority, ag_error *err);
+/* The priority in effect for an edge on `segment` of pr. */
+int32_t ag_profile_priority(const ag_profile *pr, int32_t segment);
+/* Adds a profile offset event (edges copied); fails with AG_ERR_INVALID for a height
+ * that is not > 0, a non-finite distance, an unknown profile or one with a horizontal
+ * segment (after or side), or an edge override naming no loop/edge of the plan as it is. */
+ag_status ag_plan_add_offset(ag_plan *p, const ag_plan_offset *o, ag_error *err);
+/* Adds a named mesh for anchors to place; the plan takes ownership of mesh (also on
+ * failure). *index (may be NULL) gets its index; anchors refer to it as index + 1. */
+ag_status ag_plan_add_mesh(ag_plan *p, const char *name, ag_mesh *mesh, size_t *index,
+                           ag_error *err);
+/* Index of the mesh with this name, or -1. */
+int32_t ag_plan_find_mesh(const ag_plan *p, const char *name);
 /* Index of the profile with this name, or -1. */
 int32_t ag_plan_find_profile(const ag_plan *p, const char *name);
 

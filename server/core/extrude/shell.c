@@ -147,6 +147,91 @@ static int cmp_key(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
+/* Newell normal (not normalised) of face f's loops. */
+static void face_normal(const ag_shell *s, size_t f, double *n)
+{
+    n[0] = n[1] = n[2] = 0;
+    const ag_shell_face *fc = &s->faces[f];
+    for (uint32_t l = fc->first_loop; l < fc->first_loop + (fc->nloops & 0x7fffffffu); l++) {
+        uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
+        for (uint32_t i = a; i < b; i++) {
+            const double *p = &s->pos[3 * s->idx[i]];
+            const double *q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
+            n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+            n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+            n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+        }
+    }
+}
+
+typedef struct {
+    double ang;
+    uint32_t he;
+} radial;
+
+static int cmp_radial(const void *a, const void *b)
+{
+    double x = ((const radial *)a)->ang, y = ((const radial *)b)->ang;
+    return x < y ? -1 : x > y;
+}
+
+/* An edge with k > 1 half-edges each way (solids that touch along an edge, e.g. a
+ * terrace and a soffit meeting at one line): the faces are ordered around the edge and
+ * each is paired with its neighbour across the solid's inside, as the two sides of one
+ * solid. Left unpaired (and reported) unless the directions alternate around the edge. */
+static void pair_radial(ag_shell *s, const seg_key *hk, size_t lo, size_t n, const double *fn)
+{
+    radial r[64];
+    if (n > 64)
+        return;
+    uint32_t u = (uint32_t)(hk[lo].key >> 32), v = (uint32_t)hk[lo].key;
+    const double *pu = &s->pos[3 * u], *pv = &s->pos[3 * v];
+    double a[3] = {pv[0] - pu[0], pv[1] - pu[1], pv[2] - pu[2]};
+    double al = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (!(al > 0))
+        return;
+    for (int k = 0; k < 3; k++)
+        a[k] /= al;
+    /* a basis (b1, b2) across the edge */
+    double t[3] = {fabs(a[0]) < 0.9 ? 1 : 0, fabs(a[0]) < 0.9 ? 0 : 1, 0};
+    double b1[3] = {a[1] * t[2] - a[2] * t[1], a[2] * t[0] - a[0] * t[2], a[0] * t[1] - a[1] * t[0]};
+    double bl = sqrt(b1[0] * b1[0] + b1[1] * b1[1] + b1[2] * b1[2]);
+    for (int k = 0; k < 3; k++)
+        b1[k] /= bl;
+    double b2[3] = {a[1] * b1[2] - a[2] * b1[1], a[2] * b1[0] - a[0] * b1[2], a[0] * b1[1] - a[1] * b1[0]};
+    for (size_t i = 0; i < n; i++) {
+        uint32_t h = hk[lo + i].seg;
+        const double *nf = &fn[3 * s->he_face[h]];
+        /* into the face from the edge: n x direction of the half-edge */
+        double sg = s->idx[h] == u ? 1 : -1;
+        double w[3] = {sg * (nf[1] * a[2] - nf[2] * a[1]), sg * (nf[2] * a[0] - nf[0] * a[2]),
+                       sg * (nf[0] * a[1] - nf[1] * a[0])};
+        r[i].ang = atan2(w[0] * b2[0] + w[1] * b2[1] + w[2] * b2[2],
+                         w[0] * b1[0] + w[1] * b1[1] + w[2] * b1[2]);
+        r[i].he = h;
+    }
+    qsort(r, n, sizeof *r, cmp_radial);
+    for (size_t i = 0; i < n; i++) {
+        size_t j = (i + 1) % n;
+        if ((s->idx[r[i].he] == u) == (s->idx[r[j].he] == u))
+            return; /* two faces in a row the same way: no consistent pairing */
+    }
+    /* turning from face i towards i + 1 (counter-clockwise about a) enters the inside
+     * when it goes against face i's outward normal: then i and i + 1 are one solid's */
+    const double *n0 = &fn[3 * s->he_face[r[0].he]];
+    double sg0 = s->idx[r[0].he] == u ? 1 : -1;
+    double w0[3] = {sg0 * (n0[1] * a[2] - n0[2] * a[1]), sg0 * (n0[2] * a[0] - n0[0] * a[2]),
+                    sg0 * (n0[0] * a[1] - n0[1] * a[0])};
+    double turn[3] = {a[1] * w0[2] - a[2] * w0[1], a[2] * w0[0] - a[0] * w0[2],
+                      a[0] * w0[1] - a[1] * w0[0]};
+    size_t off = turn[0] * n0[0] + turn[1] * n0[1] + turn[2] * n0[2] < 0 ? 0 : 1;
+    for (size_t i = 0; i < n; i += 2) {
+        uint32_t x = r[(i + off) % n].he, y = r[(i + off + 1) % n].he;
+        s->he_twin[x] = y;
+        s->he_twin[y] = x;
+    }
+}
+
 ag_status ag_shell_finish(ag_shell *s, double weld_tol)
 {
     uint32_t *map = malloc((s->nverts ? s->nverts : 1) * sizeof *map);
@@ -320,10 +405,54 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
             else
                 hi = mid;
         }
-        /* exactly one opposite half-edge: twin; more than one stays unpaired (reported) */
+        /* exactly one opposite half-edge: twin; more than one: paired around the edge below */
         if (lo < nidx && hk[lo].key == rev && (lo + 1 >= nidx || hk[lo + 1].key != rev))
             s->he_twin[h] = hk[lo].seg;
     }
+    /* edges used k > 1 times each way */
+    double *fn = NULL;
+    for (size_t i = 0; i < nidx;) {
+        size_t j = i;
+        while (j < nidx && hk[j].key == hk[i].key)
+            j++;
+        uint64_t key = hk[i].key, rev = (key << 32) | (key >> 32);
+        if (j - i > 1 && key < rev) {
+            size_t lo = 0, hi = nidx;
+            while (lo < hi) {
+                size_t mid = (lo + hi) / 2;
+                if (hk[mid].key < rev)
+                    lo = mid + 1;
+                else
+                    hi = mid;
+            }
+            size_t m = lo;
+            while (m < nidx && hk[m].key == rev)
+                m++;
+            if (m - lo == j - i) {
+                if (!fn) {
+                    fn = malloc((s->nfaces ? s->nfaces : 1) * 3 * sizeof *fn);
+                    if (!fn) {
+                        free(hk);
+                        st = AG_ERR_NOMEM;
+                        goto out;
+                    }
+                    for (size_t f = 0; f < s->nfaces; f++)
+                        face_normal(s, f, &fn[3 * f]);
+                }
+                /* both directions' half-edges, contiguous in a scratch copy */
+                seg_key both[64];
+                size_t nb = 0;
+                for (size_t q = i; q < j && nb < 64; q++)
+                    both[nb++] = hk[q];
+                for (size_t q = lo; q < m && nb < 64; q++)
+                    both[nb++] = hk[q];
+                if (nb == 2 * (j - i))
+                    pair_radial(s, both, 0, nb, fn);
+            }
+        }
+        i = j;
+    }
+    free(fn);
     free(hk);
 out:
     free(ord);
@@ -358,7 +487,7 @@ size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max)
         for (uint32_t l = fc->first_loop; l < fc->first_loop + nl && !why[0]; l++)
             for (uint32_t h = s->loop_start[l]; h < s->loop_start[l + 1]; h++) {
                 uint32_t u = s->idx[h], v = s->idx[s->he_next[h]];
-                if (dup && dup[h]) {
+                if (dup && dup[h] && s->he_twin[h] == NONE) {
                     snprintf(why, sizeof why,
                              "edge %u-%u is used twice in the same direction (not 2-manifold)",
                              u, v);

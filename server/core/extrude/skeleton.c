@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "eventq.h"
+#include "predicates.h"
 #include "tolerance.h"
 
 #define NONE UINT32_MAX
@@ -19,7 +20,9 @@ typedef struct {
     uint8_t alive;
     uint8_t paused;  /* held still while other edges make a horizontal face */
     uint8_t growing; /* a plan edit's edge, growing to its size in a flat interval */
-    int32_t step;    /* 0: from the plan; k + 1: made by plan edit k */
+    int32_t step;    /* 0: from the plan; k + 1: made by plan edit k; -1: an offset's side */
+    int32_t clock;   /* profile heights count from: 0 the plan, k + 1 plan edit k, then
+                      * nsteps + 1 + k offset event k */
 } sk_edge;
 
 typedef struct {
@@ -239,6 +242,26 @@ static void edge_event(sk *S, uint32_t ei)
         push(S, &ev);
 }
 
+/* Is edge fi the one after (or before) the corner's neighbouring edge, and that edge of
+ * no length at height z? Then the corner merely starts on fi's line where a side edge
+ * was put in (an offset event's cut), which is no split. */
+static int zero_gap(const sk *S, uint32_t k, uint32_t fi, double z)
+{
+    const sk_corner *c = &S->c[k];
+    const sk_edge *o = &S->e[c->out], *i = &S->e[c->in];
+    const sk_edge *g = NULL;
+    if (o->end != NONE && S->c[o->end].out == fi)
+        g = o;
+    else if (i->start != NONE && S->c[i->start].in == fi)
+        g = i;
+    if (!g || g->start == NONE || g->end == NONE)
+        return 0;
+    double ax, ay, bx, by;
+    cpos(&S->c[g->start], z, &ax, &ay);
+    cpos(&S->c[g->end], z, &bx, &by);
+    return hypot(bx - ax, by - ay) <= S->d2;
+}
+
 static void split_event(sk *S, uint32_t k, uint32_t fi)
 {
     const sk_corner *c = &S->c[k];
@@ -257,6 +280,8 @@ static void split_event(sk *S, uint32_t k, uint32_t fi)
     if (!(closing > 1e-12) || dist < -S->d2)
         return;
     double dz = dist > 0 ? dist / closing : 0;
+    if (dz <= 0 && zero_gap(S, k, fi, z0))
+        return;
     double z = z0 + dz;
     if (!isfinite(z))
         return;
@@ -302,8 +327,9 @@ static void merge(sk *S, uint32_t k)
     uint32_t ein = c->in, eout = c->out;
     int min_vol = S->plan->priority == AG_PRIORITY_MIN_VOLUME;
     double sin_ = S->e[ein].s, sout = S->e[eout].s;
-    int32_t pin = S->plan->profiles[S->e[ein].profile].priority;
-    int32_t pout = S->plan->profiles[S->e[eout].profile].priority;
+    /* the tags of the segments the two edges are on now */
+    int32_t pin = ag_profile_priority(&S->plan->profiles[S->e[ein].profile], S->e[ein].seg);
+    int32_t pout = ag_profile_priority(&S->plan->profiles[S->e[eout].profile], S->e[eout].seg);
     int in_wins = pin != pout ? pin > pout : min_vol ? sin_ > sout : sin_ < sout;
     double z = c->z;
     uint32_t vl = c->vert;
@@ -500,7 +526,11 @@ static int cmp_ray(const void *a, const void *b)
     const ray *x = a, *y = b;
     if (x->ang != y->ang)
         return x->ang < y->ang ? -1 : 1;
-    return y->out - x->out; /* outgoing first on ties */
+    if (x->out != y->out)
+        return y->out - x->out; /* outgoing first on ties */
+    /* the same way along one line: a fixed order, so that handling the point again pairs
+     * the same edges (and keeps the corners) instead of swapping them for ever */
+    return x->edge < y->edge ? -1 : x->edge > y->edge;
 }
 
 typedef struct {
@@ -601,7 +631,6 @@ static void intersection(sk *S, ag_event *evs, size_t n, scratch *W)
             }
     }
     S->stats.intersections++;
-    uint32_t vl = vertex(S, lx, ly, z);
     /* edges at the point */
     for (size_t i = 0; i < W->C.n; i++) {
         sk_corner *c = &S->c[W->C.arr[i]];
@@ -616,6 +645,7 @@ static void intersection(sk *S, ag_event *evs, size_t n, scratch *W)
                     vpush(&W->E, es[j]);
             }
     }
+    uint32_t vl = vertex(S, lx, ly, z);
     size_t nrays = 0;
     size_t need = 2 * (W->E.n + W->splits.n) + 2;
     if (!grow((void **)&W->rays, &W->cap_rays, need, sizeof(ray))) {
@@ -784,6 +814,27 @@ static int seg_flat(const ag_profile *p, int32_t seg)
 }
 
 #define FLAT_MARK UINT32_MAX
+#define OFFSET_MARK (UINT32_MAX - 2)
+
+/* Edge e's part in offset event o: returns 0 when disabled, else 1 with its distance
+ * (outwards) and profile after (-1: its own). */
+static int offset_tuple(const ag_plan_offset *o, const sk_edge *e, double *w, int32_t *prof)
+{
+    *w = o->outside;
+    *prof = o->profile;
+    for (size_t i = 0; i < o->nedges && !e->step; i++) {
+        const ag_offset_edge *x = &o->edges[i];
+        if (x->loop != e->loop || x->edge != e->edge)
+            continue;
+        if (x->disabled)
+            return 0;
+        if (x->has_outside)
+            *w = x->outside;
+        if (x->profile >= 0)
+            *prof = x->profile;
+    }
+    return 1;
+}
 
 static void direction(sk *S, ag_event *evs, size_t n)
 {
@@ -796,13 +847,30 @@ static void direction(sk *S, ag_event *evs, size_t n)
      * still for / released after a flat interval (same face) */
     u32vec ch = {0}, ks = {0};
     int flat_start = 0, flat_end = 0;
-    for (size_t j = 0; j < n; j++)
+    const ag_plan_offset *off = NULL; /* an offset event starting here */
+    int32_t off_clock = 0;
+    for (size_t j = 0; j < n; j++) {
         if (evs[j].a == FLAT_MARK) {
             flat_start |= evs[j].b == 0;
             flat_end |= evs[j].b == 1;
         }
+        if (evs[j].a == OFFSET_MARK && evs[j].ver == 0) {
+            off = &S->plan->offsets[evs[j].b];
+            off_clock = (int32_t)(S->plan->nsteps + 1 + evs[j].b);
+        }
+    }
+    double *off_w = malloc((S->nlive_e ? S->nlive_e : 1) * sizeof *off_w);
+    int32_t *off_p = malloc((S->nlive_e ? S->nlive_e : 1) * sizeof *off_p);
+    if (!off_w || !off_p) {
+        free(off_w);
+        free(off_p);
+        fail(S, AG_ERR_NOMEM);
+        return;
+    }
     uint8_t *newface = malloc(S->nlive_e ? S->nlive_e : 1);
     if (!newface) {
+        free(off_w);
+        free(off_p);
         fail(S, AG_ERR_NOMEM);
         return;
     }
@@ -812,16 +880,23 @@ static void direction(sk *S, ag_event *evs, size_t n)
         int hit = 0;
         for (size_t j = 0; j < n && !hit; j++)
             if (evs[j].a != FLAT_MARK && (uint32_t)e->profile == evs[j].a &&
-                (uint32_t)e->seg + 1 == evs[j].b && (uint32_t)e->step == evs[j].ver)
+                (uint32_t)e->seg + 1 == evs[j].b && (uint32_t)e->clock == evs[j].ver)
                 hit = 1;
         const ag_profile *p = &S->plan->profiles[e->profile];
+        if (off && !e->growing && !e->paused && offset_tuple(off, e, &off_w[ch.n], &off_p[ch.n])) {
+            newface[ch.n] = 3; /* moves by its offset over this flat interval */
+            if (!vpush(&ch, ei))
+                fail(S, AG_ERR_NOMEM);
+            continue;
+        }
         int next_flat = hit ? seg_flat(p, e->seg + 1) : seg_flat(p, e->seg);
         int grown = flat_end && e->growing;
         int pause = !hit && !e->growing && flat_start && !next_flat && !e->paused;
         int release = !hit && flat_end && e->paused;
         if (!hit && !pause && !release && !grown)
             continue;
-        newface[ch.n] = (uint8_t)(grown ? 2 : hit);
+        /* a grown edge whose own profile turns at the same height takes the next segment */
+        newface[ch.n] = (uint8_t)(grown ? (hit ? 1 : 2) : hit);
         if (!vpush(&ch, ei))
             fail(S, AG_ERR_NOMEM);
     }
@@ -853,16 +928,29 @@ static void direction(sk *S, ag_event *evs, size_t n)
         sk_edge *e = &S->e[ch.arr[i]];
         const ag_profile *p = &S->plan->profiles[e->profile];
         double s_new;
-        if (newface[i]) {
+        if (newface[i] == 3) {
+            uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
+            seg(S, e->face, ve, vs);
+            if (off_p[i] >= 0) {
+                e->profile = off_p[i];
+                e->seg = 0;
+                e->clock = off_clock;
+            }
+            e->growing = 1; /* its flat face; at the interval's end it carries on */
+            e->paused = 0;
+            s_new = -off_w[i];
+            e->face = new_face(S, e);
+            seg(S, e->face, vs, ve);
+        } else if (newface[i]) {
             uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
             seg(S, e->face, ve, vs);
             if (newface[i] == 1)
                 e->seg++; /* a grown plan edit keeps its profile's first segment */
             s_new = seg_slope(p, e->seg);
+            e->paused = 0;
+            e->growing = 0; /* before new_face: the new face is a profile segment's */
             e->face = new_face(S, e);
             seg(S, e->face, vs, ve);
-            e->paused = 0;
-            e->growing = 0;
         } else if (e->paused) {
             s_new = seg_slope(p, e->seg);
             e->paused = 0;
@@ -885,10 +973,99 @@ static void direction(sk *S, ag_event *evs, size_t n)
         settle(S, S->touched[i]);
 out:
     free(newface);
+    free(off_w);
+    free(off_p);
     free(verts);
     free(xy);
     free(ch.arr);
     free(ks.arr);
+}
+
+
+/* --- profile offset events: side edges ---------------------------------------------------- */
+
+/* After an offset event's interval has started: where a moving edge A meets a waiting
+ * (disabled) edge B, a side edge of zero length is put between them along the mitre
+ * the two would share if both moved; it holds still while A's corner slides out along
+ * it, cutting A's offset region there, and then follows the side profile. */
+static void insert_sides(sk *S, size_t k)
+{
+    const ag_plan_offset *o = &S->plan->offsets[k];
+    if (o->side < 0)
+        return;
+    compact_live(S);
+    size_t nlive = S->nlive_c;
+    for (size_t i = 0; i < nlive && S->st == AG_OK; i++) {
+        uint32_t ck = S->live_c[i];
+        sk_corner *c = &S->c[ck];
+        if (!c->alive)
+            continue;
+        const sk_edge *ein = &S->e[c->in], *eout = &S->e[c->out];
+        int a_in;
+        if (ein->growing && eout->paused)
+            a_in = 1;
+        else if (eout->growing && ein->paused)
+            a_in = 0;
+        else
+            continue;
+        const sk_edge *A = a_in ? ein : eout, *B = a_in ? eout : ein;
+        /* the shared mitre: where a corner of A and B would go if both moved out */
+        double det = A->nx * B->ny - A->ny * B->nx, mx, my;
+        if (fabs(det) <= AG_EXTRUDE_PARALLEL) {
+            mx = -A->nx;
+            my = -A->ny;
+        } else {
+            mx = (-B->ny + A->ny) / det;
+            my = (-A->nx + B->nx) / det;
+        }
+        double ml = hypot(mx, my);
+        if (!(ml > 0))
+            continue;
+        double dx = (a_in ? -mx : mx) / ml, dy = (a_in ? -my : my) / ml;
+        double nx = -dy, ny = dx;
+        /* A's end must slide away from B along the side edge, else there is nothing to cut */
+        double d2 = A->nx * ny - A->ny * nx;
+        if (fabs(d2) <= AG_EXTRUDE_PARALLEL)
+            continue;
+        double vx = (A->s * ny) / d2, vy = (-A->s * nx) / d2; /* n_A.v = s_A, n_side.v = 0 */
+        if (!((a_in ? -1 : 1) * (vx * dx + vy * dy) > 0))
+            continue;
+        double px, py;
+        cpos(c, c->z, &px, &py);
+        uint32_t se = add_edge(S);
+        if (se == NONE)
+            return;
+        c = &S->c[ck];
+        A = a_in ? &S->e[c->in] : &S->e[c->out];
+        sk_edge *e = &S->e[se];
+        e->nx = nx;
+        e->ny = ny;
+        e->s = 0;
+        e->c = nx * px + ny * py;
+        e->loop = A->loop;
+        e->edge = A->edge;
+        e->profile = o->side;
+        e->seg = 0;
+        e->step = -1;
+        e->clock = (int32_t)(S->plan->nsteps + 1 + k);
+        e->paused = 1; /* released with the others at the interval's end */
+        e->face = new_face(S, e);
+        uint32_t other = c->out;
+        c->out = se;
+        e->start = ck;
+        S->e[other].ver++;
+        if (!grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1, sizeof(uint32_t))) {
+            fail(S, AG_ERR_NOMEM);
+            return;
+        }
+        S->touched[S->ntouched++] = ck;
+        size_t first = S->ntouched - 1;
+        add_corner(S, se, other, px, py, c->z, c->vert);
+        size_t last = S->ntouched;
+        for (size_t t = first; t < last && S->st == AG_OK; t++)
+            settle(S, S->touched[t]);
+        S->stats.offset_sides++;
+    }
 }
 
 /* --- plan edits (natural steps) ----------------------------------------------------------- */
@@ -900,7 +1077,7 @@ static uint32_t anchor_point(sk *S, const ag_anchor *a, double z, double *px, do
 #define STEP_SEED 1e-3 /* side of the protrusion a natural step grows from */
 
 static uint32_t make_edge(sk *S, double ax, double ay, double bx, double by, double slope, double z,
-                          int32_t step, int32_t profile)
+                          int32_t step, int32_t profile, int growing)
 {
     uint32_t id = add_edge(S);
     if (id == NONE)
@@ -916,7 +1093,8 @@ static uint32_t make_edge(sk *S, double ax, double ay, double bx, double by, dou
     e->profile = profile;
     e->seg = 0;
     e->step = step;
-    e->growing = 1;
+    e->clock = step;
+    e->growing = (uint8_t)growing;
     e->face = new_face(S, e);
     return id;
 }
@@ -930,6 +1108,8 @@ static void insert_steps(sk *S, double v)
     const ag_plan *P = S->plan;
     for (size_t k = 0; k < P->nsteps && S->st == AG_OK; k++) {
         const ag_plan_step *st = &P->steps[k];
+        if (st->npoints)
+            continue; /* forced: see forced_step */
         size_t fk = 0;
         while (fk < S->nflat && S->flat_h[fk] != st->at.z)
             fk++;
@@ -962,9 +1142,9 @@ static void insert_steps(sk *S, double v)
         double front = (fabs(st->depth) - STEP_SEED) * (st->depth > 0 ? -1 : 1);
         int32_t sid = (int32_t)k + 1;
         uint32_t e2 = add_edge(S);
-        uint32_t s1 = make_edge(S, ax, ay, a2x, a2y, side, v, sid, st->profile);
-        uint32_t f = make_edge(S, a2x, a2y, b2x, b2y, front, v, sid, st->profile);
-        uint32_t s2 = make_edge(S, b2x, b2y, bx, by, side, v, sid, st->profile);
+        uint32_t s1 = make_edge(S, ax, ay, a2x, a2y, side, v, sid, st->profile, 1);
+        uint32_t f = make_edge(S, a2x, a2y, b2x, b2y, front, v, sid, st->profile, 1);
+        uint32_t s2 = make_edge(S, b2x, b2y, bx, by, side, v, sid, st->profile, 1);
         if (e2 == NONE || s1 == NONE || f == NONE || s2 == NONE)
             return;
         e = &S->e[ei];
@@ -1000,6 +1180,364 @@ static void insert_steps(sk *S, double v)
             settle(S, S->touched[i]);
         S->stats.steps++;
     }
+}
+
+/* --- plan edits (forced steps) ------------------------------------------------------------ */
+
+#define FORCED_MARK (UINT32_MAX - 1)
+
+typedef struct {
+    double x, y;
+    double te, tq;     /* parameters along the active edge and along the polygon edge */
+    uint32_t e;        /* active edge crossed */
+    uint32_t qi;       /* polygon edge crossing it */
+    uint32_t vert;
+    int enters;        /* the active edge enters the polygon here */
+    uint32_t p_before, p_after, q_before, q_after;
+} xing;
+
+static int cmp_xing_e(const void *a, const void *b)
+{
+    const xing *x = *(const xing *const *)a, *y = *(const xing *const *)b;
+    if (x->e != y->e)
+        return x->e < y->e ? -1 : 1;
+    return x->te < y->te ? -1 : x->te > y->te;
+}
+
+static int cmp_xing_q(const void *a, const void *b)
+{
+    const xing *x = *(const xing *const *)a, *y = *(const xing *const *)b;
+    if (x->qi != y->qi)
+        return x->qi < y->qi ? -1 : 1;
+    return x->tq < y->tq ? -1 : x->tq > y->tq;
+}
+
+static double seg_dist(double px, double py, double ax, double ay, double bx, double by)
+{
+    double dx = bx - ax, dy = by - ay, l2 = dx * dx + dy * dy;
+    double t = l2 > 0 ? ((px - ax) * dx + (py - ay) * dy) / l2 : 0;
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    return hypot(ax + t * dx - px, ay + t * dy - py);
+}
+
+/* Is (x, y) inside the active plan at height v? Even-odd over the live edges. */
+static int in_active(sk *S, double v, double x, double y)
+{
+    int in = 0;
+    for (size_t i = 0; i < S->nlive_e; i++) {
+        const sk_edge *e = &S->e[S->live_e[i]];
+        double ax, ay, bx, by;
+        cpos(&S->c[e->start], v, &ax, &ay);
+        cpos(&S->c[e->end], v, &bx, &by);
+        if ((ay > y) != (by > y) && x < ax + (y - ay) * (bx - ax) / (by - ay))
+            in = !in;
+    }
+    return in;
+}
+
+static uint32_t forced_edge(sk *S, double ax, double ay, double bx, double by, double v,
+                            const ag_plan_step *st, int32_t sid)
+{
+    double slope = seg_slope(&S->plan->profiles[st->profile], 0);
+    return make_edge(S, ax, ay, bx, by, slope, v, sid, st->profile, 0);
+}
+
+/* Unites the step's polygon Q with the active plan at virtual height v: active edges are
+ * cut where Q crosses them, the parts inside Q end (their faces closed at v), Q's parts
+ * outside the plan become new edges with the step's profile, and Q minus the plan gets a
+ * floor face. Near-touching configurations are refused (skipped) rather than guessed. */
+static void forced_step(sk *S, size_t k, double v)
+{
+    const ag_plan_step *st = &S->plan->steps[k];
+    size_t n = st->npoints;
+    compact_live(S);
+    double *q = malloc(2 * n * sizeof *q);
+    if (!q) {
+        fail(S, AG_ERR_NOMEM);
+        return;
+    }
+    xing *X = NULL, **byE = NULL, **byQ = NULL;
+    size_t nx = 0, capx = 0;
+    uint32_t *cvert = NULL, *qin = NULL, *qout = NULL, *qvert = NULL;
+    uint8_t *cin = NULL, *qinside = NULL;
+    /* the polygon in local plan coordinates, counter-clockwise */
+    if (st->plan_frame) {
+        for (size_t i = 0; i < n; i++) {
+            q[2 * i] = st->points[2 * i] - S->ox;
+            q[2 * i + 1] = st->points[2 * i + 1] - S->oy;
+        }
+    } else {
+        double ax, ay;
+        uint32_t ei = anchor_point(S, &st->at, v, &ax, &ay);
+        if (ei == NONE)
+            goto skip;
+        const sk_edge *e = &S->e[ei];
+        double dx = edx(e), dy = edy(e);
+        for (size_t i = 0; i < n; i++) {
+            double u = st->points[2 * i], w = st->points[2 * i + 1];
+            q[2 * i] = ax + u * dx - w * e->nx;
+            q[2 * i + 1] = ay + u * dy - w * e->ny;
+        }
+    }
+    double area = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t j = (i + 1) % n;
+        area += q[2 * i] * q[2 * j + 1] - q[2 * j] * q[2 * i + 1];
+    }
+    if (area < 0)
+        for (size_t i = 0; i < n / 2; i++)
+            for (int c = 0; c < 2; c++) {
+                double t = q[2 * i + c];
+                q[2 * i + c] = q[2 * (n - 1 - i) + c];
+                q[2 * (n - 1 - i) + c] = t;
+            }
+    double tol = 10 * S->d3;
+    /* crossings; anything closer than tol that is not a clean crossing is refused */
+    for (size_t i = 0; i < S->nlive_e; i++) {
+        uint32_t ei = S->live_e[i];
+        const sk_edge *e = &S->e[ei];
+        double a[2], b[2];
+        cpos(&S->c[e->start], v, &a[0], &a[1]);
+        cpos(&S->c[e->end], v, &b[0], &b[1]);
+        for (size_t j = 0; j < n; j++) {
+            const double *c = &q[2 * j], *d = &q[2 * ((j + 1) % n)];
+            if (seg_dist(c[0], c[1], a[0], a[1], b[0], b[1]) <= tol ||
+                seg_dist(a[0], a[1], c[0], c[1], d[0], d[1]) <= tol)
+                goto skip;
+            double oa = ag_pred_orient2d(c, d, a), ob = ag_pred_orient2d(c, d, b);
+            double oc = ag_pred_orient2d(a, b, c), od = ag_pred_orient2d(a, b, d);
+            /* every corner is some edge's first: the tests above covered all corner to
+             * edge distances, so the signs here are clear */
+            if ((oa > 0) == (ob > 0) || (oc > 0) == (od > 0))
+                continue;
+            if (!grow((void **)&X, &capx, nx + 1, sizeof *X)) {
+                fail(S, AG_ERR_NOMEM);
+                goto out;
+            }
+            xing *x = &X[nx++];
+            memset(x, 0, sizeof *x);
+            x->te = oa / (oa - ob);
+            x->tq = oc / (oc - od);
+            x->x = a[0] + x->te * (b[0] - a[0]);
+            x->y = a[1] + x->te * (b[1] - a[1]);
+            x->e = ei;
+            x->qi = (uint32_t)j;
+            x->enters = oa < 0; /* the active edge starts right of Q's edge: outside Q */
+            x->p_before = x->p_after = x->q_before = x->q_after = NONE;
+        }
+    }
+    /* corners of the active plan inside Q, Q's corners inside the plan */
+    cin = calloc(S->nc ? S->nc : 1, 1);
+    cvert = malloc((S->nc ? S->nc : 1) * sizeof *cvert);
+    qin = malloc(n * sizeof *qin);
+    qout = malloc(n * sizeof *qout);
+    qvert = malloc(n * sizeof *qvert);
+    qinside = malloc(2 * n); /* n corners, then n edges without crossings */
+    byE = malloc((nx ? nx : 1) * sizeof *byE);
+    byQ = malloc((nx ? nx : 1) * sizeof *byQ);
+    if (!cin || !cvert || !qin || !qout || !qvert || !qinside || !byE || !byQ) {
+        fail(S, AG_ERR_NOMEM);
+        goto out;
+    }
+    int any_out = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t i2 = (i + 1) % n;
+        qinside[i] = (uint8_t)in_active(S, v, q[2 * i], q[2 * i + 1]);
+        qinside[n + i] = (uint8_t)in_active(S, v, (q[2 * i] + q[2 * i2]) / 2,
+                                            (q[2 * i + 1] + q[2 * i2 + 1]) / 2);
+        any_out |= !qinside[i];
+        qin[i] = qout[i] = NONE;
+    }
+    int any_in = 0;
+    for (size_t i = 0; i < S->nlive_c; i++) {
+        uint32_t c = S->live_c[i];
+        double x, y;
+        cpos(&S->c[c], v, &x, &y);
+        cin[c] = (uint8_t)ag_pred_point_in_polygon(q, n, x, y);
+        any_in |= cin[c];
+    }
+    if (!nx && !any_out && !any_in) {
+        goto skip; /* wholly inside the active plan: nothing changes */
+    }
+    for (size_t i = 0; i < nx; i++)
+        byE[i] = byQ[i] = &X[i];
+    qsort(byE, nx, sizeof *byE, cmp_xing_e);
+    qsort(byQ, nx, sizeof *byQ, cmp_xing_q);
+    /* the crossings must alternate in and out along every edge of either outline, and
+     * agree with the sides its corners are on */
+    int bad = 0;
+    for (size_t i = 0; i < nx; i++) {
+        const xing *a = byE[i], *b = byQ[i];
+        if (i == 0 || byE[i - 1]->e != a->e)
+            bad |= a->enters == cin[S->e[a->e].start];
+        else
+            bad |= a->enters == byE[i - 1]->enters;
+        if (i + 1 == nx || byE[i + 1]->e != a->e)
+            bad |= a->enters != cin[S->e[a->e].end];
+        /* Q enters the plan where the active edge leaves Q */
+        if (i == 0 || byQ[i - 1]->qi != b->qi)
+            bad |= b->enters != qinside[b->qi];
+        else
+            bad |= b->enters == byQ[i - 1]->enters;
+        if (i + 1 == nx || byQ[i + 1]->qi != b->qi)
+            bad |= b->enters == qinside[(b->qi + 1) % n];
+    }
+    if (bad) {
+        goto skip;
+    }
+    ag_shell_face ff = {AG_SHELL_FACE_FLOOR, -1, (int32_t)k, st->profile, -1, 0, 0};
+    uint32_t floor = 0;
+    if (ag_shell_add_face(S->shell, &ff, &floor) != AG_OK) {
+        fail(S, AG_ERR_NOMEM);
+        goto out;
+    }
+    for (size_t i = 0; i < nx; i++)
+        X[i].vert = vertex(S, X[i].x, X[i].y, v);
+    /* corners inside Q end here */
+    size_t nlive_c = S->nlive_c;
+    for (size_t i = 0; i < nlive_c; i++) {
+        uint32_t c = S->live_c[i];
+        if (!cin[c])
+            continue;
+        double x, y;
+        cpos(&S->c[c], v, &x, &y);
+        cvert[c] = vertex(S, x, y, v);
+        retire(S, c, cvert[c]);
+    }
+    /* the active edges: pieces inside Q are closed, pieces outside carry on */
+    size_t nlive_e = S->nlive_e, xi = 0;
+    for (size_t i = 0; i < nlive_e && S->st == AG_OK; i++) {
+        uint32_t ei = S->live_e[i];
+        size_t x0 = xi;
+        while (xi < nx && byE[xi]->e == ei)
+            xi++;
+        uint32_t cs = S->e[ei].start, ce = S->e[ei].end;
+        int inside = cin[cs];
+        if (x0 == xi && !inside)
+            continue;
+        uint32_t cur = inside ? NONE : ei, va = inside ? cvert[cs] : NONE;
+        for (size_t j = x0; j <= xi; j++) {
+            int last = j == xi;
+            uint32_t vb = last ? (cin[ce] ? cvert[ce] : NONE) : byE[j]->vert;
+            if (inside) {
+                uint32_t face = S->e[ei].face;
+                seg(S, face, vb, va);
+                seg(S, floor, va, vb);
+                if (!last) {
+                    /* an outside piece starts at this crossing: a copy of the edge */
+                    uint32_t g = add_edge(S);
+                    if (g == NONE)
+                        break;
+                    S->e[g] = S->e[ei];
+                    S->e[g].ver = 0;
+                    S->e[g].alive = 1;
+                    S->e[g].start = S->e[g].end = NONE;
+                    byE[j]->p_after = g;
+                    cur = g;
+                }
+            } else {
+                if (last) {
+                    S->e[cur].end = ce;
+                    S->c[ce].in = cur;
+                    S->e[cur].ver++;
+                } else {
+                    byE[j]->p_before = cur;
+                    S->e[cur].ver++;
+                    cur = NONE;
+                }
+            }
+            va = vb;
+            inside = !inside;
+        }
+        if (cin[cs])
+            kill_edge(S, ei); /* its outside pieces, if any, carry on as copies */
+    }
+    /* Q's pieces outside the active plan become edges */
+    int32_t sid = (int32_t)k + 1;
+    for (size_t i = 0; i < n; i++)
+        qvert[i] = NONE;
+    xi = 0;
+    for (size_t i = 0; i < n && S->st == AG_OK; i++) {
+        size_t x0 = xi;
+        while (xi < nx && byQ[xi]->qi == i)
+            xi++;
+        size_t i2 = (i + 1) % n;
+        /* inside at Q's corner i: Q enters the plan where the active edge leaves Q */
+        int inside = x0 < xi ? byQ[x0]->enters : qinside[n + i];
+        double ax = q[2 * i], ay = q[2 * i + 1];
+        uint32_t va = NONE;
+        if (!inside) {
+            if (qvert[i] == NONE)
+                qvert[i] = vertex(S, ax, ay, v);
+            va = qvert[i];
+        }
+        for (size_t j = x0; j <= xi; j++) {
+            int last = j == xi;
+            double bx = last ? q[2 * i2] : byQ[j]->x, by = last ? q[2 * i2 + 1] : byQ[j]->y;
+            uint32_t vb;
+            if (last) {
+                if (!inside && qvert[i2] == NONE)
+                    qvert[i2] = vertex(S, bx, by, v);
+                vb = qvert[i2];
+            } else {
+                vb = byQ[j]->vert;
+            }
+            if (!inside) {
+                uint32_t g = forced_edge(S, ax, ay, bx, by, v, st, sid);
+                if (g == NONE)
+                    goto out;
+                seg(S, S->e[g].face, va, vb);
+                seg(S, floor, vb, va);
+                if (j == x0)
+                    qout[i] = g;
+                else
+                    byQ[j - 1]->q_after = g;
+                if (last)
+                    qin[i2] = g;
+                else
+                    byQ[j]->q_before = g;
+            }
+            ax = bx;
+            ay = by;
+            va = vb;
+            inside = !inside;
+        }
+    }
+    /* the new corners: at the crossings and at Q's corners outside the plan */
+    size_t first = S->ntouched;
+    for (size_t i = 0; i < nx && S->st == AG_OK; i++) {
+        xing *x = &X[i];
+        uint32_t in = x->enters ? x->p_before : x->q_before;
+        uint32_t out = x->enters ? x->q_after : x->p_after;
+        if (in == NONE || out == NONE) {
+            ag_error_set(S->err, AG_ERR_INTERNAL, 0, "forced step %zu: inconsistent crossing at "
+                         "(%.6f, %.6f)", k, x->x + S->ox, x->y + S->oy);
+            fail(S, AG_ERR_INTERNAL);
+            goto out;
+        }
+        add_corner(S, in, out, x->x, x->y, v, x->vert);
+    }
+    for (size_t i = 0; i < n && S->st == AG_OK; i++)
+        if (qin[i] != NONE && qout[i] != NONE)
+            add_corner(S, qin[i], qout[i], q[2 * i], q[2 * i + 1], v, qvert[i]);
+    size_t last = S->ntouched;
+    for (size_t i = first; i < last && S->st == AG_OK; i++)
+        settle(S, S->touched[i]);
+    S->stats.steps++;
+    goto out;
+skip:
+    S->stats.steps_skipped++;
+out:
+    free(q);
+    free(X);
+    free(byE);
+    free(byQ);
+    free(cin);
+    free(cvert);
+    free(qin);
+    free(qout);
+    free(qvert);
+    free(qinside);
 }
 
 /* --- anchors ----------------------------------------------------------------------------- */
@@ -1066,6 +1604,9 @@ static void locate_anchor(sk *S, ag_anchor *a, double z)
     a->normal[1] = -e->ny / nl;
     a->normal[2] = e->s / nl;
     a->face = (int32_t)e->face;
+    a->tangent[0] = edx(e);
+    a->tangent[1] = edy(e);
+    a->tangent[2] = 0;
 }
 
 /* --- the cap ----------------------------------------------------------------------------- */
@@ -1191,12 +1732,37 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         }
     }
     for (size_t k = 0; k < plan->nsteps && S.flat_h; k++) {
+        if (plan->steps[k].npoints)
+            continue; /* forced steps are not grown */
         double h = plan->steps[k].at.z;
         size_t q = 0;
         while (q < S.nflat && S.flat_h[q] < h)
             q++;
         if (q < S.nflat && S.flat_h[q] == h)
             continue;
+        double *nf = realloc(S.flat_h, (S.nflat + 1 + maxflat) * sizeof *nf);
+        if (!nf) {
+            fail(&S, AG_ERR_NOMEM);
+            break;
+        }
+        S.flat_h = nf;
+        memmove(&S.flat_h[q + 1], &S.flat_h[q], (S.nflat - q) * sizeof *S.flat_h);
+        S.flat_h[q] = h;
+        S.nflat++;
+    }
+    /* offset events: a flat interval each, of their own */
+    for (size_t k = 0; k < plan->noffsets && S.flat_h && S.st == AG_OK; k++) {
+        double h = plan->offsets[k].z;
+        size_t q = 0;
+        while (q < S.nflat && S.flat_h[q] < h)
+            q++;
+        if (q < S.nflat && S.flat_h[q] == h) {
+            ag_error_set(err, AG_ERR_INVALID, (long)k + 1,
+                         "offset %zu at height %g coincides with a horizontal profile segment, a "
+                         "natural step or another offset there (move it)", k, h);
+            fail(&S, AG_ERR_INVALID);
+            break;
+        }
         double *nf = realloc(S.flat_h, (S.nflat + 1 + maxflat) * sizeof *nf);
         if (!nf) {
             fail(&S, AG_ERR_NOMEM);
@@ -1219,6 +1785,42 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             ev.ver = (uint32_t)k + 1;
             push(&S, &ev);
         }
+    }
+    for (size_t k = 0; k < plan->noffsets && S.st == AG_OK; k++) {
+        const ag_plan_offset *o = &plan->offsets[k];
+        ag_event ev = {0};
+        ev.type = AG_EVENT_DIRECTION;
+        ev.a = OFFSET_MARK;
+        ev.b = (uint32_t)k;
+        ev.z = virtual_z(&S, o->z, 0);
+        push(&S, &ev);
+        /* the profiles the event hands out count their heights from it */
+        for (size_t e = 0; e <= o->nedges + 1; e++) {
+            int32_t pi = e == o->nedges ? o->profile : e == o->nedges + 1 ? o->side
+                                                                          : o->edges[e].profile;
+            if (pi < 0)
+                continue;
+            const ag_profile *pr = &plan->profiles[pi];
+            for (size_t j = 1; j + 1 < pr->npoints; j++) {
+                ag_event d = {0};
+                d.type = AG_EVENT_DIRECTION;
+                d.z = virtual_z(&S, o->z + pr->points[j].z, 1);
+                d.a = (uint32_t)pi;
+                d.b = (uint32_t)j;
+                d.ver = (uint32_t)(plan->nsteps + 1 + k);
+                push(&S, &d);
+            }
+        }
+    }
+    for (size_t k = 0; k < plan->nsteps; k++) {
+        if (!plan->steps[k].npoints)
+            continue;
+        ag_event ev = {0};
+        ev.type = AG_EVENT_DIRECTION;
+        ev.a = FORCED_MARK;
+        ev.b = (uint32_t)k;
+        ev.z = virtual_z(&S, plan->steps[k].at.z, 1);
+        push(&S, &ev);
     }
     for (size_t k = 0; k < S.nflat; k++) {
         ag_event ev = {0};
@@ -1350,10 +1952,22 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             batch[nb++] = nx;
         }
         if (is_dir) {
-            direction(&S, batch, nb);
+            int only_forced = 1;
+            for (size_t i = 0; i < nb; i++)
+                only_forced &= batch[i].a == FORCED_MARK;
+            if (!only_forced)
+                direction(&S, batch, nb);
+            for (size_t i = 0; i < nb && S.st == AG_OK; i++)
+                if (batch[i].a == OFFSET_MARK) {
+                    S.stats.offsets++;
+                    insert_sides(&S, batch[i].b);
+                }
             for (size_t i = 0; i < nb; i++)
                 if (batch[i].a == FLAT_MARK && batch[i].b == 0)
                     insert_steps(&S, batch[i].z);
+            for (size_t i = 0; i < nb && S.st == AG_OK; i++)
+                if (batch[i].a == FORCED_MARK)
+                    forced_step(&S, batch[i].b, batch[i].z);
             schedule_touched(&S);
             continue;
         }

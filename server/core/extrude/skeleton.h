@@ -9,7 +9,9 @@
  * corners that arrive are retired, edges passing through the point are split, and the
  * edges leaving the point are paired around it into new corners. Neighbouring edges
  * that become collinear are resolved by the plan's priority scheme (the winner's plane
- * takes over), antiparallel neighbours (a ridge) are zipped. */
+ * takes over), antiparallel neighbours (a ridge) are zipped. Horizontal profile segments,
+ * profile offset events and natural steps each get a stretched interval of sweep height in
+ * which only their edges move; forced steps are united with the active plan at their height. */
 #ifndef AG_EXTRUDE_SKELETON_H
 #define AG_EXTRUDE_SKELETON_H
 
@@ -34,6 +36,7 @@ typedef struct {
      * there may be undesirable */
     size_t irregular;
     size_t steps, steps_skipped; /* plan edits made / not made (anchor not on the plan) */
+    size_t offsets, offset_sides; /* offset events handled, side edges they made */
     int capped;           /* the top was closed flat */
     double top;           /* highest height reached */
 } ag_skeleton_stats;

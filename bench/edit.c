@@ -1,0 +1,176 @@
+/* Resize benchmark: least-squares resizes on generated walls of bricks sized for about 2k,
+ * 20k and 200k equations (running bond, so neighbours overlap partially and touch), then on
+ * the largest real meshes in ../shared/data. Per model: equations and unknowns, the first
+ * solve (equations, factorization, solve), a drag re-solve with a new target and the
+ * factorization kept, the whole committed edit (solve, emission, re-proceduralization), and
+ * the peak resident memory. Not a test. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <time.h>
+
+#include "core/edit/edit.h"
+#include "io/obj.h"
+
+#define SHARED AG_REPO_DIR "/../shared/data"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+static long peak_mib(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_maxrss / 1024;
+}
+
+static void add_box(ag_mesh *m, const double lo[3], const double hi[3], int32_t group)
+{
+    size_t c;
+    ag_mesh_add_component(m, group, &c);
+    uint32_t b = (uint32_t)m->nverts;
+    for (int i = 0; i < 8; i++)
+        ag_mesh_add_vertex(m, i & 1 ? hi[0] : lo[0], i & 2 ? hi[1] : lo[1], i & 4 ? hi[2] : lo[2]);
+    static const int f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    for (int i = 0; i < 12; i++)
+        ag_mesh_add_triangle(m, b + f[i][0], b + f[i][1], b + f[i][2], (uint32_t)c);
+}
+
+/* nx bricks per course, nz courses, alternate courses shifted by half a brick; bricks come
+ * in three lengths so that they are not all one pattern. */
+static ag_mesh *brick_wall(int nx, int nz)
+{
+    ag_mesh *m = ag_mesh_create();
+    static const double len[3] = {0.24, 0.30, 0.36};
+    for (int z = 0; z < nz; z++) {
+        double x = z & 1 ? -0.12 : 0;
+        for (int i = 0; i < nx; i++) {
+            char name[32];
+            size_t g;
+            snprintf(name, sizeof name, "b%d_%d", z, i);
+            ag_mesh_add_group(m, name, &g);
+            double l = len[(i * 7 + z * 3) % 3];
+            double lo[3] = {x, 0, z * 0.07}, hi[3] = {x + l, 0.115, z * 0.07 + 0.07};
+            add_box(m, lo, hi, (int32_t)g);
+            x += l;
+        }
+    }
+    return m;
+}
+
+/* The visible top-level node with the most neighbours: the one whose resize reaches most. */
+static int32_t busiest_node(const ag_splittree *t)
+{
+    size_t *deg = calloc(t->nnodes, sizeof *deg);
+    for (size_t k = 0; k < t->nadj; k++) {
+        deg[t->adj[2 * k]]++;
+        deg[t->adj[2 * k + 1]]++;
+    }
+    int32_t best = -1;
+    for (size_t n = 0; n < t->nnodes; n++)
+        if (t->nodes[n].kind == AG_NODE_COMPONENT && (best < 0 || deg[n] > deg[best]))
+            best = (int32_t)n;
+    free(deg);
+    return best;
+}
+
+static void run(const char *name, const ag_mesh *m)
+{
+    ag_error err = {0};
+    double t0 = now_ms();
+    ag_edit_model *model = NULL;
+    if (ag_edit_model_create(m, NULL, &model, &err)) {
+        printf("%-28s proceduralize failed: %s\n", name, err.text);
+        return;
+    }
+    double t_proc = now_ms() - t0;
+    const ag_splittree *t = model->proc->tree;
+    int32_t node = busiest_node(t);
+    if (node < 0) {
+        printf("%-28s no visible node\n", name);
+        ag_edit_model_free(model);
+        return;
+    }
+    /* local mode over the whole building: the area is everything reachable */
+    ag_edit_op op = {.kind = AG_EDIT_RESIZE, .node = node, .has_scale = 1,
+                     .scale = {1.3, 1, 1.1}, .mode = AG_EDIT_LOCAL, .has_region = 1,
+                     .region = t->nodes[0].box};
+    ag_edit_report rep = {0};
+    ag_box *boxes = NULL;
+    t0 = now_ms();
+    if (ag_edit_preview(model, &op, &boxes, &rep, &err)) {
+        printf("%-28s resize failed: %s\n", name, err.text);
+        ag_edit_model_free(model);
+        return;
+    }
+    double t_first = now_ms() - t0;
+    free(boxes);
+    /* drag: ten new targets, the factorization kept */
+    double t_drag = 0;
+    for (int k = 1; k <= 10; k++) {
+        op.scale[0] = 1.3 + 0.02 * k;
+        t0 = now_ms();
+        if (ag_edit_preview(model, &op, &boxes, NULL, &err)) {
+            printf("%-28s drag failed: %s\n", name, err.text);
+            break;
+        }
+        t_drag = fmax(t_drag, now_ms() - t0);
+        free(boxes);
+    }
+    t0 = now_ms();
+    ag_edit_model *out = NULL;
+    ag_edit_report rep2 = {0};
+    double t_apply = -1;
+    if (!ag_edit_apply(model, &op, &out, &rep2, &err))
+        t_apply = now_ms() - t0;
+    else
+        printf("(%s: the commit failed: %s)\n", name, err.text);
+    printf("%-28s %8zu %8zu %8zu | %9.2f %9.2f %9.3f %10.1f %9.1f | %8.2g %5ld\n", name,
+           m->ntris, rep.equations, rep.unknowns, t_proc, t_first, t_drag, t_apply,
+           rep.solve_ms, rep.max_residual_rel, peak_mib());
+    ag_edit_report_clear(&rep);
+    ag_edit_report_clear(&rep2);
+    ag_edit_model_free(out);
+    ag_edit_model_free(model);
+}
+
+static void run_file(const char *path, ag_up_axis up)
+{
+    ag_obj_read_options ro = {.up = up};
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    if (ag_obj_read_file(path, &ro, &m, &err)) {
+        printf("(skipping %s: %s)\n", path, err.text);
+        return;
+    }
+    const char *name = strrchr(path, '/');
+    run(name ? name + 1 : path, m);
+    ag_mesh_free(m);
+}
+
+int main(void)
+{
+    printf("%-28s %8s %8s %8s | %9s %9s %9s %10s %9s | %8s %5s\n", "model", "tris", "equations",
+           "unknowns", "proc ms", "first ms", "drag ms", "commit ms", "solve ms", "residual",
+           "MiB");
+    static const struct {
+        int nx, nz;
+    } walls[] = {{22, 18}, {70, 52}, {220, 166}};
+    for (size_t i = 0; i < sizeof walls / sizeof *walls; i++) {
+        char name[64];
+        snprintf(name, sizeof name, "bricks %dx%d", walls[i].nx, walls[i].nz);
+        ag_mesh *m = brick_wall(walls[i].nx, walls[i].nz);
+        run(name, m);
+        ag_mesh_free(m);
+    }
+    run_file(SHARED "/lod3_ingolstadt/obj/4018267.obj", AG_UP_Z);
+    run_file(SHARED "/meshes_0ad/ptol_edfu_struct.obj", AG_UP_Y);
+    return 0;
+}

@@ -1,0 +1,170 @@
+/* archgram edit DIR --op OP.json --out DIR2
+ *
+ * DIR holds a proceduralized model as `archgram proceduralize` (or an earlier edit) writes
+ * it: grammar.txt and terminals/. The grammar is derived and proceduralized again, which
+ * gives the tree whose node ids the op names (DIR/tree.json lists them). DIR2 receives the
+ * edited model's grammar.txt, terminals/, tree.json (ids for the next edit) and summary.json
+ * (the solve figures and instances per label). */
+#include <errno.h>
+#include <jansson.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "../core/edit/edit.h"
+#include "../io/edit_op_json.h"
+#include "../io/edit_tree_json.h"
+#include "../io/grammar_text.h"
+#include "../io/terminals.h"
+#include "commands.h"
+
+static int usage(void)
+{
+    fputs("usage: archgram edit DIR --op OP.json --out DIR2\n", stderr);
+    return 2;
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static int make_dirs(const char *dir)
+{
+    char p[4096];
+    snprintf(p, sizeof p, "%s", dir);
+    for (char *s = p + 1; *s; s++)
+        if (*s == '/') {
+            *s = 0;
+            if (mkdir(p, 0777) && errno != EEXIST)
+                return -1;
+            *s = '/';
+        }
+    return mkdir(p, 0777) && errno != EEXIST ? -1 : 0;
+}
+
+static int write_json(const char *path, json_t *j)
+{
+    if (!j || json_dump_file(j, path, JSON_INDENT(1) | JSON_REAL_PRECISION(12))) {
+        fprintf(stderr, "archgram: cannot write %s\n", path);
+        return 1;
+    }
+    return 0;
+}
+
+int ag_cli_edit(int argc, char **argv)
+{
+    const char *dir = NULL, *oppath = NULL, *out = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--op")) {
+            if (++i >= argc)
+                return usage();
+            oppath = argv[i];
+        } else if (!strcmp(argv[i], "--out")) {
+            if (++i >= argc)
+                return usage();
+            out = argv[i];
+        } else if (!strcmp(argv[i], "--help")) {
+            fputs("usage: archgram edit DIR --op OP.json --out DIR2\n", stdout);
+            return 0;
+        } else if (argv[i][0] == '-' && argv[i][1]) {
+            fprintf(stderr, "archgram: edit: unknown option %s\n", argv[i]);
+            return usage();
+        } else if (!dir) {
+            dir = argv[i];
+        } else {
+            return usage();
+        }
+    }
+    if (!dir || !oppath || !out)
+        return usage();
+
+    ag_error err;
+    ag_error_clear(&err);
+    ag_edit_op op;
+    if (ag_edit_op_json_read_file(oppath, &op, &err)) {
+        ag_cli_report(oppath, &err);
+        return 1;
+    }
+    int rc = 1;
+    char path[4096];
+    ag_grammar *g = NULL;
+    ag_edit_model *model = NULL, *edited = NULL;
+    ag_edit_report rep = {0};
+    char *text = NULL;
+    size_t tlen = 0;
+    json_t *summary = NULL;
+    double t0 = now();
+
+    snprintf(path, sizeof path, "%s/grammar.txt", dir);
+    long col = 0;
+    if (ag_grammar_text_read_file(path, &g, &err, &col) || ag_terminals_load(g, dir, &err)) {
+        ag_cli_report(path, &err);
+        goto done;
+    }
+    if (ag_edit_model_from_grammar(g, NULL, &model, &err)) {
+        ag_cli_report(path, &err);
+        goto done;
+    }
+    double t_load = now() - t0;
+    t0 = now();
+    if (ag_edit_apply(model, &op, &edited, &rep, &err)) {
+        /* errors that name an op field are the op file's; the rest are the model's */
+        ag_cli_report(err.code == AG_ERR_INVALID || err.code == AG_ERR_NOT_FOUND ? oppath : dir,
+                      &err);
+        goto done;
+    }
+    double t_edit = now() - t0;
+    if (make_dirs(out)) {
+        fprintf(stderr, "archgram: cannot create %s: %s\n", out, strerror(errno));
+        goto done;
+    }
+    ag_grammar *ng = edited->proc->grammar;
+    if (ag_terminals_write(ng, out, NULL, &err) || ag_grammar_text_print(ng, &text, &tlen, &err)) {
+        ag_cli_report(out, &err);
+        goto done;
+    }
+    snprintf(path, sizeof path, "%s/grammar.txt", out);
+    FILE *f = fopen(path, "wb");
+    int ok = f && fwrite(text, 1, tlen, f) == tlen;
+    if (f && fclose(f))
+        ok = 0;
+    if (!ok) {
+        fprintf(stderr, "archgram: cannot write %s: %s\n", path, strerror(errno));
+        goto done;
+    }
+    snprintf(path, sizeof path, "%s/tree.json", out);
+    json_t *tree = ag_edit_tree_json(edited->proc);
+    int bad = write_json(path, tree);
+    json_decref(tree);
+    if (bad)
+        goto done;
+    summary = ag_edit_op_json_report(&rep);
+    if (summary) {
+        json_object_set_new(summary, "op", ag_edit_op_json_to(&op));
+        json_object_set_new(summary, "tree", ag_edit_tree_json_stats(edited->proc));
+        json_object_set_new(summary, "seconds",
+                            json_pack("{s:f,s:f}", "load", t_load, "edit", t_edit));
+    }
+    snprintf(path, sizeof path, "%s/summary.json", out);
+    if (write_json(path, summary))
+        goto done;
+    printf("edit: %zu equations, %zu unknowns, solve %.3f ms, max residual %.3g m, "
+           "%zu splits, %zu joins -> %s\n",
+           rep.equations, rep.unknowns, rep.solve_ms, rep.max_residual, rep.splits, rep.joins,
+           out);
+    rc = 0;
+done:
+    json_decref(summary);
+    free(text);
+    ag_edit_report_clear(&rep);
+    ag_edit_model_free(edited);
+    ag_edit_model_free(model);
+    ag_grammar_free(g);
+    ag_edit_op_clear(&op);
+    return rc;
+}

@@ -1,0 +1,298 @@
+#include "place.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void ag_place_identity(ag_place_map *m)
+{
+    memset(m, 0, sizeof *m);
+    for (int i = 0; i < 3; i++)
+        m->M[i][i] = 1;
+}
+
+void ag_place_boxes(ag_place_map *m, const ag_box *from, const ag_box *to, int k)
+{
+    k &= 3;
+    double S[3], cf[3], ct[3];
+    for (int a = 0; a < 3; a++) {
+        S[a] = from->max[a] - from->min[a];
+        cf[a] = 0.5 * (from->min[a] + from->max[a]);
+        ct[a] = 0.5 * (to->min[a] + to->max[a]);
+    }
+    double Sr[3] = {S[0], S[1], S[2]};
+    if (k & 1) {
+        Sr[0] = S[1];
+        Sr[1] = S[0];
+    }
+    double s[3];
+    for (int a = 0; a < 3; a++) {
+        double ts = to->max[a] - to->min[a];
+        s[a] = Sr[a] > 0 ? ts / Sr[a] : 1.0;
+    }
+    double c = k == 0 ? 1 : k == 2 ? -1 : 0, sn = k == 1 ? 1 : k == 3 ? -1 : 0;
+    double R[3][3] = {{c, -sn, 0}, {sn, c, 0}, {0, 0, 1}};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            m->M[i][j] = s[i] * R[i][j];
+    for (int i = 0; i < 3; i++)
+        m->t[i] = ct[i] - (m->M[i][0] * cf[0] + m->M[i][1] * cf[1] + m->M[i][2] * cf[2]);
+}
+
+void ag_place_apply(const ag_place_map *m, const double p[3], double q[3])
+{
+    double r[3];
+    for (int i = 0; i < 3; i++)
+        r[i] = m->M[i][0] * p[0] + m->M[i][1] * p[1] + m->M[i][2] * p[2] + m->t[i];
+    memcpy(q, r, sizeof r);
+}
+
+ag_box ag_place_apply_box(const ag_place_map *m, const ag_box *b)
+{
+    ag_box o = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    for (int i = 0; i < 8; i++) {
+        double p[3] = {i & 1 ? b->max[0] : b->min[0], i & 2 ? b->max[1] : b->min[1],
+                       i & 4 ? b->max[2] : b->min[2]};
+        ag_place_apply(m, p, p);
+        for (int a = 0; a < 3; a++) {
+            o.min[a] = fmin(o.min[a], p[a]);
+            o.max[a] = fmax(o.max[a], p[a]);
+        }
+    }
+    return o;
+}
+
+ag_status ag_place_check_node(const ag_proceduralize_result *r, int32_t node, const char *what,
+                              ag_error *err)
+{
+    const ag_splittree *t = r ? r->tree : NULL;
+    if (!t)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "%s: the model has no split tree", what);
+    if (node < 0 || (size_t)node >= t->nnodes)
+        return ag_error_set(err, AG_ERR_NOT_FOUND, node,
+                            "%s: node %d is not in the split tree (nodes 0..%zu)", what,
+                            (int)node, t->nnodes - 1);
+    if (t->nodes[node].kind == AG_NODE_DEAD)
+        return ag_error_set(err, AG_ERR_NOT_FOUND, node,
+                            "%s: node %d was removed from the split tree", what, (int)node);
+    return AG_OK;
+}
+
+size_t ag_place_mark_subtree(const ag_splittree *t, int32_t node, uint8_t *mark)
+{
+    /* iterative preorder walk over first_child / next_sibling, bounded by the subtree root */
+    size_t n = 0;
+    int32_t v = node;
+    while (v >= 0) {
+        const ag_tnode *x = &t->nodes[v];
+        if (x->kind == AG_NODE_COMPONENT && x->component >= 0 && !mark[x->component]) {
+            mark[x->component] = 1;
+            n++;
+        }
+        if (x->first_child >= 0) {
+            v = x->first_child;
+            continue;
+        }
+        while (v != node && t->nodes[v].next_sibling < 0)
+            v = t->nodes[v].parent;
+        if (v == node)
+            break;
+        v = t->nodes[v].next_sibling;
+    }
+    return n;
+}
+
+int ag_place_facing(const ag_box *b, const ag_box *ref)
+{
+    double dx = b->max[0] - b->min[0], dy = b->max[1] - b->min[1];
+    int a = dx < dy ? 0 : 1; /* the thinner horizontal axis is the facing axis */
+    double off = 0.5 * (b->min[a] + b->max[a]) - 0.5 * (ref->min[a] + ref->max[a]);
+    double size = ref->max[a] - ref->min[a];
+    if (fabs(off) <= 1e-9 * (size > 0 ? size : 1.0))
+        return a == 0 ? 2 : 3;
+    if (a == 0)
+        return off > 0 ? 0 : 2;
+    return off > 0 ? 1 : 3;
+}
+
+void ag_place_label_name(const ag_proceduralize_result *r, uint32_t c, const char *prefix,
+                         char *buf, size_t cap)
+{
+    int32_t l = c < r->labels->ncomponents ? r->labels->label[c] : -1;
+    if (l >= 0)
+        snprintf(buf, cap, "%sL%d", prefix ? prefix : "", (int)l + 1);
+    else
+        snprintf(buf, cap, "%sC%u", prefix ? prefix : "", c + 1);
+}
+
+/* ---- builder ------------------------------------------------------------------------------ */
+
+struct ag_place_builder {
+    ag_mesh *m;
+    size_t comp;      /* current component */
+    int has_comp;
+    int32_t *gslot;   /* open addressing: group index or -1 */
+    size_t gcap;
+    uint32_t *vmap;   /* scratch: source vertex → new vertex, UINT32_MAX when unset */
+    size_t vcap;
+};
+
+static uint64_t hash_str(const char *s)
+{
+    uint64_t h = 1469598103934665603ULL;
+    for (; *s; s++)
+        h = (h ^ (unsigned char)*s) * 1099511628211ULL;
+    return h;
+}
+
+ag_place_builder *ag_place_builder_create(void)
+{
+    ag_place_builder *b = calloc(1, sizeof *b);
+    if (!b)
+        return NULL;
+    b->m = ag_mesh_create();
+    if (!b->m) {
+        free(b);
+        return NULL;
+    }
+    return b;
+}
+
+void ag_place_builder_free(ag_place_builder *b)
+{
+    if (!b)
+        return;
+    ag_mesh_free(b->m);
+    free(b->gslot);
+    free(b->vmap);
+    free(b);
+}
+
+static ag_status group_index(ag_place_builder *b, const char *name, int32_t *out)
+{
+    if (2 * (b->m->ngroups + 1) > b->gcap) {
+        size_t nc = b->gcap ? 2 * b->gcap : 64;
+        int32_t *ns = malloc(nc * sizeof *ns);
+        if (!ns)
+            return AG_ERR_NOMEM;
+        for (size_t i = 0; i < nc; i++)
+            ns[i] = -1;
+        for (size_t g = 0; g < b->m->ngroups; g++) {
+            size_t i = hash_str(b->m->group_names[g]) & (nc - 1);
+            while (ns[i] >= 0)
+                i = (i + 1) & (nc - 1);
+            ns[i] = (int32_t)g;
+        }
+        free(b->gslot);
+        b->gslot = ns;
+        b->gcap = nc;
+    }
+    size_t i = hash_str(name) & (b->gcap - 1);
+    while (b->gslot[i] >= 0) {
+        if (!strcmp(b->m->group_names[b->gslot[i]], name)) {
+            *out = b->gslot[i];
+            return AG_OK;
+        }
+        i = (i + 1) & (b->gcap - 1);
+    }
+    size_t g;
+    ag_status st = ag_mesh_add_group(b->m, name, &g);
+    if (st)
+        return st;
+    b->gslot[i] = (int32_t)g;
+    *out = (int32_t)g;
+    return AG_OK;
+}
+
+ag_status ag_place_begin(ag_place_builder *b, const char *group)
+{
+    int32_t g;
+    ag_status st = group_index(b, group, &g);
+    if (!st)
+        st = ag_mesh_add_component(b->m, g, &b->comp);
+    if (!st)
+        b->has_comp = 1;
+    return st;
+}
+
+ag_status ag_place_add(ag_place_builder *b, const ag_proceduralize_result *r, uint32_t c,
+                       const ag_place_map *m)
+{
+    const ag_mesh *src = r->mesh;
+    const ag_labels *L = r->labels;
+    if (!b->has_comp || c >= L->ncomponents)
+        return AG_ERR_INTERNAL;
+    if (src->nverts > b->vcap) {
+        uint32_t *nv = realloc(b->vmap, src->nverts * sizeof *nv);
+        if (!nv)
+            return AG_ERR_NOMEM;
+        for (size_t i = b->vcap; i < src->nverts; i++)
+            nv[i] = UINT32_MAX;
+        b->vmap = nv;
+        b->vcap = src->nverts;
+    }
+    ag_status st = AG_OK;
+    uint32_t s0 = L->tri_start[c], s1 = L->tri_start[c + 1];
+    for (uint32_t s = s0; s < s1 && !st; s++) {
+        const uint32_t *tr = src->tri + 3 * (size_t)L->tris[s];
+        uint32_t v[3];
+        for (int k = 0; k < 3 && !st; k++) {
+            uint32_t *slot = &b->vmap[tr[k]];
+            if (*slot == UINT32_MAX) {
+                double p[3];
+                memcpy(p, src->pos + 3 * (size_t)tr[k], sizeof p);
+                if (m)
+                    ag_place_apply(m, p, p);
+                *slot = (uint32_t)b->m->nverts;
+                st = ag_mesh_add_vertex(b->m, p[0], p[1], p[2]);
+            }
+            v[k] = *slot;
+        }
+        if (!st)
+            st = ag_mesh_add_triangle(b->m, v[0], v[1], v[2], (uint32_t)b->comp);
+    }
+    /* reset only what this component touched */
+    for (uint32_t s = s0; s < s1; s++)
+        for (int k = 0; k < 3; k++)
+            b->vmap[src->tri[3 * (size_t)L->tris[s] + k]] = UINT32_MAX;
+    return st;
+}
+
+ag_status ag_place_copy(ag_place_builder *b, const ag_proceduralize_result *r, uint32_t c,
+                        const ag_place_map *m, const char *prefix)
+{
+    char name[64];
+    ag_place_label_name(r, c, prefix, name, sizeof name);
+    ag_status st = ag_place_begin(b, name);
+    return st ? st : ag_place_add(b, r, c, m);
+}
+
+ag_status ag_place_copy_unmarked(ag_place_builder *b, const ag_proceduralize_result *r,
+                                 const uint8_t *mark)
+{
+    const ag_splittree *t = r->tree;
+    ag_status st = AG_OK;
+    for (size_t c = 0; c < t->ncomponents && !st; c++)
+        if (t->comp_node[c] >= 0 && !(mark && mark[c]))
+            st = ag_place_copy(b, r, (uint32_t)c, NULL, NULL);
+    return st;
+}
+
+size_t ag_place_triangles(const ag_place_builder *b)
+{
+    return b->m->ntris;
+}
+
+ag_status ag_place_finish(ag_place_builder *b, ag_mesh **out, ag_error *err)
+{
+    *out = NULL;
+    if (b->m->ntris == 0) {
+        ag_place_builder_free(b);
+        return ag_error_set(err, AG_ERR_INVALID, 0, "the edit would leave no geometry");
+    }
+    *out = b->m;
+    b->m = NULL;
+    ag_place_builder_free(b);
+    return AG_OK;
+}

@@ -1,0 +1,70 @@
+/* Shared pieces of the structural edits (split, join, paste, remove).
+ *
+ * A visible node's geometry is relative to its box, so a subtree moves into a new box by one
+ * affine map per subtree: the old box, turned by k quarter turns about z about its centre, is
+ * scaled per axis onto the new box (the same placement a grammar application uses). The
+ * builder collects the edited mesh: one component per placed terminal, group = label name
+ * ("L<label + 1>", the names the exported grammar gives its terminals). */
+#ifndef AG_PLACE_H
+#define AG_PLACE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../mesh.h"
+#include "../proc/proceduralize.h"
+#include "../status.h"
+
+typedef struct {
+    double M[3][3];
+    double t[3];
+} ag_place_map;
+
+void ag_place_identity(ag_place_map *m);
+/* Maps `from` onto `to` turned by k quarter turns counter-clockwise about +z. An axis along
+ * which `from` is flat keeps its (zero) size and lands on the centre of `to`. */
+void ag_place_boxes(ag_place_map *m, const ag_box *from, const ag_box *to, int k);
+void ag_place_apply(const ag_place_map *m, const double p[3], double q[3]);
+ag_box ag_place_apply_box(const ag_place_map *m, const ag_box *b);
+
+/* Checks that node names a live node of r's split tree. `what` describes the field for the
+ * message ("nodes[2] of the source model"). AG_ERR_NOT_FOUND with element = node. */
+ag_status ag_place_check_node(const ag_proceduralize_result *r, int32_t node, const char *what,
+                              ag_error *err);
+
+/* Sets mark[c] = 1 for every component of node's subtree (node included); mark holds
+ * r->tree->ncomponents entries. Returns the number of components newly marked. */
+size_t ag_place_mark_subtree(const ag_splittree *t, int32_t node, uint8_t *mark);
+
+/* The direction a box faces inside a reference box (its building): along its thinner
+ * horizontal axis, away from the reference's centre. 0: +x, 1: +y, 2: -x, 3: -y (quarter turns
+ * from +x). A box centred on the reference faces -y (x-long) or -x (y-long). */
+int ag_place_facing(const ag_box *b, const ag_box *ref);
+
+/* Label name of component c of r into buf (prefix may be NULL). */
+void ag_place_label_name(const ag_proceduralize_result *r, uint32_t c, const char *prefix,
+                         char *buf, size_t cap);
+
+typedef struct ag_place_builder ag_place_builder;
+
+ag_place_builder *ag_place_builder_create(void);
+void ag_place_builder_free(ag_place_builder *b);
+/* Starts a new component in group `group` (created on first use). */
+ag_status ag_place_begin(ag_place_builder *b, const char *group);
+/* Appends the triangles of component c of r to the current component, vertices mapped by m
+ * (NULL: unchanged). */
+ag_status ag_place_add(ag_place_builder *b, const ag_proceduralize_result *r, uint32_t c,
+                       const ag_place_map *m);
+/* begin (group = label name of c with prefix) + add. */
+ag_status ag_place_copy(ag_place_builder *b, const ag_proceduralize_result *r, uint32_t c,
+                        const ag_place_map *m, const char *prefix);
+/* Copies every component of r that has a node in the tree and is not marked (mark may be
+ * NULL), unchanged, in component order. */
+ag_status ag_place_copy_unmarked(ag_place_builder *b, const ag_proceduralize_result *r,
+                                 const uint8_t *mark);
+size_t ag_place_triangles(const ag_place_builder *b);
+/* Hands over the mesh; AG_ERR_INVALID when it has no triangle (the edit would leave nothing).
+ * The builder is freed either way. */
+ag_status ag_place_finish(ag_place_builder *b, ag_mesh **out, ag_error *err);
+
+#endif

@@ -1,0 +1,27 @@
+/* Edit op JSON (schema/edit_ops.md) ↔ ag_edit_op. The same text travels on the websocket,
+ * in POST /models/{id}/ops and in `archgram edit --op`. Errors start with the offending
+ * field ("box: ...", "nodes[2]: ..."); unknown fields are refused so that a typo is never
+ * silently ignored. Node references are an index, its decimal string, or "root". */
+#ifndef AG_EDIT_OP_JSON_H
+#define AG_EDIT_OP_JSON_H
+
+#include <jansson.h>
+#include <stddef.h>
+
+#include "../core/edit/edit.h"
+#include "../core/status.h"
+
+/* On success *op holds the op (free its arrays with ag_edit_op_clear). */
+ag_status ag_edit_op_json_parse(const char *text, size_t len, ag_edit_op *op, ag_error *err);
+ag_status ag_edit_op_json_from(const json_t *obj, ag_edit_op *op, ag_error *err);
+/* Reads a whole file (limit 1 MiB); errors as for parse (element = line for syntax). */
+ag_status ag_edit_op_json_read_file(const char *path, ag_edit_op *op, ag_error *err);
+
+/* The canonical JSON object of an op (new reference), or NULL when out of memory. */
+json_t *ag_edit_op_json_to(const ag_edit_op *op);
+
+/* The report as JSON: {"equations","unknowns","solve_ms","max_residual",
+ * "max_residual_relative","splits","joins","instances_per_label":{name: count},"message"}. */
+json_t *ag_edit_op_json_report(const ag_edit_report *rep);
+
+#endif

@@ -1,0 +1,174 @@
+#include "states.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "grammars.h"
+
+void ag_states_row_clear(ag_state_row *row)
+{
+    if (!row)
+        return;
+    free(row->stats_json);
+    free(row->grammar);
+    free(row->tree_json);
+    free(row->summary_json);
+    memset(row, 0, sizeof *row);
+}
+
+static ag_status prepared(ag_db *db, sqlite3_stmt **st, const char *sql, ag_error *err)
+{
+    *st = ag_db_prepare(db, sql, err);
+    return *st ? AG_OK : (err ? err->code : AG_ERR_DB);
+}
+
+static char *text_dup(sqlite3_stmt *st, int col, size_t *len, int *bad)
+{
+    if (sqlite3_column_type(st, col) == SQLITE_NULL)
+        return NULL;
+    const unsigned char *p = sqlite3_column_text(st, col);
+    size_t n = (size_t)sqlite3_column_bytes(st, col);
+    char *s = malloc(n + 1);
+    if (!s) {
+        *bad = 1;
+        return NULL;
+    }
+    if (n)
+        memcpy(s, p, n);
+    s[n] = '\0';
+    if (len)
+        *len = n;
+    return s;
+}
+
+ag_status ag_states_keep(ag_db *db, int64_t model, int64_t version, ag_error *err)
+{
+    sqlite3_stmt *st;
+    /* grammars keeps one row per model; it describes the model only while the mesh is its */
+    ag_status s = prepared(
+        db, &st,
+        "INSERT OR IGNORE INTO model_states "
+        "(model_id, version, mesh_blob, stats, grammar, tree, summary) "
+        "SELECT m.id, ?, m.mesh_blob, m.stats, g.text, g.tree, g.summary FROM models m "
+        "LEFT JOIN grammars g ON g.model_id = m.id AND g.mesh_blob = m.mesh_blob "
+        "WHERE m.id = ?",
+        err);
+    if (s != AG_OK)
+        return s;
+    sqlite3_bind_int64(st, 1, version);
+    sqlite3_bind_int64(st, 2, model);
+    return ag_db_step_done(db, st, "keeping a model version's state", err);
+}
+
+/* The first op after `from` up to `to` that changes geometry: its version, or 0. */
+static ag_status geometry_op_between(ag_db *db, int64_t model, int64_t from, int64_t to,
+                                     int64_t *found, char kind[32], ag_error *err)
+{
+    *found = 0;
+    sqlite3_stmt *st;
+    ag_status s = prepared(db, &st,
+                           "SELECT version, kind FROM ops WHERE model_id = ? AND version > ? "
+                           "AND version <= ? AND kind NOT IN ('rename', 'note') "
+                           "ORDER BY version LIMIT 1",
+                           err);
+    if (s != AG_OK)
+        return s;
+    sqlite3_bind_int64(st, 1, model);
+    sqlite3_bind_int64(st, 2, from);
+    sqlite3_bind_int64(st, 3, to);
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW) {
+        *found = sqlite3_column_int64(st, 0);
+        ag_db_column_copy(st, 1, kind, 32);
+    } else if (rc != SQLITE_DONE) {
+        s = ag_db_fail(db, err, "reading the op log");
+    }
+    sqlite3_reset(st);
+    return s;
+}
+
+ag_status ag_states_get(ag_db *db, int64_t model, int64_t version, ag_state_row *row,
+                        ag_error *err)
+{
+    memset(row, 0, sizeof *row);
+    sqlite3_stmt *st;
+    ag_status s = prepared(db, &st,
+                           "SELECT version, mesh_blob, stats, grammar, tree, summary, "
+                           "(SELECT version FROM models WHERE id = ?) FROM model_states "
+                           "WHERE model_id = ? AND version <= ? ORDER BY version DESC LIMIT 1",
+                           err);
+    if (s != AG_OK)
+        return s;
+    sqlite3_bind_int64(st, 1, model);
+    sqlite3_bind_int64(st, 2, model);
+    sqlite3_bind_int64(st, 3, version);
+    int rc = sqlite3_step(st);
+    if (rc == SQLITE_DONE) {
+        s = ag_error_set(err, AG_ERR_NOT_FOUND, 0,
+                         "the state of version %lld of model %lld was not kept (states are kept "
+                         "from the first structural edit on)",
+                         (long long)version, (long long)model);
+    } else if (rc != SQLITE_ROW) {
+        s = ag_db_fail(db, err, "reading a model version's state");
+    } else if (version > sqlite3_column_int64(st, 6)) {
+        s = ag_error_set(err, AG_ERR_NOT_FOUND, 0, "model %lld has no version %lld yet",
+                         (long long)model, (long long)version);
+    } else {
+        int bad = 0;
+        row->model = model;
+        row->version = sqlite3_column_int64(st, 0);
+        row->mesh_blob = sqlite3_column_int64(st, 1);
+        row->stats_json = text_dup(st, 2, NULL, &bad);
+        row->grammar = text_dup(st, 3, &row->grammar_len, &bad);
+        row->tree_json = text_dup(st, 4, NULL, &bad);
+        row->summary_json = text_dup(st, 5, NULL, &bad);
+        if (bad || !row->stats_json) {
+            ag_states_row_clear(row);
+            s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory reading a state");
+        }
+    }
+    sqlite3_reset(st);
+    if (s != AG_OK || row->version == version)
+        return s;
+    int64_t later = 0;
+    char kind[32] = "";
+    if ((s = geometry_op_between(db, model, row->version, version, &later, kind, err)) == AG_OK &&
+        later)
+        s = ag_error_set(err, AG_ERR_NOT_FOUND, 0,
+                         "the state of version %lld of model %lld was not kept (the %s op of "
+                         "version %lld changed it)",
+                         (long long)version, (long long)model, kind, (long long)later);
+    if (s != AG_OK)
+        ag_states_row_clear(row);
+    return s;
+}
+
+ag_status ag_states_restore(ag_db *db, int64_t model, int64_t version, const ag_state_row *row,
+                            ag_error *err)
+{
+    sqlite3_stmt *st;
+    ag_status s = prepared(db, &st,
+                           "UPDATE models SET mesh_blob = ?, stats = ?, "
+                           "updated_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now') WHERE id = ?",
+                           err);
+    if (s != AG_OK)
+        return s;
+    sqlite3_bind_int64(st, 1, row->mesh_blob);
+    sqlite3_bind_text(st, 2, row->stats_json ? row->stats_json : "{}", -1, SQLITE_STATIC);
+    sqlite3_bind_int64(st, 3, model);
+    if ((s = ag_db_step_done(db, st, "restoring a model's mesh", err)) != AG_OK)
+        return s;
+    if (sqlite3_changes(ag_db_handle(db)) == 0)
+        return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "there is no model %lld", (long long)model);
+    if (!row->grammar)
+        return AG_OK; /* the grammar no longer describes the mesh: not proceduralized then */
+    ag_grammar_new g = {.model = model,
+                        .version = version,
+                        .mesh_blob = row->mesh_blob,
+                        .text = row->grammar,
+                        .text_len = row->grammar_len,
+                        .tree_json = row->tree_json ? row->tree_json : "{}",
+                        .summary_json = row->summary_json};
+    return ag_grammars_put(db, &g, err);
+}

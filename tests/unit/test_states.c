@@ -1,0 +1,213 @@
+/* The model_states table (migration 0004): a kept version state comes back exactly (mesh
+ * file, stats, grammar, tree), versions separated from a kept one only by rename/note ops
+ * share its state while a geometry op in between makes it unavailable, restoring points the
+ * model at the kept file, replaced mesh files stay while a state names them, and deleting the
+ * model takes every file with it. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "store/db.h"
+#include "store/grammars.h"
+#include "store/models.h"
+#include "store/ops.h"
+#include "store/states.h"
+
+typedef struct {
+    char *path;
+    ag_db *db;
+    int64_t model;
+} fixture;
+
+static long long count(ag_db *db, const char *sql)
+{
+    sqlite3_stmt *st;
+    assert_int_equal(sqlite3_prepare_v2(ag_db_handle(db), sql, -1, &st, NULL), SQLITE_OK);
+    assert_int_equal(sqlite3_step(st), SQLITE_ROW);
+    long long n = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
+    return n;
+}
+
+static int64_t mesh_blob(ag_db *db, int64_t model)
+{
+    ag_model_row row;
+    assert_int_equal(ag_models_get(db, model, &row, NULL), AG_OK);
+    int64_t b = row.mesh_blob;
+    ag_models_row_clear(&row);
+    return b;
+}
+
+static int setup(void **state)
+{
+    fixture *f = calloc(1, sizeof *f);
+    f->path = strdup("/tmp/archgram-states-XXXXXX");
+    int fd = mkstemp(f->path);
+    assert_true(fd >= 0);
+    close(fd);
+    unlink(f->path);
+    ag_error err;
+    assert_int_equal(ag_db_open(f->path, NULL, &f->db, &err), AG_OK);
+    static const char mesh[] = "mesh of version 1";
+    ag_model_new m = {.name = "m", .mesh = mesh, .mesh_len = sizeof mesh, .stats_json = "{\"v\":1}"};
+    assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
+    assert_int_equal(ag_models_insert(f->db, &m, &f->model, &err), AG_OK);
+    assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
+    *state = f;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    fixture *f = *state;
+    ag_db_close(f->db);
+    char side[4200];
+    unlink(f->path);
+    snprintf(side, sizeof side, "%s-wal", f->path);
+    unlink(side);
+    snprintf(side, sizeof side, "%s-shm", f->path);
+    unlink(side);
+    free(f->path);
+    free(f);
+    return 0;
+}
+
+/* One op: raises the version; a geometry op also gets a new mesh file and a grammar. */
+static int64_t op(fixture *f, const char *kind, int geometry, const char *grammar)
+{
+    ag_error err;
+    int64_t v = 0;
+    ag_model_row row;
+    assert_int_equal(ag_models_get(f->db, f->model, &row, NULL), AG_OK);
+    int64_t base = row.version;
+    ag_models_row_clear(&row);
+    assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
+    assert_int_equal(ag_models_bump_version(f->db, f->model, base, &v, &err), AG_OK);
+    if (geometry) {
+        assert_int_equal(ag_states_keep(f->db, f->model, v - 1, &err), AG_OK);
+        char mesh[64], stats[64];
+        snprintf(mesh, sizeof mesh, "mesh of version %lld", (long long)v);
+        snprintf(stats, sizeof stats, "{\"v\":%lld}", (long long)v);
+        int64_t blob = 0;
+        assert_int_equal(ag_grammars_set_mesh(f->db, f->model, mesh, strlen(mesh), stats, &blob,
+                                              &err),
+                         AG_OK);
+        ag_grammar_new g = {.model = f->model, .version = v, .mesh_blob = blob, .text = grammar,
+                            .text_len = strlen(grammar), .tree_json = "{\"nodes\":[]}"};
+        assert_int_equal(ag_grammars_put(f->db, &g, &err), AG_OK);
+        assert_int_equal(ag_states_keep(f->db, f->model, v, &err), AG_OK);
+    }
+    char cid[32];
+    snprintf(cid, sizeof cid, "c%lld", (long long)v);
+    ag_op_row o = {.model = f->model, .version = v, .author = "ana", .cid = cid, .kind = kind,
+                   .body_json = "{}"};
+    assert_int_equal(ag_ops_insert(f->db, &o, &err), AG_OK);
+    assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
+    return v;
+}
+
+static void kept_states_come_back_and_gaps_are_named(void **state)
+{
+    fixture *f = *state;
+    ag_error err;
+    int64_t v2 = op(f, "resize", 1, "grammar two");   /* keeps 1 and 2 */
+    int64_t v3 = op(f, "rename", 0, NULL);            /* shares 2's state */
+    int64_t v4 = op(f, "grammar", 1, "grammar four"); /* keeps 3 (= 2's mesh) and 4 */
+    assert_int_equal(count(f->db, "SELECT count(*) FROM model_states"), 4);
+
+    ag_state_row r;
+    assert_int_equal(ag_states_get(f->db, f->model, 1, &r, &err), AG_OK);
+    assert_int_equal(r.version, 1);
+    assert_null(r.grammar); /* version 1 had no grammar */
+    assert_string_equal(r.stats_json, "{\"v\":1}");
+    ag_states_row_clear(&r);
+
+    assert_int_equal(ag_states_get(f->db, f->model, v3, &r, &err), AG_OK);
+    assert_string_equal(r.grammar, "grammar two");
+    assert_string_equal(r.tree_json, "{\"nodes\":[]}");
+    int64_t blob2 = r.mesh_blob;
+    ag_states_row_clear(&r);
+
+    /* version 5 is a rename after 4: it shares 4's state; 6 does not exist yet */
+    int64_t v5 = op(f, "note", 0, NULL);
+    assert_int_equal(ag_states_get(f->db, f->model, v5, &r, &err), AG_OK);
+    assert_int_equal(r.version, v4);
+    ag_states_row_clear(&r);
+    assert_int_equal(ag_states_get(f->db, f->model, v5 + 1, &r, &err), AG_ERR_NOT_FOUND);
+    assert_non_null(strstr(err.text, "no version"));
+
+    /* a geometry op that kept nothing: the versions after it are not available */
+    int64_t v6 = op(f, "proceduralize", 0, NULL);
+    assert_int_equal(ag_states_get(f->db, f->model, v6, &r, &err), AG_ERR_NOT_FOUND);
+    assert_non_null(strstr(err.text, "proceduralize op of version 6"));
+
+    /* restoring version 2: the model points at 2's file again, with its grammar current */
+    int64_t v = 0;
+    assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
+    assert_int_equal(ag_models_bump_version(f->db, f->model, v6, &v, &err), AG_OK);
+    assert_int_equal(ag_states_get(f->db, f->model, v2, &r, &err), AG_OK);
+    assert_int_equal(ag_states_restore(f->db, f->model, v, &r, &err), AG_OK);
+    ag_states_row_clear(&r);
+    assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
+    assert_int_equal(mesh_blob(f->db, f->model), blob2);
+    ag_grammar_row g;
+    assert_int_equal(ag_grammars_current(f->db, f->model, 1, &g, &err), AG_OK);
+    assert_string_equal(g.text, "grammar two");
+    ag_grammars_row_clear(&g);
+    void *data;
+    size_t len;
+    assert_int_equal(ag_blobs_get(f->db, blob2, &data, &len, &err), AG_OK);
+    assert_memory_equal(data, "mesh of version 2", len);
+    free(data);
+
+    /* every mesh file a state names is still there; the model's deletion takes them all */
+    assert_int_equal(count(f->db, "SELECT count(*) FROM model_states s WHERE NOT EXISTS "
+                                  "(SELECT 1 FROM blobs b WHERE b.id = s.mesh_blob)"),
+                     0);
+    assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
+    assert_int_equal(ag_models_delete(f->db, f->model, v, &err), AG_OK);
+    assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
+    assert_int_equal(count(f->db, "SELECT count(*) FROM model_states"), 0);
+    assert_int_equal(count(f->db, "SELECT count(*) FROM blobs"), 0);
+}
+
+static void restoring_a_version_without_grammar_ends_the_grammar(void **state)
+{
+    fixture *f = *state;
+    ag_error err;
+    int64_t v2 = op(f, "resize", 1, "grammar two");
+    int64_t v = 0;
+    ag_state_row r;
+    assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
+    assert_int_equal(ag_models_bump_version(f->db, f->model, v2, &v, &err), AG_OK);
+    assert_int_equal(ag_states_get(f->db, f->model, 1, &r, &err), AG_OK);
+    assert_int_equal(ag_states_restore(f->db, f->model, v, &r, &err), AG_OK);
+    ag_states_row_clear(&r);
+    assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
+    ag_grammar_row g;
+    assert_int_equal(ag_grammars_current(f->db, f->model, 0, &g, &err), AG_ERR_NOT_FOUND);
+    /* keeping the same version twice keeps the first */
+    assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
+    assert_int_equal(ag_states_keep(f->db, f->model, v2, &err), AG_OK);
+    assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
+    assert_int_equal(ag_states_get(f->db, f->model, v2, &r, &err), AG_OK);
+    assert_string_equal(r.grammar, "grammar two");
+    ag_states_row_clear(&r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(kept_states_come_back_and_gaps_are_named, setup, teardown),
+        cmocka_unit_test_setup_teardown(restoring_a_version_without_grammar_ends_the_grammar,
+                                        setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

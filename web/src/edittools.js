@@ -1,0 +1,304 @@
+// The edit panel: resize mode (global, or local within a region), the split-plane tool, join,
+// copy/paste (insert | replace × fill | derive, also from another model), remove. Every edit
+// is one op over the live connection; the op's broadcast reloads mesh, tree and grammar for
+// everyone. Also the multi-selection of split-tree nodes (Shift+click) the tools work on.
+import * as THREE from 'three';
+import { el } from './dom.js';
+import { worldBox } from './previewlayer.js';
+
+const AXES = ['x', 'y', 'z'];
+const PLANE_COLOUR = 0xff3df2; // magenta: no label or highlight colour uses it
+
+// --- selection of split-tree nodes ----------------------------------------------------------
+// The nodes a selection covers, in selection order.
+export function selectedNodes(editor) {
+  const sel = editor.selection;
+  if (!sel) return [];
+  if (Array.isArray(sel.nodes)) return sel.nodes;
+  return sel.node !== undefined && sel.node !== null ? [sel.node] : [];
+}
+
+// Selects several split-tree nodes at once: all their visible components light up.
+export function selectNodes(editor, ids) {
+  const tree = editor.tree;
+  const list = [...new Set(ids)].filter((id) => tree?.node(id));
+  if (list.length <= 1) {
+    if (list.length) editor.selectNode(list[0]);
+    else editor.select(null);
+    return;
+  }
+  const components = [...new Set(list.flatMap((id) => tree.componentsUnder(id)))];
+  editor.select({ node: list[list.length - 1], nodes: list, component: null, group: null, components });
+}
+
+// Shift+click: adds the node to the selection, or takes it out.
+export function toggleNode(editor, id) {
+  const now = selectedNodes(editor);
+  selectNodes(editor, now.includes(id) ? now.filter((n) => n !== id) : [...now, id]);
+}
+
+export class EditTools {
+  constructor(editor, live, api, viewport, container) {
+    this.editor = editor;
+    this.live = live;
+    this.api = api;
+    this.viewport = viewport;
+    this.mode = 'global';   // resize mode of the handles
+    this.region = 'auto';   // local mode: 'auto' (the server's: old ∪ new box) | 'parent' | 'grandparent' | 'model'
+    this.clipboard = null;  // {model, version, nodes, name}
+    this.plane = null;      // the split plane drawn in the view
+    this.splitting = false; // the split-plane tool is open
+
+    const radio = (name, value, text) =>
+      el('label.opt', {}, el('input', { type: 'radio', name, value, checked: value === 'global', 'data-testid': `mode-${value}` }), text);
+    this.modeBox = el('div.edit-row', {}, el('span.edit-key', {}, 'resize'), radio('resize-mode', 'global', 'global'), radio('resize-mode', 'local', 'local'));
+    this.modeBox.addEventListener('change', (e) => {
+      if (e.target.name !== 'resize-mode') return;
+      this.mode = e.target.value;
+      this.render();
+    });
+    this.regionSel = el(
+      'select',
+      { 'data-testid': 'region', title: 'Local mode: how far the resize may reach' },
+      el('option', { value: 'auto' }, 'region: around the node'),
+      el('option', { value: 'parent' }, 'region: parent'),
+      el('option', { value: 'grandparent' }, 'region: grandparent'),
+      el('option', { value: 'model' }, 'region: whole model'),
+    );
+    this.regionSel.addEventListener('change', () => {
+      this.region = this.regionSel.value;
+    });
+
+    // Split plane: an axis and a position along it (metres), drawn while the tool is open.
+    this.axisSel = el('select', { 'data-testid': 'split-axis' }, AXES.map((a) => el('option', { value: a }, a)));
+    this.atInput = el('input', { type: 'range', min: 0, max: 1, step: 0.001, value: 0.5, 'data-testid': 'split-at' });
+    this.atText = el('span.edit-value', { 'data-testid': 'split-at-text' });
+    this.splitBtn = el('button', { type: 'button', 'data-testid': 'split' }, 'Split');
+    this.toolBtn = button('Split plane', 'split-tool', () => {
+      this.splitting = !this.splitting;
+      this.render();
+    }, 'Show a plane through the selected node to split it by');
+    this.splitRow = el('div.edit-row', {}, this.axisSel, this.atInput, this.atText, this.splitBtn);
+    this.axisSel.addEventListener('change', () => this.renderPlane());
+    this.atInput.addEventListener('input', () => this.renderPlane());
+    this.splitBtn.addEventListener('click', () => this.split());
+
+    this.joinBtn = button('Join', 'join', () => this.join(), 'Join the selected nodes (Shift+click to select several)');
+    this.removeBtn = button('Remove', 'remove', () => this.remove(), 'Remove the selected nodes');
+    this.copyBtn = button('Copy', 'copy', () => this.copy(), 'Copy the selected nodes');
+    this.pasteBtn = button('Paste', 'paste', () => this.paste(), 'Paste the copied nodes into the selected node');
+    this.placementSel = el('select', { 'data-testid': 'paste-placement' }, el('option', { value: 'insert' }, 'insert'), el('option', { value: 'replace' }, 'replace'));
+    this.fitSel = el('select', { 'data-testid': 'paste-fit' }, el('option', { value: 'fill' }, 'fill'), el('option', { value: 'derive' }, 'derive'));
+    this.clipText = el('div.edit-note', { 'data-testid': 'clipboard' });
+    this.undoSlot = el('div.edit-row.undo-row');
+
+    this.body = el(
+      'div.edit-body',
+      {},
+      this.undoSlot,
+      this.modeBox,
+      el('div.edit-row', {}, this.regionSel),
+      el('div.edit-row', {}, this.toolBtn, this.joinBtn, this.removeBtn),
+      this.splitRow,
+      el('div.edit-row', {}, this.copyBtn, this.pasteBtn, this.placementSel, this.fitSel),
+      this.clipText,
+    );
+    this.empty = el('div.empty', {}, 'Proceduralize the model to edit it.');
+    container.append(el('h2', {}, 'Edit'), this.empty, this.body);
+
+    const s = editor.signals;
+    s.selectionChanged.add(() => this.render());
+    s.treeChanged.add(() => this.render());
+    s.modelOpened.add(() => this.render());
+    window.addEventListener('keydown', (e) => this.key(e));
+    this.render();
+  }
+
+  // --- the ops ------------------------------------------------------------------------------
+  async send(op) {
+    const ed = this.editor;
+    try {
+      return await this.live.sendOp(op);
+    } catch (err) {
+      if (!err.problem || !this.live.open) ed.fail(err); // a nack was already shown
+      return null;
+    }
+  }
+
+  // The resize op of the handles for `node` → `box`, in the current mode.
+  resizeOp(node, box) {
+    const op = { kind: 'resize', node: node === this.editor.tree?.root ? 'root' : node, box: box.map(round), mode: this.mode };
+    if (this.mode === 'local') {
+      const region = this.regionBox(node);
+      if (region) op.region = region.map(round);
+    }
+    return op;
+  }
+
+  // The local area of effect; null leaves the server's default (the node's old and new box).
+  regionBox(node) {
+    const tree = this.editor.tree;
+    if (!tree || this.region === 'auto') return null;
+    if (this.region === 'model') return tree.node(tree.root)?.box ?? null;
+    const up = tree.ancestors(node);
+    const k = this.region === 'parent' ? 1 : 2;
+    const id = up.length >= k ? up[up.length - k] : tree.root;
+    return tree.node(id)?.box ?? null;
+  }
+
+  splitPlane() {
+    const n = this.single();
+    if (!n || !Array.isArray(n.box)) return null;
+    const axis = AXES.indexOf(this.axisSel.value);
+    const lo = n.box[axis];
+    const hi = n.box[axis + 3];
+    return { node: n.id, axis, at: lo + (hi - lo) * Number(this.atInput.value) };
+  }
+
+  async split() {
+    const p = this.splitPlane();
+    if (!p) return;
+    await this.send({ kind: 'split', node: p.node, axis: AXES[p.axis], at: round(p.at) });
+  }
+
+  async join() {
+    const nodes = selectedNodes(this.editor);
+    if (nodes.length < 2) return;
+    await this.send({ kind: 'join', nodes });
+  }
+
+  async remove() {
+    const nodes = selectedNodes(this.editor);
+    if (!nodes.length) return;
+    await this.send({ kind: 'remove', nodes });
+  }
+
+  copy() {
+    const ed = this.editor;
+    const nodes = selectedNodes(ed);
+    if (!ed.model || !nodes.length) return;
+    this.clipboard = { model: ed.model.id, version: ed.model.version, nodes: nodes.slice(), name: ed.model.name };
+    ed.notify(`Copied ${nodes.length} node${nodes.length === 1 ? '' : 's'}`);
+    this.render();
+  }
+
+  // Pastes into the selected node (of the model the nodes were copied from: the server's paste
+  // op has no field for a source model yet).
+  async paste() {
+    const ed = this.editor;
+    const clip = this.clipboard;
+    const target = selectedNodes(ed);
+    if (!ed.model || !clip || target.length !== 1) return;
+    const op = {
+      kind: 'paste',
+      source: clip.nodes,
+      target: target[0],
+      placement: this.placementSel.value,
+      fit: this.fitSel.value,
+    };
+    if (clip.model !== ed.model.id) {
+      ed.fail({ title: 'Cannot paste here', detail: `The nodes were copied from “${clip.name}”; pasting across models is not supported by the server yet.` });
+      return;
+    }
+    if (clip.version !== ed.model.version) {
+      // node numbers belong to the tree they were copied from
+      ed.fail({ title: 'Copy again', detail: 'The model changed since the copy; its node numbers no longer apply.' });
+      return;
+    }
+    await this.send(op);
+  }
+
+  key(e) {
+    if (isTyping(e.target) || !(e.ctrlKey || e.metaKey) || e.altKey) return;
+    const k = e.key.toLowerCase();
+    if (k === 'c' && selectedNodes(this.editor).length && !window.getSelection()?.toString()) {
+      this.copy();
+    } else if (k === 'v' && this.clipboard) {
+      e.preventDefault();
+      this.paste();
+    } else if (k === 'j') {
+      e.preventDefault();
+      this.join();
+    }
+  }
+
+  // --- view ---------------------------------------------------------------------------------
+  single() {
+    const nodes = selectedNodes(this.editor);
+    return nodes.length === 1 ? this.editor.tree?.node(nodes[0]) ?? null : null;
+  }
+
+  render() {
+    const ed = this.editor;
+    const ready = !!(ed.model && ed.tree);
+    this.body.hidden = !ready;
+    this.empty.hidden = ready || !ed.model;
+    const nodes = selectedNodes(ed);
+    const one = this.single();
+    this.regionSel.hidden = this.mode !== 'local';
+    this.toolBtn.classList.toggle('on', this.splitting);
+    this.toolBtn.disabled = !one && !this.splitting;
+    this.splitRow.hidden = !this.splitting;
+    this.splitBtn.disabled = !one;
+    this.axisSel.disabled = !one;
+    this.atInput.disabled = !one;
+    this.joinBtn.disabled = nodes.length < 2;
+    this.removeBtn.disabled = !nodes.length;
+    this.copyBtn.disabled = !nodes.length;
+    this.pasteBtn.disabled = !this.clipboard || nodes.length !== 1;
+    const clip = this.clipboard;
+    this.clipText.textContent = clip
+      ? `clipboard: node${clip.nodes.length === 1 ? '' : 's'} ${clip.nodes.join(', ')}${clip.model !== ed.model?.id ? ` of “${clip.name}”` : ''}`
+      : '';
+    this.renderPlane();
+  }
+
+  // The split plane through the selected node's box, in magenta.
+  renderPlane() {
+    const vp = this.viewport;
+    if (this.plane) {
+      vp.scene.remove(this.plane);
+      this.plane.geometry.dispose();
+      this.plane.material.dispose();
+      this.plane = null;
+    }
+    const p = this.splitting ? this.splitPlane() : null;
+    const n = this.single();
+    this.atText.textContent = p ? `${p.at.toFixed(2)} m` : '';
+    if (!p || !n) {
+      vp.requestRender();
+      return;
+    }
+    const b = n.box.slice();
+    b[p.axis] = p.at;
+    b[p.axis + 3] = p.at;
+    const box = worldBox(b);
+    const size = box.getSize(new THREE.Vector3());
+    const centre = box.getCenter(new THREE.Vector3());
+    const pad = Math.max(size.x, size.y, size.z) * 0.04;
+    // world axes: archgram x → x, y → z, z → y; the flat axis gets a sliver
+    const dims = [size.x, size.y, size.z].map((d) => (d < 1e-9 ? pad * 0.05 : d + 2 * pad));
+    this.plane = new THREE.Mesh(
+      new THREE.BoxGeometry(...dims),
+      new THREE.MeshBasicMaterial({ color: PLANE_COLOUR, transparent: true, opacity: 0.35, depthWrite: false, side: THREE.DoubleSide }),
+    );
+    this.plane.position.copy(centre);
+    this.plane.renderOrder = 5;
+    this.plane.userData.tool = 'split-plane';
+    vp.scene.add(this.plane);
+    vp.requestRender();
+  }
+}
+
+function button(text, testid, onclick, title) {
+  return el('button', { type: 'button', 'data-testid': testid, title, onclick }, text);
+}
+
+function round(v) {
+  return Math.round(v * 1e6) / 1e6;
+}
+
+export function isTyping(target) {
+  if (!target || !(target instanceof Element)) return false;
+  return target.isContentEditable || /^(INPUT|TEXTAREA|SELECT)$/.test(target.tagName);
+}
