@@ -33,7 +33,8 @@ static void usage(FILE *to)
             "  --web DIR        web client folder (default: web/ beside this binary)\n"
             "  --no-web         serve no web client\n"
             "  --max-body BYTES largest accepted upload (default 536870912 = 512 MiB)\n"
-            "  --demo           store the demo buildings when the database has no model\n"
+            "  --demo           when the database has no model: store two demo buildings (then\n"
+            "                   proceduralized by jobs) and extrude a demo street\n"
             "  --help           this text\n"
             "  --version        print the version\n");
 }

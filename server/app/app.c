@@ -152,10 +152,6 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
         ag_app_free(app);
         return s;
     }
-    if (opt->demo && (s = ag_demo_load_if_empty(app, err)) != AG_OK) {
-        ag_app_free(app);
-        return s;
-    }
     app->workers = opt->workers > 0 ? opt->workers : (int)sysconf(_SC_NPROCESSORS_ONLN);
     if (app->workers < 1)
         app->workers = 1;
@@ -167,6 +163,11 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
     ag_jobqueue_register(app->jobs, &ag_import_job_kind);
     ag_jobqueue_register(app->jobs, &ag_extrude_job_kind);
     ag_jobqueue_register(app->jobs, &ag_proceduralize_job_kind);
+    /* after the job kinds: the demo content is proceduralized and extruded by jobs */
+    if (opt->demo && (s = ag_demo_load_if_empty(app, err)) != AG_OK) {
+        ag_app_free(app);
+        return s;
+    }
     *out = app;
     return AG_OK;
 }

@@ -52,8 +52,14 @@ ag_status ag_edit_ops_validate(const json_t *op, ag_error *err)
     const char *kind = json_string_value(json_object_get(op, "kind"));
     if (is_edit(kind)) {
         ag_edit_op e = {0};
-        ag_status s = ag_edit_op_json_from(op, &e, err);
+        ag_edit_op_origin o = {0};
+        ag_status s = ag_edit_op_json_from_ex(op, &e, &o, err);
+        if (s == AG_OK && o.dir)
+            s = ag_error_set(err, AG_ERR_INVALID, 0,
+                             "source_dir: a folder is for `archgram edit`; the service names "
+                             "the model to paste from with source_model");
         ag_edit_op_clear(&e);
+        ag_edit_op_origin_clear(&o);
         return s;
     }
     if (strcmp(kind, "undo") == 0 || strcmp(kind, "redo") == 0) {
@@ -194,16 +200,65 @@ static ag_status duplicate_of(ag_app *app, int64_t model, const char *author, co
     return ag_ops_find_cid(db, model, author, cid, seen, err);
 }
 
+/* The model a paste copies from, borrowed read-only (its nodes are ids of its served tree
+ * at its current version): the problem names the source_model field. */
+static ag_status acquire_source(ag_app *app, int64_t src, ag_edit_state **st, ag_error *err)
+{
+    ag_error e;
+    ag_error_clear(&e);
+    ag_status s = ag_edit_session_acquire(app, src, st, &e);
+    if (s == AG_ERR_NOT_FOUND)
+        return ag_error_set(err, s, 0, "source_model: there is no model %lld", (long long)src);
+    if (s != AG_OK)
+        return ag_error_set(err, s, e.element, "source_model: %s", e.text);
+    return AG_OK;
+}
+
+/* The paste's source nodes (served tree ids of model src) → the source state's nodes. */
+static ag_status translate_source(const ag_edit_state *st, int64_t src, ag_edit_op *e,
+                                  ag_error *err)
+{
+    for (size_t i = 0; i < e->nnodes; i++) {
+        char field[64];
+        snprintf(field, sizeof field, "source[%zu] (of model %lld)", i, (long long)src);
+        ag_status s = ag_edit_session_node(st, e->nodes[i], field, &e->nodes[i], err);
+        if (s != AG_OK)
+            return s;
+    }
+    return AG_OK;
+}
+
 static ag_status apply_edit(ag_app *app, int64_t model, int64_t base, const char *author,
                             const char *cid, const json_t *op, uint64_t origin, int64_t *version,
                             ag_error *err)
 {
     ag_edit_op e = {0};
-    ag_status s = ag_edit_op_json_from(op, &e, err);
-    if (s != AG_OK)
+    ag_edit_op_origin from = {0};
+    ag_status s = ag_edit_op_json_from_ex(op, &e, &from, err);
+    if (s == AG_OK && from.dir)
+        s = ag_error_set(err, AG_ERR_INVALID, 0,
+                         "source_dir: a folder is for `archgram edit`; the service names the "
+                         "model to paste from with source_model");
+    if (s != AG_OK) {
+        ag_edit_op_clear(&e);
+        ag_edit_op_origin_clear(&from);
         return s;
-    ag_edit_state *st = NULL;
+    }
+    /* another model as the source: both states are borrowed, the lower model id first, so
+     * two pastes between the same models in opposite directions cannot wait on each other */
+    int64_t src = from.model != model ? from.model : 0;
+    ag_edit_state *st = NULL, *sst = NULL;
+    if (src && src < model && (s = acquire_source(app, src, &sst, err)) != AG_OK) {
+        ag_edit_op_clear(&e);
+        return s;
+    }
     if ((s = ag_edit_session_acquire(app, model, &st, err)) != AG_OK) {
+        ag_edit_session_release(app, sst);
+        ag_edit_op_clear(&e);
+        return s;
+    }
+    if (src && src > model && (s = acquire_source(app, src, &sst, err)) != AG_OK) {
+        ag_edit_session_release(app, st);
         ag_edit_op_clear(&e);
         return s;
     }
@@ -219,8 +274,19 @@ static ag_status apply_edit(ag_app *app, int64_t model, int64_t base, const char
         s = stale(model, base, st->version, err);
         goto done;
     }
-    if ((s = translate(st, &e, err)) != AG_OK ||
-        (s = ag_edit_apply(st->em, &e, &out, &rep, err)) != AG_OK ||
+    if (src) {
+        /* the target alone is this model's; the source nodes are the other model's */
+        ag_edit_op dst = e;
+        dst.nnodes = 0;
+        if ((s = translate(st, &dst, err)) != AG_OK ||
+            (s = translate_source(sst, src, &e, err)) != AG_OK)
+            goto done;
+        e.node = dst.node;
+        e.source = sst->em->proc;
+    } else if ((s = translate(st, &e, err)) != AG_OK) {
+        goto done;
+    }
+    if ((s = ag_edit_apply(st->em, &e, &out, &rep, err)) != AG_OK ||
         (s = name_terminals(out->proc->grammar, &terms, err)) != AG_OK ||
         (s = ag_grammar_text_print(out->proc->grammar, &text, &tlen, err)) != AG_OK)
         goto done;
@@ -238,6 +304,8 @@ static ag_status apply_edit(ag_app *app, int64_t model, int64_t base, const char
     body = json_deep_copy(op);
     if (report)
         json_object_set_new(report, "edit_ms", json_real(edit_ms));
+    if (report && src) /* the version of the source model whose nodes were copied */
+        json_object_set_new(report, "source_version", json_integer((json_int_t)sst->version));
     if (!report || !body || json_object_set_new(body, "report", report) != 0) {
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         goto done;
@@ -280,8 +348,10 @@ static ag_status apply_edit(ag_app *app, int64_t model, int64_t base, const char
     out = NULL;
 done:
     if (s != AG_OK && st && s != AG_ERR_STALE && s != AG_ERR_INVALID && s != AG_ERR_NOT_FOUND &&
-        s != AG_ERR_CONFLICT && s != AG_ERR_PARSE)
+        s != AG_ERR_CONFLICT && s != AG_ERR_PARSE && s != AG_ERR_NOT_PROCEDURALIZED)
         ag_edit_session_reset(st); /* an unexpected failure: load afresh next time */
+    e.source = NULL;
+    ag_edit_session_release(app, sst);
     ag_edit_session_release(app, st);
     ag_edit_model_free(out);
     ag_edit_report_clear(&rep);
@@ -291,6 +361,7 @@ done:
     free(summary);
     json_decref(body);
     ag_edit_op_clear(&e);
+    ag_edit_op_origin_clear(&from);
     return s;
 }
 
@@ -324,7 +395,8 @@ static void walk(void *user, const ag_op_row *op)
         }
         return;
     }
-    int edit = is_edit(op->kind), undoes = 0, redoes = 0;
+    /* a grammar text edit (PUT …/grammar) is an undo step like a structural edit */
+    int edit = is_edit(op->kind) || strcmp(op->kind, "grammar") == 0, undoes = 0, redoes = 0;
     if (strcmp(op->kind, "restore") == 0) {
         json_t *b = json_loads(op->body_json, 0, NULL);
         undoes = json_is_integer(json_object_get(b, "undoes"));

@@ -11,6 +11,7 @@
 #include "../io/splittree_json.h"
 #include "../io/terminals.h"
 #include "../store/grammars.h"
+#include "../store/states.h"
 #include "modelops.h"
 
 void ag_grammar_derived_clear(ag_grammar_derived *d)
@@ -189,7 +190,12 @@ ag_status ag_grammar_edit_apply(ag_app *app, int64_t model, int64_t base, const 
     if (!summary_text || !op)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     if (s == AG_OK && (s = ag_modelops_server_begin(app, model, base, &t, err)) == AG_OK) {
-        s = ag_grammar_edit_store(t.db, model, t.version, &d, text, len, summary_text, err);
+        /* the states before and after are kept: the author's undo restores the old text */
+        s = ag_states_keep(t.db, model, t.version - 1, err);
+        if (s == AG_OK)
+            s = ag_grammar_edit_store(t.db, model, t.version, &d, text, len, summary_text, err);
+        if (s == AG_OK)
+            s = ag_states_keep(t.db, model, t.version, err);
         if (s == AG_OK) {
             int64_t v = t.version;
             if ((s = ag_modelops_server_commit(&t, author, cid, op, err)) == AG_OK)

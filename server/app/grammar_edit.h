@@ -5,8 +5,10 @@
  *
  * PUT /api/v1/models/{id}/grammar: ag_grammar_edit_apply stores the derived mesh, the text
  * and the tree as a new model version in one transaction and logs the op
- * {"kind":"grammar","bytes":N}. The terminals stay as they were: a grammar may use any of the
- * model's stored terminals (by their path) and no other. */
+ * {"kind":"grammar","bytes":N}. The states before and after are kept (store/states.h), so
+ * the grammar edit is one undo step of its author like a structural edit. The terminals stay
+ * as they were: a grammar may use any of the model's stored terminals (by their path) and no
+ * other. */
 #ifndef AG_GRAMMAR_EDIT_H
 #define AG_GRAMMAR_EDIT_H
 

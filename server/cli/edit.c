@@ -4,7 +4,8 @@
  * it: grammar.txt and terminals/. The grammar is derived and proceduralized again, which
  * gives the tree whose node ids the op names (DIR/tree.json lists them). DIR2 receives the
  * edited model's grammar.txt, terminals/, tree.json (ids for the next edit) and summary.json
- * (the solve figures and instances per label). */
+ * (the solve figures and instances per label). A paste may copy from another proceduralized
+ * folder: "source_dir" in the op, relative to the op file's folder (node ids of its tree.json). */
 #include <errno.h>
 #include <jansson.h>
 #include <stdio.h>
@@ -12,6 +13,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "../core/edit/edit.h"
 #include "../io/edit_op_json.h"
@@ -56,6 +58,42 @@ static int write_json(const char *path, json_t *j)
     return 0;
 }
 
+/* The proceduralized folder a paste copies from ("source_dir", relative to the op file's
+ * folder): read as DIR is, so its node ids are those of its tree.json. Reports and returns
+ * non-zero on failure. */
+static int load_source(const char *oppath, const char *sdir, ag_grammar **g,
+                       ag_edit_model **out, ag_error *err)
+{
+    char dir[4096], path[4200];
+    const char *slash = strrchr(oppath, '/');
+    if (sdir[0] == '/' || !slash)
+        snprintf(dir, sizeof dir, "%s", sdir);
+    else
+        snprintf(dir, sizeof dir, "%.*s/%s", (int)(slash - oppath), oppath, sdir);
+    struct stat sb;
+    if (stat(dir, &sb) || !S_ISDIR(sb.st_mode)) {
+        ag_error_set(err, AG_ERR_NOT_FOUND, 0, "source_dir: %s is not a folder", dir);
+        ag_cli_report(oppath, err);
+        return 1;
+    }
+    snprintf(path, sizeof path, "%s/grammar.txt", dir);
+    if (access(path, R_OK)) {
+        ag_error_set(err, AG_ERR_NOT_PROCEDURALIZED, 0,
+                     "source_dir: %s is not proceduralized (no grammar.txt; run `archgram "
+                     "proceduralize MESH --out %s`)",
+                     dir, dir);
+        ag_cli_report(oppath, err);
+        return 1;
+    }
+    long col = 0;
+    if (ag_grammar_text_read_file(path, g, err, &col) || ag_terminals_load(*g, dir, err) ||
+        ag_edit_model_from_grammar(*g, NULL, out, err)) {
+        ag_cli_report(path, err);
+        return 1;
+    }
+    return 0;
+}
+
 int ag_cli_edit(int argc, char **argv)
 {
     const char *dir = NULL, *oppath = NULL, *out = NULL;
@@ -86,14 +124,15 @@ int ag_cli_edit(int argc, char **argv)
     ag_error err;
     ag_error_clear(&err);
     ag_edit_op op;
-    if (ag_edit_op_json_read_file(oppath, &op, &err)) {
+    ag_edit_op_origin from;
+    if (ag_edit_op_json_read_file_ex(oppath, &op, &from, &err)) {
         ag_cli_report(oppath, &err);
         return 1;
     }
     int rc = 1;
     char path[4096];
-    ag_grammar *g = NULL;
-    ag_edit_model *model = NULL, *edited = NULL;
+    ag_grammar *g = NULL, *sg = NULL;
+    ag_edit_model *model = NULL, *edited = NULL, *source = NULL;
     ag_edit_report rep = {0};
     char *text = NULL;
     size_t tlen = 0;
@@ -110,6 +149,16 @@ int ag_cli_edit(int argc, char **argv)
         ag_cli_report(path, &err);
         goto done;
     }
+    if (from.model) {
+        ag_error_set(&err, AG_ERR_INVALID, 0,
+                     "source_model: names a model of the service; an op file names the "
+                     "folder to paste from with source_dir");
+        ag_cli_report(oppath, &err);
+        goto done;
+    }
+    if (from.dir && load_source(oppath, from.dir, &sg, &source, &err))
+        goto done;
+    op.source = source ? source->proc : NULL;
     double t_load = now() - t0;
     t0 = now();
     if (ag_edit_apply(model, &op, &edited, &rep, &err)) {
@@ -145,7 +194,7 @@ int ag_cli_edit(int argc, char **argv)
         goto done;
     summary = ag_edit_op_json_report(&rep);
     if (summary) {
-        json_object_set_new(summary, "op", ag_edit_op_json_to(&op));
+        json_object_set_new(summary, "op", ag_edit_op_json_to_ex(&op, &from));
         json_object_set_new(summary, "tree", ag_edit_tree_json_stats(edited->proc));
         json_object_set_new(summary, "seconds",
                             json_pack("{s:f,s:f}", "load", t_load, "edit", t_edit));
@@ -164,7 +213,11 @@ done:
     ag_edit_report_clear(&rep);
     ag_edit_model_free(edited);
     ag_edit_model_free(model);
+    ag_edit_model_free(source);
     ag_grammar_free(g);
+    ag_grammar_free(sg);
+    op.source = NULL;
     ag_edit_op_clear(&op);
+    ag_edit_op_origin_clear(&from);
     return rc;
 }

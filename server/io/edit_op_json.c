@@ -115,7 +115,50 @@ static int allowed(const char *key, const char *const *keys)
     return 0;
 }
 
-static ag_status parse(const json_t *o, ag_edit_op *op, ag_error *err)
+/* "source_model" / "source_dir" of a paste into *origin (NULL: the caller cannot load
+ * another model, so both are refused). */
+static ag_status origin_of(const json_t *o, ag_edit_op_origin *origin, ag_error *err)
+{
+    const json_t *m = json_object_get(o, "source_model"), *d = json_object_get(o, "source_dir");
+    if (!m && !d)
+        return AG_OK;
+    const char *field = m ? "source_model" : "source_dir";
+    if (!origin)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "%s: pasting from another model is not possible here", field);
+    if (m && d)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "source_dir: give either source_model or source_dir, not both");
+    if (m) {
+        json_int_t id = json_is_integer(m) ? json_integer_value(m) : 0;
+        if (json_is_string(m)) {
+            const char *s = json_string_value(m);
+            char *end;
+            errno = 0;
+            long long v = strtoll(s, &end, 10);
+            if (*s >= '0' && *s <= '9' && !*end && !errno)
+                id = (json_int_t)v;
+        }
+        if (id < 1)
+            return ag_error_set(err, AG_ERR_INVALID, 0,
+                                "source_model: expected a model id (an integer >= 1)");
+        origin->model = (int64_t)id;
+        return AG_OK;
+    }
+    const char *s = json_string_value(d);
+    size_t n = s ? json_string_length(d) : 0;
+    if (!s || !n)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "source_dir: expected the path of a proceduralized folder");
+    if (n > 3000 || strlen(s) != n)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "source_dir: not a usable path");
+    if (!(origin->dir = strdup(s)))
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    return AG_OK;
+}
+
+static ag_status parse(const json_t *o, ag_edit_op *op, ag_edit_op_origin *origin,
+                       ag_error *err)
 {
     if (!json_is_object(o))
         return ag_error_set(err, AG_ERR_INVALID, 0, "op: expected a JSON object");
@@ -132,7 +175,7 @@ static ag_status parse(const json_t *o, ag_edit_op *op, ag_error *err)
         {"kind", "node", "box", "scale", "mode", "region", NULL},
         {"kind", "node", "axis", "at", NULL},
         {"kind", "nodes", NULL},
-        {"kind", "source", "target", "placement", "fit", NULL},
+        {"kind", "source", "target", "placement", "fit", "source_model", "source_dir", NULL},
         {"kind", "nodes", NULL},
     };
     const char *key;
@@ -229,34 +272,71 @@ static ag_status parse(const json_t *o, ag_edit_op *op, ag_error *err)
             return st;
         if (f && (st = choice(f, "fit", fits, 2, &op->fit, err)))
             return st;
-        return AG_OK;
+        return origin_of(o, origin, err);
     }
     }
     return AG_OK;
 }
 
-ag_status ag_edit_op_json_from(const json_t *obj, ag_edit_op *op, ag_error *err)
+void ag_edit_op_origin_clear(ag_edit_op_origin *o)
+{
+    if (!o)
+        return;
+    free(o->dir);
+    memset(o, 0, sizeof *o);
+}
+
+static ag_status from(const json_t *obj, ag_edit_op *op, ag_edit_op_origin *origin,
+                      ag_error *err)
 {
     memset(op, 0, sizeof *op);
-    ag_status st = parse(obj, op, err);
-    if (st)
+    ag_status st = parse(obj, op, origin, err);
+    if (st) {
         ag_edit_op_clear(op);
+        ag_edit_op_origin_clear(origin);
+    }
     return st;
 }
 
-ag_status ag_edit_op_json_parse(const char *text, size_t len, ag_edit_op *op, ag_error *err)
+ag_status ag_edit_op_json_from(const json_t *obj, ag_edit_op *op, ag_error *err)
+{
+    return from(obj, op, NULL, err);
+}
+
+ag_status ag_edit_op_json_from_ex(const json_t *obj, ag_edit_op *op, ag_edit_op_origin *origin,
+                                  ag_error *err)
+{
+    memset(origin, 0, sizeof *origin);
+    return from(obj, op, origin, err);
+}
+
+static ag_status parse_text(const char *text, size_t len, ag_edit_op *op,
+                            ag_edit_op_origin *origin, ag_error *err)
 {
     memset(op, 0, sizeof *op);
     json_error_t je;
     json_t *root = json_loadb(text, len, 0, &je);
     if (!root)
         return ag_error_set(err, AG_ERR_PARSE, je.line > 0 ? je.line : 0, "%s", je.text);
-    ag_status st = ag_edit_op_json_from(root, op, err);
+    ag_status st = from(root, op, origin, err);
     json_decref(root);
     return st;
 }
 
-ag_status ag_edit_op_json_read_file(const char *path, ag_edit_op *op, ag_error *err)
+ag_status ag_edit_op_json_parse(const char *text, size_t len, ag_edit_op *op, ag_error *err)
+{
+    return parse_text(text, len, op, NULL, err);
+}
+
+ag_status ag_edit_op_json_parse_ex(const char *text, size_t len, ag_edit_op *op,
+                                   ag_edit_op_origin *origin, ag_error *err)
+{
+    memset(origin, 0, sizeof *origin);
+    return parse_text(text, len, op, origin, err);
+}
+
+static ag_status read_file(const char *path, ag_edit_op *op, ag_edit_op_origin *origin,
+                           ag_error *err)
 {
     memset(op, 0, sizeof *op);
     FILE *f = fopen(path, "rb");
@@ -277,9 +357,21 @@ ag_status ag_edit_op_json_read_file(const char *path, ag_edit_op *op, ag_error *
     else if (len > cap)
         st = ag_error_set(err, AG_ERR_TOO_LARGE, 0, "an op file is at most 1 MiB");
     else
-        st = ag_edit_op_json_parse(buf, len, op, err);
+        st = parse_text(buf, len, op, origin, err);
     free(buf);
     return st;
+}
+
+ag_status ag_edit_op_json_read_file(const char *path, ag_edit_op *op, ag_error *err)
+{
+    return read_file(path, op, NULL, err);
+}
+
+ag_status ag_edit_op_json_read_file_ex(const char *path, ag_edit_op *op,
+                                       ag_edit_op_origin *origin, ag_error *err)
+{
+    memset(origin, 0, sizeof *origin);
+    return read_file(path, op, origin, err);
 }
 
 static json_t *node_json(int32_t n) { return n == AG_EDIT_ROOT ? json_string("root") : json_integer(n); }
@@ -343,6 +435,18 @@ json_t *ag_edit_op_json_to(const ag_edit_op *op)
         break;
     }
     json_decref(list);
+    return o;
+}
+
+json_t *ag_edit_op_json_to_ex(const ag_edit_op *op, const ag_edit_op_origin *origin)
+{
+    json_t *o = ag_edit_op_json_to(op);
+    if (!o || !origin || op->kind != AG_EDIT_PASTE)
+        return o;
+    if (origin->model > 0)
+        json_object_set_new(o, "source_model", json_integer((json_int_t)origin->model));
+    else if (origin->dir)
+        json_object_set_new(o, "source_dir", json_string(origin->dir));
     return o;
 }
 

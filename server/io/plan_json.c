@@ -95,8 +95,14 @@ static ag_status read_meshes(json_t *root, const char *base, ag_plan *p, ag_erro
         if (strlen(name) >= sizeof p->meshes[0].name)
             return ag_error_set(err, AG_ERR_PARSE, 0, "plan: mesh name %s is too long (max %zu)",
                                 name, sizeof p->meshes[0].name - 1);
+        /* a description from the network or from memory has no folder of its own: naming
+         * files there would let a client make the server read any OBJ on its disk */
+        if (!base)
+            return ag_error_set(err, AG_ERR_INVALID, 0,
+                                "plan: meshes.%s: mesh files can only be named in a plan read "
+                                "from a file (archgram extrude --plan)", name);
         char full[4096];
-        if (base && path[0] != '/')
+        if (path[0] != '/')
             snprintf(full, sizeof full, "%s/%s", base, path);
         else
             snprintf(full, sizeof full, "%s", path);
@@ -494,6 +500,12 @@ ag_status ag_plan_json_read_buffer(const char *data, size_t len, ag_plan **out, 
     return read_buffer(data, len, NULL, out, err);
 }
 
+ag_status ag_plan_json_read_buffer_in(const char *data, size_t len, const char *dir, ag_plan **out,
+                                      ag_error *err)
+{
+    return read_buffer(data, len, dir ? dir : ".", out, err);
+}
+
 ag_status ag_plan_json_read_file(const char *path, ag_plan **out, ag_error *err)
 {
     *out = NULL;
@@ -507,7 +519,7 @@ ag_status ag_plan_json_read_file(const char *path, ag_plan **out, ag_error *err)
     const char *slash = strrchr(path, '/');
     if (slash)
         snprintf(base, sizeof base, "%.*s", (int)(slash - path), path);
-    st = read_buffer(buf, len, slash ? (slash == path ? "/" : base) : NULL, out, err);
+    st = read_buffer(buf, len, slash ? (slash == path ? "/" : base) : ".", out, err);
     free(buf);
     return st;
 }

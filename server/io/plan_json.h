@@ -9,7 +9,11 @@
 #include "../core/extrude/style.h"
 #include "../core/status.h"
 
+/* A description from the network or memory: it may not name mesh files ("meshes"). */
 ag_status ag_plan_json_read_buffer(const char *data, size_t len, ag_plan **out, ag_error *err);
+/* A trusted description whose mesh files are relative to folder dir. */
+ag_status ag_plan_json_read_buffer_in(const char *data, size_t len, const char *dir, ag_plan **out,
+                                      ag_error *err);
 ag_status ag_plan_json_read_file(const char *path, ag_plan **out, ag_error *err);
 
 /* Style file: {"name", "height", "cap", "seed", "short_below", "long_above", "street",

@@ -29,6 +29,16 @@ function facadeObj() {
   return out.join('\n') + '\n';
 }
 
+// An 8 m wall on a plinth, no windows.
+function bareWallObj() {
+  const [wall] = facadeObj().split('\ng window_0');
+  const plinth = ['g plinth'];
+  for (let i = 0; i < 8; i++) plinth.push(`v ${i & 1 ? 8 : 0} ${i & 2 ? 0.2 : 0} ${i & 4 ? 0 : -0.4}`);
+  const faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+  for (const [p, q, r, s] of faces) plinth.push(`f ${9 + p} ${9 + q} ${9 + r}`, `f ${9 + p} ${9 + r} ${9 + s}`);
+  return `${wall.replace(/^v 12 /gm, 'v 8 ')}\n${plinth.join('\n')}\n`;
+}
+
 function proceduralized(dir) {
   const obj = path.join(dir, 'facade.obj');
   fs.writeFileSync(obj, facadeObj());
@@ -123,6 +133,77 @@ test('a malformed op fails naming its field, and an unknown node names the node'
     ({ r } = edit(dir, p, { kind: 'remove', nodes: [9999] }, 'gone'));
     assert.notEqual(r.status, 0);
     assert.match(r.stderr, /9999/);
+  } finally {
+    removeDir(dir);
+  }
+});
+
+test('a paste from another proceduralized folder (source_dir) copies its window into this wall', () => {
+  const dir = tempDir();
+  try {
+    const a = proceduralized(dir); // the facade with six windows
+    // model B: a bare 8 m wall on a plinth, in its own folder
+    const bdir = path.join(dir, 'b');
+    fs.mkdirSync(bdir);
+    const bobj = path.join(bdir, 'bare.obj');
+    fs.writeFileSync(bobj, bareWallObj());
+    const rb = run('proceduralize', bobj, '--out', path.join(bdir, 'p'));
+    assert.equal(rb.status, 0, rb.stderr);
+    const b = path.join(bdir, 'p');
+    const treeA = JSON.parse(fs.readFileSync(path.join(a, 'tree.json'), 'utf8'));
+    const treeB = JSON.parse(fs.readFileSync(path.join(b, 'tree.json'), 'utf8'));
+    const grammarA = fs.readFileSync(path.join(a, 'grammar.txt'), 'utf8');
+    const win = treeA.nodes.find((n) => n.label === windowLabel(treeA));
+    const visibleB = treeB.nodes.filter((n) => n.kind === 'component');
+    assert.equal(visibleB.length, 2, 'B is a wall and a plinth');
+    const wallB = visibleB.sort((p, q) => (q.box[5] - q.box[2]) - (p.box[5] - p.box[2]))[0];
+    // the op file lives in B's folder; source_dir is relative to it
+    const opDir = path.join(dir, 'ops');
+    fs.mkdirSync(opDir);
+    const op = { kind: 'paste', source: [win.id], target: wallB.id, placement: 'insert', fit: 'fill', source_dir: '../p' };
+    const opFile = path.join(opDir, 'paste.json');
+    fs.writeFileSync(opFile, JSON.stringify(op));
+    const out = path.join(dir, 'pasted');
+    const r = run('edit', b, '--op', opFile, '--out', out);
+    assert.equal(r.status, 0, r.stderr);
+    const summary = JSON.parse(fs.readFileSync(path.join(out, 'summary.json'), 'utf8'));
+    assert.equal(summary.op.source_dir, '../p');
+    const tree = JSON.parse(fs.readFileSync(path.join(out, 'tree.json'), 'utf8'));
+    const visible = tree.nodes.filter((n) => n.kind === 'component');
+    assert.ok(visible.length >= 2 + 3, `B gained pasted windows: ${visible.length} visible nodes`);
+    const total = Object.values(summary.instances_per_label).reduce((x, y) => x + y, 0);
+    assert.equal(total, visible.length);
+    // the pasted windows have the source window's height and sit on the wall's face
+    const wallBox = wallB.box;
+    const small = visible.filter((n) => n.box[3] - n.box[0] < 4);
+    assert.ok(small.length >= 3, JSON.stringify(visible.map((n) => n.box)));
+    for (const n of small) {
+      assert.ok(n.box[0] >= wallBox[0] - 1e-6 && n.box[3] <= wallBox[3] + 1e-6, JSON.stringify(n.box));
+      assert.ok(Math.abs((n.box[5] - n.box[2]) - (win.box[5] - win.box[2])) < 0.25 * (win.box[5] - win.box[2]) + 1e-6 ||
+        n.box[5] - n.box[2] <= wallBox[5] - wallBox[2] + 1e-6, JSON.stringify(n.box));
+    }
+    // A is only read
+    assert.equal(fs.readFileSync(path.join(a, 'grammar.txt'), 'utf8'), grammarA);
+    assert.ok(run('fmt', path.join(out, 'grammar.txt')).status === 0);
+
+    // precise errors: a folder that is missing, one that is not proceduralized, an unknown node
+    const bad = (o, name) => {
+      const f = path.join(opDir, `${name}.json`);
+      fs.writeFileSync(f, JSON.stringify(o));
+      return run('edit', b, '--op', f, '--out', path.join(dir, name));
+    };
+    let e = bad({ ...op, source_dir: '../nowhere' }, 'missing');
+    assert.notEqual(e.status, 0);
+    assert.match(e.stderr, /missing\.json: source_dir: .*nowhere is not a folder/);
+    e = bad({ ...op, source_dir: '../b' }, 'plain');
+    assert.notEqual(e.status, 0);
+    assert.match(e.stderr, /source_dir: .* is not proceduralized/);
+    e = bad({ ...op, source: [99999] }, 'unknown');
+    assert.notEqual(e.status, 0);
+    assert.match(e.stderr, /unknown\.json: .*source.*99999/);
+    e = bad({ ...op, source_model: 3, source_dir: undefined }, 'svc');
+    assert.notEqual(e.status, 0);
+    assert.match(e.stderr, /svc\.json: source_model:/);
   } finally {
     removeDir(dir);
   }

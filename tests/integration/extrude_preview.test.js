@@ -50,4 +50,13 @@ describe('extrusion preview', () => {
     const broken = await post(d, '{"loops": [');
     assert.ok(broken.status === 400 || broken.status === 422, broken.text);
   });
+
+  it('refuses a description that names mesh files: a client cannot make the server read its disk', async () => {
+    const sneaky = structuredClone(plan);
+    sneaky.meshes = { win: '/etc/passwd' };
+    sneaky.anchors = [{ name: 'a', edge: 0, relative: 0.5, height: 1, mesh: 'win' }];
+    const r = await post(d, sneaky);
+    assert.ok(r.status === 400 || r.status === 422, r.text);
+    assert.match(r.json.detail, /meshes\.win: mesh files can only be named in a plan read from a file/);
+  });
 });

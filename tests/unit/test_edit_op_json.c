@@ -203,6 +203,74 @@ static void test_report_json(void **state)
     ag_mesh_free(m);
 }
 
+/* A paste from another model: its origin is parsed by the _ex calls, refused by the plain
+ * ones, and kept by the canonical JSON. */
+static void test_paste_origin(void **state)
+{
+    (void)state;
+    const char *m = "{\"kind\":\"paste\",\"source\":[3],\"target\":7,\"source_model\":42}";
+    const char *d = "{\"kind\":\"paste\",\"source\":[\"4\"],\"target\":\"root\","
+                    "\"source_dir\":\"../other/p\"}";
+    ag_edit_op op;
+    ag_edit_op_origin o;
+    ag_error err = {0};
+    assert_int_equal(ag_edit_op_json_parse_ex(m, strlen(m), &op, &o, &err), AG_OK);
+    assert_int_equal(o.model, 42);
+    assert_null(o.dir);
+    assert_null(op.source);
+    assert_true(op.kind == AG_EDIT_PASTE && op.nnodes == 1 && op.nodes[0] == 3 && op.node == 7);
+    json_t *j = ag_edit_op_json_to_ex(&op, &o);
+    assert_int_equal(json_integer_value(json_object_get(j, "source_model")), 42);
+    json_decref(j);
+    ag_edit_op_clear(&op);
+    ag_edit_op_origin_clear(&o);
+
+    assert_int_equal(ag_edit_op_json_parse_ex(d, strlen(d), &op, &o, &err), AG_OK);
+    assert_int_equal(o.model, 0);
+    assert_string_equal(o.dir, "../other/p");
+    j = ag_edit_op_json_to_ex(&op, &o);
+    char *text = json_dumps(j, JSON_COMPACT);
+    json_decref(j);
+    ag_edit_op back;
+    ag_edit_op_origin ob;
+    assert_int_equal(ag_edit_op_json_parse_ex(text, strlen(text), &back, &ob, &err), AG_OK);
+    assert_string_equal(ob.dir, "../other/p");
+    assert_int_equal(back.node, AG_EDIT_ROOT);
+    free(text);
+    ag_edit_op_clear(&back);
+    ag_edit_op_origin_clear(&ob);
+    ag_edit_op_clear(&op);
+    ag_edit_op_origin_clear(&o);
+
+    /* the plain parser cannot load another model: it refuses, naming the field */
+    assert_int_equal(ag_edit_op_json_parse(m, strlen(m), &op, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "source_model:"));
+    assert_int_equal(ag_edit_op_json_parse(d, strlen(d), &op, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "source_dir:"));
+
+    static const struct {
+        const char *json, *field;
+    } bad[] = {
+        {"{\"kind\":\"paste\",\"source\":[1],\"target\":2,\"source_model\":0}", "source_model:"},
+        {"{\"kind\":\"paste\",\"source\":[1],\"target\":2,\"source_model\":\"x\"}",
+         "source_model:"},
+        {"{\"kind\":\"paste\",\"source\":[1],\"target\":2,\"source_model\":[1]}", "source_model:"},
+        {"{\"kind\":\"paste\",\"source\":[1],\"target\":2,\"source_dir\":\"\"}", "source_dir:"},
+        {"{\"kind\":\"paste\",\"source\":[1],\"target\":2,\"source_dir\":7}", "source_dir:"},
+        {"{\"kind\":\"paste\",\"source\":[1],\"target\":2,\"source_dir\":\"a\",\"source_model\":3}",
+         "source_dir:"},
+        {"{\"kind\":\"remove\",\"nodes\":[1],\"source_model\":3}", "source_model:"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        ag_error_clear(&err);
+        ag_status st = ag_edit_op_json_parse_ex(bad[i].json, strlen(bad[i].json), &op, &o, &err);
+        if (st != AG_ERR_INVALID || strncmp(err.text, bad[i].field, strlen(bad[i].field)))
+            fail_msg("%s: %d %s", bad[i].json, st, err.text);
+        assert_null(o.dir);
+        assert_null(op.nodes);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -212,6 +280,7 @@ int main(void)
         cmocka_unit_test(test_syntax_error_has_line),
         cmocka_unit_test(test_read_file),
         cmocka_unit_test(test_report_json),
+        cmocka_unit_test(test_paste_origin),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

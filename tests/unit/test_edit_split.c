@@ -11,76 +11,12 @@
 
 #include "core/edit/edit.h"
 #include "core/gen_facade.h"
-#include "io/grammar_text.h"
-
-/* Proceduralizes as the edit pipeline does: the edited mesh's components are kept as they are. */
-static ag_proceduralize_result *proc(const ag_mesh *m)
-{
-    ag_proceduralize_options o = {.verify = 1, .segment.keep_groups = 1};
-    ag_proceduralize_result *r = NULL;
-    ag_error err = {0};
-    if (ag_proceduralize_run(m, &o, &r, &err))
-        fail_msg("proceduralize: %s", err.text);
-    /* the grammar derives the mesh it came from */
-    assert_int_equal(r->fidelity.unmatched, 0);
-    assert_true(r->fidelity.relative < 1e-9);
-    /* and its text parses back */
-    char *text = NULL;
-    size_t len = 0;
-    assert_int_equal(ag_grammar_text_print(r->grammar, &text, &len, &err), AG_OK);
-    ag_grammar *g = NULL;
-    long col = 0;
-    if (ag_grammar_text_parse(text, len, &g, &err, &col))
-        fail_msg("grammar does not parse: %s (line %ld)", err.text, err.element);
-    assert_int_equal(g->nrules, r->grammar->nrules);
-    ag_grammar_free(g);
-    free(text);
-    return r;
-}
-
-/* The smallest visible node whose box holds point p. */
-static int32_t node_at(const ag_proceduralize_result *r, double x, double y, double z)
-{
-    const ag_splittree *t = r->tree;
-    int32_t best = -1;
-    double bv = INFINITY;
-    for (size_t i = 0; i < t->nnodes; i++) {
-        const ag_tnode *n = &t->nodes[i];
-        if (n->kind != AG_NODE_COMPONENT)
-            continue;
-        const ag_box *b = &n->box;
-        if (x < b->min[0] || x > b->max[0] || y < b->min[1] || y > b->max[1] || z < b->min[2] ||
-            z > b->max[2])
-            continue;
-        double v = (b->max[0] - b->min[0]) * (b->max[1] - b->min[1]) * (b->max[2] - b->min[2]);
-        if (v < bv) {
-            bv = v;
-            best = (int32_t)i;
-        }
-    }
-    assert_true(best >= 0);
-    return best;
-}
-
-/* Is node a inside the subtree of node anc? */
-static int below(const ag_splittree *t, int32_t a, int32_t anc)
-{
-    for (; a >= 0; a = t->nodes[a].parent)
-        if (a == anc)
-            return 1;
-    return 0;
-}
+#include "edit_fixture.h"
 
 static ag_proceduralize_result *row_building(size_t *tris)
 {
     ag_gen_facade_options o = {.cols = 6, .rows = 1};
-    ag_mesh *m = NULL;
-    assert_int_equal(ag_gen_facade(&o, &m, NULL), AG_OK);
-    ag_proceduralize_result *r = proc(m);
-    if (tris)
-        *tris = m->ntris;
-    ag_mesh_free(m);
-    return r;
+    return proc_facade(&o, tris);
 }
 
 static void test_split_wall_duplicates_its_window_row(void **state)

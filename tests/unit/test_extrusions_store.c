@@ -12,53 +12,14 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "embedded.h"
-#include "store/db.h"
 #include "store/extrusions.h"
-#include "store/migrate.h"
-#include "store/models.h"
-
-static char *temp_db(void)
-{
-    char *path = strdup("/tmp/archgram-extrusions-XXXXXX");
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
-    unlink(path);
-    return path;
-}
-
-static void remove_db(char *path)
-{
-    char side[4200];
-    unlink(path);
-    snprintf(side, sizeof side, "%s-wal", path);
-    unlink(side);
-    snprintf(side, sizeof side, "%s-shm", path);
-    unlink(side);
-    free(path);
-}
-
-static long long count(ag_db *db, const char *sql)
-{
-    sqlite3_stmt *st;
-    assert_int_equal(sqlite3_prepare_v2(ag_db_handle(db), sql, -1, &st, NULL), SQLITE_OK);
-    assert_int_equal(sqlite3_step(st), SQLITE_ROW);
-    long long n = sqlite3_column_int64(st, 0);
-    sqlite3_finalize(st);
-    return n;
-}
+#include "store_fixture.h"
 
 static int64_t add_model(ag_db *db, const char *name, const char *kind)
 {
-    ag_error err;
     static const char mesh[] = "whole mesh";
     ag_model_new m = {.name = name, .kind = kind, .mesh = mesh, .mesh_len = sizeof mesh};
-    int64_t id = 0;
-    assert_int_equal(ag_db_begin(db, &err), AG_OK);
-    assert_int_equal(ag_models_insert(db, &m, &id, &err), AG_OK);
-    assert_int_equal(ag_db_commit(db, &err), AG_OK);
-    return id;
+    return insert_model(db, &m);
 }
 
 /* A batch of three buildings as the extrude job stores it; the middle one failed. */
@@ -251,33 +212,10 @@ static void migration_keeps_an_older_database(void **state)
     (void)state;
     assert_true(ag_migrations_count >= 3);
     assert_string_equal(ag_migrations[2].name, "0003_extrusions");
-    char *path = temp_db();
     /* a database as archgram with migrations 0001 and 0002 left it, holding a model */
-    sqlite3 *raw;
+    char *path = old_database(2);
+    ag_db *db = open_old_database(path);
     ag_error err;
-    assert_int_equal(sqlite3_open(path, &raw), SQLITE_OK);
-    assert_int_equal(ag_migrate(raw, ag_migrations, 2, &err), AG_OK);
-    assert_int_equal(ag_migrate_user_version(raw), 2);
-    assert_int_equal(sqlite3_exec(raw,
-                                  "INSERT INTO blobs (id, media_type, bytes, data) VALUES "
-                                  "(1, 'x', 3, 'abc');"
-                                  "INSERT INTO models (id, name, version, mesh_blob) VALUES "
-                                  "(5, 'old', 4, 1);"
-                                  "INSERT INTO ops VALUES (5, 2, 'ana', 'c1', 'note', "
-                                  "'{\"kind\":\"note\",\"text\":\"hi\"}', '2024-01-01');",
-                                  NULL, NULL, NULL),
-                     SQLITE_OK);
-    sqlite3_close(raw);
-
-    ag_db *db;
-    assert_int_equal(ag_db_open(path, NULL, &db, &err), AG_OK);
-    assert_int_equal(ag_db_schema_version(db), (int)ag_migrations_count);
-    ag_model_row row;
-    assert_int_equal(ag_models_get(db, 5, &row, &err), AG_OK);
-    assert_string_equal(row.name, "old");
-    assert_int_equal(row.version, 4);
-    ag_models_row_clear(&row);
-    assert_int_equal(count(db, "SELECT count(*) FROM ops WHERE model_id = 5"), 1);
     ag_extrusion_row e;
     assert_int_equal(ag_extrusions_get(db, 5, &e, &err), AG_ERR_NOT_FOUND);
     assert_non_null(strstr(err.text, "not an extrusion"));

@@ -10,30 +10,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "embedded.h"
-#include "store/db.h"
-#include "store/migrate.h"
-
-static char *temp_db(void)
-{
-    char *path = strdup("/tmp/archgram-test-XXXXXX");
-    int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    close(fd);
-    unlink(path);
-    return path;
-}
-
-static void remove_db(char *path)
-{
-    char side[4200];
-    unlink(path);
-    snprintf(side, sizeof side, "%s-wal", path);
-    unlink(side);
-    snprintf(side, sizeof side, "%s-shm", path);
-    unlink(side);
-    free(path);
-}
+#include "store_fixture.h"
 
 static int table_exists(sqlite3 *db, const char *name)
 {

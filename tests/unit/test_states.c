@@ -19,22 +19,13 @@
 #include "store/models.h"
 #include "store/ops.h"
 #include "store/states.h"
+#include "store_fixture.h"
 
 typedef struct {
     char *path;
     ag_db *db;
     int64_t model;
 } fixture;
-
-static long long count(ag_db *db, const char *sql)
-{
-    sqlite3_stmt *st;
-    assert_int_equal(sqlite3_prepare_v2(ag_db_handle(db), sql, -1, &st, NULL), SQLITE_OK);
-    assert_int_equal(sqlite3_step(st), SQLITE_ROW);
-    long long n = sqlite3_column_int64(st, 0);
-    sqlite3_finalize(st);
-    return n;
-}
 
 static int64_t mesh_blob(ag_db *db, int64_t model)
 {
@@ -48,18 +39,12 @@ static int64_t mesh_blob(ag_db *db, int64_t model)
 static int setup(void **state)
 {
     fixture *f = calloc(1, sizeof *f);
-    f->path = strdup("/tmp/archgram-states-XXXXXX");
-    int fd = mkstemp(f->path);
-    assert_true(fd >= 0);
-    close(fd);
-    unlink(f->path);
+    f->path = temp_db();
     ag_error err;
     assert_int_equal(ag_db_open(f->path, NULL, &f->db, &err), AG_OK);
     static const char mesh[] = "mesh of version 1";
     ag_model_new m = {.name = "m", .mesh = mesh, .mesh_len = sizeof mesh, .stats_json = "{\"v\":1}"};
-    assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
-    assert_int_equal(ag_models_insert(f->db, &m, &f->model, &err), AG_OK);
-    assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
+    f->model = insert_model(f->db, &m);
     *state = f;
     return 0;
 }
@@ -68,13 +53,7 @@ static int teardown(void **state)
 {
     fixture *f = *state;
     ag_db_close(f->db);
-    char side[4200];
-    unlink(f->path);
-    snprintf(side, sizeof side, "%s-wal", f->path);
-    unlink(side);
-    snprintf(side, sizeof side, "%s-shm", f->path);
-    unlink(side);
-    free(f->path);
+    remove_db(f->path);
     free(f);
     return 0;
 }

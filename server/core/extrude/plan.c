@@ -158,6 +158,11 @@ static int profile_ok(const ag_plan *p, int32_t k, int allow_none)
     return 1;
 }
 
+static int gap_ok(double from, double to)
+{
+    return isfinite(from) && isfinite(to) && from > 0 && to > from;
+}
+
 ag_status ag_plan_add_offset(ag_plan *p, const ag_plan_offset *o, ag_error *err)
 {
     long idx = (long)p->noffsets + 1;
@@ -175,10 +180,23 @@ ag_status ag_plan_add_offset(ag_plan *p, const ag_plan_offset *o, ag_error *err)
             return ag_error_set(err, AG_ERR_INVALID, idx, "offset %zu: edges[%zu] names no edge "
                                 "of the plan (loop %d, edge %d)", p->noffsets, i, (int)e->loop,
                                 (int)e->edge);
-        if ((e->has_outside && !isfinite(e->outside)) || !profile_ok(p, e->profile, 1))
+        if ((e->has_outside && !isfinite(e->outside)) || !profile_ok(p, e->profile, 1) ||
+            !profile_ok(p, e->inside - 1, 1) || !profile_ok(p, e->inner - 1, 1))
             return ag_error_set(err, AG_ERR_INVALID, idx, "offset %zu: edges[%zu] has a bad "
                                 "distance or profile", p->noffsets, i);
+        if ((e->has_gap || e->inside || e->inner) && !o->has_gap)
+            return ag_error_set(err, AG_ERR_INVALID, idx, "offset %zu: edges[%zu] has an inside "
+                                "boundary but the event has none", p->noffsets, i);
+        if (e->has_gap && !gap_ok(e->gap_from, e->gap_to))
+            return ag_error_set(err, AG_ERR_INVALID, idx, "offset %zu: edges[%zu] needs a gap "
+                                "0 < from < to", p->noffsets, i);
     }
+    if (o->has_gap && !gap_ok(o->gap_from, o->gap_to))
+        return ag_error_set(err, AG_ERR_INVALID, idx, "offset %zu: the inside boundary needs a "
+                            "gap 0 < from < to", p->noffsets);
+    if (o->has_gap && (o->inside < 0 || !profile_ok(p, o->inside, 0) || !profile_ok(p, o->inner, 1)))
+        return ag_error_set(err, AG_ERR_INVALID, idx, "offset %zu: the inside boundary needs an "
+                            "inside profile, and profiles without horizontal segments", p->noffsets);
     if (p->noffsets == p->cap_offsets) {
         size_t cap = p->cap_offsets ? 2 * p->cap_offsets : 4;
         ag_plan_offset *no = realloc(p->offsets, cap * sizeof *no);

@@ -100,6 +100,11 @@ typedef struct {
     int has_outside;    /* use `outside` below instead of the event's */
     double outside;
     int32_t profile;    /* profile after the event, -1: the event's */
+    /* the inside boundary (only with an event that has one): this edge's gap instead of
+     * the event's, and its profiles as 1 + index (0: the event's) */
+    int has_gap;
+    double gap_from, gap_to;
+    int32_t inside, inner;
 } ag_offset_edge;
 
 /* A profile offset event: at height z every active edge moves `outside` metres outwards
@@ -116,6 +121,15 @@ typedef struct {
     int32_t side;
     size_t nedges;
     ag_offset_edge *edges; /* overrides, owned by the plan */
+    /* An inside boundary (§4.6's dist_inside): when has_gap, at the end of the event's
+     * interval a gap opens between gap_from and gap_to metres inside the active plan
+     * (0 < gap_from < gap_to, per edge). The ring outside it is the outer shell (a
+     * parapet, walls around a roof): its gap-facing edges take `inside`. What is inside
+     * the gap is the inner shell: its edges take `inner` (-1: each carries on with the
+     * profile of the edge it was inset from). The gap gets a flat floor facing up. */
+    int has_gap;
+    double gap_from, gap_to;
+    int32_t inside, inner;
 } ag_plan_offset;
 
 typedef enum {
@@ -169,7 +183,9 @@ ag_status ag_plan_set_segment_priority(ag_plan *p, size_t profile, size_t segmen
 int32_t ag_profile_priority(const ag_profile *pr, int32_t segment);
 /* Adds a profile offset event (edges copied); fails with AG_ERR_INVALID for a height
  * that is not > 0, a non-finite distance, an unknown profile or one with a horizontal
- * segment (after or side), or an edge override naming no loop/edge of the plan as it is. */
+ * segment (after, side, inside, inner), an edge override naming no loop/edge of the plan
+ * as it is, or a gap that is not 0 < gap_from < gap_to (an edge's gap without the
+ * event's, an event gap without an `inside` profile). */
 ag_status ag_plan_add_offset(ag_plan *p, const ag_plan_offset *o, ag_error *err);
 /* Adds a named mesh for anchors to place; the plan takes ownership of mesh (also on
  * failure). *index (may be NULL) gets its index; anchors refer to it as index + 1. */

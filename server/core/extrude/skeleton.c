@@ -928,7 +928,20 @@ static void direction(sk *S, ag_event *evs, size_t n)
         sk_edge *e = &S->e[ch.arr[i]];
         const ag_profile *p = &S->plan->profiles[e->profile];
         double s_new;
-        if (newface[i] == 3) {
+        if (newface[i] == 3 && off_w[i] == 0) {
+            /* no move: it waits through the interval, on its new profile if it has one */
+            if (off_p[i] >= 0) {
+                uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
+                seg(S, e->face, ve, vs);
+                e->profile = off_p[i];
+                e->seg = 0;
+                e->clock = off_clock;
+                e->face = new_face(S, e);
+                seg(S, e->face, vs, ve);
+            }
+            e->paused = 1;
+            s_new = 0;
+        } else if (newface[i] == 3) {
             uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
             seg(S, e->face, ve, vs);
             if (off_p[i] >= 0) {

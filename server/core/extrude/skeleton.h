@@ -37,6 +37,7 @@ typedef struct {
     size_t irregular;
     size_t steps, steps_skipped; /* plan edits made / not made (anchor not on the plan) */
     size_t offsets, offset_sides; /* offset events handled, side edges they made */
+    size_t offset_gaps;   /* inside boundaries (gaps) opened by offset events */
     int capped;           /* the top was closed flat */
     double top;           /* highest height reached */
 } ag_skeleton_stats;
