@@ -6,7 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "../core/extrude/style.h"
 #include "../io/footprints.h"
@@ -441,14 +440,5 @@ done:
     return s;
 }
 
-static void cleanup(ag_app *app, const char *params_json)
-{
-    (void)app;
-    json_t *params = json_loads(params_json, 0, NULL);
-    const char *upload = json_string_value(json_object_get(params, "upload"));
-    if (upload)
-        unlink(upload);
-    json_decref(params);
-}
-
-const ag_job_kind ag_extrude_job_kind = {.kind = "extrude", .run = run, .cleanup = cleanup};
+const ag_job_kind ag_extrude_job_kind = {.kind = "extrude", .run = run,
+                                        .cleanup = ag_jobqueue_remove_upload};

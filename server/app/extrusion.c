@@ -10,6 +10,7 @@
 #include "../io/meshblob.h"
 #include "../io/meshjson.h"
 #include "../store/extrusions.h"
+#include "../store/models.h"
 
 void ag_extrusion_built_clear(ag_extrusion_built *b)
 {
@@ -134,7 +135,7 @@ ag_status ag_extrusion_store_mesh(ag_db *db, int64_t model, size_t *triangles, a
     if (s == AG_OK && !(stats = ag_extrusion_stats(a.mesh)))
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory summarising the mesh");
     if (s == AG_OK)
-        s = ag_extrusions_set_mesh(db, model, blob, len, stats, err);
+        s = ag_models_set_mesh(db, model, blob, len, stats, NULL, err);
     if (s == AG_OK && triangles)
         *triangles = a.mesh->ntris;
     free(stats);

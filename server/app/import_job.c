@@ -149,14 +149,5 @@ done:
     return s;
 }
 
-static void cleanup(ag_app *app, const char *params_json)
-{
-    (void)app;
-    json_t *params = json_loads(params_json, 0, NULL);
-    const char *upload = json_string_value(json_object_get(params, "upload"));
-    if (upload)
-        unlink(upload);
-    json_decref(params);
-}
-
-const ag_job_kind ag_import_job_kind = {.kind = "import", .run = run, .cleanup = cleanup};
+const ag_job_kind ag_import_job_kind = {.kind = "import", .run = run,
+                                       .cleanup = ag_jobqueue_remove_upload};

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "../store/jobs.h"
 #include "views.h"
@@ -335,4 +336,14 @@ int ag_jobctx_progress(ag_jobctx *ctx, double fraction, const char *stage)
     }
     ag_jobqueue_publish(ctx->q->app, ctx->job);
     return ag_jobctx_cancelled(ctx);
+}
+
+void ag_jobqueue_remove_upload(ag_app *app, const char *params_json)
+{
+    (void)app;
+    json_t *params = json_loads(params_json, 0, NULL);
+    const char *upload = json_string_value(json_object_get(params, "upload"));
+    if (upload)
+        unlink(upload);
+    json_decref(params);
 }

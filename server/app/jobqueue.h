@@ -25,6 +25,9 @@ typedef struct {
     void (*cleanup)(ag_app *app, const char *params_json);
 } ag_job_kind;
 
+/* A cleanup for kinds whose params name an uploaded file as "upload": removes that file. */
+void ag_jobqueue_remove_upload(ag_app *app, const char *params_json);
+
 ag_jobqueue *ag_jobqueue_create(ag_app *app, int workers, size_t capacity);
 ag_status ag_jobqueue_register(ag_jobqueue *q, const ag_job_kind *kind);
 /* Stops accepting, cancels queued and running jobs, joins the workers. */

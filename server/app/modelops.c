@@ -19,7 +19,7 @@ static size_t utf8_chars(const char *s)
     return n;
 }
 
-static ag_status only_members(const json_t *op, const char *const *allowed, ag_error *err)
+ag_status ag_modelops_only_members(const json_t *op, const char *const *allowed, ag_error *err)
 {
     const char *key;
     json_t *value;
@@ -46,7 +46,7 @@ ag_status ag_modelops_validate(const json_t *op, ag_error *err)
         if (!name)
             return ag_error_set(err, AG_ERR_INVALID, 0, "a rename op needs a string \"name\"");
         ag_status s = ag_models_check_name(name, err);
-        return s != AG_OK ? s : only_members(op, allowed, err);
+        return s != AG_OK ? s : ag_modelops_only_members(op, allowed, err);
     }
     if (strcmp(kind, "note") == 0) {
         static const char *const allowed[] = {"kind", "text", NULL};
@@ -56,7 +56,7 @@ ag_status ag_modelops_validate(const json_t *op, ag_error *err)
         if (utf8_chars(text) > AG_NOTE_MAX)
             return ag_error_set(err, AG_ERR_INVALID, 0, "a note holds at most %d characters",
                                 AG_NOTE_MAX);
-        return only_members(op, allowed, err);
+        return ag_modelops_only_members(op, allowed, err);
     }
     if (ag_plan_edit_handles(kind))
         return ag_plan_edit_validate(op, err);

@@ -26,6 +26,10 @@ ag_status ag_modelops_apply(ag_app *app, int64_t model, int64_t base, const char
 /* Deletes a model at the given version (AG_ERR_STALE otherwise) and publishes its end. */
 ag_status ag_modelops_delete(ag_app *app, int64_t model, int64_t version, ag_error *err);
 
+/* For the op validators: AG_ERR_INVALID naming the first member of op that is not in allowed
+ * (NULL-terminated). */
+ag_status ag_modelops_only_members(const json_t *op, const char *const *allowed, ag_error *err);
+
 /* Checks a client-supplied identifier (cid, author): 1..100 printable ASCII characters. */
 ag_status ag_modelops_check_token(const char *what, const char *value, ag_error *err);
 

@@ -8,26 +8,13 @@
 #include "../io/plan_json.h"
 #include "../store/extrusions.h"
 #include "extrusion.h"
+#include "modelops.h"
 
 #define AG_PROFILE_NAME_MAX 100
 
 int ag_plan_edit_handles(const char *kind)
 {
     return kind && (strcmp(kind, "plan") == 0 || strcmp(kind, "profile") == 0);
-}
-
-static ag_status only_members(const json_t *op, const char *const *allowed, ag_error *err)
-{
-    const char *key;
-    json_t *value;
-    json_object_foreach((json_t *)op, key, value) {
-        int ok = 0;
-        for (const char *const *a = allowed; *a; a++)
-            ok |= strcmp(key, *a) == 0;
-        if (!ok)
-            return ag_error_set(err, AG_ERR_INVALID, 0, "op member \"%s\" is not known", key);
-    }
-    return AG_OK;
 }
 
 /* Parses a description given as JSON; errors become AG_ERR_PARSE prefixed with `what`. */
@@ -77,7 +64,7 @@ ag_status ag_plan_edit_validate(const json_t *op, ag_error *err)
         if (!json_is_object(plan))
             return ag_error_set(err, AG_ERR_INVALID, 0,
                                 "a plan op needs \"plan\", a building description object");
-        ag_status s = only_members(op, allowed, err);
+        ag_status s = ag_modelops_only_members(op, allowed, err);
         ag_plan *p = NULL;
         if (s == AG_OK)
             s = parse(plan, "plan op: ", &p, NULL, err);
@@ -99,7 +86,7 @@ ag_status ag_plan_edit_validate(const json_t *op, ag_error *err)
     if (!json_is_array(profile) && !json_is_object(profile))
         return ag_error_set(err, AG_ERR_INVALID, 0,
                             "a profile op needs \"profile\": [[w, z], …] or {\"points\": …}");
-    ag_status s = only_members(op, allowed, err);
+    ag_status s = ag_modelops_only_members(op, allowed, err);
     return s != AG_OK ? s : check_profile(name, profile, err);
 }
 

@@ -24,102 +24,14 @@ static int on_stage(void *user, ag_stage stage)
     return ag_jobctx_progress(user, stage_start[stage], ag_proceduralize_stage_name(stage));
 }
 
-/* The terminals as stored: OBJ text under a path named after its content (as
- * `archgram proceduralize` names the files), each distinct text once. */
-typedef struct {
-    size_t n;
-    char **path, **obj;
-    size_t *len;
-    size_t bytes;
-} term_set;
-
-static void term_set_free(term_set *s)
-{
-    for (size_t i = 0; i < s->n; i++) {
-        free(s->path[i]);
-        free(s->obj[i]);
-    }
-    free(s->path);
-    free(s->obj);
-    free(s->len);
-    memset(s, 0, sizeof *s);
-}
-
-static uint64_t fnv1a(const char *s, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (size_t i = 0; i < n; i++) {
-        h ^= (unsigned char)s[i];
-        h *= 0x100000001b3ULL;
-    }
-    return h;
-}
-
-static ag_status name_terminals(ag_grammar *g, term_set *s, ag_error *err)
-{
-    size_t cap = g->nterminals + 1;
-    s->path = calloc(cap, sizeof *s->path);
-    s->obj = calloc(cap, sizeof *s->obj);
-    s->len = calloc(cap, sizeof *s->len);
-    if (!s->path || !s->obj || !s->len)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    for (size_t i = 0; i < g->nterminals; i++) {
-        ag_gterminal *t = &g->terminals[i];
-        char *text;
-        size_t len;
-        ag_status st = ag_terminals_format(t, &text, &len, err);
-        if (st != AG_OK)
-            return st;
-        char path[64];
-        snprintf(path, sizeof path, "terminals/%016llx.obj",
-                 (unsigned long long)fnv1a(text, len));
-        free(t->path);
-        if (!(t->path = strdup(path))) {
-            free(text);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
-        size_t k = 0;
-        while (k < s->n && strcmp(s->path[k], path) != 0)
-            k++;
-        if (k < s->n) {
-            free(text);
-            continue;
-        }
-        if (!(s->path[s->n] = strdup(path))) {
-            free(text);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
-        s->obj[s->n] = text;
-        s->len[s->n] = len;
-        s->bytes += len;
-        s->n++;
-    }
-    return AG_OK;
-}
-
-static ag_status lookup_set(void *user, const char *path, char **obj, size_t *len, ag_error *err)
-{
-    const term_set *s = user;
-    for (size_t i = 0; i < s->n; i++) {
-        if (strcmp(s->path[i], path) != 0)
-            continue;
-        if (!(*obj = malloc(s->len[i] + 1)))
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        memcpy(*obj, s->obj[i], s->len[i]);
-        (*obj)[s->len[i]] = '\0';
-        *len = s->len[i];
-        return AG_OK;
-    }
-    return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "no terminal %s", path);
-}
-
 static json_t *vec3(const double *v)
 {
     return json_pack("[f,f,f]", v[0], v[1], v[2]);
 }
 
 static char *summary_json(const ag_mesh *in, const ag_proceduralize_result *r, size_t text_len,
-                          const term_set *terms, const ag_fidelity *fid, const double *verify_s)
+                          const ag_terminal_set *terms, const ag_fidelity *fid,
+                          const double *verify_s)
 {
     const ag_labels *L = r->labels;
     json_t *j = json_object();
@@ -220,7 +132,7 @@ static ag_status run(ag_app *app, ag_jobctx *ctx, int64_t job, const char *param
     const char *author = json_string_value(json_object_get(params, "author"));
     ag_mesh *mesh = NULL;
     ag_proceduralize_result *r = NULL;
-    term_set terms = {0};
+    ag_terminal_set terms = {0};
     ag_grammar_derived d = {0};
     char *text = NULL, *summary = NULL;
     json_t *op = NULL;
@@ -249,13 +161,14 @@ static ag_status run(ag_app *app, ag_jobctx *ctx, int64_t job, const char *param
         goto done;
     }
     double t0 = now();
-    if ((s = name_terminals(r->grammar, &terms, err)) != AG_OK ||
+    if ((s = ag_terminals_collect(r->grammar, &terms, err)) != AG_OK ||
         (s = ag_grammar_text_print(r->grammar, &text, &tlen, err)) != AG_OK)
         goto done;
     long col = 0;
     ag_error e;
     ag_error_clear(&e);
-    if ((s = ag_grammar_edit_derive(text, tlen, lookup_set, &terms, &d, &e, &col)) != AG_OK) {
+    if ((s = ag_grammar_edit_derive(text, tlen, ag_terminals_set_lookup, &terms, &d, &e, &col)) !=
+        AG_OK) {
         s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
                          "the grammar does not read back (line %ld, column %ld): %s", e.element,
                          col, e.text);
@@ -324,7 +237,7 @@ done:
     free(summary);
     free(text);
     ag_grammar_derived_clear(&d);
-    term_set_free(&terms);
+    ag_terminals_set_clear(&terms);
     ag_proceduralize_result_free(r);
     ag_mesh_free(mesh);
     json_decref(params);

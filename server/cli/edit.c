@@ -12,7 +12,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../core/edit/edit.h"
@@ -26,27 +25,6 @@ static int usage(void)
 {
     fputs("usage: archgram edit DIR --op OP.json --out DIR2\n", stderr);
     return 2;
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static int make_dirs(const char *dir)
-{
-    char p[4096];
-    snprintf(p, sizeof p, "%s", dir);
-    for (char *s = p + 1; *s; s++)
-        if (*s == '/') {
-            *s = 0;
-            if (mkdir(p, 0777) && errno != EEXIST)
-                return -1;
-            *s = '/';
-        }
-    return mkdir(p, 0777) && errno != EEXIST ? -1 : 0;
 }
 
 static int write_json(const char *path, json_t *j)
@@ -137,7 +115,7 @@ int ag_cli_edit(int argc, char **argv)
     char *text = NULL;
     size_t tlen = 0;
     json_t *summary = NULL;
-    double t0 = now();
+    double t0 = ag_cli_seconds();
 
     snprintf(path, sizeof path, "%s/grammar.txt", dir);
     long col = 0;
@@ -159,16 +137,16 @@ int ag_cli_edit(int argc, char **argv)
     if (from.dir && load_source(oppath, from.dir, &sg, &source, &err))
         goto done;
     op.source = source ? source->proc : NULL;
-    double t_load = now() - t0;
-    t0 = now();
+    double t_load = ag_cli_seconds() - t0;
+    t0 = ag_cli_seconds();
     if (ag_edit_apply(model, &op, &edited, &rep, &err)) {
         /* errors that name an op field are the op file's; the rest are the model's */
         ag_cli_report(err.code == AG_ERR_INVALID || err.code == AG_ERR_NOT_FOUND ? oppath : dir,
                       &err);
         goto done;
     }
-    double t_edit = now() - t0;
-    if (make_dirs(out)) {
+    double t_edit = ag_cli_seconds() - t0;
+    if (ag_cli_make_dirs(out)) {
         fprintf(stderr, "archgram: cannot create %s: %s\n", out, strerror(errno));
         goto done;
     }

@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <time.h>
 
 #include "commands.h"
 #include "../core/extrude/extrude.h"
@@ -36,13 +35,6 @@ static ag_status write_mesh(const ag_mesh *m, const char *out, ag_error *err)
     if (ends_with(out, ".glb"))
         return ag_glb_write_file(m, out, err);
     return ag_obj_write_file(m, AG_UP_DEFAULT, out, err);
-}
-
-static double seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
 static int run_plan(const char *plan_path, const char *out)
@@ -125,7 +117,7 @@ static int run_batch(const char *in, const char *style_arg, const char *out, con
         style.seed = (uint64_t)seed;
     ag_footprints_options fo = {height_prop, lonlat};
     ag_footprints *f = NULL;
-    double t0 = seconds();
+    double t0 = ag_cli_seconds();
     if (ag_footprints_read_file(in, &fo, &f, &err) != AG_OK) {
         fprintf(stderr, "archgram extrude: %s: %s\n", in, err.text);
         return 1;
@@ -133,7 +125,7 @@ static int run_batch(const char *in, const char *style_arg, const char *out, con
     ag_mesh *m = ag_mesh_create();
     ag_footprints_report r;
     ag_status st = m ? ag_footprints_extrude(f, &style, m, &r, &err) : AG_ERR_NOMEM;
-    double dt = seconds() - t0;
+    double dt = ag_cli_seconds() - t0;
     if (st != AG_OK) {
         fprintf(stderr, "archgram extrude: %s\n", err.text);
         ag_mesh_free(m);

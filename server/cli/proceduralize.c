@@ -5,8 +5,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <time.h>
 
 #include "../core/proc/proceduralize.h"
 #include "../core/edit/edit.h"
@@ -24,34 +22,12 @@ static int usage(void)
     return 2;
 }
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 static json_t *vec3(const double *v)
 {
     json_t *a = json_array();
     for (int i = 0; i < 3; i++)
         json_array_append_new(a, json_real(v[i]));
     return a;
-}
-
-/* mkdir -p */
-static int make_dirs(const char *dir)
-{
-    char p[4096];
-    snprintf(p, sizeof p, "%s", dir);
-    for (char *s = p + 1; *s; s++)
-        if (*s == '/') {
-            *s = 0;
-            if (mkdir(p, 0777) && errno != EEXIST)
-                return -1;
-            *s = '/';
-        }
-    return mkdir(p, 0777) && errno != EEXIST ? -1 : 0;
 }
 
 static int write_file(const char *path, const char *data, size_t len)
@@ -113,12 +89,12 @@ int ag_cli_proceduralize(int argc, char **argv)
     if (!in || !dir)
         return usage();
 
-    double t_all = now(), t0 = now();
+    double t_all = ag_cli_seconds(), t0 = ag_cli_seconds();
     ag_mesh *m = NULL;
     size_t bytes = 0;
     if (ag_cli_load_mesh(in, up, &m, &bytes))
         return 1;
-    double t_import = now() - t0;
+    double t_import = ag_cli_seconds() - t0;
 
     ag_error err;
     ag_error_clear(&err);
@@ -136,8 +112,8 @@ int ag_cli_proceduralize(int argc, char **argv)
     ag_mesh *derived = NULL;
     json_t *j = NULL;
 
-    t0 = now();
-    if (make_dirs(dir)) {
+    t0 = ag_cli_seconds();
+    if (ag_cli_make_dirs(dir)) {
         fprintf(stderr, "archgram: cannot create %s: %s\n", dir, strerror(errno));
         goto done;
     }
@@ -149,11 +125,11 @@ int ag_cli_proceduralize(int argc, char **argv)
     snprintf(path, sizeof path, "%s/grammar.txt", dir);
     if (write_file(path, text, tlen))
         goto done;
-    double t_export = r->seconds[AG_STAGE_EXPORT] + (now() - t0);
-    double t_total = now() - t_all;
+    double t_export = r->seconds[AG_STAGE_EXPORT] + (ag_cli_seconds() - t0);
+    double t_total = ag_cli_seconds() - t_all;
 
     /* verify the files as written: parse, load terminals, derive, compare */
-    t0 = now();
+    t0 = ag_cli_seconds();
     long col = 0;
     ag_fidelity fid = {0};
     if (ag_grammar_text_read_file(path, &back, &err, &col)) {
@@ -165,7 +141,7 @@ int ag_cli_proceduralize(int argc, char **argv)
         ag_cli_report(path, &err);
         goto done;
     }
-    double t_verify = now() - t0;
+    double t_verify = ag_cli_seconds() - t0;
 
     /* tree.json: the tree `archgram edit` reads this folder as (the grammar derived and
      * proceduralized again, as ag_edit_model_from_grammar does), so its ids are the ones

@@ -120,8 +120,8 @@ static ag_status read_meshes(json_t *root, const char *base, ag_plan *p, ag_erro
     return AG_OK;
 }
 
-/* "offsets": [{"height", "outside", "profile", "side", "edges": [{"loop", "edge",
- * "disabled", "outside", "profile"}]}] */
+/* "offsets": [{"height", "outside", "profile", "side", "inside": {"gap", "profile",
+ * "inner"}, "edges": [{"loop", "edge", "disabled", "outside", "profile", "inside"}]}] */
 static int32_t opt_profile(json_t *v, const ag_plan *p, int *bad)
 {
     if (!v || json_is_null(v))
@@ -130,6 +130,33 @@ static int32_t opt_profile(json_t *v, const ag_plan *p, int *bad)
     if (k < 0)
         *bad = 1;
     return k;
+}
+
+/* "inside": {"gap": [from, to], "profile": NAME, "inner": NAME}; every member optional
+ * here (the event's are checked when it is added). Returns 0 when malformed. */
+static int read_inside(json_t *v, const ag_plan *p, int *has_gap, double *from, double *to,
+                       int32_t *inside, int32_t *inner)
+{
+    if (!json_is_object(v))
+        return 0;
+    json_t *g = json_object_get(v, "gap");
+    int bad = 0;
+    *inside = opt_profile(json_object_get(v, "profile"), p, &bad);
+    *inner = opt_profile(json_object_get(v, "inner"), p, &bad);
+    if (g && (!json_is_array(g) || json_array_size(g) != 2 ||
+              !json_is_number(json_array_get(g, 0)) || !json_is_number(json_array_get(g, 1))))
+        bad = 1;
+    const char *key;
+    json_t *x;
+    json_object_foreach(v, key, x)
+        if (strcmp(key, "gap") && strcmp(key, "profile") && strcmp(key, "inner"))
+            bad = 1;
+    if (bad)
+        return 0;
+    *has_gap = g != NULL;
+    *from = g ? json_number_value(json_array_get(g, 0)) : 0;
+    *to = g ? json_number_value(json_array_get(g, 1)) : 0;
+    return 1;
 }
 
 static ag_status read_offsets(json_t *root, ag_plan *p, ag_error *err)
@@ -150,14 +177,23 @@ static ag_status read_offsets(json_t *root, ag_plan *p, ag_error *err)
         memset(&o, 0, sizeof o);
         o.profile = opt_profile(json_object_get(ov, "profile"), p, &bad);
         o.side = opt_profile(json_object_get(ov, "side"), p, &bad);
-        if (!json_is_object(ov) || !json_is_number(h) || !json_is_number(w) || bad ||
-            (edges && !json_is_array(edges)))
+        json_t *ins = json_object_get(ov, "inside");
+        o.inner = -1;
+        o.inside = -1;
+        if (ins && (!read_inside(ins, p, &o.has_gap, &o.gap_from, &o.gap_to, &o.inside, &o.inner) ||
+                    !o.has_gap))
             return ag_error_set(err, AG_ERR_PARSE, (long)oi + 1,
-                                "plan: offsets[%zu] needs \"height\" and \"outside\" (numbers); "
-                                "\"profile\" and \"side\" must name profiles, \"edges\" be an "
-                                "array", oi);
+                                "plan: offsets[%zu].inside needs \"gap\": [from, to] (metres "
+                                "inwards) and may have \"profile\" and \"inner\" (profile "
+                                "names)", oi);
+        if (!json_is_object(ov) || !json_is_number(h) || (!json_is_number(w) && (w || !ins)) ||
+            bad || (edges && !json_is_array(edges)))
+            return ag_error_set(err, AG_ERR_PARSE, (long)oi + 1,
+                                "plan: offsets[%zu] needs \"height\" and \"outside\" (numbers; "
+                                "\"outside\" may be left out with \"inside\"); \"profile\" "
+                                "and \"side\" must name profiles, \"edges\" be an array", oi);
         o.z = json_number_value(h);
-        o.outside = json_number_value(w);
+        o.outside = w ? json_number_value(w) : 0;
         o.nedges = edges ? json_array_size(edges) : 0;
         o.edges = calloc(o.nedges ? o.nedges : 1, sizeof *o.edges);
         if (!o.edges)
@@ -170,12 +206,19 @@ static ag_status read_offsets(json_t *root, ag_plan *p, ag_error *err)
             json_t *lo = json_object_get(ev, "loop"), *ed = json_object_get(ev, "edge");
             json_t *dis = json_object_get(ev, "disabled"), *xw = json_object_get(ev, "outside");
             x->profile = opt_profile(json_object_get(ev, "profile"), p, &bad);
+            json_t *xin = json_object_get(ev, "inside");
+            int32_t xi = -1, xn = -1;
+            if (xin && !read_inside(xin, p, &x->has_gap, &x->gap_from, &x->gap_to, &xi, &xn))
+                bad = 1;
+            x->inside = xi + 1;
+            x->inner = xn + 1;
             if (!json_is_object(ev) || !json_is_integer(ed) || (lo && !json_is_integer(lo)) ||
                 (dis && !json_is_boolean(dis)) || (xw && !json_is_number(xw)) || bad) {
                 free(o.edges);
                 return ag_error_set(err, AG_ERR_PARSE, (long)oi + 1,
                                     "plan: offsets[%zu].edges[%zu] needs \"edge\" (and may have "
-                                    "\"loop\", \"disabled\", \"outside\", \"profile\")", oi, ei);
+                                    "\"loop\", \"disabled\", \"outside\", \"profile\", "
+                                    "\"inside\")", oi, ei);
             }
             x->loop = lo ? (int32_t)json_integer_value(lo) : 0;
             x->edge = (int32_t)json_integer_value(ed);

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/proc/gframe.h"
+
 enum { K_ROOT, K_SPLIT, K_COMPONENT, K_PATTERN };
 static const char *const kind_names[] = {"root", "split", "component", "pattern"};
 
@@ -19,11 +21,6 @@ typedef struct {
     uint8_t kind;
     uint16_t depth;
 } tnode;
-
-typedef struct {
-    double M[3][3];
-    double t[3];
-} frame;
 
 typedef struct {
     const ag_grammar *g;
@@ -75,19 +72,13 @@ static int32_t add_node(walk *w, int32_t parent, int kind, const ag_box *box)
     return id;
 }
 
-static void frame_apply(const frame *f, const double x[3], double y[3])
-{
-    for (int i = 0; i < 3; i++)
-        y[i] = f->M[i][0] * x[0] + f->M[i][1] * x[1] + f->M[i][2] * x[2] + f->t[i];
-}
-
 /* A local box in world coordinates: frames are quarter turns about z and per-axis scales, so
  * the image of a box is the box of two opposite corners' images. */
-static ag_box world_box(const frame *f, const ag_box *b)
+static ag_box world_box(const ag_gframe *f, const ag_box *b)
 {
     double lo[3], hi[3];
-    frame_apply(f, b->min, lo);
-    frame_apply(f, b->max, hi);
+    ag_gframe_apply(f, b->min, lo);
+    ag_gframe_apply(f, b->max, hi);
     ag_box o;
     for (int a = 0; a < 3; a++) {
         o.min[a] = fmin(lo[a], hi[a]);
@@ -96,45 +87,11 @@ static ag_box world_box(const frame *f, const ag_box *b)
     return o;
 }
 
-/* The frame that maps local box [0, S] turned by k quarter turns onto box B, after F
- * (the mapping of schema/grammar.md, "Applying"). */
-static frame place(const frame *F, const double S[3], int k, const ag_box *B)
-{
-    double Sr[3] = {S[0], S[1], S[2]};
-    if (k & 1) {
-        Sr[0] = S[1];
-        Sr[1] = S[0];
-    }
-    double s[3];
-    for (int a = 0; a < 3; a++) {
-        double bs = B->max[a] - B->min[a];
-        s[a] = Sr[a] > 1e-300 ? bs / Sr[a] : 1.0;
-    }
-    double c = (k & 3) == 0 ? 1 : (k & 3) == 2 ? -1 : 0;
-    double sn = (k & 3) == 1 ? 1 : (k & 3) == 3 ? -1 : 0;
-    double R[3][3] = {{c, -sn, 0}, {sn, c, 0}, {0, 0, 1}};
-    frame L;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            L.M[i][j] = s[i] * R[i][j];
-    double h[3] = {S[0] / 2, S[1] / 2, S[2] / 2};
-    for (int i = 0; i < 3; i++)
-        L.t[i] = 0.5 * (B->min[i] + B->max[i]) -
-                 (L.M[i][0] * h[0] + L.M[i][1] * h[1] + L.M[i][2] * h[2]);
-    frame o;
-    for (int i = 0; i < 3; i++) {
-        for (int j = 0; j < 3; j++)
-            o.M[i][j] = F->M[i][0] * L.M[0][j] + F->M[i][1] * L.M[1][j] + F->M[i][2] * L.M[2][j];
-        o.t[i] = F->M[i][0] * L.t[0] + F->M[i][1] * L.t[1] + F->M[i][2] * L.t[2] + F->t[i];
-    }
-    return o;
-}
-
-static void walk_body(walk *w, const ag_grule *r, const ag_box *p, const frame *F, int32_t pnode,
-                      int depth);
+static void walk_body(walk *w, const ag_grule *r, const ag_box *p, const ag_gframe *F,
+                      int32_t pnode, int depth);
 
 /* A node free to take a rule (or a terminal): a split node that has none yet. */
-static int32_t target_for(walk *w, int32_t node, int want_terminal, const frame *F,
+static int32_t target_for(walk *w, int32_t node, int want_terminal, const ag_gframe *F,
                           const ag_box *B)
 {
     tnode *t = &w->nodes[node];
@@ -146,8 +103,8 @@ static int32_t target_for(walk *w, int32_t node, int want_terminal, const frame 
     return add_node(w, node, want_terminal ? K_COMPONENT : K_SPLIT, &wb);
 }
 
-static void apply_one(walk *w, const ag_gstmt *s, const ag_box *B, const frame *F, int32_t node,
-                      int depth)
+static void apply_one(walk *w, const ag_gstmt *s, const ag_box *B, const ag_gframe *F,
+                      int32_t node, int depth)
 {
     if (w->st)
         return;
@@ -158,7 +115,7 @@ static void apply_one(walk *w, const ag_gstmt *s, const ag_box *B, const frame *
         const ag_grule *r = &w->g->rules[s->callee_ix];
         w->nodes[n].rule = s->callee_ix;
         w->rule_apps[s->callee_ix]++;
-        frame G = place(F, r->size, s->rot, B);
+        ag_gframe G = ag_gframe_place(F, r->size, s->rot, B);
         ag_box lb = {{0, 0, 0}, {r->size[0], r->size[1], r->size[2]}};
         walk_body(w, r, &lb, &G, n, depth + 1);
         return;
@@ -172,8 +129,8 @@ static void apply_one(walk *w, const ag_gstmt *s, const ag_box *B, const frame *
     t->component = (int64_t)w->ncomp++;
 }
 
-static void walk_body(walk *w, const ag_grule *r, const ag_box *p, const frame *F, int32_t pnode,
-                      int depth)
+static void walk_body(walk *w, const ag_grule *r, const ag_box *p, const ag_gframe *F,
+                      int32_t pnode, int depth)
 {
     if (w->st)
         return;
@@ -218,27 +175,12 @@ static void walk_body(walk *w, const ag_grule *r, const ag_box *p, const frame *
         w->nodes[pn].rule = s->callee_ix;
         w->nodes[pn].pattern = s;
         /* cells exactly as ag_grammar_derive places them */
-        double v[3][3] = {{0}};
-        for (int k = 0; k < 3; k++)
-            for (int a = 0; a < 3; a++)
-                v[k][a] = s->subdivide == 2 ? s->vec[k][a] : (k == a ? s->step[a] : 0);
-        double omin[3] = {0, 0, 0}, omax[3] = {0, 0, 0}, wd[3];
-        for (int k = 0; k < 3; k++)
-            for (int a = 0; a < 3; a++) {
-                double e = (double)(s->counts[k] - 1) * v[k][a];
-                omin[a] += e < 0 ? e : 0;
-                omax[a] += e > 0 ? e : 0;
-            }
-        for (int a = 0; a < 3; a++)
-            wd[a] = (B->max[a] - B->min[a]) - (omax[a] - omin[a]);
+        ag_gframe_cells cells;
+        ag_gframe_cells_of(s, B, &cells);
         for (uint32_t k = 0; k < s->counts[2] && !w->st; k++)
             for (uint32_t j = 0; j < s->counts[1] && !w->st; j++)
                 for (uint32_t i2 = 0; i2 < s->counts[0] && !w->st; i2++) {
-                    ag_box c;
-                    for (int a = 0; a < 3; a++) {
-                        c.min[a] = B->min[a] - omin[a] + i2 * v[0][a] + j * v[1][a] + k * v[2][a];
-                        c.max[a] = c.min[a] + wd[a];
-                    }
+                    ag_box c = ag_gframe_cell(&cells, i2, j, k);
                     ag_box wb = world_box(F, &c);
                     int32_t cell = add_node(w, pn, K_SPLIT, &wb);
                     if (cell >= 0)
@@ -410,11 +352,10 @@ ag_status ag_splittree_json_build(const ag_grammar *g, const ag_splittree_json_o
     w.rule_apps = calloc(g->nrules + 1, sizeof *w.rule_apps);
     if (!w.rule_apps)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory building the tree");
-    frame I = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
     ag_box lb = g->axiom.box;
     int32_t root = add_node(&w, -1, K_ROOT, &lb);
     if (root >= 0)
-        walk_body(&w, &g->axiom, &lb, &I, root, 0);
+        walk_body(&w, &g->axiom, &lb, &ag_gframe_identity, root, 0);
     if (!w.st) {
         json_t *j = to_json(&w);
         *json = j ? json_dumps(j, JSON_COMPACT | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(12))

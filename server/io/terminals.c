@@ -42,59 +42,98 @@ static uint64_t fnv1a(const char *s, size_t n)
     return h;
 }
 
-ag_status ag_terminals_write(ag_grammar *g, const char *dir, size_t *bytes, ag_error *err)
+void ag_terminals_set_clear(ag_terminal_set *s)
 {
-    size_t total = 0;
-    char path[4096];
-    snprintf(path, sizeof path, "%s/terminals", dir);
-    if (mkdir(path, 0777) && errno != EEXIST)
-        return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", path, strerror(errno));
-    uint64_t *hashes = malloc((g->nterminals + 1) * sizeof *hashes);
-    if (!hashes)
+    for (size_t i = 0; i < s->n; i++) {
+        free(s->path[i]);
+        free(s->obj[i]);
+    }
+    free(s->path);
+    free(s->obj);
+    free(s->len);
+    memset(s, 0, sizeof *s);
+}
+
+ag_status ag_terminals_collect(ag_grammar *g, ag_terminal_set *s, ag_error *err)
+{
+    size_t cap = g->nterminals + 1;
+    s->path = calloc(cap, sizeof *s->path);
+    s->obj = calloc(cap, sizeof *s->obj);
+    s->len = calloc(cap, sizeof *s->len);
+    if (!s->path || !s->obj || !s->len)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     for (size_t i = 0; i < g->nterminals; i++) {
         ag_gterminal *t = &g->terminals[i];
         char *text;
         size_t len;
         ag_status st = ag_terminals_format(t, &text, &len, err);
-        if (st) {
-            free(hashes);
+        if (st != AG_OK)
             return st;
-        }
-        uint64_t h = fnv1a(text, len);
-        hashes[i] = h;
-        int dup = 0;
-        for (size_t k = 0; k < i; k++)
-            dup |= hashes[k] == h;
-        char rel[64];
-        snprintf(rel, sizeof rel, "terminals/%016llx.obj", (unsigned long long)h);
+        char path[64];
+        snprintf(path, sizeof path, "terminals/%016llx.obj",
+                 (unsigned long long)fnv1a(text, len));
         free(t->path);
-        t->path = strdup(rel);
-        if (!t->path) {
+        if (!(t->path = strdup(path))) {
             free(text);
-            free(hashes);
             return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         }
-        if (!dup) {
-            snprintf(path, sizeof path, "%s/%s", dir, rel);
-            FILE *f = fopen(path, "wb");
-            int ok = f && fwrite(text, 1, len, f) == len;
-            if (f && fclose(f))
-                ok = 0;
-            if (!ok) {
-                free(text);
-                free(hashes);
-                return ag_error_set(err, AG_ERR_IO, 0, "cannot write %s: %s", path,
-                                    strerror(errno));
-            }
-            total += len;
+        size_t k = 0;
+        while (k < s->n && strcmp(s->path[k], path) != 0)
+            k++;
+        if (k < s->n) {
+            free(text);
+            continue;
         }
-        free(text);
+        if (!(s->path[s->n] = strdup(path))) {
+            free(text);
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        }
+        s->obj[s->n] = text;
+        s->len[s->n] = len;
+        s->bytes += len;
+        s->n++;
     }
-    free(hashes);
-    if (bytes)
-        *bytes = total;
     return AG_OK;
+}
+
+ag_status ag_terminals_set_lookup(void *user, const char *path, char **obj, size_t *len,
+                                  ag_error *err)
+{
+    const ag_terminal_set *s = user;
+    for (size_t i = 0; i < s->n; i++) {
+        if (strcmp(s->path[i], path) != 0)
+            continue;
+        if (!(*obj = malloc(s->len[i] + 1)))
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        memcpy(*obj, s->obj[i], s->len[i]);
+        (*obj)[s->len[i]] = '\0';
+        *len = s->len[i];
+        return AG_OK;
+    }
+    return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "no terminal %s", path);
+}
+
+ag_status ag_terminals_write(ag_grammar *g, const char *dir, size_t *bytes, ag_error *err)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/terminals", dir);
+    if (mkdir(path, 0777) && errno != EEXIST)
+        return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", path, strerror(errno));
+    ag_terminal_set set = {0};
+    ag_status st = ag_terminals_collect(g, &set, err);
+    for (size_t i = 0; st == AG_OK && i < set.n; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, set.path[i]);
+        FILE *f = fopen(path, "wb");
+        int ok = f && fwrite(set.obj[i], 1, set.len[i], f) == set.len[i];
+        if (f && fclose(f))
+            ok = 0;
+        if (!ok)
+            st = ag_error_set(err, AG_ERR_IO, 0, "cannot write %s: %s", path, strerror(errno));
+    }
+    if (st == AG_OK && bytes)
+        *bytes = set.bytes;
+    ag_terminals_set_clear(&set);
+    return st;
 }
 
 static int safe_path(const char *p)

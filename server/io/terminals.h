@@ -16,6 +16,25 @@ ag_status ag_terminals_format(const ag_gterminal *t, char **out, size_t *len, ag
  * *bytes (may be NULL) receives the total size of the distinct files. */
 ag_status ag_terminals_write(ag_grammar *g, const char *dir, size_t *bytes, ag_error *err);
 
+/* The terminals as stored without files (e.g. in a database): each distinct OBJ text once,
+ * under the path ag_terminals_write gives its file. */
+typedef struct {
+    size_t n;
+    char **path, **obj;
+    size_t *len;
+    size_t bytes; /* the distinct texts' total size */
+} ag_terminal_set;
+
+/* Formats every terminal of g, sets its path as ag_terminals_write would, and collects the
+ * distinct texts in *s (zeroed by the caller; clear it with ag_terminals_set_clear, also after
+ * a failure). */
+ag_status ag_terminals_collect(ag_grammar *g, ag_terminal_set *s, ag_error *err);
+void ag_terminals_set_clear(ag_terminal_set *s);
+/* A terminal lookup over an ag_terminal_set (user): a malloc'd NUL-terminated copy of the text
+ * stored under path; AG_ERR_NOT_FOUND when there is none. */
+ag_status ag_terminals_set_lookup(void *user, const char *path, char **obj, size_t *len,
+                                  ag_error *err);
+
 /* Sets one terminal's geometry from OBJ text in memory (e.g. a terminal kept in a database). */
 ag_status ag_terminals_load_buffer(ag_gterminal *t, const char *data, size_t len, ag_error *err);
 

@@ -5,49 +5,19 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
-#include "../app/jobqueue.h"
-#include "../app/views.h"
 #include "../core/extrude/style.h"
 #include "../store/extrusions.h"
-#include "../store/jobs.h"
 #include "../store/models.h"
 #include "routes.h"
 #include "upload.h"
-
-static ag_db *db_or_reply(ag_request *r, enum MHD_Result *rc)
-{
-    ag_error err;
-    ag_db *db = ag_app_db(r->cfg->app, &err);
-    if (!db)
-        *rc = ag_reply_problem(r, err.code, &err);
-    return db;
-}
-
-/* ?name=, the form's name part, the file name without extension, else "extrusion". */
-static void upload_name(ag_request *r, char *buf, size_t len)
-{
-    const char *name = ag_request_query(r, "name");
-    if (!name)
-        name = ag_upload_form_name(r->upload);
-    if (name) {
-        snprintf(buf, len, "%s", name);
-        return;
-    }
-    const char *file = ag_upload_filename(r->upload);
-    snprintf(buf, len, "%s", file ? file : "extrusion");
-    char *dot = strrchr(buf, '.');
-    if (dot && dot != buf)
-        *dot = '\0';
-}
 
 /* The query parameters as job params (without the upload), or a problem. */
 static ag_status job_params(ag_request *r, json_t **out, ag_error *err)
 {
     *out = NULL;
     char name[1024];
-    upload_name(r, name, sizeof name);
+    ag_upload_name(r, "extrusion", name, sizeof name);
     ag_status s = ag_models_check_name(name, err);
     if (s != AG_OK)
         return s;
@@ -109,29 +79,7 @@ enum MHD_Result ag_api_extrusions_create(ag_request *r)
         return ag_reply_problem(r, s, &err);
     const char *path = ag_upload_take_path(r->upload);
     json_object_set_new(params, "upload", json_string(path));
-    char *text = json_dumps(params, JSON_COMPACT);
-    json_decref(params);
-    int64_t job = 0;
-    s = text ? ag_jobqueue_submit(r->cfg->app, "extrude", text, &job, &err)
-             : ag_error_set(&err, AG_ERR_NOMEM, 0, "out of memory");
-    free(text);
-    if (s != AG_OK) {
-        unlink(path);
-        return ag_reply_problem(r, s, &err);
-    }
-    enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
-    if (!db)
-        return rc;
-    ag_job_row row;
-    if ((s = ag_jobs_get(db, job, &row, &err)) != AG_OK)
-        return ag_reply_problem(r, s, &err);
-    char location[64];
-    snprintf(location, sizeof location, "/api/v1/jobs/%lld", (long long)job);
-    ag_reply_header(r, MHD_HTTP_HEADER_LOCATION, location);
-    json_t *body = ag_view_job(&row);
-    ag_jobs_row_clear(&row);
-    return ag_reply_json(r, 202, body, NULL);
+    return ag_reply_new_job(r, "extrude", params, path);
 }
 
 typedef struct {
@@ -202,7 +150,7 @@ enum MHD_Result ag_api_model_plan(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     /* The version and the plans are read apart: read again if an edit came in between. */

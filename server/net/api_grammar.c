@@ -2,40 +2,21 @@
  * …/grammar, and mesh.glb with each component's label and split-tree node. */
 #include <errno.h>
 #include <fcntl.h>
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../app/grammar_edit.h"
-#include "../app/jobqueue.h"
 #include "../app/views.h"
 #include "../io/glb.h"
 #include "../io/meshblob.h"
 #include "../io/splittree_json.h"
 #include "../store/grammars.h"
-#include "../store/jobs.h"
 #include "../store/models.h"
 #include "routes.h"
 #include "upload.h"
-
-static ag_db *db_or_reply(ag_request *r, enum MHD_Result *rc)
-{
-    ag_error err;
-    ag_db *db = ag_app_db(r->cfg->app, &err);
-    if (!db)
-        *rc = ag_reply_problem(r, err.code, &err);
-    return db;
-}
-
-static const char *rest_author(ag_request *r)
-{
-    const char *user = ag_request_header(r, "X-Archgram-User");
-    return user && *user ? user : "api";
-}
 
 /* If-Match as a version ("*" = the current one); AG_OK with *version = 0 when absent and
  * not required. */
@@ -69,7 +50,7 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
     ag_error err;
     ag_error_clear(&err);
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     /* an empty body or {} */
@@ -97,31 +78,15 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
     if ((s = if_match(r, 0, current, &base, &err)) != AG_OK)
         return ag_reply_problem(r, s, &err);
     json_t *params = json_pack("{s:I, s:I, s:s}", "model", (json_int_t)r->ids[0], "base",
-                               (json_int_t)current, "author", rest_author(r));
-    char *text = params ? json_dumps(params, JSON_COMPACT) : NULL;
-    json_decref(params);
-    int64_t job = 0;
-    s = text ? ag_jobqueue_submit(r->cfg->app, "proceduralize", text, &job, &err)
-             : ag_error_set(&err, AG_ERR_NOMEM, 0, "out of memory");
-    free(text);
-    if (s != AG_OK)
-        return ag_reply_problem(r, s, &err);
-    ag_job_row jrow;
-    if ((s = ag_jobs_get(db, job, &jrow, &err)) != AG_OK)
-        return ag_reply_problem(r, s, &err);
-    char location[64];
-    snprintf(location, sizeof location, "/api/v1/jobs/%lld", (long long)job);
-    ag_reply_header(r, MHD_HTTP_HEADER_LOCATION, location);
-    json_t *body = ag_view_job(&jrow);
-    ag_jobs_row_clear(&jrow);
-    return ag_reply_json(r, 202, body, NULL);
+                               (json_int_t)current, "author", ag_request_author(r));
+    return ag_reply_new_job(r, "proceduralize", params, NULL);
 }
 
 enum MHD_Result ag_api_model_tree(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     ag_grammar_row g;
@@ -153,7 +118,7 @@ enum MHD_Result ag_api_model_grammar_get(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     ag_grammar_row g;
@@ -207,22 +172,12 @@ static ag_status read_body(ag_request *r, char **text, size_t *len, ag_error *er
     return AG_OK;
 }
 
-/* A client id for a grammar edit: unique within this process and across restarts. */
-static void fresh_cid(char *buf, size_t len)
-{
-    static atomic_ullong counter;
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    snprintf(buf, len, "grammar-%lld%09ld-%llu", (long long)ts.tv_sec, ts.tv_nsec,
-             (unsigned long long)atomic_fetch_add(&counter, 1));
-}
-
 enum MHD_Result ag_api_model_grammar_put(ag_request *r)
 {
     ag_error err;
     ag_error_clear(&err);
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     ag_model_row row;
@@ -238,10 +193,10 @@ enum MHD_Result ag_api_model_grammar_put(ag_request *r)
     if ((s = read_body(r, &text, &len, &err)) != AG_OK)
         return ag_reply_problem(r, s, &err);
     char cid[64];
-    fresh_cid(cid, sizeof cid);
+    ag_request_fresh_cid("grammar", cid, sizeof cid);
     int64_t version;
     long col = 0;
-    s = ag_grammar_edit_apply(r->cfg->app, r->ids[0], base, rest_author(r), cid, text, len,
+    s = ag_grammar_edit_apply(r->cfg->app, r->ids[0], base, ag_request_author(r), cid, text, len,
                               &version, &err, &col);
     free(text);
     if (s == AG_ERR_PARSE) {
@@ -275,27 +230,13 @@ enum MHD_Result ag_api_model_grammar_put(ag_request *r)
     return ag_reply_json(r, 200, body, etag);
 }
 
-static int etag_matches(const char *header, const char *etag)
-{
-    if (!header)
-        return 0;
-    if (strcmp(header, "*") == 0)
-        return 1;
-    size_t n = strlen(etag);
-    for (const char *p = header; (p = strstr(p, etag)); p += n)
-        if ((p == header || p[-1] == ' ' || p[-1] == ',' || p[-1] == '/') &&
-            (p[n] == '\0' || p[n] == ',' || p[n] == ' '))
-            return 1;
-    return 0;
-}
-
 /* mesh.glb: a proceduralized model's components also carry their label and tree node; any
  * other model is served as before. */
 enum MHD_Result ag_api_model_mesh_glb(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     ag_grammar_row g;
@@ -306,7 +247,7 @@ enum MHD_Result ag_api_model_mesh_glb(ag_request *r)
         return ag_reply_problem(r, s, &err);
     char etag[48];
     snprintf(etag, sizeof etag, "\"mesh-%lld\"", (long long)g.mesh_blob);
-    if (etag_matches(ag_request_header(r, MHD_HTTP_HEADER_IF_NONE_MATCH), etag)) {
+    if (ag_request_none_match(r, etag)) {
         ag_grammars_row_clear(&g);
         return ag_reply_empty(r, 304, etag);
     }

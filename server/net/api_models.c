@@ -1,18 +1,13 @@
 /* /api/v1/models: list, upload (as an import job), read, rename, delete, geometry, op log. */
-#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-#include <unistd.h>
 
-#include "../app/jobqueue.h"
 #include "../app/modelops.h"
 #include "../app/views.h"
 #include "../io/glb.h"
 #include "../io/import.h"
 #include "../io/meshblob.h"
-#include "../store/jobs.h"
 #include "../store/models.h"
 #include "../store/ops.h"
 #include "routes.h"
@@ -21,15 +16,6 @@
 #define AG_PAGE_DEFAULT 50
 #define AG_PAGE_MAX 200
 #define AG_OPS_LIST_MAX 10000
-
-static ag_db *db_or_reply(ag_request *r, enum MHD_Result *rc)
-{
-    ag_error err;
-    ag_db *db = ag_app_db(r->cfg->app, &err);
-    if (!db)
-        *rc = ag_reply_problem(r, err.code, &err);
-    return db;
-}
 
 static void version_etag(char *buf, size_t len, int64_t version)
 {
@@ -74,7 +60,7 @@ enum MHD_Result ag_api_models_list(ag_request *r)
                                      &err));
     }
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     ag_model_row *rows;
@@ -102,29 +88,12 @@ enum MHD_Result ag_api_models_list(ag_request *r)
                          NULL);
 }
 
-/* The name for an upload: ?name=, the form's name part, the file name without extension. */
-static void upload_name(ag_request *r, char *buf, size_t len)
-{
-    const char *name = ag_request_query(r, "name");
-    if (!name)
-        name = ag_upload_form_name(r->upload);
-    if (name) {
-        snprintf(buf, len, "%s", name);
-        return;
-    }
-    const char *file = ag_upload_filename(r->upload);
-    snprintf(buf, len, "%s", file ? file : "model");
-    char *dot = strrchr(buf, '.');
-    if (dot && dot != buf)
-        *dot = '\0';
-}
-
 enum MHD_Result ag_api_models_create(ag_request *r)
 {
     ag_error err;
     ag_error_clear(&err);
     char name[1024];
-    upload_name(r, name, sizeof name);
+    ag_upload_name(r, "model", name, sizeof name);
     ag_status s = ag_models_check_name(name, &err);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
@@ -149,29 +118,7 @@ enum MHD_Result ag_api_models_create(ag_request *r)
     const char *path = ag_upload_take_path(r->upload);
     json_t *params = json_pack("{s:s, s:s, s:s?, s:s?, s:s?}", "upload", path, "name", name,
                                "format", format, "up", up, "filename", filename);
-    char *text = params ? json_dumps(params, JSON_COMPACT) : NULL;
-    json_decref(params);
-    int64_t job = 0;
-    s = text ? ag_jobqueue_submit(r->cfg->app, "import", text, &job, &err)
-             : ag_error_set(&err, AG_ERR_NOMEM, 0, "out of memory");
-    free(text);
-    if (s != AG_OK) {
-        unlink(path);
-        return ag_reply_problem(r, s, &err);
-    }
-    enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
-    if (!db)
-        return rc;
-    ag_job_row row;
-    if ((s = ag_jobs_get(db, job, &row, &err)) != AG_OK)
-        return ag_reply_problem(r, s, &err);
-    char location[64];
-    snprintf(location, sizeof location, "/api/v1/jobs/%lld", (long long)job);
-    ag_reply_header(r, MHD_HTTP_HEADER_LOCATION, location);
-    json_t *body = ag_view_job(&row);
-    ag_jobs_row_clear(&row);
-    return ag_reply_json(r, 202, body, NULL);
+    return ag_reply_new_job(r, "import", params, path);
 }
 
 static enum MHD_Result reply_model(ag_request *r, ag_db *db, int64_t id, unsigned status)
@@ -192,7 +139,7 @@ static enum MHD_Result reply_model(ag_request *r, ag_db *db, int64_t id, unsigne
 enum MHD_Result ag_api_model_get(ag_request *r)
 {
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     return db ? reply_model(r, db, r->ids[0], 200) : rc;
 }
 
@@ -217,7 +164,7 @@ static int change_request(ag_request *r, ag_db **db, json_t **body, int64_t *bas
 {
     ag_error err;
     *body = NULL;
-    if (!(*db = db_or_reply(r, rc)))
+    if (!(*db = ag_request_db(r, rc)))
         return 0;
     ag_status s = ag_request_json(r, body, &err);
     if (s == AG_OK && (s = precondition(r, *db, base, &err)) != AG_OK) {
@@ -229,23 +176,6 @@ static int change_request(ag_request *r, ag_db **db, json_t **body, int64_t *bas
         return 0;
     }
     return 1;
-}
-
-static const char *rest_author(ag_request *r)
-{
-    const char *user = ag_request_header(r, "X-Archgram-User");
-    return user && *user ? user : "api";
-}
-
-/* A client id for REST changes that bring none: unique within this process and across
- * restarts (time-based), so the op log's (author, cid) uniqueness holds. */
-static void fresh_cid(char *buf, size_t len)
-{
-    static atomic_ullong counter;
-    struct timespec ts;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    snprintf(buf, len, "rest-%lld%09ld-%llu", (long long)ts.tv_sec, ts.tv_nsec,
-             (unsigned long long)atomic_fetch_add(&counter, 1));
 }
 
 enum MHD_Result ag_api_model_patch(ag_request *r)
@@ -276,10 +206,10 @@ enum MHD_Result ag_api_model_patch(ag_request *r)
     json_t *op = json_pack("{s:s, s:s}", "kind", "rename", "name", name);
     json_decref(body);
     char cid[64];
-    fresh_cid(cid, sizeof cid);
+    ag_request_fresh_cid("rest", cid, sizeof cid);
     int64_t version;
     int dup;
-    s = ag_modelops_apply(r->cfg->app, r->ids[0], base, rest_author(r), cid, op, 0, &version,
+    s = ag_modelops_apply(r->cfg->app, r->ids[0], base, ag_request_author(r), cid, op, 0, &version,
                           &dup, &err);
     json_decref(op);
     if (s != AG_OK)
@@ -291,7 +221,7 @@ enum MHD_Result ag_api_model_delete(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     int64_t version;
@@ -301,26 +231,11 @@ enum MHD_Result ag_api_model_delete(ag_request *r)
     return s == AG_OK ? ag_reply_empty(r, 204, NULL) : ag_reply_problem(r, s, &err);
 }
 
-static int etag_matches(const char *header, const char *etag)
-{
-    if (!header)
-        return 0;
-    if (strcmp(header, "*") == 0)
-        return 1;
-    /* A list of tags, possibly weak ("W/"): compare each one's opaque part. */
-    size_t n = strlen(etag);
-    for (const char *p = header; (p = strstr(p, etag)); p += n)
-        if ((p == header || p[-1] == ' ' || p[-1] == ',' || p[-1] == '/') &&
-            (p[n] == '\0' || p[n] == ',' || p[n] == ' '))
-            return 1;
-    return 0;
-}
-
 enum MHD_Result ag_api_model_mesh(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     ag_model_row row;
@@ -332,7 +247,7 @@ enum MHD_Result ag_api_model_mesh(ag_request *r)
     /* The geometry changes only with a new mesh blob, so its id is a strong validator. */
     char etag[48];
     snprintf(etag, sizeof etag, "\"mesh-%lld\"", (long long)blob_id);
-    if (etag_matches(ag_request_header(r, MHD_HTTP_HEADER_IF_NONE_MATCH), etag))
+    if (ag_request_none_match(r, etag))
         return ag_reply_empty(r, 304, etag);
     void *blob;
     size_t blob_len;
@@ -365,7 +280,7 @@ enum MHD_Result ag_api_model_ops_list(ag_request *r)
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
     enum MHD_Result rc;
-    ag_db *db = db_or_reply(r, &rc);
+    ag_db *db = ag_request_db(r, &rc);
     if (!db)
         return rc;
     ag_model_row row;
@@ -395,12 +310,12 @@ enum MHD_Result ag_api_model_ops_create(ag_request *r)
     char generated[64];
     const char *cid = json_string_value(json_object_get(body, "cid"));
     if (!cid) {
-        fresh_cid(generated, sizeof generated);
+        ag_request_fresh_cid("rest", generated, sizeof generated);
         cid = generated;
     }
     int64_t version;
     int dup;
-    s = ag_modelops_apply(r->cfg->app, r->ids[0], base, rest_author(r), cid,
+    s = ag_modelops_apply(r->cfg->app, r->ids[0], base, ag_request_author(r), cid,
                           json_object_get(body, "op"), 0, &version, &dup, &err);
     json_decref(body);
     if (s != AG_OK)

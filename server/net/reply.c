@@ -1,10 +1,14 @@
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
+#include "../app/jobqueue.h"
 #include "../app/views.h"
+#include "../store/jobs.h"
 #include "request.h"
-
 
 void ag_reply_header(ag_request *r, const char *name, const char *value)
 {
@@ -71,6 +75,85 @@ enum MHD_Result ag_reply_empty(ag_request *r, unsigned status, const char *etag)
 {
     struct MHD_Response *resp = MHD_create_response_from_buffer(0, (void *)"", MHD_RESPMEM_PERSISTENT);
     return queue(r, status, resp, NULL, etag);
+}
+
+enum MHD_Result ag_reply_job(ag_request *r, int64_t job, unsigned status)
+{
+    ag_error err;
+    enum MHD_Result rc;
+    ag_db *db = ag_request_db(r, &rc);
+    if (!db)
+        return rc;
+    ag_job_row row;
+    ag_status s = ag_jobs_get(db, job, &row, &err);
+    if (s != AG_OK)
+        return ag_reply_problem(r, s, &err);
+    if (status == 202) {
+        char location[64];
+        snprintf(location, sizeof location, "/api/v1/jobs/%lld", (long long)job);
+        ag_reply_header(r, MHD_HTTP_HEADER_LOCATION, location);
+    }
+    json_t *body = ag_view_job(&row);
+    ag_jobs_row_clear(&row);
+    return ag_reply_json(r, status, body, NULL);
+}
+
+enum MHD_Result ag_reply_new_job(ag_request *r, const char *kind, json_t *params,
+                                 const char *upload)
+{
+    ag_error err;
+    char *text = params ? json_dumps(params, JSON_COMPACT) : NULL;
+    json_decref(params);
+    int64_t job = 0;
+    ag_status s = text ? ag_jobqueue_submit(r->cfg->app, kind, text, &job, &err)
+                       : ag_error_set(&err, AG_ERR_NOMEM, 0, "out of memory");
+    free(text);
+    if (s != AG_OK) {
+        if (upload)
+            unlink(upload);
+        return ag_reply_problem(r, s, &err);
+    }
+    return ag_reply_job(r, job, 202);
+}
+
+ag_db *ag_request_db(ag_request *r, enum MHD_Result *rc)
+{
+    ag_error err;
+    ag_db *db = ag_app_db(r->cfg->app, &err);
+    if (!db)
+        *rc = ag_reply_problem(r, err.code, &err);
+    return db;
+}
+
+const char *ag_request_author(ag_request *r)
+{
+    const char *user = ag_request_header(r, "X-Archgram-User");
+    return user && *user ? user : "api";
+}
+
+void ag_request_fresh_cid(const char *prefix, char *buf, size_t len)
+{
+    static atomic_ullong counter;
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    snprintf(buf, len, "%s-%lld%09ld-%llu", prefix, (long long)ts.tv_sec, ts.tv_nsec,
+             (unsigned long long)atomic_fetch_add(&counter, 1));
+}
+
+int ag_request_none_match(ag_request *r, const char *etag)
+{
+    const char *header = ag_request_header(r, MHD_HTTP_HEADER_IF_NONE_MATCH);
+    if (!header)
+        return 0;
+    if (strcmp(header, "*") == 0)
+        return 1;
+    /* A list of tags, possibly weak ("W/"): compare each one's opaque part. */
+    size_t n = strlen(etag);
+    for (const char *p = header; (p = strstr(p, etag)); p += n)
+        if ((p == header || p[-1] == ' ' || p[-1] == ',' || p[-1] == '/') &&
+            (p[n] == '\0' || p[n] == ',' || p[n] == ' '))
+            return 1;
+    return 0;
 }
 
 const char *ag_request_query(ag_request *r, const char *name)

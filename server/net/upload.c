@@ -148,6 +148,22 @@ size_t ag_upload_bytes(const ag_upload *u) { return u->bytes; }
 const char *ag_upload_form_name(const ag_upload *u) { return u->name[0] ? u->name : NULL; }
 const char *ag_upload_filename(const ag_upload *u) { return u->filename[0] ? u->filename : NULL; }
 
+void ag_upload_name(ag_request *r, const char *fallback, char *buf, size_t len)
+{
+    const char *name = ag_request_query(r, "name");
+    if (!name)
+        name = ag_upload_form_name(r->upload);
+    if (name) {
+        snprintf(buf, len, "%s", name);
+        return;
+    }
+    const char *file = ag_upload_filename(r->upload);
+    snprintf(buf, len, "%s", file ? file : fallback);
+    char *dot = strrchr(buf, '.');
+    if (dot && dot != buf)
+        *dot = '\0';
+}
+
 const char *ag_upload_take_path(ag_upload *u)
 {
     u->owned = 0;

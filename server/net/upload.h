@@ -21,6 +21,9 @@ size_t ag_upload_bytes(const ag_upload *u);
 /* The form's `name` part / the file part's file name, or NULL. */
 const char *ag_upload_form_name(const ag_upload *u);
 const char *ag_upload_filename(const ag_upload *u);
+/* The name for what r uploads: ?name=, the form's `name` part, the file name without its
+ * extension, else fallback. */
+void ag_upload_name(ag_request *r, const char *fallback, char *buf, size_t len);
 /* The spooled file's path; after this call the file belongs to the caller. */
 const char *ag_upload_take_path(ag_upload *u);
 

@@ -218,32 +218,3 @@ ag_status ag_extrusions_each_building(ag_db *db, int64_t model, unsigned what,
     sqlite3_finalize(st);
     return s;
 }
-
-ag_status ag_extrusions_set_mesh(ag_db *db, int64_t model, const void *mesh, size_t mesh_len,
-                                 const char *stats_json, ag_error *err)
-{
-    sqlite3_stmt *st;
-    ag_status s = prepared(
-        db, &st, "INSERT INTO blobs (media_type, bytes, data) VALUES (?, ?, ?)", err);
-    if (s != AG_OK)
-        return s;
-    sqlite3_bind_text(st, 1, "application/x-archgram-mesh", -1, SQLITE_STATIC);
-    sqlite3_bind_int64(st, 2, (sqlite3_int64)mesh_len);
-    sqlite3_bind_blob64(st, 3, mesh_len ? mesh : "", mesh_len, SQLITE_STATIC);
-    if ((s = ag_db_step_done(db, st, "storing a mesh", err)) != AG_OK)
-        return s;
-    int64_t blob = sqlite3_last_insert_rowid(ag_db_handle(db));
-    if ((s = prepared(db, &st,
-                      "UPDATE models SET mesh_blob = ?, stats = ?, "
-                      "updated_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now') WHERE id = ?",
-                      err)) != AG_OK)
-        return s;
-    sqlite3_bind_int64(st, 1, blob);
-    sqlite3_bind_text(st, 2, stats_json ? stats_json : "{}", -1, SQLITE_STATIC);
-    sqlite3_bind_int64(st, 3, model);
-    if ((s = ag_db_step_done(db, st, "replacing a model's mesh", err)) != AG_OK)
-        return s;
-    if (sqlite3_changes(ag_db_handle(db)) == 0)
-        return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "there is no model %lld", (long long)model);
-    return AG_OK;
-}

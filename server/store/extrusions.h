@@ -62,9 +62,4 @@ ag_status ag_extrusions_each_building(ag_db *db, int64_t model, unsigned what,
                                       ag_status (*fn)(void *user, ag_extrusion_building *b),
                                       void *user, ag_error *err);
 
-/* Replaces the model's mesh by a new stored file (the old one goes, see migration 0002) with
- * its stats JSON. */
-ag_status ag_extrusions_set_mesh(ag_db *db, int64_t model, const void *mesh, size_t mesh_len,
-                                 const char *stats_json, ag_error *err);
-
 #endif

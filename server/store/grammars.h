@@ -37,8 +37,7 @@ typedef struct {
     const char *summary_json; /* NULL = "{}" */
 } ag_grammar_new;
 
-/* Replaces the model's mesh by a new stored file (the old file is removed by a trigger) and
- * its stats JSON; *blob gets the new file's id. */
+/* ag_models_set_mesh, under the name the grammar's users know it by. */
 ag_status ag_grammars_set_mesh(ag_db *db, int64_t model, const void *mesh, size_t mesh_len,
                                const char *stats_json, int64_t *blob, ag_error *err);
 

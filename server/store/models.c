@@ -45,7 +45,7 @@ ag_status ag_models_check_name(const char *name, ag_error *err)
 }
 
 static ag_status insert_blob(ag_db *db, const char *media, const void *data, size_t len,
-                             int64_t *id, ag_error *err)
+                             int64_t *id, const char *doing, ag_error *err)
 {
     sqlite3_stmt *st =
         ag_db_prepare(db, "INSERT INTO blobs (media_type, bytes, data) VALUES (?, ?, ?)", err);
@@ -54,7 +54,7 @@ static ag_status insert_blob(ag_db *db, const char *media, const void *data, siz
     sqlite3_bind_text(st, 1, media ? media : "application/octet-stream", -1, SQLITE_STATIC);
     sqlite3_bind_int64(st, 2, (sqlite3_int64)len);
     sqlite3_bind_blob64(st, 3, len ? data : "", len, SQLITE_STATIC);
-    ag_status done = ag_db_step_done(db, st, "storing a file", err);
+    ag_status done = ag_db_step_done(db, st, doing, err);
     if (done != AG_OK)
         return done;
     *id = sqlite3_last_insert_rowid(ag_db_handle(db));
@@ -67,10 +67,11 @@ ag_status ag_models_insert(ag_db *db, const ag_model_new *m, int64_t *id, ag_err
     if (s != AG_OK)
         return s;
     int64_t mesh_id = 0, source_id = 0;
-    if ((s = insert_blob(db, "application/x-archgram-mesh", m->mesh, m->mesh_len, &mesh_id, err)))
+    if ((s = insert_blob(db, "application/x-archgram-mesh", m->mesh, m->mesh_len, &mesh_id,
+                         "storing a file", err)))
         return s;
     if (m->source && (s = insert_blob(db, m->source_media_type, m->source, m->source_len,
-                                      &source_id, err)))
+                                      &source_id, "storing a file", err)))
         return s;
     sqlite3_stmt *st = ag_db_prepare(
         db,
@@ -247,6 +248,33 @@ ag_status ag_models_set_name(ag_db *db, int64_t id, const char *name, ag_error *
     sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
     sqlite3_bind_int64(st, 2, id);
     return ag_db_step_done(db, st, "renaming a model", err);
+}
+
+ag_status ag_models_set_mesh(ag_db *db, int64_t id, const void *mesh, size_t mesh_len,
+                             const char *stats_json, int64_t *blob, ag_error *err)
+{
+    int64_t b = 0;
+    ag_status s = insert_blob(db, "application/x-archgram-mesh", mesh, mesh_len, &b,
+                              "storing a mesh", err);
+    if (s != AG_OK)
+        return s;
+    if (blob)
+        *blob = b;
+    sqlite3_stmt *st = ag_db_prepare(db,
+                                     "UPDATE models SET mesh_blob = ?, stats = ?, "
+                                     "updated_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now') "
+                                     "WHERE id = ?",
+                                     err);
+    if (!st)
+        return err ? err->code : AG_ERR_DB;
+    sqlite3_bind_int64(st, 1, b);
+    sqlite3_bind_text(st, 2, stats_json ? stats_json : "{}", -1, SQLITE_STATIC);
+    sqlite3_bind_int64(st, 3, id);
+    if ((s = ag_db_step_done(db, st, "replacing a model's mesh", err)) != AG_OK)
+        return s;
+    if (sqlite3_changes(ag_db_handle(db)) == 0)
+        return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "there is no model %lld", (long long)id);
+    return AG_OK;
 }
 
 ag_status ag_models_delete(ag_db *db, int64_t id, int64_t version, ag_error *err)

@@ -48,6 +48,11 @@ size_t ag_models_count(ag_db *db);
 ag_status ag_models_bump_version(ag_db *db, int64_t id, int64_t base, int64_t *new_version,
                                  ag_error *err);
 ag_status ag_models_set_name(ag_db *db, int64_t id, const char *name, ag_error *err);
+/* Replaces the model's mesh by a new stored file (the old file is removed by a trigger, see
+ * migration 0002) and its stats JSON (NULL = "{}"); *blob (may be NULL) gets the new file's id.
+ * AG_ERR_NOT_FOUND when there is no such model. Inside the caller's transaction. */
+ag_status ag_models_set_mesh(ag_db *db, int64_t id, const void *mesh, size_t mesh_len,
+                             const char *stats_json, int64_t *blob, ag_error *err);
 /* Deletes when the version is `version` (AG_ERR_STALE otherwise); its blobs and ops go too. */
 ag_status ag_models_delete(ag_db *db, int64_t id, int64_t version, ag_error *err);
 

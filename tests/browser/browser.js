@@ -1,6 +1,8 @@
 // Debian's chromium driven by playwright-core, with every page's errors collected.
 import { existsSync } from 'node:fs';
+import { after, before } from 'node:test';
 import { chromium } from 'playwright-core';
+import { startDaemon } from './daemon.js';
 
 const CHROMIUM = '/usr/bin/chromium';
 
@@ -39,4 +41,19 @@ export async function openPage(browser, { user, viewport = { width: 1280, height
     if (msg.type() === 'error') page.problems.push(`console.error: ${msg.text()}`);
   });
   return page;
+}
+
+// What a test file's tests share: one archgramd and one chromium, started before the first test
+// and stopped after the last. env.daemon and env.browser are set once the tests run.
+export function daemonAndBrowser() {
+  const env = { daemon: null, browser: null };
+  before(async () => {
+    env.daemon = await startDaemon();
+    env.browser = await launchBrowser();
+  });
+  after(async () => {
+    if (env.browser) await env.browser.close();
+    if (env.daemon) await env.daemon.stop();
+  });
+  return env;
 }

@@ -4,28 +4,17 @@
 import assert from 'node:assert/strict';
 import { readFile, writeFile } from 'node:fs/promises';
 import path from 'node:path';
-import { after, before, test } from 'node:test';
-import { startDaemon, ROOT } from './daemon.js';
-import { launchBrowser, openPage } from './browser.js';
+import { test } from 'node:test';
+import { ROOT } from './daemon.js';
+import { daemonAndBrowser, openPage } from './browser.js';
 import { readCanvas } from './pixels.js';
 
 const FIXTURE = path.join(ROOT, 'tests', 'data', 'web', 'two_boxes.obj');
 const WAIT = { timeout: 20000 };
 
-let daemon;
-let browser;
+const env = daemonAndBrowser();
 
-before(async () => {
-  daemon = await startDaemon();
-  browser = await launchBrowser();
-});
-
-after(async () => {
-  if (browser) await browser.close();
-  if (daemon) await daemon.stop();
-});
-
-const newPage = (opts) => openPage(browser, opts); // contexts close with the browser
+const newPage = (opts) => openPage(env.browser, opts); // contexts close with the browser
 
 function assertNoProblems(...list) {
   for (const page of list) assert.deepEqual(page.problems, [], 'the page reported errors');
@@ -34,7 +23,7 @@ function assertNoProblems(...list) {
 // Imports the fixture over REST and returns the new model id.
 async function importOverRest(name) {
   const body = await readFile(FIXTURE);
-  const res = await fetch(`${daemon.url}api/v1/models?name=${encodeURIComponent(name)}&format=obj`, {
+  const res = await fetch(`${env.daemon.url}api/v1/models?name=${encodeURIComponent(name)}&format=obj`, {
     method: 'POST',
     body,
   });
@@ -44,7 +33,7 @@ async function importOverRest(name) {
   while (!['succeeded', 'failed', 'cancelled'].includes(job.status)) {
     assert.ok(Date.now() < deadline, 'import job did not finish');
     await new Promise((r) => setTimeout(r, 100));
-    job = await (await fetch(`${daemon.url}api/v1/jobs/${job.id}`)).json();
+    job = await (await fetch(`${env.daemon.url}api/v1/jobs/${job.id}`)).json();
   }
   assert.equal(job.status, 'succeeded', JSON.stringify(job.error));
   return job.result.model;
@@ -55,7 +44,7 @@ const versionOf = async (page) => Number((await textOf(page, 'model-version')).r
 
 test('import through the page, draw the model and pick a component', async () => {
   const page = await newPage({ user: 'tester' });
-  await page.goto(daemon.url);
+  await page.goto(env.daemon.url);
   await page.getByTestId('upload-input').setInputFiles(FIXTURE);
 
   await page.locator('[data-testid="job"][data-status="succeeded"]').waitFor(WAIT);
@@ -93,8 +82,8 @@ test('import through the page, draw the model and pick a component', async () =>
 
 test('a failed import is shown to the person', async () => {
   const page = await newPage({ user: 'tester' });
-  await page.goto(daemon.url);
-  const bad = path.join(daemon.dir, 'broken.obj');
+  await page.goto(env.daemon.url);
+  const bad = path.join(env.daemon.dir, 'broken.obj');
   await writeFile(bad, 'v 0 0 0\nv 1 0 0\nf 1 2 9\n');
   await page.getByTestId('upload-input').setInputFiles(bad);
   const banner = page.getByTestId('error');
@@ -109,9 +98,9 @@ test('two people in one model: presence and a live rename', async () => {
   const id = await importOverRest('Shared hall');
   const alice = await newPage({ user: 'alice' });
   const bob = await newPage({ user: 'bob' });
-  await alice.goto(`${daemon.url}#model=${id}`);
+  await alice.goto(`${env.daemon.url}#model=${id}`);
   await alice.getByTestId('model-name').filter({ hasText: 'Shared hall' }).waitFor(WAIT);
-  await bob.goto(`${daemon.url}#model=${id}`);
+  await bob.goto(`${env.daemon.url}#model=${id}`);
   await bob.getByTestId('model-name').filter({ hasText: 'Shared hall' }).waitFor(WAIT);
 
   await bob.getByTestId('peers').filter({ hasText: 'alice' }).waitFor(WAIT);
@@ -140,7 +129,7 @@ test('two people in one model: presence and a live rename', async () => {
   assert.equal(await versionOf(bob), before1 + 2);
 
   // The rename is stored: a fresh read of the model has it.
-  const model = await (await fetch(`${daemon.url}api/v1/models/${id}`)).json();
+  const model = await (await fetch(`${env.daemon.url}api/v1/models/${id}`)).json();
   assert.equal(model.name, 'Hall 7');
   assert.equal(model.version, before1 + 2);
 
@@ -158,18 +147,18 @@ test('two people in one model: presence and a live rename', async () => {
 test('a lost connection is shown, and the page resumes and catches up', async () => {
   const id = await importOverRest('Depot');
   const page = await newPage({ user: 'carol' });
-  await page.goto(`${daemon.url}#model=${id}`);
+  await page.goto(`${env.daemon.url}#model=${id}`);
   await page.getByTestId('model-name').filter({ hasText: 'Depot' }).waitFor(WAIT);
   await page.getByTestId('connection').filter({ hasText: 'live' }).waitFor(WAIT);
   const v0 = await versionOf(page);
 
-  await daemon.stopProcess();
+  await env.daemon.stopProcess();
   const banner = page.getByTestId('error');
   await banner.filter({ hasText: 'connection lost' }).waitFor({ state: 'visible', ...WAIT });
-  await daemon.restart();
+  await env.daemon.restart();
 
   // An edit made over REST while the page is away (or just back) reaches it.
-  const res = await fetch(`${daemon.url}api/v1/models/${id}`, {
+  const res = await fetch(`${env.daemon.url}api/v1/models/${id}`, {
     method: 'PATCH',
     headers: { 'Content-Type': 'application/json', 'If-Match': `"${v0}"`, 'X-Archgram-User': 'dave' },
     body: JSON.stringify({ name: 'Depot East' }),
@@ -185,7 +174,7 @@ test('a lost connection is shown, and the page resumes and catches up', async ()
 });
 
 test('the model list pages: load more fetches the rest', async () => {
-  const listed = async () => (await (await fetch(`${daemon.url}api/v1/models?page_size=200`)).json()).items.length;
+  const listed = async () => (await (await fetch(`${env.daemon.url}api/v1/models?page_size=200`)).json()).items.length;
   // The page shows 50 at a time; make sure there are more than that.
   const have = await listed();
   const names = Array.from({ length: Math.max(0, 53 - have) }, (_, i) => `Block ${i + 1}`);
@@ -194,7 +183,7 @@ test('the model list pages: load more fetches the rest', async () => {
   assert.ok(total > 50);
 
   const page = await newPage({ user: 'erin' });
-  await page.goto(daemon.url);
+  await page.goto(env.daemon.url);
   const items = page.getByTestId('model-item');
   await page.getByTestId('load-more').waitFor({ state: 'visible', ...WAIT });
   assert.equal(await items.count(), 50);

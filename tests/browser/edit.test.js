@@ -6,48 +6,18 @@
 // split-plane tool (more nodes). Then one person joins, copies/pastes and removes windows
 // picked in the view.
 import assert from 'node:assert/strict';
-import { after, before, test } from 'node:test';
-import { startDaemon } from './daemon.js';
-import { launchBrowser, openPage } from './browser.js';
+import { test } from 'node:test';
+import { daemonAndBrowser, openPage } from './browser.js';
+import { facadeObj } from './facade.js';
 import { countChanged, countWhere, hueOf, readCanvas } from './pixels.js';
 
 const WAIT = { timeout: 30000 };
 const COLS = 6;
 const ROWS = 2;
 
-let daemon;
-let browser;
+const env = daemonAndBrowser();
 
-before(async () => {
-  daemon = await startDaemon();
-  browser = await launchBrowser();
-});
-
-after(async () => {
-  if (browser) await browser.close();
-  if (daemon) await daemon.stop();
-});
-
-// A facade (y-up OBJ): a wall slab and a cols × rows grid of identical boxed windows, a group each.
-function facadeObj(cols, rows) {
-  const v = [];
-  const f = [];
-  const box = (name, x0, y0, z0, x1, y1, z1) => {
-    f.push(`g ${name}`);
-    const b = v.length + 1;
-    for (const z of [z0, z1]) for (const y of [y0, y1]) for (const x of [x0, x1]) v.push(`v ${x} ${y} ${z}`);
-    for (const q of [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]) {
-      f.push(`f ${q.map((i) => b + i).join(' ')}`);
-    }
-  };
-  box('wall', 0, 0, 0, 2.5 * cols + 0.5, 3.2 * rows + 0.6, 0.3);
-  for (let j = 0; j < rows; j++) {
-    for (let i = 0; i < cols; i++) box(`window_${j}_${i}`, 1 + 2.5 * i, 1 + 3.2 * j, 0.3, 2.3 + 2.5 * i, 2.86 + 3.2 * j, 0.5);
-  }
-  return `${v.join('\n')}\n${f.join('\n')}\n`;
-}
-
-const api = async (p, init) => fetch(`${daemon.url}api/v1${p}`, init);
+const api = async (p, init) => fetch(`${env.daemon.url}api/v1${p}`, init);
 
 async function waitJob(job) {
   const deadline = Date.now() + 60000;
@@ -113,10 +83,10 @@ test('select, drag a handle live, undo, redo, restore, split — seen by a secon
   const v1 = t0.version;
   const rootBox = t0.nodes.find((n) => n.id === t0.root).box;
 
-  const alice = await openPage(browser, { user: 'alice' });
-  const bob = await openPage(browser, { user: 'bob' });
+  const alice = await openPage(env.browser, { user: 'alice' });
+  const bob = await openPage(env.browser, { user: 'bob' });
   for (const page of [alice, bob]) {
-    await page.goto(`${daemon.url}#model=${id}`);
+    await page.goto(`${env.daemon.url}#model=${id}`);
     await waitMesh(page, v1);
     await waitTree(page, v1);
   }
@@ -244,8 +214,8 @@ async function nodeOnPage(page, id) {
 test('join, copy/paste and remove windows picked in the view', async () => {
   const id = await proceduralizedFacade();
   const t0 = await treeOf(id);
-  const page = await openPage(browser, { user: 'carol' });
-  await page.goto(`${daemon.url}#model=${id}`);
+  const page = await openPage(env.browser, { user: 'carol' });
+  await page.goto(`${env.daemon.url}#model=${id}`);
   await waitMesh(page, t0.version);
   await waitTree(page, t0.version);
   const visible = (t) => t.nodes.filter((n) => typeof n.component === 'number');
@@ -311,3 +281,41 @@ test('join, copy/paste and remove windows picked in the view', async () => {
   assert.equal(visible(t3).length, visible(t2).length - 1, 'remove did not take one visible node away');
   assert.deepEqual(page.problems, [], 'the page reported errors');
 });
+
+test('copy a window in one model and paste it into another (style transfer)', async () => {
+  const a = await proceduralizedFacade();
+  const b = await proceduralizedFacade();
+  const ta = await treeOf(a);
+  const tb0 = await treeOf(b);
+  const page = await openPage(env.browser, { user: 'dan' });
+  await page.goto(`${env.daemon.url}#model=${a}`);
+  await waitMesh(page, ta.version);
+  await waitTree(page, ta.version);
+  const visible = (t) => t.nodes.filter((n) => typeof n.component === 'number');
+  const area = (n) => (n.box[3] - n.box[0]) * (n.box[5] - n.box[2]);
+  const wallOf = (t) => visible(t).reduce((x, y) => (area(y) > area(x) ? y : x));
+  const win = visible(ta).find((n) => n.label !== wallOf(ta).label);
+
+  // Copy a window of A (picked in the view), switch to B in the same page, select B's wall.
+  let at = await nodeOnPage(page, win.id);
+  await page.mouse.click(at.x, at.y);
+  await page.waitForFunction((n) => window.archgram.selection?.node === n, win.id, WAIT);
+  await page.keyboard.press('Control+c');
+  await page.getByTestId('clipboard').filter({ hasText: String(win.id) }).waitFor(WAIT);
+  await page.evaluate((id) => { location.hash = `#model=${id}`; }, b);
+  await waitMesh(page, tb0.version);
+  await waitTree(page, tb0.version);
+  const wall = wallOf(tb0);
+  await page.locator(`[data-testid="tree-node"][data-node="${wall.id}"]`).click();
+  await page.waitForFunction((n) => window.archgram.selection?.node === n, wall.id, WAIT);
+  await page.getByTestId('paste-placement').selectOption('insert');
+  await page.getByTestId('paste-fit').selectOption('fill');
+  await page.getByTestId('paste').click();
+  await waitTree(page, tb0.version + 1);
+  const tb1 = await treeOf(b);
+  assert.ok(visible(tb1).length > visible(tb0).length, `${visible(tb0).length} → ${visible(tb1).length} visible nodes`);
+  // A is untouched
+  assert.equal((await treeOf(a)).version, ta.version);
+  assert.deepEqual(page.problems, [], 'the page reported errors');
+});
+

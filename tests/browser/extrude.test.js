@@ -4,28 +4,17 @@
 // changes), an invalid edit refused and reverted, and the failed footprint in the report.
 import assert from 'node:assert/strict';
 import path from 'node:path';
-import { after, before, test } from 'node:test';
-import { ROOT, startDaemon } from './daemon.js';
-import { launchBrowser, openPage } from './browser.js';
+import { test } from 'node:test';
+import { ROOT } from './daemon.js';
+import { daemonAndBrowser, openPage } from './browser.js';
 import { countChanged, readCanvas } from './pixels.js';
 
 const WAIT = { timeout: 30000 };
 const FIXTURE = path.join(ROOT, 'tests', 'data', 'extrude_web', 'city.geojson');
 
-let daemon;
-let browser;
+const env = daemonAndBrowser();
 
-before(async () => {
-  daemon = await startDaemon();
-  browser = await launchBrowser();
-});
-
-after(async () => {
-  if (browser) await browser.close();
-  if (daemon) await daemon.stop();
-});
-
-const api = async (p, init) => fetch(`${daemon.url}api/v1${p}`, init);
+const api = async (p, init) => fetch(`${env.daemon.url}api/v1${p}`, init);
 const getJson = async (p) => {
   const res = await api(p);
   assert.equal(res.status, 200, `${p}: ${res.status}`);
@@ -69,8 +58,8 @@ async function dragWithPreview(page, from, dx, dy) {
 }
 
 test('a footprint batch in the city view, edited in the plan and profile editors', async () => {
-  const page = await openPage(browser, { user: 'carol' });
-  await page.goto(daemon.url);
+  const page = await openPage(env.browser, { user: 'carol' });
+  await page.goto(env.daemon.url);
 
   // Upload: the extrude job runs and the new model opens.
   await page.getByTestId('extrude-style').selectOption('hip');
@@ -249,8 +238,8 @@ test('a footprint batch in the city view, edited in the plan and profile editors
 });
 
 test('one building from a plan: its anchor, a profile assigned to an edge, a profile op others see', async () => {
-  const alice = await openPage(browser, { user: 'alice' });
-  await alice.goto(daemon.url);
+  const alice = await openPage(env.browser, { user: 'alice' });
+  await alice.goto(env.daemon.url);
   await alice.getByTestId('extrude-input').setInputFiles(path.join(ROOT, 'tests', 'data', 'extrude_web', 'house_plan.json'));
   await alice.locator('[data-testid="job"][data-status="succeeded"]').waitFor(WAIT);
   await alice.waitForFunction(() => /^#model=\d+$/.test(location.hash), null, WAIT);
@@ -265,8 +254,8 @@ test('one building from a plan: its anchor, a profile assigned to an edge, a pro
   assert.equal(await alice.getByTestId('plan-anchor').count(), 1);
   assert.equal(await alice.getByTestId('failed-footprint').count(), 0);
 
-  const bob = await openPage(browser, { user: 'bob' });
-  await bob.goto(`${daemon.url}#model=${id}`);
+  const bob = await openPage(env.browser, { user: 'bob' });
+  await bob.goto(`${env.daemon.url}#model=${id}`);
   await bob.getByTestId('plan-corner').first().waitFor(WAIT);
   await waitMesh(bob, v0);
   await alice.getByTestId('peers').filter({ hasText: 'bob' }).waitFor(WAIT);

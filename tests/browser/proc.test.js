@@ -5,9 +5,9 @@
 import assert from 'node:assert/strict';
 import { writeFile } from 'node:fs/promises';
 import path from 'node:path';
-import { after, before, test } from 'node:test';
-import { startDaemon } from './daemon.js';
-import { launchBrowser, openPage } from './browser.js';
+import { test } from 'node:test';
+import { daemonAndBrowser, openPage } from './browser.js';
+import { facadeObj } from './facade.js';
 import { countChanged, countWhere, hueOf, readCanvas, spotWhere } from './pixels.js';
 
 const WAIT = { timeout: 30000 };
@@ -15,39 +15,9 @@ const STAGES = ['segment', 'label', 'tree', 'rules', 'patterns', 'export', 'veri
 const COLS = 6;
 const ROWS = 4;
 
-let daemon;
-let browser;
+const env = daemonAndBrowser();
 
-before(async () => {
-  daemon = await startDaemon();
-  browser = await launchBrowser();
-});
-
-after(async () => {
-  if (browser) await browser.close();
-  if (daemon) await daemon.stop();
-});
-
-// A facade (y-up OBJ): a wall slab and a cols × rows grid of identical boxed windows, a group each.
-function facadeObj(cols, rows) {
-  const v = [];
-  const f = [];
-  const box = (name, x0, y0, z0, x1, y1, z1) => {
-    f.push(`g ${name}`);
-    const b = v.length + 1;
-    for (const z of [z0, z1]) for (const y of [y0, y1]) for (const x of [x0, x1]) v.push(`v ${x} ${y} ${z}`);
-    for (const q of [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]]) {
-      f.push(`f ${q.map((i) => b + i).join(' ')}`);
-    }
-  };
-  box('wall', 0, 0, 0, 2.5 * cols + 0.5, 3.2 * rows + 0.6, 0.3);
-  for (let j = 0; j < rows; j++) {
-    for (let i = 0; i < cols; i++) box(`window_${j}_${i}`, 1 + 2.5 * i, 1 + 3.2 * j, 0.3, 2.3 + 2.5 * i, 2.86 + 3.2 * j, 0.5);
-  }
-  return `${v.join('\n')}\n${f.join('\n')}\n`;
-}
-
-const api = async (p, init) => fetch(`${daemon.url}api/v1${p}`, init);
+const api = async (p, init) => fetch(`${env.daemon.url}api/v1${p}`, init);
 const textOf = (page, testid) => page.getByTestId(testid).textContent();
 const versionOf = async (page) => Number((await textOf(page, 'model-version')).replace(/\D/g, ''));
 const waitVersion = (page, v) =>
@@ -60,11 +30,11 @@ const selectedNode = (page) => page.evaluate(() => document.querySelector('[data
 const yellow = ([r, g, b]) => r - b > 90 && g - b > 60;
 
 test('proceduralize a facade, explore its split tree and edit its grammar', async () => {
-  const file = path.join(daemon.dir, 'facade.obj');
+  const file = path.join(env.daemon.dir, 'facade.obj');
   await writeFile(file, facadeObj(COLS, ROWS));
 
-  const alice = await openPage(browser, { user: 'alice' });
-  await alice.goto(daemon.url);
+  const alice = await openPage(env.browser, { user: 'alice' });
+  await alice.goto(env.daemon.url);
   await alice.getByTestId('upload-input').setInputFiles(file);
   await alice.locator('[data-testid="job"][data-status="succeeded"]').waitFor(WAIT);
   await alice.waitForFunction(() => /^#model=\d+$/.test(location.hash), null, WAIT);
@@ -73,8 +43,8 @@ test('proceduralize a facade, explore its split tree and edit its grammar', asyn
   const v0 = await versionOf(alice);
 
   // Bob is in the room before anything happens; nothing procedural to show yet.
-  const bob = await openPage(browser, { user: 'bob' });
-  await bob.goto(`${daemon.url}#model=${id}`);
+  const bob = await openPage(env.browser, { user: 'bob' });
+  await bob.goto(`${env.daemon.url}#model=${id}`);
   await bob.getByTestId('peers').filter({ hasText: 'alice' }).waitFor(WAIT);
   await alice.getByTestId('peers').filter({ hasText: 'bob' }).waitFor(WAIT);
   assert.equal(await bob.getByTestId('tree-node').count(), 0);

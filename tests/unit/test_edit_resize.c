@@ -354,6 +354,162 @@ static void test_bad_ops(void **state)
     assert_null(m);
 }
 
+/* A box as one component of its own group. */
+static void add_box(ag_mesh *m, const char *group, const double lo[3], const double hi[3])
+{
+    size_t g, c;
+    assert_int_equal(ag_mesh_add_group(m, group, &g), AG_OK);
+    assert_int_equal(ag_mesh_add_component(m, (int32_t)g, &c), AG_OK);
+    uint32_t v0 = (uint32_t)m->nverts;
+    for (int i = 0; i < 8; i++)
+        assert_int_equal(ag_mesh_add_vertex(m, i & 1 ? hi[0] : lo[0], i & 2 ? hi[1] : lo[1],
+                                            i & 4 ? hi[2] : lo[2]),
+                         AG_OK);
+    static const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (int f = 0; f < 6; f++) {
+        assert_int_equal(ag_mesh_add_triangle(m, v0 + q[f][0], v0 + q[f][1], v0 + q[f][2],
+                                              (uint32_t)c),
+                         AG_OK);
+        assert_int_equal(ag_mesh_add_triangle(m, v0 + q[f][0], v0 + q[f][2], v0 + q[f][3],
+                                              (uint32_t)c),
+                         AG_OK);
+    }
+}
+
+/* An 8 m wall holding n identical 1.2 m windows 2 m apart, proceduralized with patterns of
+ * n + 1 instances or more only: the windows are plain siblings of one rule. *wall gets the
+ * wall's node, win_w the windows' width. */
+static ag_edit_model *plain_siblings(unsigned n, int32_t *wall)
+{
+    ag_mesh *m = ag_mesh_create();
+    assert_non_null(m);
+    add_box(m, "wall", (double[]){0, 0, 0}, (double[]){8, 0.3, 3});
+    for (unsigned i = 0; i < n; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "window%u", i);
+        double x = 0.4 + 2.0 * i;
+        add_box(m, name, (double[]){x, 0, 1}, (double[]){x + 1.2, 0.1, 2});
+    }
+    ag_proceduralize_options opt = {0};
+    opt.patterns.min_instances = n + 1;
+    ag_edit_model *em = NULL;
+    ag_error err = {0};
+    if (ag_edit_model_create(m, &opt, &em, &err))
+        fail_msg("%s", err.text);
+    ag_mesh_free(m);
+    const ag_splittree *t = em->proc->tree;
+    *wall = -1;
+    size_t windows = 0;
+    int32_t rule = -2;
+    for (size_t i = 0; i < t->nnodes; i++) {
+        const ag_tnode *x = &t->nodes[i];
+        assert_true(x->kind != AG_NODE_PATTERN); /* no pattern groups them */
+        if (x->kind != AG_NODE_COMPONENT)
+            continue;
+        if (visible_ancestor(t, (int32_t)i) > 0) {
+            windows++;
+            assert_true(x->rule >= 0 && (rule == -2 || rule == x->rule)); /* one rule */
+            rule = x->rule;
+        } else {
+            *wall = (int32_t)i;
+        }
+    }
+    assert_int_equal(windows, n);
+    assert_true(*wall > 0);
+    return em;
+}
+
+/* The windows of a model (visible nodes nested in another), their x sizes in *w. */
+static size_t nested_widths(const ag_edit_model *m, double *w, size_t cap)
+{
+    const ag_splittree *t = m->proc->tree;
+    size_t n = 0;
+    for (size_t i = 0; i < t->nnodes; i++)
+        if (t->nodes[i].kind == AG_NODE_COMPONENT && visible_ancestor(t, (int32_t)i) > 0) {
+            if (n < cap)
+                w[n] = t->nodes[i].box.max[0] - t->nodes[i].box.min[0];
+            n++;
+        }
+    return n;
+}
+
+static ag_edit_model *squeeze(ag_edit_model *em, int32_t node, double sx, ag_edit_report *rep)
+{
+    ag_edit_op op = {.kind = AG_EDIT_RESIZE, .node = node, .has_scale = 1, .scale = {sx, 1, 1}};
+    ag_edit_model *out = NULL;
+    ag_error err = {0};
+    if (ag_edit_apply(em, &op, &out, rep, &err))
+        fail_msg("apply: %s", err.text);
+    return out;
+}
+
+/* Two same-rule siblings squeezed under the join ratio become one of their summed size; a
+ * milder squeeze keeps both. */
+static void test_squeezed_siblings_join(void **state)
+{
+    (void)state;
+    int32_t wall;
+    ag_edit_model *em = plain_siblings(2, &wall);
+    double w[8];
+    ag_edit_report rep = {0};
+    ag_edit_model *m = squeeze(em, wall, 0.35, &rep);
+    assert_int_equal(nested_widths(m, w, 8), 1);
+    assert_int_equal(rep.joins, 1);
+    assert_true(fabs(w[0] - 2 * 0.35 * 1.2) < 1e-6); /* 0.7 of a window, not 0.35 */
+    const ag_box *nb = &m->proc->tree->nodes[0].box;
+    assert_true(fabs(nb->max[0] - nb->min[0] - 0.35 * 8) < 1e-6);
+    check_grammar(m);
+    ag_edit_report_clear(&rep);
+    ag_edit_model_free(m);
+
+    m = squeeze(em, wall, 0.7, &rep);
+    assert_int_equal(nested_widths(m, w, 8), 2);
+    assert_int_equal(rep.joins, 0);
+    assert_true(fabs(w[0] - 0.7 * 1.2) < 1e-6 && fabs(w[1] - 0.7 * 1.2) < 1e-6);
+    ag_edit_report_clear(&rep);
+    ag_edit_model_free(m);
+    ag_edit_model_free(em);
+}
+
+/* Joining is recursive: four windows squeezed to 0.35 pair up (each pair 0.7 of a window),
+ * squeezed to 0.25 the pairs join again into one window of the original width. */
+static void test_squeezed_siblings_join_recursively(void **state)
+{
+    (void)state;
+    int32_t wall;
+    ag_edit_model *em = plain_siblings(4, &wall);
+    double w[8];
+    ag_edit_report rep = {0};
+    ag_edit_model *m = squeeze(em, wall, 0.35, &rep);
+    assert_int_equal(nested_widths(m, w, 8), 2);
+    assert_int_equal(rep.joins, 2);
+    for (int i = 0; i < 2; i++)
+        assert_true(fabs(w[i] - 0.7 * 1.2) < 1e-6);
+    ag_edit_report_clear(&rep);
+    ag_edit_model_free(m);
+
+    m = squeeze(em, wall, 0.25, &rep);
+    assert_int_equal(nested_widths(m, w, 8), 1);
+    assert_int_equal(rep.joins, 3);
+    assert_true(fabs(w[0] - 1.2) < 1e-6);
+    /* the joined window stays inside the squeezed wall */
+    const ag_splittree *t = m->proc->tree;
+    for (size_t i = 0; i < t->nnodes; i++)
+        if (t->nodes[i].kind == AG_NODE_COMPONENT) {
+            int32_t va = visible_ancestor(t, (int32_t)i);
+            if (va > 0)
+                for (int a = 0; a < 3; a++) {
+                    assert_true(t->nodes[i].box.min[a] >= t->nodes[va].box.min[a] - 1e-9);
+                    assert_true(t->nodes[i].box.max[a] <= t->nodes[va].box.max[a] + 1e-9);
+                }
+        }
+    check_grammar(m);
+    ag_edit_report_clear(&rep);
+    ag_edit_model_free(m);
+    ag_edit_model_free(em);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -366,6 +522,8 @@ int main(void)
         cmocka_unit_test(test_root_scale),
         cmocka_unit_test(test_ids_stable),
         cmocka_unit_test(test_bad_ops),
+        cmocka_unit_test(test_squeezed_siblings_join),
+        cmocka_unit_test(test_squeezed_siblings_join_recursively),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

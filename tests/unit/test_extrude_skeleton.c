@@ -333,7 +333,8 @@ static void test_fixtures(void **state)
                            "segment_priority", "forced_chimney", "forced_dormer",
                            "mesh_anchor", "offset_overhang", "offset_open_ended",
                            "offset_disabled_extended", "grid_terrace_meets_soffit",
-                           "grid_coincident_rays"};
+                           "grid_coincident_rays", "offset_inside_cap", "offset_inside_parapet",
+                           "offset_inside_l", "offset_inside_per_edge"};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
         char path[512];
         snprintf(path, sizeof path, AG_REPO_DIR "/tests/data/extrude/%s.json", names[i]);
@@ -780,8 +781,8 @@ static ag_plan *offset_plan(double outside, int disable_gables, int side, int32_
     ag_plan *p = plan_with(wall, 2, xy, 4);
     ag_plan_add_profile(p, "roof", roof, 2, NULL, NULL, NULL);
     ag_plan_add_profile(p, "end", wall, 2, NULL, NULL, NULL);
-    ag_offset_edge ov[2] = {{0, 1, 1, 0, 0, -1}, {0, 3, 1, 0, 0, -1}};
-    ag_plan_offset o = {3, outside, after, side ? 2 : -1, disable_gables ? 2 : 0, ov};
+    ag_offset_edge ov[2] = {{0, 1, 1, 0, 0, -1, 0, 0, 0, 0, 0}, {0, 3, 1, 0, 0, -1, 0, 0, 0, 0, 0}};
+    ag_plan_offset o = {3, outside, after, side ? 2 : -1, disable_gables ? 2 : 0, ov, 0, 0, 0, -1, -1};
     assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_OK);
     return p;
 }
@@ -834,7 +835,7 @@ static void test_offset_events(void **state)
 
     /* per-edge distance and profile; anchors still find the input edge after the event */
     p = offset_plan(0.5, 1, 0, 1);
-    p->offsets[0].edges[0] = (ag_offset_edge){0, 0, 0, 1, 1.0, 0};
+    p->offsets[0].edges[0] = (ag_offset_edge){0, 0, 0, 1, 1.0, 0, 0, 0, 0, 0, 0};
     p->offsets[0].nedges = 1;
     ag_anchor a;
     memset(&a, 0, sizeof a);
@@ -869,7 +870,7 @@ static void test_offset_events(void **state)
         st.npoints = 4;
         st.profile = 1;
         assert_int_equal(ag_plan_add_step(p, &st, NULL), AG_OK);
-        ag_plan_offset oo = {2, 0.5, -1, -1, 0, NULL};
+        ag_plan_offset oo = {2, 0.5, -1, -1, 0, NULL, 0, 0, 0, -1, -1};
         assert_int_equal(ag_plan_add_offset(p, &oo, NULL), AG_OK);
         sh = extrude(p, &ra);
         assert_int_equal(ra.failing_faces, 0);
@@ -890,7 +891,7 @@ static void test_offset_events(void **state)
     const double xy[] = {0, 0, 10, 0, 10, 6, 0, 6};
     const ag_profile_point ov[] = {{0, 0}, {0, 3}, {-0.5, 3}, {0.5, 4}};
     p = plan_with(ov, 4, xy, 4);
-    ag_plan_offset o = {3, 0.2, -1, -1, 0, NULL};
+    ag_plan_offset o = {3, 0.2, -1, -1, 0, NULL, 0, 0, 0, -1, -1};
     assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_OK);
     ag_mesh *m = ag_mesh_create();
     ag_error err = {0};
@@ -909,6 +910,193 @@ static void test_offset_events(void **state)
     ag_plan_free(p);
 }
 
+/* Newell normal of a face's first loop (area-weighted, not normalised). */
+static void face_normal(const ag_shell *sh, uint32_t f, double n[3])
+{
+    n[0] = n[1] = n[2] = 0;
+    uint32_t l = sh->faces[f].first_loop, b0 = sh->loop_start[l], b1 = sh->loop_start[l + 1];
+    for (uint32_t k = b0; k < b1; k++) {
+        const double *p = &sh->pos[3 * sh->idx[k]], *q = &sh->pos[3 * sh->idx[k + 1 < b1 ? k + 1 : b0]];
+        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    }
+}
+
+static ag_plan *gap_plan(double from, double to, double cap)
+{
+    const double xy[] = {0, 0, 10, 0, 10, 6, 0, 6};
+    const ag_profile_point wall[] = {{0, 0}, {0, 1}};
+    ag_plan *p = plan_with(wall, 2, xy, 4);
+    ag_plan_add_profile(p, "roof", R45, 2, NULL, NULL, NULL);
+    ag_plan_offset o;
+    memset(&o, 0, sizeof o);
+    o.z = 3;
+    o.profile = o.side = -1;
+    o.has_gap = 1;
+    o.gap_from = from;
+    o.gap_to = to;
+    o.inside = 0;
+    o.inner = 1;
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_OK);
+    p->cap_height = cap;
+    return p;
+}
+
+/* §4.6's inside boundary: a gap between an outer ring of walls and an inner shell. */
+static void test_offset_inside(void **state)
+{
+    (void)state;
+    ag_extrude_result r;
+    ag_plan *p = gap_plan(0.5, 1.5, 4);
+    ag_shell *sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.stats.offset_gaps, 1);
+    /* the gap's floor faces up at 3 m: 9 x 5 - 7 x 3, one face tagged with the inside profile */
+    assert_true(fabs(flat_area(sh, 3) - 24) < 1e-9);
+    int floors = 0, hips = 0, walls[4] = {0}, inner_walls[4] = {0};
+    for (uint32_t f = 0; f < sh->nfaces; f++) {
+        const ag_shell_face *fc = &sh->faces[f];
+        if (!(fc->nloops & 0x7fffffffu))
+            continue;
+        if (fc->kind == AG_SHELL_FACE_CAP && fc->profile == 0) {
+            floors++;
+            double n[3];
+            face_normal(sh, f, n);
+            assert_true(n[2] > 0);
+            continue;
+        }
+        if (fc->kind != AG_SHELL_FACE_SIDE)
+            continue;
+        assert_int_equal(fc->loop, 0);
+        assert_true(fc->edge >= 0 && fc->edge < 4);
+        if (fc->profile == 1) {
+            hips++;
+            continue;
+        }
+        walls[fc->edge]++;
+        /* the ring's face towards the gap, 0.5 m in from edge 0, faces the gap (+y) */
+        double n[3];
+        face_normal(sh, f, n);
+        const double *q = &sh->pos[3 * sh->idx[sh->loop_start[fc->first_loop]]];
+        if (fc->edge == 0 && fabs(q[1] - 0.5) < 1e-9) {
+            inner_walls[0]++;
+            assert_true(n[1] > 0 && fabs(n[0]) < 1e-9 && fabs(n[2]) < 1e-9);
+        }
+    }
+    assert_int_equal(floors, 1);
+    assert_int_equal(hips, 4);
+    for (int e = 0; e < 4; e++)
+        assert_int_equal(walls[e], 2); /* the outer wall and the ring's inner face */
+    assert_int_equal(inner_walls[0], 1);
+    /* 180 below, the ring (60 - 45) and the hip over 7 x 3 capped 1 m up: 21 - 10 + 4/3 */
+    assert_true(fabs(r.volume - (180 + 15 + 21 - 10 + 4.0 / 3)) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* a gap wider than half the plan leaves no inner shell: the floor covers the inset */
+    p = gap_plan(0.5, 4, 4);
+    sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_true(fabs(flat_area(sh, 3) - 45) < 1e-9);
+    assert_true(fabs(r.volume - 195) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+    /* ... and one starting beyond it makes no gap at all */
+    p = gap_plan(3.5, 4, 4);
+    sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.stats.offset_gaps, 0);
+    assert_true(fabs(r.volume - 240) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* two gaps, one above the other: a ring inside a ring, then a block */
+    p = gap_plan(0.5, 1, 6);
+    ag_plan_offset o2 = p->offsets[0];
+    o2.z = 4;
+    o2.edges = NULL;
+    o2.inner = -1;
+    assert_int_equal(ag_plan_add_offset(p, &o2, NULL), AG_OK);
+    p->offsets[0].inner = -1;
+    sh = extrude(p, &r);
+    assert_int_equal(r.failing_faces, 0);
+    assert_int_equal(r.stats.offset_gaps, 2);
+    /* the 0.5 m ring is too narrow for the second gap; the 8 x 4 block gets a 7 x 3 ring
+     * and a 6 x 2 block: 180 + 15 * 3 + 32 + (32 - 21) * 2 + 12 * 2 */
+    assert_true(fabs(r.volume - 303) < 1e-9);
+    assert_true(fabs(flat_area(sh, 4) - 9) < 1e-9);
+    ag_shell_free(sh);
+    ag_plan_free(p);
+
+    /* refused: a gap not 0 < from < to, no inside profile, an edge gap without the event's */
+    p = gap_plan(0.5, 1.5, 0);
+    ag_plan_offset o = p->offsets[0];
+    o.z = 5;
+    o.gap_from = 1.5;
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_ERR_INVALID);
+    o.gap_from = 0;
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_ERR_INVALID);
+    o.gap_from = 0.5;
+    o.inside = -1;
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_ERR_INVALID);
+    o.inside = 0;
+    o.has_gap = 0;
+    ag_offset_edge oe;
+    memset(&oe, 0, sizeof oe);
+    oe.profile = -1;
+    oe.has_gap = 1;
+    oe.gap_from = 0.2;
+    oe.gap_to = 0.4;
+    o.edges = &oe;
+    o.nedges = 1;
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_ERR_INVALID);
+    o.has_gap = 1;
+    oe.gap_to = 0.1;
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_ERR_INVALID);
+    oe.gap_to = 0.4;
+    assert_int_equal(ag_plan_add_offset(p, &o, NULL), AG_OK);
+    ag_plan_free(p);
+
+    /* JSON: "inside" needs a gap and knows only its own members */
+    const char *bad[] = {
+        "{\"profiles\": {\"w\": [[0, 0], [0, 1]]}, \"loops\": [[[0, 0], [4, 0], [4, 4], [0, 4]]],"
+        " \"offsets\": [{\"height\": 1, \"inside\": {\"profile\": \"w\"}}]}",
+        "{\"profiles\": {\"w\": [[0, 0], [0, 1]]}, \"loops\": [[[0, 0], [4, 0], [4, 4], [0, 4]]],"
+        " \"offsets\": [{\"height\": 1, \"inside\": {\"gap\": [0.1, 0.2], \"profile\": \"w\","
+        " \"wdith\": 1}}]}",
+        "{\"profiles\": {\"w\": [[0, 0], [0, 1]]}, \"loops\": [[[0, 0], [4, 0], [4, 4], [0, 4]]],"
+        " \"offsets\": [{\"height\": 1, \"inside\": {\"gap\": [0.2, 0.1], \"profile\": \"w\"}}]}",
+        "{\"profiles\": {\"w\": [[0, 0], [0, 1]]}, \"loops\": [[[0, 0], [4, 0], [4, 4], [0, 4]]],"
+        " \"offsets\": [{\"height\": 1, \"inside\": {\"gap\": [0.1, 0.2]}}]}",
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        ag_plan *q = NULL;
+        ag_error err = {0};
+        assert_int_not_equal(ag_plan_json_read_buffer(bad[i], strlen(bad[i]), &q, &err), AG_OK);
+        assert_null(q);
+        assert_non_null(strstr(err.text, "offset"));
+    }
+    const char *good = "{\"profiles\": {\"w\": [[0, 0], [0, 1]], \"r\": [[0, 0], [1, 1]]},"
+                       " \"loops\": [[[0, 0], [4, 0], [4, 4], [0, 4]]],"
+                       " \"offsets\": [{\"height\": 1, \"inside\": {\"gap\": [0.1, 0.2],"
+                       " \"profile\": \"w\", \"inner\": \"r\"}, \"edges\": [{\"edge\": 2,"
+                       " \"inside\": {\"gap\": [0.1, 0.5], \"profile\": \"r\"}}]}]}";
+    ag_plan *q = NULL;
+    assert_int_equal(ag_plan_json_read_buffer(good, strlen(good), &q, NULL), AG_OK);
+    assert_int_equal(q->noffsets, 1);
+    const ag_plan_offset *g = &q->offsets[0];
+    assert_true(g->has_gap && g->gap_from == 0.1 && g->gap_to == 0.2 && g->outside == 0);
+    assert_int_equal(g->inside, 0);
+    assert_int_equal(g->inner, 1);
+    assert_int_equal(g->nedges, 1);
+    assert_true(g->edges[0].has_gap && g->edges[0].gap_to == 0.5);
+    assert_int_equal(g->edges[0].inside, 2); /* 1 + "r" */
+    assert_int_equal(g->edges[0].inner, 0);
+    assert_int_equal(g->edges[0].profile, -1);
+    ag_plan_free(q);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -925,6 +1113,7 @@ int main(void)
         cmocka_unit_test(test_natural_steps),
         cmocka_unit_test(test_forced_steps),
         cmocka_unit_test(test_offset_events),
+        cmocka_unit_test(test_offset_inside),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

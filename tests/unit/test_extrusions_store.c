@@ -135,7 +135,7 @@ static void stores_and_reads_back(void **state)
                                  .mesh_len = 7, .triangles = 4};
     snprintf(fix.status, sizeof fix.status, "ok");
     assert_int_equal(ag_extrusions_put_building(db, &fix, &err), AG_OK);
-    assert_int_equal(ag_extrusions_set_mesh(db, id, "assembled", 9, "{\"triangles\":26}", &err),
+    assert_int_equal(ag_models_set_mesh(db, id, "assembled", 9, "{\"triangles\":26}", NULL, &err),
                      AG_OK);
     assert_int_equal(ag_db_commit(db, &err), AG_OK);
     assert_int_equal(count(db, "SELECT count(*) FROM extrusion_buildings"), 3);
@@ -161,7 +161,7 @@ static void stores_and_reads_back(void **state)
     ag_models_row_clear(&after);
 
     assert_int_equal(ag_db_begin(db, &err), AG_OK);
-    assert_int_equal(ag_extrusions_set_mesh(db, id + 100, "x", 1, NULL, &err), AG_ERR_NOT_FOUND);
+    assert_int_equal(ag_models_set_mesh(db, id + 100, "x", 1, NULL, NULL, &err), AG_ERR_NOT_FOUND);
     ag_db_rollback(db);
     /* a building must belong to an extrusion */
     assert_int_equal(ag_db_begin(db, &err), AG_OK);

@@ -182,8 +182,8 @@ export class EditTools {
     this.render();
   }
 
-  // Pastes into the selected node (of the model the nodes were copied from: the server's paste
-  // op has no field for a source model yet).
+  // Pastes into the selected node. Nodes copied from another model travel as `source_model`
+  // (style transfer); their ids belong to that model's tree at the version they were copied at.
   async paste() {
     const ed = this.editor;
     const clip = this.clipboard;
@@ -196,13 +196,19 @@ export class EditTools {
       placement: this.placementSel.value,
       fit: this.fitSel.value,
     };
+    let sourceVersion = ed.model.version;
     if (clip.model !== ed.model.id) {
-      ed.fail({ title: 'Cannot paste here', detail: `The nodes were copied from “${clip.name}”; pasting across models is not supported by the server yet.` });
-      return;
+      op.source_model = clip.model;
+      try {
+        sourceVersion = (await this.api.getModel(clip.model)).version;
+      } catch (err) {
+        ed.fail(err.problem || { title: 'Cannot paste', detail: `“${clip.name}” cannot be read: ${err.message}` });
+        return;
+      }
     }
-    if (clip.version !== ed.model.version) {
+    if (clip.version !== sourceVersion) {
       // node numbers belong to the tree they were copied from
-      ed.fail({ title: 'Copy again', detail: 'The model changed since the copy; its node numbers no longer apply.' });
+      ed.fail({ title: 'Copy again', detail: `“${clip.name}” changed since the copy; its node numbers no longer apply.` });
       return;
     }
     await this.send(op);

@@ -849,9 +849,153 @@ static ag_box new_box(emitter *E, int32_t c, const amap *g)
     return g ? map_box(g, &E->in->tree->nodes[c].box) : E->boxes[c];
 }
 
+/* A child slot of a node and the group it joins (join_siblings). */
+typedef struct {
+    int32_t slot, end; /* the child and the node its split chain ends in */
+    int32_t leader;    /* index of the group's first member */
+    size_t members;    /* at the leader: how many */
+    int stuck;         /* at the leader: squeezed but no neighbour to join */
+    double w[3];       /* at the leader: the group's new size per axis */
+    ag_box box;        /* at the leader: the group's new box */
+} sibling;
+
+static int spans_meet(const ag_box *a, const ag_box *b, int axis, double eps)
+{
+    return a->min[axis] <= b->max[axis] + eps && b->min[axis] <= a->max[axis] + eps;
+}
+
+/* Plain siblings of one rule (children of n not gathered into a grid pattern) squeezed under
+ * AG_EDIT_JOIN_RATIO on an axis join with their nearest sibling of the same rule and turn
+ * along that axis, recursively, until no group is squeezed or none has a neighbour: the group
+ * becomes one copy of its first member's subtree whose size on that axis is the members' sizes
+ * summed (at most the span they cover), centred on that span, so two windows squeezed to 0.4×
+ * become one of 0.8×. Emits n's children and returns 1 when anything joined, else emits
+ * nothing and returns 0. */
+static int join_siblings(emitter *E, int32_t n, const amap *g, int depth)
+{
+    const ag_splittree *t = E->in->tree;
+    size_t m = 0;
+    for (int32_t c = t->nodes[n].first_child; c >= 0; c = t->nodes[c].next_sibling)
+        m++;
+    /* each round is linear in m: bound the quadratic worst case of huge flat levels */
+    if (m < 2 || m > AG_EDIT_JOIN_SIBLINGS_MAX)
+        return 0;
+    sibling *s = malloc(m * sizeof *s);
+    if (!s) {
+        E->st = ag_error_set(E->err, AG_ERR_NOMEM, 0, "out of memory");
+        return 1;
+    }
+    size_t k = 0;
+    for (int32_t c = t->nodes[n].first_child; c >= 0; c = t->nodes[c].next_sibling, k++) {
+        sibling *x = &s[k];
+        x->slot = c;
+        x->end = ag_splittree_chain_end(t, c);
+        x->leader = (int32_t)k;
+        x->members = 1;
+        x->stuck = 0;
+        if (x->end >= 0 && t->nodes[x->end].kind == AG_NODE_COMPONENT &&
+            t->nodes[x->end].rule >= 0) {
+            x->box = new_box(E, x->end, g);
+            for (int a = 0; a < 3; a++)
+                x->w[a] = x->box.max[a] - x->box.min[a];
+        } else {
+            x->leader = -1; /* takes no part */
+        }
+    }
+    double eps = 1e-9 * (1 + ag_box_diagonal(&t->nodes[0].box));
+    size_t joined = 0;
+    /* every round joins two groups or gives up on one (until a join frees it again) */
+    for (size_t round = 0; round < 4 * m; round++) {
+        /* the most squeezed group that may still join */
+        size_t best = m;
+        int axis = -1;
+        double worst = AG_EDIT_JOIN_RATIO;
+        for (size_t i = 0; i < m; i++) {
+            if (s[i].leader != (int32_t)i || s[i].stuck)
+                continue;
+            const ag_box *ob = &t->nodes[s[i].end].box;
+            for (int a = 0; a < 3; a++) {
+                double ow = ob->max[a] - ob->min[a];
+                if (ow <= 1e-12)
+                    continue;
+                double r = s[i].w[a] / ow;
+                if (r < worst) {
+                    worst = r;
+                    best = i;
+                    axis = a;
+                }
+            }
+        }
+        if (best == m)
+            break;
+        const ag_tnode *bn = &t->nodes[s[best].end];
+        const ag_box *bb = &s[best].box;
+        size_t other = m;
+        double gap = INFINITY;
+        for (size_t j = 0; j < m; j++) {
+            if (j == best || s[j].leader != (int32_t)j)
+                continue;
+            const ag_tnode *jn = &t->nodes[s[j].end];
+            if (jn->rule != bn->rule || jn->rule_rot != bn->rule_rot)
+                continue;
+            const ag_box *jb = &s[j].box;
+            if (!spans_meet(bb, jb, (axis + 1) % 3, eps) ||
+                !spans_meet(bb, jb, (axis + 2) % 3, eps))
+                continue;
+            double d = fmax(0, fmax(jb->min[axis] - bb->max[axis], bb->min[axis] - jb->max[axis]));
+            if (d < gap) {
+                gap = d;
+                other = j;
+            }
+        }
+        if (other == m) {
+            s[best].stuck = 1;
+            continue;
+        }
+        /* the earlier sibling leads: its subtree is the one kept */
+        size_t lead = best < other ? best : other, gone = best < other ? other : best;
+        sibling *L = &s[lead], *G = &s[gone];
+        ag_box u = L->box;
+        for (int a = 0; a < 3; a++) {
+            u.min[a] = fmin(u.min[a], G->box.min[a]);
+            u.max[a] = fmax(u.max[a], G->box.max[a]);
+        }
+        double span = u.max[axis] - u.min[axis];
+        double w = fmin(L->w[axis] + G->w[axis], span), mid = 0.5 * (u.min[axis] + u.max[axis]);
+        u.min[axis] = mid - 0.5 * w;
+        u.max[axis] = mid + 0.5 * w;
+        L->box = u;
+        for (int a = 0; a < 3; a++)
+            L->w[a] = a == axis ? w : u.max[a] - u.min[a];
+        L->members += G->members;
+        L->stuck = 0;
+        for (size_t i = 0; i < m; i++)
+            if (s[i].leader == (int32_t)gone)
+                s[i].leader = (int32_t)lead;
+        joined++;
+    }
+    if (!joined) {
+        free(s);
+        return 0;
+    }
+    E->joins += joined;
+    for (size_t i = 0; i < m && !E->st; i++) {
+        if (s[i].leader < 0 || (s[i].leader == (int32_t)i && s[i].members == 1)) {
+            emit_node(E, s[i].slot, g, depth + 1);
+        } else if (s[i].leader == (int32_t)i) {
+            amap jm = map_between(&t->nodes[s[i].end].box, &s[i].box);
+            emit_node(E, s[i].end, &jm, depth + 1);
+        } /* else joined into an earlier sibling */
+    }
+    free(s);
+    return 1;
+}
+
 static void emit_children(emitter *E, int32_t n, const amap *g, int depth)
 {
     const ag_splittree *t = E->in->tree;
+    if (t->nodes[n].kind != AG_NODE_SPLIT && join_siblings(E, n, g, depth))
+        return;
     for (int32_t c = t->nodes[n].first_child; c >= 0 && !E->st; c = t->nodes[c].next_sibling)
         emit_node(E, c, g, depth + 1);
 }

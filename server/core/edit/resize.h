@@ -15,7 +15,9 @@
  *    one; a node stretched past AG_EDIT_SPLIT_RATIO splits into two copies of its subtree,
  *    and a pattern whose cells pass AG_EDIT_SPLIT_RATIO or fall under AG_EDIT_JOIN_RATIO
  *    doubles or halves its count on that axis, recursively, keeping each cell's share of its
- *    period. Editing the root or an invisible node maps its subtree affinely (no solve). */
+ *    period; plain siblings of one rule (not cells of a grid pattern) squeezed under
+ *    AG_EDIT_JOIN_RATIO join with their nearest same-rule sibling along that axis, recursively.
+ *    Editing the root or an invisible node maps its subtree affinely (no solve). */
 #ifndef AG_EDIT_RESIZE_H
 #define AG_EDIT_RESIZE_H
 
@@ -26,6 +28,9 @@
 /* The counterpart of the split ratio (1 / 1.8): a pattern stretched then squeezed back
  * returns to its count, and a cell squeezed to half its size joins with its neighbour. */
 #define AG_EDIT_JOIN_RATIO (1.0 / 1.8)
+
+/* Squeezed plain siblings join only under nodes with at most this many children. */
+#define AG_EDIT_JOIN_SIBLINGS_MAX 20000
 
 /* Largest result of an emission (a huge stretch splits exponentially): AG_ERR_TOO_LARGE. */
 #define AG_EDIT_MAX_TRIANGLES 20000000

@@ -1,6 +1,7 @@
 #include "skeleton.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -23,6 +24,10 @@ typedef struct {
     int32_t step;    /* 0: from the plan; k + 1: made by plan edit k; -1: an offset's side */
     int32_t clock;   /* profile heights count from: 0 the plan, k + 1 plan edit k, then
                       * nsteps + 1 + k offset event k */
+    /* shell vertices where collinear neighbours merged into this edge at height jz: a
+     * face boundary laid along the whole edge at that height passes through them */
+    double jz;
+    uint32_t jn, jv[6];
 } sk_edge;
 
 typedef struct {
@@ -61,6 +66,10 @@ typedef struct {
     ag_status st;
     ag_error *err;
     ag_skeleton_stats stats;
+    /* while the groups of one batch of intersections are handled: new corners are settled
+     * (merged, zipped) only after all of them, so a collinear merge made at one point
+     * cannot run along the line over another point of the same height before it is met */
+    int defer_settle;
 } sk;
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
@@ -128,6 +137,43 @@ static void seg(sk *S, uint32_t face, uint32_t a, uint32_t b)
 {
     if (ag_shell_add_segment(S->shell, face, a, b) != AG_OK)
         fail(S, AG_ERR_NOMEM);
+}
+
+/* Segment a -> b along edge e at virtual height z, through the vertices where neighbours
+ * merged into e at that height (so both faces there share the same pieces). */
+static void span(sk *S, uint32_t face, const sk_edge *e, uint32_t a, uint32_t b, double z)
+{
+    if (!e->jn || fabs(e->jz - z) > S->d1) {
+        seg(S, face, a, b);
+        return;
+    }
+    const double *P = S->shell->pos;
+    double dx = edx(e), dy = edy(e);
+    double ta = dx * P[3 * a] + dy * P[3 * a + 1], tb = dx * P[3 * b] + dy * P[3 * b + 1];
+    double t[6];
+    uint32_t v[6];
+    size_t n = 0;
+    for (uint32_t i = 0; i < e->jn; i++) {
+        uint32_t j = e->jv[i];
+        double tj = dx * P[3 * j] + dy * P[3 * j + 1];
+        if (j == a || j == b || !((tj - ta) * (tb - tj) > 0))
+            continue;
+        size_t k = n++;
+        /* in order from a to b */
+        while (k > 0 && fabs(t[k - 1] - ta) > fabs(tj - ta)) {
+            t[k] = t[k - 1];
+            v[k] = v[k - 1];
+            k--;
+        }
+        t[k] = tj;
+        v[k] = j;
+    }
+    uint32_t prev = a;
+    for (size_t i = 0; i < n; i++) {
+        seg(S, face, prev, v[i]);
+        prev = v[i];
+    }
+    seg(S, face, prev, b);
 }
 
 static uint32_t new_face(sk *S, const sk_edge *e)
@@ -277,8 +323,14 @@ static void split_event(sk *S, uint32_t k, uint32_t fi)
     cpos(c, z0, &px, &py);
     double dist = f->nx * px + f->ny * py - (f->c + f->s * z0);
     double closing = f->s - (f->nx * c->vx + f->ny * c->vy);
-    if (!(closing > 1e-12) || dist < -S->d2)
+    if (dist < -S->d2 && f->s < 0 && closing < -1e-12) {
+        /* an edge moving outwards (a soffit) meets a part of the plan growing towards it
+         * from outside: parts of a growing plan collide from the outside */
+        dist = -dist;
+        closing = -closing;
+    } else if (!(closing > 1e-12) || dist < -S->d2) {
         return;
+    }
     double dz = dist > 0 ? dist / closing : 0;
     if (dz <= 0 && zero_gap(S, k, fi, z0))
         return;
@@ -335,6 +387,17 @@ static void merge(sk *S, uint32_t k)
     uint32_t vl = c->vert;
     S->stats.merges++;
     c->alive = 0; /* made and retired at the same point: no arc */
+    {
+        sk_edge *w = &S->e[in_wins ? ein : eout], *l = &S->e[in_wins ? eout : ein];
+        if (w->jn && fabs(w->jz - z) > S->d1)
+            w->jn = 0;
+        w->jz = z;
+        if (w->jn < 6)
+            w->jv[w->jn++] = vl;
+        for (uint32_t i = 0; i < l->jn && fabs(l->jz - z) <= S->d1; i++)
+            if (w->jn < 6)
+                w->jv[w->jn++] = l->jv[i];
+    }
     if (in_wins) {
         uint32_t loser = eout, m = S->e[loser].end;
         uint32_t x_out = S->c[m].out;
@@ -793,7 +856,7 @@ static void intersection(sk *S, ag_event *evs, size_t n, scratch *W)
     free(pairs);
     free(keep);
     size_t last_new = S->ntouched;
-    for (size_t i = first_new; i < last_new && S->st == AG_OK; i++)
+    for (size_t i = first_new; i < last_new && S->st == AG_OK && !S->defer_settle; i++)
         settle(S, S->touched[i]);
 }
 
@@ -932,18 +995,18 @@ static void direction(sk *S, ag_event *evs, size_t n)
             /* no move: it waits through the interval, on its new profile if it has one */
             if (off_p[i] >= 0) {
                 uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
-                seg(S, e->face, ve, vs);
+                span(S, e->face, e, ve, vs, z);
                 e->profile = off_p[i];
                 e->seg = 0;
                 e->clock = off_clock;
                 e->face = new_face(S, e);
-                seg(S, e->face, vs, ve);
+                span(S, e->face, e, vs, ve, z);
             }
             e->paused = 1;
             s_new = 0;
         } else if (newface[i] == 3) {
             uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
-            seg(S, e->face, ve, vs);
+            span(S, e->face, e, ve, vs, z);
             if (off_p[i] >= 0) {
                 e->profile = off_p[i];
                 e->seg = 0;
@@ -953,17 +1016,17 @@ static void direction(sk *S, ag_event *evs, size_t n)
             e->paused = 0;
             s_new = -off_w[i];
             e->face = new_face(S, e);
-            seg(S, e->face, vs, ve);
+            span(S, e->face, e, vs, ve, z);
         } else if (newface[i]) {
             uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
-            seg(S, e->face, ve, vs);
+            span(S, e->face, e, ve, vs, z);
             if (newface[i] == 1)
                 e->seg++; /* a grown plan edit keeps its profile's first segment */
             s_new = seg_slope(p, e->seg);
             e->paused = 0;
             e->growing = 0; /* before new_face: the new face is a profile segment's */
             e->face = new_face(S, e);
-            seg(S, e->face, vs, ve);
+            span(S, e->face, e, vs, ve, z);
         } else if (e->paused) {
             s_new = seg_slope(p, e->seg);
             e->paused = 0;
@@ -1079,6 +1142,276 @@ static void insert_sides(sk *S, size_t k)
             settle(S, S->touched[t]);
         S->stats.offset_sides++;
     }
+}
+
+/* --- profile offset events: the inside boundary ------------------------------------------- */
+
+#define GAP_MARK (UINT32_MAX - 3)
+
+/* Edge e's gap in offset event o (metres inwards) and its profiles after the event:
+ * `inside` for the outer shell's face towards the gap, `inner` for the inner shell (-1:
+ * e's own). */
+static void gap_tuple(const ag_plan_offset *o, const sk_edge *e, double *from, double *to,
+                      int32_t *inside, int32_t *inner)
+{
+    *from = o->gap_from;
+    *to = o->gap_to;
+    *inside = o->inside;
+    *inner = o->inner;
+    for (size_t i = 0; i < o->nedges && !e->step; i++) {
+        const ag_offset_edge *x = &o->edges[i];
+        if (x->loop != e->loop || x->edge != e->edge)
+            continue;
+        if (x->has_gap) {
+            *from = x->gap_from;
+            *to = x->gap_to;
+        }
+        if (x->inside)
+            *inside = x->inside - 1;
+        if (x->inner)
+            *inner = x->inner - 1;
+    }
+}
+
+/* One loop of an inset: corners (local plan coordinates) and, per corner i, the active
+ * edge the inset's edge from corner i to i + 1 came from. */
+typedef struct {
+    size_t n, cap, cap_src;
+    double *xy;
+    uint32_t *src;
+    size_t nloops, cap_loops;
+    size_t *start; /* nloops + 1 */
+} inset;
+
+static void inset_free(inset *in)
+{
+    free(in->xy);
+    free(in->src);
+    free(in->start);
+}
+
+/* The active plan at virtual height v inset by each edge's distance (dist[i] for live edge
+ * i), computed as the cross-section at height 1 of a sweep whose edges rise at slope
+ * dist: the same engine keeps the inset's topology (splits, vanishing parts) right. */
+static ag_status inset_plan(sk *S, double v, const double *dist, const uint32_t *slot,
+                            inset *out, char *why, size_t nwhy)
+{
+    memset(out, 0, sizeof *out);
+    ag_plan *P = ag_plan_create();
+    double *xy = malloc(2 * (S->nlive_e + 1) * sizeof *xy);
+    int32_t *pr = malloc((S->nlive_e + 1) * sizeof *pr);
+    uint8_t *seen = calloc(S->nlive_e + 1, 1);
+    ag_shell *sh = NULL;
+    ag_error e2 = {0};
+    ag_status st = P && xy && pr && seen ? AG_OK : AG_ERR_NOMEM;
+    for (size_t i = 0; i < S->nlive_e && st == AG_OK; i++) {
+        char name[24];
+        snprintf(name, sizeof name, "g%zu", i);
+        ag_profile_point pts[2] = {{0, 0}, {dist[i], 1}};
+        st = ag_plan_add_profile(P, name, pts, 2, NULL, NULL, &e2);
+    }
+    for (size_t i = 0; i < S->nlive_e && st == AG_OK; i++) {
+        if (seen[i])
+            continue;
+        size_t n = 0;
+        uint32_t ei = S->live_e[i];
+        for (;;) {
+            const sk_edge *e = &S->e[ei];
+            uint32_t q = slot[ei];
+            if (q != NONE && seen[q])
+                break;
+            if (q == NONE || e->start == NONE || e->end == NONE || n >= S->nlive_e) {
+                st = AG_ERR_INTERNAL;
+                snprintf(why, nwhy, "the active plan does not close into loops");
+                break;
+            }
+            seen[q] = 1;
+            cpos(&S->c[e->start], v, &xy[2 * n], &xy[2 * n + 1]);
+            pr[n++] = (int32_t)q;
+            ei = S->c[e->end].out;
+        }
+        if (st == AG_OK && n >= 3)
+            st = ag_plan_add_loop(P, xy, n, pr, &e2);
+    }
+    double extent = 0;
+    if (st == AG_OK && P->nloops) {
+        P->cap_height = 1;
+        st = ag_plan_validate(P, NULL, &extent, &e2);
+        if (st == AG_OK)
+            st = ag_skeleton_build(P, extent, NULL, &sh, NULL, &e2);
+    }
+    if (st != AG_OK && !why[0])
+        snprintf(why, nwhy, "%.120s", e2.text[0] ? e2.text : "out of memory");
+    /* the cap's loops; each cap edge's twin is the side face of the edge it came from */
+    for (size_t f = 0; sh && st == AG_OK && f < sh->nfaces; f++) {
+        const ag_shell_face *fc = &sh->faces[f];
+        if (fc->kind != AG_SHELL_FACE_CAP)
+            continue;
+        for (uint32_t l = fc->first_loop; l < fc->first_loop + (fc->nloops & 0x7fffffffu); l++) {
+            uint32_t a = sh->loop_start[l], b = sh->loop_start[l + 1];
+            size_t first = out->n;
+            for (uint32_t h = a; h < b && st == AG_OK; h++) {
+                uint32_t t = sh->he_twin[h];
+                if (t == UINT32_MAX || sh->faces[sh->he_face[t]].profile < 0) {
+                    st = AG_ERR_INTERNAL;
+                    snprintf(why, nwhy, "the inset is not closed");
+                    break;
+                }
+                uint32_t src = (uint32_t)sh->faces[sh->he_face[t]].profile;
+                /* a corner between two pieces of one edge's line is no corner */
+                uint32_t hp = h == a ? b - 1 : h - 1, tp = sh->he_twin[hp];
+                if (tp != UINT32_MAX && sh->he_face[tp] == sh->he_face[t])
+                    continue;
+                if (!grow((void **)&out->xy, &out->cap, out->n + 1, 2 * sizeof *out->xy)) {
+                    st = AG_ERR_NOMEM;
+                    break;
+                }
+                if (!grow((void **)&out->src, &out->cap_src, out->n + 1, sizeof *out->src)) {
+                    st = AG_ERR_NOMEM;
+                    break;
+                }
+                out->xy[2 * out->n] = sh->pos[3 * sh->idx[h]];
+                out->xy[2 * out->n + 1] = sh->pos[3 * sh->idx[h] + 1];
+                out->src[out->n++] = src;
+            }
+            if (st != AG_OK)
+                break;
+            if (out->n - first < 3) {
+                out->n = first; /* nothing left of it */
+                continue;
+            }
+            if (!grow((void **)&out->start, &out->cap_loops, out->nloops + 2, sizeof *out->start)) {
+                st = AG_ERR_NOMEM;
+                break;
+            }
+            out->start[out->nloops] = first;
+            out->start[++out->nloops] = out->n;
+        }
+    }
+    if (st == AG_ERR_NOMEM && !why[0])
+        snprintf(why, nwhy, "out of memory");
+    ag_shell_free(sh);
+    ag_plan_free(P);
+    free(xy);
+    free(pr);
+    free(seen);
+    return st;
+}
+
+/* At the end of offset event k's interval (virtual height v): opens the gap. The inset
+ * at gap_from, reversed, becomes the outer shell's inner boundary; the inset at gap_to
+ * the inner shell's boundary; the ring between them gets a floor facing up. Both insets
+ * lie strictly inside the active plan, so nothing is crossed when they are put in. */
+static void insert_gap(sk *S, size_t k, double v)
+{
+    const ag_plan_offset *o = &S->plan->offsets[k];
+    compact_live(S);
+    size_t n = S->nlive_e;
+    if (!n)
+        return;
+    int32_t clock = (int32_t)(S->plan->nsteps + 1 + k);
+    double *d = malloc(2 * n * sizeof *d);
+    int32_t *pin = malloc(2 * n * sizeof *pin);
+    uint32_t *slot = malloc(S->ne * sizeof *slot);
+    inset ins[2];
+    memset(ins, 0, sizeof ins);
+    char why[160] = "";
+    ag_status st = d && pin && slot ? AG_OK : AG_ERR_NOMEM;
+    for (size_t i = 0; st == AG_OK && i < S->ne; i++)
+        slot[i] = NONE;
+    for (size_t i = 0; st == AG_OK && i < n; i++) {
+        slot[S->live_e[i]] = (uint32_t)i;
+        gap_tuple(o, &S->e[S->live_e[i]], &d[i], &d[n + i], &pin[i], &pin[n + i]);
+    }
+    if (st == AG_OK)
+        st = inset_plan(S, v, d, slot, &ins[0], why, sizeof why);
+    if (st == AG_OK)
+        st = inset_plan(S, v, d + n, slot, &ins[1], why, sizeof why);
+    if (st != AG_OK) {
+        ag_error_set(S->err, st == AG_ERR_NOMEM ? AG_ERR_NOMEM : AG_ERR_INVALID, (long)k + 1,
+                     "offset %zu at height %g: the inside boundary could not be made (%s)", k,
+                     o->z, why[0] ? why : "out of memory");
+        fail(S, st == AG_ERR_NOMEM ? AG_ERR_NOMEM : AG_ERR_INVALID);
+        goto out;
+    }
+    if (!ins[0].nloops)
+        goto out; /* the active plan is narrower than the gap's start: no gap */
+    S->stats.offset_gaps++;
+    ag_shell_face ff = {AG_SHELL_FACE_CAP, -1, -1, o->inside, -1, 0, 0};
+    uint32_t floor_face = 0;
+    if (ag_shell_add_face(S->shell, &ff, &floor_face) != AG_OK) {
+        fail(S, AG_ERR_NOMEM);
+        goto out;
+    }
+    size_t first_new = S->ntouched;
+    for (int side = 0; side < 2 && S->st == AG_OK; side++) {
+        const inset *in = &ins[side];
+        for (size_t L = 0; L < in->nloops && S->st == AG_OK; L++) {
+            size_t a = in->start[L], m = in->start[L + 1] - a;
+            uint32_t v0 = (uint32_t)S->shell->nverts, e0 = (uint32_t)S->ne;
+            for (size_t j = 0; j < m; j++)
+                vertex(S, in->xy[2 * (a + j)], in->xy[2 * (a + j) + 1], v);
+            for (size_t j = 0; j < m && S->st == AG_OK; j++) {
+                size_t jn = (j + 1) % m;
+                const double *p = &in->xy[2 * (a + j)], *q = &in->xy[2 * (a + jn)];
+                uint32_t src = S->live_e[in->src[a + j]];
+                uint32_t id = add_edge(S);
+                if (id == NONE)
+                    break;
+                sk_edge *e = &S->e[id];
+                const sk_edge *E = &S->e[src];
+                double len = hypot(q[0] - p[0], q[1] - p[1]);
+                /* the outer shell's boundary runs backwards: its inside is towards the plan's */
+                double sg = side == 0 ? -1 : 1;
+                e->nx = sg * -(q[1] - p[1]) / len;
+                e->ny = sg * (q[0] - p[0]) / len;
+                e->loop = E->loop;
+                e->edge = E->edge;
+                e->step = E->step;
+                int32_t prof = pin[(size_t)side * n + in->src[a + j]];
+                if (prof >= 0) {
+                    e->profile = prof;
+                    e->seg = 0;
+                    e->clock = clock;
+                    e->s = seg_slope(&S->plan->profiles[prof], 0);
+                } else {
+                    e->profile = E->profile;
+                    e->seg = E->seg;
+                    e->clock = E->clock;
+                    e->s = E->s;
+                }
+                e->c = e->nx * p[0] + e->ny * p[1] - e->s * v;
+                e->face = new_face(S, e);
+                uint32_t vp = v0 + (uint32_t)j, vq = v0 + (uint32_t)jn;
+                if (side == 0) {
+                    seg(S, e->face, vq, vp);
+                    seg(S, floor_face, vp, vq);
+                } else {
+                    seg(S, e->face, vp, vq);
+                    seg(S, floor_face, vq, vp);
+                }
+            }
+            if (S->st != AG_OK || S->ne != e0 + m)
+                break;
+            for (size_t j = 0; j < m && S->st == AG_OK; j++) {
+                uint32_t ej = e0 + (uint32_t)j, eprev = e0 + (uint32_t)((j + m - 1) % m);
+                const double *p = &in->xy[2 * (a + j)];
+                if (side == 0)
+                    add_corner(S, ej, eprev, p[0], p[1], v, v0 + (uint32_t)j);
+                else
+                    add_corner(S, eprev, ej, p[0], p[1], v, v0 + (uint32_t)j);
+            }
+        }
+    }
+    size_t last_new = S->ntouched;
+    for (size_t i = first_new; i < last_new && S->st == AG_OK; i++)
+        settle(S, S->touched[i]);
+out:
+    inset_free(&ins[0]);
+    inset_free(&ins[1]);
+    free(d);
+    free(pin);
+    free(slot);
 }
 
 /* --- plan edits (natural steps) ----------------------------------------------------------- */
@@ -1650,8 +1983,8 @@ static void cap(sk *S, double z)
     }
     for (size_t i = 0; i < S->nlive_e; i++) {
         sk_edge *e = &S->e[S->live_e[i]];
-        seg(S, e->face, verts[e->end], verts[e->start]);
-        seg(S, face, verts[e->start], verts[e->end]);
+        span(S, e->face, e, verts[e->end], verts[e->start], z);
+        span(S, face, e, verts[e->start], verts[e->end], z);
         e->alive = 0;
     }
     free(verts);
@@ -1807,10 +2140,24 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         ev.b = (uint32_t)k;
         ev.z = virtual_z(&S, o->z, 0);
         push(&S, &ev);
+        if (o->has_gap) {
+            ev.a = GAP_MARK; /* the gap opens when the interval ends */
+            ev.z += 1;
+            push(&S, &ev);
+        }
         /* the profiles the event hands out count their heights from it */
-        for (size_t e = 0; e <= o->nedges + 1; e++) {
-            int32_t pi = e == o->nedges ? o->profile : e == o->nedges + 1 ? o->side
-                                                                          : o->edges[e].profile;
+        for (size_t e = 0; e < 3 * (o->nedges + 2); e++) {
+            size_t x = e % (o->nedges + 2), which = e / (o->nedges + 2);
+            int32_t pi;
+            if (which == 0)
+                pi = x == o->nedges ? o->profile : x == o->nedges + 1 ? o->side
+                                                                      : o->edges[x].profile;
+            else if (!o->has_gap || x == o->nedges + 1)
+                continue;
+            else if (which == 1)
+                pi = x == o->nedges ? o->inside : o->edges[x].inside - 1;
+            else
+                pi = x == o->nedges ? o->inner : o->edges[x].inner - 1;
             if (pi < 0)
                 continue;
             const ag_profile *pr = &plan->profiles[pi];
@@ -1981,6 +2328,9 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             for (size_t i = 0; i < nb && S.st == AG_OK; i++)
                 if (batch[i].a == FORCED_MARK)
                     forced_step(&S, batch[i].b, batch[i].z);
+            for (size_t i = 0; i < nb && S.st == AG_OK; i++)
+                if (batch[i].a == GAP_MARK)
+                    insert_gap(&S, batch[i].b, batch[i].z);
             schedule_touched(&S);
             continue;
         }
@@ -2026,6 +2376,8 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             gs[i].i = (uint32_t)i;
         }
         qsort(gs, nb, sizeof *gs, cmp_gsort);
+        size_t first_new = S.ntouched;
+        S.defer_settle = 1;
         for (size_t i = 0; i < nb && S.st == AG_OK;) {
             size_t j = i, ng = 0;
             while (j < nb && gs[j].root == gs[i].root)
@@ -2033,6 +2385,10 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             intersection(&S, grp, ng, &W);
             i = j;
         }
+        S.defer_settle = 0;
+        for (size_t i = first_new; i < S.ntouched && S.st == AG_OK; i++)
+            if (S.c[S.touched[i]].alive && !S.c[S.touched[i]].settled)
+                settle(&S, S.touched[i]);
         free(gs);
         free(gz);
         free(grp);

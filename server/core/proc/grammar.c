@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gframe.h"
+
 /* ---- building blocks -------------------------------------------------------------------- */
 
 ag_grammar *ag_grammar_create(void)
@@ -669,11 +671,6 @@ done:
 /* ---- derivation ------------------------------------------------------------------------- */
 
 typedef struct {
-    double M[3][3];
-    double t[3];
-} frame;
-
-typedef struct {
     const ag_grammar *g;
     ag_mesh *out;
     size_t max_tris;
@@ -682,59 +679,15 @@ typedef struct {
     ag_error *err;
 } dctx;
 
-static void frame_apply(const frame *f, const double x[3], double y[3])
-{
-    for (int i = 0; i < 3; i++)
-        y[i] = f->M[i][0] * x[0] + f->M[i][1] * x[1] + f->M[i][2] * x[2] + f->t[i];
-}
+static void derive_body(dctx *d, const ag_grule *r, const ag_box *p, const ag_gframe *F, int depth);
 
-/* Frame mapping the local box [0, S] turned by k onto box B, composed after F. */
-static frame place(const frame *F, const double S[3], int k, const ag_box *B)
-{
-    double Sr[3] = {S[0], S[1], S[2]};
-    if (k & 1) {
-        Sr[0] = S[1];
-        Sr[1] = S[0];
-    }
-    double s[3];
-    for (int a = 0; a < 3; a++) {
-        double bs = B->max[a] - B->min[a];
-        s[a] = Sr[a] > 1e-300 ? bs / Sr[a] : 1.0;
-    }
-    /* rotation matrix of k quarter turns about z */
-    double R[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    double c = (k & 3) == 0 ? 1 : (k & 3) == 2 ? -1 : 0;
-    double sn = (k & 3) == 1 ? 1 : (k & 3) == 3 ? -1 : 0;
-    R[0][0] = c;
-    R[0][1] = -sn;
-    R[1][0] = sn;
-    R[1][1] = c;
-    frame L;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            L.M[i][j] = s[i] * R[i][j];
-    double h[3] = {S[0] / 2, S[1] / 2, S[2] / 2};
-    for (int i = 0; i < 3; i++)
-        L.t[i] = 0.5 * (B->min[i] + B->max[i]) -
-                 (L.M[i][0] * h[0] + L.M[i][1] * h[1] + L.M[i][2] * h[2]);
-    frame o;
-    for (int i = 0; i < 3; i++) {
-        for (int j = 0; j < 3; j++)
-            o.M[i][j] = F->M[i][0] * L.M[0][j] + F->M[i][1] * L.M[1][j] + F->M[i][2] * L.M[2][j];
-        o.t[i] = F->M[i][0] * L.t[0] + F->M[i][1] * L.t[1] + F->M[i][2] * L.t[2] + F->t[i];
-    }
-    return o;
-}
-
-static void derive_body(dctx *d, const ag_grule *r, const ag_box *p, const frame *F, int depth);
-
-static void apply_one(dctx *d, const ag_gstmt *s, const ag_box *B, const frame *F, int depth)
+static void apply_one(dctx *d, const ag_gstmt *s, const ag_box *B, const ag_gframe *F, int depth)
 {
     if (d->st)
         return;
     if (s->callee_is_rule) {
         const ag_grule *r = &d->g->rules[s->callee_ix];
-        frame G = place(F, r->size, s->rot, B);
+        ag_gframe G = ag_gframe_place(F, r->size, s->rot, B);
         ag_box lb = {{0, 0, 0}, {r->size[0], r->size[1], r->size[2]}};
         derive_body(d, r, &lb, &G, depth + 1);
         return;
@@ -750,14 +703,14 @@ static void apply_one(dctx *d, const ag_gstmt *s, const ag_box *B, const frame *
                              "the derivation exceeds %zu triangles", d->max_tris);
         return;
     }
-    frame G = place(F, T->size, s->rot, B);
+    ag_gframe G = ag_gframe_place(F, T->size, s->rot, B);
     ag_mesh *m = d->out;
     size_t base = m->nverts, comp;
     if ((d->st = ag_mesh_add_component(m, d->tgroup[s->callee_ix], &comp)))
         return;
     for (size_t v = 0; v < T->nverts; v++) {
         double y[3];
-        frame_apply(&G, T->pos + 3 * v, y);
+        ag_gframe_apply(&G, T->pos + 3 * v, y);
         if ((d->st = ag_mesh_add_vertex(m, y[0], y[1], y[2])))
             return;
     }
@@ -774,7 +727,7 @@ static void apply_one(dctx *d, const ag_gstmt *s, const ag_box *B, const frame *
     }
 }
 
-static void derive_body(dctx *d, const ag_grule *r, const ag_box *p, const frame *F, int depth)
+static void derive_body(dctx *d, const ag_grule *r, const ag_box *p, const ag_gframe *F, int depth)
 {
     if (d->st)
         return;
@@ -801,28 +754,12 @@ static void derive_body(dctx *d, const ag_grule *r, const ag_box *p, const frame
             apply_one(d, s, B, F, depth);
             continue;
         }
-        /* cells at offsets i v0 + j v1 + k v2 (axis-aligned vectors for subdivide) */
-        double v[3][3] = {{0}};
-        for (int k = 0; k < 3; k++)
-            for (int a = 0; a < 3; a++)
-                v[k][a] = s->subdivide == 2 ? s->vec[k][a] : (k == a ? s->step[a] : 0);
-        double omin[3] = {0, 0, 0}, omax[3] = {0, 0, 0}, w[3];
-        for (int k = 0; k < 3; k++)
-            for (int a = 0; a < 3; a++) {
-                double e = (double)(s->counts[k] - 1) * v[k][a];
-                omin[a] += e < 0 ? e : 0;
-                omax[a] += e > 0 ? e : 0;
-            }
-        for (int a = 0; a < 3; a++)
-            w[a] = (B->max[a] - B->min[a]) - (omax[a] - omin[a]);
+        ag_gframe_cells cells;
+        ag_gframe_cells_of(s, B, &cells);
         for (uint32_t k = 0; k < s->counts[2] && !d->st; k++)
             for (uint32_t j = 0; j < s->counts[1] && !d->st; j++)
                 for (uint32_t i2 = 0; i2 < s->counts[0] && !d->st; i2++) {
-                    ag_box c;
-                    for (int a = 0; a < 3; a++) {
-                        c.min[a] = B->min[a] - omin[a] + i2 * v[0][a] + j * v[1][a] + k * v[2][a];
-                        c.max[a] = c.min[a] + w[a];
-                    }
+                    ag_box c = ag_gframe_cell(&cells, i2, j, k);
                     apply_one(d, s, &c, F, depth);
                 }
     }
@@ -854,9 +791,8 @@ ag_status ag_grammar_derive(const ag_grammar *g, const ag_grammar_derive_options
             d.st = ag_mesh_add_group(d.out, gn, &k);
         d.tgroup[i] = (int32_t)k;
     }
-    frame I = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
     if (!d.st)
-        derive_body(&d, &g->axiom, &g->axiom.box, &I, 0);
+        derive_body(&d, &g->axiom, &g->axiom.box, &ag_gframe_identity, 0);
     free(d.tgroup);
     if (d.st) {
         ag_mesh_free(d.out);
