@@ -189,6 +189,60 @@ static void generated_batch(size_t count)
     ag_mesh_free(m);
 }
 
+/* Offset events with an inside boundary (a parapet ring around a hip roof) on generated
+ * footprints: walls to h + 1 then 45 deg in; at h a gap opens between 0.2..0.6 m and
+ * 0.5..2.6 m inside, the ring's inner face rises 1 m then leans out (a ridged parapet),
+ * the inner shell is a 45 deg hip. */
+static void inside_batch(size_t count)
+{
+    size_t failed = 0, leaky = 0, tris = 0, gaps = 0;
+    double xy[128];
+    double t0 = now();
+    for (size_t i = 0; i < count; i++) {
+        size_t n = gen_shape(xy, 0, 0);
+        double h = 3 + rnd() * 6;
+        ag_plan *p = ag_plan_create();
+        ag_profile_point wall[] = {{0, 0}, {0, h + 1}, {1, h + 2}};
+        ag_profile_point in[] = {{0, 0}, {0, 1}, {1, 2}}, roof[] = {{0, 0}, {1, 1}};
+        ag_plan_add_profile(p, "wall", wall, 3, NULL, NULL, NULL);
+        ag_plan_add_profile(p, "parapet", in, 3, NULL, NULL, NULL);
+        ag_plan_add_profile(p, "roof", roof, 2, NULL, NULL, NULL);
+        ag_plan_add_loop(p, xy, n, NULL, NULL);
+        ag_plan_offset o;
+        memset(&o, 0, sizeof o);
+        o.z = h;
+        o.profile = o.side = -1;
+        o.has_gap = 1;
+        o.gap_from = 0.2 + rnd() * 0.4;
+        o.gap_to = o.gap_from + 0.3 + rnd() * 2;
+        o.inside = 1;
+        o.inner = 2;
+        ag_plan_add_offset(p, &o, NULL);
+        ag_mesh *m = ag_mesh_create();
+        ag_error err = {0};
+        ag_extrude_result r;
+        ag_status st = ag_extrude_plan(p, m, -1, &r, NULL, &err);
+        if (st != AG_OK) {
+            failed++;
+            printf("    failed inside%zu: %s\n", i, err.text);
+        } else {
+            tris += r.triangles;
+            gaps += r.stats.offset_gaps;
+            if (r.failing_faces) {
+                leaky++;
+                printf("    not watertight inside%zu: face %d: %s\n", i, (int)r.problems[0].face,
+                       r.problems[0].reason);
+            }
+        }
+        ag_mesh_free(m);
+        ag_plan_free(p);
+    }
+    double dt = now() - t0;
+    printf("  %-22s %5zu footprints  %.3f s  failed %zu  not watertight %zu  gaps %zu  "
+           "triangles %zu\n",
+           "inside boundaries", count, dt, failed, leaky, gaps, tris);
+}
+
 static void big_polygon(size_t n, const char *prof_kind)
 {
     double *xy = malloc(2 * n * sizeof *xy);
@@ -445,6 +499,7 @@ int main(void)
     big_polygon(1000, "mixed");
     big_polygon(2000, "hip");
     big_polygon(2000, "mixed");
+    inside_batch(2000);
     printf("  peak RSS %ld MB\n", peak_kb() / 1024);
     return 0;
 }

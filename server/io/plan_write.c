@@ -295,6 +295,22 @@ static void put_opt_profile(writer *w, const ag_plan *p, json_t *o, const char *
         fail(w, AG_ERR_INVALID, 0, "plan: %s names no profile (%d)", what, (int)k);
 }
 
+/* "inside": {"gap": [from, to], "profile", "inner"} of an event or an edge (-1: unset) */
+static void put_inside(writer *w, const ag_plan *p, json_t *o, int has_gap, double from,
+                       double to, int32_t inside, int32_t inner, const char *what)
+{
+    json_t *in = container(w, json_object());
+    set(w, o, "inside", in);
+    if (has_gap) {
+        json_t *gap = container(w, json_array());
+        set(w, in, "gap", gap);
+        append(w, gap, num(w, from, what));
+        append(w, gap, num(w, to, what));
+    }
+    put_opt_profile(w, p, in, "profile", inside, what);
+    put_opt_profile(w, p, in, "inner", inner, what);
+}
+
 static void put_offsets(writer *w, const ag_plan *p, json_t *root)
 {
     if (!p->noffsets || w->st != AG_OK)
@@ -311,6 +327,8 @@ static void put_offsets(writer *w, const ag_plan *p, json_t *root)
         set(w, o, "outside", num(w, of->outside, what));
         put_opt_profile(w, p, o, "profile", of->profile, what);
         put_opt_profile(w, p, o, "side", of->side, what);
+        if (of->has_gap)
+            put_inside(w, p, o, 1, of->gap_from, of->gap_to, of->inside, of->inner, what);
         if (!of->nedges)
             continue;
         json_t *edges = container(w, json_array());
@@ -327,6 +345,10 @@ static void put_offsets(writer *w, const ag_plan *p, json_t *root)
             if (e->has_outside)
                 set(w, eo, "outside", num(w, e->outside, what));
             put_opt_profile(w, p, eo, "profile", e->profile, what);
+            /* an edge's inside profiles are stored as 1 + index, 0 meaning the event's */
+            if (e->has_gap || e->inside || e->inner)
+                put_inside(w, p, eo, e->has_gap, e->gap_from, e->gap_to, e->inside - 1,
+                           e->inner - 1, what);
         }
     }
 }

@@ -334,7 +334,9 @@ static void test_fixtures(void **state)
                            "mesh_anchor", "offset_overhang", "offset_open_ended",
                            "offset_disabled_extended", "grid_terrace_meets_soffit",
                            "grid_coincident_rays", "offset_inside_cap", "offset_inside_parapet",
-                           "offset_inside_l", "offset_inside_per_edge"};
+                           "offset_inside_l", "offset_inside_per_edge",
+                           "grid_merge_before_meeting", "grid_merge_before_meeting2",
+                           "grid_soffits_meet_from_outside"};
     for (size_t i = 0; i < sizeof names / sizeof *names; i++) {
         char path[512];
         snprintf(path, sizeof path, AG_REPO_DIR "/tests/data/extrude/%s.json", names[i]);

@@ -121,6 +121,9 @@ static int plan_diff(const ag_plan *a, const ag_plan *b, char *why, size_t nwhy)
         const ag_plan_offset *x = &a->offsets[i], *y = &b->offsets[i];
         DIFF(x->z != y->z || x->outside != y->outside, "offset %zu: height/outside", i);
         DIFF(x->profile != y->profile || x->side != y->side, "offset %zu: profile/side", i);
+        DIFF(x->has_gap != y->has_gap || x->gap_from != y->gap_from || x->gap_to != y->gap_to ||
+                 x->inside != y->inside || x->inner != y->inner,
+             "offset %zu: inside", i);
         DIFF(x->nedges != y->nedges, "offset %zu: nedges", i);
         for (size_t k = 0; k < x->nedges; k++) {
             const ag_offset_edge *e = &x->edges[k], *f = &y->edges[k];
@@ -130,6 +133,9 @@ static int plan_diff(const ag_plan *a, const ag_plan *b, char *why, size_t nwhy)
             DIFF(e->has_outside != f->has_outside || e->outside != f->outside,
                  "offset %zu edge %zu: outside", i, k);
             DIFF(e->profile != f->profile, "offset %zu edge %zu: profile", i, k);
+            DIFF(e->has_gap != f->has_gap || e->gap_from != f->gap_from ||
+                     e->gap_to != f->gap_to || e->inside != f->inside || e->inner != f->inner,
+                 "offset %zu edge %zu: inside", i, k);
         }
     }
     return 0;
@@ -277,9 +283,11 @@ static const char *const full_doc =
     "            {\"name\": \"annex\", \"height\": 2, \"profile\": \"wall\","
     "             \"points\": [[12,0],[14,0],[14,2]]}],"
     " \"offsets\": [{\"height\": 3, \"outside\": 0.5, \"profile\": \"steep\", \"side\": \"wall\","
+    "               \"inside\": {\"gap\": [0.5, 1.5], \"profile\": \"wall\", \"inner\": \"steep\"},"
     "               \"edges\": [{\"edge\": 1, \"disabled\": true},"
     "                         {\"loop\": 1, \"edge\": 3, \"outside\": -0.25, \"profile\": \"wall\"},"
-    "                         {\"edge\": 0, \"outside\": 0.8}]},"
+    "                         {\"edge\": 0, \"outside\": 0.8,"
+    "                          \"inside\": {\"gap\": [0.25, 1], \"profile\": \"roof\"}}]},"
     "              {\"height\": 5, \"outside\": -1}],"
     " \"cap_height\": 12.5, \"priority\": \"min_volume\"}";
 
@@ -302,6 +310,8 @@ static void test_every_member_roundtrips(void **state)
     assert_int_equal(p->offsets[0].nedges, 3);
     assert_true(p->offsets[0].edges[1].has_outside && p->offsets[0].edges[1].loop == 1);
     assert_int_equal(p->offsets[1].profile, -1);
+    assert_true(p->offsets[0].has_gap && p->offsets[0].inner >= 0);
+    assert_true(p->offsets[0].edges[2].has_gap && p->offsets[0].edges[2].inside > 0);
     ag_plan_write_options opt = {.mesh_files = full_meshes};
     check_roundtrip(p, &opt, "full document");
 
@@ -355,6 +365,10 @@ static void test_comparison_sees_each_member(void **state)
     MUTATE(b->offsets[0].edges[0].disabled = 0);
     MUTATE(b->offsets[0].edges[1].has_outside = 0);
     MUTATE(b->offsets[0].edges[1].profile = -1);
+    MUTATE(b->offsets[0].gap_to = 2);
+    MUTATE(b->offsets[0].inner = -1);
+    MUTATE(b->offsets[0].edges[2].has_gap = 0);
+    MUTATE(b->offsets[0].edges[2].inside = 0);
     MUTATE(b->cap_height = 0);
     MUTATE(b->priority = AG_PRIORITY_MAX_VOLUME);
 #undef MUTATE

@@ -24,10 +24,6 @@ typedef struct {
     int32_t step;    /* 0: from the plan; k + 1: made by plan edit k; -1: an offset's side */
     int32_t clock;   /* profile heights count from: 0 the plan, k + 1 plan edit k, then
                       * nsteps + 1 + k offset event k */
-    /* shell vertices where collinear neighbours merged into this edge at height jz: a
-     * face boundary laid along the whole edge at that height passes through them */
-    double jz;
-    uint32_t jn, jv[6];
 } sk_edge;
 
 typedef struct {
@@ -137,43 +133,6 @@ static void seg(sk *S, uint32_t face, uint32_t a, uint32_t b)
 {
     if (ag_shell_add_segment(S->shell, face, a, b) != AG_OK)
         fail(S, AG_ERR_NOMEM);
-}
-
-/* Segment a -> b along edge e at virtual height z, through the vertices where neighbours
- * merged into e at that height (so both faces there share the same pieces). */
-static void span(sk *S, uint32_t face, const sk_edge *e, uint32_t a, uint32_t b, double z)
-{
-    if (!e->jn || fabs(e->jz - z) > S->d1) {
-        seg(S, face, a, b);
-        return;
-    }
-    const double *P = S->shell->pos;
-    double dx = edx(e), dy = edy(e);
-    double ta = dx * P[3 * a] + dy * P[3 * a + 1], tb = dx * P[3 * b] + dy * P[3 * b + 1];
-    double t[6];
-    uint32_t v[6];
-    size_t n = 0;
-    for (uint32_t i = 0; i < e->jn; i++) {
-        uint32_t j = e->jv[i];
-        double tj = dx * P[3 * j] + dy * P[3 * j + 1];
-        if (j == a || j == b || !((tj - ta) * (tb - tj) > 0))
-            continue;
-        size_t k = n++;
-        /* in order from a to b */
-        while (k > 0 && fabs(t[k - 1] - ta) > fabs(tj - ta)) {
-            t[k] = t[k - 1];
-            v[k] = v[k - 1];
-            k--;
-        }
-        t[k] = tj;
-        v[k] = j;
-    }
-    uint32_t prev = a;
-    for (size_t i = 0; i < n; i++) {
-        seg(S, face, prev, v[i]);
-        prev = v[i];
-    }
-    seg(S, face, prev, b);
 }
 
 static uint32_t new_face(sk *S, const sk_edge *e)
@@ -387,17 +346,6 @@ static void merge(sk *S, uint32_t k)
     uint32_t vl = c->vert;
     S->stats.merges++;
     c->alive = 0; /* made and retired at the same point: no arc */
-    {
-        sk_edge *w = &S->e[in_wins ? ein : eout], *l = &S->e[in_wins ? eout : ein];
-        if (w->jn && fabs(w->jz - z) > S->d1)
-            w->jn = 0;
-        w->jz = z;
-        if (w->jn < 6)
-            w->jv[w->jn++] = vl;
-        for (uint32_t i = 0; i < l->jn && fabs(l->jz - z) <= S->d1; i++)
-            if (w->jn < 6)
-                w->jv[w->jn++] = l->jv[i];
-    }
     if (in_wins) {
         uint32_t loser = eout, m = S->e[loser].end;
         uint32_t x_out = S->c[m].out;
@@ -627,6 +575,54 @@ static int near_l(sk *S, uint32_t k, double z, double lx, double ly, double spre
     return hypot(x - lx, y - ly) <= tol;
 }
 
+/* The point nearest (least squares) to the planes of the edges meeting at an event, near
+ * the events' mean (lx, ly, z): events of one cluster computed from fast corners can be
+ * tens of micrometres apart, and their mean is then off the faces' planes. Kept only when
+ * it moves less than the cluster's drift allowance. */
+static void apex(const sk *S, const uint32_t *es, size_t n, double spread, double *lx,
+                 double *ly, double *z)
+{
+    if (n < 3)
+        return;
+    double A[3][3] = {{0}}, b[3] = {0};
+    const double lam = 1e-6; /* pulls the free directions (parallel planes) to the mean */
+    for (size_t i = 0; i < n; i++) {
+        const sk_edge *e = &S->e[es[i]];
+        /* plane: nx x + ny y - s z = c, through the mean: residual r, row g */
+        double g[3] = {e->nx, e->ny, -e->s}, w = 1 / (1 + e->s * e->s);
+        double r = e->c + e->s * *z - e->nx * *lx - e->ny * *ly;
+        for (int p = 0; p < 3; p++) {
+            b[p] += w * g[p] * r;
+            for (int q = 0; q < 3; q++)
+                A[p][q] += w * g[p] * g[q];
+        }
+    }
+    for (int p = 0; p < 3; p++)
+        A[p][p] += lam;
+    /* Cramer's rule on the 3 x 3 normal equations for the move d */
+    double det = A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) -
+                 A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
+                 A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0]);
+    if (!(fabs(det) > 1e-300))
+        return;
+    double d[3];
+    for (int c = 0; c < 3; c++) {
+        double M[3][3];
+        memcpy(M, A, sizeof M);
+        for (int p = 0; p < 3; p++)
+            M[p][c] = b[p];
+        d[c] = (M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) -
+                M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+                M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0])) / det;
+    }
+    double allow = 2 * S->d2 + fmin(100 * S->d3, 10 * spread);
+    if (!(hypot(d[0], d[1]) <= allow && fabs(d[2]) <= S->d1))
+        return;
+    *lx += d[0];
+    *ly += d[1];
+    *z = fmax(*z + d[2], S->zcur);
+}
+
 static void intersection(sk *S, ag_event *evs, size_t n, scratch *W)
 {
     S->stamp++;
@@ -708,6 +704,7 @@ static void intersection(sk *S, ag_event *evs, size_t n, scratch *W)
                     vpush(&W->E, es[j]);
             }
     }
+    apex(S, W->E.arr, W->E.n, spread, &lx, &ly, &z);
     uint32_t vl = vertex(S, lx, ly, z);
     size_t nrays = 0;
     size_t need = 2 * (W->E.n + W->splits.n) + 2;
@@ -995,18 +992,18 @@ static void direction(sk *S, ag_event *evs, size_t n)
             /* no move: it waits through the interval, on its new profile if it has one */
             if (off_p[i] >= 0) {
                 uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
-                span(S, e->face, e, ve, vs, z);
+                seg(S, e->face, ve, vs);
                 e->profile = off_p[i];
                 e->seg = 0;
                 e->clock = off_clock;
                 e->face = new_face(S, e);
-                span(S, e->face, e, vs, ve, z);
+                seg(S, e->face, vs, ve);
             }
             e->paused = 1;
             s_new = 0;
         } else if (newface[i] == 3) {
             uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
-            span(S, e->face, e, ve, vs, z);
+            seg(S, e->face, ve, vs);
             if (off_p[i] >= 0) {
                 e->profile = off_p[i];
                 e->seg = 0;
@@ -1016,17 +1013,17 @@ static void direction(sk *S, ag_event *evs, size_t n)
             e->paused = 0;
             s_new = -off_w[i];
             e->face = new_face(S, e);
-            span(S, e->face, e, vs, ve, z);
+            seg(S, e->face, vs, ve);
         } else if (newface[i]) {
             uint32_t vs = verts[S->c[e->start].stamp], ve = verts[S->c[e->end].stamp];
-            span(S, e->face, e, ve, vs, z);
+            seg(S, e->face, ve, vs);
             if (newface[i] == 1)
                 e->seg++; /* a grown plan edit keeps its profile's first segment */
             s_new = seg_slope(p, e->seg);
             e->paused = 0;
             e->growing = 0; /* before new_face: the new face is a profile segment's */
             e->face = new_face(S, e);
-            span(S, e->face, e, vs, ve, z);
+            seg(S, e->face, vs, ve);
         } else if (e->paused) {
             s_new = seg_slope(p, e->seg);
             e->paused = 0;
@@ -1983,8 +1980,8 @@ static void cap(sk *S, double z)
     }
     for (size_t i = 0; i < S->nlive_e; i++) {
         sk_edge *e = &S->e[S->live_e[i]];
-        span(S, e->face, e, verts[e->end], verts[e->start], z);
-        span(S, face, e, verts[e->start], verts[e->end], z);
+        seg(S, e->face, verts[e->end], verts[e->start]);
+        seg(S, face, verts[e->start], verts[e->end]);
         e->alive = 0;
     }
     free(verts);
@@ -2020,6 +2017,21 @@ static uint32_t uf_find(uint32_t *p, uint32_t x)
         x = p[x];
     }
     return x;
+}
+
+/* Plan speed of the fastest corner an intersection event moves (m per unit of height). */
+static double event_speed(const sk *S, const ag_event *ev)
+{
+    uint32_t ks[2] = {ev->a, NONE};
+    if (ev->type == AG_EVENT_EDGE) {
+        ks[0] = S->e[ev->a].start;
+        ks[1] = S->e[ev->a].end;
+    }
+    double v = 0;
+    for (int j = 0; j < 2; j++)
+        if (ks[j] != NONE)
+            v = fmax(v, hypot(S->c[ks[j]].vx, S->c[ks[j]].vy));
+    return v;
 }
 
 static int event_valid(sk *S, const ag_event *ev)
@@ -2343,15 +2355,33 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         for (size_t i = 0; i < nb; i++)
             uf[i] = (uint32_t)i;
         double r = 10 * S.d2;
+        /* events a little apart in height (within delta1) are compared where their points
+         * would be at one height: a fast corner (nearly parallel edges) moves its point
+         * by its speed times the height difference (bounded: 0.2 mm at building scale) */
+        double *sp = malloc(nb * sizeof *sp), maxsp = 0, zlo = INFINITY, zhi = -INFINITY;
+        if (!sp) {
+            fail(&S, AG_ERR_NOMEM);
+            break;
+        }
+        for (size_t i = 0; i < nb; i++) {
+            sp[i] = event_speed(&S, &batch[i]);
+            maxsp = fmax(maxsp, sp[i]);
+            zlo = fmin(zlo, batch[i].z);
+            zhi = fmax(zhi, batch[i].z);
+        }
+        double rmax = r + fmin(2 * maxsp * (zhi - zlo), 20 * S.d3);
         /* a window of 64 suffices: points of one cluster chain each other */
         for (size_t i = 0; i < nb; i++)
-            for (size_t j = i + 1; j < nb && j < i + 64 && batch[j].x - batch[i].x <= r; j++)
-                if (fabs(batch[j].y - batch[i].y) <= r &&
-                    hypot(batch[j].x - batch[i].x, batch[j].y - batch[i].y) <= r) {
+            for (size_t j = i + 1; j < nb && j < i + 64 && batch[j].x - batch[i].x <= rmax; j++) {
+                double tol = r + fmin((sp[i] + sp[j]) * fabs(batch[j].z - batch[i].z), 20 * S.d3);
+                if (fabs(batch[j].y - batch[i].y) <= tol &&
+                    hypot(batch[j].x - batch[i].x, batch[j].y - batch[i].y) <= tol) {
                     uint32_t a = uf_find(uf, (uint32_t)i), b = uf_find(uf, (uint32_t)j);
                     if (a != b)
                         uf[a > b ? a : b] = a < b ? a : b;
                 }
+            }
+        free(sp);
         /* handle groups lowest first: order events by (group's lowest z, group) */
         gsort *gs = malloc(nb * sizeof *gs);
         double *gz = malloc(nb * sizeof *gz);

@@ -11,7 +11,10 @@
  * that become collinear are resolved by the plan's priority scheme (the winner's plane
  * takes over), antiparallel neighbours (a ridge) are zipped. Horizontal profile segments,
  * profile offset events and natural steps each get a stretched interval of sweep height in
- * which only their edges move; forced steps are united with the active plan at their height. */
+ * which only their edges move; forced steps are united with the active plan at their height.
+ * An offset event's inside boundary (a gap between an outer and an inner shell) is opened
+ * at the end of its interval from two insets of the active plan, each computed by a sweep
+ * of its own (edges rising at their gap distance, cut at height 1). */
 #ifndef AG_EXTRUDE_SKELETON_H
 #define AG_EXTRUDE_SKELETON_H
 

@@ -1,0 +1,90 @@
+// archgram live editing latency: two clients in the room of a proceduralized demo building;
+// A commits resize ops (each re-solved, re-proceduralized and stored) and sends drag previews
+// (solved with the kept factorization, never stored); prints op→ack, op→broadcast (to B) and
+// preview→room (to B) times. Target: an op reaches the other clients ≤ 50 ms after it is sent.
+// Prints figures; not a test.
+import fs from 'node:fs';
+import { performance } from 'node:perf_hooks';
+import { DAEMON, http, removeDir, sleep, startDaemon, WsClient } from '../tests/integration/harness.js';
+
+const OPS = 60;
+const PREVIEWS = 200;
+
+function summary(ms) {
+  const s = [...ms].sort((a, b) => a - b);
+  const q = (p) => s[Math.min(s.length - 1, Math.floor(p * s.length))];
+  return `median ${q(0.5).toFixed(2)} ms, p95 ${q(0.95).toFixed(2)} ms, max ${s.at(-1).toFixed(2)} ms (n=${s.length})`;
+}
+
+if (!fs.existsSync(DAEMON)) {
+  console.log(`bench/edit_ws.js: ${DAEMON} is missing (make build/archgramd); skipped`);
+  process.exit(0);
+}
+
+const d = await startDaemon({ args: ['--demo'] });
+let A;
+let B;
+try {
+  // the demo's first building, once its proceduralize job has run
+  let model;
+  for (const t0 = Date.now(); Date.now() - t0 < 60000; await sleep(100)) {
+    model = (await http(d, 'GET', '/api/v1/models/1')).json;
+    if (model && model.proceduralized) break;
+  }
+  if (!model || !model.proceduralized) throw new Error('the demo building was not proceduralized');
+  const tree = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`)).json;
+  console.log(`edit ws: model "${model.name}", ${tree.nodes.length} tree nodes, ${model.stats.triangles} triangles`);
+
+  A = await WsClient.open(d.wsUrl);
+  B = await WsClient.open(d.wsUrl);
+  let version = (await A.request({ type: 'hello', model: model.id, user: 'a' }, 'welcome')).version;
+  await B.request({ type: 'hello', model: model.id, user: 'b' }, 'welcome');
+  await A.next('join');
+
+  // drag previews: root stretched by a varying amount, one at a time (the server keeps 30/s
+  // per connection, so they are spaced 34 ms apart)
+  const box0 = tree.nodes.find((n) => n.id === tree.root).box;
+  const toRoom = [];
+  for (let i = 0; i < PREVIEWS; i++) {
+    const box = [...box0];
+    box[3] = box0[0] + (box0[3] - box0[0]) * (1 + 0.3 * ((i % 20) / 20));
+    const seen = B.next((m) => m.type === 'preview', 10000);
+    const ts = performance.now();
+    A.send({ type: 'preview', model: model.id, base: version, op: { kind: 'resize', node: 'root', box, mode: 'global' } });
+    await seen;
+    toRoom.push(performance.now() - ts);
+    B.all.length = 0;
+    await sleep(34);
+  }
+  A.send({ type: 'preview.end' });
+
+  // committed resize ops, alternately wider and back
+  const toAck = [];
+  const toPeer = [];
+  for (let i = 0; i < OPS; i++) {
+    const cid = `edit-${i}`;
+    const t = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`)).json;
+    const box = [...t.nodes.find((n) => n.id === t.root).box];
+    box[3] = box[0] + (box[3] - box[0]) * (i % 2 ? 1 / 1.25 : 1.25);
+    const ack = A.next((m) => (m.type === 'ack' || m.type === 'nack') && m.cid === cid, 30000);
+    const seen = B.next((m) => m.type === 'op' && m.cid === cid, 30000);
+    const ts = performance.now();
+    A.send({ type: 'op', base: version, cid, op: { kind: 'resize', node: 'root', box, mode: 'global' } });
+    const [a] = await Promise.all([
+      ack.then((m) => { toAck.push(performance.now() - ts); return m; }),
+      seen.then(() => { toPeer.push(performance.now() - ts); }),
+    ]);
+    if (a.type !== 'ack') throw new Error(`op ${i} refused: ${JSON.stringify(a)}`);
+    version = a.version;
+    A.all.length = 0;
+    B.all.length = 0;
+  }
+  console.log(`edit ws preview→room:   ${summary(toRoom)}`);
+  console.log(`edit ws op→ack:         ${summary(toAck)}`);
+  console.log(`edit ws op→broadcast:   ${summary(toPeer)}   (target ≤ 50 ms)`);
+} finally {
+  if (A) await A.close();
+  if (B) await B.close();
+  await d.stop();
+  removeDir(d.dir);
+}
