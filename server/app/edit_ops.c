@@ -33,20 +33,6 @@ int ag_edit_ops_handles(const char *kind)
                     strcmp(kind, "restore") == 0);
 }
 
-static ag_status only_members(const json_t *op, const char *const *allowed, ag_error *err)
-{
-    const char *key;
-    json_t *value;
-    json_object_foreach((json_t *)op, key, value) {
-        int ok = 0;
-        for (const char *const *a = allowed; *a; a++)
-            ok |= strcmp(key, *a) == 0;
-        if (!ok)
-            return ag_error_set(err, AG_ERR_INVALID, 0, "op member \"%s\" is not known", key);
-    }
-    return AG_OK;
-}
-
 ag_status ag_edit_ops_validate(const json_t *op, ag_error *err)
 {
     const char *kind = json_string_value(json_object_get(op, "kind"));
@@ -64,99 +50,14 @@ ag_status ag_edit_ops_validate(const json_t *op, ag_error *err)
     }
     if (strcmp(kind, "undo") == 0 || strcmp(kind, "redo") == 0) {
         static const char *const allowed[] = {"kind", NULL};
-        return only_members(op, allowed, err);
+        return ag_modelops_only_members(op, allowed, err);
     }
     static const char *const allowed[] = {"kind", "version", NULL};
     json_t *v = json_object_get(op, "version");
     if (!json_is_integer(v) || json_integer_value(v) < 1)
         return ag_error_set(err, AG_ERR_INVALID, 0,
                             "a restore op needs \"version\", the model version to restore (>= 1)");
-    return only_members(op, allowed, err);
-}
-
-/* --- terminals, as the proceduralize job names them ------------------------------------ */
-
-typedef struct {
-    size_t n;
-    char **path, **obj;
-    size_t *len;
-} term_set;
-
-static void term_set_free(term_set *s)
-{
-    for (size_t i = 0; i < s->n; i++) {
-        free(s->path[i]);
-        free(s->obj[i]);
-    }
-    free(s->path);
-    free(s->obj);
-    free(s->len);
-    memset(s, 0, sizeof *s);
-}
-
-static uint64_t fnv1a(const char *s, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (size_t i = 0; i < n; i++) {
-        h ^= (unsigned char)s[i];
-        h *= 0x100000001b3ULL;
-    }
-    return h;
-}
-
-/* Paths named after the OBJ text's hash, so the same geometry keeps its stored path and
- * older versions' grammars still find theirs. */
-static ag_status name_terminals(ag_grammar *g, term_set *s, ag_error *err)
-{
-    size_t cap = g->nterminals + 1;
-    s->path = calloc(cap, sizeof *s->path);
-    s->obj = calloc(cap, sizeof *s->obj);
-    s->len = calloc(cap, sizeof *s->len);
-    if (!s->path || !s->obj || !s->len)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    for (size_t i = 0; i < g->nterminals; i++) {
-        ag_gterminal *t = &g->terminals[i];
-        char *text;
-        size_t len;
-        ag_status st = ag_terminals_format(t, &text, &len, err);
-        if (st != AG_OK)
-            return st;
-        char path[64];
-        snprintf(path, sizeof path, "terminals/%016llx.obj",
-                 (unsigned long long)fnv1a(text, len));
-        free(t->path);
-        size_t k = 0;
-        while (k < s->n && strcmp(s->path[k], path) != 0)
-            k++;
-        if (!(t->path = strdup(path)) || (k == s->n && !(s->path[s->n] = strdup(path)))) {
-            free(text);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
-        if (k < s->n) {
-            free(text);
-            continue;
-        }
-        s->obj[s->n] = text;
-        s->len[s->n] = len;
-        s->n++;
-    }
-    return AG_OK;
-}
-
-static ag_status lookup_set(void *user, const char *path, char **obj, size_t *len, ag_error *err)
-{
-    const term_set *s = user;
-    for (size_t i = 0; i < s->n; i++) {
-        if (strcmp(s->path[i], path) != 0)
-            continue;
-        if (!(*obj = malloc(s->len[i] + 1)))
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        memcpy(*obj, s->obj[i], s->len[i]);
-        (*obj)[s->len[i]] = '\0';
-        *len = s->len[i];
-        return AG_OK;
-    }
-    return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "no terminal %s", path);
+    return ag_modelops_only_members(op, allowed, err);
 }
 
 /* --- structural edits -------------------------------------------------------------------- */
@@ -264,7 +165,7 @@ static ag_status apply_edit(ag_app *app, int64_t model, int64_t base, const char
     }
     ag_edit_model *out = NULL;
     ag_edit_report rep = {0};
-    term_set terms = {0};
+    ag_terminal_set terms = {0};
     ag_grammar_derived d = {0};
     char *text = NULL, *summary = NULL;
     size_t tlen = 0;
@@ -287,13 +188,13 @@ static ag_status apply_edit(ag_app *app, int64_t model, int64_t base, const char
         goto done;
     }
     if ((s = ag_edit_apply(st->em, &e, &out, &rep, err)) != AG_OK ||
-        (s = name_terminals(out->proc->grammar, &terms, err)) != AG_OK ||
+        (s = ag_terminals_collect(out->proc->grammar, &terms, err)) != AG_OK ||
         (s = ag_grammar_text_print(out->proc->grammar, &text, &tlen, err)) != AG_OK)
         goto done;
     long col = 0;
     ag_error de;
     ag_error_clear(&de);
-    if ((s = ag_grammar_edit_derive(text, tlen, lookup_set, &terms, &d, &de, &col)) != AG_OK) {
+    if ((s = ag_grammar_edit_derive(text, tlen, ag_terminals_set_lookup, &terms, &d, &de, &col)) != AG_OK) {
         s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
                          "the edited grammar does not read back (line %ld, column %ld): %s",
                          de.element, col, de.text);
@@ -356,7 +257,7 @@ done:
     ag_edit_model_free(out);
     ag_edit_report_clear(&rep);
     ag_grammar_derived_clear(&d);
-    term_set_free(&terms);
+    ag_terminals_set_clear(&terms);
     free(text);
     free(summary);
     json_decref(body);

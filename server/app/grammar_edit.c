@@ -11,6 +11,7 @@
 #include "../io/splittree_json.h"
 #include "../io/terminals.h"
 #include "../store/grammars.h"
+#include "../store/models.h"
 #include "../store/states.h"
 #include "modelops.h"
 
@@ -127,7 +128,7 @@ ag_status ag_grammar_edit_store(ag_db *db, int64_t model, int64_t version,
     if (!stats)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory summarising the mesh");
     if (s == AG_OK)
-        s = ag_grammars_set_mesh(db, model, blob, blob_len, stats, &mesh_blob, err);
+        s = ag_models_set_mesh(db, model, blob, blob_len, stats, &mesh_blob, err);
     if (s == AG_OK) {
         ag_grammar_new g = {.model = model,
                             .version = version,

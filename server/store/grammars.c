@@ -37,12 +37,6 @@ static char *column_dup(sqlite3_stmt *st, int col, size_t *len)
     return s;
 }
 
-ag_status ag_grammars_set_mesh(ag_db *db, int64_t model, const void *mesh, size_t mesh_len,
-                               const char *stats_json, int64_t *blob, ag_error *err)
-{
-    return ag_models_set_mesh(db, model, mesh, mesh_len, stats_json, blob, err);
-}
-
 ag_status ag_grammars_put(ag_db *db, const ag_grammar_new *g, ag_error *err)
 {
     sqlite3_stmt *st;

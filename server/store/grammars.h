@@ -37,10 +37,6 @@ typedef struct {
     const char *summary_json; /* NULL = "{}" */
 } ag_grammar_new;
 
-/* ag_models_set_mesh, under the name the grammar's users know it by. */
-ag_status ag_grammars_set_mesh(ag_db *db, int64_t model, const void *mesh, size_t mesh_len,
-                               const char *stats_json, int64_t *blob, ag_error *err);
-
 /* Stores a grammar and drops the model's older ones. */
 ag_status ag_grammars_put(ag_db *db, const ag_grammar_new *g, ag_error *err);
 

@@ -30,7 +30,7 @@ static int64_t store_grammar(ag_db *db, int64_t model, int64_t base, const char 
     int64_t version = 0, blob = 0;
     assert_int_equal(ag_db_begin(db, &err), AG_OK);
     assert_int_equal(ag_models_bump_version(db, model, base, &version, &err), AG_OK);
-    assert_int_equal(ag_grammars_set_mesh(db, model, "derived", 7, "{\"triangles\":2}", &blob,
+    assert_int_equal(ag_models_set_mesh(db, model, "derived", 7, "{\"triangles\":2}", &blob,
                                           &err),
                      AG_OK);
     ag_grammar_new g = {.model = model, .version = version, .mesh_blob = blob, .text = text,
@@ -136,11 +136,11 @@ static void stores_and_reads_back(void **state)
     /* a new mesh without a grammar ends it */
     int64_t blob;
     assert_int_equal(ag_db_begin(db, &err), AG_OK);
-    assert_int_equal(ag_grammars_set_mesh(db, id, "other", 5, NULL, &blob, &err), AG_OK);
+    assert_int_equal(ag_models_set_mesh(db, id, "other", 5, NULL, &blob, &err), AG_OK);
     assert_int_equal(ag_db_commit(db, &err), AG_OK);
     assert_int_equal(ag_grammars_current(db, id, 0, &row, &err), AG_ERR_NOT_FOUND);
     assert_int_equal(ag_db_begin(db, &err), AG_OK);
-    assert_int_equal(ag_grammars_set_mesh(db, id + 100, "other", 5, NULL, &blob, &err),
+    assert_int_equal(ag_models_set_mesh(db, id + 100, "other", 5, NULL, &blob, &err),
                      AG_ERR_NOT_FOUND);
     ag_db_rollback(db);
 

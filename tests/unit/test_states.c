@@ -75,7 +75,7 @@ static int64_t op(fixture *f, const char *kind, int geometry, const char *gramma
         snprintf(mesh, sizeof mesh, "mesh of version %lld", (long long)v);
         snprintf(stats, sizeof stats, "{\"v\":%lld}", (long long)v);
         int64_t blob = 0;
-        assert_int_equal(ag_grammars_set_mesh(f->db, f->model, mesh, strlen(mesh), stats, &blob,
+        assert_int_equal(ag_models_set_mesh(f->db, f->model, mesh, strlen(mesh), stats, &blob,
                                               &err),
                          AG_OK);
         ag_grammar_new g = {.model = f->model, .version = v, .mesh_blob = blob, .text = grammar,
