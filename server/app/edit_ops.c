@@ -187,7 +187,8 @@ static ag_status apply_edit(ag_app *app, int64_t model, int64_t base, const char
     } else if ((s = translate(st, &e, err)) != AG_OK) {
         goto done;
     }
-    if ((s = ag_edit_apply(st->em, &e, &out, &rep, err)) != AG_OK ||
+    /* the session maps GET …/tree ids onto the kept model itself: no read-back needed */
+    if ((s = ag_edit_apply_ex(st->em, &e, 0, &out, &rep, err)) != AG_OK ||
         (s = ag_terminals_collect(out->proc->grammar, &terms, err)) != AG_OK ||
         (s = ag_grammar_text_print(out->proc->grammar, &text, &tlen, err)) != AG_OK)
         goto done;

@@ -202,6 +202,12 @@ void ag_edit_model_free(ag_edit_model *m)
 ag_status ag_edit_apply(ag_edit_model *m, const ag_edit_op *op, ag_edit_model **out,
                         ag_edit_report *rep, ag_error *err)
 {
+    return ag_edit_apply_ex(m, op, AG_EDIT_READ_BACK, out, rep, err);
+}
+
+ag_status ag_edit_apply_ex(ag_edit_model *m, const ag_edit_op *op, unsigned flags,
+                           ag_edit_model **out, ag_edit_report *rep, ag_error *err)
+{
     *out = NULL;
     ag_edit_report local = {0};
     if (!rep)
@@ -239,10 +245,14 @@ ag_status ag_edit_apply(ag_edit_model *m, const ag_edit_op *op, ag_edit_model **
     ag_edit_model *first = NULL;
     if ((st = ag_edit_model_create(mesh, &m->opt, &first, err)))
         goto done;
-    st = ag_edit_model_from_grammar(first->proc->grammar, &m->opt, out, err);
-    ag_edit_model_free(first);
-    if (st)
-        goto done;
+    if (flags & AG_EDIT_READ_BACK) {
+        st = ag_edit_model_from_grammar(first->proc->grammar, &m->opt, out, err);
+        ag_edit_model_free(first);
+        if (st)
+            goto done;
+    } else {
+        *out = first;
+    }
     st = count_tree_labels(rep, (*out)->proc, err);
     if (st) {
         ag_edit_model_free(*out);

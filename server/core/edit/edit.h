@@ -138,6 +138,18 @@ void ag_edit_model_free(ag_edit_model *m);
 ag_status ag_edit_apply(ag_edit_model *m, const ag_edit_op *op, ag_edit_model **out,
                         ag_edit_report *rep, ag_error *err);
 
+typedef enum {
+    /* read the result back through its grammar (a second proceduralization) so its ids are
+     * those a reload of the grammar gives: for callers that keep no model between edits
+     * (the CLI). A caller that keeps the returned model and maps ids itself (the service)
+     * leaves it out and saves the second run. */
+    AG_EDIT_READ_BACK = 1,
+} ag_edit_apply_flags;
+
+/* ag_edit_apply is ag_edit_apply_ex(..., AG_EDIT_READ_BACK, ...). */
+ag_status ag_edit_apply_ex(ag_edit_model *m, const ag_edit_op *op, unsigned flags,
+                           ag_edit_model **out, ag_edit_report *rep, ag_error *err);
+
 /* Live drag of a resize: solves for op's target reusing the model's factorization when only
  * the target moved since the last call (same node, mode and region), and returns the new box
  * of every tree node (*boxes: malloc'd, model->proc->tree->nnodes entries; dead nodes keep
