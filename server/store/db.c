@@ -166,3 +166,30 @@ void ag_db_column_copy(sqlite3_stmt *st, int col, char *dst, size_t cap)
         memcpy(dst, src, n);
     dst[n] = '\0';
 }
+
+ag_status ag_db_prepared(ag_db *db, sqlite3_stmt **st, const char *sql, ag_error *err)
+{
+    *st = ag_db_prepare(db, sql, err);
+    return *st ? AG_OK : (err ? err->code : AG_ERR_DB);
+}
+
+char *ag_db_column_dup(sqlite3_stmt *st, int col, size_t *len, int *nomem)
+{
+    if (len)
+        *len = 0;
+    if (sqlite3_column_type(st, col) == SQLITE_NULL)
+        return NULL;
+    const unsigned char *p = sqlite3_column_text(st, col);
+    size_t n = p ? (size_t)sqlite3_column_bytes(st, col) : 0;
+    char *s = malloc(n + 1);
+    if (!s) {
+        *nomem = 1;
+        return NULL;
+    }
+    if (n)
+        memcpy(s, p, n);
+    s[n] = '\0';
+    if (len)
+        *len = n;
+    return s;
+}

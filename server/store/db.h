@@ -44,4 +44,11 @@ ag_status ag_db_step_done(ag_db *db, sqlite3_stmt *st, const char *doing, ag_err
 /* Copies a text column into a fixed buffer (truncating; "" for NULL). */
 void ag_db_column_copy(sqlite3_stmt *st, int col, char *dst, size_t cap);
 
+/* ag_db_prepare as a status: AG_OK with *st, or the failure (err filled). */
+ag_status ag_db_prepared(ag_db *db, sqlite3_stmt **st, const char *sql, ag_error *err);
+
+/* A malloc'd NUL-terminated copy of a text column and its length (len may be NULL); NULL for
+ * SQL NULL, and NULL with *nomem set when out of memory. */
+char *ag_db_column_dup(sqlite3_stmt *st, int col, size_t *len, int *nomem);
+
 #endif

@@ -24,38 +24,14 @@ void ag_extrusions_building_clear(ag_extrusion_building *b)
     b->mesh_len = 0;
 }
 
-static ag_status prepared(ag_db *db, sqlite3_stmt **st, const char *sql, ag_error *err)
-{
-    *st = ag_db_prepare(db, sql, err);
-    return *st ? AG_OK : (err ? err->code : AG_ERR_DB);
-}
-
-/* A malloc'd NUL-terminated copy of a text column; NULL for SQL NULL (and *bad on no memory). */
-static char *text_dup(sqlite3_stmt *st, int col, int *bad)
-{
-    if (sqlite3_column_type(st, col) == SQLITE_NULL)
-        return NULL;
-    const unsigned char *p = sqlite3_column_text(st, col);
-    size_t n = (size_t)sqlite3_column_bytes(st, col);
-    char *s = malloc(n + 1);
-    if (!s) {
-        *bad = 1;
-        return NULL;
-    }
-    if (n)
-        memcpy(s, p, n);
-    s[n] = '\0';
-    return s;
-}
-
 ag_status ag_extrusions_put(ag_db *db, int64_t model, int batch, const char *meta_json,
                             ag_error *err)
 {
     sqlite3_stmt *st;
-    ag_status s = prepared(db, &st,
-                           "INSERT OR REPLACE INTO extrusions (model_id, batch, meta) "
-                           "VALUES (?, ?, ?)",
-                           err);
+    ag_status s = ag_db_prepared(db, &st,
+                                 "INSERT OR REPLACE INTO extrusions (model_id, batch, meta) "
+                                 "VALUES (?, ?, ?)",
+                                 err);
     if (s != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, model);
@@ -69,7 +45,7 @@ ag_status ag_extrusions_get(ag_db *db, int64_t model, ag_extrusion_row *row, ag_
     memset(row, 0, sizeof *row);
     sqlite3_stmt *st;
     /* The LEFT JOIN tells "no such model" from "not an extrusion" in one statement. */
-    ag_status s = prepared(
+    ag_status s = ag_db_prepared(
         db, &st,
         "SELECT e.model_id, e.batch, e.meta, "
         "(SELECT count(*) FROM extrusion_buildings b WHERE b.model_id = m.id) "
@@ -90,7 +66,7 @@ ag_status ag_extrusions_get(ag_db *db, int64_t model, ag_extrusion_row *row, ag_
         int bad = 0;
         row->model = model;
         row->batch = sqlite3_column_int(st, 1);
-        row->meta_json = text_dup(st, 2, &bad);
+        row->meta_json = ag_db_column_dup(st, 2, NULL, &bad);
         row->buildings = (size_t)sqlite3_column_int64(st, 3);
         if (bad || !row->meta_json) {
             ag_extrusions_row_clear(row);
@@ -104,7 +80,7 @@ ag_status ag_extrusions_get(ag_db *db, int64_t model, ag_extrusion_row *row, ag_
 ag_status ag_extrusions_put_building(ag_db *db, const ag_extrusion_building *b, ag_error *err)
 {
     sqlite3_stmt *st;
-    ag_status s = prepared(
+    ag_status s = ag_db_prepared(
         db, &st,
         "INSERT INTO extrusion_buildings "
         "(model_id, building, footprint, plan, mesh, triangles, status, reason) "
@@ -139,12 +115,12 @@ static int read_building(sqlite3_stmt *st, int64_t model, unsigned what, ag_extr
     int bad = 0;
     b->model = model;
     b->building = sqlite3_column_int64(st, 0);
-    b->footprint = text_dup(st, 1, &bad);
+    b->footprint = ag_db_column_dup(st, 1, NULL, &bad);
     b->triangles = sqlite3_column_int64(st, 2);
     ag_db_column_copy(st, 3, b->status, sizeof b->status);
-    b->reason = text_dup(st, 4, &bad);
+    b->reason = ag_db_column_dup(st, 4, NULL, &bad);
     if (what & AG_EXTRUSIONS_PLAN)
-        b->plan_json = text_dup(st, 5, &bad);
+        b->plan_json = ag_db_column_dup(st, 5, NULL, &bad);
     if ((what & AG_EXTRUSIONS_MESH) && sqlite3_column_type(st, 6) == SQLITE_BLOB) {
         size_t n = (size_t)sqlite3_column_bytes(st, 6);
         b->mesh = malloc(n ? n : 1);
@@ -171,7 +147,7 @@ ag_status ag_extrusions_get_building(ag_db *db, int64_t model, int64_t building,
 {
     memset(b, 0, sizeof *b);
     sqlite3_stmt *st;
-    ag_status s = prepared(db, &st, BUILDING_COLUMNS "AND building = ?", err);
+    ag_status s = ag_db_prepared(db, &st, BUILDING_COLUMNS "AND building = ?", err);
     if (s != AG_OK)
         return s;
     sqlite3_bind_int(st, 1, (what & AG_EXTRUSIONS_PLAN) != 0);

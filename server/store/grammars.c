@@ -15,12 +15,6 @@ void ag_grammars_row_clear(ag_grammar_row *row)
     row->text = row->tree_json = row->summary_json = NULL;
 }
 
-static ag_status prepared(ag_db *db, sqlite3_stmt **st, const char *sql, ag_error *err)
-{
-    *st = ag_db_prepare(db, sql, err);
-    return *st ? AG_OK : (err ? err->code : AG_ERR_DB);
-}
-
 /* A malloc'd NUL-terminated copy of a text column ("" for NULL). */
 static char *column_dup(sqlite3_stmt *st, int col, size_t *len)
 {
@@ -40,16 +34,16 @@ static char *column_dup(sqlite3_stmt *st, int col, size_t *len)
 ag_status ag_grammars_put(ag_db *db, const ag_grammar_new *g, ag_error *err)
 {
     sqlite3_stmt *st;
-    ag_status s = prepared(db, &st, "DELETE FROM grammars WHERE model_id = ?", err);
+    ag_status s = ag_db_prepared(db, &st, "DELETE FROM grammars WHERE model_id = ?", err);
     if (s != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, g->model);
     if ((s = ag_db_step_done(db, st, "replacing a model's grammar", err)) != AG_OK)
         return s;
-    if ((s = prepared(db, &st,
-                      "INSERT INTO grammars (model_id, version, mesh_blob, text, tree, summary) "
-                      "VALUES (?, ?, ?, ?, ?, ?)",
-                      err)) != AG_OK)
+    if ((s = ag_db_prepared(db, &st,
+                            "INSERT INTO grammars (model_id, version, mesh_blob, text, tree, summary) "
+                            "VALUES (?, ?, ?, ?, ?, ?)",
+                            err)) != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, g->model);
     sqlite3_bind_int64(st, 2, g->version);
@@ -66,7 +60,7 @@ ag_status ag_grammars_current(ag_db *db, int64_t model, int with_tree, ag_gramma
     memset(row, 0, sizeof *row);
     /* The LEFT JOIN tells "no such model" from "no grammar" in one statement. */
     sqlite3_stmt *st;
-    ag_status s = prepared(
+    ag_status s = ag_db_prepared(
         db, &st,
         "SELECT m.version, g.version, g.mesh_blob, g.text, g.summary, "
         "CASE WHEN ? THEN g.tree END "
@@ -108,7 +102,7 @@ ag_status ag_grammars_is_current(ag_db *db, int64_t model, int64_t mesh_blob, in
 {
     *yes = 0;
     sqlite3_stmt *st;
-    ag_status s = prepared(
+    ag_status s = ag_db_prepared(
         db, &st, "SELECT EXISTS (SELECT 1 FROM grammars WHERE model_id = ? AND mesh_blob = ?)",
         err);
     if (s != AG_OK)
@@ -126,7 +120,7 @@ ag_status ag_grammars_is_current(ag_db *db, int64_t model, int64_t mesh_blob, in
 ag_status ag_grammars_clear_terminals(ag_db *db, int64_t model, ag_error *err)
 {
     sqlite3_stmt *st;
-    ag_status s = prepared(db, &st, "DELETE FROM terminals WHERE model_id = ?", err);
+    ag_status s = ag_db_prepared(db, &st, "DELETE FROM terminals WHERE model_id = ?", err);
     if (s != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, model);
@@ -137,7 +131,7 @@ ag_status ag_grammars_put_terminal(ag_db *db, int64_t model, const char *path, c
                                    size_t len, ag_error *err)
 {
     sqlite3_stmt *st;
-    ag_status s = prepared(
+    ag_status s = ag_db_prepared(
         db, &st, "INSERT OR IGNORE INTO terminals (model_id, path, obj) VALUES (?, ?, ?)", err);
     if (s != AG_OK)
         return s;
@@ -153,8 +147,8 @@ ag_status ag_grammars_get_terminal(ag_db *db, int64_t model, const char *path, c
     *obj = NULL;
     *len = 0;
     sqlite3_stmt *st;
-    ag_status s = prepared(db, &st, "SELECT obj FROM terminals WHERE model_id = ? AND path = ?",
-                           err);
+    ag_status s = ag_db_prepared(db, &st, "SELECT obj FROM terminals WHERE model_id = ? AND path = ?",
+                                 err);
     if (s != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, model);

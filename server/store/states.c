@@ -17,36 +17,11 @@ void ag_states_row_clear(ag_state_row *row)
     memset(row, 0, sizeof *row);
 }
 
-static ag_status prepared(ag_db *db, sqlite3_stmt **st, const char *sql, ag_error *err)
-{
-    *st = ag_db_prepare(db, sql, err);
-    return *st ? AG_OK : (err ? err->code : AG_ERR_DB);
-}
-
-static char *text_dup(sqlite3_stmt *st, int col, size_t *len, int *bad)
-{
-    if (sqlite3_column_type(st, col) == SQLITE_NULL)
-        return NULL;
-    const unsigned char *p = sqlite3_column_text(st, col);
-    size_t n = (size_t)sqlite3_column_bytes(st, col);
-    char *s = malloc(n + 1);
-    if (!s) {
-        *bad = 1;
-        return NULL;
-    }
-    if (n)
-        memcpy(s, p, n);
-    s[n] = '\0';
-    if (len)
-        *len = n;
-    return s;
-}
-
 ag_status ag_states_keep(ag_db *db, int64_t model, int64_t version, ag_error *err)
 {
     sqlite3_stmt *st;
     /* grammars keeps one row per model; it describes the model only while the mesh is its */
-    ag_status s = prepared(
+    ag_status s = ag_db_prepared(
         db, &st,
         "INSERT OR IGNORE INTO model_states "
         "(model_id, version, mesh_blob, stats, grammar, tree, summary) "
@@ -67,11 +42,11 @@ static ag_status geometry_op_between(ag_db *db, int64_t model, int64_t from, int
 {
     *found = 0;
     sqlite3_stmt *st;
-    ag_status s = prepared(db, &st,
-                           "SELECT version, kind FROM ops WHERE model_id = ? AND version > ? "
-                           "AND version <= ? AND kind NOT IN ('rename', 'note') "
-                           "ORDER BY version LIMIT 1",
-                           err);
+    ag_status s = ag_db_prepared(db, &st,
+                                 "SELECT version, kind FROM ops WHERE model_id = ? AND version > ? "
+                                 "AND version <= ? AND kind NOT IN ('rename', 'note') "
+                                 "ORDER BY version LIMIT 1",
+                                 err);
     if (s != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, model);
@@ -93,11 +68,11 @@ ag_status ag_states_get(ag_db *db, int64_t model, int64_t version, ag_state_row 
 {
     memset(row, 0, sizeof *row);
     sqlite3_stmt *st;
-    ag_status s = prepared(db, &st,
-                           "SELECT version, mesh_blob, stats, grammar, tree, summary, "
-                           "(SELECT version FROM models WHERE id = ?) FROM model_states "
-                           "WHERE model_id = ? AND version <= ? ORDER BY version DESC LIMIT 1",
-                           err);
+    ag_status s = ag_db_prepared(db, &st,
+                                 "SELECT version, mesh_blob, stats, grammar, tree, summary, "
+                                 "(SELECT version FROM models WHERE id = ?) FROM model_states "
+                                 "WHERE model_id = ? AND version <= ? ORDER BY version DESC LIMIT 1",
+                                 err);
     if (s != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, model);
@@ -119,10 +94,10 @@ ag_status ag_states_get(ag_db *db, int64_t model, int64_t version, ag_state_row 
         row->model = model;
         row->version = sqlite3_column_int64(st, 0);
         row->mesh_blob = sqlite3_column_int64(st, 1);
-        row->stats_json = text_dup(st, 2, NULL, &bad);
-        row->grammar = text_dup(st, 3, &row->grammar_len, &bad);
-        row->tree_json = text_dup(st, 4, NULL, &bad);
-        row->summary_json = text_dup(st, 5, NULL, &bad);
+        row->stats_json = ag_db_column_dup(st, 2, NULL, &bad);
+        row->grammar = ag_db_column_dup(st, 3, &row->grammar_len, &bad);
+        row->tree_json = ag_db_column_dup(st, 4, NULL, &bad);
+        row->summary_json = ag_db_column_dup(st, 5, NULL, &bad);
         if (bad || !row->stats_json) {
             ag_states_row_clear(row);
             s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory reading a state");
@@ -148,10 +123,10 @@ ag_status ag_states_restore(ag_db *db, int64_t model, int64_t version, const ag_
                             ag_error *err)
 {
     sqlite3_stmt *st;
-    ag_status s = prepared(db, &st,
-                           "UPDATE models SET mesh_blob = ?, stats = ?, "
-                           "updated_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now') WHERE id = ?",
-                           err);
+    ag_status s = ag_db_prepared(db, &st,
+                                 "UPDATE models SET mesh_blob = ?, stats = ?, "
+                                 "updated_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now') WHERE id = ?",
+                                 err);
     if (s != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, row->mesh_blob);

@@ -84,7 +84,7 @@ export class SplitTreePanel {
     const at = STAGES.indexOf(job.stage);
     this.stages.replaceChildren(
       ...STAGES.map((name, i) => {
-        let state = 'todo';
+        let state = 'pending'; // a stage not reached yet
         if (job.status === 'succeeded' || i < at) state = 'done';
         else if (i === at) state = done ? job.status : 'now';
         return el('li', { className: `stage ${state}`, dataset: { stage: name } }, name);
