@@ -29,7 +29,7 @@ typedef struct {
     int turn;                       /* quarter turns of the whole building about z */
     double ox, oy;                  /* offset */
     double sx, sz;                  /* window spacing */
-    int back_blank;                 /* nothing on the back wall (it is always blank) */
+    int balcony;                    /* a balcony in front of the front wall */
 } pf_options;
 
 typedef struct {
@@ -123,6 +123,16 @@ static inline ag_mesh *pf_building(const pf_options *o, ag_box **slots, size_t *
     for (unsigned j = 0; j < o->rows; j++)
         for (unsigned i = 0; i < o->cols; i++)
             s[n++] = pf_window(&g, o, 0.9 + i * sx, 1.0 + j * sz);
+    if (o->balcony) {
+        /* the balcony's volume holds its slab, its front rail and five posts */
+        double u = 0.9, L = 3.0, d = 1.0, h = 1.1;
+        pf_box(&g, "balcony", u, u + L, -d, 0, 1.0, 1.0 + h);
+        pf_box(&g, "slab", u, u + L, -d, 0, 1.0, 1.15);
+        pf_box(&g, "rail", u, u + L, -d, -d + 0.05, 1.0 + h - 0.05, 1.0 + h);
+        for (int k = 0; k < 5; k++)
+            pf_box(&g, "post", u + 0.1 + k * 0.7, u + 0.15 + k * 0.7, -d, -d + 0.05, 1.15,
+                   1.0 + h - 0.05);
+    }
     g.fk = 1, g.fx = Wd, g.fy = 0;
     pf_box(&g, "wall_right", 0, Dp, 0, 0.3, 0, Ht);
     for (unsigned j = 0; j < o->rows; j++)

@@ -209,6 +209,288 @@ static void test_rule_replace_proud_utm(void **state)
 }
 static void test_rule_replace_both_turned(void **state) { (void)state; rule_scope_replace(PF_RECESSED, 2, 1, 0, 0); }
 
+
+static ag_proceduralize_result *building(const pf_options *o, ag_mesh **m, ag_box **slots,
+                                         size_t *ns)
+{
+    *m = pf_building(o, slots, ns);
+    return pf_proc(*m);
+}
+
+static ag_grammar *compose(const ag_proceduralize_result *r, const ag_part *p, int32_t target,
+                           int mode, int scope, ag_compose_report *rep)
+{
+    ag_compose_op op = {.target = target, .mode = mode, .scope = scope};
+    ag_grammar *g = NULL;
+    ag_error err = {0};
+    if (ag_compose(r, p, &op, &g, rep, &err))
+        fail_msg("compose: %s", err.text);
+    print_message("%s\n", rep->message);
+    check_roundtrip(g);
+    return g;
+}
+
+static ag_mesh *derive(const ag_grammar *g)
+{
+    ag_mesh *d = NULL;
+    ag_error err = {0};
+    if (ag_grammar_derive(g, NULL, &d, &err))
+        fail_msg("derive: %s", err.text);
+    return d;
+}
+
+/* Scope node: one window of B gets A's design, the others keep B's. */
+static void test_node_replace(void **state)
+{
+    (void)state;
+    for (int turn = 0; turn < 4; turn += 3) {
+        pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, turn, 0, 0);
+        ag_part *p = save_window(&oa, 0);
+        ag_mesh *m;
+        ag_box *slots;
+        size_t ns;
+        ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+        size_t which = 13; /* on the right facade */
+        int32_t target = pf_node_with_box(r, &slots[which], TOL);
+        assert_true(target > 0);
+        ag_compose_report rep;
+        ag_grammar *g = compose(r, p, target, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, &rep);
+        assert_int_equal(rep.instances, 1);
+        assert_true(rep.cloned >= 1);
+        ag_mesh *d = derive(g);
+        ag_box *cb = pf_component_boxes(d);
+        ag_box bb = ag_mesh_bounds(d);
+        for (size_t s = 0; s < ns; s++)
+            if (s == which)
+                check_window(cb, d->ncomponents, &slots[s], 0.08, 1, &bb);
+            else
+                check_window(cb, d->ncomponents, &slots[s], 0.12, 2, &bb);
+        assert_int_equal(d->ncomponents, 5 + 8 * (ns - 1) + 7);
+        free(cb);
+        ag_mesh_free(d);
+        ag_grammar_free(g);
+        free(slots);
+        ag_proceduralize_result_free(r);
+        ag_mesh_free(m);
+        ag_part_free(p);
+    }
+}
+
+/* Fill: B's blank back wall becomes a grid of A's window, each fitted to its cell (frames kept),
+ * flush with the wall's outer face. */
+static void test_fill_blank_wall(void **state)
+{
+    (void)state;
+    pf_options oa = design_a(PF_FLUSH, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    ag_part *p = save_window(&oa, 2);
+    ag_mesh *m;
+    ag_box *slots;
+    size_t ns;
+    ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+    /* the back wall: 11.2 x 0.3 x 10.6 at y in [D - 0.3, D] */
+    ag_box bounds = ag_mesh_bounds(m);
+    double Dp = bounds.max[1] - 0.2; /* the roof overhangs by 0.2 */
+    ag_box back = {{0, Dp - 0.3, 0}, {11.2, Dp, 10.6}};
+    int32_t target = pf_node_with_box(r, &back, TOL);
+    assert_true(target > 0);
+    ag_compose_report rep;
+    ag_grammar *g = compose(r, p, target, AG_COMPOSE_FILL, AG_COMPOSE_NODE, &rep);
+    /* 11.2 / 1.2 -> 9 columns, 10.6 / 1.8 -> 6 rows, one layer */
+    assert_int_equal(rep.counts[0], 9);
+    assert_int_equal(rep.counts[1], 1);
+    assert_int_equal(rep.counts[2], 6);
+    ag_mesh *d = derive(g);
+    ag_box *cb = pf_component_boxes(d);
+    ag_box bb = ag_mesh_bounds(d);
+    double cw = 11.2 / 9, ch = 10.6 / 6;
+    for (int j = 0; j < 6; j++)
+        for (int i = 0; i < 9; i++) {
+            /* the back faces +y: the cell is flush with y = Dp, 0.16 deep */
+            ag_box cell = {{i * cw, Dp - 0.16, j * ch}, {(i + 1) * cw, Dp, (j + 1) * ch}};
+            check_window(cb, d->ncomponents, &cell, 0.08, 1, &bb);
+        }
+    /* B's windows are untouched */
+    for (size_t s = 0; s < ns; s++)
+        check_window(cb, d->ncomponents, &slots[s], 0.12, 2, &bb);
+    assert_int_equal(d->ncomponents, 5 + 8 * ns + 7 * 54);
+    free(cb);
+    ag_mesh_free(d);
+    ag_grammar_free(g);
+    free(slots);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+    ag_part_free(p);
+}
+
+/* Insert: a balcony part stands between B's front wall and its windows. */
+static void test_insert_balcony(void **state)
+{
+    (void)state;
+    pf_options oc = design_a(PF_FLUSH, 0, 0, 0);
+    oc.balcony = 1;
+    ag_mesh *mc;
+    ag_box *sc;
+    size_t nsc;
+    ag_proceduralize_result *rc = building(&oc, &mc, &sc, &nsc);
+    ag_box bal = {{0.9, -1.0, 1.0}, {3.9, 0, 2.1}};
+    int32_t bn = pf_node_with_box(rc, &bal, TOL);
+    assert_true(bn > 0);
+    ag_part_meta meta = {.name = "balcony", .tags = (const char *const[]){"balcony", "steel"}, .ntags = 2};
+    ag_part *p = NULL;
+    ag_error err = {0};
+    if (ag_part_extract(rc, bn, &meta, &p, &err))
+        fail_msg("extract: %s", err.text);
+    pf_options ob = design_b(PF_RECESSED, 0, 0, 0);
+    ag_mesh *m;
+    ag_box *slots;
+    size_t ns;
+    ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+    ag_box front = {{0, 0, 0}, {11.2, 0.3, 10.6}};
+    int32_t target = pf_node_with_box(r, &front, TOL);
+    assert_true(target > 0);
+    ag_compose_report rep;
+    ag_grammar *g = compose(r, p, target, AG_COMPOSE_INSERT, AG_COMPOSE_NODE, &rep);
+    ag_mesh *d = derive(g);
+    ag_box *cb = pf_component_boxes(d);
+    ag_box bb = ag_mesh_bounds(d);
+    /* the wall and all of B's windows are where they were */
+    size_t walls = 0, slabs = 0, in_wall = 0;
+    for (size_t c = 0; c < d->ncomponents; c++) {
+        walls += pf_same_box(&cb[c], &front, TOL);
+        int32_t gi = d->component_group[c];
+        if (gi >= 0 && !strncmp(d->group_names[gi], "balcony_", 8)) {
+            in_wall += pf_inside(&cb[c], &front, TOL);
+            /* the slab keeps its 0.15 thickness, spanning the wall's width */
+            slabs += fabs(cb[c].max[2] - cb[c].min[2] - 0.15) < TOL &&
+                     fabs(cb[c].max[0] - cb[c].min[0] - 11.2) < TOL;
+        }
+    }
+    assert_true(walls >= 2); /* the wall's own terminal and the balcony's volume */
+    assert_int_equal(slabs, 1);
+    assert_int_equal(in_wall, 8); /* volume, slab, rail, 5 posts */
+    for (size_t s = 0; s < ns; s++)
+        check_window(cb, d->ncomponents, &slots[s], 0.12, 2, &bb);
+    assert_int_equal(d->ncomponents, 5 + 8 * ns + 8);
+    /* in the grammar the windows hang below the inserted rule, after the part's root */
+    int32_t ins = -1;
+    for (size_t i = 0; i < g->nrules; i++)
+        if (strstr(g->rules[i].name, "balcony_over_"))
+            ins = (int32_t)i;
+    assert_true(ins >= 0);
+    const ag_grule *ir = &g->rules[ins];
+    assert_string_equal(ir->stmts[0].callee, rep.root);
+    size_t applies = 0;
+    for (size_t i = 1; i < ir->nstmts; i++)
+        applies += ir->stmts[i].kind == AG_GSTMT_APPLY;
+    assert_true(applies >= 1);
+    free(cb);
+    ag_mesh_free(d);
+    ag_grammar_free(g);
+    free(slots);
+    free(sc);
+    ag_proceduralize_result_free(r);
+    ag_proceduralize_result_free(rc);
+    ag_mesh_free(m);
+    ag_mesh_free(mc);
+    ag_part_free(p);
+}
+
+/* Target and part with rules of the same names: both kept (the part's renamed), the target's
+ * other rules unchanged; composing a building's own window into itself shares everything. */
+static void test_names_clash_and_share(void **state)
+{
+    (void)state;
+    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    ag_part *p = save_window(&oa, 0);
+    ag_mesh *m;
+    ag_box *slots;
+    size_t ns;
+    ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+    int32_t target = pf_node_with_box(r, &slots[0], TOL);
+    ag_compose_report rep;
+    ag_grammar *g = compose(r, p, target, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE, &rep);
+    size_t clashes = 0;
+    for (size_t i = 0; i < p->grammar->nrules; i++)
+        for (size_t k = 0; k < r->grammar->nrules; k++)
+            clashes += !strcmp(p->grammar->rules[i].name, r->grammar->rules[k].name);
+    assert_true(clashes > 0);
+    assert_true(rep.renamed > 0);
+    /* every rule of B is still there under its name, unchanged but for the rewritten one */
+    for (size_t k = 0; k < r->grammar->nrules; k++) {
+        const ag_grule *o = &r->grammar->rules[k];
+        int found = 0;
+        for (size_t i = 0; i < g->nrules && !found; i++)
+            if (!strcmp(g->rules[i].name, o->name)) {
+                found = 1;
+                if (strcmp(o->name, rep.target_rule))
+                    assert_int_equal(g->rules[i].nstmts, o->nstmts);
+            }
+        assert_true(found);
+    }
+    ag_grammar_free(g);
+    /* a window of A composed into A: its rules and terminals are A's own */
+    ag_mesh *ma;
+    ag_box *sa;
+    size_t na;
+    ag_proceduralize_result *ra = building(&oa, &ma, &sa, &na);
+    int32_t ta = pf_node_with_box(ra, &sa[3], TOL);
+    g = compose(ra, p, ta, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, &rep);
+    assert_int_equal(rep.terminals_added, 0);
+    assert_true(rep.terminals_shared > 0);
+    assert_true(rep.rules_shared > 0);
+    ag_mesh *d = derive(g);
+    ag_box *cb = pf_component_boxes(d);
+    ag_box bb = ag_mesh_bounds(d);
+    for (size_t s = 0; s < na; s++)
+        check_window(cb, d->ncomponents, &sa[s], 0.08, 1, &bb);
+    free(cb);
+    ag_mesh_free(d);
+    ag_grammar_free(g);
+    free(sa);
+    ag_proceduralize_result_free(ra);
+    ag_mesh_free(ma);
+    free(slots);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+    ag_part_free(p);
+}
+
+/* Bad ops: a node that does not exist, an inlined target with scope rule, a bad mode. */
+static void test_bad_ops(void **state)
+{
+    (void)state;
+    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    ag_part *p = save_window(&oa, 0);
+    ag_mesh *m;
+    ag_box *slots;
+    size_t ns;
+    ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+    ag_grammar *g = NULL;
+    ag_error err = {0};
+    ag_compose_op op = {.target = 100000, .mode = AG_COMPOSE_REPLACE, .scope = AG_COMPOSE_NODE};
+    assert_int_equal(ag_compose(r, p, &op, &g, NULL, &err), AG_ERR_NOT_FOUND);
+    assert_non_null(strstr(err.text, "100000"));
+    op.target = -1;
+    assert_int_equal(ag_compose(r, p, &op, &g, NULL, &err), AG_ERR_NOT_FOUND);
+    op.target = 0;
+    op.scope = AG_COMPOSE_RULE;
+    assert_int_equal(ag_compose(r, p, &op, &g, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "scope node"));
+    op.mode = 7;
+    assert_int_equal(ag_compose(r, p, &op, &g, NULL, &err), AG_ERR_INVALID);
+    assert_null(g);
+    ag_part_meta meta = {.name = ""};
+    ag_part *q = NULL;
+    assert_int_equal(ag_part_extract(r, 1, &meta, &q, &err), AG_ERR_INVALID);
+    meta.name = "x";
+    assert_int_equal(ag_part_extract(r, 99999, &meta, &q, &err), AG_ERR_NOT_FOUND);
+    assert_null(q);
+    free(slots);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+    ag_part_free(p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -216,6 +498,11 @@ int main(void)
         cmocka_unit_test(test_rule_replace_flush_turned),
         cmocka_unit_test(test_rule_replace_proud_utm),
         cmocka_unit_test(test_rule_replace_both_turned),
+        cmocka_unit_test(test_node_replace),
+        cmocka_unit_test(test_fill_blank_wall),
+        cmocka_unit_test(test_insert_balcony),
+        cmocka_unit_test(test_names_clash_and_share),
+        cmocka_unit_test(test_bad_ops),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -232,8 +232,28 @@ static void map_free(namemap *m)
 /* Brings the part's rules and terminals that `fitted` reaches into W (rules at *at, advancing
  * it), sharing identical ones; renames fitted's callees. */
 static ag_status instantiate(ag_grammar *W, const ag_part *part, ag_grule *fitted, size_t *at,
-                             const char *ident, ag_compose_report *rep, namemap *map)
+                             const char *ident, const char *body, ag_compose_report *rep,
+                             namemap *map)
 {
+    /* never share a rule that reaches the rewritten body: it would come to apply itself */
+    uint8_t *noshare = calloc(W->nrules + 1, 1);
+    if (!noshare)
+        return AG_ERR_NOMEM;
+    if (body && body[0]) {
+        int32_t b = rule_index(W, body);
+        if (b >= 0) {
+            noshare[b] = 1;
+            /* rules are in declare-before-use order: one pass upwards */
+            for (size_t i = (size_t)b + 1; i < W->nrules; i++)
+                for (size_t k = 0; k < W->rules[i].nstmts && !noshare[i]; k++) {
+                    const ag_gstmt *s = &W->rules[i].stmts[k];
+                    int32_t c = s->kind == AG_GSTMT_APPLY && s->callee_is_rule ? s->callee_ix : -1;
+                    if (c >= 0 && (size_t)c < W->nrules && noshare[c])
+                        noshare[i] = 1;
+                }
+        }
+    }
+    size_t nshareable = W->nrules;
     const ag_grammar *P = part->grammar;
     uint8_t *rules = calloc(P->nrules + 1, 1), *terms = calloc(P->nterminals + 1, 1);
     if (!rules || !terms) {
@@ -285,9 +305,10 @@ static ag_status instantiate(ag_grammar *W, const ag_part *part, ag_grule *fitte
             continue;
         const ag_grule *r = &P->rules[i];
         int32_t same = -1;
-        for (size_t k = 0; k < W->nrules && same < 0; k++)
-            if (same_body(r, &W->rules[k], map->from, map->to, map->n))
-                same = (int32_t)k;
+        /* target rules keep their indices until the part's are inserted in front of them */
+        for (size_t k = 0; k < nshareable && same < 0; k++)
+            if (!noshare[k] && same_body(r, &W->rules[*at + k], map->from, map->to, map->n))
+                same = (int32_t)(*at + k);
         if (same >= 0) {
             rep->rules_shared++;
             st = map_add(map, r->name, W->rules[same].name);
@@ -320,6 +341,7 @@ static ag_status instantiate(ag_grammar *W, const ag_part *part, ag_grule *fitte
     }
     free(rules);
     free(terms);
+    free(noshare);
     return st;
 }
 
@@ -475,6 +497,12 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
                                               ? (size_t)r->stmts[k].counts[0] * r->stmts[k].counts[1] *
                                                     r->stmts[k].counts[2]
                                               : 1;
+            }
+            long wcol;
+            if ((st = ag_grammar_resolve(W, err, &wcol))) {
+                st = ag_error_set(err, AG_ERR_INTERNAL, 0, "wrapping the target: %s",
+                                  err ? err->text : "");
+                goto done;
             }
             rc = (t->inst[content.instance].rot + s->rot) & 3;
             L = (ag_box){{0, 0, 0}, {T->size[0], T->size[1], T->size[2]}};
@@ -652,7 +680,7 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
     char ident[64];
     ag_gcopy_identifier(part->name, ident);
     size_t at = 0;
-    if ((st = instantiate(W, part, &fitted, &at, ident, rep, &map)))
+    if ((st = instantiate(W, part, &fitted, &at, ident, body_name, rep, &map)))
         goto nomem;
     ag_gcopy_unique_name(W, NULL, NULL, part->root, rep->root);
     {
@@ -664,7 +692,7 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
         fr->cap = fitted.cap;
         memset(&fitted, 0, sizeof fitted);
         long col;
-        if ((st = ag_grammar_resolve(W, err, &col))) {
+        if ((st = ag_gcopy_sort_rules(W, err)) || (st = ag_grammar_resolve(W, err, &col))) {
             st = ag_error_set(err, AG_ERR_INTERNAL, 0, "instantiating the part: %s",
                               err ? err->text : "");
             goto done;
@@ -743,7 +771,7 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
             goto nomem;
     }
     long col;
-    if ((st = ag_grammar_resolve(W, err, &col))) {
+    if ((st = ag_gcopy_sort_rules(W, err)) || (st = ag_grammar_resolve(W, err, &col))) {
         st = ag_error_set(err, AG_ERR_INTERNAL, 0, "the composed grammar does not resolve: %s",
                           err ? err->text : "");
         goto done;

@@ -153,3 +153,79 @@ void ag_gcopy_mark_reachable(const ag_grammar *g, const ag_grule *r, uint8_t *ru
         }
     }
 }
+
+typedef struct {
+    const char *name;
+    size_t index;
+} named;
+
+static int by_name(const void *a, const void *b)
+{
+    return strcmp(((const named *)a)->name, ((const named *)b)->name);
+}
+
+ag_status ag_gcopy_sort_rules(ag_grammar *g, ag_error *err)
+{
+    size_t n = g->nrules;
+    named *idx = malloc((n + 1) * sizeof *idx);
+    uint8_t *state = calloc(n + 1, 1); /* 0 new, 1 on the stack, 2 placed */
+    size_t *order = malloc((n + 1) * sizeof *order);
+    /* an explicit stack of (rule, next statement) */
+    size_t *stack = malloc((2 * n + 2) * sizeof *stack);
+    ag_grule *sorted = malloc((n + 1) * sizeof *sorted);
+    ag_status st = AG_OK;
+    if (!idx || !state || !order || !stack || !sorted) {
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < n; i++)
+        idx[i] = (named){g->rules[i].name, i};
+    qsort(idx, n, sizeof *idx, by_name);
+    size_t placed = 0;
+    for (size_t root = 0; root < n && !st; root++) {
+        if (state[root])
+            continue;
+        size_t sp = 0;
+        stack[sp++] = root;
+        stack[sp++] = 0;
+        state[root] = 1;
+        while (sp && !st) {
+            size_t r = stack[sp - 2], k = stack[sp - 1];
+            const ag_grule *rule = &g->rules[r];
+            if (k == rule->nstmts) {
+                state[r] = 2;
+                order[placed++] = r;
+                sp -= 2;
+                continue;
+            }
+            stack[sp - 1] = k + 1;
+            const ag_gstmt *s = &rule->stmts[k];
+            if (s->kind != AG_GSTMT_APPLY)
+                continue;
+            named key = {s->callee, 0};
+            named *f = bsearch(&key, idx, n, sizeof *idx, by_name);
+            if (!f)
+                continue;
+            if (state[f->index] == 1)
+                st = ag_error_set(err, AG_ERR_INVALID, 0, "rule '%s' applies itself through '%s'",
+                                  g->rules[f->index].name, rule->name);
+            else if (!state[f->index]) {
+                state[f->index] = 1;
+                stack[sp++] = f->index;
+                stack[sp++] = 0;
+            }
+        }
+    }
+    if (!st) {
+        for (size_t i = 0; i < n; i++)
+            sorted[i] = g->rules[order[i]];
+        memcpy(g->rules, sorted, n * sizeof *sorted);
+    }
+done:
+    free(idx);
+    free(state);
+    free(order);
+    free(stack);
+    free(sorted);
+    return st;
+}

@@ -33,6 +33,11 @@ void ag_gcopy_unique_name(const ag_grammar *a, const ag_grammar *b, const ag_gra
  * prefixed with '_', at most 40 characters; "part" when nothing is left. */
 void ag_gcopy_identifier(const char *text, char out[64]);
 
+/* Reorders g's rules so that every rule comes after the rules it applies, keeping the order
+ * otherwise (depth-first, in the current order). AG_ERR_INVALID naming a rule when they apply
+ * each other in a cycle. Indices are stale afterwards: resolve. */
+ag_status ag_gcopy_sort_rules(ag_grammar *g, ag_error *err);
+
 /* Marks, in *rules (g->nrules) and *terminals (g->nterminals), everything that the statements
  * of body r reach, directly or through rules (r is resolved against g). */
 void ag_gcopy_mark_reachable(const ag_grammar *g, const ag_grule *r, uint8_t *rules,
