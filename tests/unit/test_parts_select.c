@@ -112,9 +112,9 @@ static void test_click_and_walk(void **state)
     assert_int_equal(ag_select_pick(R, o, d, &hit, NULL), AG_OK);
     int32_t casing = pf_node_with_box(R, s, TOL);
     assert_int_equal(hit, casing);
-    double away[3] = {0, -1, 0};
+    double away[3] = {0, -1, 0}, far[3] = {o[0], -10, o[2]};
     ag_error err = {0};
-    assert_int_equal(ag_select_pick(R, o, away, &hit, &err), AG_ERR_NOT_FOUND);
+    assert_int_equal(ag_select_pick(R, far, away, &hit, &err), AG_ERR_NOT_FOUND);
     /* walking down from the casing reaches its 7 members, each child's parent is the casing
      * (or a pattern below it), siblings walk both ways */
     const ag_splittree *t = R->tree;
