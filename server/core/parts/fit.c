@@ -234,6 +234,21 @@ ag_status ag_fit_body(const ag_grammar *g, const ag_grule *r, const double size[
     for (int a = 0; a < 3; a++)
         if (!isfinite(size[a]) || size[a] < 0)
             return ag_error_set(err, AG_ERR_INVALID, 0, "the fitted size is not finite");
+    /* the same size: the body as it is (no solve) */
+    {
+        double d = 0, sc = 0;
+        for (int a = 0; a < 3; a++) {
+            d = fmax(d, fabs(size[a] - S[a]));
+            sc = fmax(sc, fabs(S[a]));
+        }
+        if (d <= 1e-12 * (sc + 1)) {
+            for (size_t i = 0; i < r->nstmts; i++)
+                if (ag_gcopy_stmt(out, &r->stmts[i], NULL, NULL, NULL))
+                    return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            rep->elements = r->nstmts;
+            return AG_OK;
+        }
+    }
     size_t nn = r->nnodes ? r->nnodes : 1;
     ag_box *nb = malloc(nn * sizeof *nb);
     int32_t *elem_of = malloc(nn * sizeof *elem_of);
@@ -317,6 +332,13 @@ ag_status ag_fit_body(const ag_grammar *g, const ag_grule *r, const double size[
     double ratio[3];
     for (int a = 0; a < 3; a++)
         ratio[a] = S[a] > 0 ? size[a] / S[a] : 1;
+    /* an axis that keeps its size keeps every coordinate on it: no unknowns there */
+    for (int a = 0; a < 3; a++)
+        if (fabs(size[a] - S[a]) <= tol)
+            for (size_t e = 1; e < ne; e++) {
+                fix(&c, (uint32_t)(6 * e + a), el[e].box.min[a], tol);
+                fix(&c, (uint32_t)(6 * e + 3 + a), el[e].box.max[a], tol);
+            }
     /* pairs by a sweep along x: only boxes that meet on x can share or overlap anything */
     for (size_t i = 0; i < ne; i++)
         order[i] = (uint32_t)i;

@@ -210,16 +210,13 @@ size_t ag_trace_site_terminals(const ag_trace *t, const ag_grammar *g, ag_trace_
     size_t n = 0;
     for (size_t i = 0; i < r->nstmts; i++) {
         const ag_gstmt *st = &r->stmts[i];
-        if (st->kind != AG_GSTMT_APPLY || !below[st->node_ix])
-            continue;
-        if (!st->callee_is_rule) {
+        if (st->kind == AG_GSTMT_APPLY && below[st->node_ix] && !st->callee_is_rule)
             n += st->subdivide ? (size_t)st->counts[0] * st->counts[1] * st->counts[2] : 1;
-            continue;
-        }
-        for (int32_t c = in->first_child; c >= 0; c = t->inst[c].next_sibling)
-            if (t->inst[c].stmt == (int32_t)i)
-                n += t->inst[c].terminals;
     }
+    /* rules applied below the node: their instances, one pass over the children */
+    for (int32_t c = in->first_child; c >= 0; c = t->inst[c].next_sibling)
+        if (below[r->stmts[t->inst[c].stmt].node_ix])
+            n += t->inst[c].terminals;
     if (below != stackmark)
         free(below);
     return n;
