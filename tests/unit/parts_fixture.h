@@ -1,4 +1,5 @@
-/* Generated buildings for the parts library tests (test_parts_*.c), header-only.
+/* Generated buildings for the parts library tests (test_parts_*.c), header-only; include it
+ * after <cmocka.h>.
  *
  * A block of four wall slabs and a roof; windows on the front (facing -y before the building's
  * turn) and optionally on the right facade (facing +x). A window is a casing box holding four
@@ -18,6 +19,7 @@
 
 #include "core/mesh.h"
 #include "core/proc/proceduralize.h"
+#include "edit_fixture.h"
 
 enum { PF_RECESSED = 0, PF_FLUSH = 1, PF_PROUD = 2 };
 
@@ -153,16 +155,8 @@ static inline ag_mesh *pf_building(const pf_options *o, ag_box **slots, size_t *
     return g.m;
 }
 
-static inline ag_proceduralize_result *pf_proc(const ag_mesh *m)
-{
-    ag_proceduralize_options o = {.verify = 1, .segment.keep_groups = 1};
-    ag_proceduralize_result *r = NULL;
-    ag_error err = {0};
-    if (ag_proceduralize_run(m, &o, &r, &err))
-        fail_msg("proceduralize: %s", err.text);
-    assert_int_equal(r->fidelity.unmatched, 0);
-    return r;
-}
+/* Proceduralized as the edit pipeline does (edit_fixture.h): checked to derive back exactly. */
+static inline ag_proceduralize_result *pf_proc(const ag_mesh *m) { return proc(m); }
 
 /* The visible node whose box is b (within tol); -1 when none. */
 static inline int32_t pf_node_with_box(const ag_proceduralize_result *r, const ag_box *b,

@@ -455,6 +455,59 @@ static void test_names_clash_and_share(void **state)
     ag_part_free(p);
 }
 
+
+/* Scope rule on a terminal (B's glass, inlined in its window rule): every application of the
+ * terminal gives way to the part, fitted to the pane. */
+static void test_rule_scope_terminal(void **state)
+{
+    (void)state;
+    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    ag_part *p = save_window(&oa, 0);
+    ag_mesh *m;
+    ag_box *slots;
+    size_t ns;
+    ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+    /* the glass of the first window: inset by the frame, 0.07 behind the casing's face */
+    ag_box glass = {{slots[0].min[0] + 0.12, slots[0].min[1] + 0.07, slots[0].min[2] + 0.12},
+                    {slots[0].max[0] - 0.12, slots[0].min[1] + 0.08, slots[0].max[2] - 0.12}};
+    int32_t target = pf_node_with_box(r, &glass, TOL);
+    assert_true(target > 0);
+    ag_compose_report rep;
+    ag_grammar *g = compose(r, p, target, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE, &rep);
+    assert_int_equal(rep.instances, ns);
+    ag_mesh *d = derive(g);
+    ag_box *cb = pf_component_boxes(d);
+    size_t part = 0;
+    for (size_t c = 0; c < d->ncomponents; c++) {
+        int32_t gi = d->component_group[c];
+        if (gi < 0 || strncmp(d->group_names[gi], "sash_window_", 12))
+            continue;
+        part++;
+        int in = 0;
+        for (size_t s = 0; s < ns && !in; s++) {
+            const ag_box *w = &slots[s];
+            int u = along_axis(w);
+            ag_box gb = *w; /* the pane of slot s */
+            gb.min[u] += 0.12;
+            gb.max[u] -= 0.12;
+            gb.min[2] += 0.12;
+            gb.max[2] -= 0.12;
+            in = pf_inside(&cb[c], &gb, TOL);
+        }
+        assert_true(in);
+    }
+    assert_int_equal(part, 7 * ns);
+    /* B's window keeps its casing, bars and mullions around the new content */
+    assert_int_equal(d->ncomponents, 5 + (7 + 7) * ns);
+    free(cb);
+    ag_mesh_free(d);
+    ag_grammar_free(g);
+    free(slots);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+    ag_part_free(p);
+}
+
 /* Bad ops: a node that does not exist, an inlined target with scope rule, a bad mode. */
 static void test_bad_ops(void **state)
 {
@@ -502,6 +555,7 @@ int main(void)
         cmocka_unit_test(test_fill_blank_wall),
         cmocka_unit_test(test_insert_balcony),
         cmocka_unit_test(test_names_clash_and_share),
+        cmocka_unit_test(test_rule_scope_terminal),
         cmocka_unit_test(test_bad_ops),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
