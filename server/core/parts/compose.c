@@ -610,30 +610,14 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
     ag_box fillbox = L;
     double cell[3] = {D[0], D[1], D[2]};
     if (op->mode == AG_COMPOSE_FILL) {
-        int ax[3] = {0, 1, 2};
-        for (int i = 0; i < 3; i++)
-            for (int j = i + 1; j < 3; j++)
-                if (D[ax[j]] > D[ax[i]]) {
-                    int x = ax[i];
-                    ax[i] = ax[j];
-                    ax[j] = x;
-                }
-        double total = 1;
-        for (int i = 0; i < 2; i++) {
-            int a = ax[i];
-            double rr = Pk[a] > 0 ? D[a] / Pk[a] : 1;
-            if (!(rr < 1e7)) {
-                st = ag_error_set(err, AG_ERR_TOO_LARGE, op->target,
-                                  "the part is too small to fill node %d", (int)op->target);
-                goto done;
-            }
-            rep->counts[a] = rr < 1.5 ? 1u : (unsigned)lround(rr);
-            cell[a] = D[a] / rep->counts[a];
-            total *= rep->counts[a];
+        /* the grid in the body's local axes: the face it faces there */
+        double step[3];
+        if (ag_place_fill_grid(&L, Pk, (fd - rc) & 3, rep->counts, step, &fillbox)) {
+            st = ag_error_set(err, AG_ERR_TOO_LARGE, op->target,
+                              "the part is too small to fill node %d", (int)op->target);
+            goto done;
         }
-        int a = ax[2];
-        rep->counts[a] = 1;
-        double tris = 0;
+        double total = (double)rep->counts[0] * rep->counts[1] * rep->counts[2], tris = 0;
         for (size_t i = 0; i < P->nterminals; i++)
             tris += (double)P->terminals[i].ntris;
         if (total > AG_COMPOSE_MAX_FILL_CELLS || total * tris > 5e7) {
@@ -643,16 +627,9 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
                               (int)op->target, total, AG_COMPOSE_MAX_FILL_CELLS);
             goto done;
         }
-        cell[a] = fmin(Pk[a] > 0 ? Pk[a] : D[a], D[a]);
-        int lf = (fd - rc) & 3, facing_axis = lf & 1;
-        if (a == facing_axis && lf < 2)
-            fillbox.min[a] = L.max[a] - cell[a];
-        else if (a == facing_axis)
-            fillbox.max[a] = L.min[a] + cell[a];
-        else {
-            double c = 0.5 * (L.min[a] + L.max[a]);
-            fillbox.min[a] = c - 0.5 * cell[a];
-            fillbox.max[a] = c + 0.5 * cell[a];
+        for (int a = 0; a < 3; a++) {
+            cell[a] = fillbox.max[a] - fillbox.min[a];
+            fillbox.max[a] += (rep->counts[a] - 1) * step[a];
         }
     }
     Sk[0] = k & 1 ? cell[1] : cell[0];
