@@ -508,6 +508,56 @@ static void test_rule_scope_terminal(void **state)
     ag_part_free(p);
 }
 
+
+/* A pattern node (B's front window grid): scope node replaces the whole grid by one part fitted
+ * to it; scope rule is refused with the rule named. */
+static void test_pattern_target(void **state)
+{
+    (void)state;
+    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    ag_part *p = save_window(&oa, 0);
+    ag_mesh *m;
+    ag_box *slots;
+    size_t ns;
+    ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+    int32_t w0 = pf_node_with_box(r, &slots[0], TOL);
+    int32_t pat = r->tree->nodes[w0].parent;
+    while (pat >= 0 && r->tree->nodes[pat].kind == AG_NODE_SPLIT)
+        pat = r->tree->nodes[pat].parent;
+    assert_int_equal(r->tree->nodes[pat].kind, AG_NODE_PATTERN);
+    ag_box grid = r->tree->nodes[pat].box;
+    ag_compose_op op = {.target = pat, .mode = AG_COMPOSE_REPLACE, .scope = AG_COMPOSE_RULE};
+    ag_grammar *g = NULL;
+    ag_error err = {0};
+    assert_int_equal(ag_compose(r, p, &op, &g, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "pattern"));
+    ag_compose_report rep;
+    g = compose(r, p, pat, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, &rep);
+    ag_mesh *d = derive(g);
+    ag_box *cb = pf_component_boxes(d);
+    size_t in_grid = 0, part = 0;
+    for (size_t c = 0; c < d->ncomponents; c++) {
+        int32_t gi = d->component_group[c];
+        int is_part = gi >= 0 && !strncmp(d->group_names[gi], "sash_window_", 12);
+        part += is_part;
+        in_grid += pf_inside(&cb[c], &grid, TOL);
+        if (is_part)
+            assert_true(pf_inside(&cb[c], &grid, TOL));
+    }
+    assert_int_equal(part, 7);
+    assert_int_equal(in_grid, 7); /* nothing of B's front windows is left in the grid */
+    /* the part's casing spans the grid: the frame bars keep 0.08 */
+    ag_box bb = ag_mesh_bounds(d);
+    check_window(cb, d->ncomponents, &grid, 0.08, 1, &bb);
+    free(cb);
+    ag_mesh_free(d);
+    ag_grammar_free(g);
+    free(slots);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+    ag_part_free(p);
+}
+
 /* Bad ops: a node that does not exist, an inlined target with scope rule, a bad mode. */
 static void test_bad_ops(void **state)
 {
@@ -556,6 +606,7 @@ int main(void)
         cmocka_unit_test(test_insert_balcony),
         cmocka_unit_test(test_names_clash_and_share),
         cmocka_unit_test(test_rule_scope_terminal),
+        cmocka_unit_test(test_pattern_target),
         cmocka_unit_test(test_bad_ops),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -507,6 +507,12 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
             rc = (t->inst[content.instance].rot + s->rot) & 3;
             L = (ag_box){{0, 0, 0}, {T->size[0], T->size[1], T->size[2]}};
             body_node = 0;
+        } else if (nu == 1 && cb->stmts[only].kind == AG_GSTMT_APPLY && cb->stmts[only].subdivide) {
+            st = ag_error_set(err, AG_ERR_INVALID, op->target,
+                              "target: node %d is a pattern of rule %s; compose into one of its "
+                              "cells for scope rule, or use scope node",
+                              (int)op->target, cb->stmts[only].callee);
+            goto done;
         } else {
             const ag_trace_instance *ci = &t->inst[content.instance];
             st = ag_error_set(err, AG_ERR_INVALID, op->target,
@@ -698,7 +704,10 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
     for (size_t i = 0; i < M->nstmts; i++) {
         const ag_gstmt *s = &M->stmts[i];
         int in = s->kind == AG_GSTMT_SPLIT ? below[s->parent_ix] : below[s->node_ix];
-        int own = s->kind == AG_GSTMT_APPLY && s->node_ix == body_node;
+        /* the target's own geometry: terminals placed on it; rules and patterns applied on
+         * its box are content below it */
+        int own = s->kind == AG_GSTMT_APPLY && s->node_ix == body_node && !s->callee_is_rule &&
+                  !s->subdivide;
         drop[i] = in && (op->mode == AG_COMPOSE_REPLACE || !own);
     }
     if (op->mode == AG_COMPOSE_INSERT) {

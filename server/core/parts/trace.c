@@ -172,25 +172,6 @@ void ag_trace_free(ag_trace *t)
     free(t);
 }
 
-int ag_trace_node_below(const ag_grule *r, int32_t node, int32_t anc)
-{
-    /* body nodes are defined in statement order, each by one split */
-    while (node != anc) {
-        if (node <= 0)
-            return 0;
-        int32_t parent = -1;
-        for (size_t i = 0; i < r->nstmts; i++)
-            if (r->stmts[i].kind == AG_GSTMT_SPLIT && r->stmts[i].node_ix == node) {
-                parent = r->stmts[i].parent_ix;
-                break;
-            }
-        if (parent < 0)
-            return 0;
-        node = parent;
-    }
-    return 1;
-}
-
 size_t ag_trace_site_terminals(const ag_trace *t, const ag_grammar *g, ag_trace_site s)
 {
     const ag_trace_instance *in = &t->inst[s.instance];

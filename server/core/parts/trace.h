@@ -54,8 +54,6 @@ void ag_trace_free(ag_trace *t);
 
 /* The body of an instance. */
 const ag_grule *ag_trace_body(const ag_grammar *g, const ag_trace_instance *in);
-/* Non-zero when body node `node` lies below (or is) body node `anc` of rule body r. */
-int ag_trace_node_below(const ag_grule *r, int32_t node, int32_t anc);
 /* Terminal placements under one site (its own applications and those of nested bodies). */
 size_t ag_trace_site_terminals(const ag_trace *t, const ag_grammar *g, ag_trace_site s);
 
