@@ -7,7 +7,8 @@
  * `mullions` vertical mullions 0.05 wide: the casing is the window's node, its members are
  * its children. Every piece is its own group, so components are pieces. Windows sit
  * recessed, flush or proud of the wall's outer face. The whole building may be turned by
- * quarter turns about z and moved by a large (UTM-sized) offset. slots[] receives every
+ * quarter turns about z and moved by a large (UTM-sized) offset, its windows jittered and its
+ * boxes triangulated along the other diagonals. slots[] receives every
  * window's world box (in generation order: front row by row, then right). */
 #ifndef AG_TEST_PARTS_FIXTURE_H
 #define AG_TEST_PARTS_FIXTURE_H
@@ -32,6 +33,8 @@ typedef struct {
     double ox, oy;                  /* offset */
     double sx, sz;                  /* window spacing */
     int balcony;                    /* a balcony in front of the front wall */
+    double jitter;                  /* windows moved by up to this much (deterministic) */
+    int flip;                       /* boxes triangulated along their other diagonals */
 } pf_options;
 
 typedef struct {
@@ -39,6 +42,8 @@ typedef struct {
     int turn;
     double ox, oy;
     unsigned piece;
+    int flip;
+    uint32_t seed;
     /* facade frame */
     double fx, fy;
     int fk;
@@ -87,13 +92,27 @@ static inline ag_box pf_box(pf_gen *g, const char *what, double u0, double u1, d
     }
     static const int f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                                  {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-    for (int i = 0; i < 12; i++)
-        ag_mesh_add_triangle(g->m, base + f[i][0], base + f[i][1], base + f[i][2], (uint32_t)comp);
+    /* the same quads split along the other diagonal */
+    static const int h[12][3] = {{0, 3, 1}, {0, 2, 3}, {4, 5, 7}, {4, 7, 6}, {0, 5, 4}, {0, 1, 5},
+                                 {2, 7, 3}, {2, 6, 7}, {0, 6, 2}, {0, 4, 6}, {1, 7, 5}, {1, 3, 7}};
+    for (int i = 0; i < 12; i++) {
+        const int *q = g->flip ? h[i] : f[i];
+        ag_mesh_add_triangle(g->m, base + q[0], base + q[1], base + q[2], (uint32_t)comp);
+    }
     return b;
+}
+
+/* Deterministic offsets in [-1, 1]. */
+static inline double pf_rand(pf_gen *g)
+{
+    g->seed = g->seed * 1664525u + 1013904223u;
+    return (double)(g->seed >> 8) / (double)(1u << 23) - 1.0;
 }
 
 static inline ag_box pf_window(pf_gen *g, const pf_options *o, double u, double w)
 {
+    u += o->jitter * pf_rand(g);
+    w += o->jitter * pf_rand(g);
     double v0 = o->depth == PF_RECESSED ? 0.1 : o->depth == PF_FLUSH ? 0.0 : -0.08;
     double v1 = v0 + 0.16, W = o->ww, H = o->wh, fr = o->frame;
     ag_box slot = pf_box(g, "casing", u, u + W, v0, v1, w, w + H);
@@ -112,7 +131,8 @@ static inline ag_box pf_window(pf_gen *g, const pf_options *o, double u, double 
 /* The building; *slots (malloc'd, may be NULL) gets the window boxes, *nslots their count. */
 static inline ag_mesh *pf_building(const pf_options *o, ag_box **slots, size_t *nslots)
 {
-    pf_gen g = {.m = ag_mesh_create(), .turn = o->turn, .ox = o->ox, .oy = o->oy};
+    pf_gen g = {.m = ag_mesh_create(), .turn = o->turn, .ox = o->ox, .oy = o->oy,
+                .flip = o->flip, .seed = 12345};
     double sx = o->sx > 0 ? o->sx : o->ww + 1.0, sz = o->sz > 0 ? o->sz : o->wh + 1.2;
     double Wd = 2 * 0.9 + (o->cols - 1) * sx + o->ww;
     unsigned sc = o->side_cols ? o->side_cols : 2;

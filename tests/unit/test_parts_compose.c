@@ -145,9 +145,12 @@ static void check_window(const ag_box *cb, size_t nc, const ag_box *slot, double
     assert_int_equal(mull, mullions);
 }
 
-static void rule_scope_replace(int depth, int turn_a, int turn_b, double ox, double oy)
+static void rule_scope_replace_ex(int depth, int turn_a, int turn_b, double ox, double oy,
+                                  double jitter, int flip)
 {
     pf_options oa = design_a(depth, turn_a, ox, oy), ob = design_b(depth, turn_b, -ox, oy);
+    oa.flip = flip;
+    ob.jitter = jitter;
     ag_part *p = save_window(&oa, 1);
     ag_box *slots;
     size_t ns;
@@ -198,6 +201,19 @@ static void rule_scope_replace(int depth, int turn_a, int turn_b, double ox, dou
     ag_proceduralize_result_free(r);
     ag_mesh_free(m);
     ag_part_free(p);
+}
+
+static void rule_scope_replace(int depth, int turn_a, int turn_b, double ox, double oy)
+{
+    rule_scope_replace_ex(depth, turn_a, turn_b, ox, oy, 0, 0);
+}
+
+/* B's windows off their grid by up to 3 mm (no pattern holds them), A's boxes triangulated
+ * the other way. */
+static void test_rule_replace_jittered_flipped(void **state)
+{
+    (void)state;
+    rule_scope_replace_ex(PF_RECESSED, 0, 1, 0, 0, 0.003, 1);
 }
 
 static void test_rule_replace_recessed(void **state) { (void)state; rule_scope_replace(PF_RECESSED, 0, 0, 0, 0); }
@@ -601,6 +617,7 @@ int main(void)
         cmocka_unit_test(test_rule_replace_flush_turned),
         cmocka_unit_test(test_rule_replace_proud_utm),
         cmocka_unit_test(test_rule_replace_both_turned),
+        cmocka_unit_test(test_rule_replace_jittered_flipped),
         cmocka_unit_test(test_node_replace),
         cmocka_unit_test(test_fill_blank_wall),
         cmocka_unit_test(test_insert_balcony),
