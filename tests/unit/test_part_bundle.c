@@ -366,6 +366,121 @@ static void test_absurd_sizes(void **state)
     expect_refused(j, AG_ERR_TOO_LARGE, "parts[0].grammar", "derives");
 }
 
+
+/* Deterministic mutations of a good bundle: every read either succeeds or fails with a message,
+ * never crashes; mutations inside the grammar and the terminals are read through their parsers. */
+static void test_mutations(void **state)
+{
+    (void)state;
+    char *text = bundle_text();
+    size_t len = strlen(text);
+    uint32_t seed = 7;
+    size_t refused = 0, read = 0;
+    for (int i = 0; i < 400; i++) {
+        char *m = strdup(text);
+        int edits = 1 + i % 4;
+        for (int e = 0; e < edits; e++) {
+            seed = seed * 1664525u + 1013904223u;
+            size_t at = (seed >> 4) % len;
+            static const char pool[] = "{}[],:\"0123456789-.e \\nvfT_aZ";
+            seed = seed * 1664525u + 1013904223u;
+            m[at] = pool[(seed >> 8) % (sizeof pool - 1)];
+        }
+        ag_part **parts = NULL;
+        size_t n = 0;
+        ag_error err = {0};
+        ag_status st = ag_part_bundle_read(m, len, &parts, &n, &err);
+        if (st) {
+            assert_null(parts);
+            assert_true(err.text[0] != 0);
+            refused++;
+        } else {
+            assert_true(n >= 1);
+            read++;
+            ag_part_bundle_free(parts, n);
+        }
+        free(m);
+    }
+    print_message("%zu mutated bundles refused, %zu still valid\n", refused, read);
+    assert_true(refused > 0);
+    /* inside the grammar text, and inside a terminal's OBJ text kept under its new hash */
+    size_t deep_refused = 0;
+    for (int i = 0; i < 300; i++) {
+        json_t *j = json_loads(text, 0, NULL);
+        int in_obj = i & 1;
+        json_t *terms = json_object_get(j, "terminals");
+        char *g = strdup(json_string_value(json_object_get(part0(j), "grammar")));
+        char *target = g;
+        const char *key = NULL;
+        json_t *val = NULL;
+        if (in_obj) {
+            const char *k;
+            json_t *v;
+            json_object_foreach(terms, k, v) {
+                if (strstr(g, k)) {
+                    key = k;
+                    val = v;
+                    break;
+                }
+            }
+            assert_non_null(key);
+            target = strdup(json_string_value(val));
+        }
+        size_t tl = strlen(target);
+        for (int e = 0; e < 1 + i % 3; e++) {
+            seed = seed * 1664525u + 1013904223u;
+            size_t at = (seed >> 4) % tl;
+            static const char pool[] = "(){}=,.-0123456789 \nvfpR_Tsplitrot";
+            seed = seed * 1664525u + 1013904223u;
+            target[at] = pool[(seed >> 8) % (sizeof pool - 1)];
+        }
+        if (in_obj) {
+            char hex[AG_SHA256_HEX], oldkey[AG_SHA256_HEX];
+            snprintf(oldkey, sizeof oldkey, "%s", key);
+            assert_int_equal(ag_sha256_hex(target, tl, hex, NULL), AG_OK);
+            json_object_set_new(terms, hex, json_string(target));
+            char *g2 = replace(g, oldkey, hex);
+            free(g);
+            g = g2;
+            free(target);
+        }
+        set_grammar(j, g);
+        free(g);
+        char *m = json_dumps(j, 0);
+        json_decref(j);
+        ag_part **parts = NULL;
+        size_t n = 0;
+        ag_error err = {0};
+        ag_status st = ag_part_bundle_read(m, strlen(m), &parts, &n, &err);
+        if (st) {
+            assert_null(parts);
+            assert_true(err.text[0] != 0);
+            deep_refused++;
+        } else {
+            /* a part that reads composes, or is refused with a message */
+            for (size_t k = 0; k < n; k++) {
+                ag_compose_op op = {.target = pf_node_with_box(B, &SB[4], TOL),
+                                    .mode = (int)(k + i) % 3, .scope = AG_COMPOSE_RULE};
+                ag_grammar *cg = NULL;
+                ag_error ce = {0};
+                if (ag_compose(B, parts[k], &op, &cg, NULL, &ce) == AG_OK) {
+                    ag_mesh *d = NULL;
+                    if (ag_grammar_derive(cg, NULL, &d, &ce) == AG_OK)
+                        ag_mesh_free(d);
+                    ag_grammar_free(cg);
+                } else {
+                    assert_true(ce.text[0] != 0);
+                }
+            }
+            ag_part_bundle_free(parts, n);
+        }
+        free(m);
+    }
+    print_message("%zu of 300 grammar and terminal mutations refused\n", deep_refused);
+    assert_true(deep_refused > 0);
+    free(text);
+}
+
 static void test_write_file_leaves_nothing(void **state)
 {
     (void)state;
@@ -397,6 +512,7 @@ int main(void)
         cmocka_unit_test(test_bad_terminal_obj),
         cmocka_unit_test(test_cyclic_and_bad_names),
         cmocka_unit_test(test_absurd_sizes),
+        cmocka_unit_test(test_mutations),
         cmocka_unit_test(test_write_file_leaves_nothing),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
