@@ -348,29 +348,42 @@ static ag_status find_cycle(const char *s, size_t len, char *msg, size_t msgcap,
     return st;
 }
 
-/* Triangles the grammar derives, by rule (declare-before-use order), capped. */
-static double derived_triangles(const ag_grammar *g)
+/* Triangles the grammar derives and how deep its rules nest, by rule (declare-before-use
+ * order); the triangles capped. */
+static double derived_triangles(const ag_grammar *g, size_t *depth)
 {
     double *tr = calloc(g->nrules + 1, sizeof *tr);
-    if (!tr)
+    size_t *dp = calloc(g->nrules + 1, sizeof *dp);
+    if (!tr || !dp) {
+        free(tr);
+        free(dp);
         return INFINITY;
+    }
     double axiom = 0;
+    *depth = 0;
     for (size_t i = 0; i <= g->nrules; i++) {
         const ag_grule *r = i < g->nrules ? &g->rules[i] : &g->axiom;
         double n = 0;
+        size_t d = 0;
         for (size_t k = 0; k < r->nstmts; k++) {
             const ag_gstmt *s = &r->stmts[k];
             if (s->kind != AG_GSTMT_APPLY)
                 continue;
             double cells = s->subdivide ? (double)s->counts[0] * s->counts[1] * s->counts[2] : 1;
             n += cells * (s->callee_is_rule ? tr[s->callee_ix] : (double)g->terminals[s->callee_ix].ntris);
+            if (s->callee_is_rule && dp[s->callee_ix] + 1 > d)
+                d = dp[s->callee_ix] + 1;
         }
-        if (i < g->nrules)
+        if (i < g->nrules) {
             tr[i] = fmin(n, 1e300);
-        else
+            dp[i] = d;
+        } else {
             axiom = n;
+            *depth = d;
+        }
     }
     free(tr);
+    free(dp);
     return axiom;
 }
 
@@ -531,7 +544,13 @@ static ag_status read_part(json_t *o, size_t pi, const bterm *terms, size_t nter
             goto fail;
         }
     }
-    double dt = derived_triangles(g);
+    size_t depth = 0;
+    double dt = derived_triangles(g, &depth);
+    if (depth > 512) {
+        st = ag_error_set(err, AG_ERR_TOO_LARGE, 0,
+                          "%s.grammar: rules are nested %zu deep (at most 512)", where, depth);
+        goto fail;
+    }
     if (!(dt <= AG_PART_BUNDLE_MAX_TRIANGLES)) {
         st = ag_error_set(err, AG_ERR_TOO_LARGE, 0,
                           "%s.grammar: derives %.3g triangles (at most %d)", where, dt,

@@ -364,6 +364,24 @@ static void test_absurd_sizes(void **state)
     set_grammar(j, text);
     free(text);
     expect_refused(j, AG_ERR_TOO_LARGE, "parts[0].grammar", "derives");
+
+    /* rules nested 2000 deep */
+    j = fresh();
+    g = json_string_value(json_object_get(part0(j), "grammar"));
+    root = json_string_value(json_object_get(part0(j), "root"));
+    ax = strstr(g, "axiom box");
+    size_t cap = strlen(g) + 2000 * 80 + 200;
+    text = malloc(cap);
+    head = (size_t)(ax - g);
+    memcpy(text, g, head);
+    size_t at = head;
+    at += (size_t)sprintf(text + at, "rule Deep0 size 1 1 1 {\n  %s(p)\n}\n\n", root);
+    for (int k = 1; k < 2000; k++)
+        at += (size_t)sprintf(text + at, "rule Deep%d size 1 1 1 {\n  Deep%d(p)\n}\n\n", k, k - 1);
+    sprintf(text + at, "axiom box 0 0 0 1 1 1 {\n  Deep1999(p)\n}\n");
+    set_grammar(j, text);
+    free(text);
+    expect_refused(j, AG_ERR_TOO_LARGE, "parts[0].grammar", "nested");
 }
 
 

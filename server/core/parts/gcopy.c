@@ -141,15 +141,33 @@ void ag_gcopy_identifier(const char *text, char out[64])
 void ag_gcopy_mark_reachable(const ag_grammar *g, const ag_grule *r, uint8_t *rules,
                              uint8_t *terminals)
 {
+    /* rules are declared before use: every rule r reaches has a smaller index, so one pass
+     * downwards over the marked rules reaches everything (no recursion, whatever the depth) */
+    size_t top = 0;
     for (size_t i = 0; i < r->nstmts; i++) {
         const ag_gstmt *s = &r->stmts[i];
         if (s->kind != AG_GSTMT_APPLY || s->callee_ix < 0)
             continue;
         if (!s->callee_is_rule) {
             terminals[s->callee_ix] = 1;
-        } else if (!rules[s->callee_ix]) {
+        } else {
             rules[s->callee_ix] = 1;
-            ag_gcopy_mark_reachable(g, &g->rules[s->callee_ix], rules, terminals);
+            if ((size_t)s->callee_ix + 1 > top)
+                top = (size_t)s->callee_ix + 1;
+        }
+    }
+    for (size_t k = top; k-- > 0;) {
+        if (!rules[k])
+            continue;
+        const ag_grule *q = &g->rules[k];
+        for (size_t i = 0; i < q->nstmts; i++) {
+            const ag_gstmt *s = &q->stmts[i];
+            if (s->kind != AG_GSTMT_APPLY || s->callee_ix < 0)
+                continue;
+            if (s->callee_is_rule)
+                rules[s->callee_ix] = 1;
+            else
+                terminals[s->callee_ix] = 1;
         }
     }
 }
