@@ -26,6 +26,7 @@ static pf_options design_a(int depth, int turn, double ox, double oy)
     return (pf_options){.cols = 3, .rows = 2, .ww = 1.2, .wh = 1.8, .frame = 0.08, .mullions = 1,
                         .depth = depth, .turn = turn, .ox = ox, .oy = oy};
 }
+
 static pf_options design_b(int depth, int turn, double ox, double oy)
 {
     return (pf_options){.cols = 4, .rows = 3, .side_cols = 2, .ww = 1.6, .wh = 2.0,
@@ -145,87 +146,6 @@ static void check_window(const ag_box *cb, size_t nc, const ag_box *slot, double
     assert_int_equal(mull, mullions);
 }
 
-static void rule_scope_replace_ex(int depth, int turn_a, int turn_b, double ox, double oy,
-                                  double jitter, int flip)
-{
-    pf_options oa = design_a(depth, turn_a, ox, oy), ob = design_b(depth, turn_b, -ox, oy);
-    oa.flip = flip;
-    ob.jitter = jitter;
-    ag_part *p = save_window(&oa, 1);
-    ag_box *slots;
-    size_t ns;
-    ag_mesh *m = pf_building(&ob, &slots, &ns);
-    ag_proceduralize_result *r = pf_proc(m);
-    int32_t target = pf_node_with_box(r, &slots[5], TOL);
-    assert_true(target > 0);
-    ag_compose_op op = {.target = target, .mode = AG_COMPOSE_REPLACE, .scope = AG_COMPOSE_RULE};
-    ag_grammar *g = NULL;
-    ag_compose_report rep;
-    ag_error err = {0};
-    if (ag_compose(r, p, &op, &g, &rep, &err))
-        fail_msg("compose: %s", err.text);
-    print_message("%s\n", rep.message);
-    assert_int_equal(rep.instances, ns);
-    check_roundtrip(g);
-    ag_mesh *d = NULL;
-    assert_int_equal(ag_grammar_derive(g, NULL, &d, &err), AG_OK);
-    ag_box *cb = pf_component_boxes(d);
-    ag_box bb = ag_mesh_bounds(d);
-    /* every window slot of B holds A's design fitted to B's slot: frame 0.08, one mullion */
-    for (size_t s = 0; s < ns; s++)
-        check_window(cb, d->ncomponents, &slots[s], 0.08, 1, &bb);
-    /* B's own window pieces are gone, its walls and roof stay: 5 + 7 per slot */
-    assert_int_equal(d->ncomponents, 5 + 7 * ns);
-    /* the part's terminals are the ones in the slots, under the part's labels */
-    size_t part_comps = 0;
-    for (size_t c = 0; c < d->ncomponents; c++) {
-        int32_t gi = d->component_group[c];
-        if (gi >= 0 && !strncmp(d->group_names[gi], "sash_window_", 12)) {
-            part_comps++;
-            int in = 0;
-            for (size_t s = 0; s < ns && !in; s++)
-                in = pf_inside(&cb[c], &slots[s], TOL);
-            assert_true(in);
-        }
-    }
-    assert_int_equal(part_comps, 7 * ns);
-    /* editable like any model: it proceduralizes again */
-    ag_edit_model *em = NULL;
-    if (ag_edit_model_from_grammar(g, NULL, &em, &err))
-        fail_msg("re-proceduralize: %s", err.text);
-    ag_edit_model_free(em);
-    free(cb);
-    ag_mesh_free(d);
-    ag_grammar_free(g);
-    free(slots);
-    ag_proceduralize_result_free(r);
-    ag_mesh_free(m);
-    ag_part_free(p);
-}
-
-static void rule_scope_replace(int depth, int turn_a, int turn_b, double ox, double oy)
-{
-    rule_scope_replace_ex(depth, turn_a, turn_b, ox, oy, 0, 0);
-}
-
-/* B's windows off their grid by up to 3 mm (no pattern holds them), A's boxes triangulated
- * the other way. */
-static void test_rule_replace_jittered_flipped(void **state)
-{
-    (void)state;
-    rule_scope_replace_ex(PF_RECESSED, 0, 1, 0, 0, 0.003, 1);
-}
-
-static void test_rule_replace_recessed(void **state) { (void)state; rule_scope_replace(PF_RECESSED, 0, 0, 0, 0); }
-static void test_rule_replace_flush_turned(void **state) { (void)state; rule_scope_replace(PF_FLUSH, 1, 0, 0, 0); }
-static void test_rule_replace_proud_utm(void **state)
-{
-    (void)state;
-    rule_scope_replace(PF_PROUD, 0, 3, 512345.0, 5403210.0);
-}
-static void test_rule_replace_both_turned(void **state) { (void)state; rule_scope_replace(PF_RECESSED, 2, 1, 0, 0); }
-
-
 static ag_proceduralize_result *building(const pf_options *o, ag_mesh **m, ag_box **slots,
                                          size_t *ns)
 {
@@ -255,40 +175,139 @@ static ag_mesh *derive(const ag_grammar *g)
     return d;
 }
 
+/* A part saved from building A (window `which`) and building B to compose it into; after
+ * scene_compose, the composed grammar, its derived mesh and the mesh's component boxes. */
+typedef struct {
+    ag_part *part;
+    ag_mesh *m;
+    ag_box *slots;
+    size_t ns;
+    ag_proceduralize_result *r;
+    ag_grammar *g;
+    ag_mesh *d;
+    ag_box *cb, bounds;
+    ag_compose_report rep;
+} scene;
+
+static void scene_open(scene *sc, const pf_options *oa, int which, const pf_options *ob)
+{
+    memset(sc, 0, sizeof *sc);
+    sc->part = save_window(oa, which);
+    sc->m = pf_building(ob, &sc->slots, &sc->ns);
+    sc->r = pf_proc(sc->m);
+}
+
+static void scene_compose(scene *sc, int32_t target, int mode, int scope)
+{
+    sc->g = compose(sc->r, sc->part, target, mode, scope, &sc->rep);
+    sc->d = derive(sc->g);
+    sc->cb = pf_component_boxes(sc->d);
+    sc->bounds = ag_mesh_bounds(sc->d);
+}
+
+static void scene_close(scene *sc)
+{
+    free(sc->cb);
+    ag_mesh_free(sc->d);
+    ag_grammar_free(sc->g);
+    free(sc->slots);
+    ag_proceduralize_result_free(sc->r);
+    ag_mesh_free(sc->m);
+    ag_part_free(sc->part);
+}
+
+/* Components of the part's labels (groups "sash_window_*") and how many lie in one of boxes. */
+static size_t part_components(const scene *sc, const ag_box *boxes, size_t nb, size_t *inside)
+{
+    size_t n = 0;
+    *inside = 0;
+    for (size_t c = 0; c < sc->d->ncomponents; c++) {
+        int32_t gi = sc->d->component_group[c];
+        if (gi < 0 || strncmp(sc->d->group_names[gi], "sash_window_", 12))
+            continue;
+        n++;
+        int in = 0;
+        for (size_t k = 0; k < nb && !in; k++)
+            in = pf_inside(&sc->cb[c], &boxes[k], TOL);
+        *inside += in;
+    }
+    return n;
+}
+
+static void rule_scope_replace_ex(int depth, int turn_a, int turn_b, double ox, double oy,
+                                  double jitter, int flip)
+{
+    pf_options oa = design_a(depth, turn_a, ox, oy), ob = design_b(depth, turn_b, -ox, oy);
+    oa.flip = flip;
+    ob.jitter = jitter;
+    scene sc;
+    scene_open(&sc, &oa, 1, &ob);
+    int32_t target = pf_node_with_box(sc.r, &sc.slots[5], TOL);
+    assert_true(target > 0);
+    scene_compose(&sc, target, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE);
+    assert_int_equal(sc.rep.instances, sc.ns);
+    /* every window slot of B holds A's design fitted to B's slot: frame 0.08, one mullion */
+    for (size_t s = 0; s < sc.ns; s++)
+        check_window(sc.cb, sc.d->ncomponents, &sc.slots[s], 0.08, 1, &sc.bounds);
+    /* B's own window pieces are gone, its walls and roof stay: 5 + 7 per slot */
+    assert_int_equal(sc.d->ncomponents, 5 + 7 * sc.ns);
+    /* the part's terminals are the ones in the slots, under the part's labels */
+    size_t inside, n = part_components(&sc, sc.slots, sc.ns, &inside);
+    assert_int_equal(n, 7 * sc.ns);
+    assert_int_equal(inside, n);
+    /* editable like any model: it proceduralizes again */
+    ag_edit_model *em = NULL;
+    ag_error err = {0};
+    if (ag_edit_model_from_grammar(sc.g, NULL, &em, &err))
+        fail_msg("re-proceduralize: %s", err.text);
+    ag_edit_model_free(em);
+    scene_close(&sc);
+}
+
+static void rule_scope_replace(int depth, int turn_a, int turn_b, double ox, double oy)
+{
+    rule_scope_replace_ex(depth, turn_a, turn_b, ox, oy, 0, 0);
+}
+
+/* B's windows off their grid by up to 3 mm (no pattern holds them), A's boxes triangulated
+ * the other way. */
+static void test_rule_replace_jittered_flipped(void **state)
+{
+    (void)state;
+    rule_scope_replace_ex(PF_RECESSED, 0, 1, 0, 0, 0.003, 1);
+}
+
+static void test_rule_replace_recessed(void **state) { (void)state; rule_scope_replace(PF_RECESSED, 0, 0, 0, 0); }
+static void test_rule_replace_flush_turned(void **state) { (void)state; rule_scope_replace(PF_FLUSH, 1, 0, 0, 0); }
+static void test_rule_replace_proud_utm(void **state)
+{
+    (void)state;
+    rule_scope_replace(PF_PROUD, 0, 3, 512345.0, 5403210.0);
+}
+
+static void test_rule_replace_both_turned(void **state) { (void)state; rule_scope_replace(PF_RECESSED, 2, 1, 0, 0); }
+
 /* Scope node: one window of B gets A's design, the others keep B's. */
 static void test_node_replace(void **state)
 {
     (void)state;
     for (int turn = 0; turn < 4; turn += 3) {
         pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, turn, 0, 0);
-        ag_part *p = save_window(&oa, 0);
-        ag_mesh *m;
-        ag_box *slots;
-        size_t ns;
-        ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+        scene sc;
+        scene_open(&sc, &oa, 0, &ob);
         size_t which = 13; /* on the right facade */
-        int32_t target = pf_node_with_box(r, &slots[which], TOL);
+        int32_t target = pf_node_with_box(sc.r, &sc.slots[which], TOL);
         assert_true(target > 0);
-        ag_compose_report rep;
-        ag_grammar *g = compose(r, p, target, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, &rep);
-        assert_int_equal(rep.instances, 1);
-        assert_true(rep.cloned >= 1);
-        ag_mesh *d = derive(g);
-        ag_box *cb = pf_component_boxes(d);
-        ag_box bb = ag_mesh_bounds(d);
-        for (size_t s = 0; s < ns; s++)
+        scene_compose(&sc, target, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE);
+        assert_int_equal(sc.rep.instances, 1);
+        assert_true(sc.rep.cloned >= 1);
+        for (size_t s = 0; s < sc.ns; s++)
             if (s == which)
-                check_window(cb, d->ncomponents, &slots[s], 0.08, 1, &bb);
+                check_window(sc.cb, sc.d->ncomponents, &sc.slots[s], 0.08, 1, &sc.bounds);
             else
-                check_window(cb, d->ncomponents, &slots[s], 0.12, 2, &bb);
-        assert_int_equal(d->ncomponents, 5 + 8 * (ns - 1) + 7);
-        free(cb);
-        ag_mesh_free(d);
-        ag_grammar_free(g);
-        free(slots);
-        ag_proceduralize_result_free(r);
-        ag_mesh_free(m);
-        ag_part_free(p);
+                check_window(sc.cb, sc.d->ncomponents, &sc.slots[s], 0.12, 2, &sc.bounds);
+        assert_int_equal(sc.d->ncomponents, 5 + 8 * (sc.ns - 1) + 7);
+        scene_close(&sc);
     }
 }
 
@@ -298,44 +317,31 @@ static void test_fill_blank_wall(void **state)
 {
     (void)state;
     pf_options oa = design_a(PF_FLUSH, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
-    ag_part *p = save_window(&oa, 2);
-    ag_mesh *m;
-    ag_box *slots;
-    size_t ns;
-    ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+    scene sc;
+    scene_open(&sc, &oa, 2, &ob);
     /* the back wall: 11.2 x 0.3 x 10.6 at y in [D - 0.3, D] */
-    ag_box bounds = ag_mesh_bounds(m);
+    ag_box bounds = ag_mesh_bounds(sc.m);
     double Dp = bounds.max[1] - 0.2; /* the roof overhangs by 0.2 */
     ag_box back = {{0, Dp - 0.3, 0}, {11.2, Dp, 10.6}};
-    int32_t target = pf_node_with_box(r, &back, TOL);
+    int32_t target = pf_node_with_box(sc.r, &back, TOL);
     assert_true(target > 0);
-    ag_compose_report rep;
-    ag_grammar *g = compose(r, p, target, AG_COMPOSE_FILL, AG_COMPOSE_NODE, &rep);
+    scene_compose(&sc, target, AG_COMPOSE_FILL, AG_COMPOSE_NODE);
     /* 11.2 / 1.2 -> 9 columns, 10.6 / 1.8 -> 6 rows, one layer */
-    assert_int_equal(rep.counts[0], 9);
-    assert_int_equal(rep.counts[1], 1);
-    assert_int_equal(rep.counts[2], 6);
-    ag_mesh *d = derive(g);
-    ag_box *cb = pf_component_boxes(d);
-    ag_box bb = ag_mesh_bounds(d);
+    assert_int_equal(sc.rep.counts[0], 9);
+    assert_int_equal(sc.rep.counts[1], 1);
+    assert_int_equal(sc.rep.counts[2], 6);
     double cw = 11.2 / 9, ch = 10.6 / 6;
     for (int j = 0; j < 6; j++)
         for (int i = 0; i < 9; i++) {
             /* the back faces +y: the cell is flush with y = Dp, 0.16 deep */
             ag_box cell = {{i * cw, Dp - 0.16, j * ch}, {(i + 1) * cw, Dp, (j + 1) * ch}};
-            check_window(cb, d->ncomponents, &cell, 0.08, 1, &bb);
+            check_window(sc.cb, sc.d->ncomponents, &cell, 0.08, 1, &sc.bounds);
         }
     /* B's windows are untouched */
-    for (size_t s = 0; s < ns; s++)
-        check_window(cb, d->ncomponents, &slots[s], 0.12, 2, &bb);
-    assert_int_equal(d->ncomponents, 5 + 8 * ns + 7 * 54);
-    free(cb);
-    ag_mesh_free(d);
-    ag_grammar_free(g);
-    free(slots);
-    ag_proceduralize_result_free(r);
-    ag_mesh_free(m);
-    ag_part_free(p);
+    for (size_t s = 0; s < sc.ns; s++)
+        check_window(sc.cb, sc.d->ncomponents, &sc.slots[s], 0.12, 2, &sc.bounds);
+    assert_int_equal(sc.d->ncomponents, 5 + 8 * sc.ns + 7 * 54);
+    scene_close(&sc);
 }
 
 /* Insert: a balcony part stands between B's front wall and its windows. */
@@ -471,59 +477,40 @@ static void test_names_clash_and_share(void **state)
     ag_part_free(p);
 }
 
-
 /* Scope rule on a terminal (B's glass, inlined in its window rule): every application of the
  * terminal gives way to the part, fitted to the pane. */
 static void test_rule_scope_terminal(void **state)
 {
     (void)state;
     pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
-    ag_part *p = save_window(&oa, 0);
-    ag_mesh *m;
-    ag_box *slots;
-    size_t ns;
-    ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
+    scene sc;
+    scene_open(&sc, &oa, 0, &ob);
     /* the glass of the first window: inset by the frame, 0.07 behind the casing's face */
-    ag_box glass = {{slots[0].min[0] + 0.12, slots[0].min[1] + 0.07, slots[0].min[2] + 0.12},
-                    {slots[0].max[0] - 0.12, slots[0].min[1] + 0.08, slots[0].max[2] - 0.12}};
-    int32_t target = pf_node_with_box(r, &glass, TOL);
+    const ag_box *w0 = &sc.slots[0];
+    ag_box glass = {{w0->min[0] + 0.12, w0->min[1] + 0.07, w0->min[2] + 0.12},
+                    {w0->max[0] - 0.12, w0->min[1] + 0.08, w0->max[2] - 0.12}};
+    int32_t target = pf_node_with_box(sc.r, &glass, TOL);
     assert_true(target > 0);
-    ag_compose_report rep;
-    ag_grammar *g = compose(r, p, target, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE, &rep);
-    assert_int_equal(rep.instances, ns);
-    ag_mesh *d = derive(g);
-    ag_box *cb = pf_component_boxes(d);
-    size_t part = 0;
-    for (size_t c = 0; c < d->ncomponents; c++) {
-        int32_t gi = d->component_group[c];
-        if (gi < 0 || strncmp(d->group_names[gi], "sash_window_", 12))
-            continue;
-        part++;
-        int in = 0;
-        for (size_t s = 0; s < ns && !in; s++) {
-            const ag_box *w = &slots[s];
-            int u = along_axis(w);
-            ag_box gb = *w; /* the pane of slot s */
-            gb.min[u] += 0.12;
-            gb.max[u] -= 0.12;
-            gb.min[2] += 0.12;
-            gb.max[2] -= 0.12;
-            in = pf_inside(&cb[c], &gb, TOL);
-        }
-        assert_true(in);
+    scene_compose(&sc, target, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE);
+    assert_int_equal(sc.rep.instances, sc.ns);
+    /* the panes of every slot: inset by B's frame */
+    ag_box *panes = malloc(sc.ns * sizeof *panes);
+    for (size_t s = 0; s < sc.ns; s++) {
+        int u = along_axis(&sc.slots[s]);
+        panes[s] = sc.slots[s];
+        panes[s].min[u] += 0.12;
+        panes[s].max[u] -= 0.12;
+        panes[s].min[2] += 0.12;
+        panes[s].max[2] -= 0.12;
     }
-    assert_int_equal(part, 7 * ns);
+    size_t inside, n = part_components(&sc, panes, sc.ns, &inside);
+    assert_int_equal(n, 7 * sc.ns);
+    assert_int_equal(inside, n);
     /* B's window keeps its casing, bars and mullions around the new content */
-    assert_int_equal(d->ncomponents, 5 + (7 + 7) * ns);
-    free(cb);
-    ag_mesh_free(d);
-    ag_grammar_free(g);
-    free(slots);
-    ag_proceduralize_result_free(r);
-    ag_mesh_free(m);
-    ag_part_free(p);
+    assert_int_equal(sc.d->ncomponents, 5 + (7 + 7) * sc.ns);
+    free(panes);
+    scene_close(&sc);
 }
-
 
 /* A pattern node (B's front window grid): scope node replaces the whole grid by one part fitted
  * to it; scope rule is refused with the rule named. */
@@ -531,47 +518,29 @@ static void test_pattern_target(void **state)
 {
     (void)state;
     pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
-    ag_part *p = save_window(&oa, 0);
-    ag_mesh *m;
-    ag_box *slots;
-    size_t ns;
-    ag_proceduralize_result *r = building(&ob, &m, &slots, &ns);
-    int32_t w0 = pf_node_with_box(r, &slots[0], TOL);
-    int32_t pat = r->tree->nodes[w0].parent;
-    while (pat >= 0 && r->tree->nodes[pat].kind == AG_NODE_SPLIT)
-        pat = r->tree->nodes[pat].parent;
-    assert_int_equal(r->tree->nodes[pat].kind, AG_NODE_PATTERN);
-    ag_box grid = r->tree->nodes[pat].box;
+    scene sc;
+    scene_open(&sc, &oa, 0, &ob);
+    const ag_splittree *t = sc.r->tree;
+    int32_t pat = t->nodes[pf_node_with_box(sc.r, &sc.slots[0], TOL)].parent;
+    while (pat >= 0 && t->nodes[pat].kind == AG_NODE_SPLIT)
+        pat = t->nodes[pat].parent;
+    assert_int_equal(t->nodes[pat].kind, AG_NODE_PATTERN);
+    ag_box grid = t->nodes[pat].box;
     ag_compose_op op = {.target = pat, .mode = AG_COMPOSE_REPLACE, .scope = AG_COMPOSE_RULE};
     ag_grammar *g = NULL;
     ag_error err = {0};
-    assert_int_equal(ag_compose(r, p, &op, &g, NULL, &err), AG_ERR_INVALID);
+    assert_int_equal(ag_compose(sc.r, sc.part, &op, &g, NULL, &err), AG_ERR_INVALID);
     assert_non_null(strstr(err.text, "pattern"));
-    ag_compose_report rep;
-    g = compose(r, p, pat, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, &rep);
-    ag_mesh *d = derive(g);
-    ag_box *cb = pf_component_boxes(d);
-    size_t in_grid = 0, part = 0;
-    for (size_t c = 0; c < d->ncomponents; c++) {
-        int32_t gi = d->component_group[c];
-        int is_part = gi >= 0 && !strncmp(d->group_names[gi], "sash_window_", 12);
-        part += is_part;
-        in_grid += pf_inside(&cb[c], &grid, TOL);
-        if (is_part)
-            assert_true(pf_inside(&cb[c], &grid, TOL));
-    }
-    assert_int_equal(part, 7);
+    scene_compose(&sc, pat, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE);
+    size_t inside, n = part_components(&sc, &grid, 1, &inside), in_grid = 0;
+    for (size_t c = 0; c < sc.d->ncomponents; c++)
+        in_grid += pf_inside(&sc.cb[c], &grid, TOL);
+    assert_int_equal(n, 7);
+    assert_int_equal(inside, 7);
     assert_int_equal(in_grid, 7); /* nothing of B's front windows is left in the grid */
     /* the part's casing spans the grid: the frame bars keep 0.08 */
-    ag_box bb = ag_mesh_bounds(d);
-    check_window(cb, d->ncomponents, &grid, 0.08, 1, &bb);
-    free(cb);
-    ag_mesh_free(d);
-    ag_grammar_free(g);
-    free(slots);
-    ag_proceduralize_result_free(r);
-    ag_mesh_free(m);
-    ag_part_free(p);
+    check_window(sc.cb, sc.d->ncomponents, &grid, 0.08, 1, &sc.bounds);
+    scene_close(&sc);
 }
 
 /* Bad ops: a node that does not exist, an inlined target with scope rule, a bad mode. */
