@@ -25,6 +25,7 @@ static const struct {
      "proceduralize IN --out DIR [--up y|z]  split grammar + terminals + summary.json"},
     {"derive", ag_cli_derive, "derive GRAMMAR --out FILE.obj|FILE.glb  derive a grammar into a mesh"},
     {"edit", ag_cli_edit, "edit DIR --op OP.json --out DIR2     apply one edit op to a proceduralized model"},
+    {"part", ag_cli_part, "part save|compose|info ...          the parts library (archgram part --help)"},
     {"fmt", ag_cli_fmt, "fmt GRAMMAR                     print a grammar in canonical form"},
     {"extrude", ag_cli_extrude, "extrude --plan PLAN.json | FOOTPRINTS.geojson --style S --out OUT  roofs and shells"},
 };

@@ -11,6 +11,7 @@ int ag_cli_derive(int argc, char **argv);
 int ag_cli_fmt(int argc, char **argv);
 int ag_cli_extrude(int argc, char **argv);
 int ag_cli_edit(int argc, char **argv);
+int ag_cli_part(int argc, char **argv);
 
 /* Shared by the subcommands (defined in server/cli.c). */
 #include "../core/mesh.h"

@@ -83,11 +83,9 @@ ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
     int fs = ag_place_facing(&Bs, &ts->nodes[AG_EDIT_ROOT].box);
     int fd = ag_place_facing(&Bd, &td->nodes[AG_EDIT_ROOT].box);
     int k = (fd - fs) & 3;
-    double S[3], D[3];
-    for (int a = 0; a < 3; a++) {
+    double S[3];
+    for (int a = 0; a < 3; a++)
         S[a] = Bs.max[a] - Bs.min[a];
-        D[a] = Bd.max[a] - Bd.min[a];
-    }
     if (k & 1) {
         double x = S[0];
         S[0] = S[1];
@@ -99,46 +97,18 @@ ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
     ag_box cell0 = Bd;
     double step[3] = {0, 0, 0};
     if (op->fit == AG_EDIT_FILL) {
-        int ax[3] = {0, 1, 2};
-        for (int i = 0; i < 3; i++)
-            for (int j = i + 1; j < 3; j++)
-                if (D[ax[j]] > D[ax[i]]) {
-                    int x = ax[i];
-                    ax[i] = ax[j];
-                    ax[j] = x;
-                }
-        double total = 1;
-        for (int i = 0; i < 2; i++) {
-            int a = ax[i];
-            double r = S[a] > 0 ? D[a] / S[a] : 1.0;
-            if (!(r < 1e7)) {
-                st = ag_error_set(err, AG_ERR_TOO_LARGE, op->node,
-                                  "the source is too small to fill node %d", (int)op->node);
-                goto done;
-            }
-            counts[a] = r < 1.5 ? 1u : (unsigned)lround(r);
-            step[a] = D[a] / counts[a];
-            cell0.max[a] = cell0.min[a] + step[a];
-            total *= counts[a];
+        if (ag_place_fill_grid(&Bd, S, fd, counts, step, &cell0)) {
+            st = ag_error_set(err, AG_ERR_TOO_LARGE, op->node,
+                              "the source is too small to fill node %d", (int)op->node);
+            goto done;
         }
+        double total = (double)counts[0] * counts[1] * counts[2];
         if (total * (double)stris > PASTE_MAX_TRIANGLES) {
             st = ag_error_set(err, AG_ERR_TOO_LARGE, op->node,
                               "filling node %d needs %.0f copies of %zu triangles (limit %.0f "
                               "triangles)",
                               (int)op->node, total, stris, PASTE_MAX_TRIANGLES);
             goto done;
-        }
-        int a = ax[2];
-        double size = fmin(S[a], D[a]);
-        int facing_axis = fd & 1;
-        if (a == facing_axis && fd < 2) {
-            cell0.min[a] = Bd.max[a] - size; /* faces +x / +y */
-        } else if (a == facing_axis) {
-            cell0.max[a] = Bd.min[a] + size; /* faces -x / -y */
-        } else {
-            double c = 0.5 * (Bd.min[a] + Bd.max[a]);
-            cell0.min[a] = c - 0.5 * size;
-            cell0.max[a] = c + 0.5 * size;
         }
     }
 

@@ -116,6 +116,49 @@ int ag_place_facing(const ag_box *b, const ag_box *ref)
     return off > 0 ? 1 : 3;
 }
 
+int ag_place_fill_grid(const ag_box *B, const double S[3], int facing, unsigned counts[3],
+                       double step[3], ag_box *cell0)
+{
+    double D[3];
+    for (int a = 0; a < 3; a++) {
+        D[a] = B->max[a] - B->min[a];
+        counts[a] = 1;
+        step[a] = 0;
+    }
+    *cell0 = *B;
+    int ax[3] = {0, 1, 2};
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++)
+            if (D[ax[j]] > D[ax[i]]) {
+                int x = ax[i];
+                ax[i] = ax[j];
+                ax[j] = x;
+            }
+    for (int i = 0; i < 2; i++) {
+        int a = ax[i];
+        double r = S[a] > 0 ? D[a] / S[a] : 1.0;
+        if (!(r < 1e7))
+            return -1;
+        counts[a] = r < 1.5 ? 1u : (unsigned)lround(r);
+        step[a] = D[a] / counts[a];
+        cell0->max[a] = cell0->min[a] + step[a];
+    }
+    int a = ax[2];
+    double size = fmin(S[a], D[a]);
+    int facing_axis = facing & 1;
+    if (a == facing_axis && facing < 2) {
+        cell0->min[a] = B->max[a] - size; /* faces +x / +y */
+    } else if (a == facing_axis) {
+        cell0->max[a] = B->min[a] + size; /* faces -x / -y */
+    } else {
+        double c = 0.5 * (B->min[a] + B->max[a]);
+        cell0->min[a] = c - 0.5 * size;
+        cell0->max[a] = c + 0.5 * size;
+    }
+    step[a] = 0;
+    return 0;
+}
+
 void ag_place_label_name(const ag_proceduralize_result *r, uint32_t c, const char *prefix,
                          char *buf, size_t cap)
 {

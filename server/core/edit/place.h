@@ -41,6 +41,15 @@ size_t ag_place_mark_subtree(const ag_splittree *t, int32_t node, uint8_t *mark)
  * from +x). A box centred on the reference faces -y (x-long) or -x (y-long). */
 int ag_place_facing(const ag_box *b, const ag_box *ref);
 
+/* The grid of a fill: a source of size S (already turned to B's axes) repeated in box B along
+ * B's two longest axes, counts = round(B / S) per axis (1 below 1.5 copies), each cell B / count
+ * there; along the third axis one cell of min(S, B), flush with the face B faces (facing as
+ * ag_place_facing gives it) when that is the axis, else centred. cell0 is the first cell, step
+ * the offset between cells (0 on the third axis). Returns -1 when a source is too small to
+ * count (1e7 copies or more along an axis). */
+int ag_place_fill_grid(const ag_box *B, const double S[3], int facing, unsigned counts[3],
+                       double step[3], ag_box *cell0);
+
 /* Label name of component c of r into buf (prefix may be NULL). */
 void ag_place_label_name(const ag_proceduralize_result *r, uint32_t c, const char *prefix,
                          char *buf, size_t cap);

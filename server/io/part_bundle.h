@@ -1,0 +1,44 @@
+/* Part bundles (.agpart): one self-contained JSON file holding one part or a whole library
+ * (schema/part_bundle.md). Terminals are OBJ texts keyed by the SHA-256 of their content and
+ * shared between the bundle's parts; each part's grammar names them as
+ * "terminals/<sha256>.obj", a key into the bundle, never a file: reading a bundle opens
+ * nothing but the bundle.
+ *
+ * A bundle is untrusted input: reading checks everything and refuses the whole bundle at the
+ * first problem, with the element named in err->text ("parts[0].grammar:12:3: ...",
+ * "terminals.<hash>: line 4: ..."): bad JSON (line and column), an unknown format or version,
+ * a missing or tampered terminal, a terminal OBJ with bad indices, rules that apply each other,
+ * names that are not identifiers, sizes past the limits below. */
+#ifndef AG_PART_BUNDLE_H
+#define AG_PART_BUNDLE_H
+
+#include <stddef.h>
+
+#include "../core/parts/part.h"
+#include "../core/status.h"
+
+#define AG_PART_BUNDLE_FORMAT "archgram-part-bundle"
+#define AG_PART_BUNDLE_VERSION 1
+#define AG_PART_BUNDLE_MAX_BYTES (256u << 20)
+#define AG_PART_BUNDLE_MAX_PARTS 10000
+#define AG_PART_BUNDLE_MAX_TERMINALS 1000000
+#define AG_PART_BUNDLE_MAX_NODES 1000000
+#define AG_PART_BUNDLE_MAX_TRIANGLES 50000000
+#define AG_PART_BUNDLE_MAX_ATTRS 256
+#define AG_PART_BUNDLE_MAX_COORD 1e7 /* metres: |box coordinates| */
+
+/* The bundle text of n parts; *out malloc'd, NUL-terminated. */
+ag_status ag_part_bundle_write(const ag_part *const *parts, size_t n, char **out, size_t *len,
+                               ag_error *err);
+/* Writes the bundle to path through a temporary file renamed into place: on failure nothing
+ * is left at path. */
+ag_status ag_part_bundle_write_file(const ag_part *const *parts, size_t n, const char *path,
+                                    ag_error *err);
+
+/* Reads a bundle: *parts (malloc'd array of *n parts) or nothing. */
+ag_status ag_part_bundle_read(const char *data, size_t len, ag_part ***parts, size_t *n,
+                              ag_error *err);
+ag_status ag_part_bundle_read_file(const char *path, ag_part ***parts, size_t *n, ag_error *err);
+void ag_part_bundle_free(ag_part **parts, size_t n);
+
+#endif
