@@ -87,12 +87,8 @@ export class HistoryPanel {
   }
 
   // Restoring an old version is an op too: it appends, so it can itself be undone.
-  async restore(version) {
-    try {
-      await this.session.live.sendOp({ kind: 'restore', version });
-    } catch (err) {
-      if (!err.problem || !this.session.live.open) this.editor.fail(err); // a nack was already shown
-    }
+  restore(version) {
+    return this.editor.execute({ kind: 'restore', version });
   }
 
   render() {

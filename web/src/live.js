@@ -148,7 +148,8 @@ export class Live {
     this.send({ type: 'hello', model: this.room, since: ed.model.version, user: ed.user });
   }
 
-  // Sends an op made against the current version; resolves with the version it got.
+  // Sends an op made against the current version; resolves with the version it got, rejects
+  // with the problem of a nack or a failed REST request. Only editor.execute calls this.
   sendOp(op) {
     const ed = this.editor;
     const cid = newCid();
@@ -189,7 +190,7 @@ export class Live {
         type: 'presence',
         state: {
           name: ed.user,
-          selection: ed.selectedComponents().slice(0, PRESENCE_MAX_SELECTION),
+          selection: ed.selected.components().slice(0, PRESENCE_MAX_SELECTION),
           camera: ed.camera,
         },
       });
@@ -255,10 +256,13 @@ export class Live {
         const p = this.pending.get(msg.cid);
         this.pending.delete(msg.cid);
         const problem = msg.problem || { title: 'Edit refused' };
-        ed.fail(problem);
-        ed.refreshModel();
         this.hello(); // resync from our version
-        if (p) p.reject(Object.assign(new Error(problem.title), { problem }));
+        if (p) {
+          p.reject(Object.assign(new Error(problem.title), { problem })); // editor.execute tells
+        } else {
+          ed.fail(problem); // an op of an earlier connection
+          ed.refreshModel();
+        }
         break;
       }
       case 'job.progress':

@@ -69,24 +69,13 @@ export class Session {
       ed.refreshModel();
       return;
     }
-    try {
-      await this.live.sendOp({ kind: 'rename', name: clean });
-    } catch (err) {
-      if (!err.problem || !this.live.open) ed.fail(err); // a nack was already shown
-      ed.refreshModel();
-    }
+    await ed.execute({ kind: 'rename', name: clean });
   }
 
   async note(text) {
     const ed = this.editor;
     const clean = text.trim();
     if (!ed.model || !clean) return false;
-    try {
-      await this.live.sendOp({ kind: 'note', text: clean });
-      return true;
-    } catch (err) {
-      if (!err.problem || !this.live.open) ed.fail(err);
-      return false;
-    }
+    return (await ed.execute({ kind: 'note', text: clean })) !== null;
   }
 }
