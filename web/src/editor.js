@@ -3,7 +3,7 @@
 // they never talk to each other. Parts with state of their own are sub-editors it owns:
 // the selection (selection.js) and the extrusion being edited (extrusioneditor.js).
 import { ExtrusionEditor } from './extrusioneditor.js';
-import { REMESHING, isSendable } from './opkinds.js';
+import { OP, REMESHING, isSendable } from './opkinds.js';
 import { Selection } from './selection.js';
 import { Signal } from './signal.js';
 
@@ -157,7 +157,7 @@ export class Editor {
     if (entry.version <= this.model.version) return;
     this.model.version = entry.version;
     const op = entry.op || {};
-    if (op.kind === 'rename' && typeof op.name === 'string') this.model.name = op.name;
+    if (op.kind === OP.rename && typeof op.name === 'string') this.model.name = op.name;
     const remeshed = REMESHING.has(op.kind);
     if (remeshed) this.model.proceduralized = true;
     const listed = this.models.find((m) => m.id === this.model.id);

@@ -4,6 +4,7 @@
 // The tools work on the selected split-tree nodes (Shift+click selects several).
 import * as THREE from 'three';
 import { el } from './dom.js';
+import { OP } from './opkinds.js';
 import { worldBox } from './previewlayer.js';
 
 const AXES = ['x', 'y', 'z'];
@@ -88,7 +89,7 @@ export class EditTools {
   // --- the ops ------------------------------------------------------------------------------
   // The resize op of the handles for `node` → `box`, in the current mode.
   resizeOp(node, box) {
-    const op = { kind: 'resize', node: node === this.editor.tree?.root ? 'root' : node, box: box.map(round), mode: this.mode };
+    const op = { kind: OP.resize, node: node === this.editor.tree?.root ? 'root' : node, box: box.map(round), mode: this.mode };
     if (this.mode === 'local') {
       const region = this.regionBox(node);
       if (region) op.region = region.map(round);
@@ -119,19 +120,19 @@ export class EditTools {
   async split() {
     const p = this.splitPlane();
     if (!p) return;
-    await this.editor.execute({ kind: 'split', node: p.node, axis: AXES[p.axis], at: round(p.at) });
+    await this.editor.execute({ kind: OP.split, node: p.node, axis: AXES[p.axis], at: round(p.at) });
   }
 
   async join() {
     const nodes = this.editor.selected.nodeIds();
     if (nodes.length < 2) return;
-    await this.editor.execute({ kind: 'join', nodes });
+    await this.editor.execute({ kind: OP.join, nodes });
   }
 
   async remove() {
     const nodes = this.editor.selected.nodeIds();
     if (!nodes.length) return;
-    await this.editor.execute({ kind: 'remove', nodes });
+    await this.editor.execute({ kind: OP.remove, nodes });
   }
 
   copy() {
@@ -151,7 +152,7 @@ export class EditTools {
     const target = ed.selected.nodeIds();
     if (!ed.model || !clip || target.length !== 1) return;
     const op = {
-      kind: 'paste',
+      kind: OP.paste,
       source: clip.nodes,
       target: target[0],
       placement: this.placementSel.value,

@@ -3,6 +3,7 @@
 // profile ops that commit an edit. The plan editor, the profile editor and the city view read
 // this state and listen to its signals; the Extrusion service (extrusion.js) loads the
 // descriptions and draws the live previews it asks for.
+import { OP } from './opkinds.js';
 import { Signal } from './signal.js';
 import { normalizePlan } from './plandoc.js';
 
@@ -20,19 +21,9 @@ export class ExtrusionEditor {
       toolChanged: new Signal(),     // what a click on a plan edge does (tool or null)
       featureChanged: new Signal(),  // the selected step or offset event ({kind, index} or null)
     };
-    this.doc = null;       // GET …/plan as read
-    this.batch = false;
-    this.buildings = [];   // [{id, plan, status, reason, triangles, component}]
-    this.current = null;   // index of the edited building
-    this.draft = null;     // its description as being edited (normalized)
-    this.version = null;   // model version the descriptions belong to
-    this.dragging = false; // an edit is in progress (previews, not yet committed)
+    this.clear();
     this.previews = 0;     // preview requests made (shown as a data attribute for tests)
     this.preview = null;   // the last preview state
-    // A click on a plan edge: null selects it; 'anchor', 'step' place one there; 'offset'
-    // leaves the edge out of the selected offset event (or puts it back).
-    this.tool = null;
-    this.feature = null;   // {kind: 'step'|'offset', index}: the step or offset event selected
     // What the step tool places: natural (a rectangle grown out of or into the plan) or
     // forced (a polygon united with the plan), at a height, its size, its edges' profile.
     this.stepTool = { kind: 'natural', height: 3.5, width: 2, depth: 1, profile: null };
@@ -46,17 +37,23 @@ export class ExtrusionEditor {
   // --- the descriptions -----------------------------------------------------------------------
   // Nothing loaded (another model was opened).
   reset() {
-    this.doc = null;
-    this.batch = false;
-    this.buildings = [];
-    this.current = null;
-    this.draft = null;
-    this.version = null;
-    this.dragging = false;
-    this.tool = null;
-    this.feature = null;
+    this.clear();
     this.signals.docChanged.dispatch(null);
     this.signals.buildingChanged.dispatch(null);
+  }
+
+  clear() {
+    this.doc = null;       // GET …/plan as read
+    this.batch = false;
+    this.buildings = [];   // [{id, plan, status, reason, triangles, component}]
+    this.current = null;   // index of the edited building
+    this.draft = null;     // its description as being edited (normalized)
+    this.version = null;   // model version the descriptions belong to
+    this.dragging = false; // an edit is in progress (previews, not yet committed)
+    // A click on a plan edge: null selects it; 'anchor', 'step' place one there; 'offset'
+    // leaves the edge out of the selected offset event (or puts it back).
+    this.tool = null;
+    this.feature = null;   // {kind: 'step'|'offset', index}: the step or offset event selected
   }
 
   // The descriptions of model version `version` as GET …/plan gave them.
@@ -161,12 +158,12 @@ export class ExtrusionEditor {
   // The edited building's description as a plan op (it reaches everyone in the room).
   commitPlan(draft = this.draft) {
     this.setDraft(draft);
-    return this.commit({ kind: 'plan', building: this.current, plan: draft });
+    return this.commit({ kind: OP.plan, building: this.current, plan: draft });
   }
 
   // A profile replaced in every building whose description has it.
   commitProfile(name, profile) {
-    return this.commit({ kind: 'profile', name, profile });
+    return this.commit({ kind: OP.profile, name, profile });
   }
 
   // Resolves true once the op is applied; a refused op puts the stored description back.

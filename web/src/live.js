@@ -1,6 +1,7 @@
 // The live connection: one websocket to archgramd for a model's room and for job progress.
 // It turns server messages into editor changes, reconnects with backoff after a loss and
 // resumes the room with hello {since} so no op is missed.
+import { OP } from './opkinds.js';
 
 const PRESENCE_INTERVAL_MS = 100; // at most 10 presence messages a second
 const PRESENCE_MAX_SELECTION = 1000; // keeps a presence state well under the server's 16 KiB
@@ -165,7 +166,7 @@ export class Live {
     const ed = this.editor;
     const { id, version } = ed.model;
     let newVersion;
-    if (op.kind === 'rename') {
+    if (op.kind === OP.rename) {
       const model = await this.api.rename(id, version, op.name);
       newVersion = model.version;
     } else {

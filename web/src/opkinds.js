@@ -7,10 +7,20 @@ export const OP_KINDS = ["rename", "note", "resize", "split", "join", "paste", "
 export const SERVER_MADE = ['proceduralize', 'grammar'];
 
 const KNOWN = new Set([...OP_KINDS, ...SERVER_MADE]);
+const unknown = (name) => new Error(`archgram: "${String(name)}" is not an op kind`);
+
+// The kinds by name, where the client makes or tests an op: OP.resize is "resize", and a name
+// that is not a kind (a typing mistake) throws where it is used instead of never matching.
+export const OP = new Proxy(Object.freeze(Object.fromEntries([...KNOWN].map((k) => [k, k]))), {
+  get(table, name) {
+    if (typeof name === 'string' && !(name in table)) throw unknown(name);
+    return table[name];
+  },
+});
 
 // A set of known kinds; a name that is not a kind is a mistake in this client, caught at load.
-function kinds(...names) {
-  for (const n of names) if (!KNOWN.has(n)) throw new Error(`archgram: "${n}" is not an op kind`);
+export function kinds(...names) {
+  for (const n of names) if (!KNOWN.has(n)) throw unknown(n);
   return new Set(names);
 }
 

@@ -4,13 +4,13 @@
 // everyone in the room sees it and each person undoes only their own edits.
 import { el } from './dom.js';
 import { isTyping } from './edittools.js';
-import { UNDOABLE } from './opkinds.js';
+import { OP, UNDOABLE } from './opkinds.js';
 
 // 'undo', 'redo' or 'edit': the server logs an undo as {kind: 'restore', undoes: K}; our own
 // entry keeps the op we sent.
 function step(op) {
-  if (op.kind === 'undo' || (op.kind === 'restore' && op.undoes != null)) return 'undo';
-  if (op.kind === 'redo' || (op.kind === 'restore' && op.redoes != null)) return 'redo';
+  if (op.kind === OP.undo || (op.kind === OP.restore && op.undoes != null)) return 'undo';
+  if (op.kind === OP.redo || (op.kind === OP.restore && op.redoes != null)) return 'redo';
   return 'edit';
 }
 
@@ -40,11 +40,11 @@ export class Undo {
   }
 
   undo() {
-    return this.send('undo');
+    return this.send(OP.undo);
   }
 
   redo() {
-    return this.send('redo');
+    return this.send(OP.redo);
   }
 
   async send(kind) {
