@@ -93,6 +93,11 @@ export class ExtrusionEditor {
     this.signals.toolChanged.dispatch(next);
   }
 
+  // The step tool's settings (read when a step is placed; nothing is drawn from them).
+  setStepTool(fields) {
+    this.stepTool = { ...this.stepTool, ...fields };
+  }
+
   selectFeature(feature) {
     const f = feature ?? null;
     if (f?.kind === this.feature?.kind && f?.index === this.feature?.index) return;

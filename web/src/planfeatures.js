@@ -31,7 +31,7 @@ export class PlanFeatures {
     this.depth = num({ value: String(tool.depth), 'data-testid': 'new-step-depth', title: 'Depth (m): natural, > 0 outwards and < 0 a recess; forced, the square’s extent across the edge' });
     this.profile = el('select', { 'data-testid': 'new-step-profile', title: 'Profile of the step’s new edges' });
     const settings = () => {
-      Object.assign(ext.stepTool, {
+      ext.setStepTool({
         kind: this.kind.value,
         height: Number(this.height.value),
         width: Number(this.width.value),
@@ -117,7 +117,7 @@ export class PlanFeatures {
     const chosen = ext.stepTool.profile;
     this.profile.replaceChildren(...names.map((n) => el('option', { value: n }, n)));
     this.profile.value = names.includes(chosen) ? chosen : names[names.length - 1] ?? '';
-    ext.stepTool.profile = this.profile.value || null;
+    ext.setStepTool({ profile: this.profile.value || null });
     if (this.typing) return; // the row being typed in stays as it is
     const f = ext.feature;
     if (f && !plan?.[f.kind === 'step' ? 'steps' : 'offsets']?.[f.index]) ext.selectFeature(null);
