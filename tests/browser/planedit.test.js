@@ -199,7 +199,39 @@ test('steps and offset events edited in the plan editor', async () => {
   assertBounds(shell, { x0: 0, x1: 10, y0: -0.8, y1: 6.8, top: 6.8 }, 'a deeper overhang');
   assert.ok(countChanged(eaves, await readCanvas(page)) > 20, 'the deeper overhang did not show');
 
-  assert.deepEqual(page.problems, [], page.problems.join('\n'));
+  // Removed: the house as it was.
+  await page.getByTestId('offset-row').first().getByTestId('offset-remove').click();
+  plan = await next();
+  assert.equal(plan.offsets, undefined);
+  assertBounds(await shellOf(id), { x0: 0, x1: 10, y0: 0, y1: 6, top: 6 }, 'without offsets');
+
+  // A refused edit: a forced step's corners typed into a bowtie. The preview says why, the
+  // plan op is refused, the person is told once, and the plan and the row stay as stored.
+  await page.getByTestId('new-step-kind').selectOption('forced');
+  await page.getByTestId('step-mode').click();
+  at = await onEdge(page, 0, 0.3);
+  await page.mouse.click(at.x, at.y);
+  const stored = await next();
+  await page.evaluate(() => {
+    window.problemsTold = [];
+    window.archgram.signals.problem.add((p) => window.problemsTold.push(p.detail || p.title));
+  });
+  const corners = page.getByTestId('step-row').first().getByTestId('step-points');
+  const text = await corners.inputValue();
+  await corners.fill('0 0, 1 1, 1 0, 0 1');
+  await page.waitForFunction(() => document.querySelector('[data-testid="plan-status"]')?.dataset.state === 'failed', null, WAIT);
+  await corners.press('Enter');
+  await page.getByTestId('error').waitFor({ state: 'visible', ...WAIT });
+  await page.waitForFunction((t) => document.querySelector('[data-testid="step-points"]')?.value === t, text, WAIT);
+  assert.deepEqual(await getJson(`/models/${id}/plan`), stored);
+  assert.equal((await getJson(`/models/${id}`)).version, v);
+  const told = await page.evaluate(() => window.problemsTold);
+  assert.equal(told.length, 1, `told ${JSON.stringify(told)}`);
+  assert.match(told[0], /step|polygon|simple|cross/i);
+
+  // The only logged problems are the browser's notes on the refused preview and op.
+  const refused = /Failed to load resource: the server responded with a status of 422\b/;
+  assert.deepEqual(page.problems.filter((p) => !refused.test(p)), [], page.problems.join('\n'));
 });
 
 // Edge 0 of a 10 × 6 m plan cut in two collinear edges with different roof slopes: where
