@@ -9,9 +9,9 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { daemonAndBrowser, openPage } from './browser.js';
 import { facadeObj } from './facade.js';
+import { versionOf, WAIT, waitMesh, waitVersion } from './page.js';
 import { countChanged, countWhere, hueOf, readCanvas } from './pixels.js';
 
-const WAIT = { timeout: 30000 };
 const COLS = 6;
 const ROWS = 2;
 
@@ -53,10 +53,6 @@ const treeOf = async (id) => {
 };
 // The tree without the version it was read at.
 const shape = (t) => JSON.stringify({ root: t.root, nodes: t.nodes, labels: t.labels, rules: t.rules });
-const versionOf = async (page) => Number((await page.getByTestId('model-version').textContent()).replace(/\D/g, ''));
-const waitVersion = (page, v) =>
-  page.waitForFunction((want) => Number(document.querySelector('[data-testid="model-version"]').textContent.replace(/\D/g, '')) === want, v, WAIT);
-const waitMesh = (page, v) => page.locator(`#viewport[data-version="${v}"]`).waitFor({ state: 'attached', ...WAIT });
 const waitTree = (page, v) => page.waitForFunction((want) => window.archgram.tree?.version === want, v, WAIT);
 const settle = (page) => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
 

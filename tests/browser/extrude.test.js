@@ -7,9 +7,9 @@ import path from 'node:path';
 import { test } from 'node:test';
 import { ROOT } from './daemon.js';
 import { daemonAndBrowser, openPage } from './browser.js';
+import { centre, uploadAndOpen, versionOf, WAIT, waitMesh, waitVersion } from './page.js';
 import { countChanged, readCanvas } from './pixels.js';
 
-const WAIT = { timeout: 30000 };
 const FIXTURE = path.join(ROOT, 'tests', 'data', 'extrude_web', 'city.geojson');
 
 const env = daemonAndBrowser();
@@ -19,14 +19,6 @@ const getJson = async (p) => {
   const res = await api(p);
   assert.equal(res.status, 200, `${p}: ${res.status}`);
   return res.json();
-};
-const versionOf = async (page) => Number((await page.getByTestId('model-version').textContent()).replace(/\D/g, ''));
-const waitVersion = (page, v) =>
-  page.waitForFunction((want) => Number(document.querySelector('[data-testid="model-version"]').textContent.replace(/\D/g, '')) === want, v, WAIT);
-const waitMesh = (page, v) => page.locator(`#viewport[data-version="${v}"]`).waitFor({ state: 'attached', ...WAIT });
-const centre = async (locator) => {
-  const b = await locator.boundingBox();
-  return { x: b.x + b.width / 2, y: b.y + b.height / 2 };
 };
 
 // Presses at `from`, moves by (dx, dy) in steps (so several previews go out), and waits for
@@ -63,10 +55,7 @@ test('a footprint batch in the city view, edited in the plan and profile editors
 
   // Upload: the extrude job runs and the new model opens.
   await page.getByTestId('extrude-style').selectOption('hip');
-  await page.getByTestId('extrude-input').setInputFiles(FIXTURE);
-  await page.locator('[data-testid="job"][data-status="succeeded"]').waitFor(WAIT);
-  await page.waitForFunction(() => /^#model=\d+$/.test(location.hash), null, WAIT);
-  const id = Number((await page.evaluate(() => location.hash)).replace(/\D/g, ''));
+  const id = await uploadAndOpen(page, 'extrude-input', FIXTURE);
   const model = await getJson(`/models/${id}`);
   assert.equal(model.kind, 'extrusion');
   const v0 = model.version;
@@ -240,10 +229,7 @@ test('a footprint batch in the city view, edited in the plan and profile editors
 test('one building from a plan: its anchor, a profile assigned to an edge, a profile op others see', async () => {
   const alice = await openPage(env.browser, { user: 'alice' });
   await alice.goto(env.daemon.url);
-  await alice.getByTestId('extrude-input').setInputFiles(path.join(ROOT, 'tests', 'data', 'extrude_web', 'house_plan.json'));
-  await alice.locator('[data-testid="job"][data-status="succeeded"]').waitFor(WAIT);
-  await alice.waitForFunction(() => /^#model=\d+$/.test(location.hash), null, WAIT);
-  const id = Number((await alice.evaluate(() => location.hash)).replace(/\D/g, ''));
+  const id = await uploadAndOpen(alice, 'extrude-input', path.join(ROOT, 'tests', 'data', 'extrude_web', 'house_plan.json'));
   const v0 = (await getJson(`/models/${id}`)).version;
   await waitMesh(alice, v0);
 

@@ -8,9 +8,9 @@ import path from 'node:path';
 import { test } from 'node:test';
 import { daemonAndBrowser, openPage } from './browser.js';
 import { facadeObj } from './facade.js';
+import { versionOf, WAIT, waitMesh, waitVersion } from './page.js';
 import { countChanged, countWhere, hueOf, readCanvas, spotWhere } from './pixels.js';
 
-const WAIT = { timeout: 30000 };
 const STAGES = ['segment', 'label', 'tree', 'rules', 'patterns', 'export', 'verify'];
 const COLS = 6;
 const ROWS = 4;
@@ -19,11 +19,6 @@ const env = daemonAndBrowser();
 
 const api = async (p, init) => fetch(`${env.daemon.url}api/v1${p}`, init);
 const textOf = (page, testid) => page.getByTestId(testid).textContent();
-const versionOf = async (page) => Number((await textOf(page, 'model-version')).replace(/\D/g, ''));
-const waitVersion = (page, v) =>
-  page.waitForFunction((want) => Number(document.querySelector('[data-testid="model-version"]').textContent.replace(/\D/g, '')) === want, v, WAIT);
-// The viewport shows the mesh of version v.
-const waitMesh = (page, v) => page.locator(`#viewport[data-version="${v}"]`).waitFor({ state: 'attached', ...WAIT });
 const selectedNode = (page) => page.evaluate(() => document.querySelector('[data-testid="tree-node"].selected')?.dataset.node ?? null);
 
 // The highlight colour (yellow) under any lighting: green and red well above blue.

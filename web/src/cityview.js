@@ -4,7 +4,7 @@
 // the reasons. Also the "new extrusion" upload: footprints (GeoJSON) or a plan, and a style.
 import * as THREE from 'three';
 import { el } from './dom.js';
-import { STYLES } from './extrusion.js';
+import { STYLES } from './plandoc.js';
 
 // Low → high: blue, teal, green, ochre, brick (all well away from the light background and
 // from the yellow of a selection).
@@ -29,10 +29,11 @@ function styleKey(plan) {
 }
 
 export class CityView {
-  constructor(editor, ext, viewport, container) {
+  constructor(editor, viewport, container) {
     this.editor = editor;
-    this.ext = ext;
+    this.ext = editor.extrusion;
     this.viewport = viewport;
+    const ext = this.ext;
     this.mode = 'height';
     this.heights = null; // {root, byComponent: Map, min, max}
 
@@ -49,7 +50,7 @@ export class CityView {
       this.recolour();
     });
     this.fitBtn = el('button', { type: 'button', 'data-testid': 'city-fit', title: 'Fit the whole city in the view' }, 'Fit city');
-    this.fitBtn.addEventListener('click', () => this.fitCity());
+    this.fitBtn.addEventListener('click', () => viewport.frameGround());
     this.legend = el('div.city-legend', { 'data-testid': 'city-legend' });
     this.failed = el('ul.failed-list', { 'data-testid': 'extrude-report' });
     container.append(
@@ -63,13 +64,14 @@ export class CityView {
     this.container = container;
 
     // The viewport asks each mesh for a colour once it is shown (see Viewport.colourize).
-    viewport.tint = (mesh) => this.tint(mesh);
+    viewport.layers.model.tint = (mesh) => this.tint(mesh);
     ext.signals.docChanged.add(() => {
       this.render();
       this.recolour();
       this.fitOnce();
     });
     ext.signals.buildingChanged.add(() => this.renderSelected());
+    viewport.signals.shown.add(() => this.fitOnce());
   }
 
   render() {
@@ -116,42 +118,14 @@ export class CityView {
   }
 
   // --- framing ------------------------------------------------------------------------------
-  // A steep look down that fits the city's ground extent (the orbit view's default framing
-  // fits a bounding sphere from low down, which leaves a flat city small).
-  fitCity() {
-    const vp = this.viewport;
-    if (!vp.root) return;
-    const box = new THREE.Box3().setFromObject(vp.root);
-    if (box.isEmpty()) return;
-    const size = box.getSize(new THREE.Vector3());
-    const centre = box.getCenter(new THREE.Vector3());
-    const cam = vp.camera;
-    const r = Math.max(0.5 * Math.hypot(size.x, size.z), size.y, 1e-3);
-    const fov = THREE.MathUtils.degToRad(cam.fov);
-    const fit = Math.min(fov, 2 * Math.atan(Math.tan(fov / 2) * cam.aspect));
-    const dist = (r / Math.tan(fit / 2)) * 1.05;
-    cam.position.copy(centre).addScaledVector(new THREE.Vector3(0.35, 1, 0.6).normalize(), dist);
-    cam.near = dist / 500;
-    cam.far = dist * 20;
-    cam.updateProjectionMatrix();
-    vp.controls.target.copy(centre);
-    vp.controls.update();
-    vp.requestRender();
-  }
-
-  // Once per opened batch, as soon as its mesh is on screen.
+  // Once per opened batch, as soon as both its descriptions and its mesh are there.
   fitOnce() {
     const ext = this.ext;
     const id = this.editor.model?.id;
     if (!ext.active || !ext.batch || id == null || this.fitted === id) return;
+    if (this.viewport.shown?.model !== id) return; // the mesh's arrival calls again
     this.fitted = id;
-    const started = Date.now();
-    const wait = () => {
-      if (this.editor.model?.id !== id) return;
-      if (this.viewport.container.dataset.model === String(id) && this.viewport.root) this.fitCity();
-      else if (Date.now() - started < 60000) setTimeout(wait, 50);
-    };
-    wait();
+    this.viewport.frameGround();
   }
 
   // --- colours ------------------------------------------------------------------------------
@@ -163,15 +137,15 @@ export class CityView {
 
   // Each component's top (the highest point of its meshes) in the loaded model.
   measure() {
-    const vp = this.viewport;
-    if (this.heights && this.heights.root === vp.root) return this.heights;
+    const layer = this.viewport.layers.model;
+    if (this.heights && this.heights.root === layer.root) return this.heights;
     const byComponent = new Map();
     let min = Infinity;
     let max = -Infinity;
     let ground = Infinity;
     const box = new THREE.Box3();
-    vp.root?.updateWorldMatrix(true, true);
-    for (const [component, meshes] of vp.byComponent) {
+    layer.root?.updateWorldMatrix(true, true);
+    for (const [component, meshes] of layer.components()) {
       let top = -Infinity;
       for (const m of meshes) {
         box.setFromObject(m);
@@ -185,13 +159,13 @@ export class CityView {
       min = Math.min(min, top - ground);
       max = Math.max(max, top - ground);
     }
-    this.heights = { root: vp.root, byComponent, min, max };
+    this.heights = { root: layer.root, byComponent, min, max };
     return this.heights;
   }
 
   tint(mesh) {
     const ext = this.ext;
-    if (!ext.active || !ext.batch || this.mode === 'none' || !this.viewport.root) return null;
+    if (!ext.active || !ext.batch || this.mode === 'none' || !this.viewport.layers.model.root) return null;
     const c = mesh.userData.componentId;
     if (this.mode === 'height') {
       const h = this.measure();
@@ -217,7 +191,7 @@ export class CityView {
     }
     const chip = (colour, text) => el('span.chip', {}, el('span.swatch', { style: `background:#${colour.getHexString()}` }), text);
     if (this.mode === 'height') {
-      const h = this.viewport.root ? this.measure() : null;
+      const h = this.viewport.layers.model.root ? this.measure() : null;
       if (!h || !Number.isFinite(h.min)) {
         this.legend.replaceChildren();
         return;
@@ -232,7 +206,7 @@ export class CityView {
 
 // "New extrusion": a GeoJSON footprint file (or one plan JSON) and a style → the extrude job.
 export class NewExtrusionPanel {
-  constructor(editor, ext, container) {
+  constructor(editor, upload, container) {
     this.file = el('input', { type: 'file', 'data-testid': 'extrude-input', accept: '.geojson,.json' });
     this.style = el(
       'select.up',
@@ -242,7 +216,7 @@ export class NewExtrusionPanel {
     this.file.addEventListener('change', () => {
       const f = this.file.files[0];
       this.file.value = '';
-      if (f) ext.upload(f, this.style.value);
+      if (f) upload.extrusion(f, this.style.value);
     });
     const drop = el(
       'label.drop',
@@ -262,7 +236,7 @@ export class NewExtrusionPanel {
       e.preventDefault();
       drop.classList.remove('over');
       const f = e.dataTransfer?.files?.[0];
-      if (f) ext.upload(f, this.style.value);
+      if (f) upload.extrusion(f, this.style.value);
     });
     container.append(el('h2', {}, 'Extrude'), el('div.import', {}, drop, this.style));
   }

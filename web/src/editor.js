@@ -1,5 +1,10 @@
-// The editor: all client state plus the signals that announce its changes.
-// Panels and the viewport read state here and listen to signals; they never talk to each other.
+// The editor: all client state plus the signals that announce its changes, and the one path
+// every op takes (execute). Panels and the viewport read state here and listen to signals;
+// they never talk to each other. Parts with state of their own are sub-editors it owns:
+// the selection (selection.js) and the extrusion being edited (extrusioneditor.js).
+import { ExtrusionEditor } from './extrusioneditor.js';
+import { OP, REMESHING, isSendable } from './opkinds.js';
+import { Selection } from './selection.js';
 import { Signal } from './signal.js';
 
 const USER_KEY = 'archgram.user';
@@ -48,7 +53,7 @@ export class Editor {
     this.nextPageToken = null;
 
     this.model = null;      // the open model object, name/version kept current by ops
-    this.selection = null;  // {component, group, node?, components?} or null
+    this.selected = new Selection(() => this.tree, this.signals.selectionChanged);
     this.tree = null;       // SplitTree of the open model once proceduralized
     this.grammar = null;    // {text, version} of the open model once proceduralized
     this.procJob = null;
@@ -58,6 +63,40 @@ export class Editor {
     this.connection = 'offline';
     this.user = loadUser();
     this.camera = null;
+    this.transport = null;  // sends ops: the live connection (REST while it is down)
+    this.extrusion = new ExtrusionEditor(this);
+  }
+
+  // The selection's value ({component, group, node?, nodes?, components?} or null).
+  get selection() {
+    return this.selected.value;
+  }
+
+  // --- ops ----------------------------------------------------------------------------------
+  useTransport(transport) {
+    this.transport = transport;
+  }
+
+  // Every op this client makes goes through here: it is sent against the current version, and
+  // a refusal (nack, problem), a lost connection or a failed request is told to the person
+  // once, after which the views drop what they showed of it. Resolves with the version the op
+  // got, or null when it was not applied.
+  async execute(op) {
+    if (!op || !isSendable(op.kind)) {
+      this.fail({ title: 'Not an op', detail: `"${op?.kind}" is not a kind of op this client sends` });
+      return null;
+    }
+    if (!this.model || !this.transport) {
+      this.fail({ title: 'Edit not sent', detail: this.model ? 'not connected to the server' : 'no model is open' });
+      return null;
+    }
+    try {
+      return await this.transport.sendOp(op);
+    } catch (err) {
+      this.fail(err);
+      this.refreshModel();
+      return null;
+    }
   }
 
   // --- model list ---------------------------------------------------------------------------
@@ -75,7 +114,7 @@ export class Editor {
   // --- the open model -----------------------------------------------------------------------
   openModel(model) {
     this.model = model ? { ...model } : null;
-    this.selection = null;
+    this.selected.reset();
     this.tree = null;
     this.grammar = null;
     this.procJob = null;
@@ -118,8 +157,8 @@ export class Editor {
     if (entry.version <= this.model.version) return;
     this.model.version = entry.version;
     const op = entry.op || {};
-    if (op.kind === 'rename' && typeof op.name === 'string') this.model.name = op.name;
-    const remeshed = MESH_OPS.has(op.kind);
+    if (op.kind === OP.rename && typeof op.name === 'string') this.model.name = op.name;
+    const remeshed = REMESHING.has(op.kind);
     if (remeshed) this.model.proceduralized = true;
     const listed = this.models.find((m) => m.id === this.model.id);
     if (listed) {
@@ -131,7 +170,7 @@ export class Editor {
     this.signals.modelChanged.dispatch(this.model);
     if (remeshed) {
       // Component numbers refer to the old mesh: drop the pick before the views reload.
-      this.select(null);
+      this.selected.clear();
       this.signals.meshChanged.dispatch(this.model);
     }
   }
@@ -155,43 +194,7 @@ export class Editor {
     if (this.model) this.signals.modelChanged.dispatch(this.model);
   }
 
-  // --- selection, camera --------------------------------------------------------------------
-  // A picked component also selects its split-tree node once the model has a tree.
-  select(selection) {
-    let sel = selection;
-    if (sel && sel.node == null && this.tree && typeof sel.component === 'number') {
-      const node = this.tree.nodeOfComponent(sel.component);
-      if (node !== null) sel = { ...sel, node };
-    }
-    const same = selectionKey(this.selection) === selectionKey(sel);
-    this.selection = sel;
-    if (!same) this.signals.selectionChanged.dispatch(sel);
-  }
-
-  // Selects a split-tree node: all components of its visible descendants light up.
-  selectNode(id) {
-    const n = this.tree?.node(id);
-    if (!n) {
-      this.select(null);
-      return;
-    }
-    const components = this.tree.componentsUnder(id);
-    this.select({
-      node: id,
-      component: typeof n.component === 'number' ? n.component : null,
-      group: n.label ?? null,
-      components,
-    });
-  }
-
-  // The components a selection covers.
-  selectedComponents() {
-    const sel = this.selection;
-    if (!sel) return [];
-    if (Array.isArray(sel.components)) return sel.components;
-    return typeof sel.component === 'number' ? [sel.component] : [];
-  }
-
+  // --- camera -------------------------------------------------------------------------------
   setCamera(camera) {
     this.camera = camera;
     this.signals.cameraChanged.dispatch(camera);
@@ -241,13 +244,7 @@ export class Editor {
   setTree(tree) {
     this.tree = tree;
     this.signals.treeChanged.dispatch(tree);
-    // The pick's node belongs to the previous tree: keep a picked component, drop a node pick.
-    const sel = this.selection;
-    if (sel) {
-      this.selection = null;
-      if (typeof sel.component === 'number' && !sel.components) this.select({ component: sel.component, group: sel.group });
-      else this.signals.selectionChanged.dispatch(null);
-    }
+    this.selected.treeReplaced(); // the pick's node belongs to the previous tree
   }
 
   setGrammar(grammar) {
@@ -271,14 +268,6 @@ export class Editor {
   notify(text) {
     this.signals.notice.dispatch(text);
   }
-}
-
-// Ops after which the model's mesh, tree and grammar must be read again.
-const MESH_OPS = new Set(['proceduralize', 'grammar', 'resize', 'split', 'join', 'paste', 'remove', 'undo', 'redo', 'restore']);
-
-function selectionKey(sel) {
-  if (!sel) return '';
-  return `${sel.component ?? ''}|${sel.node ?? ''}|${Array.isArray(sel.components) ? sel.components.join(',') : ''}`;
 }
 
 function mergeById(list, items) {

@@ -1,46 +1,18 @@
 // The edit panel: resize mode (global, or local within a region), the split-plane tool, join,
 // copy/paste (insert | replace × fill | derive, also from another model), remove. Every edit
-// is one op over the live connection; the op's broadcast reloads mesh, tree and grammar for
-// everyone. Also the multi-selection of split-tree nodes (Shift+click) the tools work on.
+// is one op (editor.execute); the op's broadcast reloads mesh, tree and grammar for everyone.
+// The tools work on the selected split-tree nodes (Shift+click selects several).
 import * as THREE from 'three';
 import { el } from './dom.js';
+import { OP } from './opkinds.js';
 import { worldBox } from './previewlayer.js';
 
 const AXES = ['x', 'y', 'z'];
 const PLANE_COLOUR = 0xff3df2; // magenta: no label or highlight colour uses it
 
-// --- selection of split-tree nodes ----------------------------------------------------------
-// The nodes a selection covers, in selection order.
-export function selectedNodes(editor) {
-  const sel = editor.selection;
-  if (!sel) return [];
-  if (Array.isArray(sel.nodes)) return sel.nodes;
-  return sel.node !== undefined && sel.node !== null ? [sel.node] : [];
-}
-
-// Selects several split-tree nodes at once: all their visible components light up.
-export function selectNodes(editor, ids) {
-  const tree = editor.tree;
-  const list = [...new Set(ids)].filter((id) => tree?.node(id));
-  if (list.length <= 1) {
-    if (list.length) editor.selectNode(list[0]);
-    else editor.select(null);
-    return;
-  }
-  const components = [...new Set(list.flatMap((id) => tree.componentsUnder(id)))];
-  editor.select({ node: list[list.length - 1], nodes: list, component: null, group: null, components });
-}
-
-// Shift+click: adds the node to the selection, or takes it out.
-export function toggleNode(editor, id) {
-  const now = selectedNodes(editor);
-  selectNodes(editor, now.includes(id) ? now.filter((n) => n !== id) : [...now, id]);
-}
-
 export class EditTools {
-  constructor(editor, live, api, viewport, container) {
+  constructor(editor, api, viewport, container) {
     this.editor = editor;
-    this.live = live;
     this.api = api;
     this.viewport = viewport;
     this.mode = 'global';   // resize mode of the handles
@@ -115,19 +87,9 @@ export class EditTools {
   }
 
   // --- the ops ------------------------------------------------------------------------------
-  async send(op) {
-    const ed = this.editor;
-    try {
-      return await this.live.sendOp(op);
-    } catch (err) {
-      if (!err.problem || !this.live.open) ed.fail(err); // a nack was already shown
-      return null;
-    }
-  }
-
   // The resize op of the handles for `node` → `box`, in the current mode.
   resizeOp(node, box) {
-    const op = { kind: 'resize', node: node === this.editor.tree?.root ? 'root' : node, box: box.map(round), mode: this.mode };
+    const op = { kind: OP.resize, node: node === this.editor.tree?.root ? 'root' : node, box: box.map(round), mode: this.mode };
     if (this.mode === 'local') {
       const region = this.regionBox(node);
       if (region) op.region = region.map(round);
@@ -158,24 +120,24 @@ export class EditTools {
   async split() {
     const p = this.splitPlane();
     if (!p) return;
-    await this.send({ kind: 'split', node: p.node, axis: AXES[p.axis], at: round(p.at) });
+    await this.editor.execute({ kind: OP.split, node: p.node, axis: AXES[p.axis], at: round(p.at) });
   }
 
   async join() {
-    const nodes = selectedNodes(this.editor);
+    const nodes = this.editor.selected.nodeIds();
     if (nodes.length < 2) return;
-    await this.send({ kind: 'join', nodes });
+    await this.editor.execute({ kind: OP.join, nodes });
   }
 
   async remove() {
-    const nodes = selectedNodes(this.editor);
+    const nodes = this.editor.selected.nodeIds();
     if (!nodes.length) return;
-    await this.send({ kind: 'remove', nodes });
+    await this.editor.execute({ kind: OP.remove, nodes });
   }
 
   copy() {
     const ed = this.editor;
-    const nodes = selectedNodes(ed);
+    const nodes = ed.selected.nodeIds();
     if (!ed.model || !nodes.length) return;
     this.clipboard = { model: ed.model.id, version: ed.model.version, nodes: nodes.slice(), name: ed.model.name };
     ed.notify(`Copied ${nodes.length} node${nodes.length === 1 ? '' : 's'}`);
@@ -187,10 +149,10 @@ export class EditTools {
   async paste() {
     const ed = this.editor;
     const clip = this.clipboard;
-    const target = selectedNodes(ed);
+    const target = ed.selected.nodeIds();
     if (!ed.model || !clip || target.length !== 1) return;
     const op = {
-      kind: 'paste',
+      kind: OP.paste,
       source: clip.nodes,
       target: target[0],
       placement: this.placementSel.value,
@@ -211,13 +173,13 @@ export class EditTools {
       ed.fail({ title: 'Copy again', detail: `“${clip.name}” changed since the copy; its node numbers no longer apply.` });
       return;
     }
-    await this.send(op);
+    await ed.execute(op);
   }
 
   key(e) {
     if (isTyping(e.target) || !(e.ctrlKey || e.metaKey) || e.altKey) return;
     const k = e.key.toLowerCase();
-    if (k === 'c' && selectedNodes(this.editor).length && !window.getSelection()?.toString()) {
+    if (k === 'c' && this.editor.selected.nodeIds().length && !window.getSelection()?.toString()) {
       this.copy();
     } else if (k === 'v' && this.clipboard) {
       e.preventDefault();
@@ -230,8 +192,8 @@ export class EditTools {
 
   // --- view ---------------------------------------------------------------------------------
   single() {
-    const nodes = selectedNodes(this.editor);
-    return nodes.length === 1 ? this.editor.tree?.node(nodes[0]) ?? null : null;
+    const id = this.editor.selected.single();
+    return id !== null ? this.editor.tree?.node(id) ?? null : null;
   }
 
   render() {
@@ -239,7 +201,7 @@ export class EditTools {
     const ready = !!(ed.model && ed.tree);
     this.body.hidden = !ready;
     this.empty.hidden = ready || !ed.model;
-    const nodes = selectedNodes(ed);
+    const nodes = ed.selected.nodeIds();
     const one = this.single();
     this.regionSel.hidden = this.mode !== 'local';
     this.toolBtn.classList.toggle('on', this.splitting);
@@ -261,20 +223,13 @@ export class EditTools {
 
   // The split plane through the selected node's box, in magenta.
   renderPlane() {
-    const vp = this.viewport;
-    if (this.plane) {
-      vp.scene.remove(this.plane);
-      this.plane.geometry.dispose();
-      this.plane.material.dispose();
-      this.plane = null;
-    }
+    const layer = this.viewport.layers.handles;
+    layer.remove(this.plane);
+    this.plane = null;
     const p = this.splitting ? this.splitPlane() : null;
     const n = this.single();
     this.atText.textContent = p ? `${p.at.toFixed(2)} m` : '';
-    if (!p || !n) {
-      vp.requestRender();
-      return;
-    }
+    if (!p || !n) return;
     const b = n.box.slice();
     b[p.axis] = p.at;
     b[p.axis + 3] = p.at;
@@ -291,8 +246,7 @@ export class EditTools {
     this.plane.position.copy(centre);
     this.plane.renderOrder = 5;
     this.plane.userData.tool = 'split-plane';
-    vp.scene.add(this.plane);
-    vp.requestRender();
+    layer.add(this.plane);
   }
 }
 

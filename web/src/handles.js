@@ -3,7 +3,6 @@
 // 30 a second); the server's re-solved boxes for the whole area of effect reach everyone in the
 // room. Releasing sends one resize op — one undo step.
 import * as THREE from 'three';
-import { selectedNodes } from './edittools.js';
 import { worldBox } from './previewlayer.js';
 
 const PREVIEW_INTERVAL_MS = 1000 / 30;
@@ -37,7 +36,7 @@ export class Handles {
     this.group = new THREE.Group();
     this.group.userData.tool = 'handles';
     this.group.renderOrder = 10;
-    viewport.scene.add(this.group);
+    viewport.layers.handles.add(this.group);
     this.node = null;   // the node the handles belong to
     this.box = null;    // its box as shown (archgram axes)
     this.drag = null;
@@ -46,7 +45,7 @@ export class Handles {
     this.sendTimer = null;
     this.sent = 0;      // previews sent (for tests)
 
-    const el = viewport.renderer.domElement;
+    const el = viewport.canvas;
     // Capture phase: a press on a handle must reach neither the orbit controls nor picking.
     el.addEventListener('pointerdown', (e) => this.down(e), { capture: true });
     el.addEventListener('pointermove', (e) => this.move(e));
@@ -67,8 +66,8 @@ export class Handles {
   sync() {
     if (this.drag) this.cancel();
     const tree = this.editor.tree;
-    const nodes = selectedNodes(this.editor);
-    const n = nodes.length === 1 && tree ? tree.node(nodes[0]) : null;
+    const id = this.editor.selected.single();
+    const n = id !== null && tree ? tree.node(id) : null;
     if (!n || !Array.isArray(n.box) || n.box.length !== 6) {
       this.node = null;
       this.box = null;
@@ -127,12 +126,8 @@ export class Handles {
   // Keeps the handles a constant size on screen.
   scale() {
     const vp = this.viewport;
-    const h = vp.renderer.domElement.clientHeight || 1;
     for (const c of this.group.children) {
-      if (!c.userData.face) continue;
-      const d = vp.camera.position.distanceTo(c.position);
-      const world = (2 * d * Math.tan(THREE.MathUtils.degToRad(vp.camera.fov) / 2) * HANDLE_PX) / h;
-      c.scale.setScalar(world);
+      if (c.userData.face) c.scale.setScalar(vp.worldPerPixel(c.position) * HANDLE_PX);
     }
     vp.requestRender();
   }
@@ -140,23 +135,14 @@ export class Handles {
   // The handle under a pointer position, or null.
   hit(e) {
     if (!this.box) return null;
-    const ray = this.ray(e);
+    const ray = this.viewport.ray(e.clientX, e.clientY);
     const hits = ray.intersectObjects(this.group.children.filter((c) => c.userData.face), false);
     return hits.length ? hits[0].object : null;
   }
 
-  ray(e) {
-    const vp = this.viewport;
-    const rect = vp.renderer.domElement.getBoundingClientRect();
-    const ndc = new THREE.Vector2(((e.clientX - rect.left) / rect.width) * 2 - 1, -((e.clientY - rect.top) / rect.height) * 2 + 1);
-    const rc = new THREE.Raycaster();
-    rc.setFromCamera(ndc, vp.camera);
-    return rc;
-  }
-
   // Where along the handle's axis (world units from its start) the pointer ray passes closest.
   along(e, drag) {
-    const r = this.ray(e).ray;
+    const r = this.viewport.ray(e.clientX, e.clientY).ray;
     const d = drag.normal;
     const w = drag.origin.clone().sub(r.origin);
     const b = d.dot(r.direction);
@@ -189,9 +175,9 @@ export class Handles {
     };
     drag.t0 = this.along(e, drag) ?? 0;
     this.drag = drag;
-    this.viewport.controls.enabled = false;
-    this.viewport.renderer.domElement.setPointerCapture?.(e.pointerId);
-    this.viewport.container.dataset.dragging = name;
+    this.viewport.setOrbit(false);
+    this.viewport.canvas.setPointerCapture?.(e.pointerId);
+    this.viewport.mark('dragging', name);
   }
 
   move(e) {
@@ -240,9 +226,9 @@ export class Handles {
     this.drag = null;
     clearTimeout(this.sendTimer);
     this.sendTimer = null;
-    this.viewport.controls.enabled = true;
-    this.viewport.renderer.domElement.releasePointerCapture?.(e.pointerId);
-    delete this.viewport.container.dataset.dragging;
+    this.viewport.setOrbit(true);
+    this.viewport.canvas.releasePointerCapture?.(e.pointerId);
+    this.viewport.mark('dragging', null);
     const ed = this.editor;
     if (drag.sent) this.live.send({ type: 'preview.end', model: ed.model?.id });
     if (cancelled || !drag.moved || sameBox(drag.box, drag.start)) {
@@ -251,7 +237,7 @@ export class Handles {
       this.place();
       return;
     }
-    const version = await this.tools.send(this.tools.resizeOp(drag.node, drag.box));
+    const version = await ed.execute(this.tools.resizeOp(drag.node, drag.box));
     if (version === null) {
       // refused: back to what the model is
       this.preview.clear();
@@ -265,8 +251,8 @@ export class Handles {
     this.drag = null;
     clearTimeout(this.sendTimer);
     this.sendTimer = null;
-    this.viewport.controls.enabled = true;
-    delete this.viewport.container.dataset.dragging;
+    this.viewport.setOrbit(true);
+    this.viewport.mark('dragging', null);
     if (drag.sent) this.live.send({ type: 'preview.end', model: this.editor.model?.id });
     this.preview.clear();
     this.box = drag.start;
@@ -278,7 +264,7 @@ export class Handles {
     if (this.hover) this.hover.material.color.set(HANDLE_COLOUR);
     this.hover = h;
     if (h) h.material.color.set(HANDLE_HOVER);
-    this.viewport.renderer.domElement.style.cursor = h ? 'grab' : '';
+    this.viewport.canvas.style.cursor = h ? 'grab' : '';
     this.viewport.requestRender();
   }
 
@@ -286,12 +272,7 @@ export class Handles {
   // tests and scripted demos.
   screen(face) {
     const h = this.group.children.find((c) => c.userData.face?.name === face);
-    if (!h) return null;
-    const vp = this.viewport;
-    vp.camera.updateMatrixWorld();
-    const p = h.position.clone().project(vp.camera);
-    const el = vp.renderer.domElement;
-    return { x: ((p.x + 1) / 2) * el.clientWidth, y: ((1 - p.y) / 2) * el.clientHeight };
+    return h ? this.viewport.toScreen(h.position) : null;
   }
 }
 

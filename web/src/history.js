@@ -1,37 +1,38 @@
 // The open model's op log, newest first, and the note box.
 import { el, timeAgo } from './dom.js';
+import { OP } from './opkinds.js';
 
 const SHOWN = 200; // newest entries listed; older ones stay in the log
 
 function summary(op) {
   switch (op?.kind) {
-    case 'rename':
+    case OP.rename:
       return `→ “${op.name}”`;
-    case 'note':
+    case OP.note:
       return op.text.length > 80 ? `${op.text.slice(0, 79)}…` : op.text;
-    case 'proceduralize':
+    case OP.proceduralize:
       return `${count(op.rules, 'rule')} · ${count(op.terminals, 'terminal')} · ${count(op.patterns, 'pattern')}`;
-    case 'grammar':
+    case OP.grammar:
       return typeof op.bytes === 'number' ? `grammar edited (${count(op.bytes, 'byte')})` : 'grammar edited';
-    case 'resize':
+    case OP.resize:
       return `node ${op.node} ${op.scale ? `× ${op.scale.join(', ')}` : boxText(op.box)} · ${op.mode || 'global'}${reportText(op.report)}`;
-    case 'split':
+    case OP.split:
       return `node ${op.node} at ${op.axis} = ${Number(op.at).toFixed(2)} m${reportText(op.report)}`;
-    case 'join':
-    case 'remove':
+    case OP.join:
+    case OP.remove:
       return Array.isArray(op.nodes) ? `nodes ${op.nodes.join(', ')}` : '';
-    case 'paste':
+    case OP.paste:
       return `${Array.isArray(op.source) ? op.source.join(', ') : '?'} → ${op.target} · ${op.placement || 'insert'}, ${op.fit || 'fill'}`;
-    case 'undo':
-    case 'redo':
+    case OP.undo:
+    case OP.redo:
       return '';
-    case 'restore':
+    case OP.restore:
       if (op.undoes != null) return `undo of v${op.undoes}`;
       if (op.redoes != null) return `redo of v${op.redoes}`;
       return `back to v${op.version}`;
-    case 'plan':
+    case OP.plan:
       return `building ${op.building} · plan edited`;
-    case 'profile':
+    case OP.profile:
       return `profile “${op.name}” edited`;
     default:
       return '';
@@ -87,12 +88,8 @@ export class HistoryPanel {
   }
 
   // Restoring an old version is an op too: it appends, so it can itself be undone.
-  async restore(version) {
-    try {
-      await this.session.live.sendOp({ kind: 'restore', version });
-    } catch (err) {
-      if (!err.problem || !this.session.live.open) this.editor.fail(err); // a nack was already shown
-    }
+  restore(version) {
+    return this.editor.execute({ kind: OP.restore, version });
   }
 
   render() {

@@ -1,6 +1,7 @@
 // The live connection: one websocket to archgramd for a model's room and for job progress.
 // It turns server messages into editor changes, reconnects with backoff after a loss and
 // resumes the room with hello {since} so no op is missed.
+import { OP } from './opkinds.js';
 
 const PRESENCE_INTERVAL_MS = 100; // at most 10 presence messages a second
 const PRESENCE_MAX_SELECTION = 1000; // keeps a presence state well under the server's 16 KiB
@@ -148,7 +149,8 @@ export class Live {
     this.send({ type: 'hello', model: this.room, since: ed.model.version, user: ed.user });
   }
 
-  // Sends an op made against the current version; resolves with the version it got.
+  // Sends an op made against the current version; resolves with the version it got, rejects
+  // with the problem of a nack or a failed REST request. Only editor.execute calls this.
   sendOp(op) {
     const ed = this.editor;
     const cid = newCid();
@@ -164,7 +166,7 @@ export class Live {
     const ed = this.editor;
     const { id, version } = ed.model;
     let newVersion;
-    if (op.kind === 'rename') {
+    if (op.kind === OP.rename) {
       const model = await this.api.rename(id, version, op.name);
       newVersion = model.version;
     } else {
@@ -189,7 +191,7 @@ export class Live {
         type: 'presence',
         state: {
           name: ed.user,
-          selection: ed.selectedComponents().slice(0, PRESENCE_MAX_SELECTION),
+          selection: ed.selected.components().slice(0, PRESENCE_MAX_SELECTION),
           camera: ed.camera,
         },
       });
@@ -255,10 +257,13 @@ export class Live {
         const p = this.pending.get(msg.cid);
         this.pending.delete(msg.cid);
         const problem = msg.problem || { title: 'Edit refused' };
-        ed.fail(problem);
-        ed.refreshModel();
         this.hello(); // resync from our version
-        if (p) p.reject(Object.assign(new Error(problem.title), { problem }));
+        if (p) {
+          p.reject(Object.assign(new Error(problem.title), { problem })); // editor.execute tells
+        } else {
+          ed.fail(problem); // an op of an earlier connection
+          ed.refreshModel();
+        }
         break;
       }
       case 'job.progress':

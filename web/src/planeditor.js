@@ -1,9 +1,11 @@
 // The 2D plan editor of the edited building: its loops (outer rings and holes) drawn in an
 // SVG, corners dragged (previewed live in 3D, committed as a plan op on release), a corner
 // inserted by double-clicking an edge, the selected corner removed with Delete, a profile
-// assigned to the clicked edge, and anchors shown and added on an edge.
+// assigned to the clicked edge, anchors shown and added on an edge, steps (natural and
+// forced) placed on an edge and drawn, and the edges an offset event leaves out picked. The
+// step tool's settings and the list of steps and offset events are planfeatures.js.
 import { el } from './dom.js';
-import { clone } from './extrusion.js';
+import { anchorSpot, clone, makeStep, mergeEdges, offsetEdge, round3, shiftEdges, stepKind, stepOutline, toggleOffsetEdge } from './plandoc.js';
 
 const SVG = 'http://www.w3.org/2000/svg';
 const MARGIN = 22;   // px around the plan
@@ -23,40 +25,21 @@ export function profileColours(plan) {
   return m;
 }
 
-// Where on edge e of loop l an anchor lies, as a point and the fraction along the edge.
-function anchorSpot(plan, a) {
-  const loop = plan.loops[a.loop ?? 0];
-  if (!loop) return null;
-  const pts = loop.points;
-  const p = pts[a.edge];
-  const q = pts[(a.edge + 1) % pts.length];
-  if (!p || !q) return null;
-  const len = Math.hypot(q[0] - p[0], q[1] - p[1]) || 1;
-  const t = typeof a.relative === 'number' ? a.relative : (a.absolute ?? 0) / len;
-  return { x: p[0] + (q[0] - p[0]) * t, y: p[1] + (q[1] - p[1]) * t, t };
-}
-
-// Everything in a description that names an edge: anchors, steps, offset-event overrides.
-function edgeRefs(plan) {
-  return [plan.anchors, plan.steps, ...(plan.offsets || []).map((o) => o.edges)];
-}
-
-// Edge indices after inserting a corner after corner `from` (edges past it shift by one).
-function shiftEdges(plan, loop, from, by) {
-  for (const list of edgeRefs(plan)) {
-    for (const a of list || []) {
-      if ((a.loop ?? 0) === loop && typeof a.edge === 'number' && a.edge > from) a.edge += by;
-    }
-  }
-}
+// What a click on an edge does: select it, or place an anchor or a step there, or take it
+// out of the selected offset event (or put it back).
+const TOOLS = {
+  anchor: 'Click an edge to place an anchor there',
+  step: 'Click an edge to place a step there',
+  offset: 'Click edges to leave them out of the selected offset event (again: back in)',
+};
 
 export class PlanEditor {
-  constructor(editor, ext, container) {
+  constructor(editor, container) {
     this.editor = editor;
-    this.ext = ext;
+    this.ext = editor.extrusion;
+    const ext = this.ext;
     this.sel = null;        // {kind: 'corner'|'edge', loop, index}
     this.drag = null;
-    this.anchorMode = false;
     this.frame = null;      // plan → screen mapping, kept while dragging
 
     this.title = el('span.plan-title', { 'data-testid': 'plan-title' });
@@ -65,11 +48,8 @@ export class PlanEditor {
     this.profileSel.addEventListener('change', () => this.assignProfile(this.profileSel.value));
     this.delBtn = el('button', { type: 'button', 'data-testid': 'delete-corner', disabled: true, title: 'Remove the selected corner (Delete)' }, 'Delete corner');
     this.delBtn.addEventListener('click', () => this.deleteCorner());
-    this.anchorBtn = el('button', { type: 'button', 'data-testid': 'anchor-mode', title: 'Click an edge to place an anchor there' }, 'Add anchor');
-    this.anchorBtn.addEventListener('click', () => {
-      this.anchorMode = !this.anchorMode;
-      this.render();
-    });
+    this.anchorBtn = el('button', { type: 'button', 'data-testid': 'anchor-mode', title: TOOLS.anchor }, 'Add anchor');
+    this.anchorBtn.addEventListener('click', () => ext.setTool('anchor'));
     this.anchorHeight = el('input.num', { type: 'number', step: '0.1', min: '0', value: '1', 'data-testid': 'anchor-height', title: 'Anchor height (m)' });
     this.anchorKind = el(
       'select',
@@ -83,7 +63,8 @@ export class PlanEditor {
         e.preventDefault();
         this.deleteCorner();
       } else if (e.key === 'Escape') {
-        this.select(null);
+        if (ext.tool) ext.setTool(ext.tool);
+        else this.select(null);
       }
     });
     this.svg.addEventListener('pointerdown', (e) => {
@@ -117,7 +98,6 @@ export class PlanEditor {
       // A reload of the same building (after an op) keeps what is selected.
       if (b?.index !== this.shown) this.sel = null;
       this.shown = b?.index;
-      this.anchorMode = false;
       this.frame = null;
       this.render();
     });
@@ -126,6 +106,8 @@ export class PlanEditor {
       this.render();
     });
     s.previewChanged.add((p) => this.renderStatus(p));
+    s.toolChanged.add(() => this.render());
+    s.featureChanged.add(() => this.render());
     this.render();
   }
 
@@ -133,7 +115,13 @@ export class PlanEditor {
     return this.ext.draft;
   }
 
+  // A changed draft, shown at once and committed as a plan op.
+  commit(draft) {
+    this.ext.commitPlan(draft);
+  }
+
   // --- plan ↔ screen ------------------------------------------------------------------------
+  // Fits the loops and the steps' outlines.
   fit() {
     const plan = this.plan;
     const w = Math.max(40, this.svg.clientWidth);
@@ -142,8 +130,9 @@ export class PlanEditor {
     let y0 = Infinity;
     let x1 = -Infinity;
     let y1 = -Infinity;
-    for (const l of plan.loops) {
-      for (const [x, y] of l.points) {
+    const outlines = (plan.steps || []).map((st) => stepOutline(plan, st)).filter(Boolean);
+    for (const pts of [...plan.loops.map((l) => l.points), ...outlines]) {
+      for (const [x, y] of pts) {
         x0 = Math.min(x0, x);
         y0 = Math.min(y0, y);
         x1 = Math.max(x1, x);
@@ -175,10 +164,13 @@ export class PlanEditor {
     const ext = this.ext;
     const plan = this.plan;
     const b = ext.building;
+    const tool = ext.tool;
     this.svg.replaceChildren();
-    this.anchorBtn.classList.toggle('on', this.anchorMode);
-    this.svg.classList.toggle('anchoring', this.anchorMode);
+    this.anchorBtn.classList.toggle('on', tool === 'anchor');
+    this.svg.classList.toggle('anchoring', tool !== null);
+    this.svg.dataset.tool = tool ?? '';
     if (!plan) {
+      this.hint.classList.remove('tool');
       this.title.textContent = b ? `${b.id}` : '';
       this.hint.textContent = !ext.active
         ? ''
@@ -190,7 +182,9 @@ export class PlanEditor {
       this.delBtn.disabled = true;
       return;
     }
-    this.hint.hidden = true;
+    this.hint.hidden = !tool;
+    this.hint.classList.toggle('tool', !!tool);
+    this.hint.textContent = tool ? TOOLS[tool] : '';
     if (this.sel && !(this.sel.index < (plan.loops[this.sel.loop]?.points.length ?? 0))) this.sel = null; // gone
     const state = b?.status && b.status !== 'ok' ? ` · ${b.status}` : '';
     this.title.textContent = `${ext.batch ? `building ${b?.id ?? ext.current}` : 'plan'}${state}`;
@@ -199,32 +193,58 @@ export class PlanEditor {
     const f = this.frame;
     this.svg.setAttribute('viewBox', `0 0 ${f.w} ${f.h}`);
     const colours = profileColours(plan);
+    const path = (pts) => pts.map(([x, y], i) => `${i ? 'L' : 'M'}${f.toScreen(x, y).map((v) => v.toFixed(1)).join(',')}`).join('') + 'Z';
 
     // Area: all loops in one path, holes cut out by the even-odd rule.
-    const d = plan.loops
-      .map((l) => l.points.map(([x, y], i) => `${i ? 'L' : 'M'}${f.toScreen(x, y).map((v) => v.toFixed(1)).join(',')}`).join('') + 'Z')
-      .join('');
-    this.svg.append(svg('path', { d, class: 'plan-area', 'fill-rule': 'evenodd' }));
+    this.svg.append(svg('path', { d: plan.loops.map((l) => path(l.points)).join(''), class: 'plan-area', 'fill-rule': 'evenodd' }));
 
+    // Steps under the edges, so edges stay clickable where a step overlaps them.
+    const feature = ext.feature;
+    (plan.steps || []).forEach((st, i) => {
+      const outline = stepOutline(plan, st);
+      if (!outline) return;
+      const on = feature?.kind === 'step' && feature.index === i;
+      const g = svg('path', {
+        d: path(outline),
+        class: `plan-step ${stepKind(st)}${on ? ' selected' : ''}`,
+        stroke: colours.get(st.profile) || '#888',
+        'data-testid': 'plan-step',
+        'data-index': i,
+        'data-kind': stepKind(st),
+      });
+      const t = svg('title');
+      t.textContent = `${stepKind(st)} step ${st.name ?? i} · ${st.height} m · ${st.profile}`;
+      g.append(t);
+      g.addEventListener('pointerdown', (e) => {
+        if (e.button !== 0 || ext.tool) return;
+        e.stopPropagation();
+        ext.selectFeature({ kind: 'step', index: i });
+      });
+      this.svg.append(g);
+    });
+
+    const offset = feature?.kind === 'offset' ? plan.offsets?.[feature.index] : null;
     plan.loops.forEach((l, li) => {
       const n = l.points.length;
       for (let i = 0; i < n; i++) {
         const [ax, ay] = f.toScreen(...l.points[i]);
         const [bx, by] = f.toScreen(...l.points[(i + 1) % n]);
         const selected = this.sel?.kind === 'edge' && this.sel.loop === li && this.sel.index === i;
+        const left = offsetEdge(offset, li, i)?.disabled === true;
         const g = svg('g', {
-          class: `plan-edge${selected ? ' selected' : ''}`,
+          class: `plan-edge${selected ? ' selected' : ''}${left ? ' offset-off' : ''}`,
           'data-testid': 'plan-edge',
           'data-loop': li,
           'data-edge': i,
           'data-profile': l.profiles[i],
         });
+        if (offset) g.dataset.offset = left ? 'disabled' : 'moves';
         g.append(
           svg('line', { x1: ax, y1: ay, x2: bx, y2: by, class: 'edge-line', stroke: colours.get(l.profiles[i]) || '#888' }),
           svg('line', { x1: ax, y1: ay, x2: bx, y2: by, class: 'edge-hit' }),
         );
         const title = svg('title');
-        title.textContent = `edge ${i}${plan.loops.length > 1 ? ` of loop ${li}` : ''} · ${l.profiles[i]}`;
+        title.textContent = `edge ${i}${plan.loops.length > 1 ? ` of loop ${li}` : ''} · ${l.profiles[i]}${offset ? (left ? ' · left out of the offset' : ' · offset') : ''}`;
         g.append(title);
         g.addEventListener('pointerdown', (e) => this.edgeDown(e, li, i));
         g.addEventListener('dblclick', (e) => this.insertCorner(e, li, i));
@@ -244,6 +264,7 @@ export class PlanEditor {
       const where = typeof a.relative === 'number' ? `${Math.round(a.relative * 100)}% of edge ${a.edge}` : `${a.absolute} m along edge ${a.edge}`;
       t.textContent = `anchor ${a.name ?? ai} · ${where} · height ${a.height} m`;
       m.append(t);
+      m.addEventListener('pointerdown', (e) => this.edgeDown(e, a.loop ?? 0, a.edge)); // as if on its edge
       this.svg.append(m);
     }
 
@@ -328,7 +349,7 @@ export class PlanEditor {
       if (!moved && Math.hypot(ev.clientX - start.x, ev.clientY - start.y) <= CLICK_SLOP) return;
       moved = true;
       const draft = clone(base);
-      draft.loops[loop].points[index] = this.eventPoint(ev).map((v) => Math.round(v * 1000) / 1000);
+      draft.loops[loop].points[index] = this.eventPoint(ev).map(round3);
       this.ext.edit(draft);
     };
     const up = () => {
@@ -355,18 +376,10 @@ export class PlanEditor {
     // Edges index-1 and index merge into one that keeps the earlier edge's profile.
     l.points.splice(sel.index, 1);
     l.profiles.splice(sel.index, 1);
-    const merged = (sel.index - 1 + l.points.length + 1) % (l.points.length + 1);
-    for (const list of edgeRefs(draft)) {
-      for (const a of list || []) {
-        if ((a.loop ?? 0) !== sel.loop || typeof a.edge !== 'number') continue;
-        if (a.edge === sel.index) a.edge = Math.min(merged, l.points.length - 1);
-        else if (a.edge > sel.index) a.edge -= 1;
-      }
-    }
+    const n = l.points.length;
+    mergeEdges(draft, sel.loop, sel.index, Math.min((sel.index - 1 + n + 1) % (n + 1), n - 1));
     this.sel = null;
-    this.ext.draft = draft;
-    this.render();
-    this.ext.commitPlan(draft);
+    this.commit(draft);
   }
 
   // --- edges --------------------------------------------------------------------------------
@@ -374,11 +387,11 @@ export class PlanEditor {
     if (e.button !== 0) return;
     e.stopPropagation();
     this.svg.focus({ preventScroll: true });
-    if (this.anchorMode) {
-      this.addAnchor(e, loop, index);
-      return;
-    }
-    this.select({ kind: 'edge', loop, index });
+    const tool = this.ext.tool;
+    if (tool === 'anchor') this.addAnchor(e, loop, index);
+    else if (tool === 'step') this.addStep(e, loop, index);
+    else if (tool === 'offset') this.toggleOffset(loop, index);
+    else this.select({ kind: 'edge', loop, index });
   }
 
   // The click's foot on edge i of loop l, as a fraction of the edge.
@@ -397,18 +410,16 @@ export class PlanEditor {
   insertCorner(e, loop, index) {
     e.preventDefault();
     e.stopPropagation();
+    if (this.ext.tool) return; // the clicks were for the tool
     const foot = this.footOn(e, loop, index);
     if (foot.t < 0.02 || foot.t > 0.98) return; // on a corner: nothing to insert
     const draft = clone(this.plan);
     const l = draft.loops[loop];
-    const round = (v) => Math.round(v * 1000) / 1000;
-    l.points.splice(index + 1, 0, [round(foot.x), round(foot.y)]);
+    l.points.splice(index + 1, 0, [round3(foot.x), round3(foot.y)]);
     l.profiles.splice(index + 1, 0, l.profiles[index]); // both halves keep the edge's profile
     shiftEdges(draft, loop, index, 1);
     this.sel = { kind: 'corner', loop, index: index + 1 };
-    this.ext.draft = draft;
-    this.render();
-    this.ext.commitPlan(draft);
+    this.commit(draft);
   }
 
   assignProfile(name) {
@@ -417,9 +428,7 @@ export class PlanEditor {
     const draft = clone(this.plan);
     if (draft.loops[sel.loop].profiles[sel.index] === name) return;
     draft.loops[sel.loop].profiles[sel.index] = name;
-    this.ext.draft = draft;
-    this.render();
-    this.ext.commitPlan(draft);
+    this.commit(draft);
   }
 
   addAnchor(e, loop, index) {
@@ -427,12 +436,46 @@ export class PlanEditor {
     const height = Math.max(0, Number(this.anchorHeight.value) || 0);
     const draft = clone(this.plan);
     const a = { name: `anchor${(draft.anchors?.length ?? 0) + 1}`, loop, edge: index, height };
-    if (this.anchorKind.value === 'absolute') a.absolute = Math.round(foot.t * foot.len * 1000) / 1000;
-    else a.relative = Math.round(foot.t * 1000) / 1000;
+    if (this.anchorKind.value === 'absolute') a.absolute = round3(foot.t * foot.len);
+    else a.relative = round3(foot.t);
     draft.anchors = [...(draft.anchors || []), a];
-    this.anchorMode = false;
-    this.ext.draft = draft;
-    this.render();
-    this.ext.commitPlan(draft);
+    this.ext.setTool(null);
+    this.commit(draft);
   }
+
+  // A step (the step tool's kind and sizes) at the clicked point of the edge.
+  addStep(e, loop, index) {
+    const ext = this.ext;
+    const params = ext.stepTool;
+    const bad = stepProblem(params, this.plan);
+    if (bad) {
+      this.editor.fail({ title: 'Cannot place the step', detail: bad });
+      return;
+    }
+    const foot = this.footOn(e, loop, index);
+    const draft = clone(this.plan);
+    const i = draft.steps?.length ?? 0;
+    const step = makeStep(params.kind, { ...params, loop, edge: index, relative: foot.t, name: `${params.kind === 'forced' ? 'forced' : 'step'}${i + 1}` });
+    draft.steps = [...(draft.steps || []), step];
+    ext.setTool(null);
+    ext.setDraft(draft);
+    ext.selectFeature({ kind: 'step', index: i });
+    this.commit(draft);
+  }
+
+  // The clicked edge out of (or back into) the selected offset event.
+  toggleOffset(loop, index) {
+    const f = this.ext.feature;
+    if (f?.kind !== 'offset' || !this.plan.offsets?.[f.index]) return;
+    this.commit(toggleOffsetEdge(this.plan, f.index, loop, index));
+  }
+}
+
+// Why the step tool cannot place a step on this plan, or null.
+function stepProblem({ height, width, depth, profile }, plan) {
+  if (!(height > 0)) return 'its height must be more than 0 m';
+  if (!(width >= 0.002)) return 'its width must be at least 2 mm';
+  if (!(Math.abs(depth) >= 0.002)) return 'its depth must be at least 2 mm either way';
+  if (!plan?.profiles?.[profile]) return 'choose the profile of its new edges';
+  return null;
 }

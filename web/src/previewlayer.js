@@ -1,8 +1,8 @@
 // The live drag preview: while someone drags a handle, the server re-solves the resize and
-// sends the room the nodes' new boxes; this layer moves and stretches each displayed
-// component from its node's stored box to the previewed one, until the committed op's mesh
-// arrives (or the drag is abandoned). Our own drag is shown the same way at once, before the
-// server's answer, for the dragged node alone.
+// sends the room the nodes' new boxes; this moves and stretches each component of the
+// viewport's model layer from its node's stored box to the previewed one, until the committed
+// op's mesh arrives (or the drag is abandoned). Our own drag is shown the same way at once,
+// before the server's answer, for the dragged node alone.
 import * as THREE from 'three';
 
 const ABANDONED_MS = 3000; // a preview.end not followed by an op: drop the preview after this
@@ -58,9 +58,8 @@ export class PreviewLayer {
       if (Array.isArray(box) && box.length === 6 && box.every(Number.isFinite)) this.boxes.set(node, box);
     }
     this.apply();
-    const c = this.viewport.container;
-    c.dataset.preview = String(this.boxes.size);
-    c.dataset.previewBy = author || peer || 'me';
+    this.viewport.mark('preview', this.boxes.size);
+    this.viewport.mark('previewBy', author || peer || 'me');
   }
 
   // Back to the loaded geometry.
@@ -70,8 +69,8 @@ export class PreviewLayer {
     this.peer = null;
     for (const o of this.meshes) restore(o);
     this.meshes.clear();
-    delete this.viewport.container.dataset.preview;
-    delete this.viewport.container.dataset.previewBy;
+    this.viewport.mark('preview', null);
+    this.viewport.mark('previewBy', null);
     this.viewport.requestRender();
   }
 
@@ -86,7 +85,7 @@ export class PreviewLayer {
     const tree = this.editor.tree;
     const vp = this.viewport;
     if (!tree) return;
-    for (const [component, meshes] of vp.byComponent) {
+    for (const [component, meshes] of vp.layers.model.components()) {
       const target = this.nearest(tree, component);
       for (const o of meshes) {
         if (!target) {

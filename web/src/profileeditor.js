@@ -2,9 +2,12 @@
 // w growing towards the inside of the plan. The chosen profile's points are dragged
 // (previewed live, committed on release), inserted by double-clicking a segment, removed
 // with Delete; "Insert overhang" adds the same outward horizontal segment at one height to
-// every profile of the building, so the eave stays level all round.
+// every profile of the building, so the eave stays level all round. Priority tags decide
+// which plane carries on where collinear neighbours with different slopes meet: the
+// profile's, and the clicked segment's (empty: the profile's). The rule for equal tags
+// belongs to the plan (planfeatures.js).
 import { el } from './dom.js';
-import { clone, profilePoints, withPoints } from './extrusion.js';
+import { clone, profilePoints, segmentPriority, withPoints, withPriority, withSegmentPriority } from './plandoc.js';
 import { profileColours, svg } from './planeditor.js';
 
 const MARGIN = 24;
@@ -52,11 +55,13 @@ export function withOverhang(points, h, width) {
 }
 
 export class ProfileEditor {
-  constructor(editor, ext, container) {
+  constructor(editor, container) {
     this.editor = editor;
-    this.ext = ext;
+    this.ext = editor.extrusion;
+    const ext = this.ext;
     this.name = null;   // the chosen profile
     this.sel = null;    // index of the selected point
+    this.seg = null;    // index of the selected segment (its priority tag is edited)
     this.frame = null;
     this.drag = null;
 
@@ -64,6 +69,7 @@ export class ProfileEditor {
     this.choose.addEventListener('change', () => {
       this.name = this.choose.value;
       this.sel = null;
+      this.seg = null;
       this.render();
     });
     this.everywhere = el('input', { type: 'checkbox', 'data-testid': 'profile-everywhere' });
@@ -76,6 +82,10 @@ export class ProfileEditor {
     this.ohBtn = el('button', { type: 'button', 'data-testid': 'insert-overhang', title: 'Add an outward horizontal segment at the selected point’s height (else the eave) to every profile of this building' }, 'Insert overhang');
     this.ohBtn.addEventListener('click', () => this.insertOverhang());
     this.readout = el('span.plan-status', { 'data-testid': 'profile-readout' });
+    this.priority = tagInput('profile-priority', 'Priority tag of the whole profile: the higher wins where collinear neighbours meet (default 0)');
+    this.priority.addEventListener('change', () => this.setPriority(this.priority.value));
+    this.segPriority = tagInput('segment-priority', 'Priority tag of the selected segment (empty: the profile’s)');
+    this.segPriority.addEventListener('change', () => this.setSegmentPriority(this.segPriority.value));
     this.roofOnly = true;
     this.zoomBtn = el('button', { type: 'button', 'data-testid': 'profile-zoom', title: 'Show the whole profile or only from its first bend up' }, 'whole');
     this.zoomBtn.addEventListener('click', () => {
@@ -95,6 +105,9 @@ export class ProfileEditor {
     container.append(
       el('div.pane-bar', {}, el('label', {}, 'profile ', this.choose), this.zoomBtn, this.everyLabel, this.readout),
       el('div.pane-bar.tools', {}, this.addBtn, this.delBtn, el('label', {}, 'overhang ', this.ohWidth, ' m'), this.ohBtn),
+      el('div.pane-bar.tools', {},
+        el('label', {}, 'priority ', this.priority),
+        el('label', {}, 'segment ', this.segPriority)),
       el('div.plan-box', {}, this.svg),
       this.legend,
     );
@@ -106,7 +119,10 @@ export class ProfileEditor {
     }).observe(this.svg);
     ext.signals.buildingChanged.add((b) => {
       // A reload of the same building (after an op) keeps what is selected.
-      if (b?.index !== this.shown) this.sel = null;
+      if (b?.index !== this.shown) {
+        this.sel = null;
+        this.seg = null;
+      }
       this.shown = b?.index;
       this.frame = null;
       this.render();
@@ -175,11 +191,12 @@ export class ProfileEditor {
     this.svg.replaceChildren();
     const names = Object.keys(plan?.profiles || {});
     this.everyLabel.hidden = !this.ext.batch;
-    for (const b of [this.addBtn, this.ohBtn, this.choose]) b.disabled = !plan;
+    for (const b of [this.addBtn, this.ohBtn, this.choose, this.priority]) b.disabled = !plan;
     if (!plan) {
       this.choose.replaceChildren();
       this.legend.replaceChildren();
       this.delBtn.disabled = true;
+      this.segPriority.disabled = true;
       return;
     }
     if (!names.includes(this.name)) {
@@ -191,6 +208,7 @@ export class ProfileEditor {
       this.sel = null;
     }
     if (this.sel !== null && this.sel >= this.points().length) this.sel = null;
+    if (this.seg !== null && this.seg >= this.points().length - 1) this.seg = null;
     this.choose.replaceChildren(...names.map((n) => el('option', { value: n }, n)));
     this.choose.value = this.name;
     const colours = profileColours(plan);
@@ -225,13 +243,35 @@ export class ProfileEditor {
       this.svg.append(svg('polyline', { points: poly(profilePoints(plan.profiles[n])), class: 'profile-line other', stroke: colours.get(n) }));
     }
     const pts = this.points();
+    const profile = plan.profiles[this.name];
     pts.forEach((p, i) => {
       if (i + 1 >= pts.length) return;
       const [ax, ay] = f.toScreen(...p);
       const [bx, by] = f.toScreen(...pts[i + 1]);
-      const seg = svg('line', { x1: ax, y1: ay, x2: bx, y2: by, class: 'profile-seg', stroke: colours.get(this.name), 'data-testid': 'profile-segment', 'data-index': i });
+      const tag = segmentPriority(profile, i);
+      const seg = svg('line', {
+        x1: ax, y1: ay, x2: bx, y2: by,
+        class: `profile-seg${this.seg === i ? ' selected' : ''}`,
+        stroke: colours.get(this.name),
+        'data-testid': 'profile-segment',
+        'data-index': i,
+        'data-priority': tag.value,
+      });
+      const t = svg('title');
+      t.textContent = `segment ${i} · priority ${tag.value}${tag.own === null ? ' (the profile’s)' : ''}`;
+      seg.append(t);
+      seg.addEventListener('pointerdown', (e) => {
+        if (e.button !== 0) return;
+        this.seg = i;
+        this.render();
+      });
       seg.addEventListener('dblclick', (e) => this.insertPoint(e, i));
       this.svg.append(seg);
+      if (tag.own !== null) {
+        const label = svg('text', { x: (ax + bx) / 2 + 6, y: (ay + by) / 2 - 4, class: 'tick seg-tag' });
+        label.textContent = `p${tag.own}`;
+        this.svg.append(label);
+      }
     });
     // The last segment goes on upwards until the roof closes: hint it.
     if (pts.length >= 2) {
@@ -260,6 +300,43 @@ export class ProfileEditor {
     this.delBtn.disabled = this.sel === null || this.sel === 0 || pts.length <= 2;
     const p = this.sel !== null ? pts[this.sel] : null;
     this.readout.textContent = p ? `w ${p[0]} · z ${p[1]}` : '';
+    this.renderPriorities(profile);
+  }
+
+  // The tag fields follow the description unless the person is typing in them.
+  renderPriorities(profile) {
+    const typing = (input) => document.activeElement === input;
+    if (!typing(this.priority)) this.priority.value = String(Array.isArray(profile) ? 0 : profile?.priority ?? 0);
+    this.segPriority.disabled = this.seg === null;
+    if (!typing(this.segPriority)) {
+      const own = this.seg === null ? null : segmentPriority(profile, this.seg).own;
+      this.segPriority.value = own === null ? '' : String(own);
+      this.segPriority.placeholder = this.seg === null ? '—' : 'profile’s';
+    }
+  }
+
+  // --- priority tags --------------------------------------------------------------------------
+  setPriority(text) {
+    const v = tagValue(text, false);
+    if (v === undefined) return this.badTag('the profile’s priority is a whole number');
+    const draft = clone(this.plan);
+    draft.profiles[this.name] = withPriority(draft.profiles[this.name], v);
+    return this.commit(draft);
+  }
+
+  setSegmentPriority(text) {
+    if (this.seg === null) return null;
+    const v = tagValue(text, true);
+    if (v === undefined) return this.badTag('a segment’s priority is a whole number (empty: the profile’s)');
+    const draft = clone(this.plan);
+    draft.profiles[this.name] = withSegmentPriority(draft.profiles[this.name], this.seg, v);
+    return this.commit(draft);
+  }
+
+  badTag(detail) {
+    this.editor.fail({ title: 'Cannot set the priority', detail });
+    this.render();
+    return null;
   }
 
   // The description with the chosen profile's points replaced.
@@ -273,7 +350,10 @@ export class ProfileEditor {
   // single building) or when asked for every building; otherwise a plan op for this building.
   commit(draft) {
     const profile = draft.profiles[this.name];
-    if (!this.ext.batch || this.everywhere.checked) return this.ext.commitProfile(this.name, profile);
+    if (!this.ext.batch || this.everywhere.checked) {
+      this.ext.setDraft(draft);
+      return this.ext.commitProfile(this.name, profile);
+    }
     return this.ext.commitPlan(draft);
   }
 
@@ -349,10 +429,7 @@ export class ProfileEditor {
   }
 
   apply(pts) {
-    const draft = this.draftWith(pts);
-    this.ext.draft = draft;
-    this.render();
-    this.commit(draft);
+    this.commit(this.draftWith(pts));
   }
 
   // §3.3: the same overhang (a horizontal segment outwards) at one height in every profile.
@@ -380,8 +457,25 @@ export class ProfileEditor {
       }
       draft.profiles[n] = withPoints(p, next);
     }
-    this.ext.draft = draft;
-    this.render();
     this.ext.commitPlan(draft);
   }
+}
+
+function tagInput(testid, title) {
+  const input = el('input.num', { type: 'number', step: '1', 'data-testid': testid, title });
+  input.addEventListener('keydown', (e) => {
+    if (e.key === 'Enter') {
+      e.preventDefault();
+      input.blur(); // commits through the change event
+    }
+  });
+  return input;
+}
+
+// A typed priority tag: an integer, null for an empty segment field, undefined when unusable.
+function tagValue(text, emptyIsNull) {
+  const t = String(text).trim();
+  if (t === '') return emptyIsNull ? null : 0;
+  const v = Number(t);
+  return Number.isInteger(v) ? v : undefined;
 }

@@ -1,5 +1,7 @@
 // What a person does to a model (open, rename, add a note), carried out over REST and the
 // live connection; the results land in the editor, which tells the views.
+import { OP } from './opkinds.js';
+
 export class Session {
   constructor(editor, api, live) {
     this.editor = editor;
@@ -69,24 +71,13 @@ export class Session {
       ed.refreshModel();
       return;
     }
-    try {
-      await this.live.sendOp({ kind: 'rename', name: clean });
-    } catch (err) {
-      if (!err.problem || !this.live.open) ed.fail(err); // a nack was already shown
-      ed.refreshModel();
-    }
+    await ed.execute({ kind: OP.rename, name: clean });
   }
 
   async note(text) {
     const ed = this.editor;
     const clean = text.trim();
     if (!ed.model || !clean) return false;
-    try {
-      await this.live.sendOp({ kind: 'note', text: clean });
-      return true;
-    } catch (err) {
-      if (!err.problem || !this.live.open) ed.fail(err);
-      return false;
-    }
+    return (await ed.execute({ kind: OP.note, text: clean })) !== null;
   }
 }

@@ -3,7 +3,6 @@
 // geometry; a component picked in the viewport is revealed here (both through the editor).
 import { el } from './dom.js';
 import { boxSize, nodeTitle } from './splittree.js';
-import { selectedNodes, toggleNode } from './edittools.js';
 
 const STAGES = ['segment', 'label', 'tree', 'rules', 'patterns', 'export', 'verify'];
 const OPEN_DEPTH = 2; // levels shown expanded when a tree arrives
@@ -161,7 +160,7 @@ export class SplitTreePanel {
         style: `padding-left:${depth * 12 + 2}px`,
         title: `node ${id}`,
         // Shift+click adds to the selection (join, copy, remove work on several nodes)
-        onclick: (e) => (e.shiftKey ? toggleNode(this.editor, id) : this.editor.selectNode(id)),
+        onclick: (e) => (e.shiftKey ? this.editor.selected.toggle(id) : this.editor.selected.node(id)),
         onkeydown: (e) => this.key(e, id),
       },
       kids.length ? toggle : el('span.toggle-space'),
@@ -188,7 +187,7 @@ export class SplitTreePanel {
     if (!n) return;
     if (e.key === 'Enter' || e.key === ' ') {
       e.preventDefault();
-      this.editor.selectNode(id);
+      this.editor.selected.node(id);
     } else if (e.key === 'ArrowRight' && n.children?.length && !this.expanded.has(id)) {
       this.expanded.add(id);
       this.render();
@@ -207,7 +206,7 @@ export class SplitTreePanel {
 
   // Marks the selected nodes' rows.
   mark() {
-    const ids = new Set(selectedNodes(this.editor));
+    const ids = new Set(this.editor.selected.nodeIds());
     for (const [nid, row] of this.rows) {
       const on = ids.has(nid);
       row.classList.toggle('selected', on);

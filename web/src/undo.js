@@ -4,22 +4,19 @@
 // everyone in the room sees it and each person undoes only their own edits.
 import { el } from './dom.js';
 import { isTyping } from './edittools.js';
-
-// Op kinds in a person's undo history (the server's: structural edits and restores).
-const EDITS = new Set(['resize', 'split', 'join', 'paste', 'remove', 'restore', 'undo', 'redo']);
+import { OP, UNDOABLE } from './opkinds.js';
 
 // 'undo', 'redo' or 'edit': the server logs an undo as {kind: 'restore', undoes: K}; our own
 // entry keeps the op we sent.
 function step(op) {
-  if (op.kind === 'undo' || (op.kind === 'restore' && op.undoes != null)) return 'undo';
-  if (op.kind === 'redo' || (op.kind === 'restore' && op.redoes != null)) return 'redo';
+  if (op.kind === OP.undo || (op.kind === OP.restore && op.undoes != null)) return 'undo';
+  if (op.kind === OP.redo || (op.kind === OP.restore && op.redoes != null)) return 'redo';
   return 'edit';
 }
 
 export class Undo {
-  constructor(editor, live, container) {
+  constructor(editor, container) {
     this.editor = editor;
-    this.live = live;
     this.busy = false;
     this.undoBtn = el('button', { type: 'button', 'data-testid': 'undo', title: 'Undo your last edit (Ctrl+Z)', onclick: () => this.undo() }, '↶ Undo');
     this.redoBtn = el('button', { type: 'button', 'data-testid': 'redo', title: 'Redo (Ctrl+Shift+Z)', onclick: () => this.redo() }, '↷ Redo');
@@ -43,11 +40,11 @@ export class Undo {
   }
 
   undo() {
-    return this.send('undo');
+    return this.send(OP.undo);
   }
 
   redo() {
-    return this.send('redo');
+    return this.send(OP.redo);
   }
 
   async send(kind) {
@@ -56,10 +53,7 @@ export class Undo {
     this.busy = true;
     this.render();
     try {
-      return await this.live.sendOp({ kind });
-    } catch (err) {
-      if (!err.problem || !this.live.open) ed.fail(err); // a nack was already shown
-      return null;
+      return await ed.execute({ kind });
     } finally {
       this.busy = false;
       this.render();
@@ -71,7 +65,7 @@ export class Undo {
   // problem when there is nothing left).
   render() {
     const ed = this.editor;
-    const mine = ed.model ? ed.history().filter((e) => e.author === ed.user && EDITS.has(e.op?.kind)) : [];
+    const mine = ed.model ? ed.history().filter((e) => e.author === ed.user && UNDOABLE.has(e.op?.kind)) : [];
     let undone = 0;
     for (let i = mine.length - 1; i >= 0; i--) {
       const kind = step(mine[i].op);

@@ -1,11 +1,13 @@
 // The 3D view: loads a model's GLB, frames it, renders on demand and turns clicks into
 // component selections. It only reacts to editor signals and reports picks/camera moves back.
 // Once the model is proceduralized its components are coloured by label (the tree's colours).
+// Other modules draw through its layers (layers.js) and its camera helpers, never its scene.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
-import { toggleNode } from './edittools.js';
+import { Layer, ModelLayer } from './layers.js';
 import { colourOf } from './peers.js';
+import { Signal } from './signal.js';
 
 // Flat, light background; model colours are mid-tones kept well away from it so the model
 // always stands out (and the grid stays close to it so it never does).
@@ -23,37 +25,44 @@ export class Viewport {
     this.editor = editor;
     this.api = api;
     this.container = container;
+    this.signals = {
+      shown: new Signal(), // {model, version}: that model's mesh is on screen now
+    };
 
     this.renderer = new THREE.WebGLRenderer({ antialias: true });
     this.renderer.setPixelRatio(window.devicePixelRatio || 1);
     this.renderer.domElement.setAttribute('data-testid', 'viewport-canvas');
     container.appendChild(this.renderer.domElement);
+    this.canvas = this.renderer.domElement;
 
     this.scene = new THREE.Scene();
     this.scene.background = new THREE.Color(BACKGROUND);
     const hemi = new THREE.HemisphereLight(0xffffff, 0x8d8475, 1.0);
     this.scene.add(hemi);
-    const sun = new THREE.DirectionalLight(0xffffff, 1.3);
-    sun.position.set(0.6, 1.0, 0.45);
-    this.scene.add(sun);
-    this.scene.add(sun.target);
+    this.sun = new THREE.DirectionalLight(0xffffff, 1.3);
+    this.sun.position.set(0.6, 1.0, 0.45);
+    this.scene.add(this.sun);
+    this.scene.add(this.sun.target);
 
     this.grid = null;
-    this.root = null;           // the loaded model
-    this.byComponent = new Map(); // component -> meshes
+    this.layers = {
+      model: new ModelLayer(this),
+      preview: new Layer(this, 'preview'),
+      handles: new Layer(this, 'handles'),
+    };
     this.loadToken = 0;
+    this.shown = null; // {model, version} on screen
 
     this.camera = new THREE.PerspectiveCamera(45, 1, 0.1, 1000);
     this.camera.position.set(12, 9, 14);
-    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls = new OrbitControls(this.camera, this.canvas);
     this.controls.addEventListener('change', () => {
       this.requestRender();
       this.reportCamera();
     });
 
-    this.raycaster = new THREE.Raycaster();
     this.pointerDown = null;
-    const el = this.renderer.domElement;
+    const el = this.canvas;
     el.addEventListener('pointerdown', (e) => {
       if (e.button === 0) this.pointerDown = { x: e.clientX, y: e.clientY };
     });
@@ -105,14 +114,22 @@ export class Viewport {
     this.status.hidden = !text;
   }
 
+  // A data attribute on the view (what tests and scripted demos wait for); null removes it.
+  mark(name, value) {
+    if (value === null || value === undefined) delete this.container.dataset[name];
+    else this.container.dataset[name] = String(value);
+  }
+
   // --- loading ------------------------------------------------------------------------------
   // keepCamera: the same model with a new mesh (it stays where the person was looking).
   async load(model, { keepCamera = false } = {}) {
     const token = ++this.loadToken;
-    const reframe = !(keepCamera && this.root);
-    delete this.container.dataset.model;
-    delete this.container.dataset.version;
-    if (reframe) this.clear();
+    const layer = this.layers.model;
+    const reframe = !(keepCamera && layer.root);
+    this.shown = null;
+    this.mark('model', null);
+    this.mark('version', null);
+    if (reframe) layer.clear();
     if (!model) {
       this.setStatus('Open or import a model');
       return;
@@ -124,11 +141,12 @@ export class Viewport {
       if (token !== this.loadToken) return;
       const gltf = await new GLTFLoader().parseAsync(buffer, '');
       if (token !== this.loadToken) return;
-      this.clear();
       this.show(gltf.scene, reframe);
       this.setStatus('');
-      this.container.dataset.model = String(model.id); // which model is on screen
-      this.container.dataset.version = String(version); // and which version of its mesh
+      this.shown = { model: model.id, version };
+      this.mark('model', model.id); // which model is on screen
+      this.mark('version', version); // and which version of its mesh
+      this.signals.shown.dispatch(this.shown);
     } catch (err) {
       if (token !== this.loadToken) return;
       this.setStatus('The mesh could not be shown');
@@ -136,55 +154,36 @@ export class Viewport {
     }
   }
 
-  clear() {
-    if (this.root) {
-      this.scene.remove(this.root);
-      this.root.traverse((o) => {
-        if (o.isMesh) {
-          o.geometry.dispose();
-          for (const m of [].concat(o.material)) m.dispose();
-        }
-      });
-    }
-    this.root = null;
-    this.byComponent.clear();
-    this.requestRender();
-  }
-
   show(root, reframe = true) {
-    root.traverse((o) => {
-      if (!o.isMesh) return;
-      const owner = componentOwner(o);
-      const component = owner ? owner.userData.component : -1;
-      o.userData.componentId = component;
-      o.userData.groupName = owner ? owner.userData.group ?? null : null;
-      o.userData.label = owner && typeof owner.userData.label === 'string' ? owner.userData.label : null;
-      // Own material per mesh so a highlight touches only the picked component.
-      for (const m of [].concat(o.material)) m.dispose();
-      o.material = new THREE.MeshStandardMaterial({
-        roughness: 0.85,
-        metalness: 0,
-        side: THREE.DoubleSide,
-        polygonOffset: true,
-        polygonOffsetFactor: 1,
-        polygonOffsetUnits: 1,
-      });
-      if (!this.byComponent.has(component)) this.byComponent.set(component, []);
-      this.byComponent.get(component).push(o);
-    });
-    this.root = root;
-    this.scene.add(root);
+    const layer = this.layers.model;
+    layer.set(root);
+    for (const meshes of layer.byComponent.values()) {
+      for (const o of meshes) {
+        // Own material per mesh so a highlight touches only the picked component.
+        for (const m of [].concat(o.material)) m.dispose();
+        o.material = new THREE.MeshStandardMaterial({
+          roughness: 0.85,
+          metalness: 0,
+          side: THREE.DoubleSide,
+          polygonOffset: true,
+          polygonOffsetFactor: 1,
+          polygonOffsetUnits: 1,
+        });
+      }
+    }
     if (reframe) this.frameModel();
     this.colourize();
   }
 
-  // Base colours: by label with the tree's colours once the model is proceduralized;
+  // Base colours: the model layer's tint when one is set (e.g. the city view's height
+  // colours), else by label with the tree's colours once the model is proceduralized;
   // otherwise one palette colour per kind of group ("window_3" and "window_7" are both
   // windows), or per component when ungrouped.
   colourize() {
     const tree = this.editor.tree;
+    const layer = this.layers.model;
     const groupColour = new Map();
-    for (const meshes of this.byComponent.values()) {
+    for (const meshes of layer.byComponent.values()) {
       for (const o of meshes) {
         const byLabel = tree && o.userData.label !== null ? tree.colourOf(o.userData.label) : null;
         let colour;
@@ -196,40 +195,86 @@ export class Viewport {
           if (!groupColour.has(key)) groupColour.set(key, PALETTE[groupColour.size % PALETTE.length]);
           colour = new THREE.Color(groupColour.get(key));
         }
-        o.userData.baseColour = (this.tint && this.tint(o)) || colour; // e.g. the city view's height colours
+        o.userData.baseColour = (layer.tint && layer.tint(o)) || colour;
       }
     }
     this.highlight();
   }
 
+  // --- camera -------------------------------------------------------------------------------
   // Places the camera so the whole model fits, and the grid under it.
   frameModel() {
-    const box = new THREE.Box3().setFromObject(this.root);
+    const box = this.layers.model.bounds();
     if (box.isEmpty()) return;
     const sphere = box.getBoundingSphere(new THREE.Sphere());
     const r = Math.max(sphere.radius, 1e-3);
-    const fov = THREE.MathUtils.degToRad(this.camera.fov);
-    const fit = Math.min(fov, 2 * Math.atan(Math.tan(fov / 2) * this.camera.aspect));
-    const dist = (r / Math.sin(fit / 2)) * 1.15;
-    const dir = new THREE.Vector3(1, 0.75, 1.25).normalize();
-    this.camera.position.copy(sphere.center).addScaledVector(dir, dist);
-    this.camera.near = dist / 200;
-    this.camera.far = dist * 50;
-    this.camera.updateProjectionMatrix();
-    this.controls.target.copy(sphere.center);
-    this.controls.update();
+    const dist = (r / Math.sin(this.fitAngle() / 2)) * 1.15;
+    this.look(sphere.center, new THREE.Vector3(1, 0.75, 1.25), dist, { near: dist / 200, far: dist * 50 });
 
     const size = box.getSize(new THREE.Vector3());
     this.makeGrid(niceSize(Math.max(size.x, size.z) * 3));
     this.grid.position.set(sphere.center.x, box.min.y - r * 1e-3, sphere.center.z);
-    this.sun().position.copy(sphere.center).addScaledVector(new THREE.Vector3(0.6, 1.0, 0.45), dist);
-    this.sun().target.position.copy(sphere.center);
+    this.sun.position.copy(sphere.center).addScaledVector(new THREE.Vector3(0.6, 1.0, 0.45), dist);
+    this.sun.target.position.copy(sphere.center);
+    this.requestRender();
+  }
+
+  // A steep look down that fits the model's ground extent (the orbit framing fits a bounding
+  // sphere from low down, which leaves a flat city small).
+  frameGround() {
+    const box = this.layers.model.bounds();
+    if (box.isEmpty()) return;
+    const size = box.getSize(new THREE.Vector3());
+    const centre = box.getCenter(new THREE.Vector3());
+    const r = Math.max(0.5 * Math.hypot(size.x, size.z), size.y, 1e-3);
+    const dist = (r / Math.tan(this.fitAngle() / 2)) * 1.05;
+    this.look(centre, new THREE.Vector3(0.35, 1, 0.6), dist, { near: dist / 500, far: dist * 20 });
+  }
+
+  // The narrower of the vertical and horizontal fields of view.
+  fitAngle() {
+    const fov = THREE.MathUtils.degToRad(this.camera.fov);
+    return Math.min(fov, 2 * Math.atan(Math.tan(fov / 2) * this.camera.aspect));
+  }
+
+  // Looks at `target` from `dist` away along `direction`.
+  look(target, direction, dist, { near, far }) {
+    this.camera.position.copy(target).addScaledVector(direction.clone().normalize(), dist);
+    this.camera.near = near;
+    this.camera.far = far;
+    this.camera.updateProjectionMatrix();
+    this.controls.target.copy(target);
+    this.controls.update();
     this.requestRender();
     this.reportCamera();
   }
 
-  sun() {
-    return this.scene.children.find((o) => o.isDirectionalLight);
+  // Orbiting on or off (a tool dragging in the view turns it off).
+  setOrbit(enabled) {
+    this.controls.enabled = enabled;
+  }
+
+  // A ray through a pointer position (client pixels).
+  ray(clientX, clientY) {
+    const rect = this.canvas.getBoundingClientRect();
+    const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+    const rc = new THREE.Raycaster();
+    rc.setFromCamera(ndc, this.camera);
+    return rc;
+  }
+
+  // Where a world point is drawn, in CSS pixels relative to the canvas.
+  toScreen(point) {
+    this.camera.updateMatrixWorld();
+    const p = point.clone().project(this.camera);
+    return { x: ((p.x + 1) / 2) * this.canvas.clientWidth, y: ((1 - p.y) / 2) * this.canvas.clientHeight };
+  }
+
+  // World size of one CSS pixel at a point (to keep tools a constant size on screen).
+  worldPerPixel(point) {
+    const h = this.canvas.clientHeight || 1;
+    const d = this.camera.position.distanceTo(point);
+    return (2 * d * Math.tan(THREE.MathUtils.degToRad(this.camera.fov) / 2)) / h;
   }
 
   makeGrid(size) {
@@ -246,30 +291,25 @@ export class Viewport {
   // --- picking ------------------------------------------------------------------------------
   // Shift adds the component's split-tree node to the selection (or takes it out).
   pick(clientX, clientY, extend = false) {
-    if (!this.root) return;
-    const rect = this.renderer.domElement.getBoundingClientRect();
-    const ndc = new THREE.Vector2(
-      ((clientX - rect.left) / rect.width) * 2 - 1,
-      -((clientY - rect.top) / rect.height) * 2 + 1,
-    );
-    this.raycaster.setFromCamera(ndc, this.camera);
-    const hit = this.raycaster.intersectObject(this.root, true).find((h) => h.object.isMesh);
-    const owner = hit ? componentOwner(hit.object) : null;
+    const layer = this.layers.model;
+    if (!layer.root) return;
+    const owner = layer.hit(this.ray(clientX, clientY));
+    const selected = this.editor.selected;
     if (!owner) {
-      this.editor.select(null);
+      selected.clear();
       return;
     }
     const node = this.editor.tree?.nodeOfComponent(owner.userData.component) ?? null;
     if (extend && node !== null) {
-      toggleNode(this.editor, node);
+      selected.toggle(node);
       return;
     }
-    this.editor.select({ component: owner.userData.component, group: owner.userData.group ?? null });
+    selected.set({ component: owner.userData.component, group: owner.userData.group ?? null });
   }
 
   // Our selection in yellow; what others have selected in their colours.
   highlight() {
-    const on = new Set(this.editor.selectedComponents());
+    const on = new Set(this.editor.selected.components());
     const theirs = new Map();
     for (const p of this.editor.peers.values()) {
       const sel = p.state?.selection;
@@ -277,7 +317,7 @@ export class Viewport {
       const colour = new THREE.Color(colourOf(p.state?.name || p.user || p.peer));
       for (const c of sel) if (!theirs.has(c)) theirs.set(c, colour);
     }
-    for (const [component, meshes] of this.byComponent) {
+    for (const [component, meshes] of this.layers.model.components()) {
       const lit = on.has(component);
       const peer = lit ? null : theirs.get(component);
       for (const mesh of meshes) {
@@ -295,14 +335,6 @@ export class Viewport {
 }
 
 const BLACK = new THREE.Color(0x000000);
-
-// The nearest object (itself or an ancestor) that the GLB marked with a component id.
-function componentOwner(o) {
-  for (let x = o; x; x = x.parent) {
-    if (typeof x.userData?.component === 'number') return x;
-  }
-  return null;
-}
 
 function groupKind(name) {
   const m = /^[A-Za-z]+/.exec(String(name));

@@ -1,0 +1,25 @@
+// What the browser tests wait for on a page: the model version in the toolbar, the mesh of a
+// version on screen, an uploaded file's model opened.
+export const WAIT = { timeout: 30000 };
+
+export const versionOf = async (page) => Number((await page.getByTestId('model-version').textContent()).replace(/\D/g, ''));
+
+export const waitVersion = (page, v) =>
+  page.waitForFunction((want) => Number(document.querySelector('[data-testid="model-version"]').textContent.replace(/\D/g, '')) === want, v, WAIT);
+
+// The viewport shows the mesh of version v.
+export const waitMesh = (page, v) => page.locator(`#viewport[data-version="${v}"]`).waitFor({ state: 'attached', ...WAIT });
+
+export const centre = async (locator) => {
+  const b = await locator.boundingBox();
+  return { x: b.x + b.width / 2, y: b.y + b.height / 2 };
+};
+
+// Gives a file (a path, or {name, mimeType, buffer}) to a file input, waits for its job to
+// succeed and its model to open; resolves with the model's id.
+export async function uploadAndOpen(page, testid, file) {
+  await page.getByTestId(testid).setInputFiles(file);
+  await page.locator('[data-testid="job"][data-status="succeeded"]').waitFor(WAIT);
+  await page.waitForFunction(() => /^#model=\d+$/.test(location.hash), null, WAIT);
+  return Number((await page.evaluate(() => location.hash)).replace(/\D/g, ''));
+}
