@@ -16,6 +16,7 @@
 #include "../store/jobs.h"
 #include "../store/models.h"
 #include "extrusion.h"
+#include "store_env.h"
 
 typedef struct {
     char *id;         /* footprint id: the mesh group's name */
@@ -179,21 +180,18 @@ static ag_status read_buildings(json_t *root, batch *b, ag_error *err)
     return AG_OK;
 }
 
-static ag_status read_geojson(const char *data, size_t len, json_t *params, batch *b,
-                              ag_error *err)
+static ag_status read_geojson(const char *data, size_t len, const ag_extrude_job *params,
+                              batch *b, ag_error *err)
 {
-    const char *style_name = json_string_value(json_object_get(params, "style"));
     ag_style style;
-    ag_status s = ag_style_builtin(style_name ? style_name : "hip", &style, err);
+    ag_status s = ag_style_builtin(params->style ? params->style : "hip", &style, err);
     if (s != AG_OK)
         return s;
-    json_t *seed = json_object_get(params, "seed");
-    if (json_is_integer(seed))
-        style.seed = (uint64_t)json_integer_value(seed);
-    json_t *ll = json_object_get(params, "lonlat");
+    if (params->seed >= 0)
+        style.seed = (uint64_t)params->seed;
     ag_footprints_options fo = {
-        .height_property = json_string_value(json_object_get(params, "height_property")),
-        .lonlat = json_is_true(ll) ? 1 : json_is_false(ll) ? -1 : 0,
+        .height_property = params->height_property,
+        .lonlat = params->lonlat,
     };
     ag_footprints *f = NULL;
     if ((s = ag_footprints_read_buffer(data, len, &fo, &f, err)) != AG_OK)
@@ -320,13 +318,15 @@ out:
     return s;
 }
 
-static ag_status run(ag_app *app, ag_jobctx *ctx, int64_t job, const char *params_json,
+static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_params *p,
                      ag_error *err)
 {
-    json_t *params = json_loads(params_json, 0, NULL);
-    const char *upload = json_string_value(json_object_get(params, "upload"));
-    const char *name = json_string_value(json_object_get(params, "name"));
-    const char *format = json_string_value(json_object_get(params, "format"));
+    if (p->type != AG_JOB_EXTRUDE)
+        return ag_error_set(err, AG_ERR_INTERNAL, 0, "an extrude job without its params");
+    const ag_extrude_job *params = &p->u.extrude;
+    const char *upload = params->upload;
+    const char *name = params->name;
+    const char *format = params->format;
     char *data = NULL;
     size_t len = 0;
     json_t *root = NULL;
@@ -427,18 +427,17 @@ static ag_status run(ag_app *app, ag_jobctx *ctx, int64_t job, const char *param
         s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
         goto done;
     }
-    ag_db *db = ag_app_db(app, err);
-    s = db ? store(db, ctx, job, name, &b, mesh, data, len, report, err)
-           : (err ? err->code : AG_ERR_DB);
+    ag_store_env env;
+    s = ag_store_services_env(services, &env, err);
+    if (s == AG_OK)
+        s = store(env.db, ctx, job, name, &b, mesh, data, len, report, err);
     json_decref(report);
 done:
     json_decref(root);
     ag_mesh_free(mesh);
     batch_clear(&b);
     free(data);
-    json_decref(params);
     return s;
 }
 
-const ag_job_kind ag_extrude_job_kind = {.kind = "extrude", .run = run,
-                                        .cleanup = ag_jobqueue_remove_upload};
+const ag_job_kind ag_extrude_job_kind = {.kind = "extrude", .run = run};

@@ -1,7 +1,6 @@
-/* The extrude use case (POST /api/v1/extrusions), off the request thread. Params JSON:
- * {"upload": path, "name": text, "format": "plan"|"buildings"|"geojson"|null (sniffed),
- *  "style": built-in style name, "height_property": text|null, "seed": integer|null,
- *  "lonlat": true|false|null}.
+/* The extrude job (POST /api/v1/extrusions), off the request thread, with the params of
+ * app/job_params.h (ag_extrude_job: the upload, name, format or sniffed, style, height
+ * property, seed, lon/lat), registered with the store services (app/store_env.h).
  *
  * The upload is one building description (plan JSON, schema/plan.md), a list of them
  * ({"buildings": [{"id", "plan"}]}, as GET …/plan gives for a batch) or a GeoJSON
