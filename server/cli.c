@@ -69,20 +69,6 @@ int ag_cli_parse_up(const char *value, ag_up_axis *up)
     return 0;
 }
 
-int ag_cli_make_dirs(const char *dir)
-{
-    char p[4096];
-    snprintf(p, sizeof p, "%s", dir);
-    for (char *s = p + 1; *s; s++)
-        if (*s == '/') {
-            *s = 0;
-            if (mkdir(p, 0777) && errno != EEXIST)
-                return -1;
-            *s = '/';
-        }
-    return mkdir(p, 0777) && errno != EEXIST ? -1 : 0;
-}
-
 double ag_cli_seconds(void)
 {
     struct timespec ts;

@@ -8,7 +8,6 @@
 #include "../io/glb.h"
 #include "../io/meshblob.h"
 #include "../io/plan_json.h"
-#include "../io/splittree_json.h"
 #include "../store/extrusions.h"
 #include "../store/grammars.h"
 #include "../store/jobs.h"
@@ -339,7 +338,7 @@ ag_status ag_app_query_glb(ag_app *app, int64_t id, int (*fresh)(void *user, con
     char *labels = NULL;
     s = load_mesh(db, blob_id, &mesh, err);
     if (s == AG_OK && proceduralized)
-        s = ag_splittree_json_component_meta(g.tree_json, mesh->ncomponents, &meta, &labels, err);
+        s = ag_model_tree_component_meta(g.tree_json, mesh->ncomponents, &meta, &labels, err);
     if (s == AG_OK)
         s = meta ? ag_glb_write_meta(mesh, meta, mesh->ncomponents, &out->data, &out->len, err)
                  : ag_glb_write(mesh, &out->data, &out->len, err);

@@ -1,10 +1,11 @@
 #include "model_tree.h"
 
+#include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "../io/splittree_json.h"
 
 static const char *kind_name(int k)
 {
@@ -162,7 +163,7 @@ json_t *ag_model_tree_served(const ag_edit_model *em)
             continue;
         }
         char color[8];
-        ag_splittree_json_label_color(label, color);
+        ag_model_tree_label_color(label, color);
         json_object_set_new(index, label, json_integer((json_int_t)json_array_size(labels)));
         json_array_append_new(labels, json_pack("{s:s, s:i, s:s}", "label", label, "count", 1,
                                                 "color", color));
@@ -274,5 +275,89 @@ ag_status ag_model_tree_check_node(const ag_edit_model *em, int32_t id, const ch
                             "%s: node %d of the split tree cannot be edited (proceduralization "
                             "removed it when it found a pattern)",
                             field, (int)id);
+    return AG_OK;
+}
+
+void ag_model_tree_label_color(const char *label, char out[8])
+{
+    unsigned long idx;
+    char *end;
+    if (label[0] == 'L' && label[1] >= '1' && label[1] <= '9' &&
+        (idx = strtoul(label + 1, &end, 10), *end == '\0')) {
+        idx -= 1;
+    } else {
+        uint32_t h = 2166136261u;
+        for (const char *p = label; *p; p++)
+            h = (h ^ (unsigned char)*p) * 16777619u;
+        idx = h % 9973;
+    }
+    /* golden-ratio hue steps keep neighbouring labels apart */
+    double hue = fmod((double)idx * 0.618033988749895, 1.0), x = hue * 6;
+    int i = (int)x;
+    double f = x - i, v = 0.85, s = 0.55;
+    double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f)), r, g, b;
+    switch (i % 6) {
+    case 0: r = v, g = t, b = p; break;
+    case 1: r = q, g = v, b = p; break;
+    case 2: r = p, g = v, b = t; break;
+    case 3: r = p, g = q, b = v; break;
+    case 4: r = t, g = p, b = v; break;
+    default: r = v, g = p, b = q; break;
+    }
+    snprintf(out, 8, "#%02x%02x%02x", (unsigned)lround(r * 255), (unsigned)lround(g * 255),
+             (unsigned)lround(b * 255));
+}
+
+ag_status ag_model_tree_component_meta(const char *json, size_t ncomponents,
+                                       ag_glb_component_meta **meta, char **labels,
+                                       ag_error *err)
+{
+    *meta = NULL;
+    *labels = NULL;
+    json_error_t je;
+    json_t *tree = json_loads(json, 0, &je);
+    json_t *nodes = json_object_get(tree, "nodes");
+    if (!json_is_array(nodes)) {
+        json_decref(tree);
+        return ag_error_set(err, AG_ERR_PARSE, 0, "the stored split tree is not valid: %s",
+                            tree ? "no nodes" : je.text);
+    }
+    /* first pass: room for the label strings */
+    size_t bytes = 1, i;
+    json_t *n;
+    json_array_foreach(nodes, i, n) {
+        const char *l = json_string_value(json_object_get(n, "label"));
+        if (l && json_is_integer(json_object_get(n, "component")))
+            bytes += strlen(l) + 1;
+    }
+    ag_glb_component_meta *m = malloc((ncomponents + 1) * sizeof *m);
+    char *block = malloc(bytes), *at = block;
+    if (!m || !block) {
+        free(m);
+        free(block);
+        json_decref(tree);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t c = 0; c < ncomponents; c++)
+        m[c] = (ag_glb_component_meta){NULL, -1};
+    json_array_foreach(nodes, i, n) {
+        json_t *comp = json_object_get(n, "component");
+        if (!json_is_integer(comp))
+            continue;
+        json_int_t c = json_integer_value(comp);
+        if (c < 0 || (size_t)c >= ncomponents)
+            continue;
+        m[c].node = json_integer_value(json_object_get(n, "id"));
+        const char *l = json_string_value(json_object_get(n, "label"));
+        if (l) {
+            size_t len = strlen(l) + 1;
+            memcpy(at, l, len);
+            m[c].label = at;
+            at += len;
+        }
+    }
+    json_decref(tree);
+    *meta = m;
+    *labels = block;
     return AG_OK;
 }

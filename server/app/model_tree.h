@@ -25,6 +25,7 @@
 #include <jansson.h>
 
 #include "../core/edit/edit.h"
+#include "../io/glb.h"
 
 /* The numbering stored with a tree (store/grammars.h tree_numbering): trees stored with any
  * other value (read off the grammar's derivation, before this numbering) are rebuilt. */
@@ -43,5 +44,15 @@ ag_status ag_model_tree_check_node(const ag_edit_model *em, int32_t id, const ch
 
 /* The served tree as compact text (malloc'd), or NULL when out of memory. */
 char *ag_model_tree_served_text(const ag_edit_model *em);
+
+/* A stored tree (text) read for mesh.glb (ag_glb_write_meta): *meta has ncomponents entries
+ * (label NULL / node -1 where the tree says nothing); the labels point into *labels, a
+ * malloc'd block the caller frees after use. AG_ERR_PARSE for a tree that is not one. */
+ag_status ag_model_tree_component_meta(const char *json, size_t ncomponents,
+                                       ag_glb_component_meta **meta, char **labels,
+                                       ag_error *err);
+
+/* "#rrggbb" for a label name: "L<n>" spreads n over the hue circle, other names by a hash. */
+void ag_model_tree_label_color(const char *label, char out[8]);
 
 #endif

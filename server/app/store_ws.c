@@ -83,22 +83,37 @@ static ag_status open_models(ag_workspace *ws, const ag_edit_op_origin *from, ag
 
 /* --- writing --------------------------------------------------------------------------- */
 
+/* A mesh as the store keeps it: the meshblob and the stats JSON (both malloc'd). */
+static ag_status encode_mesh(const ag_mesh *mesh, uint8_t **blob, size_t *len, char **stats,
+                             ag_error *err)
+{
+    *stats = NULL;
+    ag_status s = ag_meshblob_encode(mesh, blob, len);
+    if (s != AG_OK)
+        return ag_error_set(err, s, 0, "cannot encode the mesh");
+    json_t *summary = ag_meshjson_summary(mesh);
+    *stats = summary ? json_dumps(summary, JSON_COMPACT) : NULL;
+    json_decref(summary);
+    if (*stats)
+        return AG_OK;
+    free(*blob);
+    *blob = NULL;
+    return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory summarising the mesh");
+}
+
 ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
                                  const ag_model_state *st, const char *summary_json,
                                  ag_error *err)
 {
-    const ag_mesh *mesh = st->em->proc->mesh;
     uint8_t *blob = NULL;
     size_t blob_len = 0;
-    ag_status s = ag_meshblob_encode(mesh, &blob, &blob_len);
+    char *stats = NULL;
+    ag_status s = encode_mesh(st->em->proc->mesh, &blob, &blob_len, &stats, err);
     if (s != AG_OK)
-        return ag_error_set(err, s, 0, "cannot encode the model's mesh");
-    json_t *summary = ag_meshjson_summary(mesh);
-    char *stats = summary ? json_dumps(summary, JSON_COMPACT) : NULL;
-    json_decref(summary);
+        return s;
     char *tree = ag_model_tree_served_text(st->em);
     int64_t mesh_blob = 0;
-    if (!stats || !tree)
+    if (!tree)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory describing the model");
     if (s == AG_OK)
         s = ag_models_set_mesh(db, model, blob, blob_len, stats, &mesh_blob, err);
@@ -335,16 +350,10 @@ ag_status ag_store_ws_insert_model(ag_db *db, const char *name, const ag_mesh *m
 {
     uint8_t *blob = NULL;
     size_t blob_len = 0;
-    ag_status s = ag_meshblob_encode(mesh, &blob, &blob_len);
+    char *stats = NULL;
+    ag_status s = encode_mesh(mesh, &blob, &blob_len, &stats, err);
     if (s != AG_OK)
-        return ag_error_set(err, s, 0, "cannot encode the mesh");
-    json_t *summary = ag_meshjson_summary(mesh);
-    char *stats = summary ? json_dumps(summary, JSON_COMPACT) : NULL;
-    json_decref(summary);
-    if (!stats) {
-        free(blob);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory summarising the mesh");
-    }
+        return s;
     ag_model_new m = {
         .name = name,
         .stats_json = stats,

@@ -3,7 +3,8 @@
  * visible nodes name their components, labelled as the mesh groups them, which is what
  * mesh.glb carries), and the reload of what a workspace keeps gives the same tree again —
  * from the kept mesh (the store, after a proceduralization and after an edit without
- * read-back) and from the kept grammar (a folder, after a read-back edit). Every variant of
+ * read-back) and from the kept grammar (a folder, after a read-back edit); a tree stored in the
+ * numbering before this one is rebuilt when the model is loaded. Every variant of
  * the generated building is checked: several window grids with and without groups, moved to
  * UTM-sized coordinates, turned by a quarter turn and by 30 degrees, and jittered. Kept
  * sessions without a registry load and free a state of their own. */
@@ -15,16 +16,22 @@
 
 #include <jansson.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
+#include "app/edit_session.h"
 #include "app/model_state.h"
 #include "app/model_tree.h"
+#include "app/modelops.h"
+#include "app/store_ws.h"
+#include "store/grammars.h"
+#include "store/models.h"
 #include "core/edit/edit.h"
 #include "core/gen_facade.h"
 #include "core/proc/proceduralize.h"
 #include "io/meshblob.h"
-#include "io/splittree_json.h"
 
 /* x, y turned by angle about z, then moved by (dx, dy, dz), then jittered (a deterministic
  * pattern of amplitude jitter). */
@@ -122,7 +129,7 @@ static void assert_one_numbering(const ag_edit_model *em, const char *tree_text)
     ag_glb_component_meta *meta = NULL;
     char *labels = NULL;
     ag_error err;
-    assert_int_equal(ag_splittree_json_component_meta(tree_text, m->ncomponents, &meta, &labels,
+    assert_int_equal(ag_model_tree_component_meta(tree_text, m->ncomponents, &meta, &labels,
                                                       &err),
                      AG_OK);
     for (size_t c = 0; c < m->ncomponents; c++) {
@@ -235,9 +242,95 @@ static void a_stored_tree_that_is_not_json_is_refused(void **state)
     ag_glb_component_meta *meta = NULL;
     char *labels = NULL;
     ag_error err;
-    assert_int_not_equal(ag_splittree_json_component_meta("not json", 3, &meta, &labels, &err),
+    assert_int_not_equal(ag_model_tree_component_meta("not json", 3, &meta, &labels, &err),
                          AG_OK);
     assert_null(meta);
+}
+
+/* A model stored as archgram stored it before this numbering: the derived mesh and a tree in
+ * numbering 1. Loading it rebuilds and stores the tree; the kept session is reused while the
+ * version stays, and reloaded, to the same tree, after an op moves the version on. */
+static void an_old_tree_is_renumbered_and_sessions_are_kept(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/archgram-numbering-XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    unlink(path);
+    ag_error err;
+    ag_db *db = NULL;
+    assert_int_equal(ag_db_open(path, NULL, &db, &err), AG_OK);
+    ag_events *bus = ag_events_create();
+    ag_store_env env = {.db = db, .seq = ag_sequencer_create(bus)};
+
+    ag_mesh *m = NULL;
+    assert_int_equal(ag_gen_facade(&(ag_gen_facade_options){.cols = 4, .rows = 2}, &m, &err),
+                     AG_OK);
+    ag_proceduralize_result *r = NULL;
+    assert_int_equal(ag_proceduralize_run(m, NULL, &r, &err), AG_OK);
+    ag_mesh *derived = NULL;
+    assert_int_equal(ag_grammar_derive(r->grammar, NULL, &derived, &err), AG_OK);
+    int64_t model = 0;
+    assert_int_equal(ag_db_begin(db, &err), AG_OK);
+    assert_int_equal(ag_store_ws_insert_model(db, "old", derived, NULL, 0, NULL, &model, &err),
+                     AG_OK);
+    ag_model_row row;
+    assert_int_equal(ag_models_get(db, model, &row, &err), AG_OK);
+    ag_grammar_new g = {.model = model, .version = 1, .mesh_blob = row.mesh_blob,
+                        .text = "archgram-grammar 1\n", .text_len = 19,
+                        .tree_json = "{\"root\":0,\"nodes\":[]}", .tree_numbering = 1};
+    ag_models_row_clear(&row);
+    assert_int_equal(ag_grammars_put(db, &g, &err), AG_OK);
+    assert_int_equal(ag_db_commit(db, &err), AG_OK);
+
+    ag_edit_state *st = NULL;
+    assert_int_equal(ag_edit_session_acquire(NULL, db, model, &st, &err), AG_OK);
+    char *want = ag_model_tree_served_text(st->em);
+    ag_edit_session_release(NULL, st);
+    ag_grammar_row cur;
+    assert_int_equal(ag_grammars_current(db, model, 1, &cur, &err), AG_OK);
+    assert_int_equal(cur.tree_numbering, AG_MODEL_TREE_NUMBERING);
+    assert_string_equal(cur.tree_json, want);
+    ag_grammars_row_clear(&cur);
+
+    /* a registry keeps the loaded model while the version stays the same */
+    ag_edit_sessions *reg = ag_edit_sessions_create();
+    env.sessions = reg;
+    assert_int_equal(ag_edit_session_acquire(reg, db, model, &st, &err), AG_OK);
+    const ag_edit_model *first = st->em;
+    ag_edit_session_release(reg, st);
+    assert_int_equal(ag_edit_session_acquire(reg, db, model, &st, &err), AG_OK);
+    assert_ptr_equal(st->em, first);
+    ag_edit_session_release(reg, st);
+    /* a rename moves the version on: the state is loaded again, to the same tree */
+    json_t *rename = json_pack("{s:s, s:s}", "kind", "rename", "name", "renamed");
+    ag_op_request rq = {.model = model, .base = 1, .author = "ana", .cid = "r1", .op = rename};
+    int64_t v;
+    int dup;
+    assert_int_equal(ag_modelops_apply(&env, &rq, &v, &dup, &err), AG_OK);
+    json_decref(rename);
+    assert_int_equal(ag_edit_session_acquire(reg, db, model, &st, &err), AG_OK);
+    assert_int_equal(st->version, 2);
+    char *again = ag_model_tree_served_text(st->em);
+    assert_string_equal(again, want);
+    ag_edit_session_release(reg, st);
+    free(again);
+    free(want);
+
+    ag_edit_sessions_free(reg);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(derived);
+    ag_mesh_free(m);
+    ag_sequencer_free(env.seq);
+    ag_events_free(bus);
+    ag_db_close(db);
+    unlink(path);
+    char side[64];
+    snprintf(side, sizeof side, "%s-wal", path);
+    unlink(side);
+    snprintf(side, sizeof side, "%s-shm", path);
+    unlink(side);
 }
 
 int main(void)
@@ -245,6 +338,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(one_numbering_survives_every_reload),
         cmocka_unit_test(a_stored_tree_that_is_not_json_is_refused),
+        cmocka_unit_test(an_old_tree_is_renumbered_and_sessions_are_kept),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
