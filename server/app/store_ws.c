@@ -7,11 +7,14 @@
 #include "../io/edit_op_json.h"
 #include "../io/meshblob.h"
 #include "../io/meshjson.h"
+#include "../store/extrusions.h"
 #include "../store/grammars.h"
 #include "../store/jobs.h"
 #include "../store/models.h"
 #include "../store/states.h"
+#include "extrusion.h"
 #include "model_tree.h"
+#include "usecase_extrude.h"
 
 /* --- reading --------------------------------------------------------------------------- */
 
@@ -391,6 +394,77 @@ static ag_status add_model(ag_workspace *ws, const char *name, const ag_mesh *me
     return s == AG_OK ? ag_db_commit(db, err) : (ag_db_rollback(db), s);
 }
 
+static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extrude_batch *b,
+                               const ag_mesh *mesh, const char *source, size_t source_len,
+                               const json_t *report, int64_t *model_out, ag_error *err)
+{
+    ag_store_ws *w = (ag_store_ws *)ws;
+    ag_db *db = w->o.env.db;
+    uint8_t *blob = NULL;
+    size_t blob_len = 0;
+    char *stats = ag_extrusion_stats(mesh), *meta = json_dumps(b->meta, JSON_COMPACT);
+    ag_status s = stats && meta ? ag_meshblob_encode(mesh, &blob, &blob_len) : AG_ERR_NOMEM;
+    if (s != AG_OK) {
+        free(stats);
+        free(meta);
+        return ag_error_set(err, s, 0, "cannot encode the mesh");
+    }
+    if ((s = ag_db_begin(db, err)) != AG_OK)
+        goto out;
+    int geo = strcmp(b->format, "geojson") == 0;
+    ag_model_new m = {
+        .name = name,
+        .kind = "extrusion",
+        .stats_json = stats,
+        .source = source,
+        .source_len = source_len,
+        .source_format = b->format,
+        .source_media_type = geo ? "application/geo+json" : "application/json",
+        .mesh = blob,
+        .mesh_len = blob_len,
+    };
+    int64_t model = 0;
+    s = ag_models_insert(db, &m, &model, err);
+    *model_out = model;
+    if (s == AG_OK)
+        s = ag_extrusions_put(db, model, strcmp(b->format, "plan") != 0, meta, err);
+    for (size_t i = 0; s == AG_OK && i < b->n; i++) {
+        const ag_extrude_building *it = &b->items[i];
+        ag_extrusion_building row = {.model = model,
+                                     .building = (int64_t)i,
+                                     .footprint = it->id,
+                                     .plan_json = it->plan_json ? it->plan_json : "null",
+                                     .mesh = it->built.blob,
+                                     .mesh_len = it->built.blob_len,
+                                     .triangles = (int64_t)it->built.triangles,
+                                     .reason = it->built.reason[0] ? (char *)it->built.reason
+                                                                   : NULL};
+        snprintf(row.status, sizeof row.status, "%s", it->built.status);
+        s = ag_extrusions_put_building(db, &row, err);
+    }
+    if (s == AG_OK && w->o.job && ag_jobctx_cancelled(w->o.job))
+        s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
+    char *result = NULL;
+    if (s == AG_OK && w->o.job_id) {
+        char href[64];
+        snprintf(href, sizeof href, "/api/v1/models/%lld", (long long)model);
+        json_t *r = json_pack("{s:I, s:s, s:O}", "model", (json_int_t)model, "href", href,
+                              "report", (json_t *)report);
+        result = r ? json_dumps(r, JSON_COMPACT) : NULL;
+        json_decref(r);
+        s = result ? ag_jobs_finish(db, w->o.job_id, "succeeded", result, NULL, model, err)
+                   : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    free(result);
+    s = s == AG_OK ? ag_db_commit(db, err) : (ag_db_rollback(db), s);
+out:
+    free(blob);
+    free(stats);
+    free(meta);
+    return s;
+}
+
+
 static int cancelled(ag_workspace *ws)
 {
     ag_store_ws *w = (ag_store_ws *)ws;
@@ -406,6 +480,7 @@ static void progress(ag_workspace *ws, double fraction, const char *stage)
 
 static const ag_workspace_ops store_ops = {
     .add_model = add_model,
+    .add_extrusion = add_extrusion,
     .input_mesh = input_mesh,
     .open_models = open_models,
     .save = save,

@@ -15,6 +15,17 @@ ag_status ag_workspace_add_model(ag_workspace *ws, const char *name, const ag_me
                : unsupported("store a new model", err);
 }
 
+ag_status ag_workspace_add_extrusion(ag_workspace *ws, const char *name,
+                                    const struct ag_extrude_batch *batch, const ag_mesh *mesh,
+                                    const char *source, size_t source_len, const json_t *report,
+                                    int64_t *model, ag_error *err)
+{
+    *model = 0;
+    return ws->ops->add_extrusion ? ws->ops->add_extrusion(ws, name, batch, mesh, source,
+                                                           source_len, report, model, err)
+                                  : unsupported("store an extrusion", err);
+}
+
 ag_status ag_workspace_input_mesh(ag_workspace *ws, ag_mesh **mesh, ag_error *err)
 {
     *mesh = NULL;

@@ -13,6 +13,7 @@
 #ifndef AG_WORKSPACE_H
 #define AG_WORKSPACE_H
 
+#include <jansson.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -22,6 +23,7 @@
 #include "model_state.h"
 
 typedef struct ag_workspace ag_workspace;
+struct ag_extrude_batch;
 
 /* What a proceduralization found and how long it took, for the saved summary. */
 typedef struct {
@@ -47,6 +49,13 @@ typedef struct {
     ag_status (*add_model)(ag_workspace *ws, const char *name, const ag_mesh *mesh,
                            const void *source, size_t source_len, const char *source_format,
                            int64_t *model, ag_error *err);
+    /* Stores an extruded batch (app/usecase_extrude.h) as a new model of kind "extrusion":
+     * its mesh, each building's description, mesh and outcome, the input as its source, and
+     * the report (for a job's result). */
+    ag_status (*add_extrusion)(ag_workspace *ws, const char *name,
+                               const struct ag_extrude_batch *batch, const ag_mesh *mesh,
+                               const char *source, size_t source_len, const json_t *report,
+                               int64_t *model, ag_error *err);
     /* The mesh to proceduralize. */
     ag_status (*input_mesh)(ag_workspace *ws, ag_mesh **mesh, ag_error *err);
     /* The model to edit and, for a paste from elsewhere (from), its source; both are the
@@ -75,6 +84,10 @@ struct ag_workspace {
 ag_status ag_workspace_add_model(ag_workspace *ws, const char *name, const ag_mesh *mesh,
                                  const void *source, size_t source_len, const char *source_format,
                                  int64_t *model, ag_error *err);
+ag_status ag_workspace_add_extrusion(ag_workspace *ws, const char *name,
+                                    const struct ag_extrude_batch *batch, const ag_mesh *mesh,
+                                    const char *source, size_t source_len, const json_t *report,
+                                    int64_t *model, ag_error *err);
 ag_status ag_workspace_input_mesh(ag_workspace *ws, ag_mesh **mesh, ag_error *err);
 ag_status ag_workspace_open_models(ag_workspace *ws, const ag_edit_op_origin *from,
                                    ag_edit_model **em, const ag_edit_model **source,
