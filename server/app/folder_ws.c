@@ -188,7 +188,7 @@ static json_t *vec3(const double *v)
 
 /* summary.json of `archgram proceduralize`. */
 static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
-                            const ag_proc_outcome *o)
+                            const ag_proc_outcome *o, double write_s)
 {
     const ag_proceduralize_result *r = o->proc;
     const ag_mesh *m = o->input;
@@ -303,9 +303,11 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
     json_object_set_new(j, "fidelity", jf);
     json_t *js = json_object();
     json_object_set_new(js, "import", json_real(w->import_s));
-    for (int s = AG_STAGE_SEGMENT; s <= AG_STAGE_EXPORT; s++)
+    for (int s = AG_STAGE_SEGMENT; s < AG_STAGE_EXPORT; s++)
         json_object_set_new(js, ag_proceduralize_stage_name((ag_stage)s), json_real(o->seconds[s]));
-    json_object_set_new(js, "total", json_real(o->total_s));
+    /* the export includes writing the files */
+    json_object_set_new(js, "export", json_real(o->seconds[AG_STAGE_EXPORT] + write_s));
+    json_object_set_new(js, "total", json_real(o->total_s + write_s));
     json_object_set_new(js, "verify", json_real(o->seconds[AG_STAGE_VERIFY]));
     json_object_set_new(j, "seconds", js);
     return j;
@@ -328,11 +330,13 @@ static ag_status save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcom
                       const ag_edit_outcome *edit, ag_error *err)
 {
     ag_folder_ws *w = (ag_folder_ws *)ws;
+    double t0 = now();
     ag_status s = write_model(w, st, err);
+    double write_s = now() - t0;
     if (s == AG_OK) {
         char path[4200];
         snprintf(path, sizeof path, "%s/summary.json", w->o.out_dir);
-        json_t *j = proc ? proc_summary(w, st, proc) : edit_summary(st, edit);
+        json_t *j = proc ? proc_summary(w, st, proc, write_s) : edit_summary(st, edit);
         s = write_json(w, path, j,
                        proc ? JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10)
                             : JSON_INDENT(1) | JSON_REAL_PRECISION(12),
