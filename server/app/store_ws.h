@@ -3,7 +3,8 @@
  * model's mesh, grammar, split tree, summary and terminals are written with the version the
  * op raises, the op is logged and announced, in one transaction; a job doing the work records
  * its success in the same transaction after a last cancellation check. The saved edit model
- * is kept in the environment's edit sessions for the next edit. Imports add a new model. */
+ * is kept in the environment's edit sessions for the next edit. Imports and extrusions add
+ * a new model. */
 #ifndef AG_STORE_WS_H
 #define AG_STORE_WS_H
 
