@@ -19,6 +19,7 @@
 #include "app/modelops.h"
 #include "app/optable.h"
 #include "net/live_protocol.h"
+#include "file_fixture.h"
 
 #define MAX_KINDS 64
 
@@ -32,17 +33,7 @@ static char *read_repo_file(const char *rel)
 {
     char path[4096];
     snprintf(path, sizeof path, "%s/%s", AG_REPO_DIR, rel);
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        fail_msg("cannot read %s", path);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    rewind(f);
-    char *text = malloc((size_t)n + 1);
-    assert_int_equal(fread(text, 1, (size_t)n, f), (size_t)n);
-    text[n] = '\0';
-    fclose(f);
-    return text;
+    return read_text_file(path);
 }
 
 static void add(kind_list *l, const char *k, size_t len, int server_only)

@@ -26,23 +26,9 @@
 #include "core/gen_facade.h"
 #include "io/obj.h"
 #include "store/grammars.h"
+#include "file_fixture.h"
 
 static char dir[64];
-
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        fail_msg("cannot read %s", path);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    rewind(f);
-    char *text = malloc((size_t)n + 1);
-    assert_int_equal(fread(text, 1, (size_t)n, f), (size_t)n);
-    text[n] = '\0';
-    fclose(f);
-    return text;
-}
 
 static void the_store_and_a_folder_run_the_same_pipeline(void **state)
 {
@@ -92,7 +78,7 @@ static void the_store_and_a_folder_run_the_same_pipeline(void **state)
     /* the same grammar, byte for byte, and the same tree */
     char path[256];
     snprintf(path, sizeof path, "%s/grammar.txt", p1);
-    char *folder_text = slurp(path);
+    char *folder_text = read_text_file(path);
     ag_grammar_row g;
     assert_int_equal(ag_grammars_current(db, model, 1, &g, &err), AG_OK);
     assert_string_equal(g.text, folder_text);
@@ -138,7 +124,7 @@ static void the_store_and_a_folder_run_the_same_pipeline(void **state)
     assert_int_equal(ag_edit_ops_run_edit(&env, &rq, &v, &dup, &err), AG_OK);
     assert_int_equal(v, 3);
     snprintf(path, sizeof path, "%s/grammar.txt", p2);
-    folder_text = slurp(path);
+    folder_text = read_text_file(path);
     assert_int_equal(ag_grammars_current(db, model, 0, &g, &err), AG_OK);
     assert_string_equal(g.text, folder_text);
     ag_grammars_row_clear(&g);
