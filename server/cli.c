@@ -1,16 +1,13 @@
 /* archgram — the command-line tool: one dispatcher, one file per subcommand. */
 #include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <time.h>
-#include <unistd.h>
 
+#include "app/usecase_import.h"
 #include "cli/commands.h"
-#include "io/import.h"
 
 #define ARCHGRAM_VERSION "0.1.0"
 
@@ -44,10 +41,13 @@ static void usage(FILE *f)
           f);
 }
 
+/* An empty file names nothing: the message says what it is about. */
 void ag_cli_report(const char *file, const ag_error *err)
 {
     const char *text = err->text[0] ? err->text : ag_status_message(err->code);
-    if (err->code == AG_ERR_PARSE && err->element > 0) {
+    if (!file || !*file) { /* the message names what it is about */
+        fprintf(stderr, "archgram: %s\n", text);
+    } else if (err->code == AG_ERR_PARSE && err->element > 0) {
         /* GCC style file:line: — drop the reader's own "line N: " prefix. */
         char prefix[32];
         int n = snprintf(prefix, sizeof prefix, "line %ld: ", err->element);
@@ -70,20 +70,6 @@ int ag_cli_parse_up(const char *value, ag_up_axis *up)
     return 0;
 }
 
-int ag_cli_make_dirs(const char *dir)
-{
-    char p[4096];
-    snprintf(p, sizeof p, "%s", dir);
-    for (char *s = p + 1; *s; s++)
-        if (*s == '/') {
-            *s = 0;
-            if (mkdir(p, 0777) && errno != EEXIST)
-                return -1;
-            *s = '/';
-        }
-    return mkdir(p, 0777) && errno != EEXIST ? -1 : 0;
-}
-
 double ag_cli_seconds(void)
 {
     struct timespec ts;
@@ -95,37 +81,11 @@ int ag_cli_load_mesh(const char *path, ag_up_axis up, ag_mesh **out, size_t *byt
 {
     ag_error err;
     ag_error_clear(&err);
-    *out = NULL;
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    struct stat sb;
-    if (fd < 0 || fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
-        int e = errno;
-        if (fd >= 0)
-            close(fd);
-        fprintf(stderr, "archgram: %s: %s\n", path,
-                fd < 0 || e ? strerror(e) : "not a regular file");
-        return 1;
-    }
-    *bytes = (size_t)sb.st_size;
-    const uint8_t *data = (const uint8_t *)"";
-    void *map = NULL;
-    if (sb.st_size > 0) {
-        map = mmap(NULL, (size_t)sb.st_size, PROT_READ, MAP_PRIVATE, fd, 0);
-        if (map == MAP_FAILED) {
-            fprintf(stderr, "archgram: %s: %s\n", path, strerror(errno));
-            close(fd);
-            return 1;
-        }
-        data = map;
-    }
-    close(fd);
-    ag_format fmt = ag_format_sniff(data, *bytes, path);
-    ag_import_options opt = {.up = up};
-    ag_status st = fmt == AG_FORMAT_UNKNOWN && *bytes == 0
-                       ? ag_error_set(&err, AG_ERR_EMPTY, 0, "empty file")
-                       : ag_import_buffer(data, *bytes, fmt, &opt, out, &err);
-    if (map)
-        munmap(map, (size_t)sb.st_size);
+    ag_mesh_source src = {.path = path, .up = up};
+    ag_mesh_file file;
+    ag_status st = ag_usecase_import_read(&src, NULL, NULL, out, &file, &err);
+    *bytes = file.len;
+    ag_usecase_import_release(&file);
     if (st != AG_OK) {
         ag_cli_report(path, &err);
         return 1;

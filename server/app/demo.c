@@ -8,8 +8,7 @@
 
 #include "../core/demo_building.h"
 #include "../store/models.h"
-#include "import_job.h"
-#include "jobqueue.h"
+#include "store_ws.h"
 
 /* A short street of footprints in metres (x along the street), each with a height: the
  * extrusion demo. Written as GeoJSON so it goes through the same job as an upload. */
@@ -75,22 +74,8 @@ static char *spool_street(ag_error *err)
     return path;
 }
 
-static ag_status submit(ag_app *app, const char *kind, json_t *params, ag_error *err)
+ag_status ag_demo_load_if_empty(ag_db *db, ag_jobqueue *jobs, ag_error *err)
 {
-    char *text = params ? json_dumps(params, JSON_COMPACT) : NULL;
-    json_decref(params);
-    int64_t job;
-    ag_status s = text ? ag_jobqueue_submit(app, kind, text, &job, err)
-                       : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    free(text);
-    return s;
-}
-
-ag_status ag_demo_load_if_empty(ag_app *app, ag_error *err)
-{
-    ag_db *db = ag_app_db(app, err);
-    if (!db)
-        return err ? err->code : AG_ERR_DB;
     ag_status s = ag_db_begin(db, err);
     if (s != AG_OK)
         return s;
@@ -101,8 +86,8 @@ ag_status ag_demo_load_if_empty(ag_app *app, ag_error *err)
             ag_mesh *m = ag_demo_building(i);
             if (!m)
                 break;
-            s = ag_import_store_model(db, ag_demo_building_name(i), m, NULL, 0, NULL, &ids[n++],
-                                      err);
+            s = ag_store_ws_insert_model(db, ag_demo_building_name(i), m, NULL, 0, NULL,
+                                         &ids[n++], err);
             ag_mesh_free(m);
         }
     }
@@ -111,18 +96,23 @@ ag_status ag_demo_load_if_empty(ag_app *app, ag_error *err)
         return s;
     /* The demo buildings are proceduralized and the street extruded by ordinary jobs, so a
      * newcomer can edit at once; a job that fails leaves the plain model, never a partial one. */
-    for (int i = 0; s == AG_OK && i < n; i++)
-        s = submit(app, "proceduralize",
-                   json_pack("{s:I, s:I, s:s}", "model", (json_int_t)ids[i], "base",
-                             (json_int_t)1, "author", "demo"),
-                   err);
+    int64_t job;
+    for (int i = 0; s == AG_OK && i < n; i++) {
+        ag_job_params p = {.type = AG_JOB_PROCEDURALIZE,
+                           .u.proceduralize = {.model = ids[i], .base = 1, .author = "demo"}};
+        s = ag_jobqueue_submit(jobs, "proceduralize", &p, &job, err);
+    }
     char *path = s == AG_OK ? spool_street(err) : NULL;
     if (path) {
-        s = submit(app, "extrude",
-                   json_pack("{s:s, s:s, s:s, s:s, s:b, s:s}", "upload", path, "name",
-                             "Demo street", "format", "geojson", "style", "gable", "lonlat", 0,
-                             "height_property", "height"),
-                   err);
+        ag_job_params p = {.type = AG_JOB_EXTRUDE,
+                           .u.extrude = {.upload = path,
+                                         .name = "Demo street",
+                                         .format = "geojson",
+                                         .style = "gable",
+                                         .height_property = "height",
+                                         .seed = -1,
+                                         .lonlat = -1}};
+        s = ag_jobqueue_submit(jobs, "extrude", &p, &job, err);
         if (s != AG_OK)
             unlink(path);
         free(path);

@@ -1,7 +1,5 @@
 #include "edit_session.h"
 
-#include <jansson.h>
-#include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,9 +8,11 @@
 #include "../io/meshblob.h"
 #include "../store/grammars.h"
 #include "../store/models.h"
+#include "model_state.h"
+#include "model_tree.h"
 
 typedef struct entry {
-    ag_edit_state state;
+    ag_edit_state state;  /* first member: a state is its entry */
     pthread_mutex_t lock; /* held while borrowed */
     int borrowed;         /* guarded by the registry's lock */
     uint64_t used;        /* LRU tick */
@@ -36,11 +36,7 @@ ag_edit_sessions *ag_edit_sessions_create(void)
 void ag_edit_session_reset(ag_edit_state *st)
 {
     ag_edit_model_free(st->em);
-    free(st->tree_to_node);
-    free(st->node_to_tree);
     st->em = NULL;
-    st->tree_to_node = st->node_to_tree = NULL;
-    st->ntree = 0;
     st->version = 0;
 }
 
@@ -63,185 +59,12 @@ void ag_edit_sessions_free(ag_edit_sessions *s)
     free(s);
 }
 
-/* --- matching the served tree with the in-memory one ----------------------------------- */
-
-typedef struct {
-    int32_t parent;
-    int kind; /* ag_node_kind, as the served tree names it */
-    double box[6];
-} jnode;
-
-static int jkind(const char *k)
+void ag_edit_session_replace(ag_edit_state *st, int64_t version, ag_edit_model *em)
 {
-    if (!k)
-        return -1;
-    if (strcmp(k, "root") == 0)
-        return AG_NODE_ROOT;
-    if (strcmp(k, "component") == 0)
-        return AG_NODE_COMPONENT;
-    if (strcmp(k, "pattern") == 0)
-        return AG_NODE_PATTERN;
-    return AG_NODE_SPLIT;
+    ag_edit_session_reset(st);
+    st->em = em;
+    st->version = version;
 }
-
-static double box_distance(const double a[6], const ag_box *b)
-{
-    double d = 0;
-    for (int k = 0; k < 3; k++) {
-        d = fmax(d, fabs(a[k] - b->min[k]));
-        d = fmax(d, fabs(a[3 + k] - b->max[k]));
-    }
-    return d;
-}
-
-/* Live nodes below p, at most two levels down (a served node may skip one intermediate
- * split the in-memory tree has, or the other way round). */
-static size_t candidates(const ag_splittree *t, int32_t p, int32_t *out, size_t cap)
-{
-    size_t n = 0;
-    for (int32_t c = t->nodes[p].first_child; c >= 0; c = t->nodes[c].next_sibling) {
-        if (t->nodes[c].kind == AG_NODE_DEAD)
-            continue;
-        if (n < cap)
-            out[n++] = c;
-        for (int32_t g = t->nodes[c].first_child; g >= 0; g = t->nodes[g].next_sibling)
-            if (t->nodes[g].kind != AG_NODE_DEAD && n < cap)
-                out[n++] = g;
-    }
-    return n;
-}
-
-ag_status ag_edit_session_map(const char *tree_json, const ag_splittree *t, int32_t **tree_to_node,
-                              size_t *ntree, int32_t **node_to_tree, ag_error *err)
-{
-    *tree_to_node = *node_to_tree = NULL;
-    *ntree = 0;
-    json_t *doc = json_loads(tree_json, 0, NULL);
-    json_t *nodes = json_object_get(doc, "nodes");
-    size_t n = json_array_size(nodes);
-    if (!n || t->nnodes == 0) {
-        json_decref(doc);
-        return ag_error_set(err, AG_ERR_INTERNAL, 0, "the stored split tree is not readable");
-    }
-    jnode *j = calloc(n, sizeof *j);
-    int32_t *t2n = malloc(n * sizeof *t2n), *n2t = malloc(t->nnodes * sizeof *n2t);
-    size_t *first = calloc(n, sizeof *first), *next = calloc(n, sizeof *next);
-    size_t *queue = malloc(n * sizeof *queue);
-    /* a node's candidates are at most every live node */
-    size_t cap = t->nnodes;
-    int32_t *cand = malloc(cap * sizeof *cand);
-    if (!j || !t2n || !n2t || !first || !next || !queue || !cand) {
-        free(j), free(t2n), free(n2t), free(first), free(next), free(queue), free(cand);
-        json_decref(doc);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
-    /* children lists of the served tree: first[i]/next[i] hold index + 1 */
-    ag_box all = t->nodes[0].box;
-    double tol = 1e-6 * fmax(1.0, ag_box_diagonal(&all));
-    for (size_t i = 0; i < n; i++) {
-        json_t *o = json_array_get(nodes, i), *b = json_object_get(o, "box");
-        j[i].parent = json_is_integer(json_object_get(o, "parent"))
-                          ? (int32_t)json_integer_value(json_object_get(o, "parent"))
-                          : -1;
-        j[i].kind = jkind(json_string_value(json_object_get(o, "kind")));
-        for (int k = 0; k < 6; k++)
-            j[i].box[k] = json_number_value(json_array_get(b, (size_t)k));
-        t2n[i] = -1;
-    }
-    for (size_t i = 0; i < t->nnodes; i++)
-        n2t[i] = -1;
-    for (size_t i = n; i-- > 1;) {
-        int32_t p = j[i].parent;
-        if (p >= 0 && (size_t)p < n && (size_t)p != i) {
-            next[i] = first[p];
-            first[p] = i + 1;
-        }
-    }
-    /* breadth first from the roots; a served node without a counterpart passes its parent's
-     * counterpart on to its children */
-    int32_t *anchor = malloc(n * sizeof *anchor);
-    if (!anchor) {
-        free(j), free(t2n), free(n2t), free(first), free(next), free(queue), free(cand);
-        json_decref(doc);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
-    size_t qh = 0, qt = 0;
-    t2n[0] = 0;
-    n2t[0] = 0;
-    anchor[0] = 0;
-    queue[qt++] = 0;
-    while (qh < qt) {
-        size_t i = queue[qh++];
-        int32_t p = anchor[i];
-        size_t nc = candidates(t, p, cand, cap), start = 0;
-        for (size_t c = first[i]; c; c = next[c - 1]) {
-            size_t ci = c - 1;
-            int32_t best = -1;
-            size_t bestk = 0;
-            double bestd = INFINITY;
-            /* both trees list siblings mostly in the same order: start after the last match
-             * and stop at an exact one, so a pattern of many cells costs little */
-            for (size_t step = 0; step < nc; step++) {
-                size_t k = (start + step) % nc;
-                int32_t q = cand[k];
-                if (n2t[q] >= 0)
-                    continue;
-                double dd = box_distance(j[ci].box, &t->nodes[q].box);
-                /* equal boxes: prefer the same kind, then the shallower node */
-                if (t->nodes[q].kind != j[ci].kind)
-                    dd += tol * 0.5;
-                if (t->nodes[q].parent != p)
-                    dd += tol * 0.25;
-                if (dd < bestd) {
-                    bestd = dd;
-                    best = q;
-                    bestk = k;
-                }
-                if (dd <= tol * 0.1)
-                    break;
-            }
-            if (best >= 0 && bestd <= tol) {
-                start = bestk + 1;
-                t2n[ci] = best;
-                n2t[best] = (int32_t)ci;
-                anchor[ci] = best;
-            } else {
-                anchor[ci] = p;
-            }
-            if (qt < n)
-                queue[qt++] = ci;
-        }
-    }
-    free(anchor);
-    free(j);
-    free(first);
-    free(next);
-    free(queue);
-    free(cand);
-    json_decref(doc);
-    *tree_to_node = t2n;
-    *node_to_tree = n2t;
-    *ntree = n;
-    return AG_OK;
-}
-
-ag_status ag_edit_session_node(const ag_edit_state *st, int32_t id, const char *field,
-                               int32_t *node, ag_error *err)
-{
-    if (id < 0 || (size_t)id >= st->ntree)
-        return ag_error_set(err, AG_ERR_NOT_FOUND, id,
-                            "%s: node %d is not in the model's split tree (nodes 0..%zu)", field,
-                            (int)id, st->ntree ? st->ntree - 1 : 0);
-    if (st->tree_to_node[id] < 0)
-        return ag_error_set(err, AG_ERR_NOT_FOUND, id,
-                            "%s: node %d of the split tree cannot be edited (it has no "
-                            "counterpart in the model's structure)",
-                            field, (int)id);
-    *node = st->tree_to_node[id];
-    return AG_OK;
-}
-
-/* --- loading ----------------------------------------------------------------------------- */
 
 static double now_ms(void)
 {
@@ -250,19 +73,20 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-ag_status ag_edit_session_replace(ag_edit_state *st, int64_t version, ag_edit_model *em,
-                                  const char *tree_json, ag_error *err)
+/* A tree stored in the numbering before this one (read off the derivation) is replaced by
+ * the loaded model's; a failure only means it is rebuilt again next time. */
+static void renumber_stored_tree(ag_db *db, int64_t model, int64_t mesh_blob,
+                                 const ag_edit_model *em)
 {
-    ag_edit_session_reset(st);
-    ag_status s = ag_edit_session_map(tree_json, em->proc->tree, &st->tree_to_node, &st->ntree,
-                                      &st->node_to_tree, err);
-    if (s != AG_OK) {
-        ag_edit_model_free(em);
-        return s;
+    char *tree = ag_model_tree_served_text(em);
+    if (tree && ag_db_begin(db, NULL) == AG_OK) {
+        if (ag_grammars_set_tree(db, model, mesh_blob, tree, AG_MODEL_TREE_NUMBERING, NULL) ==
+            AG_OK)
+            ag_db_commit(db, NULL);
+        else
+            ag_db_rollback(db);
     }
-    st->em = em;
-    st->version = version;
-    return AG_OK;
+    free(tree);
 }
 
 static ag_status load(ag_db *db, ag_edit_state *st, int64_t version, ag_error *err)
@@ -271,7 +95,7 @@ static ag_status load(ag_db *db, ag_edit_state *st, int64_t version, ag_error *e
     ag_grammar_row g;
     ag_error e;
     ag_error_clear(&e);
-    ag_status s = ag_grammars_current(db, st->model, 1, &g, &e);
+    ag_status s = ag_grammars_current(db, st->model, 0, &g, &e);
     if (s == AG_ERR_NOT_FOUND && strstr(e.text, "proceduralized"))
         return ag_error_set(err, AG_ERR_NOT_PROCEDURALIZED, 0,
                             "model %lld is not proceduralized: structural edits need a grammar "
@@ -288,8 +112,11 @@ static ag_status load(ag_db *db, ag_edit_state *st, int64_t version, ag_error *e
     ag_edit_model *em = NULL;
     if ((s = ag_blobs_get(db, g.mesh_blob, &blob, &len, err)) == AG_OK &&
         (s = ag_meshblob_decode(blob, len, &mesh, err)) == AG_OK &&
-        (s = ag_edit_model_create(mesh, NULL, &em, err)) == AG_OK)
-        s = ag_edit_session_replace(st, version, em, g.tree_json, err);
+        (s = ag_model_state_reload(mesh, &em, err)) == AG_OK) {
+        if (g.tree_numbering != AG_MODEL_TREE_NUMBERING)
+            renumber_stored_tree(db, st->model, g.mesh_blob, em);
+        ag_edit_session_replace(st, version, em);
+    }
     free(blob);
     ag_mesh_free(mesh);
     ag_grammars_row_clear(&g);
@@ -299,6 +126,16 @@ static ag_status load(ag_db *db, ag_edit_state *st, int64_t version, ag_error *e
 
 static entry *take_entry(ag_edit_sessions *r, int64_t model, ag_error *err)
 {
+    if (!r) { /* no registry: a state of its own */
+        entry *e = calloc(1, sizeof *e);
+        if (!e) {
+            ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            return NULL;
+        }
+        pthread_mutex_init(&e->lock, NULL);
+        e->state.model = model;
+        return e;
+    }
     pthread_mutex_lock(&r->lock);
     entry *e = NULL;
     for (size_t i = 0; i < r->n && !e; i++)
@@ -335,14 +172,11 @@ static entry *take_entry(ag_edit_sessions *r, int64_t model, ag_error *err)
     return e;
 }
 
-ag_status ag_edit_session_acquire(ag_app *app, int64_t model, ag_edit_state **state,
-                                  ag_error *err)
+ag_status ag_edit_session_acquire(ag_edit_sessions *reg, ag_db *db, int64_t model,
+                                  ag_edit_state **state, ag_error *err)
 {
     *state = NULL;
-    ag_db *db = ag_app_db(app, err);
-    if (!db)
-        return err ? err->code : AG_ERR_DB;
-    entry *e = take_entry(ag__app_edit_sessions(app), model, err);
+    entry *e = take_entry(reg, model, err);
     if (!e)
         return err ? err->code : AG_ERR_BUSY;
     ag_model_row row;
@@ -355,28 +189,32 @@ ag_status ag_edit_session_acquire(ag_app *app, int64_t model, ag_edit_state **st
     }
     if (s != AG_OK) {
         ag_edit_session_reset(&e->state);
-        ag_edit_session_release(app, &e->state);
+        ag_edit_session_release(reg, &e->state);
         return s;
     }
     *state = &e->state;
     return AG_OK;
 }
 
-ag_status ag_edit_session_hold(ag_app *app, int64_t model, ag_edit_state **state, ag_error *err)
+ag_status ag_edit_session_hold(ag_edit_sessions *reg, int64_t model, ag_edit_state **state,
+                               ag_error *err)
 {
-    entry *e = take_entry(ag__app_edit_sessions(app), model, err);
+    entry *e = take_entry(reg, model, err);
     *state = e ? &e->state : NULL;
     return e ? AG_OK : (err ? err->code : AG_ERR_BUSY);
 }
 
-void ag_edit_session_release(ag_app *app, ag_edit_state *state)
+void ag_edit_session_release(ag_edit_sessions *reg, ag_edit_state *state)
 {
     if (!state)
         return;
-    entry *e = (entry *)state; /* state is the entry's first member */
-    ag_edit_sessions *r = ag__app_edit_sessions(app);
+    entry *e = (entry *)state;
+    if (!reg) {
+        entry_free(e);
+        return;
+    }
     pthread_mutex_unlock(&e->lock);
-    pthread_mutex_lock(&r->lock);
+    pthread_mutex_lock(&reg->lock);
     e->borrowed--;
-    pthread_mutex_unlock(&r->lock);
+    pthread_mutex_unlock(&reg->lock);
 }

@@ -1,56 +1,12 @@
 #include "extrude_job.h"
 
 #include <errno.h>
-#include <jansson.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
-#include "../core/extrude/style.h"
-#include "../io/footprints.h"
-#include "../io/meshblob.h"
-#include "../io/plan_json.h"
-#include "../io/plan_write.h"
-#include "../store/extrusions.h"
-#include "../store/jobs.h"
-#include "../store/models.h"
-#include "extrusion.h"
-
-typedef struct {
-    char *id;         /* footprint id: the mesh group's name */
-    char *plan_json;  /* the description as stored; NULL when none could be made */
-    ag_plan *plan;    /* NULL when none could be made (reason in built) */
-    ag_extrusion_built built;
-} building;
-
-typedef struct {
-    building *items;
-    size_t n;
-    const char *format;
-    json_t *meta; /* style, origin, lonlat, skipped features */
-    size_t skipped;
-} batch;
-
-static void batch_clear(batch *b)
-{
-    for (size_t i = 0; i < b->n; i++) {
-        free(b->items[i].id);
-        free(b->items[i].plan_json);
-        ag_plan_free(b->items[i].plan);
-        ag_extrusion_built_clear(&b->items[i].built);
-    }
-    free(b->items);
-    json_decref(b->meta);
-    memset(b, 0, sizeof *b);
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
+#include "store_ws.h"
+#include "usecase_extrude.h"
 
 static ag_status read_upload(const char *path, char **data, size_t *len, ag_error *err)
 {
@@ -87,358 +43,35 @@ static ag_status read_upload(const char *path, char **data, size_t *len, ag_erro
     return s;
 }
 
-/* What the body is when ?format= does not say: GeoJSON by its "type", a list of buildings by
- * "buildings", a building description by "loops". */
-static const char *sniff(const json_t *root)
-{
-    const char *type = json_string_value(json_object_get(root, "type"));
-    if (type && (strcmp(type, "FeatureCollection") == 0 || strcmp(type, "Feature") == 0))
-        return "geojson";
-    if (json_is_array(json_object_get(root, "buildings")))
-        return "buildings";
-    if (json_object_get(root, "loops"))
-        return "plan";
-    return NULL;
-}
-
-static ag_status add_building(batch *b, size_t cap, const char *id, char *plan_json,
-                              ag_plan *plan, ag_error *err)
-{
-    if (!b->items && !(b->items = calloc(cap ? cap : 1, sizeof *b->items))) {
-        free(plan_json);
-        ag_plan_free(plan);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
-    building *it = &b->items[b->n++];
-    it->id = strdup(id);
-    it->plan_json = plan_json;
-    it->plan = plan;
-    if (!it->id)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    return AG_OK;
-}
-
-/* A description as stored: compact, members in the order given. */
-static ag_status parse_description(json_t *doc, const char *what, char **text, ag_plan **plan,
-                                   ag_error *err)
-{
-    *plan = NULL;
-    *text = json_dumps(doc, JSON_COMPACT);
-    if (!*text)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    ag_error e = {0};
-    ag_status s = ag_plan_json_read_buffer(*text, strlen(*text), plan, &e);
-    if (s != AG_OK) {
-        free(*text);
-        *text = NULL;
-        return ag_error_set(err, s, e.element, "%s%s", what, e.text);
-    }
-    return AG_OK;
-}
-
-static ag_status read_plan(json_t *root, const char *name, batch *b, ag_error *err)
-{
-    char *text;
-    ag_plan *plan;
-    ag_status s = parse_description(root, "", &text, &plan, err);
-    return s != AG_OK ? s : add_building(b, 1, name, text, plan, err);
-}
-
-static ag_status read_buildings(json_t *root, batch *b, ag_error *err)
-{
-    json_t *list = json_object_get(root, "buildings");
-    size_t n = json_array_size(list);
-    if (!json_is_array(list) || n == 0)
-        return ag_error_set(err, AG_ERR_PARSE, 0, "\"buildings\" must be a non-empty array");
-    size_t i;
-    json_t *item;
-    json_array_foreach(list, i, item)
-    {
-        json_t *id = json_object_get(item, "id"), *plan = json_object_get(item, "plan");
-        if (!json_is_object(item) || !json_is_object(plan) ||
-            (id && !json_is_string(id) && !json_is_integer(id)))
-            return ag_error_set(err, AG_ERR_PARSE, (long)i + 1,
-                                "buildings[%zu] must be an object with a \"plan\" object and "
-                                "an optional \"id\" (string or integer)", i);
-        char idbuf[32];
-        const char *ids = json_string_value(id);
-        if (!ids) {
-            snprintf(idbuf, sizeof idbuf, "%lld",
-                     id ? (long long)json_integer_value(id) : (long long)i);
-            ids = idbuf;
-        }
-        char what[64], *text;
-        ag_plan *p;
-        snprintf(what, sizeof what, "buildings[%zu].", i);
-        ag_status s = parse_description(plan, what, &text, &p, err);
-        if (s == AG_OK)
-            s = add_building(b, n, ids, text, p, err);
-        if (s != AG_OK)
-            return s;
-    }
-    return AG_OK;
-}
-
-static ag_status read_geojson(const char *data, size_t len, json_t *params, batch *b,
-                              ag_error *err)
-{
-    const char *style_name = json_string_value(json_object_get(params, "style"));
-    ag_style style;
-    ag_status s = ag_style_builtin(style_name ? style_name : "hip", &style, err);
-    if (s != AG_OK)
-        return s;
-    json_t *seed = json_object_get(params, "seed");
-    if (json_is_integer(seed))
-        style.seed = (uint64_t)json_integer_value(seed);
-    json_t *ll = json_object_get(params, "lonlat");
-    ag_footprints_options fo = {
-        .height_property = json_string_value(json_object_get(params, "height_property")),
-        .lonlat = json_is_true(ll) ? 1 : json_is_false(ll) ? -1 : 0,
-    };
-    ag_footprints *f = NULL;
-    if ((s = ag_footprints_read_buffer(data, len, &fo, &f, err)) != AG_OK)
-        return s;
-    if (f->n == 0) {
-        s = ag_error_set(err, AG_ERR_EMPTY, 0, "the GeoJSON holds no polygon footprint%s%s",
-                         f->skipped ? "; " : "", f->skipped ? f->first_skip : "");
-        ag_footprints_free(f);
-        return s;
-    }
-    b->skipped = f->skipped;
-    b->meta = json_pack("{s:s, s:s, s:b, s:[f,f], s:I}", "format", "geojson", "style",
-                        style.name, "lonlat", f->lonlat, "origin", f->origin[0], f->origin[1],
-                        "skipped_features", (json_int_t)f->skipped);
-    for (size_t i = 0; i < f->n && s == AG_OK; i++) {
-        const ag_footprint *fp = &f->items[i];
-        ag_plan *plan = NULL;
-        json_t *doc = NULL;
-        char *text = NULL;
-        ag_error e = {0};
-        ag_status made = ag_style_apply(&style, (const double *const *)fp->loops, fp->sizes,
-                                        fp->nloops, fp->height, i, &plan, &e);
-        if (made == AG_OK && (made = ag_plan_write_json(plan, &doc, &e)) == AG_OK &&
-            !(text = json_dumps(doc, JSON_COMPACT)))
-            made = ag_error_set(&e, AG_ERR_NOMEM, 0, "out of memory");
-        json_decref(doc);
-        if (made == AG_ERR_NOMEM) {
-            ag_plan_free(plan);
-            s = ag_error_set(err, made, 0, "out of memory");
-            break;
-        }
-        if (made != AG_OK) {
-            ag_plan_free(plan);
-            free(text);
-            plan = NULL;
-            text = NULL;
-        }
-        s = add_building(b, f->n, fp->id, text, plan, err);
-        if (s == AG_OK && made != AG_OK) {
-            building *it = &b->items[b->n - 1];
-            snprintf(it->built.status, sizeof it->built.status, "failed");
-            snprintf(it->built.reason, sizeof it->built.reason, "%s", e.text);
-            it->built.failure = made;
-        }
-    }
-    ag_footprints_free(f);
-    return s;
-}
-
-static json_t *issues(const batch *b, const char *status)
-{
-    json_t *a = json_array();
-    for (size_t i = 0; i < b->n; i++)
-        if (strcmp(b->items[i].built.status, status) == 0)
-            json_array_append_new(a, json_pack("{s:s, s:s}", "id", b->items[i].id, "reason",
-                                               b->items[i].built.reason));
-    return a;
-}
-
-static ag_status store(ag_db *db, ag_jobctx *ctx, int64_t job, const char *name, const batch *b,
-                       const ag_mesh *mesh, const char *source, size_t source_len,
-                       json_t *report, ag_error *err)
-{
-    uint8_t *blob = NULL;
-    size_t blob_len = 0;
-    char *stats = ag_extrusion_stats(mesh), *meta = json_dumps(b->meta, JSON_COMPACT);
-    ag_status s = stats && meta ? ag_meshblob_encode(mesh, &blob, &blob_len) : AG_ERR_NOMEM;
-    if (s != AG_OK) {
-        free(stats);
-        free(meta);
-        return ag_error_set(err, s, 0, "cannot encode the mesh");
-    }
-    if ((s = ag_db_begin(db, err)) != AG_OK)
-        goto out;
-    int geo = strcmp(b->format, "geojson") == 0;
-    ag_model_new m = {
-        .name = name,
-        .kind = "extrusion",
-        .stats_json = stats,
-        .source = source,
-        .source_len = source_len,
-        .source_format = b->format,
-        .source_media_type = geo ? "application/geo+json" : "application/json",
-        .mesh = blob,
-        .mesh_len = blob_len,
-    };
-    int64_t model = 0;
-    s = ag_models_insert(db, &m, &model, err);
-    if (s == AG_OK)
-        s = ag_extrusions_put(db, model, strcmp(b->format, "plan") != 0, meta, err);
-    for (size_t i = 0; s == AG_OK && i < b->n; i++) {
-        const building *it = &b->items[i];
-        ag_extrusion_building row = {.model = model,
-                                     .building = (int64_t)i,
-                                     .footprint = it->id,
-                                     .plan_json = it->plan_json ? it->plan_json : "null",
-                                     .mesh = it->built.blob,
-                                     .mesh_len = it->built.blob_len,
-                                     .triangles = (int64_t)it->built.triangles,
-                                     .reason = it->built.reason[0] ? (char *)it->built.reason
-                                                                   : NULL};
-        snprintf(row.status, sizeof row.status, "%s", it->built.status);
-        s = ag_extrusions_put_building(db, &row, err);
-    }
-    if (s == AG_OK && ag_jobctx_cancelled(ctx))
-        s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
-    char *result = NULL;
-    if (s == AG_OK) {
-        char href[64];
-        snprintf(href, sizeof href, "/api/v1/models/%lld", (long long)model);
-        json_t *r = json_pack("{s:I, s:s, s:O}", "model", (json_int_t)model, "href", href,
-                              "report", report);
-        result = r ? json_dumps(r, JSON_COMPACT) : NULL;
-        json_decref(r);
-        s = result ? ag_jobs_finish(db, job, "succeeded", result, NULL, model, err)
-                   : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
-    free(result);
-    s = s == AG_OK ? ag_db_commit(db, err) : (ag_db_rollback(db), s);
-out:
-    free(blob);
-    free(stats);
-    free(meta);
-    return s;
-}
-
-static ag_status run(ag_app *app, ag_jobctx *ctx, int64_t job, const char *params_json,
+static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_params *p,
                      ag_error *err)
 {
-    json_t *params = json_loads(params_json, 0, NULL);
-    const char *upload = json_string_value(json_object_get(params, "upload"));
-    const char *name = json_string_value(json_object_get(params, "name"));
-    const char *format = json_string_value(json_object_get(params, "format"));
+    if (p->type != AG_JOB_EXTRUDE)
+        return ag_error_set(err, AG_ERR_INTERNAL, 0, "an extrude job without its params");
+    const ag_extrude_job *j = &p->u.extrude;
+    ag_store_env env;
+    ag_status s = ag_store_services_env(services, &env, err);
     char *data = NULL;
     size_t len = 0;
-    json_t *root = NULL;
-    ag_mesh *mesh = NULL;
-    batch b = {0};
-    ag_status s;
-    if (!upload || !name) {
-        s = ag_error_set(err, AG_ERR_INTERNAL, 0, "extrude job without an upload or a name");
-        goto done;
-    }
-    if ((s = read_upload(upload, &data, &len, err)) != AG_OK)
-        goto done;
-    ag_jobctx_progress(ctx, 0.01, "parse");
-    json_error_t je;
-    if (!(root = json_loadb(data, len, 0, &je))) {
-        s = ag_error_set(err, AG_ERR_PARSE, je.line, "the body is not JSON: %s (line %d, column %d)",
-                         je.text, je.line, je.column);
-        goto done;
-    }
-    if (!format)
-        format = json_is_object(root) ? sniff(root) : NULL;
-    if (!format) {
-        s = ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
-                         "the body is neither a building description (with \"loops\"), a list of "
-                         "them (\"buildings\") nor a GeoJSON FeatureCollection; say which with "
-                         "?format=plan|buildings|geojson");
-        goto done;
-    }
-    if (!json_is_object(root)) {
-        s = ag_error_set(err, AG_ERR_PARSE, 0, "the body must be a JSON object");
-        goto done;
-    }
-    if (strcmp(format, "geojson") == 0) {
-        s = read_geojson(data, len, params, &b, err);
-    } else if (strcmp(format, "buildings") == 0) {
-        b.meta = json_pack("{s:s}", "format", "buildings");
-        s = read_buildings(root, &b, err);
-    } else {
-        format = "plan";
-        b.meta = json_pack("{s:s}", "format", "plan");
-        s = read_plan(root, name, &b, err);
-    }
-    b.format = format;
-    json_decref(root);
-    root = NULL;
+    if (s == AG_OK)
+        s = read_upload(j->upload, &data, &len, err);
     if (s != AG_OK)
-        goto done;
-    if (!b.meta) {
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        goto done;
-    }
-
-    /* Extrude each building on its own: progress per building, failures reported. */
-    if (!(mesh = ag_mesh_create())) {
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        goto done;
-    }
-    double t0 = now();
-    size_t succeeded = 0, not_watertight = 0, triangles = 0;
-    for (size_t i = 0; i < b.n; i++) {
-        building *it = &b.items[i];
-        if (ag_jobctx_progress(ctx, 0.05 + 0.85 * (double)i / (double)b.n, "extrude")) {
-            s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
-            goto done;
-        }
-        if (it->plan && (s = ag_extrusion_build(it->plan, it->id, mesh, &it->built, err)) != AG_OK)
-            goto done;
-        if (strcmp(it->built.status, "failed") != 0) {
-            succeeded++;
-            triangles += it->built.triangles;
-            not_watertight += strcmp(it->built.status, "not_watertight") == 0;
-        }
-    }
-    double seconds = now() - t0;
-    int single = strcmp(format, "plan") == 0;
-    if (succeeded == 0) {
-        const building *first = &b.items[0];
-        s = single ? ag_error_set(err, first->built.failure ? first->built.failure : AG_ERR_INVALID,
-                                  0, "the plan cannot be extruded: %s", first->built.reason)
-                   : ag_error_set(err, AG_ERR_EMPTY, 0,
-                                  "none of the %zu footprints could be extruded; the first, "
-                                  "\"%s\": %s",
-                                  b.n, first->id, first->built.reason);
-        goto done;
-    }
-    json_t *report = json_pack(
-        "{s:I, s:I, s:o, s:I, s:o, s:I, s:f, s:I}", "footprints", (json_int_t)b.n, "succeeded",
-        (json_int_t)succeeded, "failed", issues(&b, "failed"), "not_watertight",
-        (json_int_t)not_watertight, "not_watertight_items", issues(&b, "not_watertight"),
-        "triangles", (json_int_t)triangles, "seconds", seconds, "skipped_features",
-        (json_int_t)b.skipped);
-    if (!report) {
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        goto done;
-    }
-    if (ag_jobctx_progress(ctx, 0.92, "store")) {
-        json_decref(report);
-        s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
-        goto done;
-    }
-    ag_db *db = ag_app_db(app, err);
-    s = db ? store(db, ctx, job, name, &b, mesh, data, len, report, err)
-           : (err ? err->code : AG_ERR_DB);
-    json_decref(report);
-done:
-    json_decref(root);
-    ag_mesh_free(mesh);
-    batch_clear(&b);
+        return s;
+    ag_store_ws w;
+    ag_store_ws_init(&w, &(ag_store_ws_options){.env = env, .job = ctx, .job_id = job});
+    ag_extrude_input in = {.data = data,
+                           .len = len,
+                           .name = j->name,
+                           .format = j->format,
+                           .style = j->style,
+                           .height_property = j->height_property,
+                           .seed = j->seed,
+                           .lonlat = j->lonlat};
+    int64_t model = 0;
+    s = ag_usecase_extrude_run(&w.ws, &in, &model, err);
+    ag_store_ws_end(&w, s);
     free(data);
-    json_decref(params);
     return s;
 }
 
-const ag_job_kind ag_extrude_job_kind = {.kind = "extrude", .run = run,
-                                        .cleanup = ag_jobqueue_remove_upload};
+const ag_job_kind ag_extrude_job_kind = {.kind = "extrude", .run = run};

@@ -5,13 +5,18 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "../store/jobs.h"
+#include "problem.h"
 #include "views.h"
 
 #define AG_JOBQUEUE_MAX_KINDS 16
+
+typedef struct {
+    ag_job_kind kind;
+    void *env;
+} kind_entry;
 
 struct ag_jobctx {
     ag_jobqueue *q;
@@ -23,29 +28,39 @@ struct ag_jobctx {
 };
 
 typedef struct queued {
-    int64_t job;
-    const ag_job_kind *kind;
-    char *params;
     struct queued *next;
+    /* a stored job */
+    int64_t job;
+    const kind_entry *kind;
+    ag_job_params params;
+    /* or a fast task */
+    void (*run)(void *user);
+    void (*drop)(void *user);
+    void *user;
 } queued;
 
-struct ag_jobqueue {
-    ag_app *app;
-    pthread_mutex_t lock;
+typedef struct {
     pthread_cond_t wake;
     queued *head, *tail;
     size_t length, capacity;
-    int stopping;
-    ag_jobctx *running; /* list of jobs on workers, for cancel */
     pthread_t *threads;
     int nthreads;
-    ag_job_kind kinds[AG_JOBQUEUE_MAX_KINDS];
+} lane;
+
+struct ag_jobqueue {
+    ag_dbpool *db;
+    ag_sequencer *seq;
+    pthread_mutex_t lock;
+    lane normal, fast;
+    int stopping;
+    ag_jobctx *running; /* jobs on workers, for cancel */
+    kind_entry kinds[AG_JOBQUEUE_MAX_KINDS];
     int nkinds;
 };
 
-void ag_jobqueue_publish(ag_app *app, int64_t job)
+void ag_jobqueue_publish(ag_jobqueue *q, int64_t job)
 {
-    ag_db *db = ag_app_db(app, NULL);
+    ag_db *db = ag_dbpool_get(q->db, NULL);
     if (!db)
         return;
     ag_job_row row;
@@ -55,19 +70,19 @@ void ag_jobqueue_publish(ag_app *app, int64_t job)
     char *text = v ? json_dumps(v, JSON_COMPACT) : NULL;
     if (text) {
         ag_event ev = {.kind = AG_EVENT_JOB, .job = job, .model = row.model, .json = text};
-        ag_events_publish(ag_app_events(app), &ev);
+        ag_sequencer_publish(q->seq, &ev);
     }
     free(text);
     json_decref(v);
     ag_jobs_row_clear(&row);
 }
 
-static void finish_unsuccessful(ag_app *app, int64_t job, ag_status s, const ag_error *err)
+static void finish_unsuccessful(ag_jobqueue *q, int64_t job, ag_status s, const ag_error *err)
 {
-    ag_db *db = ag_app_db(app, NULL);
+    ag_db *db = ag_dbpool_get(q->db, NULL);
     if (!db)
         return;
-    char *problem = ag_view_problem_text(s, err);
+    char *problem = ag_problem_text(s, err);
     /* The run function may have left a transaction open on its way out. */
     ag_db_rollback(db);
     if (ag_db_begin(db, NULL) == AG_OK) {
@@ -78,7 +93,16 @@ static void finish_unsuccessful(ag_app *app, int64_t job, ag_status s, const ag_
     free(problem);
 }
 
-static void run_one(ag_jobqueue *q, queued *item)
+/* What a job leaves behind goes whatever its outcome: the upload it read. */
+static void cleanup(queued *item)
+{
+    const char *upload = ag_job_params_upload(&item->params);
+    if (upload)
+        unlink(upload);
+    ag_job_params_clear(&item->params);
+}
+
+static void run_job(ag_jobqueue *q, queued *item)
 {
     ag_jobctx ctx = {.q = q, .job = item->job, .last_progress = -1};
     pthread_mutex_lock(&q->lock);
@@ -91,14 +115,14 @@ static void run_one(ag_jobqueue *q, queued *item)
     ag_error err;
     ag_error_clear(&err);
     ag_status s;
-    ag_db *db = ag_app_db(q->app, &err);
+    ag_db *db = ag_dbpool_get(q->db, &err);
     if (!db) {
         s = err.code;
     } else if (ag_jobctx_progress(&ctx, 0, "start")) {
         s = ag_error_set(&err, AG_ERR_CANCELLED, 0, "the job was cancelled before it started");
     } else {
         /* On success the run function has recorded the outcome itself. */
-        s = item->kind->run(q->app, &ctx, item->job, item->params, &err);
+        s = item->kind->kind.run(item->kind->env, &ctx, item->job, &item->params, &err);
     }
     pthread_mutex_lock(&q->lock);
     int stopping = q->stopping;
@@ -106,9 +130,8 @@ static void run_one(ag_jobqueue *q, queued *item)
     if (s == AG_ERR_CANCELLED && stopping)
         ag_error_set(&err, AG_ERR_CANCELLED, 0, "archgramd stopped before the job finished");
     if (s != AG_OK)
-        finish_unsuccessful(q->app, item->job, s, &err);
-    if (item->kind->cleanup)
-        item->kind->cleanup(q->app, item->params);
+        finish_unsuccessful(q, item->job, s, &err);
+    cleanup(item);
 
     pthread_mutex_lock(&q->lock);
     for (ag_jobctx **p = &q->running; *p; p = &(*p)->next_running) {
@@ -118,65 +141,104 @@ static void run_one(ag_jobqueue *q, queued *item)
         }
     }
     pthread_mutex_unlock(&q->lock);
-    ag_jobqueue_publish(q->app, item->job);
+    ag_jobqueue_publish(q, item->job);
 }
 
-static void *worker_main(void *arg)
+static queued *pop(lane *l)
+{
+    queued *item = l->head;
+    if (item) {
+        l->head = item->next;
+        if (!l->head)
+            l->tail = NULL;
+        l->length--;
+    }
+    return item;
+}
+
+static void *normal_main(void *arg)
 {
     ag_jobqueue *q = arg;
     for (;;) {
         pthread_mutex_lock(&q->lock);
-        while (!q->head && !q->stopping)
-            pthread_cond_wait(&q->wake, &q->lock);
-        if (!q->head) { /* stopping and nothing left */
-            pthread_mutex_unlock(&q->lock);
-            break;
-        }
-        queued *item = q->head;
-        q->head = item->next;
-        if (!q->head)
-            q->tail = NULL;
-        q->length--;
+        while (!q->normal.head && !q->stopping)
+            pthread_cond_wait(&q->normal.wake, &q->lock);
+        queued *item = pop(&q->normal); /* stopping: drained, each cancelled by run_job */
         pthread_mutex_unlock(&q->lock);
-        run_one(q, item);
-        free(item->params);
+        if (!item)
+            break;
+        run_job(q, item);
         free(item);
     }
     return NULL;
 }
 
-ag_jobqueue *ag_jobqueue_create(ag_app *app, int workers, size_t capacity)
+static void *fast_main(void *arg)
+{
+    ag_jobqueue *q = arg;
+    for (;;) {
+        pthread_mutex_lock(&q->lock);
+        while (!q->fast.head && !q->stopping)
+            pthread_cond_wait(&q->fast.wake, &q->lock);
+        queued *item = q->stopping ? NULL : pop(&q->fast);
+        pthread_mutex_unlock(&q->lock);
+        if (!item)
+            break;
+        item->run(item->user);
+        free(item);
+    }
+    return NULL;
+}
+
+static int start_lane(ag_jobqueue *q, lane *l, int n, size_t capacity, void *(*fn)(void *))
+{
+    pthread_cond_init(&l->wake, NULL);
+    l->capacity = capacity ? capacity : 256;
+    l->threads = calloc((size_t)n, sizeof *l->threads);
+    if (!l->threads)
+        return -1;
+    for (int i = 0; i < n; i++) {
+        if (pthread_create(&l->threads[i], NULL, fn, q) != 0)
+            break;
+        l->nthreads++;
+    }
+    return l->nthreads ? 0 : -1;
+}
+
+ag_jobqueue *ag_jobqueue_create(const ag_jobqueue_options *opt)
 {
     ag_jobqueue *q = calloc(1, sizeof *q);
     if (!q)
         return NULL;
-    q->app = app;
-    q->capacity = capacity ? capacity : 256;
+    q->db = opt->db;
+    q->seq = opt->seq;
     pthread_mutex_init(&q->lock, NULL);
-    pthread_cond_init(&q->wake, NULL);
-    q->threads = calloc((size_t)(workers > 0 ? workers : 1), sizeof *q->threads);
-    if (!q->threads) {
-        ag_jobqueue_free(q);
-        return NULL;
-    }
-    for (int i = 0; i < (workers > 0 ? workers : 1); i++) {
-        if (pthread_create(&q->threads[i], NULL, worker_main, q) != 0)
-            break;
-        q->nthreads++;
-    }
-    if (q->nthreads == 0) {
+    int fail = start_lane(q, &q->normal, opt->workers > 0 ? opt->workers : 1, opt->capacity,
+                          normal_main);
+    fail |= start_lane(q, &q->fast, opt->fast_workers > 0 ? opt->fast_workers : 1,
+                       opt->fast_capacity, fast_main);
+    if (fail) {
         ag_jobqueue_free(q);
         return NULL;
     }
     return q;
 }
 
-ag_status ag_jobqueue_register(ag_jobqueue *q, const ag_job_kind *kind)
+ag_status ag_jobqueue_register(ag_jobqueue *q, const ag_job_kind *kind, void *env)
 {
     if (q->nkinds >= AG_JOBQUEUE_MAX_KINDS)
         return AG_ERR_INTERNAL;
-    q->kinds[q->nkinds++] = *kind;
+    q->kinds[q->nkinds].kind = *kind;
+    q->kinds[q->nkinds].env = env;
+    q->nkinds++;
     return AG_OK;
+}
+
+static void join_lane(lane *l)
+{
+    for (int i = 0; i < l->nthreads; i++)
+        pthread_join(l->threads[i], NULL);
+    l->nthreads = 0;
 }
 
 void ag_jobqueue_stop(ag_jobqueue *q)
@@ -185,15 +247,19 @@ void ag_jobqueue_stop(ag_jobqueue *q)
         return;
     pthread_mutex_lock(&q->lock);
     q->stopping = 1;
-    /* Queued jobs never start: they are cancelled by the workers as they drain the queue
-     * (run_one sees `stopping`), which keeps the store writes on worker connections. */
     for (ag_jobctx *c = q->running; c; c = c->next_running)
         atomic_store(&c->cancel, 1);
-    pthread_cond_broadcast(&q->wake);
+    pthread_cond_broadcast(&q->normal.wake);
+    pthread_cond_broadcast(&q->fast.wake);
     pthread_mutex_unlock(&q->lock);
-    for (int i = 0; i < q->nthreads; i++)
-        pthread_join(q->threads[i], NULL);
-    q->nthreads = 0;
+    join_lane(&q->normal);
+    join_lane(&q->fast);
+    /* tasks that never ran */
+    for (queued *t; (t = pop(&q->fast));) {
+        if (t->drop)
+            t->drop(t->user);
+        free(t);
+    }
 }
 
 void ag_jobqueue_free(ag_jobqueue *q)
@@ -201,76 +267,113 @@ void ag_jobqueue_free(ag_jobqueue *q)
     if (!q)
         return;
     ag_jobqueue_stop(q);
-    while (q->head) {
-        queued *next = q->head->next;
-        free(q->head->params);
-        free(q->head);
-        q->head = next;
+    for (queued *item; (item = pop(&q->normal));) {
+        cleanup(item);
+        free(item);
     }
+    pthread_cond_destroy(&q->normal.wake);
+    pthread_cond_destroy(&q->fast.wake);
     pthread_mutex_destroy(&q->lock);
-    pthread_cond_destroy(&q->wake);
-    free(q->threads);
+    free(q->normal.threads);
+    free(q->fast.threads);
     free(q);
 }
 
-ag_status ag_jobqueue_submit(ag_app *app, const char *kind, const char *params_json,
+static void append(lane *l, queued *item)
+{
+    if (l->tail)
+        l->tail->next = item;
+    else
+        l->head = item;
+    l->tail = item;
+    l->length++;
+    pthread_cond_signal(&l->wake);
+}
+
+ag_status ag_jobqueue_submit(ag_jobqueue *q, const char *kind, const ag_job_params *p,
                              int64_t *job, ag_error *err)
 {
-    ag_jobqueue *q = ag__app_jobqueue(app);
-    const ag_job_kind *k = NULL;
+    const kind_entry *k = NULL;
     for (int i = 0; i < q->nkinds; i++)
-        if (strcmp(q->kinds[i].kind, kind) == 0)
+        if (strcmp(q->kinds[i].kind.kind, kind) == 0)
             k = &q->kinds[i];
     if (!k)
         return ag_error_set(err, AG_ERR_INTERNAL, 0, "no job kind %s", kind);
     queued *item = calloc(1, sizeof *item);
-    if (!item || !(item->params = strdup(params_json ? params_json : "{}"))) {
+    char *text = NULL;
+    ag_status s = item ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory queueing a job");
+    if (s == AG_OK && p)
+        s = ag_job_params_copy(&item->params, p, err);
+    else if (s == AG_OK)
+        item->params.type = AG_JOB_TEST;
+    if (s == AG_OK && !(text = ag_job_params_encode(&item->params)))
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory queueing a job");
+    if (s != AG_OK) {
+        if (item)
+            ag_job_params_clear(&item->params);
         free(item);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory queueing a job");
+        return s;
     }
     item->kind = k;
 
     pthread_mutex_lock(&q->lock);
-    ag_status s = AG_OK;
     if (q->stopping)
         s = ag_error_set(err, AG_ERR_CANCELLED, 0, "archgramd is shutting down");
-    else if (q->length >= q->capacity)
+    else if (q->normal.length >= q->normal.capacity)
         s = ag_error_set(err, AG_ERR_BUSY, 0,
                          "%zu jobs are waiting already; try again when some have finished",
-                         q->length);
+                         q->normal.length);
     if (s == AG_OK) {
         /* Stored and queued under the lock, so a worker cannot pick up a job whose row
          * does not exist yet and shutdown cannot miss it. */
-        ag_db *db = ag_app_db(app, err);
+        ag_db *db = ag_dbpool_get(q->db, err);
         if (!db)
             s = err ? err->code : AG_ERR_DB;
         else if ((s = ag_db_begin(db, err)) == AG_OK) {
-            s = ag_jobs_insert(db, kind, item->params, &item->job, err);
+            s = ag_jobs_insert(db, kind, text, &item->job, err);
             s = s == AG_OK ? ag_db_commit(db, err) : (ag_db_rollback(db), s);
         }
     }
     if (s == AG_OK) {
-        if (q->tail)
-            q->tail->next = item;
-        else
-            q->head = item;
-        q->tail = item;
-        q->length++;
         *job = item->job;
-        pthread_cond_signal(&q->wake);
+        append(&q->normal, item);
     }
     pthread_mutex_unlock(&q->lock);
+    free(text);
     if (s != AG_OK) {
-        free(item->params);
+        ag_job_params_clear(&item->params);
         free(item);
     }
     return s;
 }
 
-ag_status ag_jobqueue_cancel(ag_app *app, int64_t job, ag_error *err)
+ag_status ag_jobqueue_run_fast(ag_jobqueue *q, void (*run)(void *user), void (*drop)(void *user),
+                               void *user, ag_error *err)
 {
-    ag_jobqueue *q = ag__app_jobqueue(app);
-    ag_db *db = ag_app_db(app, err);
+    queued *item = calloc(1, sizeof *item);
+    if (!item)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    item->run = run;
+    item->drop = drop;
+    item->user = user;
+    ag_status s = AG_OK;
+    pthread_mutex_lock(&q->lock);
+    if (q->stopping)
+        s = ag_error_set(err, AG_ERR_CANCELLED, 0, "archgramd is shutting down");
+    else if (q->fast.length >= q->fast.capacity)
+        s = ag_error_set(err, AG_ERR_BUSY, 0, "%zu tasks are waiting already; send it again later",
+                         q->fast.length);
+    else
+        append(&q->fast, item);
+    pthread_mutex_unlock(&q->lock);
+    if (s != AG_OK)
+        free(item);
+    return s;
+}
+
+ag_status ag_jobqueue_cancel(ag_jobqueue *q, int64_t job, ag_error *err)
+{
+    ag_db *db = ag_dbpool_get(q->db, err);
     if (!db)
         return err ? err->code : AG_ERR_DB;
     ag_job_row row;
@@ -281,16 +384,17 @@ ag_status ag_jobqueue_cancel(ag_app *app, int64_t job, ag_error *err)
 
     queued *removed = NULL;
     pthread_mutex_lock(&q->lock);
-    for (queued **p = &q->head; *p; p = &(*p)->next) {
+    lane *l = &q->normal;
+    for (queued **p = &l->head; *p; p = &(*p)->next) {
         if ((*p)->job == job) {
             removed = *p;
             *p = removed->next;
-            if (q->tail == removed) {
-                q->tail = NULL;
-                for (queued *t = q->head; t; t = t->next)
-                    q->tail = t;
+            if (l->tail == removed) {
+                l->tail = NULL;
+                for (queued *t = l->head; t; t = t->next)
+                    l->tail = t;
             }
-            q->length--;
+            l->length--;
             break;
         }
     }
@@ -302,12 +406,10 @@ ag_status ag_jobqueue_cancel(ag_app *app, int64_t job, ag_error *err)
     if (removed) {
         ag_error e;
         ag_error_set(&e, AG_ERR_CANCELLED, 0, "the job was cancelled before it started");
-        finish_unsuccessful(app, job, AG_ERR_CANCELLED, &e);
-        if (removed->kind->cleanup)
-            removed->kind->cleanup(app, removed->params);
-        free(removed->params);
+        finish_unsuccessful(q, job, AG_ERR_CANCELLED, &e);
+        cleanup(removed);
         free(removed);
-        ag_jobqueue_publish(app, job);
+        ag_jobqueue_publish(q, job);
     }
     return AG_OK;
 }
@@ -329,21 +431,11 @@ int ag_jobctx_progress(ag_jobctx *ctx, double fraction, const char *stage)
         strncpy(ctx->last_stage, stage, sizeof ctx->last_stage - 1);
         ctx->last_stage[sizeof ctx->last_stage - 1] = '\0';
     }
-    ag_db *db = ag_app_db(ctx->q->app, NULL);
+    ag_db *db = ag_dbpool_get(ctx->q->db, NULL);
     if (db && ag_db_begin(db, NULL) == AG_OK) {
         ag_jobs_update(db, ctx->job, "running", fraction, stage, NULL);
         ag_db_commit(db, NULL);
     }
-    ag_jobqueue_publish(ctx->q->app, ctx->job);
+    ag_jobqueue_publish(ctx->q, ctx->job);
     return ag_jobctx_cancelled(ctx);
-}
-
-void ag_jobqueue_remove_upload(ag_app *app, const char *params_json)
-{
-    (void)app;
-    json_t *params = json_loads(params_json, 0, NULL);
-    const char *upload = json_string_value(json_object_get(params, "upload"));
-    if (upload)
-        unlink(upload);
-    json_decref(params);
 }

@@ -12,11 +12,6 @@
 
 #define AG_PROFILE_NAME_MAX 100
 
-int ag_plan_edit_handles(const char *kind)
-{
-    return kind && (strcmp(kind, "plan") == 0 || strcmp(kind, "profile") == 0);
-}
-
 /* Parses a description given as JSON; errors become AG_ERR_PARSE prefixed with `what`. */
 static ag_status parse(const json_t *doc, const char *what, ag_plan **plan, char **text,
                        ag_error *err)

@@ -1,5 +1,6 @@
 /* Plan and profile edits of extrusion models, as ops (validated and applied by
- * app/modelops.c like every op, inside the transaction that raises the version):
+ * app/modelops.c like every op from their rows of the op table, app/optable.h, inside the
+ * transaction that raises the version):
  *
  *   {"kind": "plan", "building": i, "plan": {...}}   replaces building i's description
  *   {"kind": "profile", "name": "...", "profile": [[w, z], ...] | {"points", "tag", "priority"}}
@@ -19,9 +20,6 @@
 
 #include "../core/status.h"
 #include "../store/db.h"
-
-/* Non-zero for the op kinds this file handles ("plan", "profile"). */
-int ag_plan_edit_handles(const char *kind);
 
 /* The op's shape and its description or profile (parsed and validated without a model). */
 ag_status ag_plan_edit_validate(const json_t *op, ag_error *err);

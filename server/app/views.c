@@ -42,25 +42,3 @@ json_t *ag_view_op(const ag_op_row *op)
                      op->author ? op->author : "", "cid", op->cid ? op->cid : "", "op",
                      parse_or_null(op->body_json), "at", op->at ? op->at : "");
 }
-
-json_t *ag_view_problem(ag_status status, const ag_error *err)
-{
-    char type[96];
-    snprintf(type, sizeof type, "urn:archgram:problem:%s", ag_status_slug(status));
-    const char *detail = err && err->text[0] ? err->text : ag_status_message(status);
-    json_t *p = json_pack("{s:s, s:s, s:i, s:s}", "type", type, "title",
-                          ag_status_message(status), "status", ag_status_http(status), "detail",
-                          detail);
-    if (p && err && err->element > 0)
-        json_object_set_new(p, status == AG_ERR_PARSE ? "line" : "element",
-                            json_integer(err->element));
-    return p;
-}
-
-char *ag_view_problem_text(ag_status status, const ag_error *err)
-{
-    json_t *p = ag_view_problem(status, err);
-    char *text = p ? json_dumps(p, JSON_COMPACT) : NULL;
-    json_decref(p);
-    return text;
-}

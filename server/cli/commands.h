@@ -22,8 +22,6 @@ int ag_cli_part(int argc, char **argv);
 void ag_cli_report(const char *file, const ag_error *err);
 /* "--up y|z" value → axis; returns 0, or -1 on a bad value. */
 int ag_cli_parse_up(const char *value, ag_up_axis *up);
-/* mkdir -p: creates dir and its missing parents; 0, or -1 with errno set. */
-int ag_cli_make_dirs(const char *dir);
 /* A monotonic clock in seconds, for timing stages. */
 double ag_cli_seconds(void);
 /* Reads a mesh file of any importable format; on failure reports it and returns 1.

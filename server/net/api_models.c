@@ -3,13 +3,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../app/modelops.h"
-#include "../app/views.h"
-#include "../io/glb.h"
-#include "../io/import.h"
-#include "../io/meshblob.h"
-#include "../store/models.h"
-#include "../store/ops.h"
+#include "../app/app_change.h"
+#include "../app/app_jobs.h"
+#include "../app/app_query.h"
 #include "routes.h"
 #include "upload.h"
 
@@ -59,31 +55,18 @@ enum MHD_Result ag_api_models_list(ag_request *r)
                                                   "page_token is not one this server gave out"),
                                      &err));
     }
-    enum MHD_Result rc;
-    ag_db *db = ag_request_db(r, &rc);
-    if (!db)
-        return rc;
-    ag_model_row *rows;
-    size_t n;
-    /* One extra row tells whether another page follows. */
-    if ((s = ag_models_list(db, after, (size_t)size + 1, &rows, &n, &err)) != AG_OK)
+    json_t *items;
+    int more;
+    if ((s = ag_app_query_models(r->cfg->app, after, (size_t)size, &items, &more, &err)) != AG_OK)
         return ag_reply_problem(r, s, &err);
-    json_t *items = json_array();
-    size_t shown = n > (size_t)size ? (size_t)size : n;
-    for (size_t i = 0; i < shown; i++) {
-        json_t *m = ag_view_model(&rows[i]);
-        ag_api_grammar_decorate_model(db, m, &rows[i]);
-        json_array_append_new(items, m);
-    }
     json_t *next = json_null();
-    if (n > (size_t)size) {
+    size_t n = json_array_size(items);
+    if (more && n) {
         char buf[32];
-        snprintf(buf, sizeof buf, "m%lld", (long long)rows[shown - 1].id);
+        snprintf(buf, sizeof buf, "m%lld",
+                 (long long)json_integer_value(json_object_get(json_array_get(items, n - 1), "id")));
         next = json_string(buf);
     }
-    for (size_t i = 0; i < n; i++)
-        ag_models_row_clear(&rows[i]);
-    free(rows);
     return ag_reply_json(r, 200, json_pack("{s:o, s:o}", "items", items, "next_page_token", next),
                          NULL);
 }
@@ -94,80 +77,61 @@ enum MHD_Result ag_api_models_create(ag_request *r)
     ag_error_clear(&err);
     char name[1024];
     ag_upload_name(r, "model", name, sizeof name);
-    ag_status s = ag_models_check_name(name, &err);
+    ag_import_job p = {.name = name,
+                       .format = (char *)ag_request_query(r, "format"),
+                       .up = (char *)ag_request_query(r, "up"),
+                       .filename = (char *)ag_upload_filename(r->upload)};
+    ag_status s = ag_app_jobs_check_import(&p, &err);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
-    const char *format = ag_request_query(r, "format");
-    if (format && ag_format_from_name(format) == AG_FORMAT_UNKNOWN) {
-        ag_error_set(&err, AG_ERR_UNSUPPORTED, 0, "unknown format \"%s\"; archgram reads obj, ply, stl, gltf, glb, "
-                     "fbx and dae",
-                     format);
-        return ag_reply_problem(r, AG_ERR_UNSUPPORTED, &err);
-    }
-    const char *up = ag_request_query(r, "up");
-    if (up && strcmp(up, "y") != 0 && strcmp(up, "z") != 0) {
-        ag_error_set(&err, AG_ERR_INVALID, 0, "up must be \"y\" or \"z\", not \"%s\"", up);
-        return ag_reply_problem(r, AG_ERR_INVALID, &err);
-    }
     if (ag_upload_bytes(r->upload) == 0) {
         ag_error_set(&err, AG_ERR_INVALID, 0,
                      "the request has no file: send it as the body (or a multipart \"file\" part)");
         return ag_reply_problem(r, AG_ERR_INVALID, &err);
     }
-    const char *filename = ag_upload_filename(r->upload);
-    const char *path = ag_upload_take_path(r->upload);
-    json_t *params = json_pack("{s:s, s:s, s:s?, s:s?, s:s?}", "upload", path, "name", name,
-                               "format", format, "up", up, "filename", filename);
-    return ag_reply_new_job(r, "import", params, path);
+    p.upload = (char *)ag_upload_take_path(r->upload);
+    int64_t job = 0;
+    s = ag_app_jobs_import(r->cfg->app, &p, &job, &err);
+    return ag_reply_new_job(r, s, job, &err);
 }
 
-static enum MHD_Result reply_model(ag_request *r, ag_db *db, int64_t id, unsigned status)
+enum MHD_Result ag_api_reply_model(ag_request *r, int64_t id, unsigned status)
 {
     ag_error err;
-    ag_model_row row;
-    ag_status s = ag_models_get(db, id, &row, &err);
+    json_t *body;
+    int64_t version;
+    ag_status s = ag_app_query_model(r->cfg->app, id, &body, &version, &err);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
     char etag[32];
-    version_etag(etag, sizeof etag, row.version);
-    json_t *body = ag_view_model(&row);
-    ag_api_grammar_decorate_model(db, body, &row);
-    ag_models_row_clear(&row);
+    version_etag(etag, sizeof etag, version);
     return ag_reply_json(r, status, body, etag);
 }
 
 enum MHD_Result ag_api_model_get(ag_request *r)
 {
-    enum MHD_Result rc;
-    ag_db *db = ag_request_db(r, &rc);
-    return db ? reply_model(r, db, r->ids[0], 200) : rc;
+    return ag_api_reply_model(r, r->ids[0], 200);
 }
 
-/* If-Match as a version; "*" stands for the current one. */
-static ag_status precondition(ag_request *r, ag_db *db, int64_t *version, ag_error *err)
+ag_status ag_api_precondition(ag_request *r, int required, int64_t *version, ag_error *err)
 {
+    *version = 0;
+    if (!required && !ag_request_header(r, MHD_HTTP_HEADER_IF_MATCH))
+        return AG_OK;
     ag_status s = ag_request_if_match(r, version, err);
     if (s != AG_OK || *version != -1)
         return s;
-    ag_model_row row;
-    if ((s = ag_models_get(db, r->ids[0], &row, err)) != AG_OK)
-        return s;
-    *version = row.version;
-    ag_models_row_clear(&row);
-    return AG_OK;
+    return ag_app_query_version(r->cfg->app, r->ids[0], version, err);
 }
 
-/* What every change needs: a connection, the JSON body and the If-Match version. Returns 0
- * after answering the request itself when one is missing. */
-static int change_request(ag_request *r, ag_db **db, json_t **body, int64_t *base,
-                          enum MHD_Result *rc)
+/* What every change needs: the JSON body and the If-Match version. Returns 0 after answering
+ * the request itself when one is missing. */
+static int change_request(ag_request *r, json_t **body, int64_t *base, enum MHD_Result *rc)
 {
     ag_error err;
     *body = NULL;
-    if (!(*db = ag_request_db(r, rc)))
-        return 0;
     ag_status s = ag_request_json(r, body, &err);
-    if (s == AG_OK && (s = precondition(r, *db, base, &err)) != AG_OK) {
+    if (s == AG_OK && (s = ag_api_precondition(r, 1, base, &err)) != AG_OK) {
         json_decref(*body);
         *body = NULL;
     }
@@ -182,12 +146,10 @@ enum MHD_Result ag_api_model_patch(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db;
     json_t *body;
     int64_t base;
-    if (!change_request(r, &db, &body, &base, &rc))
+    if (!change_request(r, &body, &base, &rc))
         return rc;
-    ag_status s;
     const char *key;
     json_t *value;
     json_object_foreach(body, key, value) {
@@ -209,67 +171,41 @@ enum MHD_Result ag_api_model_patch(ag_request *r)
     ag_request_fresh_cid("rest", cid, sizeof cid);
     int64_t version;
     int dup;
-    s = ag_modelops_apply(r->cfg->app, r->ids[0], base, ag_request_author(r), cid, op, 0, &version,
-                          &dup, &err);
+    ag_op_request rq = {.model = r->ids[0], .base = base, .author = ag_request_author(r),
+                        .cid = cid, .op = op};
+    ag_status s = ag_app_change_op(r->cfg->app, &rq, &version, &dup, &err);
     json_decref(op);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
-    return reply_model(r, db, r->ids[0], 200);
+    return ag_api_reply_model(r, r->ids[0], 200);
 }
 
 enum MHD_Result ag_api_model_delete(ag_request *r)
 {
     ag_error err;
-    enum MHD_Result rc;
-    ag_db *db = ag_request_db(r, &rc);
-    if (!db)
-        return rc;
     int64_t version;
-    ag_status s = precondition(r, db, &version, &err);
+    ag_status s = ag_api_precondition(r, 1, &version, &err);
     if (s == AG_OK)
-        s = ag_modelops_delete(r->cfg->app, r->ids[0], version, &err);
+        s = ag_app_change_delete(r->cfg->app, r->ids[0], version, &err);
     return s == AG_OK ? ag_reply_empty(r, 204, NULL) : ag_reply_problem(r, s, &err);
 }
 
-enum MHD_Result ag_api_model_mesh(ag_request *r)
+static int client_has(void *user, const char *etag)
 {
-    ag_error err;
-    enum MHD_Result rc;
-    ag_db *db = ag_request_db(r, &rc);
-    if (!db)
-        return rc;
-    ag_model_row row;
-    ag_status s = ag_models_get(db, r->ids[0], &row, &err);
-    if (s != AG_OK)
-        return ag_reply_problem(r, s, &err);
-    int64_t blob_id = row.mesh_blob;
-    ag_models_row_clear(&row);
-    /* The geometry changes only with a new mesh blob, so its id is a strong validator. */
-    char etag[48];
-    snprintf(etag, sizeof etag, "\"mesh-%lld\"", (long long)blob_id);
-    if (ag_request_none_match(r, etag))
-        return ag_reply_empty(r, 304, etag);
-    void *blob;
-    size_t blob_len;
-    if ((s = ag_blobs_get(db, blob_id, &blob, &blob_len, &err)) != AG_OK)
-        return ag_reply_problem(r, s, &err);
-    ag_mesh *mesh = NULL;
-    s = ag_meshblob_decode(blob, blob_len, &mesh, &err);
-    free(blob);
-    if (s != AG_OK)
-        return ag_reply_problem(r, AG_ERR_INTERNAL, &err);
-    uint8_t *glb;
-    size_t glb_len;
-    s = ag_glb_write(mesh, &glb, &glb_len, &err);
-    ag_mesh_free(mesh);
-    if (s != AG_OK)
-        return ag_reply_problem(r, s, &err);
-    return ag_reply_bytes(r, 200, "model/gltf-binary", glb, glb_len, etag);
+    return ag_request_none_match(user, etag);
 }
 
-static void append_op(void *user, const ag_op_row *op)
+/* mesh.glb: a proceduralized model's components also carry their label and tree node. */
+enum MHD_Result ag_api_model_mesh_glb(ag_request *r)
 {
-    json_array_append_new(user, ag_view_op(op));
+    ag_error err;
+    ag_app_bytes glb;
+    ag_status s = ag_app_query_glb(r->cfg->app, r->ids[0], client_has, r, &glb, &err);
+    if (s != AG_OK)
+        return ag_reply_problem(r, s, &err);
+    if (!glb.data)
+        return ag_reply_empty(r, 304, glb.etag);
+    return ag_reply_bytes(r, 200, "model/gltf-binary", glb.data, glb.len, glb.etag);
 }
 
 enum MHD_Result ag_api_model_ops_list(ag_request *r)
@@ -279,21 +215,13 @@ enum MHD_Result ag_api_model_ops_list(ag_request *r)
     ag_status s = query_int(r, "since", 0, (long long)1 << 62, 0, &since, &err);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
-    enum MHD_Result rc;
-    ag_db *db = ag_request_db(r, &rc);
-    if (!db)
-        return rc;
-    ag_model_row row;
-    if ((s = ag_models_get(db, r->ids[0], &row, &err)) != AG_OK)
+    json_t *items;
+    int64_t version;
+    if ((s = ag_app_query_ops(r->cfg->app, r->ids[0], since, AG_OPS_LIST_MAX, &items, &version,
+                              &err)) != AG_OK)
         return ag_reply_problem(r, s, &err);
     char etag[32];
-    version_etag(etag, sizeof etag, row.version);
-    ag_models_row_clear(&row);
-    json_t *items = json_array();
-    if ((s = ag_ops_each_since(db, r->ids[0], since, AG_OPS_LIST_MAX, append_op, items, &err))) {
-        json_decref(items);
-        return ag_reply_problem(r, s, &err);
-    }
+    version_etag(etag, sizeof etag, version);
     return ag_reply_json(r, 200, json_pack("{s:o}", "items", items), etag);
 }
 
@@ -301,12 +229,10 @@ enum MHD_Result ag_api_model_ops_create(ag_request *r)
 {
     ag_error err;
     enum MHD_Result rc;
-    ag_db *db;
     json_t *body;
     int64_t base;
-    if (!change_request(r, &db, &body, &base, &rc))
+    if (!change_request(r, &body, &base, &rc))
         return rc;
-    ag_status s;
     char generated[64];
     const char *cid = json_string_value(json_object_get(body, "cid"));
     if (!cid) {
@@ -315,8 +241,9 @@ enum MHD_Result ag_api_model_ops_create(ag_request *r)
     }
     int64_t version;
     int dup;
-    s = ag_modelops_apply(r->cfg->app, r->ids[0], base, ag_request_author(r), cid,
-                          json_object_get(body, "op"), 0, &version, &dup, &err);
+    ag_op_request rq = {.model = r->ids[0], .base = base, .author = ag_request_author(r),
+                        .cid = cid, .op = json_object_get(body, "op")};
+    ag_status s = ag_app_change_op(r->cfg->app, &rq, &version, &dup, &err);
     json_decref(body);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);

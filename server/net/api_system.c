@@ -2,19 +2,16 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../app/app_query.h"
 #include "../embedded.h"
 #include "routes.h"
 
 enum MHD_Result ag_api_health(ag_request *r)
 {
     ag_error err;
-    ag_db *db = ag_app_db(r->cfg->app, &err);
-    if (!db)
+    json_t *body = ag_app_query_health(r->cfg->app, r->cfg->ws_port, &err);
+    if (!body)
         return ag_reply_problem(r, err.code, &err);
-    json_t *body = json_pack("{s:s, s:s, s:{s:s, s:i}, s:i, s:i}", "status", "ok", "version",
-                             AG_VERSION, "db", "path", ag_db_path(db), "schema_version",
-                             ag_db_schema_version(db), "ws_port", r->cfg->ws_port, "workers",
-                             ag_app_workers(r->cfg->app));
     return ag_reply_json(r, 200, body, NULL);
 }
 

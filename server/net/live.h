@@ -1,5 +1,8 @@
 /* The live layer: websocket rooms per model on their own port (libwebsockets), fed by the
- * app's event bus. The protocol is documented in schema/websocket.md. */
+ * app's event bus. The protocol is documented in schema/websocket.md; its handlers are in
+ * live_protocol.c, rooms and presence in live_rooms.c, structural ops and previews run on the
+ * app's fast lane. Stop the app (ag_app_shutdown, which drops the fast lane's waiting work)
+ * before the live layer. */
 #ifndef AG_LIVE_H
 #define AG_LIVE_H
 

@@ -5,9 +5,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "../app/jobqueue.h"
-#include "../app/views.h"
-#include "../store/jobs.h"
+#include "../app/app_query.h"
+#include "../app/problem.h"
 #include "request.h"
 
 void ag_reply_header(ag_request *r, const char *name, const char *value)
@@ -64,7 +63,7 @@ enum MHD_Result ag_reply_json(ag_request *r, unsigned status, json_t *body, cons
 
 enum MHD_Result ag_reply_problem(ag_request *r, ag_status s, const ag_error *err)
 {
-    char *text = ag_view_problem_text(s, err);
+    char *text = ag_problem_text(s, err);
     if (!text)
         return MHD_NO;
     return ag_reply_bytes(r, (unsigned)ag_status_http(s), "application/problem+json", text,
@@ -80,12 +79,8 @@ enum MHD_Result ag_reply_empty(ag_request *r, unsigned status, const char *etag)
 enum MHD_Result ag_reply_job(ag_request *r, int64_t job, unsigned status)
 {
     ag_error err;
-    enum MHD_Result rc;
-    ag_db *db = ag_request_db(r, &rc);
-    if (!db)
-        return rc;
-    ag_job_row row;
-    ag_status s = ag_jobs_get(db, job, &row, &err);
+    json_t *body = NULL;
+    ag_status s = ag_app_query_job(r->cfg->app, job, &body, NULL, &err);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
     if (status == 202) {
@@ -93,36 +88,12 @@ enum MHD_Result ag_reply_job(ag_request *r, int64_t job, unsigned status)
         snprintf(location, sizeof location, "/api/v1/jobs/%lld", (long long)job);
         ag_reply_header(r, MHD_HTTP_HEADER_LOCATION, location);
     }
-    json_t *body = ag_view_job(&row);
-    ag_jobs_row_clear(&row);
     return ag_reply_json(r, status, body, NULL);
 }
 
-enum MHD_Result ag_reply_new_job(ag_request *r, const char *kind, json_t *params,
-                                 const char *upload)
+enum MHD_Result ag_reply_new_job(ag_request *r, ag_status s, int64_t job, const ag_error *err)
 {
-    ag_error err;
-    char *text = params ? json_dumps(params, JSON_COMPACT) : NULL;
-    json_decref(params);
-    int64_t job = 0;
-    ag_status s = text ? ag_jobqueue_submit(r->cfg->app, kind, text, &job, &err)
-                       : ag_error_set(&err, AG_ERR_NOMEM, 0, "out of memory");
-    free(text);
-    if (s != AG_OK) {
-        if (upload)
-            unlink(upload);
-        return ag_reply_problem(r, s, &err);
-    }
-    return ag_reply_job(r, job, 202);
-}
-
-ag_db *ag_request_db(ag_request *r, enum MHD_Result *rc)
-{
-    ag_error err;
-    ag_db *db = ag_app_db(r->cfg->app, &err);
-    if (!db)
-        *rc = ag_reply_problem(r, err.code, &err);
-    return db;
+    return s == AG_OK ? ag_reply_job(r, job, 202) : ag_reply_problem(r, s, err);
 }
 
 const char *ag_request_author(ag_request *r)

@@ -54,17 +54,11 @@ enum MHD_Result ag_reply_bytes(ag_request *r, unsigned status, const char *conte
 enum MHD_Result ag_reply_empty(ag_request *r, unsigned status, const char *etag);
 /* Adds a header to the next reply of this request (Location, Allow …); copied. */
 void ag_reply_header(ag_request *r, const char *name, const char *value);
-/* Submits a job of kind with params (stolen) and answers 202 Accepted with its Location and
- * view. When it cannot be submitted, the file at upload (if not NULL; the job's input) is
- * removed and a problem answered. */
-enum MHD_Result ag_reply_new_job(ag_request *r, const char *kind, json_t *params,
-                                 const char *upload);
+/* Answers a job just asked for (app/app_jobs.h): 202 Accepted with its Location and view, or
+ * the problem s when it could not be queued. */
+enum MHD_Result ag_reply_new_job(ag_request *r, ag_status s, int64_t job, const ag_error *err);
 /* Answers with job's view; a 202 also names it in Location. */
 enum MHD_Result ag_reply_job(ag_request *r, int64_t job, unsigned status);
-
-/* This thread's database connection; NULL after answering the request with a problem
- * (*rc is the answer's result then). */
-ag_db *ag_request_db(ag_request *r, enum MHD_Result *rc);
 /* Who makes a change over REST: the X-Archgram-User header, else "api". */
 const char *ag_request_author(ag_request *r);
 /* A client id for a REST change that brings none, "<prefix>-…": unique within this process

@@ -5,7 +5,6 @@
 
 #include <stddef.h>
 
-#include "../store/models.h"
 #include "request.h"
 
 typedef enum {
@@ -39,7 +38,6 @@ enum MHD_Result ag_api_models_create(ag_request *r);
 enum MHD_Result ag_api_model_get(ag_request *r);
 enum MHD_Result ag_api_model_patch(ag_request *r);
 enum MHD_Result ag_api_model_delete(ag_request *r);
-enum MHD_Result ag_api_model_mesh(ag_request *r);
 enum MHD_Result ag_api_model_ops_list(ag_request *r);
 enum MHD_Result ag_api_model_ops_create(ag_request *r);
 enum MHD_Result ag_api_model_mesh_glb(ag_request *r);
@@ -53,7 +51,9 @@ enum MHD_Result ag_api_model_plan(ag_request *r);
 enum MHD_Result ag_api_job_get(ag_request *r);
 enum MHD_Result ag_api_job_cancel(ag_request *r);
 
-/* Adds "proceduralized" (a grammar describes the model's current mesh) to a model's JSON. */
-void ag_api_grammar_decorate_model(ag_db *db, json_t *model, const ag_model_row *row);
+/* Shared by the handlers (api_models.c): a model's view with its ETag; the If-Match version
+ * of a change ("*" = the current one; not required: 0 when absent). */
+enum MHD_Result ag_api_reply_model(ag_request *r, int64_t id, unsigned status);
+ag_status ag_api_precondition(ag_request *r, int required, int64_t *version, ag_error *err);
 
 #endif

@@ -41,8 +41,8 @@ ag_status ag_grammars_put(ag_db *db, const ag_grammar_new *g, ag_error *err)
     if ((s = ag_db_step_done(db, st, "replacing a model's grammar", err)) != AG_OK)
         return s;
     if ((s = ag_db_prepared(db, &st,
-                            "INSERT INTO grammars (model_id, version, mesh_blob, text, tree, summary) "
-                            "VALUES (?, ?, ?, ?, ?, ?)",
+                            "INSERT INTO grammars (model_id, version, mesh_blob, text, tree, summary, "
+                            "tree_numbering) VALUES (?, ?, ?, ?, ?, ?, ?)",
                             err)) != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, g->model);
@@ -51,6 +51,7 @@ ag_status ag_grammars_put(ag_db *db, const ag_grammar_new *g, ag_error *err)
     sqlite3_bind_text64(st, 4, g->text, g->text_len, SQLITE_STATIC, SQLITE_UTF8);
     sqlite3_bind_text(st, 5, g->tree_json ? g->tree_json : "{}", -1, SQLITE_STATIC);
     sqlite3_bind_text(st, 6, g->summary_json ? g->summary_json : "{}", -1, SQLITE_STATIC);
+    sqlite3_bind_int(st, 7, g->tree_numbering);
     return ag_db_step_done(db, st, "storing a grammar", err);
 }
 
@@ -63,7 +64,7 @@ ag_status ag_grammars_current(ag_db *db, int64_t model, int with_tree, ag_gramma
     ag_status s = ag_db_prepared(
         db, &st,
         "SELECT m.version, g.version, g.mesh_blob, g.text, g.summary, "
-        "CASE WHEN ? THEN g.tree END "
+        "CASE WHEN ? THEN g.tree END, g.tree_numbering "
         "FROM models m LEFT JOIN grammars g ON g.model_id = m.id AND g.mesh_blob = m.mesh_blob "
         "WHERE m.id = ? ORDER BY g.version DESC LIMIT 1",
         err);
@@ -84,6 +85,7 @@ ag_status ag_grammars_current(ag_db *db, int64_t model, int with_tree, ag_gramma
         row->model_version = sqlite3_column_int64(st, 0);
         row->version = sqlite3_column_int64(st, 1);
         row->mesh_blob = sqlite3_column_int64(st, 2);
+        row->tree_numbering = sqlite3_column_int(st, 6);
         row->text = column_dup(st, 3, &row->text_len);
         row->summary_json = column_dup(st, 4, NULL);
         if (with_tree)
@@ -95,6 +97,23 @@ ag_status ag_grammars_current(ag_db *db, int64_t model, int with_tree, ag_gramma
     }
     sqlite3_reset(st);
     return s;
+}
+
+ag_status ag_grammars_set_tree(ag_db *db, int64_t model, int64_t mesh_blob, const char *tree_json,
+                               int tree_numbering, ag_error *err)
+{
+    sqlite3_stmt *st;
+    ag_status s = ag_db_prepared(db, &st,
+                                 "UPDATE grammars SET tree = ?, tree_numbering = ? "
+                                 "WHERE model_id = ? AND mesh_blob = ?",
+                                 err);
+    if (s != AG_OK)
+        return s;
+    sqlite3_bind_text(st, 1, tree_json, -1, SQLITE_STATIC);
+    sqlite3_bind_int(st, 2, tree_numbering);
+    sqlite3_bind_int64(st, 3, model);
+    sqlite3_bind_int64(st, 4, mesh_blob);
+    return ag_db_step_done(db, st, "replacing a split tree", err);
 }
 
 ag_status ag_grammars_is_current(ag_db *db, int64_t model, int64_t mesh_blob, int *yes,

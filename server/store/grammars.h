@@ -22,6 +22,7 @@ typedef struct {
     char *text;            /* malloc'd, NUL-terminated */
     size_t text_len;
     char *tree_json;       /* malloc'd; NULL unless asked for */
+    int tree_numbering;    /* which numbering tree_json uses (the app's, see migration 0005) */
     char *summary_json;    /* malloc'd */
 } ag_grammar_row;
 
@@ -34,6 +35,7 @@ typedef struct {
     const char *text;
     size_t text_len;
     const char *tree_json;
+    int tree_numbering;       /* stored as given */
     const char *summary_json; /* NULL = "{}" */
 } ag_grammar_new;
 
@@ -45,6 +47,11 @@ ag_status ag_grammars_put(ag_db *db, const ag_grammar_new *g, ag_error *err);
  * message says which). */
 ag_status ag_grammars_current(ag_db *db, int64_t model, int with_tree, ag_grammar_row *row,
                               ag_error *err);
+
+/* Replaces the tree of the model's grammar for mesh_blob (a tree rebuilt in another
+ * numbering); AG_OK and nothing changed when that grammar is no longer the model's. */
+ag_status ag_grammars_set_tree(ag_db *db, int64_t model, int64_t mesh_blob, const char *tree_json,
+                               int tree_numbering, ag_error *err);
 
 /* *yes = 1 when the model (with this mesh file) has a current grammar. */
 ag_status ag_grammars_is_current(ag_db *db, int64_t model, int64_t mesh_blob, int *yes,

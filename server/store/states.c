@@ -24,8 +24,9 @@ ag_status ag_states_keep(ag_db *db, int64_t model, int64_t version, ag_error *er
     ag_status s = ag_db_prepared(
         db, &st,
         "INSERT OR IGNORE INTO model_states "
-        "(model_id, version, mesh_blob, stats, grammar, tree, summary) "
-        "SELECT m.id, ?, m.mesh_blob, m.stats, g.text, g.tree, g.summary FROM models m "
+        "(model_id, version, mesh_blob, stats, grammar, tree, summary, tree_numbering) "
+        "SELECT m.id, ?, m.mesh_blob, m.stats, g.text, g.tree, g.summary, "
+        "coalesce(g.tree_numbering, 1) FROM models m "
         "LEFT JOIN grammars g ON g.model_id = m.id AND g.mesh_blob = m.mesh_blob "
         "WHERE m.id = ?",
         err);
@@ -70,7 +71,8 @@ ag_status ag_states_get(ag_db *db, int64_t model, int64_t version, ag_state_row 
     sqlite3_stmt *st;
     ag_status s = ag_db_prepared(db, &st,
                                  "SELECT version, mesh_blob, stats, grammar, tree, summary, "
-                                 "(SELECT version FROM models WHERE id = ?) FROM model_states "
+                                 "(SELECT version FROM models WHERE id = ?), tree_numbering "
+                                 "FROM model_states "
                                  "WHERE model_id = ? AND version <= ? ORDER BY version DESC LIMIT 1",
                                  err);
     if (s != AG_OK)
@@ -98,6 +100,7 @@ ag_status ag_states_get(ag_db *db, int64_t model, int64_t version, ag_state_row 
         row->grammar = ag_db_column_dup(st, 3, &row->grammar_len, &bad);
         row->tree_json = ag_db_column_dup(st, 4, NULL, &bad);
         row->summary_json = ag_db_column_dup(st, 5, NULL, &bad);
+        row->tree_numbering = sqlite3_column_int(st, 7);
         if (bad || !row->stats_json) {
             ag_states_row_clear(row);
             s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory reading a state");
@@ -144,6 +147,7 @@ ag_status ag_states_restore(ag_db *db, int64_t model, int64_t version, const ag_
                         .text = row->grammar,
                         .text_len = row->grammar_len,
                         .tree_json = row->tree_json ? row->tree_json : "{}",
+                        .tree_numbering = row->tree_numbering,
                         .summary_json = row->summary_json};
     return ag_grammars_put(db, &g, err);
 }

@@ -19,6 +19,7 @@ typedef struct {
     char *grammar;     /* malloc'd; NULL when that version had no grammar */
     size_t grammar_len;
     char *tree_json;   /* malloc'd; NULL with grammar */
+    int tree_numbering;
     char *summary_json;
 } ag_state_row;
 

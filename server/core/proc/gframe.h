@@ -1,7 +1,6 @@
 /* Where a grammar statement puts what it applies (grammar.h, "Applying"): the frame that maps
  * a rule's or terminal's local box onto a box of its parent, and the cells of a subdivide or
- * repeat pattern. Derivation (grammar.c) and the split tree served to clients
- * (io/splittree_json.c) both place with these, so their boxes agree exactly. */
+ * repeat pattern. Derivation (grammar.c) places with these. */
 #ifndef AG_GFRAME_H
 #define AG_GFRAME_H
 

@@ -1,0 +1,29 @@
+/* The jobs the REST layer asks for, with typed parameters (app/job_params.h), checked before
+ * they are queued; and cancelling them. */
+#ifndef AG_APP_JOBS_H
+#define AG_APP_JOBS_H
+
+#include <stdint.h>
+
+#include "app.h"
+#include "job_params.h"
+
+/* An import of an uploaded file: the name, format ("obj", …, or NULL) and up axis ("y", "z"
+ * or NULL) are checked. The upload is removed when the job cannot be queued. */
+/* The checks ag_app_jobs_import and _extrude make, for a caller that checks before it takes
+ * the upload. */
+ag_status ag_app_jobs_check_import(const ag_import_job *p, ag_error *err);
+ag_status ag_app_jobs_check_extrude(const ag_extrude_job *p, ag_error *err);
+
+ag_status ag_app_jobs_import(ag_app *app, const ag_import_job *p, int64_t *job, ag_error *err);
+/* Proceduralizing a model at its current version; if_match (NULL: none; -1: any) must be the
+ * current version (AG_ERR_STALE otherwise). */
+ag_status ag_app_jobs_proceduralize(ag_app *app, int64_t model, const int64_t *if_match,
+                                    const char *author, int64_t *job, ag_error *err);
+/* An extrusion of an uploaded description or GeoJSON: the name, format and style are checked.
+ * The upload is removed when the job cannot be queued. */
+ag_status ag_app_jobs_extrude(ag_app *app, const ag_extrude_job *p, int64_t *job,
+                              ag_error *err);
+ag_status ag_app_jobs_cancel(ag_app *app, int64_t job, ag_error *err);
+
+#endif

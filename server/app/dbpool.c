@@ -1,0 +1,82 @@
+#include "dbpool.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct ag_dbpool {
+    char *path;
+    pthread_key_t key;
+    pthread_mutex_t lock;
+    ag_db **conns; /* every connection opened, closed at free */
+    size_t n, cap;
+};
+
+static void forget_thread_db(void *db)
+{
+    (void)db; /* connections belong to the pool's list; nothing to do at thread exit */
+}
+
+ag_status ag_dbpool_create(const char *path, ag_dbpool **out, ag_error *err)
+{
+    *out = NULL;
+    ag_dbpool *p = calloc(1, sizeof *p);
+    if (!p || !(p->path = strdup(path))) {
+        free(p);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    /* The first connection creates and migrates the schema; the others only open it. */
+    ag_db *db = NULL;
+    ag_status s = ag_db_open(path, NULL, &db, err);
+    if (s != AG_OK) {
+        free(p->path);
+        free(p);
+        return s;
+    }
+    ag_db_close(db);
+    pthread_key_create(&p->key, forget_thread_db);
+    pthread_mutex_init(&p->lock, NULL);
+    *out = p;
+    return AG_OK;
+}
+
+ag_db *ag_dbpool_get(ag_dbpool *p, ag_error *err)
+{
+    ag_db *db = pthread_getspecific(p->key);
+    if (db)
+        return db;
+    if (ag_db_open(p->path, &(ag_db_options){.no_migrate = 1}, &db, err) != AG_OK)
+        return NULL;
+    pthread_mutex_lock(&p->lock);
+    if (p->n == p->cap) {
+        size_t cap = p->cap ? p->cap * 2 : 16;
+        ag_db **grown = realloc(p->conns, cap * sizeof *grown);
+        if (!grown) {
+            pthread_mutex_unlock(&p->lock);
+            ag_db_close(db);
+            ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory opening a connection");
+            return NULL;
+        }
+        p->conns = grown;
+        p->cap = cap;
+    }
+    p->conns[p->n++] = db;
+    pthread_mutex_unlock(&p->lock);
+    pthread_setspecific(p->key, db);
+    return db;
+}
+
+const char *ag_dbpool_path(const ag_dbpool *p) { return p->path; }
+
+void ag_dbpool_free(ag_dbpool *p)
+{
+    if (!p)
+        return;
+    for (size_t i = 0; i < p->n; i++)
+        ag_db_close(p->conns[i]);
+    free(p->conns);
+    pthread_key_delete(p->key);
+    pthread_mutex_destroy(&p->lock);
+    free(p->path);
+    free(p);
+}

@@ -1,0 +1,371 @@
+#include "folder_ws.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "../io/grammar_text.h"
+#include "../io/import.h"
+#include "model_tree.h"
+#include "usecase_import.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static void blame(ag_folder_ws *w, const char *file)
+{
+    snprintf(w->blame, sizeof w->blame, "%s", file ? file : "");
+    w->blamed = 1;
+}
+
+/* mkdir -p */
+static int make_dirs(const char *dir)
+{
+    char p[4096];
+    snprintf(p, sizeof p, "%s", dir);
+    for (char *s = p + 1; *s; s++)
+        if (*s == '/') {
+            *s = 0;
+            if (mkdir(p, 0777) && errno != EEXIST)
+                return -1;
+            *s = '/';
+        }
+    return mkdir(p, 0777) && errno != EEXIST ? -1 : 0;
+}
+
+static ag_status write_file(ag_folder_ws *w, const char *path, const char *data, size_t len,
+                            ag_error *err)
+{
+    FILE *f = fopen(path, "wb");
+    int ok = f && fwrite(data, 1, len, f) == len;
+    int e = errno;
+    if (f && fclose(f))
+        ok = 0, e = errno;
+    if (ok)
+        return AG_OK;
+    blame(w, NULL);
+    return ag_error_set(err, AG_ERR_IO, 0, "cannot write %s: %s", path, strerror(e));
+}
+
+static ag_status write_json(ag_folder_ws *w, const char *path, json_t *j, size_t flags,
+                            ag_error *err)
+{
+    if (j && json_dump_file(j, path, flags) == 0)
+        return AG_OK;
+    blame(w, NULL);
+    return ag_error_set(err, AG_ERR_IO, 0, "cannot write %s", path);
+}
+
+/* --- reading --------------------------------------------------------------------------- */
+
+static ag_status input_mesh(ag_workspace *ws, ag_mesh **mesh, ag_error *err)
+{
+    ag_folder_ws *w = (ag_folder_ws *)ws;
+    double t0 = now();
+    ag_mesh_source src = {.path = w->o.mesh_path, .up = w->o.up};
+    ag_mesh_file file;
+    blame(w, w->o.mesh_path);
+    ag_status s = ag_usecase_import_read(&src, NULL, NULL, mesh, &file, err);
+    w->input_bytes = file.len;
+    ag_usecase_import_release(&file);
+    w->import_s = now() - t0;
+    return s;
+}
+
+/* A proceduralized folder read as its grammar derived and proceduralized anew. */
+static ag_status read_folder(ag_folder_ws *w, const char *dir, ag_edit_model **em, ag_error *err)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/grammar.txt", dir);
+    blame(w, path);
+    ag_grammar *g = NULL;
+    ag_mesh *d = NULL;
+    long col = 0;
+    ag_status s = ag_grammar_text_read_file(path, &g, err, &col);
+    if (s == AG_OK && (s = ag_terminals_load(g, dir, err)) == AG_OK &&
+        (s = ag_grammar_derive(g, NULL, &d, err)) == AG_OK)
+        s = ag_model_state_reload(d, em, err);
+    ag_mesh_free(d);
+    ag_grammar_free(g);
+    return s;
+}
+
+/* The folder a paste copies from ("source_dir", relative to the op file's folder). */
+static ag_status read_source(ag_folder_ws *w, const char *sdir, ag_error *err)
+{
+    char dir[4096], path[4200];
+    const char *oppath = w->o.op_path ? w->o.op_path : "";
+    const char *slash = strrchr(oppath, '/');
+    if (sdir[0] == '/' || !slash)
+        snprintf(dir, sizeof dir, "%s", sdir);
+    else
+        snprintf(dir, sizeof dir, "%.*s/%s", (int)(slash - oppath), oppath, sdir);
+    blame(w, oppath);
+    struct stat sb;
+    if (stat(dir, &sb) || !S_ISDIR(sb.st_mode))
+        return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "source_dir: %s is not a folder", dir);
+    snprintf(path, sizeof path, "%s/grammar.txt", dir);
+    if (access(path, R_OK))
+        return ag_error_set(err, AG_ERR_NOT_PROCEDURALIZED, 0,
+                            "source_dir: %s is not proceduralized (no grammar.txt; run `archgram "
+                            "proceduralize MESH --out %s`)",
+                            dir, dir);
+    return read_folder(w, dir, &w->source, err);
+}
+
+static ag_status open_models(ag_workspace *ws, const ag_edit_op_origin *from, ag_edit_model **em,
+                             const ag_edit_model **source, int64_t *source_version, ag_error *err)
+{
+    ag_folder_ws *w = (ag_folder_ws *)ws;
+    (void)source_version;
+    ag_status s = read_folder(w, w->o.in_dir, &w->em, err);
+    if (s != AG_OK)
+        return s;
+    if (from && from->model) {
+        blame(w, w->o.op_path);
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "source_model: names a model of the service; an op file names the "
+                            "folder to paste from with source_dir");
+    }
+    if (from && from->dir && (s = read_source(w, from->dir, err)) != AG_OK)
+        return s;
+    *em = w->em;
+    *source = w->source;
+    /* problems from here on are the op's (a field) or the model's */
+    w->blamed = 0;
+    return AG_OK;
+}
+
+/* --- writing --------------------------------------------------------------------------- */
+
+/* grammar.txt, terminals/ and tree.json of st. */
+static ag_status write_model(ag_folder_ws *w, const ag_model_state *st, ag_error *err)
+{
+    const char *dir = w->o.out_dir;
+    char path[4200];
+    if (make_dirs(dir)) {
+        blame(w, NULL);
+        return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", dir, strerror(errno));
+    }
+    if (st->terms.n) {
+        snprintf(path, sizeof path, "%s/terminals", dir);
+        if (make_dirs(path)) {
+            blame(w, dir);
+            return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", path, strerror(errno));
+        }
+    }
+    ag_status s = AG_OK;
+    for (size_t i = 0; s == AG_OK && i < st->terms.n; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, st->terms.path[i]);
+        s = write_file(w, path, st->terms.obj[i], st->terms.len[i], err);
+    }
+    snprintf(path, sizeof path, "%s/grammar.txt", dir);
+    if (s == AG_OK)
+        s = write_file(w, path, st->text, st->text_len, err);
+    snprintf(path, sizeof path, "%s/tree.json", dir);
+    json_t *tree = s == AG_OK ? ag_model_tree_folder(st->em) : NULL;
+    if (s == AG_OK)
+        s = write_json(w, path, tree, JSON_INDENT(1) | JSON_REAL_PRECISION(12), err);
+    json_decref(tree);
+    return s;
+}
+
+static json_t *vec3(const double *v)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < 3; i++)
+        json_array_append_new(a, json_real(v[i]));
+    return a;
+}
+
+/* summary.json of `archgram proceduralize`. */
+static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
+                            const ag_proc_outcome *o, double write_s)
+{
+    const ag_proceduralize_result *r = o->proc;
+    const ag_mesh *m = o->input;
+    const char *in = w->o.mesh_path;
+    json_t *j = json_object();
+    json_t *ji = json_object();
+    json_object_set_new(ji, "file", json_string(in));
+    json_object_set_new(ji, "triangles", json_integer((json_int_t)m->ntris));
+    json_object_set_new(ji, "vertices", json_integer((json_int_t)m->nverts));
+    json_object_set_new(ji, "components", json_integer((json_int_t)r->mesh->ncomponents));
+    json_object_set_new(ji, "groups", json_integer((json_int_t)m->ngroups));
+    json_object_set_new(ji, "bytes", json_integer((json_int_t)w->input_bytes));
+    /* what import did to reach z-up metres (see io/import.h and io/assimp_import.h) */
+    ag_format fmt = ag_format_sniff(NULL, 0, in);
+    int zup = w->o.up == AG_UP_Z ||
+              (w->o.up == AG_UP_DEFAULT && (fmt == AG_FORMAT_PLY || fmt == AG_FORMAT_STL));
+    char norm[160];
+    snprintf(norm, sizeof norm, "%s; %s",
+             zup ? "input taken as z-up, kept" : "y-up input turned to z-up: (x, y, z) -> (x, -z, y)",
+             fmt == AG_FORMAT_FBX ? "FBX units (UnitScaleFactor) converted to metres"
+                                  : "units taken as metres");
+    json_object_set_new(ji, "format", json_string(ag_format_name(fmt)));
+    json_object_set_new(ji, "up", json_string(zup ? "z" : "y"));
+    json_object_set_new(ji, "normalization", json_string(norm));
+    json_object_set_new(ji, "groups_split", json_integer((json_int_t)r->segment.groups_split));
+    json_object_set_new(ji, "planar_fallback", json_boolean(r->segment.planar_fallback));
+    json_object_set_new(j, "input", ji);
+
+    const ag_labels *L = r->labels;
+    json_t *jl = json_array();
+    for (size_t l = 0; l < L->nlabels; l++) {
+        json_t *lo = json_object();
+        uint32_t ex = L->exemplar[l];
+        double size[3];
+        for (int a = 0; a < 3; a++)
+            size[a] = L->box[ex].max[a] - L->box[ex].min[a];
+        json_object_set_new(lo, "label", json_integer((json_int_t)l));
+        json_t *tv = json_array();
+        for (size_t v = 0; v < L->nvariants; v++) {
+            int32_t ti = r->info.terminal_of_variant ? r->info.terminal_of_variant[v] : -1;
+            if (L->variant_label[v] == (int32_t)l && ti >= 0)
+                json_array_append_new(tv, json_string(r->grammar->terminals[ti].name));
+        }
+        json_object_set_new(lo, "terminals", tv);
+        json_object_set_new(lo, "count", json_integer(L->count[l]));
+        json_object_set_new(lo, "triangles", json_integer(L->ntris[ex]));
+        json_object_set_new(lo, "size", vec3(size));
+        json_array_append_new(jl, lo);
+    }
+    json_object_set_new(j, "labels", jl);
+
+    json_t *jc = json_array();
+    for (size_t c = 0; c < r->mesh->ncomponents; c++) {
+        json_t *co = json_object();
+        int32_t g = r->mesh->component_group[c];
+        json_object_set_new(co, "index", json_integer((json_int_t)c));
+        json_object_set_new(co, "group", g >= 0 ? json_string(r->mesh->group_names[g]) : json_null());
+        json_object_set_new(co, "label", L->label[c] >= 0 ? json_integer(L->label[c]) : json_null());
+        json_object_set_new(co, "variant",
+                            L->variant[c] >= 0 ? json_integer(L->variant[c]) : json_null());
+        json_object_set_new(co, "rot", json_integer(90 * L->rot[c]));
+        json_object_set_new(co, "node", r->tree->comp_node[c] >= 0
+                                            ? json_integer(r->tree->comp_node[c])
+                                            : json_null());
+        json_array_append_new(jc, co);
+    }
+    json_object_set_new(j, "components", jc);
+
+    ag_splittree_stats ts = ag_splittree_stats_of(r->tree);
+    json_t *jt = json_object();
+    json_object_set_new(jt, "nodes", json_integer((json_int_t)ts.nodes));
+    json_object_set_new(jt, "visible", json_integer((json_int_t)ts.visible));
+    json_object_set_new(jt, "invisible", json_integer((json_int_t)ts.invisible));
+    json_object_set_new(jt, "depth", json_integer((json_int_t)ts.depth));
+    json_object_set_new(jt, "adjacent_pairs", json_integer((json_int_t)r->tree->nadj));
+    json_object_set_new(j, "tree", jt);
+    json_object_set_new(j, "rules", json_integer((json_int_t)r->grammar->nrules));
+    json_object_set_new(j, "terminals", json_integer((json_int_t)r->grammar->nterminals));
+
+    json_t *jp = json_array();
+    for (size_t p = 0; p < r->tree->npatterns; p++) {
+        const ag_pattern *pt = &r->tree->patterns[p];
+        int32_t ri = r->info.rule_of_class ? r->info.rule_of_class[pt->rule] : -1;
+        json_t *po = json_object();
+        json_object_set_new(po, "rule", ri >= 0 ? json_string(r->grammar->rules[ri].name) : json_null());
+        json_t *cnt = json_array();
+        for (int a = 0; a < 3; a++)
+            json_array_append_new(cnt, json_integer(pt->counts[a]));
+        json_object_set_new(po, "counts", cnt);
+        json_object_set_new(po, "step", vec3(pt->step));
+        json_object_set_new(po, "kind", json_string(pt->nvec ? "repeat" : "subdivide"));
+        if (pt->nvec) {
+            json_t *vs = json_array();
+            for (int k = 0; k < pt->nvec; k++)
+                json_array_append_new(vs, vec3(pt->vec[k]));
+            json_object_set_new(po, "vectors", vs);
+        }
+        json_object_set_new(po, "rot", json_integer(90 * pt->rot));
+        json_object_set_new(po, "instances",
+                            json_integer((json_int_t)pt->counts[0] * pt->counts[1] * pt->counts[2]));
+        json_array_append_new(jp, po);
+    }
+    json_object_set_new(j, "patterns", jp);
+    json_object_set_new(j, "grammar_bytes", json_integer((json_int_t)st->text_len));
+    json_object_set_new(j, "terminal_bytes", json_integer((json_int_t)st->terms.bytes));
+    json_t *jf = json_object();
+    json_object_set_new(jf, "max_error", json_real(o->fidelity.max_error));
+    json_object_set_new(jf, "relative", json_real(o->fidelity.relative));
+    json_object_set_new(jf, "unmatched", json_integer((json_int_t)o->fidelity.unmatched));
+    json_object_set_new(jf, "derived_triangles",
+                        json_integer((json_int_t)o->fidelity.derived_triangles));
+    json_object_set_new(j, "fidelity", jf);
+    json_t *js = json_object();
+    json_object_set_new(js, "import", json_real(w->import_s));
+    for (int s = AG_STAGE_SEGMENT; s < AG_STAGE_EXPORT; s++)
+        json_object_set_new(js, ag_proceduralize_stage_name((ag_stage)s), json_real(o->seconds[s]));
+    /* the export includes writing the files */
+    json_object_set_new(js, "export", json_real(o->seconds[AG_STAGE_EXPORT] + write_s));
+    json_object_set_new(js, "total", json_real(o->total_s + write_s));
+    json_object_set_new(js, "verify", json_real(o->seconds[AG_STAGE_VERIFY]));
+    json_object_set_new(j, "seconds", js);
+    return j;
+}
+
+/* summary.json of `archgram edit`. */
+static json_t *edit_summary(const ag_model_state *st, const ag_edit_outcome *o)
+{
+    json_t *j = ag_edit_op_json_report(&o->report);
+    if (j) {
+        json_object_set_new(j, "op", ag_edit_op_json_to_ex(o->op, o->from));
+        json_object_set_new(j, "tree", ag_model_tree_folder_stats(st->em));
+        json_object_set_new(j, "seconds", json_pack("{s:f,s:f}", "load", o->load_ms / 1e3,
+                                                    "edit", o->edit_ms / 1e3));
+    }
+    return j;
+}
+
+static ag_status save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
+                      const ag_edit_outcome *edit, ag_error *err)
+{
+    ag_folder_ws *w = (ag_folder_ws *)ws;
+    double t0 = now();
+    ag_status s = write_model(w, st, err);
+    double write_s = now() - t0;
+    if (s == AG_OK) {
+        char path[4200];
+        snprintf(path, sizeof path, "%s/summary.json", w->o.out_dir);
+        json_t *j = proc ? proc_summary(w, st, proc, write_s) : edit_summary(st, edit);
+        s = write_json(w, path, j,
+                       proc ? JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10)
+                            : JSON_INDENT(1) | JSON_REAL_PRECISION(12),
+                       err);
+        json_decref(j);
+    }
+    ag_model_state_clear(st);
+    return s;
+}
+
+static void close_ws(ag_workspace *ws)
+{
+    ag_folder_ws *w = (ag_folder_ws *)ws;
+    ag_edit_model_free(w->em);
+    ag_edit_model_free(w->source);
+    w->em = w->source = NULL;
+}
+
+static const ag_workspace_ops folder_ops = {
+    .input_mesh = input_mesh,
+    .open_models = open_models,
+    .save = save,
+    .close = close_ws,
+    .state_flags = AG_MODEL_READ_BACK,
+};
+
+void ag_folder_ws_init(ag_folder_ws *w, const ag_folder_ws_options *o)
+{
+    memset(w, 0, sizeof *w);
+    w->ws.ops = &folder_ops;
+    w->o = *o;
+}

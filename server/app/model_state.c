@@ -1,0 +1,203 @@
+#include "model_state.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../io/grammar_text.h"
+
+void ag_model_state_clear(ag_model_state *s)
+{
+    if (!s)
+        return;
+    free(s->text);
+    ag_terminals_set_clear(&s->terms);
+    ag_mesh_free(s->derived);
+    ag_edit_model_free(s->em);
+    memset(s, 0, sizeof *s);
+}
+
+/* Line and column of "terminal NAME" in the text (1, 1 when it cannot be found). */
+static void find_declaration(const char *text, size_t len, const char *name, long *line,
+                             long *col)
+{
+    *line = 1;
+    *col = 1;
+    size_t nl = strlen(name);
+    long ln = 1;
+    for (size_t i = 0; i < len;) {
+        size_t s = i;
+        while (s < len && (text[s] == ' ' || text[s] == '\t'))
+            s++;
+        if (len - s > 9 + nl && memcmp(text + s, "terminal", 8) == 0 &&
+            (text[s + 8] == ' ' || text[s + 8] == '\t')) {
+            size_t n = s + 8;
+            while (n < len && (text[n] == ' ' || text[n] == '\t'))
+                n++;
+            if (len - n >= nl && memcmp(text + n, name, nl) == 0 &&
+                (n + nl == len || text[n + nl] == ' ' || text[n + nl] == '\t' ||
+                 text[n + nl] == '\r' || text[n + nl] == '\n')) {
+                *line = ln;
+                *col = (long)(s - i) + 1;
+                return;
+            }
+        }
+        while (i < len && text[i] != '\n')
+            i++;
+        i++;
+        ln++;
+    }
+}
+
+/* Parses text, loads every terminal through lookup and derives the mesh. */
+static ag_status derive_text(const char *text, size_t len, ag_terminal_lookup lookup, void *user,
+                             ag_grammar **g, ag_mesh **mesh, ag_error *err, long *col)
+{
+    *g = NULL;
+    *mesh = NULL;
+    if (col)
+        *col = 0;
+    long c = 0;
+    ag_status s = ag_grammar_text_parse(text, len, g, err, &c);
+    if (s != AG_OK) {
+        if (col)
+            *col = c;
+        /* name and resolve errors come with a position too: all are the text's fault */
+        if (s != AG_ERR_NOMEM && err && err->element > 0)
+            err->code = s = AG_ERR_PARSE;
+        return s;
+    }
+    for (size_t i = 0; i < (*g)->nterminals && s == AG_OK; i++) {
+        ag_gterminal *t = &(*g)->terminals[i];
+        char *obj = NULL;
+        size_t olen = 0;
+        ag_error e;
+        ag_error_clear(&e);
+        s = t->path ? lookup(user, t->path, &obj, &olen, &e) : AG_ERR_NOT_FOUND;
+        if (s == AG_ERR_NOT_FOUND) {
+            long line, cc;
+            find_declaration(text, len, t->name, &line, &cc);
+            if (col)
+                *col = cc;
+            s = ag_error_set(err, AG_ERR_PARSE, line,
+                             "terminal '%s' names \"%s\", which is not one of this model's "
+                             "terminals",
+                             t->name, t->path ? t->path : "");
+        } else if (s != AG_OK) {
+            if (err)
+                *err = e;
+        } else {
+            s = ag_terminals_load_buffer(t, obj, olen, err);
+        }
+        free(obj);
+    }
+    ag_grammar_derive_options dopt = {.max_triangles = AG_GRAMMAR_MAX_TRIANGLES};
+    if (s == AG_OK)
+        s = ag_grammar_derive(*g, &dopt, mesh, err);
+    if (s != AG_OK) {
+        ag_grammar_free(*g);
+        *g = NULL;
+    }
+    return s;
+}
+
+/* A copy of m whose components are grouped by the labels of r, named "L<n>" as the grammar
+ * export names them. */
+static ag_status regroup(const ag_proceduralize_result *r, ag_mesh **out, ag_error *err)
+{
+    const ag_mesh *m = r->mesh;
+    const ag_labels *L = r->labels;
+    ag_mesh *o = ag_mesh_create();
+    int32_t *group = L->nlabels ? malloc(L->nlabels * sizeof *group) : NULL;
+    ag_status s = o && (group || !L->nlabels) ? ag_mesh_reserve(o, m->nverts, m->ntris)
+                                              : AG_ERR_NOMEM;
+    for (size_t l = 0; s == AG_OK && l < L->nlabels; l++)
+        group[l] = -1;
+    for (size_t c = 0; s == AG_OK && c < m->ncomponents; c++) {
+        int32_t l = c < L->ncomponents ? L->label[c] : -1;
+        if (l >= 0 && (size_t)l < L->nlabels && group[l] < 0) {
+            char name[32];
+            size_t g;
+            snprintf(name, sizeof name, "L%d", l + 1);
+            if ((s = ag_mesh_add_group(o, name, &g)) == AG_OK)
+                group[l] = (int32_t)g;
+        }
+        if (s == AG_OK)
+            s = ag_mesh_add_component(o, l >= 0 && (size_t)l < L->nlabels ? group[l] : -1, NULL);
+    }
+    for (size_t v = 0; s == AG_OK && v < m->nverts; v++)
+        s = ag_mesh_add_vertex(o, m->pos[3 * v], m->pos[3 * v + 1], m->pos[3 * v + 2]);
+    for (size_t t = 0; s == AG_OK && t < m->ntris; t++)
+        s = ag_mesh_add_triangle(o, m->tri[3 * t], m->tri[3 * t + 1], m->tri[3 * t + 2],
+                                 m->tri_component[t]);
+    free(group);
+    if (s != AG_OK) {
+        ag_mesh_free(o);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory naming the labels");
+    }
+    *out = o;
+    return AG_OK;
+}
+
+ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_state *out,
+                              ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    ag_edit_model *m = *made;
+    ag_grammar *back = NULL;
+    long col = 0;
+    ag_error e;
+    ag_error_clear(&e);
+    ag_status s = ag_terminals_collect(m->proc->grammar, &out->terms, err);
+    if (s == AG_OK)
+        s = ag_grammar_text_print(m->proc->grammar, &out->text, &out->text_len, err);
+    if (s == AG_OK &&
+        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms, &back,
+                         &out->derived, &e, &col)) != AG_OK)
+        s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
+                         "the grammar does not read back (line %ld, column %ld): %s", e.element,
+                         col, e.text);
+    ag_grammar_free(back);
+    if (s == AG_OK && (flags & AG_MODEL_READ_BACK)) {
+        s = ag_model_state_reload(out->derived, &out->em, err);
+    } else if (s == AG_OK) {
+        ag_mesh *named = NULL;
+        if ((s = regroup(m->proc, &named, err)) == AG_OK) {
+            ag_mesh_free(m->proc->mesh);
+            m->proc->mesh = named;
+            out->em = m;
+            *made = NULL;
+        }
+    }
+    if (s != AG_OK)
+        ag_model_state_clear(out);
+    return s;
+}
+
+ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_lookup lookup,
+                                   void *user, ag_model_state *out, ag_error *err, long *col)
+{
+    memset(out, 0, sizeof *out);
+    ag_grammar *g = NULL;
+    ag_status s = derive_text(text, len, lookup, user, &g, &out->derived, err, col);
+    if (s != AG_OK)
+        return s;
+    if (!(out->text = malloc(len + 1)))
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    else {
+        memcpy(out->text, text, len);
+        out->text[len] = '\0';
+        out->text_len = len;
+    }
+    ag_grammar_free(g);
+    if (s == AG_OK)
+        s = ag_model_state_reload(out->derived, &out->em, err);
+    if (s != AG_OK)
+        ag_model_state_clear(out);
+    return s;
+}
+
+ag_status ag_model_state_reload(const ag_mesh *mesh, ag_edit_model **em, ag_error *err)
+{
+    return ag_edit_model_create(mesh, NULL, em, err);
+}

@@ -1,0 +1,61 @@
+/* A proceduralized model as a workspace keeps it: its grammar text, the terminals the text
+ * names (OBJ text by path), the mesh the grammar derives, and the edit model whose split tree
+ * numbers the nodes (app/model_tree.h).
+ *
+ * The edit model's mesh (em->proc->mesh) is the model's mesh: the components in the order the
+ * tree's components name them, in groups named as the grammar names its labels. An edit model
+ * is rebuilt from that mesh alone (ag_model_state_reload gives the same tree, node for node),
+ * so a workspace that keeps the mesh (the store) reloads exactly the model it saved; one that
+ * keeps only the grammar (a folder) reads it back: the grammar derived and proceduralized
+ * anew, which is the edit model AG_MODEL_READ_BACK makes before saving. */
+#ifndef AG_MODEL_STATE_H
+#define AG_MODEL_STATE_H
+
+#include <stddef.h>
+
+#include "../core/edit/edit.h"
+#include "../core/status.h"
+#include "../io/terminals.h"
+
+/* Largest grammar text accepted from outside (PUT …/grammar). */
+#define AG_GRAMMAR_TEXT_MAX ((size_t)8 << 20)
+/* Derivations larger than this are refused (AG_ERR_TOO_LARGE). */
+#define AG_GRAMMAR_MAX_TRIANGLES ((size_t)20000000)
+
+typedef struct {
+    char *text;            /* the grammar, NUL-terminated */
+    size_t text_len;
+    ag_terminal_set terms; /* the terminals the text names (made states) */
+    ag_mesh *derived;      /* what the text derives (with the terminals as kept) */
+    ag_edit_model *em;     /* the edit model; em->proc->mesh is the model's mesh */
+} ag_model_state;
+
+void ag_model_state_clear(ag_model_state *s);
+
+enum { AG_MODEL_READ_BACK = 1 };
+
+/* The state of a model a proceduralization or an edit made: its grammar printed with its
+ * terminals, checked to read back (the text, with the terminals as they will be kept, parses
+ * and derives), and the edit model: with AG_MODEL_READ_BACK the derivation proceduralized
+ * anew (*made stays the caller's), else *made itself, moved into out (*made = NULL), its
+ * mesh's groups renamed to the grammar's label names. */
+ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_state *out,
+                              ag_error *err);
+
+/* OBJ text of the terminal kept under path: AG_OK with *obj malloc'd, AG_ERR_NOT_FOUND when
+ * there is none. */
+typedef ag_status (*ag_terminal_lookup)(void *user, const char *path, char **obj, size_t *len,
+                                        ag_error *err);
+
+/* A grammar text with its terminals from lookup (a grammar text edit): parsed, derived and
+ * proceduralized; out->terms stays empty (the text names terminals the model keeps). Parse errors (syntax, names): AG_ERR_PARSE
+ * with the line in err->element and the column in *col; a terminal path lookup does not know:
+ * AG_ERR_PARSE at the terminal's declaration, naming it; a grammar that derives nothing:
+ * AG_ERR_EMPTY; a derivation larger than AG_GRAMMAR_MAX_TRIANGLES: AG_ERR_TOO_LARGE. */
+ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_lookup lookup,
+                                   void *user, ag_model_state *out, ag_error *err, long *col);
+
+/* The edit model of a kept model mesh (the store's reload). */
+ag_status ag_model_state_reload(const ag_mesh *mesh, ag_edit_model **em, ag_error *err);
+
+#endif

@@ -1,0 +1,363 @@
+#include "model_tree.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+
+static const char *kind_name(int k)
+{
+    switch (k) {
+    case AG_NODE_ROOT:
+        return "root";
+    case AG_NODE_SPLIT:
+        return "split";
+    case AG_NODE_COMPONENT:
+        return "component";
+    case AG_NODE_PATTERN:
+        return "pattern";
+    default:
+        return "dead";
+    }
+}
+
+static json_t *box_json(const ag_box *b)
+{
+    json_t *a = json_array();
+    for (int k = 0; k < 6; k++) {
+        double x = k < 3 ? b->min[k] : b->max[k - 3];
+        json_array_append_new(a, json_real(x == 0 ? 0 : x));
+    }
+    return a;
+}
+
+static json_t *vec_json(const double *v)
+{
+    json_t *a = json_array();
+    for (int k = 0; k < 3; k++)
+        json_array_append_new(a, json_real(v[k] == 0 ? 0 : v[k]));
+    return a;
+}
+
+/* The label of a visible node: its component's group in the model's mesh. */
+static const char *label_of(const ag_proceduralize_result *r, const ag_tnode *x, char fallback[32])
+{
+    const ag_mesh *m = r->mesh;
+    if (x->component >= 0 && (size_t)x->component < m->ncomponents) {
+        int32_t g = m->component_group[x->component];
+        if (g >= 0 && (size_t)g < m->ngroups)
+            return m->group_names[g];
+    }
+    if (x->label < 0)
+        return NULL;
+    snprintf(fallback, 32, "L%d", x->label + 1);
+    return fallback;
+}
+
+/* The grammar rule of a rule class, NULL when the class is inlined. */
+static const char *rule_name(const ag_proceduralize_result *r, int32_t cls)
+{
+    if (cls < 0 || (size_t)cls >= r->tree->nrules || !r->info.rule_of_class)
+        return NULL;
+    int32_t ri = r->info.rule_of_class[cls];
+    return ri >= 0 && (size_t)ri < r->grammar->nrules ? r->grammar->rules[ri].name : NULL;
+}
+
+static const char *terminal_name(const ag_proceduralize_result *r, const ag_tnode *x)
+{
+    if (x->variant < 0 || !r->info.terminal_of_variant ||
+        (size_t)x->variant >= r->labels->nvariants)
+        return NULL;
+    int32_t ti = r->info.terminal_of_variant[x->variant];
+    return ti >= 0 && (size_t)ti < r->grammar->nterminals ? r->grammar->terminals[ti].name : NULL;
+}
+
+static const ag_pattern *pattern_of(const ag_splittree *t, const ag_tnode *x)
+{
+    if (x->kind != AG_NODE_PATTERN || x->pattern < 0 || (size_t)x->pattern >= t->npatterns)
+        return NULL;
+    return &t->patterns[x->pattern];
+}
+
+static json_t *pattern_json(const ag_pattern *p)
+{
+    json_t *o = json_object();
+    /* a lattice has counts per vector; the axes it does not use count 1 */
+    json_t *counts = json_array();
+    for (int k = 0; k < 3; k++)
+        json_array_append_new(counts, json_integer(p->nvec && k >= p->nvec ? 1 : p->counts[k]));
+    json_object_set_new(o, "counts", counts);
+    if (p->nvec) {
+        json_object_set_new(o, "step", json_null());
+        json_t *vs = json_array();
+        for (int k = 0; k < p->nvec; k++)
+            json_array_append_new(vs, vec_json(p->vec[k]));
+        json_object_set_new(o, "vectors", vs);
+    } else {
+        json_object_set_new(o, "step", vec_json(p->step));
+    }
+    if (p->rot)
+        json_object_set_new(o, "rot", json_integer(90 * p->rot));
+    return o;
+}
+
+static json_t *children_json(const ag_splittree *t, const ag_tnode *x)
+{
+    json_t *ch = json_array();
+    for (int32_t c = x->first_child; c >= 0; c = t->nodes[c].next_sibling)
+        json_array_append_new(ch, json_integer(c));
+    return ch;
+}
+
+json_t *ag_model_tree_served(const ag_edit_model *em)
+{
+    const ag_proceduralize_result *r = em->proc;
+    const ag_splittree *t = r->tree;
+    json_t *root = json_object(), *nodes = json_array(), *labels = json_array();
+    json_t *index = json_object(); /* label → position in labels */
+    size_t *apps = calloc(t->nrules + 1, sizeof *apps);
+    if (!root || !nodes || !labels || !index || !apps)
+        goto fail;
+    size_t visible = 0, live = 0;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        json_t *o = json_object();
+        if (!o)
+            goto fail;
+        json_array_append_new(nodes, o);
+        int dead = x->kind == AG_NODE_DEAD;
+        live += !dead;
+        json_object_set_new(o, "id", json_integer((json_int_t)n));
+        json_object_set_new(o, "parent",
+                            !dead && x->parent >= 0 ? json_integer(x->parent) : json_null());
+        json_object_set_new(o, "children", dead ? json_array() : children_json(t, x));
+        json_object_set_new(o, "kind", json_string(kind_name(x->kind)));
+        json_object_set_new(o, "box", box_json(&x->box));
+        json_object_set_new(o, "visible", json_boolean(x->kind == AG_NODE_COMPONENT));
+        const ag_pattern *p = dead ? NULL : pattern_of(t, x);
+        char fallback[32];
+        const char *label = x->kind == AG_NODE_COMPONENT ? label_of(r, x, fallback) : NULL;
+        int32_t cls = dead ? -1 : p ? p->rule : x->rule;
+        const char *rule = rule_name(r, cls);
+        if (rule && !p && cls >= 0)
+            apps[cls]++;
+        json_object_set_new(o, "label", label ? json_string(label) : json_null());
+        json_object_set_new(o, "rule", rule ? json_string(rule) : json_null());
+        const char *term = x->kind == AG_NODE_COMPONENT ? terminal_name(r, x) : NULL;
+        json_object_set_new(o, "terminal", term ? json_string(term) : json_null());
+        json_object_set_new(o, "component", x->kind == AG_NODE_COMPONENT && x->component >= 0
+                                                ? json_integer(x->component)
+                                                : json_null());
+        json_object_set_new(o, "pattern", p ? pattern_json(p) : json_null());
+        if (x->kind == AG_NODE_COMPONENT && x->component >= 0)
+            visible++;
+        if (x->kind != AG_NODE_COMPONENT || !label)
+            continue;
+        json_t *at = json_object_get(index, label);
+        if (at) {
+            json_t *l = json_array_get(labels, (size_t)json_integer_value(at));
+            json_object_set_new(l, "count",
+                                json_integer(json_integer_value(json_object_get(l, "count")) + 1));
+            continue;
+        }
+        char color[8];
+        ag_model_tree_label_color(label, color);
+        json_object_set_new(index, label, json_integer((json_int_t)json_array_size(labels)));
+        json_array_append_new(labels, json_pack("{s:s, s:i, s:s}", "label", label, "count", 1,
+                                                "color", color));
+    }
+    json_t *rules = json_array();
+    for (size_t ri = 0; rules && ri < r->grammar->nrules; ri++) {
+        size_t n = 0;
+        for (size_t c = 0; c < t->nrules; c++)
+            if (r->info.rule_of_class && r->info.rule_of_class[c] == (int32_t)ri)
+                n += apps[c];
+        json_array_append_new(rules, json_pack("{s:s, s:I}", "name", r->grammar->rules[ri].name,
+                                               "instances", (json_int_t)n));
+    }
+    ag_splittree_stats st = ag_splittree_stats_of(t);
+    json_object_set_new(root, "root", json_integer(0));
+    json_object_set_new(root, "nodes", nodes);
+    json_object_set_new(root, "labels", labels);
+    json_object_set_new(root, "rules", rules);
+    json_object_set_new(root, "stats",
+                        json_pack("{s:I, s:I, s:I, s:I, s:I, s:I}", "nodes", (json_int_t)live,
+                                  "visible", (json_int_t)st.visible, "invisible",
+                                  (json_int_t)(live - st.visible), "depth", (json_int_t)st.depth,
+                                  "components", (json_int_t)visible, "patterns",
+                                  (json_int_t)t->npatterns));
+    json_decref(index);
+    free(apps);
+    return root;
+fail:
+    json_decref(root);
+    json_decref(nodes);
+    json_decref(labels);
+    json_decref(index);
+    free(apps);
+    return NULL;
+}
+
+char *ag_model_tree_served_text(const ag_edit_model *em)
+{
+    json_t *j = ag_model_tree_served(em);
+    char *text = j ? json_dumps(j, JSON_COMPACT | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(12))
+                   : NULL;
+    json_decref(j);
+    return text;
+}
+
+json_t *ag_model_tree_folder_stats(const ag_edit_model *em)
+{
+    const ag_splittree *t = em->proc->tree;
+    ag_splittree_stats st = ag_splittree_stats_of(t);
+    return json_pack("{s:I,s:I,s:I,s:I,s:I,s:I}", "nodes", (json_int_t)st.nodes, "visible",
+                     (json_int_t)st.visible, "invisible", (json_int_t)st.invisible, "depth",
+                     (json_int_t)st.depth, "patterns", (json_int_t)t->npatterns, "rules",
+                     (json_int_t)t->nrules);
+}
+
+json_t *ag_model_tree_folder(const ag_edit_model *em)
+{
+    const ag_proceduralize_result *r = em->proc;
+    const ag_splittree *t = r->tree;
+    json_t *o = json_object(), *nodes = json_array();
+    if (!o || !nodes)
+        goto fail;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        if (x->kind == AG_NODE_DEAD)
+            continue;
+        json_t *j = json_object();
+        if (!j)
+            goto fail;
+        json_array_append_new(nodes, j);
+        json_object_set_new(j, "id", json_integer((json_int_t)n));
+        json_object_set_new(j, "parent", x->parent >= 0 ? json_integer(x->parent) : json_null());
+        json_object_set_new(j, "kind", json_string(kind_name(x->kind)));
+        json_object_set_new(j, "box", box_json(&x->box));
+        json_object_set_new(j, "children", children_json(t, x));
+        if (x->kind == AG_NODE_COMPONENT) {
+            char fallback[32];
+            const char *label = label_of(r, x, fallback);
+            json_object_set_new(j, "label", label ? json_string(label) : json_null());
+            json_object_set_new(j, "component", json_integer(x->component));
+            json_object_set_new(j, "rule", x->rule >= 0 ? json_integer(x->rule) : json_null());
+        }
+        const ag_pattern *p = pattern_of(t, x);
+        if (p)
+            json_object_set_new(j, "counts", json_pack("[I,I,I]", (json_int_t)p->counts[0],
+                                                       (json_int_t)p->counts[1],
+                                                       (json_int_t)p->counts[2]));
+    }
+    json_object_set_new(o, "root", json_integer(0));
+    json_object_set_new(o, "nodes", nodes);
+    json_object_set_new(o, "stats", ag_model_tree_folder_stats(em));
+    return o;
+fail:
+    json_decref(o);
+    json_decref(nodes);
+    return NULL;
+}
+
+ag_status ag_model_tree_check_node(const ag_edit_model *em, int32_t id, const char *field,
+                                   ag_error *err)
+{
+    const ag_splittree *t = em->proc->tree;
+    if (id < 0 || (size_t)id >= t->nnodes)
+        return ag_error_set(err, AG_ERR_NOT_FOUND, id,
+                            "%s: node %d is not in the model's split tree (nodes 0..%zu)", field,
+                            (int)id, t->nnodes ? t->nnodes - 1 : 0);
+    if (t->nodes[id].kind == AG_NODE_DEAD)
+        return ag_error_set(err, AG_ERR_NOT_FOUND, id,
+                            "%s: node %d of the split tree cannot be edited (proceduralization "
+                            "removed it when it found a pattern)",
+                            field, (int)id);
+    return AG_OK;
+}
+
+void ag_model_tree_label_color(const char *label, char out[8])
+{
+    unsigned long idx;
+    char *end;
+    if (label[0] == 'L' && label[1] >= '1' && label[1] <= '9' &&
+        (idx = strtoul(label + 1, &end, 10), *end == '\0')) {
+        idx -= 1;
+    } else {
+        uint32_t h = 2166136261u;
+        for (const char *p = label; *p; p++)
+            h = (h ^ (unsigned char)*p) * 16777619u;
+        idx = h % 9973;
+    }
+    /* golden-ratio hue steps keep neighbouring labels apart */
+    double hue = fmod((double)idx * 0.618033988749895, 1.0), x = hue * 6;
+    int i = (int)x;
+    double f = x - i, v = 0.85, s = 0.55;
+    double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f)), r, g, b;
+    switch (i % 6) {
+    case 0: r = v, g = t, b = p; break;
+    case 1: r = q, g = v, b = p; break;
+    case 2: r = p, g = v, b = t; break;
+    case 3: r = p, g = q, b = v; break;
+    case 4: r = t, g = p, b = v; break;
+    default: r = v, g = p, b = q; break;
+    }
+    snprintf(out, 8, "#%02x%02x%02x", (unsigned)lround(r * 255), (unsigned)lround(g * 255),
+             (unsigned)lround(b * 255));
+}
+
+ag_status ag_model_tree_component_meta(const char *json, size_t ncomponents,
+                                       ag_glb_component_meta **meta, char **labels,
+                                       ag_error *err)
+{
+    *meta = NULL;
+    *labels = NULL;
+    json_error_t je;
+    json_t *tree = json_loads(json, 0, &je);
+    json_t *nodes = json_object_get(tree, "nodes");
+    if (!json_is_array(nodes)) {
+        json_decref(tree);
+        return ag_error_set(err, AG_ERR_PARSE, 0, "the stored split tree is not valid: %s",
+                            tree ? "no nodes" : je.text);
+    }
+    /* first pass: room for the label strings */
+    size_t bytes = 1, i;
+    json_t *n;
+    json_array_foreach(nodes, i, n) {
+        const char *l = json_string_value(json_object_get(n, "label"));
+        if (l && json_is_integer(json_object_get(n, "component")))
+            bytes += strlen(l) + 1;
+    }
+    ag_glb_component_meta *m = malloc((ncomponents + 1) * sizeof *m);
+    char *block = malloc(bytes), *at = block;
+    if (!m || !block) {
+        free(m);
+        free(block);
+        json_decref(tree);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t c = 0; c < ncomponents; c++)
+        m[c] = (ag_glb_component_meta){NULL, -1};
+    json_array_foreach(nodes, i, n) {
+        json_t *comp = json_object_get(n, "component");
+        if (!json_is_integer(comp))
+            continue;
+        json_int_t c = json_integer_value(comp);
+        if (c < 0 || (size_t)c >= ncomponents)
+            continue;
+        m[c].node = json_integer_value(json_object_get(n, "id"));
+        const char *l = json_string_value(json_object_get(n, "label"));
+        if (l) {
+            size_t len = strlen(l) + 1;
+            memcpy(at, l, len);
+            m[c].label = at;
+            at += len;
+        }
+    }
+    json_decref(tree);
+    *meta = m;
+    *labels = block;
+    return AG_OK;
+}

@@ -1,0 +1,51 @@
+#include "optable.h"
+
+#include <string.h>
+
+#include "edit_ops.h"
+#include "modelops.h"
+#include "plan_edit.h"
+
+#define EDIT (AG_OP_CLIENT | AG_OP_UNDOABLE | AG_OP_GEOMETRY)
+
+const ag_op_kind ag_optable[] = {
+    /* kind         validate                       effect                      run                      flags                         lane              made_by */
+    {"rename",      ag__modelops_rename_validate,  ag__modelops_rename_effect, NULL,                    AG_OP_CLIENT,                 AG_OP_FAST,       NULL},
+    {"note",        ag__modelops_note_validate,    NULL,                       NULL,                    AG_OP_CLIENT,                 AG_OP_FAST,       NULL},
+    {"resize",      ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL},
+    {"split",       ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL},
+    {"join",        ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL},
+    {"paste",       ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL},
+    {"remove",      ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL},
+    /* undo and redo are logged as the restore they become */
+    {"undo",        ag_edit_ops_validate_history,  NULL,                       ag_edit_ops_run_restore, AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL},
+    {"redo",        ag_edit_ops_validate_history,  NULL,                       ag_edit_ops_run_restore, AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL},
+    /* an undo step unless it carries "undoes"/"redoes" (an undo or redo logged) */
+    {"restore",     ag_edit_ops_validate_restore,  NULL,                       ag_edit_ops_run_restore, EDIT,                         AG_OP_STRUCTURAL, NULL},
+    {"plan",        ag_plan_edit_validate,         ag_plan_edit_apply,         NULL,                    AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL},
+    {"profile",     ag_plan_edit_validate,         ag_plan_edit_apply,         NULL,                    AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL},
+    {"proceduralize", NULL,                        NULL,                       NULL,                    AG_OP_GEOMETRY,               AG_OP_STRUCTURAL, "POST /api/v1/models/{id}/proceduralize"},
+    {"grammar",     NULL,                          NULL,                       NULL,                    AG_OP_UNDOABLE | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, "PUT /api/v1/models/{id}/grammar"},
+};
+const size_t ag_optable_count = sizeof ag_optable / sizeof ag_optable[0];
+
+const ag_op_kind *ag_optable_find(const char *kind)
+{
+    for (size_t i = 0; kind && i < ag_optable_count; i++)
+        if (strcmp(ag_optable[i].kind, kind) == 0)
+            return &ag_optable[i];
+    return NULL;
+}
+
+ag_status ag_optable_lookup(const json_t *op, const ag_op_kind **row, ag_error *err)
+{
+    *row = NULL;
+    if (!json_is_object(op))
+        return ag_error_set(err, AG_ERR_INVALID, 0, "an op must be a JSON object");
+    const char *kind = json_string_value(json_object_get(op, "kind"));
+    if (!kind)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "an op needs a string \"kind\"");
+    if (!(*row = ag_optable_find(kind)))
+        return ag_error_set(err, AG_ERR_INVALID, 0, "unknown op kind \"%s\"", kind);
+    return AG_OK;
+}

@@ -1,0 +1,59 @@
+/* The store as a workspace (app/workspace.h): one model of the SQLite store, changed by one
+ * op made on a known version by one author. Its saves are server ops (app/sequencer.h): the
+ * model's mesh, grammar, split tree, summary and terminals are written with the version the
+ * op raises, the op is logged and announced, in one transaction; a job doing the work records
+ * its success in the same transaction after a last cancellation check. The saved edit model
+ * is kept in the environment's edit sessions for the next edit. Imports and extrusions add
+ * a new model. */
+#ifndef AG_STORE_WS_H
+#define AG_STORE_WS_H
+
+#include <jansson.h>
+#include <stdint.h>
+
+#include "jobqueue.h"
+#include "store_env.h"
+#include "workspace.h"
+
+typedef struct {
+    ag_store_env env;
+    int64_t model;      /* 0 for an import */
+    int64_t base;       /* the version the change is made on */
+    const char *author;
+    const char *cid;
+    uint64_t origin;    /* the live session the op came from, 0 = none */
+    const json_t *op;   /* an edit: the client's op, logged with the edit's report */
+    ag_jobctx *job;     /* the job doing the work (progress, cancellation, its outcome), or NULL */
+    int64_t job_id;
+} ag_store_ws_options;
+
+typedef struct {
+    ag_workspace ws;
+    ag_store_ws_options o;
+    ag_edit_state *target, *source; /* borrowed edit sessions */
+    int64_t version;                /* what the save got (or the duplicate's version) */
+    int duplicate;                  /* the cid was used before: nothing was applied */
+} ag_store_ws;
+
+void ag_store_ws_init(ag_store_ws *w, const ag_store_ws_options *o);
+/* Gives the sessions back; after a failure that is not the op's or the model's fault the
+ * target's kept model is dropped (it is loaded afresh next time). */
+void ag_store_ws_end(ag_store_ws *w, ag_status outcome);
+
+/* Stores a mesh as a new model inside the caller's transaction (imports, the demo content);
+ * source may be NULL. */
+ag_status ag_store_ws_insert_model(ag_db *db, const char *name, const ag_mesh *mesh,
+                                   const void *source, size_t source_len,
+                                   const char *source_format, int64_t *model, ag_error *err);
+
+/* For the store's other writers of model states (a grammar text edit): writes st's mesh (its
+ * edit model's mesh, with its stats), grammar text, served tree and summary for `version`
+ * inside the caller's transaction. */
+ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
+                                 const ag_model_state *st, const char *summary_json,
+                                 ag_error *err);
+/* Keeps st's edit model (taken) as the model's edit session at version. */
+void ag__store_ws_keep_model(ag_edit_sessions *reg, int64_t model, int64_t version,
+                             ag_model_state *st);
+
+#endif

@@ -1,0 +1,73 @@
+#include "workspace.h"
+
+static ag_status unsupported(const char *what, ag_error *err)
+{
+    return ag_error_set(err, AG_ERR_UNSUPPORTED, 0, "this workspace cannot %s", what);
+}
+
+ag_status ag_workspace_add_model(ag_workspace *ws, const char *name, const ag_mesh *mesh,
+                                 const void *source, size_t source_len, const char *source_format,
+                                 int64_t *model, ag_error *err)
+{
+    *model = 0;
+    return ws->ops->add_model
+               ? ws->ops->add_model(ws, name, mesh, source, source_len, source_format, model, err)
+               : unsupported("store a new model", err);
+}
+
+ag_status ag_workspace_add_extrusion(ag_workspace *ws, const char *name,
+                                    const struct ag_extrude_batch *batch, const ag_mesh *mesh,
+                                    const char *source, size_t source_len, const json_t *report,
+                                    int64_t *model, ag_error *err)
+{
+    *model = 0;
+    return ws->ops->add_extrusion ? ws->ops->add_extrusion(ws, name, batch, mesh, source,
+                                                           source_len, report, model, err)
+                                  : unsupported("store an extrusion", err);
+}
+
+ag_status ag_workspace_input_mesh(ag_workspace *ws, ag_mesh **mesh, ag_error *err)
+{
+    *mesh = NULL;
+    return ws->ops->input_mesh ? ws->ops->input_mesh(ws, mesh, err)
+                               : unsupported("give a mesh to proceduralize", err);
+}
+
+ag_status ag_workspace_open_models(ag_workspace *ws, const ag_edit_op_origin *from,
+                                   ag_edit_model **em, const ag_edit_model **source,
+                                   int64_t *source_version, ag_error *err)
+{
+    *em = NULL;
+    *source = NULL;
+    *source_version = 0;
+    return ws->ops->open_models ? ws->ops->open_models(ws, from, em, source, source_version, err)
+                                : unsupported("open a model to edit", err);
+}
+
+ag_status ag_workspace_save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
+                            const ag_edit_outcome *edit, ag_error *err)
+{
+    if (!ws->ops->save) {
+        ag_model_state_clear(st);
+        return unsupported("save a model", err);
+    }
+    return ws->ops->save(ws, st, proc, edit, err);
+}
+
+int ag_workspace_cancelled(ag_workspace *ws)
+{
+    return ws->ops->cancelled ? ws->ops->cancelled(ws) : 0;
+}
+
+int ag_workspace_progress(ag_workspace *ws, double fraction, const char *stage)
+{
+    if (ws->ops->progress)
+        ws->ops->progress(ws, fraction, stage);
+    return ag_workspace_cancelled(ws);
+}
+
+void ag_workspace_close(ag_workspace *ws)
+{
+    if (ws && ws->ops->close)
+        ws->ops->close(ws);
+}

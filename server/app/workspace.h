@@ -1,0 +1,102 @@
+/* A workspace: where the use cases (app/usecase_*.h) read a model and save what they made.
+ * Two kinds, one interface, so the CLI and the service run the same pipeline:
+ *
+ *   the store (app/store_ws.h)    one model of the SQLite store, changed by one op at a known
+ *                                 version; saves are server ops (sequenced, logged, announced)
+ *                                 and keep the model's mesh, so a reload is exact
+ *   a folder (app/folder_ws.h)    `archgram`'s --out DIR layout: grammar.txt, terminals/,
+ *                                 tree.json, summary.json; it keeps only the grammar, so its
+ *                                 models are read back (grammar derived and proceduralized)
+ *
+ * A workspace that cannot do something answers AG_ERR_UNSUPPORTED. Segmenting point clouds
+ * and composing parts will be use cases over the same interface. */
+#ifndef AG_WORKSPACE_H
+#define AG_WORKSPACE_H
+
+#include <jansson.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../core/edit/edit.h"
+#include "../core/status.h"
+#include "../io/edit_op_json.h"
+#include "model_state.h"
+
+typedef struct ag_workspace ag_workspace;
+struct ag_extrude_batch;
+
+/* What a proceduralization found and how long it took, for the saved summary. */
+typedef struct {
+    const ag_mesh *input;                 /* the mesh proceduralized */
+    const ag_proceduralize_result *proc;  /* its result (labels, tree, patterns, grammar) */
+    ag_fidelity fidelity;                 /* the saved grammar's derivation against the input */
+    double seconds[AG_STAGE_COUNT];       /* per stage; AG_STAGE_EXPORT includes printing */
+    double total_s;                       /* everything up to the save, verify excluded */
+} ag_proc_outcome;
+
+/* What an edit did, for the saved summary and the log. */
+typedef struct {
+    const ag_edit_op *op;
+    const ag_edit_op_origin *from;
+    ag_edit_report report;  /* instances per label counted on the saved model */
+    double load_ms, edit_ms;
+    int64_t source_version; /* a paste from another model of the store: its version */
+} ag_edit_outcome;
+
+typedef struct {
+    /* Stores a mesh as a new model (an import); source (the file as it came, may be NULL) and
+     * its format are kept with it. *model gets its id. */
+    ag_status (*add_model)(ag_workspace *ws, const char *name, const ag_mesh *mesh,
+                           const void *source, size_t source_len, const char *source_format,
+                           int64_t *model, ag_error *err);
+    /* Stores an extruded batch (app/usecase_extrude.h) as a new model of kind "extrusion":
+     * its mesh, each building's description, mesh and outcome, the input as its source, and
+     * the report (for a job's result). */
+    ag_status (*add_extrusion)(ag_workspace *ws, const char *name,
+                               const struct ag_extrude_batch *batch, const ag_mesh *mesh,
+                               const char *source, size_t source_len, const json_t *report,
+                               int64_t *model, ag_error *err);
+    /* The mesh to proceduralize. */
+    ag_status (*input_mesh)(ag_workspace *ws, ag_mesh **mesh, ag_error *err);
+    /* The model to edit and, for a paste from elsewhere (from), its source; both are the
+     * workspace's until close. *source_version: the source's version in the store, else 0. */
+    ag_status (*open_models)(ag_workspace *ws, const ag_edit_op_origin *from, ag_edit_model **em,
+                             const ag_edit_model **source, int64_t *source_version,
+                             ag_error *err);
+    /* Saves a proceduralized or edited model (st is the workspace's afterwards: taken and
+     * cleared); exactly one of proc and edit is given. */
+    ag_status (*save)(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
+                      const ag_edit_outcome *edit, ag_error *err);
+    /* Non-zero when the work should stop (a cancelled job). May be NULL. */
+    int (*cancelled)(ag_workspace *ws);
+    /* Progress of long work (0..1, stage name); may be NULL. */
+    void (*progress)(ag_workspace *ws, double fraction, const char *stage);
+    void (*close)(ag_workspace *ws);
+    /* AG_MODEL_READ_BACK when the workspace keeps only the grammar, else 0. */
+    unsigned state_flags;
+} ag_workspace_ops;
+
+struct ag_workspace {
+    const ag_workspace_ops *ops;
+};
+
+/* Dispatch, answering AG_ERR_UNSUPPORTED where the workspace has no such operation. */
+ag_status ag_workspace_add_model(ag_workspace *ws, const char *name, const ag_mesh *mesh,
+                                 const void *source, size_t source_len, const char *source_format,
+                                 int64_t *model, ag_error *err);
+ag_status ag_workspace_add_extrusion(ag_workspace *ws, const char *name,
+                                    const struct ag_extrude_batch *batch, const ag_mesh *mesh,
+                                    const char *source, size_t source_len, const json_t *report,
+                                    int64_t *model, ag_error *err);
+ag_status ag_workspace_input_mesh(ag_workspace *ws, ag_mesh **mesh, ag_error *err);
+ag_status ag_workspace_open_models(ag_workspace *ws, const ag_edit_op_origin *from,
+                                   ag_edit_model **em, const ag_edit_model **source,
+                                   int64_t *source_version, ag_error *err);
+ag_status ag_workspace_save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
+                            const ag_edit_outcome *edit, ag_error *err);
+int ag_workspace_cancelled(ag_workspace *ws);
+/* Reports progress; returns ag_workspace_cancelled. */
+int ag_workspace_progress(ag_workspace *ws, double fraction, const char *stage);
+void ag_workspace_close(ag_workspace *ws);
+
+#endif

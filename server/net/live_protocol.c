@@ -1,0 +1,376 @@
+#include "live_protocol.h"
+
+#include <jansson.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "../app/app_change.h"
+#include "../app/app_query.h"
+#include "../app/optable.h"
+#include "../app/problem.h"
+
+#define AG_LIVE_MAX_PRESENCE (16u << 10)
+#define AG_LIVE_WELCOME_OPS 5000
+/* Live drag previews solved per connection per second at most; extra ones wait, the newest
+ * replacing the one waiting. */
+#define AG_LIVE_PREVIEW_HZ 30
+
+static double mono_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* --- hello, presence, watch ----------------------------------------------------------------- */
+
+static void on_hello(ag_live *live, ag_live_session *s, json_t *msg)
+{
+    json_t *jmodel = json_object_get(msg, "model");
+    json_t *jsince = json_object_get(msg, "since");
+    json_t *juser = json_object_get(msg, "user");
+    ag_error err;
+    if (!json_is_integer(jmodel) || json_integer_value(jmodel) < 1)
+        return ag_live_rooms_send_error(s, AG_ERR_INVALID, "hello needs \"model\", a model id%s",
+                                        "");
+    if (jsince && !json_is_null(jsince) &&
+        (!json_is_integer(jsince) || json_integer_value(jsince) < 0))
+        return ag_live_rooms_send_error(s, AG_ERR_INVALID,
+                                        "\"since\" must be a version (0 or more)%s", "");
+    const char *user = juser ? json_string_value(juser) : "guest";
+    if (!user)
+        return ag_live_rooms_send_error(s, AG_ERR_INVALID, "\"user\" must be a string%s", "");
+    ag_status st = ag_app_check_name(user, &err);
+    if (st != AG_OK)
+        return ag_live_rooms_send_problem(s, st, &err);
+
+    ag_app *app = ag__live_app(live);
+    int64_t model = json_integer_value(jmodel), version;
+    if ((st = ag_app_query_version(app, model, &version, &err)) != AG_OK)
+        return ag_live_rooms_send_problem(s, st, &err);
+    json_t *ops = NULL;
+    int more = 0;
+    if (jsince && json_is_integer(jsince)) {
+        int64_t since = json_integer_value(jsince), v2;
+        if (since > version) {
+            char detail[128];
+            snprintf(detail, sizeof detail, "%lld", (long long)version);
+            return ag_live_rooms_send_error(
+                s, AG_ERR_INVALID, "\"since\" is ahead of the model, which is at version %s",
+                detail);
+        }
+        if ((st = ag_app_query_ops(app, model, since, AG_LIVE_WELCOME_OPS, &ops, &v2, &err)) !=
+            AG_OK)
+            return ag_live_rooms_send_problem(s, st, &err);
+        more = version - since > AG_LIVE_WELCOME_OPS;
+    }
+    if (!ops)
+        ops = json_array();
+    json_t *peers = ag_live_rooms_join(ag__live_rooms(live), s, model, version, user);
+    char you[32];
+    ag_live_rooms_peer_name(s, you, sizeof you);
+    ag_live_rooms_send_json(s, json_pack("{s:s, s:I, s:I, s:s, s:o, s:b, s:o}", "type",
+                                         "welcome", "model", (json_int_t)model, "version",
+                                         (json_int_t)version, "you", you, "ops", ops, "more",
+                                         more, "peers", peers));
+}
+
+static void on_presence(ag_live *live, ag_live_session *s, json_t *msg)
+{
+    if (!s->model)
+        return ag_live_rooms_send_error(s, AG_ERR_INVALID, "send hello before presence%s", "");
+    json_t *state = json_object_get(msg, "state");
+    if (!json_is_object(state))
+        return ag_live_rooms_send_error(s, AG_ERR_INVALID, "presence needs a \"state\" object%s",
+                                        "");
+    char *text = json_dumps(state, JSON_COMPACT);
+    if (!text)
+        return;
+    if (strlen(text) > AG_LIVE_MAX_PRESENCE) {
+        free(text);
+        return ag_live_rooms_send_error(s, AG_ERR_TOO_LARGE,
+                                        "a presence state holds at most 16 KiB%s", "");
+    }
+    ag_live_rooms_presence(ag__live_rooms(live), s, text, state);
+}
+
+static void on_watch(ag_live *live, ag_live_session *s, json_t *msg)
+{
+    json_t *jjob = json_object_get(msg, "job");
+    if (!json_is_integer(jjob) || json_integer_value(jjob) < 1)
+        return ag_live_rooms_send_error(s, AG_ERR_INVALID, "watch needs \"job\", a job id%s", "");
+    ag_error err;
+    json_t *view = NULL;
+    int done = 0;
+    int64_t id = json_integer_value(jjob);
+    ag_status st = ag_app_query_job(ag__live_app(live), id, &view, &done, &err);
+    if (st == AG_OK && !done)
+        st = ag_live_rooms_watch(s, id, json_number_value(json_object_get(view, "progress")),
+                                 &err);
+    if (st != AG_OK) {
+        json_decref(view);
+        return ag_live_rooms_send_problem(s, st, &err);
+    }
+    ag_live_rooms_send_json(s, ag_live_rooms_job_message(view));
+    json_decref(view);
+}
+
+/* --- ops ----------------------------------------------------------------------------------- */
+
+/* The ack or nack of an op (any thread). */
+static json_t *op_reply(ag_app *app, int64_t model, const char *user, uint64_t origin,
+                        json_t *msg)
+{
+    json_t *jcid = json_object_get(msg, "cid");
+    const char *cid = json_string_value(jcid);
+    json_t *jbase = json_object_get(msg, "base");
+    ag_error err;
+    ag_error_clear(&err);
+    ag_status st = AG_OK;
+    if (!cid)
+        st = ag_error_set(&err, AG_ERR_INVALID, 0, "an op needs a string \"cid\"");
+    else if (!json_is_integer(jbase))
+        st = ag_error_set(&err, AG_ERR_INVALID, 0,
+                          "an op needs \"base\", the version it was made on");
+    int64_t version = 0;
+    int dup = 0;
+    if (st == AG_OK) {
+        ag_op_request rq = {.model = model,
+                            .base = json_integer_value(jbase),
+                            .author = user,
+                            .cid = cid,
+                            .op = json_object_get(msg, "op"),
+                            .origin = origin};
+        st = ag_app_change_op(app, &rq, &version, &dup, &err);
+    }
+    if (st == AG_OK)
+        return json_pack("{s:s, s:s, s:I, s:b}", "type", "ack", "cid", cid, "version",
+                         (json_int_t)version, "duplicate", dup);
+    int64_t current = 0;
+    if (st == AG_ERR_STALE) {
+        current = err.element;
+        err.element = 0;
+    } else if (ag_app_query_version(app, model, &current, NULL) != AG_OK) {
+        current = 0;
+    }
+    return json_pack("{s:s, s:o, s:I, s:o}", "type", "nack", "cid",
+                     cid ? json_string(cid) : json_null(), "version", (json_int_t)current,
+                     "problem", ag_problem_json(st, &err));
+}
+
+/* Solves a drag preview (any thread): the message for the whole room (the author too: the
+ * server's solve is what everyone sees), or with *to_room = 0 a problem for the author only.
+ * Nothing is stored. */
+static json_t *preview_message(ag_app *app, int64_t model, const char *user, const char *peer,
+                               json_t *msg, int *to_room)
+{
+    *to_room = 0;
+    json_t *jbase = json_object_get(msg, "base");
+    ag_error err;
+    ag_error_clear(&err);
+    json_t *boxes = NULL;
+    double solve_ms = 0;
+    ag_status st = json_is_integer(jbase)
+                       ? ag_app_change_preview(app, model, json_integer_value(jbase),
+                                               json_object_get(msg, "op"), &boxes, &solve_ms,
+                                               &err)
+                       : ag_error_set(&err, AG_ERR_INVALID, 0,
+                                      "a preview needs \"base\", the version it was made on");
+    if (st != AG_OK) {
+        int64_t current = st == AG_ERR_STALE ? err.element : 0;
+        if (st == AG_ERR_STALE)
+            err.element = 0;
+        return json_pack("{s:s, s:O?, s:I, s:o}", "type", "preview.error", "base", jbase,
+                         "version", (json_int_t)current, "problem", ag_problem_json(st, &err));
+    }
+    *to_room = 1;
+    return json_pack("{s:s, s:s, s:s, s:O, s:o, s:f}", "type", "preview", "peer", peer, "author",
+                     user, "base", jbase, "boxes", boxes, "solve_ms", solve_ms);
+}
+
+/* A structural op or a preview, computed on the job queue's fast lane. */
+typedef struct {
+    ag_live *live;
+    uint64_t session;
+    int64_t model;
+    char *user, *peer;
+    json_t *msg;
+    int preview;
+} task;
+
+static void task_free(void *user)
+{
+    task *t = user;
+    json_decref(t->msg);
+    free(t->user);
+    free(t->peer);
+    free(t);
+}
+
+static void task_run(void *user)
+{
+    task *t = user;
+    ag_app *app = ag__live_app(t->live);
+    int to_room = 0;
+    json_t *reply = t->preview ? preview_message(app, t->model, t->user, t->peer, t->msg, &to_room)
+                               : op_reply(app, t->model, t->user, t->session, t->msg);
+    char *text = reply ? json_dumps(reply, JSON_COMPACT) : NULL;
+    json_decref(reply);
+    if (text && to_room)
+        ag__live_post_to_room(t->live, t->model, text);
+    else if (text)
+        ag__live_post_to_session(t->live, t->session, text);
+    free(text);
+    task_free(t);
+}
+
+static void run_on_fast_lane(ag_live *live, ag_live_session *s, json_t *msg, int preview)
+{
+    task *t = calloc(1, sizeof *t);
+    char peer[32];
+    ag_live_rooms_peer_name(s, peer, sizeof peer);
+    if (t && (!(t->user = strdup(s->user)) || !(t->peer = strdup(peer)))) {
+        free(t->user);
+        free(t);
+        t = NULL;
+    }
+    if (!t)
+        return ag_live_rooms_send_error(s, AG_ERR_NOMEM, "out of memory%s", "");
+    t->live = live;
+    t->session = s->id;
+    t->model = s->model;
+    t->msg = json_incref(msg);
+    t->preview = preview;
+    ag_error err;
+    ag_status st = ag_app_run_fast(ag__live_app(live), task_run, task_free, t, &err);
+    if (st == AG_OK)
+        return;
+    task_free(t);
+    if (preview)
+        return; /* a preview is only worth its newest position: drop it */
+    if (st == AG_ERR_BUSY)
+        ag_error_set(&err, AG_ERR_BUSY, 0, "too many edits are waiting; send it again later");
+    ag_live_rooms_send_json(s, json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid",
+                                         json_object_get(msg, "cid"), "version", (json_int_t)0,
+                                         "problem", ag_problem_json(st, &err)));
+}
+
+static void on_op(ag_live *live, ag_live_session *s, json_t *msg)
+{
+    if (!s->model)
+        return ag_live_rooms_send_error(s, AG_ERR_INVALID, "send hello before ops%s", "");
+    const ag_op_kind *row =
+        ag_optable_find(json_string_value(json_object_get(json_object_get(msg, "op"), "kind")));
+    /* structural kinds a client may send go to the fast lane; the rest (and every refusal
+     * that needs no model) is answered here */
+    if (row && row->lane == AG_OP_STRUCTURAL && (row->flags & AG_OP_CLIENT) &&
+        json_is_string(json_object_get(msg, "cid")))
+        return run_on_fast_lane(live, s, msg, 0);
+    ag_live_rooms_send_json(s, op_reply(ag__live_app(live), s->model, s->user, s->id, msg));
+}
+
+/* --- previews ------------------------------------------------------------------------------ */
+
+static void send_preview(ag_live *live, ag_live_session *s, json_t *msg)
+{
+    s->preview_at = mono_ms();
+    run_on_fast_lane(live, s, msg, 1);
+}
+
+static void on_preview(ag_live *live, ag_live_session *s, json_t *msg)
+{
+    if (!s->model)
+        return ag_live_rooms_send_error(s, AG_ERR_INVALID, "send hello before previews%s", "");
+    json_t *jm = json_object_get(msg, "model");
+    if (jm && (!json_is_integer(jm) || json_integer_value(jm) != s->model))
+        return ag_live_rooms_send_error(
+            s, AG_ERR_INVALID, "a preview is for the model of the connection's room%s", "");
+    double wait = s->preview_at + 1000.0 / AG_LIVE_PREVIEW_HZ - mono_ms();
+    if (wait <= 0 && !s->preview_next)
+        return send_preview(live, s, msg);
+    /* too soon: keep the newest, solve it when its turn comes */
+    if (!s->preview_next)
+        lws_set_timer_usecs(s->wsi, wait > 0 ? (lws_usec_t)(wait * 1000) : 1);
+    json_decref(s->preview_next);
+    s->preview_next = json_incref(msg);
+}
+
+static void on_preview_end(ag_live *live, ag_live_session *s, json_t *msg)
+{
+    (void)msg;
+    if (!s->model)
+        return;
+    json_decref(s->preview_next);
+    s->preview_next = NULL;
+    char peer[32];
+    ag_live_rooms_peer_name(s, peer, sizeof peer);
+    ag_live_rooms_broadcast_json(ag__live_rooms(live), s->model, s,
+                                 json_pack("{s:s, s:s, s:s}", "type", "preview.end", "peer", peer,
+                                           "author", s->user));
+}
+
+void ag_live_protocol_timer(ag_live *live, ag_live_session *s)
+{
+    if (!s->preview_next)
+        return;
+    json_t *msg = s->preview_next;
+    s->preview_next = NULL;
+    if (s->model)
+        send_preview(live, s, msg);
+    json_decref(msg);
+}
+
+/* --- dispatch ------------------------------------------------------------------------------ */
+
+static const struct {
+    const char *type;
+    void (*handle)(ag_live *live, ag_live_session *s, json_t *msg);
+} handlers[] = {
+    {"hello", on_hello},
+    {"op", on_op},
+    {"presence", on_presence},
+    {"watch", on_watch},
+    {"preview", on_preview},
+    {"preview.end", on_preview_end},
+};
+
+const char *ag_live_protocol_type(size_t i)
+{
+    return i < sizeof handlers / sizeof handlers[0] ? handlers[i].type : NULL;
+}
+
+void ag_live_protocol_message(ag_live *live, ag_live_session *s, const char *data, size_t len,
+                              int binary, int overflow)
+{
+    if (overflow) {
+        char limit[32];
+        snprintf(limit, sizeof limit, "%u", AG_LIVE_MAX_MESSAGE);
+        return ag_live_rooms_send_error(s, AG_ERR_TOO_LARGE, "a message holds at most %s bytes",
+                                        limit);
+    }
+    if (binary)
+        return ag_live_rooms_send_error(s, AG_ERR_INVALID,
+                                        "messages are JSON text frames, not binary%s", "");
+    json_error_t je;
+    json_t *msg = json_loadb(data ? data : "", len, 0, &je);
+    if (!msg) {
+        ag_error err;
+        ag_error_set(&err, AG_ERR_INVALID, je.column, "the message is not JSON: %s (column %d)",
+                     je.text, je.column);
+        return ag_live_rooms_send_problem(s, AG_ERR_INVALID, &err);
+    }
+    const char *type = json_string_value(json_object_get(msg, "type"));
+    size_t i = 0, n = sizeof handlers / sizeof handlers[0];
+    while (type && i < n && strcmp(type, handlers[i].type) != 0)
+        i++;
+    if (!json_is_object(msg) || !type)
+        ag_live_rooms_send_error(s, AG_ERR_INVALID,
+                                 "a message is a JSON object with a string \"type\"%s", "");
+    else if (i == n)
+        ag_live_rooms_send_error(s, AG_ERR_INVALID, "unknown message type \"%s\"", type);
+    else
+        handlers[i].handle(live, s, msg);
+    json_decref(msg);
+}
