@@ -26,8 +26,7 @@ static void blame(ag_folder_ws *w, const char *file)
     w->blamed = 1;
 }
 
-/* mkdir -p */
-static int make_dirs(const char *dir)
+int ag_folder_ws_make_dirs(const char *dir)
 {
     char p[4096];
     snprintf(p, sizeof p, "%s", dir);
@@ -151,13 +150,13 @@ static ag_status write_model(ag_folder_ws *w, const ag_model_state *st, ag_error
 {
     const char *dir = w->o.out_dir;
     char path[4200];
-    if (make_dirs(dir)) {
+    if (ag_folder_ws_make_dirs(dir)) {
         blame(w, NULL);
         return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", dir, strerror(errno));
     }
     if (st->terms.n) {
         snprintf(path, sizeof path, "%s/terminals", dir);
-        if (make_dirs(path)) {
+        if (ag_folder_ws_make_dirs(path)) {
             blame(w, dir);
             return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", path, strerror(errno));
         }

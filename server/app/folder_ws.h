@@ -41,4 +41,7 @@ typedef struct {
 
 void ag_folder_ws_init(ag_folder_ws *w, const ag_folder_ws_options *o);
 
+/* mkdir -p: 0, or -1 with errno set. */
+int ag_folder_ws_make_dirs(const char *dir);
+
 #endif

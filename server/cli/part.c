@@ -19,7 +19,8 @@
 #include "../core/edit/edit.h"
 #include "../core/parts/compose.h"
 #include "../core/parts/part.h"
-#include "../io/edit_tree_json.h"
+#include "../app/folder_ws.h"
+#include "../app/model_tree.h"
 #include "../io/grammar_text.h"
 #include "../io/part_bundle.h"
 #include "../io/terminals.h"
@@ -182,7 +183,7 @@ static int write_dir(const char *out, ag_grammar *g, const ag_compose_report *re
     ag_edit_model *back = NULL;
     json_t *summary = NULL;
     int rc = 1;
-    if (ag_cli_make_dirs(out)) {
+    if (ag_folder_ws_make_dirs(out)) {
         fprintf(stderr, "archgram: cannot create %s: %s\n", out, strerror(errno));
         return 1;
     }
@@ -205,7 +206,7 @@ static int write_dir(const char *out, ag_grammar *g, const ag_compose_report *re
         goto done;
     }
     snprintf(path, sizeof path, "%s/tree.json", out);
-    json_t *tree = ag_edit_tree_json(back->proc);
+    json_t *tree = ag_model_tree_folder(back);
     int bad = !tree || json_dump_file(tree, path, JSON_INDENT(1) | JSON_REAL_PRECISION(12));
     json_decref(tree);
     if (bad) {
@@ -228,7 +229,7 @@ static int write_dir(const char *out, ag_grammar *g, const ag_compose_report *re
         "expanded_cells", (json_int_t)rep->expanded_cells, "fit", "elements",
         (json_int_t)rep->fit.elements, "equations", (json_int_t)rep->fit.equations, "rigid",
         (json_int_t)rep->fit.rigid, "rigid_relaxed", (json_int_t)rep->fit.rigid_relaxed, "tree",
-        ag_edit_tree_json_stats(back->proc), "seconds", "compose", seconds);
+        ag_model_tree_folder_stats(back), "seconds", "compose", seconds);
     snprintf(path, sizeof path, "%s/summary.json", out);
     if (!summary || json_dump_file(summary, path, JSON_INDENT(1) | JSON_REAL_PRECISION(12))) {
         fprintf(stderr, "archgram: cannot write %s\n", path);
