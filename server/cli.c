@@ -119,7 +119,8 @@ int ag_cli_load_mesh(const char *path, ag_up_axis up, ag_mesh **out, size_t *byt
     }
     close(fd);
     ag_format fmt = ag_format_sniff(data, *bytes, path);
-    ag_import_options opt = {.up = up};
+    /* the user's own file: what it refers to is read from next to it */
+    ag_import_options opt = {.up = up, .allow_external_files = 1, .source_path = path};
     ag_status st = fmt == AG_FORMAT_UNKNOWN && *bytes == 0
                        ? ag_error_set(&err, AG_ERR_EMPTY, 0, "empty file")
                        : ag_import_buffer(data, *bytes, fmt, &opt, out, &err);
