@@ -7,10 +7,12 @@
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <jansson.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <threads.h>
 
 /* --- the file system assimp sees ------------------------------------------------------------
@@ -178,6 +180,62 @@ static const char *external_texture(const struct aiScene *s, char *buf, size_t c
     return NULL;
 }
 
+/* The URIs a glTF names (buffers and images; shaders in glTF 1), checked before assimp sees
+ * the file: refusing them here gives the member's name, and spares assimp's glTF importers a
+ * failed open, after which they leak what they had read. The sandbox stays as the guarantee. */
+static ag_status gltf_references(const uint8_t *data, size_t len, ag_format fmt, ag_error *err)
+{
+    const uint8_t *text = data;
+    size_t tlen = len;
+    if (fmt == AG_FORMAT_GLB) {
+        /* the JSON follows a 20-byte header in both binary forms: glTF 2 (chunk length,
+         * "JSON") and glTF 1 (content length, content format 0 = JSON) */
+        uint32_t version, clen, ctype;
+        if (len < 20)
+            return AG_OK; /* not a GLB assimp can read: it says why */
+        memcpy(&version, data + 4, 4);
+        memcpy(&clen, data + 12, 4);
+        memcpy(&ctype, data + 16, 4);
+        if (!((version == 2 && memcmp(data + 16, "JSON", 4) == 0) || (version == 1 && ctype == 0)) ||
+            clen > len - 20)
+            return AG_OK;
+        text = data + 20;
+        tlen = clen;
+    }
+    /* JSON that jansson refuses (a NUL in a string, nesting past its limit) goes on to assimp,
+     * whose opens the sandbox still refuses */
+    json_t *root = json_loadb((const char *)text, tlen, 0, NULL);
+    if (!root)
+        return AG_OK;
+    static const char *const lists[] = {"buffers", "images", "shaders"};
+    ag_status st = AG_OK;
+    for (size_t l = 0; l < sizeof lists / sizeof lists[0] && !st; l++) {
+        json_t *list = json_object_get(root, lists[l]);
+        size_t n = json_is_array(list) ? json_array_size(list)
+                   : json_is_object(list) ? json_object_size(list) : 0;
+        void *it = json_is_object(list) ? json_object_iter(list) : NULL;
+        for (size_t i = 0; i < n && !st; i++) {
+            json_t *item = json_is_array(list) ? json_array_get(list, i) : json_object_iter_value(it);
+            char where[96];
+            if (json_is_array(list))
+                snprintf(where, sizeof where, "%s: %s[%zu].uri", ag_format_name(fmt), lists[l], i);
+            else
+                snprintf(where, sizeof where, "%s: %s.%.40s.uri", ag_format_name(fmt), lists[l],
+                         json_object_iter_key(it));
+            if (it)
+                it = json_object_iter_next(list, it);
+            json_t *uri = json_object_get(item, "uri");
+            if (!json_is_string(uri))
+                continue;
+            const char *u = json_string_value(uri);
+            if (strncasecmp(u, "data:", 5) != 0)
+                st = ag_external_ref_refuse(err, 0, where, u, json_string_length(uri));
+        }
+    }
+    json_decref(root);
+    return st;
+}
+
 /* assimp's C API keeps the last error in one global string: imports from several threads
  * take turns (they are a small part of an import job). */
 static mtx_t import_lock;
@@ -321,6 +379,11 @@ ag_status ag_assimp_import_buffer(const uint8_t *data, size_t len, ag_format fmt
     if (len > UINT32_MAX)
         return ag_error_set(err, AG_ERR_TOO_LARGE, 0, "the file is larger than 4 GiB");
     int allow = opt && opt->allow_external_files;
+    if (!allow && (fmt == AG_FORMAT_GLTF || fmt == AG_FORMAT_GLB)) {
+        ag_status st = gltf_references(data, len, fmt, err);
+        if (st)
+            return st;
+    }
     char upload_name[16];
     snprintf(upload_name, sizeof upload_name, "upload.%s", hint);
     sandbox sb = {.data = data,

@@ -175,6 +175,40 @@ static blob gltf1(const char *buffer_uri)
                 buffer_uri, TRI_LEN);
 }
 
+/* Binary glTF 1 (KHR_binary_glTF): the positions in the body, the indices from buffer `uri`. */
+static blob gltf1_binary(const char *buffer_uri)
+{
+    blob j = text("{\"asset\":{\"version\":\"1.0\"},\"extensionsUsed\":[\"KHR_binary_glTF\"],"
+                  "\"buffers\":{\"binary_glTF\":{\"uri\":\"data:,\",\"byteLength\":%d},"
+                  "\"b0\":{\"uri\":\"%s\",\"byteLength\":%d}},"
+                  "\"bufferViews\":{\"bv0\":{\"buffer\":\"binary_glTF\",\"byteOffset\":0,"
+                  "\"byteLength\":36,\"target\":34962},\"bv1\":{\"buffer\":\"b0\",\"byteOffset\":36,"
+                  "\"byteLength\":6,\"target\":34963}},"
+                  "\"accessors\":{\"a0\":{\"bufferView\":\"bv0\",\"byteOffset\":0,"
+                  "\"byteStride\":12,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+                  "\"a1\":{\"bufferView\":\"bv1\",\"byteOffset\":0,\"componentType\":5123,"
+                  "\"count\":3,\"type\":\"SCALAR\"}},"
+                  "\"meshes\":{\"m0\":{\"primitives\":[{\"attributes\":{\"POSITION\":\"a0\"},"
+                  "\"indices\":\"a1\",\"mode\":4}]}},\"nodes\":{\"n0\":{\"name\":\"N\","
+                  "\"meshes\":[\"m0\"]}},\"scenes\":{\"s0\":{\"nodes\":[\"n0\"]}},"
+                  "\"scene\":\"s0\"}",
+                  TRI_LEN, buffer_uri, TRI_LEN);
+    size_t jl = (j.len + 3) & ~(size_t)3;
+    size_t total = 20 + jl + TRI_LEN;
+    uint8_t *b = calloc(1, total);
+    assert_non_null(b);
+    memcpy(b, "glTF", 4);
+    put32(b + 4, 1);
+    put32(b + 8, (uint32_t)total);
+    put32(b + 12, (uint32_t)jl);
+    put32(b + 16, 0); /* JSON */
+    memset(b + 20, ' ', jl);
+    memcpy(b + 20, j.data, j.len);
+    tri_bytes(b + 20 + jl);
+    free(j.data);
+    return (blob){(char *)b, total};
+}
+
 /* Collada: one triangle whose material's diffuse texture is the image `ref`. */
 static blob dae(const char *ref)
 {
@@ -277,7 +311,16 @@ static int opened(int fd)
 
 /* ---- cases ------------------------------------------------------------------------------ */
 
-typedef enum { GLTF2_BUFFER, GLTF2_IMAGE, GLB_BUFFER, GLTF1_BUFFER, DAE_IMAGE, FBX_TEXTURE, OBJ_MTLLIB } kind;
+typedef enum {
+    GLTF2_BUFFER,
+    GLTF2_IMAGE,
+    GLB_BUFFER,
+    GLTF1_BUFFER,
+    GLTF1_BINARY_BUFFER,
+    DAE_IMAGE,
+    FBX_TEXTURE,
+    OBJ_MTLLIB
+} kind;
 
 static const struct {
     kind k;
@@ -286,6 +329,7 @@ static const struct {
 } kinds[] = {
     {GLTF2_BUFFER, AG_FORMAT_GLTF, "glTF 2 buffer"}, {GLTF2_IMAGE, AG_FORMAT_GLTF, "glTF 2 image"},
     {GLB_BUFFER, AG_FORMAT_GLB, "GLB buffer"},       {GLTF1_BUFFER, AG_FORMAT_GLTF, "glTF 1 buffer"},
+    {GLTF1_BINARY_BUFFER, AG_FORMAT_GLB, "binary glTF 1 buffer"},
     {DAE_IMAGE, AG_FORMAT_DAE, "Collada image"},     {FBX_TEXTURE, AG_FORMAT_FBX, "FBX texture"},
     {OBJ_MTLLIB, AG_FORMAT_OBJ, "OBJ mtllib"},
 };
@@ -297,6 +341,7 @@ static blob make(kind k, const char *ref)
     case GLTF2_IMAGE: return gltf2_json(data_uri(), ref);
     case GLB_BUFFER: return glb(ref);
     case GLTF1_BUFFER: return gltf1(ref);
+    case GLTF1_BINARY_BUFFER: return gltf1_binary(ref);
     case DAE_IMAGE: return dae(ref);
     case FBX_TEXTURE: return fbx(ref);
     case OBJ_MTLLIB: return obj(ref);
@@ -358,7 +403,7 @@ static void test_every_reference_is_refused(void **state)
             free(b.data);
             checked++;
         }
-    assert_int_equal(checked, 49);
+    assert_int_equal(checked, 56);
 }
 
 /* Allowed (the CLI, reading the user's own file): the references resolve and import. The
@@ -366,17 +411,18 @@ static void test_every_reference_is_refused(void **state)
 static void test_allowed_references_resolve(void **state)
 {
     (void)state;
-    const kind buffers[] = {GLTF2_BUFFER, GLB_BUFFER, GLTF1_BUFFER};
+    const kind buffers[] = {GLTF2_BUFFER, GLB_BUFFER, GLTF1_BUFFER, GLTF1_BINARY_BUFFER};
     for (size_t i = 0; i < sizeof buffers / sizeof buffers[0]; i++) {
         blob b = make(buffers[i], "tri.bin");
         char src[PATH_MAX + 16];
-        snprintf(src, sizeof src, "%s/model.%s", dir, buffers[i] == GLB_BUFFER ? "glb" : "gltf");
+        int binary = buffers[i] == GLB_BUFFER || buffers[i] == GLTF1_BINARY_BUFFER;
+        snprintf(src, sizeof src, "%s/model.%s", dir, binary ? "glb" : "gltf");
         ag_import_options o = {.allow_external_files = 1, .source_path = src};
         int wd, fd = watch_open(&wd);
         ag_mesh *m = NULL;
         ag_error e = {0};
         ag_status st = ag_import_buffer((const uint8_t *)b.data, b.len,
-                                        buffers[i] == GLB_BUFFER ? AG_FORMAT_GLB : AG_FORMAT_GLTF,
+                                        binary ? AG_FORMAT_GLB : AG_FORMAT_GLTF,
                                         &o, &m, &e);
         int n = opened(fd);
         if (st != AG_OK)
@@ -427,6 +473,30 @@ static void test_inline_data_imports(void **state)
     }
 }
 
+/* glTF URIs are checked before assimp runs; a JSON text that check cannot read (a NUL in a
+ * string, which assimp's parser takes as the end of the name) reaches assimp, and its open of
+ * "tri.bin" is refused by the file system assimp is given: nothing is read either way. */
+static void test_sandbox_refuses_what_the_scan_misses(void **state)
+{
+    (void)state;
+    blob cases[2] = {gltf2_json("tri.bin\\u0000.ignored", NULL),
+                     glb("tri.bin\\u0000.ignored")};
+    const ag_format fmts[2] = {AG_FORMAT_GLTF, AG_FORMAT_GLB};
+    for (int i = 0; i < 2; i++) {
+        int wd, fd = watch_open(&wd);
+        ag_mesh *m = (ag_mesh *)1;
+        ag_error e = {0};
+        ag_status st = ag_import_buffer((const uint8_t *)cases[i].data, cases[i].len, fmts[i],
+                                        NULL, &m, &e);
+        int n = opened(fd);
+        if (st != AG_ERR_EXTERNAL_REF || !strstr(e.text, "\"tri.bin\""))
+            fail_msg("case %d: status %d, %s", i, st, e.text);
+        assert_null(m);
+        assert_int_equal(n, 0);
+        free(cases[i].data);
+    }
+}
+
 /* A name that is not text is shown with '?' so the message stays valid UTF-8 and bounded. */
 static void test_reference_is_shown_safely(void **state)
 {
@@ -457,6 +527,7 @@ int main(void)
         cmocka_unit_test(test_every_reference_is_refused),
         cmocka_unit_test(test_allowed_references_resolve),
         cmocka_unit_test(test_inline_data_imports),
+        cmocka_unit_test(test_sandbox_refuses_what_the_scan_misses),
         cmocka_unit_test(test_reference_is_shown_safely),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
