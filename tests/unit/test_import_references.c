@@ -135,27 +135,37 @@ static void put32(uint8_t *p, uint32_t v)
     memcpy(p, &v, 4);
 }
 
-/* Binary glTF: the JSON chunk and a BIN chunk holding the triangle; with buffer_uri the
- * indices come from a second buffer by that URI. */
-static blob glb(const char *buffer_uri)
+/* A binary glTF around json (freed) with the triangle after it: version 2 as a JSON and a
+ * BIN chunk, version 1 (KHR_binary_glTF) as content (format 0, JSON) and body. */
+static blob binary_gltf(uint32_t version, blob json)
 {
-    blob j = gltf2_json_buffers(buffer_uri, NULL, 1);
-    size_t jl = (j.len + 3) & ~(size_t)3;
-    size_t total = 12 + 8 + jl + 8 + TRI_LEN;
+    size_t jl = (json.len + 3) & ~(size_t)3;
+    size_t bin_header = version == 2 ? 8 : 0;
+    size_t total = 20 + jl + bin_header + TRI_LEN;
     uint8_t *b = calloc(1, total);
     assert_non_null(b);
     memcpy(b, "glTF", 4);
-    put32(b + 4, 2);
+    put32(b + 4, version);
     put32(b + 8, (uint32_t)total);
     put32(b + 12, (uint32_t)jl);
-    memcpy(b + 16, "JSON", 4);
+    if (version == 2)
+        memcpy(b + 16, "JSON", 4);
     memset(b + 20, ' ', jl);
-    memcpy(b + 20, j.data, j.len);
-    put32(b + 20 + jl, TRI_LEN);
-    memcpy(b + 24 + jl, "BIN\0", 4);
-    tri_bytes(b + 28 + jl);
-    free(j.data);
+    memcpy(b + 20, json.data, json.len);
+    if (version == 2) {
+        put32(b + 20 + jl, TRI_LEN);
+        memcpy(b + 24 + jl, "BIN\0", 4);
+    }
+    tri_bytes(b + 20 + jl + bin_header);
+    free(json.data);
     return (blob){(char *)b, total};
+}
+
+/* GLB: the triangle in the BIN chunk; with buffer_uri the indices come from a second buffer
+ * by that URI. */
+static blob glb(const char *buffer_uri)
+{
+    return binary_gltf(2, gltf2_json_buffers(buffer_uri, NULL, 1));
 }
 
 /* glTF 1.0 (objects keyed by id) with its buffer by URI. */
@@ -193,20 +203,7 @@ static blob gltf1_binary(const char *buffer_uri)
                   "\"meshes\":[\"m0\"]}},\"scenes\":{\"s0\":{\"nodes\":[\"n0\"]}},"
                   "\"scene\":\"s0\"}",
                   TRI_LEN, buffer_uri, TRI_LEN);
-    size_t jl = (j.len + 3) & ~(size_t)3;
-    size_t total = 20 + jl + TRI_LEN;
-    uint8_t *b = calloc(1, total);
-    assert_non_null(b);
-    memcpy(b, "glTF", 4);
-    put32(b + 4, 1);
-    put32(b + 8, (uint32_t)total);
-    put32(b + 12, (uint32_t)jl);
-    put32(b + 16, 0); /* JSON */
-    memset(b + 20, ' ', jl);
-    memcpy(b + 20, j.data, j.len);
-    tri_bytes(b + 20 + jl);
-    free(j.data);
-    return (blob){(char *)b, total};
+    return binary_gltf(1, j);
 }
 
 /* Collada: one triangle whose material's diffuse texture is the image `ref`. */
