@@ -74,15 +74,24 @@ all: programs web
 programs: $(BUILD)/archgramd $(BUILD)/archgram
 
 # --- packages -----------------------------------------------------------------------------
+# apt waits for a lock another apt holds (up to 10 minutes), and a failed round is tried again
+# a few times: on a shared machine or a CI runner something else may be installing too.
+APT_GET := apt-get -q -o DPkg::Lock::Timeout=600
+define apt_install
+	SUDO=; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+	for try in 1 2 3 4 5; do \
+	  $$SUDO $(APT_GET) update && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO $(APT_GET) install -y --no-install-recommends $(1) && break; \
+	  [ $$try = 5 ] && exit 1; echo "archgram: apt-get failed, trying again in 20 s"; sleep 20; \
+	done
+endef
 define install_missing
 	@missing=$$(for p in $(1); do \
 	    dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; \
 	  done); \
 	if [ -n "$$missing" ]; then \
 	  echo "archgram: installing Debian packages:" $$missing; \
-	  SUDO=; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
-	  $$SUDO apt-get update -q && \
-	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y --no-install-recommends $$missing; \
+	  $(call apt_install,$$missing); \
 	fi
 endef
 
@@ -95,9 +104,7 @@ deps:
 	@# conflicts with Debian's npm package: ask for the commands, not the packages.
 	@if ! command -v node >/dev/null || ! command -v npm >/dev/null; then \
 	  echo "archgram: installing Node.js and npm"; \
-	  SUDO=; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
-	  $$SUDO apt-get update -q && \
-	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y --no-install-recommends nodejs npm; \
+	  $(call apt_install,nodejs npm); \
 	fi
 
 deps-test: deps
