@@ -33,15 +33,10 @@ DEB_TEST  := libcmocka-dev chromium curl sqlite3 python3 binutils libasan8 libub
 DEB_BENCH := wrk
 
 # --- layers -------------------------------------------------------------------------------
-# One archive per layer, core → io → store → app → net; programs link them in that order, so
-# a layer that reaches up fails to link. The libraries each layer may use (and the headers and
-# layers it may use) are checked by tools/check_layers.py (make check-layers).
+# One archive per layer, core → io → store → app → net; programs link them highest first, so
+# a layer that reaches up fails to link. Which layers, headers and system libraries each layer
+# may use is written once, in tools/check_layers.py (make check-layers).
 LAYERS     := core io store app net
-LAYER_LIBS_core  := -lcholmod -lspqr -lsuitesparseconfig -lm
-LAYER_LIBS_io    := -ljansson -lassimp
-LAYER_LIBS_store := -lsqlite3
-LAYER_LIBS_app   := -lpthread
-LAYER_LIBS_net   := -lwebsockets -lmicrohttpd
 LIBDIR     := $(BUILD)/lib
 layer_src   = $(shell find server/$(1) -name '*.c' | sort)
 layer_obj   = $(patsubst %.c,$(BUILD)/obj/%.o,$(call layer_src,$(1)))
@@ -52,7 +47,9 @@ GEN_SRC   := $(BUILD)/gen/migrations.c $(BUILD)/gen/openapi.c
 ARCHIVES  := $(foreach l,$(LAYERS),$(LIBDIR)/libag_$(l).a)
 # Link order: the highest layer first, each followed by what it may use.
 LINK_ARCHIVES := $(foreach l,net app store io core,$(LIBDIR)/libag_$(l).a)
-LDLIBS    := $(foreach l,net app store io core,$(LAYER_LIBS_$(l)))
+# The system libraries, in the same order: net's, app's, store's, io's, core's.
+LDLIBS    := -lwebsockets -lmicrohttpd -lpthread -lsqlite3 -ljansson -lassimp \
+             -lcholmod -lspqr -lsuitesparseconfig -lm
 LIB_OBJ   := $(foreach l,$(LAYERS),$(call layer_obj,$(l)))
 
 # The command-line tool: a dispatcher (server/cli.c) and one file per subcommand.
