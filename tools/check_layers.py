@@ -131,7 +131,8 @@ def check_local_include(root, rel, lineno, layer, name, violations):
         return
     up = tlayer == "main" or ORDER.index(tlayer) > ORDER.index(layer)
     violations.append(("include", rel, target,
-                       f"{rel}:{lineno}: includes {target} ({tlayer}{', up the layers' if up else ''}): "
+                       f"{rel}:{lineno}: includes {target} "
+                       f"({tlayer}{', up the layers' if up else ''}): "
                        f"{layer} may use {may_use_text(layer)}"))
 
 
@@ -262,7 +263,8 @@ def check_symbols(root, libdir, cc, violations):
         ok_members = {}  # layer -> members allowed through single headers
         for h in spec["headers"]:
             hl, hname = h.split("/", 1)
-            ok_members.setdefault(hl, set()).add(os.path.splitext(os.path.basename(hname))[0] + ".o")
+            member = os.path.splitext(os.path.basename(hname))[0] + ".o"
+            ok_members.setdefault(hl, set()).add(member)
         archive = os.path.relpath(os.path.join(libdir, f"libag_{layer}.a"), root)
         for member, (_, undef) in sorted(archives[layer].items()):
             for s in sorted(undef):

@@ -196,8 +196,9 @@ static ag_status gltf_references(const uint8_t *data, size_t len, ag_format fmt,
         memcpy(&version, data + 4, 4);
         memcpy(&clen, data + 12, 4);
         memcpy(&ctype, data + 16, 4);
-        if (!((version == 2 && memcmp(data + 16, "JSON", 4) == 0) || (version == 1 && ctype == 0)) ||
-            clen > len - 20)
+        int json2 = version == 2 && memcmp(data + 16, "JSON", 4) == 0;
+        int json1 = version == 1 && ctype == 0;
+        if (!(json2 || json1) || clen > len - 20)
             return AG_OK;
         text = data + 20;
         tlen = clen;
@@ -215,7 +216,8 @@ static ag_status gltf_references(const uint8_t *data, size_t len, ag_format fmt,
                    : json_is_object(list) ? json_object_size(list) : 0;
         void *it = json_is_object(list) ? json_object_iter(list) : NULL;
         for (size_t i = 0; i < n && !st; i++) {
-            json_t *item = json_is_array(list) ? json_array_get(list, i) : json_object_iter_value(it);
+            json_t *item =
+                json_is_array(list) ? json_array_get(list, i) : json_object_iter_value(it);
             char where[96];
             if (json_is_array(list))
                 snprintf(where, sizeof where, "%s: %s[%zu].uri", ag_format_name(fmt), lists[l], i);

@@ -192,7 +192,8 @@ static blob gltf1_binary(const char *buffer_uri)
                   "\"buffers\":{\"binary_glTF\":{\"uri\":\"data:,\",\"byteLength\":%d},"
                   "\"b0\":{\"uri\":\"%s\",\"byteLength\":%d}},"
                   "\"bufferViews\":{\"bv0\":{\"buffer\":\"binary_glTF\",\"byteOffset\":0,"
-                  "\"byteLength\":36,\"target\":34962},\"bv1\":{\"buffer\":\"b0\",\"byteOffset\":36,"
+                  "\"byteLength\":36,\"target\":34962},"
+                  "\"bv1\":{\"buffer\":\"b0\",\"byteOffset\":36,"
                   "\"byteLength\":6,\"target\":34963}},"
                   "\"accessors\":{\"a0\":{\"bufferView\":\"bv0\",\"byteOffset\":0,"
                   "\"byteStride\":12,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
@@ -324,10 +325,13 @@ static const struct {
     ag_format fmt;
     const char *name;
 } kinds[] = {
-    {GLTF2_BUFFER, AG_FORMAT_GLTF, "glTF 2 buffer"}, {GLTF2_IMAGE, AG_FORMAT_GLTF, "glTF 2 image"},
-    {GLB_BUFFER, AG_FORMAT_GLB, "GLB buffer"},       {GLTF1_BUFFER, AG_FORMAT_GLTF, "glTF 1 buffer"},
+    {GLTF2_BUFFER, AG_FORMAT_GLTF, "glTF 2 buffer"},
+    {GLTF2_IMAGE, AG_FORMAT_GLTF, "glTF 2 image"},
+    {GLB_BUFFER, AG_FORMAT_GLB, "GLB buffer"},
+    {GLTF1_BUFFER, AG_FORMAT_GLTF, "glTF 1 buffer"},
     {GLTF1_BINARY_BUFFER, AG_FORMAT_GLB, "binary glTF 1 buffer"},
-    {DAE_IMAGE, AG_FORMAT_DAE, "Collada image"},     {FBX_TEXTURE, AG_FORMAT_FBX, "FBX texture"},
+    {DAE_IMAGE, AG_FORMAT_DAE, "Collada image"},
+    {FBX_TEXTURE, AG_FORMAT_FBX, "FBX texture"},
     {OBJ_MTLLIB, AG_FORMAT_OBJ, "OBJ mtllib"},
 };
 
