@@ -27,6 +27,8 @@ static const struct {
     {"edit", ag_cli_edit, "edit DIR --op OP.json --out DIR2     apply one edit op to a proceduralized model"},
     {"fmt", ag_cli_fmt, "fmt GRAMMAR                     print a grammar in canonical form"},
     {"extrude", ag_cli_extrude, "extrude --plan PLAN.json | FOOTPRINTS.geojson --style S --out OUT  roofs and shells"},
+    {"segment", ag_cli_segment, "segment CLOUD --out SEG.ply [--roi BOX] [--threshold F]  planes and clusters of a point cloud"},
+    {"cut", ag_cli_cut, "cut TILE --footprints F.geojson --out DIR   one point cloud per building footprint"},
 };
 
 #define NCOMMANDS (sizeof commands / sizeof commands[0])

@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "bytes.h"
-#include "filemap.h"
 #include "laz.h"
 
 #define VLR_HEADER 54
@@ -409,19 +408,6 @@ ag_status ag_las_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag
     ag_cloud_rebase(r.c, want);
     *out = r.c;
     return AG_OK;
-}
-
-ag_status ag_las_read_file(const char *path, ag_cloud **out, ag_error *err)
-{
-    *out = NULL;
-    ag_filemap fm;
-    ag_status st = ag_filemap_open(path, &fm, err);
-    if (st != AG_OK)
-        return st;
-    st = fm.len ? ag_las_read_buffer(fm.data, fm.len, out, err)
-                : ag_error_set(err, AG_ERR_EMPTY, 0, "empty file");
-    ag_filemap_close(&fm);
-    return st;
 }
 
 /* ---- writing --------------------------------------------------------------------------- */

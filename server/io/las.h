@@ -42,7 +42,6 @@ ag_status ag_las_read_header(const uint8_t *data, size_t len, ag_las_header *h, 
 
 /* LAS, or LAZ (decoded by laz.c), into a cloud. */
 ag_status ag_las_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag_error *err);
-ag_status ag_las_read_file(const char *path, ag_cloud **out, ag_error *err);
 
 typedef struct {
     int point_format;  /* 0-10; -1 picks the smallest format that holds the cloud's fields */

@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "bytes.h"
-#include "filemap.h"
 
 #define MAX_HEADER (1u << 20) /* bytes */
 #define MAX_LINE 4096
@@ -602,19 +601,6 @@ ag_status ag_ply_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag
     }
     *out = r.c;
     return AG_OK;
-}
-
-ag_status ag_ply_read_file(const char *path, ag_cloud **out, ag_error *err)
-{
-    *out = NULL;
-    ag_filemap fm;
-    ag_status st = ag_filemap_open(path, &fm, err);
-    if (st != AG_OK)
-        return st;
-    st = fm.len ? ag_ply_read_buffer(fm.data, fm.len, out, err)
-                : ag_error_set(err, AG_ERR_EMPTY, 0, "empty file");
-    ag_filemap_close(&fm);
-    return st;
 }
 
 /* ---- the writer ------------------------------------------------------------------------ */

@@ -21,7 +21,6 @@
 #include "../core/status.h"
 
 ag_status ag_ply_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag_error *err);
-ag_status ag_ply_read_file(const char *path, ag_cloud **out, ag_error *err);
 
 /* Whether data is a PLY whose header declares a face element with at least one face (a
  * mesh rather than a point cloud). */

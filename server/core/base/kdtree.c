@@ -189,12 +189,13 @@ typedef struct {
     size_t k, count;
     uint32_t *idx;
     double *d2;
+    double bound; /* squared distance a point must beat: the k-th so far, or a known cap */
 } knn_query;
 
+/* Sorted insertion (k is small), dropping the farthest when full. */
 static void knn_offer(knn_query *s, double d2, uint32_t id)
 {
     size_t i = s->count < s->k ? s->count++ : s->k - 1;
-    /* insertion into the sorted list, dropping the farthest when full */
     while (i > 0 && s->d2[i - 1] > d2) {
         s->d2[i] = s->d2[i - 1];
         s->idx[i] = s->idx[i - 1];
@@ -202,6 +203,8 @@ static void knn_offer(knn_query *s, double d2, uint32_t id)
     }
     s->d2[i] = d2;
     s->idx[i] = id;
+    if (s->count == s->k)
+        s->bound = s->d2[s->k - 1];
 }
 
 /* rd: squared distance from q to the node's cell (incremental, Arya & Mount); off: per-axis
@@ -214,7 +217,7 @@ static void knn_search(knn_query *s, uint32_t index, double rd, double off[3])
         for (; p < end; p++) {
             double dx = p->p[0] - s->q[0], dy = p->p[1] - s->q[1], dz = p->p[2] - s->q[2];
             double d2 = dx * dx + dy * dy + dz * dz;
-            if (s->count < s->k || d2 < s->d2[s->k - 1])
+            if (d2 < s->bound)
                 knn_offer(s, d2, p->id);
         }
         return;
@@ -224,34 +227,52 @@ static void knn_search(knn_query *s, uint32_t index, double rd, double off[3])
     knn_search(s, near, rd, off);
     double old = off[nd->dim];
     double far_rd = rd - old * old + diff * diff;
-    if (s->count < s->k || far_rd < s->d2[s->k - 1]) {
+    if (far_rd < s->bound) {
         off[nd->dim] = diff;
         knn_search(s, far, far_rd, off);
         off[nd->dim] = old;
     }
 }
 
+static size_t knn_run(const ag_kdtree *t, const double q[3], size_t k, double bound, uint32_t *idx,
+                      double *d2)
+{
+    knn_query s = {t, {q[0], q[1], q[2]}, k, 0, idx, d2, bound};
+    double off[3] = {0, 0, 0};
+    knn_search(&s, 0, 0, off);
+    return s.count;
+}
+
 size_t ag_kdtree_knn(const ag_kdtree *t, const double q[3], size_t k, uint32_t *idx, double *d2)
 {
     if (!t->n || !k)
         return 0;
-    double local_d2[64], *dist = d2;
-    double *heap_d2 = NULL;
-    if (!dist) {
-        if (k <= 64) {
-            dist = local_d2;
-        } else {
-            heap_d2 = malloc(k * sizeof *heap_d2);
-            if (!heap_d2)
-                return 0;
-            dist = heap_d2;
-        }
+    double local[64], *dist = d2;
+    if (!dist)
+        dist = k <= 64 ? local : malloc(k * sizeof *dist);
+    if (!dist)
+        return 0;
+    size_t m = knn_run(t, q, k, INFINITY, idx, dist);
+    if (dist != d2 && dist != local)
+        free(dist);
+    return m;
+}
+
+size_t ag_kdtree_knn_hint(const ag_kdtree *t, const double q[3], size_t k, const uint32_t *hint,
+                          const double *xyz, uint32_t *idx, double *d2)
+{
+    if (!t->n || !k || k > t->n || !d2)
+        return ag_kdtree_knn(t, q, k, idx, d2);
+    /* k distinct points at most `cap` away: the k-th nearest is no farther */
+    double cap = 0;
+    for (size_t j = 0; j < k; j++) {
+        const double *p = xyz + 3 * (size_t)hint[j];
+        double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        double dd = dx * dx + dy * dy + dz * dz;
+        if (dd > cap)
+            cap = dd;
     }
-    knn_query s = {t, {q[0], q[1], q[2]}, k, 0, idx, dist};
-    double off[3] = {0, 0, 0};
-    knn_search(&s, 0, 0, off);
-    free(heap_d2);
-    return s.count;
+    return knn_run(t, q, k, nextafter(cap, INFINITY), idx, d2);
 }
 
 typedef struct {

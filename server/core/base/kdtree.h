@@ -29,6 +29,12 @@ const uint32_t *ag_kdtree_order(const ag_kdtree *t);
  * first: their numbers in idx and squared distances in d2 (optional). Returns the count. */
 size_t ag_kdtree_knn(const ag_kdtree *t, const double q[3], size_t k, uint32_t *idx, double *d2);
 
+/* The same as ag_kdtree_knn (d2 required), faster when hint holds k distinct
+ * tree points near q (the neighbours of the previous query in tree order): their farthest
+ * bounds the search from the start. xyz are the positions the tree was built from. */
+size_t ag_kdtree_knn_hint(const ag_kdtree *t, const double q[3], size_t k, const uint32_t *hint,
+                          const double *xyz, uint32_t *idx, double *d2);
+
 /* Calls visit for every point within distance r of q (inclusive), in no particular order.
  * A non-zero return from visit stops the query; that value is returned, else 0. */
 typedef int (*ag_kdtree_visit)(void *user, uint32_t id, double d2);

@@ -146,8 +146,9 @@ ag_status ag_normals_compute(ag_cloud *c, const ag_kdtree *tree, const ag_normal
     if (!nearest)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     const uint32_t *order = ag_kdtree_order(tree);
-    uint32_t idx[MAX_K];
+    uint32_t idx[MAX_K], prev[MAX_K];
     double d2[MAX_K];
+    int have_prev = 0;
     for (size_t t = 0; t < n; t++) {
         if (opt && opt->progress && (t & 16383) == 0 && opt->progress(opt->user, (double)t / n)) {
             free(nearest);
@@ -155,7 +156,12 @@ ag_status ag_normals_compute(ag_cloud *c, const ag_kdtree *tree, const ag_normal
         }
         uint32_t i = order[t];
         const double *p = c->xyz + 3 * (size_t)i;
-        size_t m = ag_kdtree_knn(tree, p, k, idx, d2);
+        /* the previous point's neighbours (it is close by in tree order) bound the search;
+         * they must be k distinct points, which a full previous answer is */
+        size_t m = t && have_prev ? ag_kdtree_knn_hint(tree, p, k, prev, c->xyz, idx, d2)
+                                  : ag_kdtree_knn(tree, p, k, idx, d2);
+        have_prev = m == k;
+        memcpy(prev, idx, m * sizeof *idx);
         if (neighbours) {
             uint32_t *row = neighbours + (size_t)i * k;
             for (size_t j = 0; j < k; j++)
