@@ -204,8 +204,8 @@ ag_status ag_normals_compute(ag_cloud *c, const ag_kdtree *tree, const ag_normal
         for (int a = 0; a < 3; a++)
             c->normals[3 * (size_t)i + a] = (float)nv[a];
         if (variation) {
-            double sum = ev[0] + ev[1] + ev[2];
-            variation[i] = sum > 0 ? (float)(ev[0] / sum) : 0;
+            double e0 = ev[0] > 0 ? ev[0] : 0, sum = e0 + ev[1] + ev[2]; /* rounding: ev0 >= 0 */
+            variation[i] = sum > 0 ? (float)(e0 / sum) : 0;
         }
     }
     if (info && nsample) {

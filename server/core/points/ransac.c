@@ -52,8 +52,8 @@ int ag_ransac_fit(const double *xyz, const uint32_t *idx, size_t m, ag_plane *pl
     }
     double n[3], ev[3];
     ag_normals_smallest_eigenvector(cov, n, ev);
-    if (!(ev[1] > 0))
-        return -1; /* all points on a line or one spot */
+    if (!(ev[1] > ev[2] * 4e-4))
+        return -1; /* a line (second axis under 2 % of the first) or one spot: no plane */
     memcpy(pl->n, n, sizeof n);
     pl->d = -(n[0] * mean[0] + n[1] * mean[1] + n[2] * mean[2]);
     pl->count = m;
@@ -240,19 +240,25 @@ ag_status ag_ransac_global(const ag_cloud *c, const uint32_t *idx, size_t m,
         /* refit to all inliers, twice, with the threshold adapted to the plane's noise */
         size_t nin = 0;
         double tau_it = tau;
+        int fitted = 0;
         for (int it = 0; it < 3; it++) {
             nin = 0;
             for (size_t j = 0; j < nf; j++)
                 if (is_inlier(c, free_pts[j], &best, tau_it, cosmax))
                     in[nin++] = free_pts[j];
             ag_plane fit;
-            if (it == 2 || ag_ransac_fit(c->xyz, in, nin, &fit))
+            if (it == 2)
                 break;
+            if (ag_ransac_fit(c->xyz, in, nin, &fit)) {
+                fitted = 0; /* the inliers are no plane (a line, a spot) */
+                break;
+            }
+            fitted = 1;
             best = fit;
             if (o->adaptive)
                 tau_it = adapted_threshold(c, in, nin, &best, tau, resid);
         }
-        if (nin < min_points) {
+        if (nin < min_points || !fitted) {
             fails++;
             continue;
         }
@@ -447,8 +453,14 @@ ag_status ag_ransac_local(const ag_cloud *c, const ag_ransac_graph *g, const flo
             continue;
         }
         ag_plane fit;
-        if (!ag_ransac_fit(c->xyz, gr.queue, cn, &fit))
-            pl = fit;
+        if (ag_ransac_fit(c->xyz, gr.queue, cn, &fit)) {
+            /* a line or a spot: no plane */
+            for (size_t j = 0; j < cn; j++)
+                tried[gr.queue[j]] = 1;
+            tried[seed] = 1;
+            continue;
+        }
+        pl = fit;
         pl.count = cn;
         int32_t id = (int32_t)planes->n;
         if (list_push(planes, &pl)) {

@@ -87,7 +87,33 @@ static void cross3(const double a[3], const double b[3], double o[3])
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/* Principal axes and extents of a segment. */
+/* The largest principal direction of the points' covariance projected on the plane with
+ * normal `normal` (unit): the in-plane axis of a flat segment. */
+static void in_plane_axis(const ag_cloud *c, const uint32_t *idx, size_t m, const double mean[3],
+                          const double normal[3], double axis[3])
+{
+    double cov[6] = {0, 0, 0, 0, 0, 0};
+    for (size_t j = 0; j < m; j++) {
+        const double *p = c->xyz + 3 * (size_t)idx[j];
+        double d[3] = {p[0] - mean[0], p[1] - mean[1], p[2] - mean[2]};
+        double h = d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2];
+        for (int a = 0; a < 3; a++)
+            d[a] -= h * normal[a];
+        cov[0] -= d[0] * d[0];
+        cov[1] -= d[0] * d[1];
+        cov[2] -= d[0] * d[2];
+        cov[3] -= d[1] * d[1];
+        cov[4] -= d[1] * d[2];
+        cov[5] -= d[2] * d[2];
+    }
+    /* the smallest eigenvector of -cov is the largest of cov */
+    ag_normals_smallest_eigenvector(cov, axis, NULL);
+}
+
+/* A segment's frame and extents. The frame follows the building rather than the points'
+ * principal axes, which turn freely for nearly square shapes: a wall or roof plane has its
+ * horizontal direction and its slope line as axes, a level plane and a cluster the vertical
+ * and the principal direction of their plan. */
 static void describe(const ag_cloud *c, const uint32_t *idx, size_t m, ag_segment_cloud_item *s)
 {
     double mean[3] = {0, 0, 0};
@@ -107,30 +133,33 @@ static void describe(const ag_cloud *c, const uint32_t *idx, size_t m, ag_segmen
         cov[4] += y * z;
         cov[5] += z * z;
     }
-    double small[3], big[3], ev[3];
+    double small[3], ev[3];
     ag_normals_smallest_eigenvector(cov, small, ev);
-    double neg[6];
-    for (int i = 0; i < 6; i++)
-        neg[i] = -cov[i];
-    ag_normals_smallest_eigenvector(neg, big, NULL);
-    /* make the largest axis exactly orthogonal to the smallest */
-    double dt = big[0] * small[0] + big[1] * small[1] + big[2] * small[2];
-    for (int a = 0; a < 3; a++)
-        big[a] -= dt * small[a];
-    double l = sqrt(big[0] * big[0] + big[1] * big[1] + big[2] * big[2]);
-    if (l < 1e-9) {
-        double t[3] = {fabs(small[0]) < 0.9 ? 1 : 0, fabs(small[0]) < 0.9 ? 0 : 1, 0};
-        cross3(small, t, big);
-        l = sqrt(big[0] * big[0] + big[1] * big[1] + big[2] * big[2]);
+    double a0[3], a1[3], a2[3];
+    const double up[3] = {0, 0, 1};
+    if (s->kind == AG_SEGMENT_CLOUD_PLANE && fabs(small[2]) < 0.9) {
+        /* walls and roof planes: horizontal in-plane axis, then the slope line */
+        cross3(up, small, a0);
+        double l = sqrt(a0[0] * a0[0] + a0[1] * a0[1] + a0[2] * a0[2]);
+        for (int a = 0; a < 3; a++)
+            a0[a] /= l;
+        cross3(small, a0, a1);
+        memcpy(a2, small, sizeof a2);
+    } else if (s->kind == AG_SEGMENT_CLOUD_PLANE) {
+        /* level planes: the principal direction of the plan */
+        in_plane_axis(c, idx, m, mean, small, a0);
+        cross3(small, a0, a1);
+        memcpy(a2, small, sizeof a2);
+    } else {
+        /* clusters: vertical, and the principal direction of the plan */
+        in_plane_axis(c, idx, m, mean, up, a0);
+        cross3(up, a0, a1);
+        memcpy(a2, up, sizeof a2);
     }
-    for (int a = 0; a < 3; a++)
-        big[a] /= l;
-    double mid[3];
-    cross3(small, big, mid);
     memcpy(s->centroid, mean, sizeof mean);
-    memcpy(s->axes[0], big, sizeof big);
-    memcpy(s->axes[1], mid, sizeof mid);
-    memcpy(s->axes[2], small, sizeof small);
+    memcpy(s->axes[0], a0, sizeof a0);
+    memcpy(s->axes[1], a1, sizeof a1);
+    memcpy(s->axes[2], a2, sizeof a2);
     for (int k = 0; k < 3; k++) {
         double lo = INFINITY, hi = -INFINITY;
         for (size_t j = 0; j < m; j++) {
@@ -195,8 +224,8 @@ static ag_status finish(const ag_cloud *c, ag_segment_cloud_result *r, size_t np
     size_t nlabels = 0;
     for (size_t s = 0; s < r->nsegments; s++) {
         ag_segment_cloud_item *it = &r->segments[s];
-        describe(c, r->members + r->member_start[s], r->member_start[s + 1] - r->member_start[s], it);
         it->kind = s < nplanes ? AG_SEGMENT_CLOUD_PLANE : AG_SEGMENT_CLOUD_CLUSTERED;
+        describe(c, r->members + r->member_start[s], r->member_start[s + 1] - r->member_start[s], it);
         it->label = -1;
         for (size_t l = 0; l < nlabels; l++)
             if (similar(&r->segments[rep[l]], it, 2 * r->spacing)) {

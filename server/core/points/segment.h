@@ -63,7 +63,10 @@ typedef struct {
     size_t count;
     ag_plane plane;         /* least-squares plane (also for clusters: their flattest axis) */
     double centroid[3];
-    double axes[3][3];      /* principal axes, unit, the longest first */
+    /* The box frame: walls and roof planes have their horizontal direction, their slope line
+     * and their normal; level planes the principal direction of their plan, the direction
+     * across it and the normal; clusters the principal plan direction, across, vertical. */
+    double axes[3][3];
     double extent[3];       /* size along each axis */
     int32_t label;
 } ag_segment_cloud_item;
