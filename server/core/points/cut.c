@@ -225,12 +225,12 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
                               "ground by class needs a classification property");
             goto out;
         }
+        for (size_t f = 0; stats && f < nfp; f++)
+            stats[f].by_class = 1;
         for (size_t i = 0; i < n; i++)
             if (owner[i] >= 0 && ag_cloud_get(cls, i) == 2) {
-                if (stats) {
+                if (stats)
                     stats[owner[i]].ground++;
-                    stats[owner[i]].by_class = 1;
-                }
                 owner[i] = -1;
             }
     } else if (method == AG_CUT_GROUND_PLANE) {
