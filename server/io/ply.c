@@ -503,6 +503,11 @@ static ag_status read_ascii(reader *r, ply_element *el, ascii_cursor *cur, int s
                     return ag_error_set(r->err, AG_ERR_PARSE, (long)cur->line,
                                         "line %zu: '%.40s' is not a valid %s for property '%s'",
                                         cur->line, tok, ag_scalar_name(pr->type), pr->name);
+                if (pr->target >= TARGET_X && pr->target < TARGET_NX &&
+                    !isfinite(value_to_double(value, pr->type)))
+                    return ag_error_set(r->err, AG_ERR_PARSE, (long)cur->line,
+                                        "line %zu: point %llu has %s = %s, not a finite number",
+                                        cur->line, (unsigned long long)row + 1, pr->name, tok);
                 if (store_rows)
                     store(r->c, pr, (size_t)row, value);
                 continue;

@@ -245,7 +245,8 @@ static void test_errors(void **state)
     assert_non_null(strstr(e.text, "ends inside vertex row 2"));
     /* the fixture with a NaN names its line */
     assert_int_equal(ag_cloud_import_file(DATA "nan.ply", &c, &e), AG_ERR_PARSE);
-    assert_non_null(strstr(e.text, "point 3"));
+    assert_int_equal(e.element, 10);
+    assert_non_null(strstr(e.text, "point 3 has x = nan"));
 }
 
 static void test_truncation_and_corruption(void **state)
