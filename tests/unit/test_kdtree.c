@@ -115,6 +115,24 @@ static int stop_at_three(void *user, uint32_t id, double d2)
     return ++*(int *)user == 3 ? 7 : 0;
 }
 
+typedef struct {
+    const double *p;
+    size_t n;
+    const ag_kdtree *t;
+    size_t seen;
+} each_check;
+
+static int each_cb(void *user, uint32_t id, const uint32_t *ids, const double *d2,
+                   const double *const *pos, size_t m)
+{
+    each_check *ec = user;
+    if (ec->seen++ % 53 == 0)
+        check_knn(ec->p, ec->n, ec->t, ec->p + 3 * (size_t)id, 16, ids, d2, m);
+    for (size_t j = 0; j < m; j++)
+        assert_memory_equal(pos[j], ec->p + 3 * (size_t)ids[j], 3 * sizeof(double));
+    return 0;
+}
+
 static void run_kind(kind kd, size_t n)
 {
     double *p = make_points(kd, n, 1000 + kd);
@@ -169,6 +187,10 @@ static void run_kind(kind kd, size_t n)
         have = m == 16;
         memcpy(prev, ids, m * sizeof *ids);
     }
+    /* every point's neighbours at once: the same distances, positions that match the ids */
+    each_check ec = {p, n, t, 0};
+    assert_int_equal(ag_kdtree_knn_each(t, 16, each_cb, &ec), 0);
+    assert_int_equal(ec.seen, n);
     /* a visitor can stop the query */
     if (n >= 3) {
         int count = 0;

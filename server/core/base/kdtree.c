@@ -111,8 +111,8 @@ static int build_nodes(ag_kdtree *t)
         for (int a = 1; a < 3; a++)
             if (mx[a] - mn[a] > mx[dim] - mn[dim])
                 dim = a;
-        if (!(mx[dim] > mn[dim]))
-            continue; /* all points equal: one (possibly big) leaf */
+        /* equal points are split by position too: no leaf grows past LEAF_SIZE, so a pile of
+         * duplicates cannot make every query scan it */
         uint32_t mid = lo + (hi - lo) / 2;
         select_kth(t->pts, lo, hi, mid, dim);
         uint32_t left, right;
@@ -190,19 +190,24 @@ typedef struct {
     uint32_t *idx;
     double *d2;
     double bound; /* squared distance a point must beat: the k-th so far, or a known cap */
+    uint32_t *slot; /* optional: the answers' positions in the tree's point array */
 } knn_query;
 
 /* Sorted insertion (k is small), dropping the farthest when full. */
-static void knn_offer(knn_query *s, double d2, uint32_t id)
+static void knn_offer(knn_query *s, double d2, const kd_point *p)
 {
     size_t i = s->count < s->k ? s->count++ : s->k - 1;
     while (i > 0 && s->d2[i - 1] > d2) {
         s->d2[i] = s->d2[i - 1];
         s->idx[i] = s->idx[i - 1];
+        if (s->slot)
+            s->slot[i] = s->slot[i - 1];
         i--;
     }
     s->d2[i] = d2;
-    s->idx[i] = id;
+    s->idx[i] = p->id;
+    if (s->slot)
+        s->slot[i] = (uint32_t)(p - s->t->pts);
     if (s->count == s->k)
         s->bound = s->d2[s->k - 1];
 }
@@ -218,7 +223,7 @@ static void knn_search(knn_query *s, uint32_t index, double rd, double off[3])
             double dx = p->p[0] - s->q[0], dy = p->p[1] - s->q[1], dz = p->p[2] - s->q[2];
             double d2 = dx * dx + dy * dy + dz * dz;
             if (d2 < s->bound)
-                knn_offer(s, d2, p->id);
+                knn_offer(s, d2, p);
         }
         return;
     }
@@ -237,7 +242,7 @@ static void knn_search(knn_query *s, uint32_t index, double rd, double off[3])
 static size_t knn_run(const ag_kdtree *t, const double q[3], size_t k, double bound, uint32_t *idx,
                       double *d2)
 {
-    knn_query s = {t, {q[0], q[1], q[2]}, k, 0, idx, d2, bound};
+    knn_query s = {t, {q[0], q[1], q[2]}, k, 0, idx, d2, bound, NULL};
     double off[3] = {0, 0, 0};
     knn_search(&s, 0, 0, off);
     return s.count;
@@ -321,4 +326,45 @@ int ag_kdtree_radius(const ag_kdtree *t, const double q[3], double r, ag_kdtree_
     radius_query s = {t, {q[0], q[1], q[2]}, r * r, visit, user};
     double off[3] = {0, 0, 0};
     return radius_search(&s, 0, 0, off);
+}
+
+/* ---- all points' neighbours ------------------------------------------------------------- */
+
+int ag_kdtree_knn_each(const ag_kdtree *t, size_t k, ag_kdtree_knn_fn fn, void *user)
+{
+    if (!t->n || !k)
+        return 0;
+    if (k > 64)
+        k = 64;
+    uint32_t ids[64], slots[64];
+    double d2[64];
+    size_t m = 0;
+    for (size_t i = 0; i < t->n; i++) {
+        const kd_point *q = &t->pts[i];
+        /* the previous point is close by in tree order: its k neighbours, k distinct points,
+         * bound the search from the start */
+        double bound = INFINITY;
+        if (m == k) {
+            double cap = 0;
+            for (size_t j = 0; j < k; j++) {
+                const double *p = t->pts[slots[j]].p;
+                double dx = p[0] - q->p[0], dy = p[1] - q->p[1], dz = p[2] - q->p[2];
+                double dd = dx * dx + dy * dy + dz * dz;
+                if (dd > cap)
+                    cap = dd;
+            }
+            bound = nextafter(cap, INFINITY);
+        }
+        knn_query s = {t, {q->p[0], q->p[1], q->p[2]}, k, 0, ids, d2, bound, slots};
+        double off[3] = {0, 0, 0};
+        knn_search(&s, 0, 0, off);
+        m = s.count;
+        const double *pos[64];
+        for (size_t j = 0; j < m; j++)
+            pos[j] = t->pts[slots[j]].p;
+        int stop = fn(user, q->id, ids, d2, pos, m);
+        if (stop)
+            return stop;
+    }
+    return 0;
 }

@@ -119,6 +119,78 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+typedef struct {
+    ag_cloud *c;
+    const ag_normals_options *opt;
+    unsigned k;
+    double centroid[3];
+    float *variation;
+    uint32_t *neighbours;
+    float *nearest;
+    size_t sample_every, nsample, done;
+} normals_pass;
+
+/* One point: covariance of its neighbours, smallest axis, orientation, variation. */
+static int normal_of(void *user, uint32_t i, const uint32_t *idx, const double *d2,
+                     const double *const *pos, size_t m)
+{
+    normals_pass *np = user;
+    ag_cloud *c = np->c;
+    const ag_normals_options *opt = np->opt;
+    if (opt && opt->progress && (np->done & 16383) == 0 &&
+        opt->progress(opt->user, (double)np->done / (double)c->n))
+        return 1;
+    np->done++;
+    unsigned k = np->k;
+    const double *p = c->xyz + 3 * (size_t)i;
+    if (np->neighbours) {
+        uint32_t *row = np->neighbours + (size_t)i * k;
+        for (size_t j = 0; j < k; j++)
+            row[j] = j < m ? idx[j] : m ? idx[m - 1] : i;
+    }
+    if (i % np->sample_every == 0)
+        for (size_t j = 1; j < m; j++)
+            if (d2[j] > 0) { /* duplicates do not count as neighbours */
+                np->nearest[np->nsample++] = (float)sqrt(d2[j]);
+                break;
+            }
+    double mean[3] = {0, 0, 0};
+    for (size_t j = 0; j < m; j++)
+        for (int a = 0; a < 3; a++)
+            mean[a] += pos[j][a];
+    for (int a = 0; a < 3; a++)
+        mean[a] /= (double)(m ? m : 1);
+    double cov[6] = {0, 0, 0, 0, 0, 0};
+    for (size_t j = 0; j < m; j++) {
+        const double *q = pos[j];
+        double x = q[0] - mean[0], y = q[1] - mean[1], z = q[2] - mean[2];
+        cov[0] += x * x;
+        cov[1] += x * y;
+        cov[2] += x * z;
+        cov[3] += y * y;
+        cov[4] += y * z;
+        cov[5] += z * z;
+    }
+    double nv[3], ev[3];
+    ag_normals_smallest_eigenvector(cov, nv, ev);
+    /* orientation: up for roofs and floors, outwards for walls */
+    if (fabs(nv[2]) > 0.5) {
+        if (nv[2] < 0)
+            for (int a = 0; a < 3; a++)
+                nv[a] = -nv[a];
+    } else if (nv[0] * (p[0] - np->centroid[0]) + nv[1] * (p[1] - np->centroid[1]) < 0) {
+        for (int a = 0; a < 3; a++)
+            nv[a] = -nv[a];
+    }
+    for (int a = 0; a < 3; a++)
+        c->normals[3 * (size_t)i + a] = (float)nv[a];
+    if (np->variation) {
+        double e0 = ev[0] > 0 ? ev[0] : 0, sum = e0 + ev[1] + ev[2]; /* rounding: ev0 >= 0 */
+        np->variation[i] = sum > 0 ? (float)(e0 / sum) : 0;
+    }
+    return 0;
+}
+
 ag_status ag_normals_compute(ag_cloud *c, const ag_kdtree *tree, const ag_normals_options *opt,
                              float *variation, uint32_t *neighbours, ag_normals_info *info,
                              ag_error *err)
@@ -134,84 +206,25 @@ ag_status ag_normals_compute(ag_cloud *c, const ag_kdtree *tree, const ag_normal
     size_t n = c->n;
     if (ag_kdtree_size(tree) != n)
         return ag_error_set(err, AG_ERR_INVALID, 0, "the spatial index does not hold the cloud");
-    double centroid[3] = {0, 0, 0};
+    normals_pass np = {c, opt, k, {0, 0, 0}, variation, neighbours, NULL, 1, 0, 0};
     for (size_t i = 0; i < n; i++)
         for (int a = 0; a < 3; a++)
-            centroid[a] += c->xyz[3 * i + a];
+            np.centroid[a] += c->xyz[3 * i + a];
     for (int a = 0; a < 3 && n; a++)
-        centroid[a] /= (double)n;
+        np.centroid[a] /= (double)n;
     /* nearest-neighbour distances of a sample, for the spacing */
-    size_t sample_every = n > 200000 ? n / 100000 : 1, nsample = 0;
-    float *nearest = malloc((n / sample_every + 1) * sizeof *nearest);
-    if (!nearest)
+    np.sample_every = n > 200000 ? n / 100000 : 1;
+    np.nearest = malloc((n / np.sample_every + 1) * sizeof *np.nearest);
+    if (!np.nearest)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    const uint32_t *order = ag_kdtree_order(tree);
-    uint32_t idx[MAX_K], prev[MAX_K];
-    double d2[MAX_K];
-    int have_prev = 0;
-    for (size_t t = 0; t < n; t++) {
-        if (opt && opt->progress && (t & 16383) == 0 && opt->progress(opt->user, (double)t / n)) {
-            free(nearest);
-            return ag_error_set(err, AG_ERR_CANCELLED, 0, "cancelled");
-        }
-        uint32_t i = order[t];
-        const double *p = c->xyz + 3 * (size_t)i;
-        /* the previous point's neighbours (it is close by in tree order) bound the search;
-         * they must be k distinct points, which a full previous answer is */
-        size_t m = t && have_prev ? ag_kdtree_knn_hint(tree, p, k, prev, c->xyz, idx, d2)
-                                  : ag_kdtree_knn(tree, p, k, idx, d2);
-        have_prev = m == k;
-        memcpy(prev, idx, m * sizeof *idx);
-        if (neighbours) {
-            uint32_t *row = neighbours + (size_t)i * k;
-            for (size_t j = 0; j < k; j++)
-                row[j] = j < m ? idx[j] : m ? idx[m - 1] : i;
-        }
-        if (t % sample_every == 0)
-            for (size_t j = 1; j < m; j++)
-                if (d2[j] > 0) { /* duplicates do not count as neighbours */
-                    nearest[nsample++] = (float)sqrt(d2[j]);
-                    break;
-                }
-        double mean[3] = {0, 0, 0};
-        for (size_t j = 0; j < m; j++)
-            for (int a = 0; a < 3; a++)
-                mean[a] += c->xyz[3 * (size_t)idx[j] + a];
-        for (int a = 0; a < 3; a++)
-            mean[a] /= (double)(m ? m : 1);
-        double cov[6] = {0, 0, 0, 0, 0, 0};
-        for (size_t j = 0; j < m; j++) {
-            const double *q = c->xyz + 3 * (size_t)idx[j];
-            double x = q[0] - mean[0], y = q[1] - mean[1], z = q[2] - mean[2];
-            cov[0] += x * x;
-            cov[1] += x * y;
-            cov[2] += x * z;
-            cov[3] += y * y;
-            cov[4] += y * z;
-            cov[5] += z * z;
-        }
-        double nv[3], ev[3];
-        ag_normals_smallest_eigenvector(cov, nv, ev);
-        /* orientation: up for roofs and floors, outwards for walls */
-        if (fabs(nv[2]) > 0.5) {
-            if (nv[2] < 0)
-                for (int a = 0; a < 3; a++)
-                    nv[a] = -nv[a];
-        } else if (nv[0] * (p[0] - centroid[0]) + nv[1] * (p[1] - centroid[1]) < 0) {
-            for (int a = 0; a < 3; a++)
-                nv[a] = -nv[a];
-        }
-        for (int a = 0; a < 3; a++)
-            c->normals[3 * (size_t)i + a] = (float)nv[a];
-        if (variation) {
-            double e0 = ev[0] > 0 ? ev[0] : 0, sum = e0 + ev[1] + ev[2]; /* rounding: ev0 >= 0 */
-            variation[i] = sum > 0 ? (float)(e0 / sum) : 0;
-        }
+    if (ag_kdtree_knn_each(tree, k, normal_of, &np)) {
+        free(np.nearest);
+        return ag_error_set(err, AG_ERR_CANCELLED, 0, "cancelled");
     }
-    if (info && nsample) {
-        qsort(nearest, nsample, sizeof *nearest, cmp_float);
-        info->spacing = nearest[nsample / 2];
+    if (info && np.nsample) {
+        qsort(np.nearest, np.nsample, sizeof *np.nearest, cmp_float);
+        info->spacing = np.nearest[np.nsample / 2];
     }
-    free(nearest);
+    free(np.nearest);
     return AG_OK;
 }
