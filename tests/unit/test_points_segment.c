@@ -327,6 +327,35 @@ static void test_hard_cases(void **state)
     ag_cloud_free(c);
 }
 
+static void test_pile_of_duplicates(void **state)
+{
+    (void)state;
+    /* 300k copies of one spot next to a small plane: linear work, no plane in the pile */
+    ag_cloud *c = ag_cloud_create();
+    assert_int_equal(ag_cloud_resize(c, 302500, NULL), AG_OK);
+    for (size_t i = 0; i < 300000; i++) {
+        c->xyz[3 * i] = 5;
+        c->xyz[3 * i + 1] = 5;
+        c->xyz[3 * i + 2] = 5;
+    }
+    for (size_t i = 0; i < 2500; i++) {
+        double *p = c->xyz + 3 * (300000 + i);
+        p[0] = (double)(i % 50) * 0.1;
+        p[1] = (double)(i / 50) * 0.1;
+        p[2] = 0;
+    }
+    ag_segment_cloud_result *r;
+    assert_int_equal(ag_segment_cloud_run(c, NULL, &r, NULL), AG_OK);
+    size_t plane_pts = 0;
+    for (size_t i = 300000; i < c->n; i++)
+        plane_pts += r->segment[i] >= 0 && r->segments[r->segment[i]].kind == AG_SEGMENT_CLOUD_PLANE;
+    assert_true(plane_pts > 2400);
+    for (size_t i = 0; i < 300000; i += 997)
+        assert_true(r->segment[i] < 0 || r->segments[r->segment[i]].kind == AG_SEGMENT_CLOUD_CLUSTERED);
+    ag_segment_cloud_free(r);
+    ag_cloud_free(c);
+}
+
 static void test_cgal_building(void **state)
 {
     (void)state;
@@ -369,6 +398,7 @@ int main(void)
         cmocka_unit_test(test_roi_refinement),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_hard_cases),
+        cmocka_unit_test(test_pile_of_duplicates),
         cmocka_unit_test(test_cgal_building),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

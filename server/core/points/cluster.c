@@ -4,7 +4,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../base/kdtree.h"
 
 ag_status ag_cluster_components(const ag_cloud *c, const ag_ransac_graph *g, double radius,
                                 int32_t *labels, size_t min_size, size_t *ncomponents,
@@ -84,62 +83,35 @@ ag_status ag_cluster_components(const ag_cloud *c, const ag_ransac_graph *g, dou
     return AG_OK;
 }
 
-typedef struct {
-    uint8_t *seen;
-    uint32_t *queue;
-    size_t qn;
-} cluster_bfs;
-
-static int visit(void *user, uint32_t id, double d2)
-{
-    (void)d2;
-    cluster_bfs *b = user;
-    if (!b->seen[id]) {
-        b->seen[id] = 1;
-        b->queue[b->qn++] = id;
-    }
-    return 0;
-}
-
 ag_status ag_cluster_euclidean(const ag_cloud *c, const uint32_t *idx, size_t m, double tolerance,
                                size_t min_size, int32_t first_id, int32_t *out, size_t *nclusters,
                                ag_error *err)
 {
+    /* the grid of pieces with the tolerance as cell: linear time whatever the density (a
+     * radius search per point is quadratic on a pile of duplicates) */
     *nclusters = 0;
     if (!m)
         return AG_OK;
-    ag_kdtree *t;
-    ag_status st = ag_kdtree_build(c->xyz, idx, m, &t, err);
-    if (st != AG_OK)
-        return st;
-    cluster_bfs b = {calloc(c->n, 1), malloc(m * sizeof(uint32_t)), 0};
-    if (!b.seen || !b.queue) {
-        free(b.seen);
-        free(b.queue);
-        ag_kdtree_free(t);
+    int32_t *labels = malloc(c->n * sizeof *labels), *piece = malloc(c->n * sizeof *piece);
+    if (!labels || !piece) {
+        free(labels);
+        free(piece);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
-    /* seeds in tree order: spatially coherent, and the same on every run */
-    const uint32_t *order = ag_kdtree_order(t);
-    int32_t next = first_id;
-    for (size_t s = 0; s < m; s++) {
-        uint32_t seed = order[s];
-        if (b.seen[seed])
-            continue;
-        b.qn = 0;
-        b.seen[seed] = 1;
-        b.queue[b.qn++] = seed;
-        for (size_t h = 0; h < b.qn; h++)
-            ag_kdtree_radius(t, c->xyz + 3 * (size_t)b.queue[h], tolerance, visit, &b);
-        int32_t id = b.qn >= min_size ? next++ : -1;
-        for (size_t h = 0; h < b.qn; h++)
-            out[b.queue[h]] = id;
+    for (size_t i = 0; i < c->n; i++)
+        labels[i] = -1;
+    for (size_t j = 0; j < m; j++)
+        labels[idx[j]] = 0;
+    size_t np = 0;
+    ag_status st = ag_cluster_pieces(c, labels, tolerance, min_size, piece, &np, err);
+    if (st == AG_OK) {
+        for (size_t j = 0; j < m; j++)
+            out[idx[j]] = piece[idx[j]] >= 0 ? first_id + piece[idx[j]] : -1;
+        *nclusters = np;
     }
-    *nclusters = (size_t)(next - first_id);
-    free(b.seen);
-    free(b.queue);
-    ag_kdtree_free(t);
-    return AG_OK;
+    free(labels);
+    free(piece);
+    return st;
 }
 
 /* ---- pieces on a grid ------------------------------------------------------------------ */

@@ -2,10 +2,11 @@
  *
  * Components: each plane's inliers split into pieces connected through the neighbour
  * graph (two points are connected when one is among the other's k nearest and they are at
- * most `radius` apart). Euclidean clustering: what no plane holds is grouped into clusters
- * whose points are chained by gaps of at most the tolerance T_C (single linkage, as PCL's
- * Euclidean cluster extraction that the paper uses), found with radius queries in a
- * kd-tree over just those points. */
+ * most `radius` apart). Pieces on a grid: the same on a grid of cells, for gaps larger than
+ * the graph reaches. Euclidean clustering: what no plane holds is grouped into clusters
+ * whose points are chained by gaps below the tolerance T_C (single linkage, as PCL's
+ * Euclidean cluster extraction that the paper uses), on the grid: linear time at any
+ * density. */
 #ifndef AG_CLUSTER_H
 #define AG_CLUSTER_H
 
@@ -33,7 +34,9 @@ ag_status ag_cluster_pieces(const ag_cloud *c, int32_t *labels, double cell, siz
                             int32_t *piece, size_t *npieces, ag_error *err);
 
 /* Clusters the points idx[0..m): out[idx[j]] = first_id + cluster, or -1 for clusters
- * smaller than min_size. *nclusters receives the count of clusters kept. */
+ * smaller than min_size. *nclusters receives the count of clusters kept. Points closer than
+ * the tolerance are always in one cluster; the chain may also bridge gaps up to about 3.5
+ * times the tolerance (cells of the tolerance's size that touch). */
 ag_status ag_cluster_euclidean(const ag_cloud *c, const uint32_t *idx, size_t m, double tolerance,
                                size_t min_size, int32_t first_id, int32_t *out, size_t *nclusters,
                                ag_error *err);

@@ -234,6 +234,27 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
                 owner[i] = -1;
             }
     } else if (method == AG_CUT_GROUND_PLANE) {
+        /* each footprint's points (CSR by owner) */
+        size_t *fstart = calloc(nfp + 2, sizeof *fstart);
+        uint32_t *fmembers = malloc((n ? n : 1) * sizeof *fmembers);
+        size_t *ffill = malloc((nfp + 1) * sizeof *ffill);
+        if (!fstart || !fmembers || !ffill) {
+            free(fstart);
+            free(fmembers);
+            free(ffill);
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            goto out;
+        }
+        for (size_t i = 0; i < n; i++)
+            if (owner[i] >= 0)
+                fstart[owner[i] + 1]++;
+        for (size_t f = 0; f < nfp; f++)
+            fstart[f + 1] += fstart[f];
+        memcpy(ffill, fstart, (nfp + 1) * sizeof *ffill);
+        for (size_t i = 0; i < n; i++)
+            if (owner[i] >= 0)
+                fmembers[ffill[owner[i]]++] = (uint32_t)i;
+        free(ffill);
         for (size_t f = 0; f < nfp; f++) {
             /* the ring around the footprint, its lowest third as the ground sample */
             double mn[2], mx[2];
@@ -258,9 +279,8 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
             int own = m < 10;
             if (own) {
                 m = 0;
-                for (size_t i = 0; i < n; i++)
-                    if (owner[i] == (int32_t)f)
-                        cand[m++] = (uint32_t)i;
+                for (size_t j = fstart[f]; j < fstart[f + 1]; j++)
+                    cand[m++] = fmembers[j];
             }
             if (!m)
                 continue;
@@ -283,9 +303,8 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
             double cxm = (mn[0] + mx[0]) / 2, cym = (mn[1] + mx[1]) / 2;
             if (stats)
                 stats[f].ground_z = -(pl.n[0] * cxm + pl.n[1] * cym + pl.d) / pl.n[2];
-            for (size_t i = 0; i < n; i++) {
-                if (owner[i] != (int32_t)f)
-                    continue;
+            for (size_t j = fstart[f]; j < fstart[f + 1]; j++) {
+                size_t i = fmembers[j];
                 const double *p = c->xyz + 3 * i;
                 double zg = -(pl.n[0] * p[0] + pl.n[1] * p[1] + pl.d) / pl.n[2];
                 if (p[2] - zg < ground_height) {
@@ -295,6 +314,8 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
                 }
             }
         }
+        free(fstart);
+        free(fmembers);
     }
     if (stats)
         for (size_t f = 0; f < nfp; f++)

@@ -200,7 +200,9 @@ ag_status ag_ransac_global(const ag_cloud *c, const uint32_t *idx, size_t m,
         free(resid);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
-    while (na >= min_points && fails < max_fail && (!o->max_planes || found < o->max_planes)) {
+    /* a budget: a cloud of tiny planes would otherwise cost a full pass per plane */
+    unsigned max_planes = o->max_planes ? o->max_planes : 2000;
+    while (na >= min_points && fails < max_fail && found < max_planes) {
         if (o->progress && o->progress(o->user, 1.0 - (double)na / (double)(m ? m : 1))) {
             st = ag_error_set(err, AG_ERR_CANCELLED, 0, "cancelled");
             break;

@@ -44,7 +44,8 @@ typedef struct {
     double threshold;    /* inlier distance in metres (> 0) */
     double max_angle;    /* degrees between a point's normal and the plane's; 0: no test */
     size_t min_points;   /* smallest plane taken (>= 3) */
-    unsigned max_planes; /* planes per call; 0: no limit */
+    unsigned max_planes; /* planes per call; 0: 2000 for the global pass, no limit for the
+                          * local one (its work is bounded by the points) */
     /* global pass */
     unsigned hypotheses; /* candidates per round; 0 = 256 */
     unsigned sample;     /* points a candidate is scored on; 0 = 4096 */
