@@ -97,6 +97,19 @@ static const char *format_of(const char *path, size_t *bytes)
     return name;
 }
 
+static void prop_range(const ag_cloud *c, const ag_cloud_property *p, double *lo, double *hi)
+{
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (size_t i = 0; i < c->n; i++) {
+        double v = ag_cloud_get(p, i);
+        if (v < *lo)
+            *lo = v;
+        if (v > *hi)
+            *hi = v;
+    }
+}
+
 int ag_cli_cloud_info(const char *file, int as_json)
 {
     ag_cloud *c;
@@ -134,14 +147,8 @@ int ag_cli_cloud_info(const char *file, int as_json)
         json_t *props = json_array();
         for (size_t p = 0; p < c->nprops; p++) {
             const ag_cloud_property *pr = &c->props[p];
-            double lo = INFINITY, hi = -INFINITY;
-            for (size_t i = 0; i < c->n; i++) {
-                double v = ag_cloud_get(pr, i);
-                if (v < lo)
-                    lo = v;
-                if (v > hi)
-                    hi = v;
-            }
+            double lo, hi;
+            prop_range(c, pr, &lo, &hi);
             json_t *o = json_object();
             json_object_set_new(o, "name", json_string(pr->name));
             json_object_set_new(o, "type", json_string(ag_scalar_name(pr->type)));
@@ -172,14 +179,8 @@ int ag_cli_cloud_info(const char *file, int as_json)
         }
         for (size_t p = 0; p < c->nprops; p++) {
             const ag_cloud_property *pr = &c->props[p];
-            double lo = INFINITY, hi = -INFINITY;
-            for (size_t i = 0; i < c->n; i++) {
-                double v = ag_cloud_get(pr, i);
-                if (v < lo)
-                    lo = v;
-                if (v > hi)
-                    hi = v;
-            }
+            double lo, hi;
+            prop_range(c, pr, &lo, &hi);
             printf("property    %-22s %-8s", pr->name, ag_scalar_name(pr->type));
             if (c->n)
                 printf(" %.10g .. %.10g", lo, hi);

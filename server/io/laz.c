@@ -474,6 +474,13 @@ static ac_model *lazy_get(lazy_models *l, unsigned i, int *fail)
     return l->m[i];
 }
 
+/* A byte coded with the model chosen by the previous byte; `keep` when memory runs out. */
+static uint8_t lazy_decode(lazy_models *l, unsigned context, ac_dec *d, uint8_t keep, int *fail)
+{
+    ac_model *m = lazy_get(l, context, fail);
+    return m ? (uint8_t)decode_symbol(d, m) : keep;
+}
+
 static void lazy_init(lazy_models *l)
 {
     for (int i = 0; i < 256; i++)
@@ -641,23 +648,14 @@ static void point10_read_v1(point10_dec *s, ac_dec *d, uint8_t *item, int *fail)
         if (changed & 32)
             ag_bytes_put_u16le(item + 12,
                                (uint16_t)ic_decompress(&s->ic_intensity, d, ag_bytes_u16le(last + 12), 0));
-        if (changed & 16) {
-            ac_model *m = lazy_get(&s->bit_byte, last[14], fail);
-            if (m)
-                item[14] = (uint8_t)decode_symbol(d, m);
-        }
-        if (changed & 8) {
-            ac_model *m = lazy_get(&s->classification, last[15], fail);
-            if (m)
-                item[15] = (uint8_t)decode_symbol(d, m);
-        }
+        if (changed & 16)
+            item[14] = lazy_decode(&s->bit_byte, last[14], d, item[14], fail);
+        if (changed & 8)
+            item[15] = lazy_decode(&s->classification, last[15], d, item[15], fail);
         if (changed & 4)
             item[16] = (uint8_t)ic_decompress(&s->ic_scan_angle, d, last[16], k_bits < 3);
-        if (changed & 2) {
-            ac_model *m = lazy_get(&s->user_data, last[17], fail);
-            if (m)
-                item[17] = (uint8_t)decode_symbol(d, m);
-        }
+        if (changed & 2)
+            item[17] = lazy_decode(&s->user_data, last[17], d, item[17], fail);
         if (changed & 1)
             ag_bytes_put_u16le(item + 18,
                                (uint16_t)ic_decompress(&s->ic_psid, d, ag_bytes_u16le(last + 18), 0));
@@ -673,17 +671,12 @@ static void point10_read_v2(point10_dec *s, ac_dec *d, uint8_t *item, int *fail)
 {
     uint8_t *last = s->last;
     uint32_t changed = decode_symbol(d, &s->changed_values);
-    unsigned r, n, m, l;
+    if (changed & 32)
+        last[14] = lazy_decode(&s->bit_byte, last[14], d, last[14], fail);
+    /* contexts from the return number and the number of returns */
+    unsigned r = last[14] & 7, n = (last[14] >> 3) & 7;
+    unsigned m = number_return_map[n][r], l = number_return_level[n][r];
     if (changed) {
-        if (changed & 32) {
-            ac_model *bm = lazy_get(&s->bit_byte, last[14], fail);
-            if (bm)
-                last[14] = (uint8_t)decode_symbol(d, bm);
-        }
-        r = last[14] & 7;
-        n = (last[14] >> 3) & 7;
-        m = number_return_map[n][r];
-        l = number_return_level[n][r];
         if (changed & 16) {
             uint16_t v = (uint16_t)ic_decompress(&s->ic_intensity, d, s->last_intensity[m], m < 3 ? m : 3);
             ag_bytes_put_u16le(last + 12, v);
@@ -691,28 +684,17 @@ static void point10_read_v2(point10_dec *s, ac_dec *d, uint8_t *item, int *fail)
         } else {
             ag_bytes_put_u16le(last + 12, s->last_intensity[m]);
         }
-        if (changed & 8) {
-            ac_model *cm = lazy_get(&s->classification, last[15], fail);
-            if (cm)
-                last[15] = (uint8_t)decode_symbol(d, cm);
-        }
+        if (changed & 8)
+            last[15] = lazy_decode(&s->classification, last[15], d, last[15], fail);
         if (changed & 4) {
             int32_t v = (int32_t)decode_symbol(d, &s->scan_angle[(last[14] >> 6) & 1]);
             last[16] = u8_fold(v + last[16]);
         }
-        if (changed & 2) {
-            ac_model *um = lazy_get(&s->user_data, last[17], fail);
-            if (um)
-                last[17] = (uint8_t)decode_symbol(d, um);
-        }
+        if (changed & 2)
+            last[17] = lazy_decode(&s->user_data, last[17], d, last[17], fail);
         if (changed & 1)
             ag_bytes_put_u16le(last + 18,
                                (uint16_t)ic_decompress(&s->ic_psid, d, ag_bytes_u16le(last + 18), 0));
-    } else {
-        r = last[14] & 7;
-        n = (last[14] >> 3) & 7;
-        m = number_return_map[n][r];
-        l = number_return_level[n][r];
     }
     int32_t median = s->last_x_diff_median[m].v[2];
     int32_t diff = ic_decompress(&s->ic_dx, d, median, n == 1);
@@ -822,6 +804,18 @@ static void gpstime_read_v1(gpstime_dec *s, ac_dec *d, uint8_t *item)
     ag_bytes_put_u64le(item, *last);
 }
 
+/* A time far from the last one: a new sequence, its upper half predicted, the lower raw. */
+static void gpstime_v2_full(gpstime_dec *s, ac_dec *d, unsigned from)
+{
+    s->next = (s->next + 1) & 3;
+    uint64_t hi = (uint32_t)ic_decompress(&s->ic_gpstime, d,
+                                          (int32_t)(uint32_t)(s->last_gpstime[from] >> 32), 8);
+    s->last_gpstime[s->next] = hi << 32 | read_int(d);
+    s->last = s->next;
+    s->last_gpstime_diff[s->last] = 0;
+    s->multi_extreme_counter[s->last] = 0;
+}
+
 static void gpstime_read_v2(gpstime_dec *s, ac_dec *d, uint8_t *item)
 {
     /* a switch to another sequence reads again; a valid stream switches at most once per
@@ -835,13 +829,7 @@ static void gpstime_read_v2(gpstime_dec *s, ac_dec *d, uint8_t *item)
                 s->last_gpstime[L] += (uint64_t)(int64_t)s->last_gpstime_diff[L];
                 s->multi_extreme_counter[L] = 0;
             } else if (multi == 2) {
-                s->next = (s->next + 1) & 3;
-                uint64_t hi = (uint32_t)ic_decompress(&s->ic_gpstime, d,
-                                                      (int32_t)(uint32_t)(s->last_gpstime[L] >> 32), 8);
-                s->last_gpstime[s->next] = hi << 32 | read_int(d);
-                s->last = s->next;
-                s->last_gpstime_diff[s->last] = 0;
-                s->multi_extreme_counter[s->last] = 0;
+                gpstime_v2_full(s, d, L);
             } else if (multi > 2) {
                 s->last = (L + multi - 2) & 3;
                 continue;
@@ -883,13 +871,7 @@ static void gpstime_read_v2(gpstime_dec *s, ac_dec *d, uint8_t *item)
                 }
                 s->last_gpstime[L] += (uint64_t)(int64_t)diff;
             } else if (multi == GPS_MULTI_CODE_FULL) {
-                s->next = (s->next + 1) & 3;
-                uint64_t hi = (uint32_t)ic_decompress(&s->ic_gpstime, d,
-                                                      (int32_t)(uint32_t)(s->last_gpstime[L] >> 32), 8);
-                s->last_gpstime[s->next] = hi << 32 | read_int(d);
-                s->last = s->next;
-                s->last_gpstime_diff[s->last] = 0;
-                s->multi_extreme_counter[s->last] = 0;
+                gpstime_v2_full(s, d, L);
             } else if (multi > GPS_MULTI_CODE_FULL) {
                 s->last = (L + (unsigned)(multi - GPS_MULTI_CODE_FULL)) & 3;
                 continue;

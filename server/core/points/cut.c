@@ -134,18 +134,31 @@ static int grid_build(grid2 *g, const ag_cloud *c)
     return 0;
 }
 
-/* Cell index range covering [mn, mx]. */
-static void grid_range(const grid2 *g, const double mn[2], const double mx[2], size_t lo[2],
-                       size_t hi[2])
+/* The points inside the box [mn, mx] (x y), into out; returns their count. */
+static size_t grid_points(const grid2 *g, const ag_cloud *c, const double mn[2], const double mx[2],
+                          uint32_t *out)
 {
     const size_t dims[2] = {g->nx, g->ny};
+    size_t lo[2], hi[2];
     for (int a = 0; a < 2; a++) {
         double l = floor((mn[a] - g->min[a]) / g->h), h = floor((mx[a] - g->min[a]) / g->h);
-        lo[a] = l < 0 ? 0 : l >= (double)dims[a] ? dims[a] : (size_t)l;
-        hi[a] = h < 0 ? 0 : h >= (double)dims[a] ? dims[a] - 1 : (size_t)h;
-        if (h < 0)
-            lo[a] = 1, hi[a] = 0; /* empty */
+        if (h < 0 || l >= (double)dims[a])
+            return 0;
+        lo[a] = l < 0 ? 0 : (size_t)l;
+        hi[a] = h >= (double)dims[a] ? dims[a] - 1 : (size_t)h;
     }
+    size_t m = 0;
+    for (size_t cy = lo[1]; cy <= hi[1]; cy++)
+        for (size_t cx = lo[0]; cx <= hi[0]; cx++) {
+            size_t cell = cy * g->nx + cx;
+            for (uint32_t k = g->start[cell]; k < g->start[cell + 1]; k++) {
+                uint32_t i = g->pts[k];
+                double x = c->xyz[3 * (size_t)i], y = c->xyz[3 * (size_t)i + 1];
+                if (x >= mn[0] && x <= mx[0] && y >= mn[1] && y <= mx[1])
+                    out[m++] = i;
+            }
+        }
+    return m;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -185,29 +198,24 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
         buildings_classified = ag_cloud_get(cls, i) == 6;
     for (size_t f = 0; f < nfp; f++) {
         double mn[2], mx[2];
-        size_t lo[2], hi[2];
         footprint_box(&fps[f], buffer, mn, mx);
-        grid_range(&g, mn, mx, lo, hi);
-        for (size_t cy = lo[1]; cy <= hi[1] && lo[1] <= hi[1]; cy++)
-            for (size_t cx = lo[0]; cx <= hi[0] && lo[0] <= hi[0]; cx++) {
-                size_t cell = cy * g.nx + cx;
-                for (uint32_t k = g.start[cell]; k < g.start[cell + 1]; k++) {
-                    uint32_t i = g.pts[k];
-                    double x = c->xyz[3 * (size_t)i], y = c->xyz[3 * (size_t)i + 1];
-                    if (x < mn[0] || x > mx[0] || y < mn[1] || y > mx[1] || best[i] < 0)
-                        continue;
-                    if (ag_cut_inside(&fps[f], x, y)) {
-                        owner[i] = (int32_t)f;
-                        best[i] = -1;
-                    } else if (buffer > 0 && (!buildings_classified || ag_cloud_get(cls, i) == 6)) {
-                        double d = ag_cut_edge_distance(&fps[f], x, y);
-                        if (d <= buffer && d < best[i]) {
-                            owner[i] = (int32_t)f;
-                            best[i] = (float)d;
-                        }
-                    }
+        size_t m = grid_points(&g, c, mn, mx, cand);
+        for (size_t j = 0; j < m; j++) {
+            uint32_t i = cand[j];
+            double x = c->xyz[3 * (size_t)i], y = c->xyz[3 * (size_t)i + 1];
+            if (best[i] < 0)
+                continue;
+            if (ag_cut_inside(&fps[f], x, y)) {
+                owner[i] = (int32_t)f;
+                best[i] = -1;
+            } else if (buffer > 0 && (!buildings_classified || ag_cloud_get(cls, i) == 6)) {
+                double d = ag_cut_edge_distance(&fps[f], x, y);
+                if (d <= buffer && d < best[i]) {
+                    owner[i] = (int32_t)f;
+                    best[i] = (float)d;
                 }
             }
+        }
     }
     if (stats)
         for (size_t i = 0; i < n; i++)
@@ -258,24 +266,17 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
         for (size_t f = 0; f < nfp; f++) {
             /* the ring around the footprint, its lowest third as the ground sample */
             double mn[2], mx[2];
-            size_t lo[2], hi[2];
             footprint_box(&fps[f], buffer + RING, mn, mx);
-            grid_range(&g, mn, mx, lo, hi);
-            size_t m = 0;
-            for (size_t cy = lo[1]; cy <= hi[1] && lo[1] <= hi[1]; cy++)
-                for (size_t cx = lo[0]; cx <= hi[0] && lo[0] <= hi[0]; cx++) {
-                    size_t cell = cy * g.nx + cx;
-                    for (uint32_t k = g.start[cell]; k < g.start[cell + 1]; k++) {
-                        uint32_t i = g.pts[k];
-                        double x = c->xyz[3 * (size_t)i], y = c->xyz[3 * (size_t)i + 1];
-                        if (x < mn[0] || x > mx[0] || y < mn[1] || y > mx[1] ||
-                            ag_cut_inside(&fps[f], x, y))
-                            continue;
-                        double d = ag_cut_edge_distance(&fps[f], x, y);
-                        if (d > buffer && d <= buffer + RING)
-                            cand[m++] = i;
-                    }
-                }
+            size_t all = grid_points(&g, c, mn, mx, cand), m = 0;
+            for (size_t j = 0; j < all; j++) {
+                uint32_t i = cand[j];
+                double x = c->xyz[3 * (size_t)i], y = c->xyz[3 * (size_t)i + 1];
+                if (ag_cut_inside(&fps[f], x, y))
+                    continue;
+                double d = ag_cut_edge_distance(&fps[f], x, y);
+                if (d > buffer && d <= buffer + RING)
+                    cand[m++] = i;
+            }
             int own = m < 10;
             if (own) {
                 m = 0;

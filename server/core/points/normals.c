@@ -113,6 +113,31 @@ void ag_normals_smallest_eigenvector(const double a_in[6], double n[3], double e
     n[2] = 1; /* isotropic: no preferred direction */
 }
 
+void ag_normals_covariance(const double *xyz, const uint32_t *idx, size_t m, double mean[3],
+                           double cov[6])
+{
+    mean[0] = mean[1] = mean[2] = 0;
+    for (int i = 0; i < 6; i++)
+        cov[i] = 0;
+    for (size_t j = 0; j < m; j++) {
+        const double *p = xyz + 3 * (size_t)(idx ? idx[j] : j);
+        for (int a = 0; a < 3; a++)
+            mean[a] += p[a];
+    }
+    for (int a = 0; a < 3 && m; a++)
+        mean[a] /= (double)m;
+    for (size_t j = 0; j < m; j++) {
+        const double *p = xyz + 3 * (size_t)(idx ? idx[j] : j);
+        double x = p[0] - mean[0], y = p[1] - mean[1], z = p[2] - mean[2];
+        cov[0] += x * x;
+        cov[1] += x * y;
+        cov[2] += x * z;
+        cov[3] += y * y;
+        cov[4] += y * z;
+        cov[5] += z * z;
+    }
+}
+
 static int cmp_float(const void *a, const void *b)
 {
     float x = *(const float *)a, y = *(const float *)b;
@@ -154,23 +179,11 @@ static int normal_of(void *user, uint32_t i, const uint32_t *idx, const double *
                 np->nearest[np->nsample++] = (float)sqrt(d2[j]);
                 break;
             }
-    double mean[3] = {0, 0, 0};
+    /* the neighbours side by side, for the shared covariance */
+    double near[3 * MAX_K], mean[3], cov[6];
     for (size_t j = 0; j < m; j++)
-        for (int a = 0; a < 3; a++)
-            mean[a] += pos[j][a];
-    for (int a = 0; a < 3; a++)
-        mean[a] /= (double)(m ? m : 1);
-    double cov[6] = {0, 0, 0, 0, 0, 0};
-    for (size_t j = 0; j < m; j++) {
-        const double *q = pos[j];
-        double x = q[0] - mean[0], y = q[1] - mean[1], z = q[2] - mean[2];
-        cov[0] += x * x;
-        cov[1] += x * y;
-        cov[2] += x * z;
-        cov[3] += y * y;
-        cov[4] += y * z;
-        cov[5] += z * z;
-    }
+        memcpy(near + 3 * j, pos[j], 3 * sizeof(double));
+    ag_normals_covariance(near, NULL, m, mean, cov);
     double nv[3], ev[3];
     ag_normals_smallest_eigenvector(cov, nv, ev);
     /* orientation: up for roofs and floors, outwards for walls */

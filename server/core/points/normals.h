@@ -31,6 +31,11 @@ ag_status ag_normals_compute(ag_cloud *c, const ag_kdtree *tree, const ag_normal
                              float *variation, uint32_t *neighbours, ag_normals_info *info,
                              ag_error *err);
 
+/* Mean and covariance {xx, xy, xz, yy, yz, zz} (sums, not divided) of the points
+ * xyz[3*idx[j]..] for j < m, or of the first m points when idx is NULL. */
+void ag_normals_covariance(const double *xyz, const uint32_t *idx, size_t m, double mean[3],
+                           double cov[6]);
+
 /* The unit eigenvector of the smallest eigenvalue of the symmetric 3x3 matrix
  * {a00, a01, a02, a11, a12, a22}, and the eigenvalues ascending in ev (optional). */
 void ag_normals_smallest_eigenvector(const double a[6], double n[3], double ev[3]);

@@ -31,25 +31,8 @@ int ag_ransac_fit(const double *xyz, const uint32_t *idx, size_t m, ag_plane *pl
 {
     if (m < 3)
         return -1;
-    double mean[3] = {0, 0, 0};
-    for (size_t j = 0; j < m; j++) {
-        const double *p = xyz + 3 * (size_t)(idx ? idx[j] : j);
-        for (int a = 0; a < 3; a++)
-            mean[a] += p[a];
-    }
-    for (int a = 0; a < 3; a++)
-        mean[a] /= (double)m;
-    double cov[6] = {0, 0, 0, 0, 0, 0};
-    for (size_t j = 0; j < m; j++) {
-        const double *p = xyz + 3 * (size_t)(idx ? idx[j] : j);
-        double x = p[0] - mean[0], y = p[1] - mean[1], z = p[2] - mean[2];
-        cov[0] += x * x;
-        cov[1] += x * y;
-        cov[2] += x * z;
-        cov[3] += y * y;
-        cov[4] += y * z;
-        cov[5] += z * z;
-    }
+    double mean[3], cov[6];
+    ag_normals_covariance(xyz, idx, m, mean, cov);
     double n[3], ev[3];
     ag_normals_smallest_eigenvector(cov, n, ev);
     if (!(ev[1] > ev[2] * 4e-4))

@@ -116,23 +116,8 @@ static void in_plane_axis(const ag_cloud *c, const uint32_t *idx, size_t m, cons
  * and the principal direction of their plan. */
 static void describe(const ag_cloud *c, const uint32_t *idx, size_t m, ag_segment_cloud_item *s)
 {
-    double mean[3] = {0, 0, 0};
-    for (size_t j = 0; j < m; j++)
-        for (int a = 0; a < 3; a++)
-            mean[a] += c->xyz[3 * (size_t)idx[j] + a];
-    for (int a = 0; a < 3; a++)
-        mean[a] /= (double)(m ? m : 1);
-    double cov[6] = {0, 0, 0, 0, 0, 0};
-    for (size_t j = 0; j < m; j++) {
-        const double *p = c->xyz + 3 * (size_t)idx[j];
-        double x = p[0] - mean[0], y = p[1] - mean[1], z = p[2] - mean[2];
-        cov[0] += x * x;
-        cov[1] += x * y;
-        cov[2] += x * z;
-        cov[3] += y * y;
-        cov[4] += y * z;
-        cov[5] += z * z;
-    }
+    double mean[3], cov[6];
+    ag_normals_covariance(c->xyz, idx, m, mean, cov);
     double small[3], ev[3];
     ag_normals_smallest_eigenvector(cov, small, ev);
     double a0[3], a1[3], a2[3];
