@@ -109,6 +109,12 @@ static void emodel_init(emodel *m, uint32_t symbols)
     m->until = m->cycle = (symbols + 6) >> 1;
 }
 
+static void emodel_free(emodel *m)
+{
+    free(m->dist);
+    m->dist = m->count = NULL;
+}
+
 static void enc_symbol(enc *e, emodel *m, uint32_t sym)
 {
     uint32_t x, init = e->base;
@@ -263,6 +269,17 @@ static void eic_compress(eic *c, enc *e, int32_t pred, int32_t real, uint32_t ct
     } else {
         enc_bit(e, &c->corr0, (uint32_t)cv);
     }
+}
+
+static void eic_free(eic *c)
+{
+    for (uint32_t i = 0; c->bits && i < c->contexts; i++)
+        emodel_free(&c->bits[i]);
+    for (uint32_t i = 0; c->corr && i < c->corr_bits; i++)
+        emodel_free(&c->corr[i]);
+    free(c->bits);
+    free(c->corr);
+    c->bits = c->corr = NULL;
 }
 
 #endif

@@ -410,6 +410,23 @@ static buf_t make_laz(const laz_layout *L, const uint8_t *recs, size_t n, uint16
         nchunks++;
         done += k;
     }
+    /* the encoders' models */
+    eic *ics[] = {&p10.dx, &p10.dy, &p10.z, &p10.inten, &p10.angle, &p10.psid, &gps.ic, &rgb.ic, &by.ic};
+    for (size_t i = 0; i < sizeof ics / sizeof ics[0]; i++)
+        eic_free(ics[i]);
+    emodel_free(&p10.changed);
+    for (int i = 0; i < 256; i++) {
+        emodel_free(&p10.bitbyte[i]);
+        emodel_free(&p10.cls[i]);
+        emodel_free(&p10.user[i]);
+    }
+    emodel_free(&gps.multi);
+    emodel_free(&gps.zero);
+    emodel_free(&rgb.used);
+    for (int i = 0; i < 6; i++)
+        emodel_free(&rgb.diff[i]);
+    for (int i = 0; i < 16; i++)
+        emodel_free(&by.m[i]);
     if (L->compressor == 2) {
         int64_t at = (int64_t)o.n;
         uint32_t ver = 0, nc = (uint32_t)nchunks;
@@ -431,6 +448,7 @@ static buf_t make_laz(const laz_layout *L, const uint8_t *recs, size_t n, uint16
         enc_done(&e);
         bput(&o, e.buf, e.n);
         free(e.buf);
+        eic_free(&ic);
         if (L->table_at_end) {
             int64_t minus = -1;
             memcpy(o.b + table_ptr, &minus, 8);
