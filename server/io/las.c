@@ -359,10 +359,12 @@ ag_status ag_las_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag
     if (h.compressed && !laszip.data)
         return ag_error_set(err, AG_ERR_PARSE, 0,
                             "the point format says LAZ but there is no LASzip VLR");
-    /* a LAZ point needs at least a few bits; this bounds memory for lying counts */
-    if (h.compressed && h.count / 64 > len)
+    /* LASzip takes several bytes per point (AHN3: 5.5); more than one point per byte of file
+     * is refused before anything is allocated, which bounds memory for a count that lies */
+    if (h.compressed && h.count > len)
         return ag_error_set(err, AG_ERR_PARSE, 0,
-                            "the header says %llu points, more than a %zu-byte LAZ file can hold",
+                            "the header says %llu points, more than a %zu-byte LAZ file holds "
+                            "(archgram reads at most one point per byte)",
                             (unsigned long long)h.count, len);
     las_reader r;
     memset(&r, 0, sizeof r);

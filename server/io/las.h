@@ -11,7 +11,8 @@
  * wavepacket_yt, wavepacket_zt. Extra bytes described by the LASF_Spec extra-bytes record
  * become properties of their own type (extra bytes nx, ny, nz become normals); undescribed
  * extra bytes are skipped. Other VLRs and EVLRs are skipped. The header's point count and
- * record length are checked against the file size before anything is allocated. */
+ * record length are checked against the file size before anything is allocated (for LAZ: at
+ * most one point per byte of file). */
 #ifndef AG_LAS_H
 #define AG_LAS_H
 

@@ -545,6 +545,23 @@ static void run_layout(const laz_layout *L, size_t n)
     compare_clouds(a, b);
     ag_cloud_free(a);
     ag_cloud_free(b);
+    /* a count that lies is refused before anything is allocated */
+    uint32_t lie = 4000000000u, keep;
+    memcpy(&keep, laz.b + 107, 4);
+    memcpy(laz.b + 107, &lie, 4);
+    assert_int_equal(ag_las_read_buffer(laz.b, laz.n, &b, &e), AG_ERR_PARSE);
+    assert_non_null(strstr(e.text, "one point per byte"));
+    memcpy(laz.b + 107, &keep, 4);
+    /* one point more than the chunks hold */
+    uint32_t more = keep + (L->compressor == 2 ? 0 : 1);
+    if (L->compressor == 2 && L->chunk != UINT32_MAX) {
+        uint32_t nchunks = (uint32_t)((n + L->chunk - 1) / L->chunk);
+        more = nchunks * L->chunk + 1;
+        memcpy(laz.b + 107, &more, 4);
+        assert_int_equal(ag_las_read_buffer(laz.b, laz.n, &b, &e), AG_ERR_PARSE);
+        assert_non_null(strstr(e.text, "chunks hold at most"));
+        memcpy(laz.b + 107, &keep, 4);
+    }
     /* truncated: an error, never a crash or a read past the end */
     for (size_t cut = 230; cut < laz.n; cut += laz.n / 23 + 1) {
         uint8_t *t = malloc(cut);
