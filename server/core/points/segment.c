@@ -28,6 +28,13 @@ static double now(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
 void ag_segment_cloud_free(ag_segment_cloud_result *r)
 {
     if (!r)
@@ -283,7 +290,7 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
     r->coarse_threshold = coarse > 0 ? coarse * r->diagonal : 0;
     progress_ctx pc = {&o, AG_SEGMENT_CLOUD_INDEX};
 
-    double t = now();
+    double t = now(), tc = cpu_now();
     ag_kdtree *tree = NULL;
     float *variation = malloc(n * sizeof *variation);
     uint32_t *graph = malloc(n * (size_t)k * sizeof *graph);
@@ -300,8 +307,11 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
     if (st != AG_OK)
         goto done;
     r->seconds[AG_SEGMENT_CLOUD_INDEX] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_INDEX] = cpu_now() - tc;
 
     t = now();
+
+    tc = cpu_now();
     pc.stage = AG_SEGMENT_CLOUD_NORMALS;
     ag_normals_options no = {k, o.progress ? stage_progress : NULL, &pc};
     ag_normals_info info;
@@ -317,12 +327,14 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
     }
     ag_ransac_graph g = {graph, k};
     r->seconds[AG_SEGMENT_CLOUD_NORMALS] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_NORMALS] = cpu_now() - tc;
 
     for (size_t i = 0; i < n; i++) {
         plane_of[i] = -1;
         idx[i] = (uint32_t)i;
     }
     t = now();
+    tc = cpu_now();
     if (coarse > 0) {
         pc.stage = AG_SEGMENT_CLOUD_COARSE;
         ag_ransac_options ro = {.threshold = r->coarse_threshold,
@@ -340,8 +352,11 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
             plane_of[i] = -1;
     }
     r->seconds[AG_SEGMENT_CLOUD_COARSE] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_COARSE] = cpu_now() - tc;
 
     t = now();
+
+    tc = cpu_now();
     pc.stage = AG_SEGMENT_CLOUD_REFINE;
     double radius = 4 * r->spacing;
     ag_ransac_options lo = {.threshold = r->fine_threshold,
@@ -373,8 +388,11 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
             goto done;
     }
     r->seconds[AG_SEGMENT_CLOUD_REFINE] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_REFINE] = cpu_now() - tc;
 
     t = now();
+
+    tc = cpu_now();
     size_t ncomp = 0;
     {
         /* pieces of each plane; stray pieces leave their plane (for the clustering) */
@@ -438,8 +456,11 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         free(pseg);
     }
     r->seconds[AG_SEGMENT_CLOUD_COMPONENTS] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_COMPONENTS] = cpu_now() - tc;
 
     t = now();
+
+    tc = cpu_now();
     {
         size_t m = 0;
         for (size_t i = 0; i < n; i++) {
@@ -463,10 +484,14 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         r->npieces += ncl;
     }
     r->seconds[AG_SEGMENT_CLOUD_CLUSTER] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_CLUSTER] = cpu_now() - tc;
 
     t = now();
+
+    tc = cpu_now();
     st = finish(c, r, ncomp, err);
     r->seconds[AG_SEGMENT_CLOUD_LABEL] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_LABEL] = cpu_now() - tc;
 
 done:
     if (view.normals && view.normals != c->normals)

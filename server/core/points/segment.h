@@ -86,7 +86,8 @@ typedef struct {
     size_t nplanes, nclusters; /* segments of each kind */
     double diagonal, spacing;  /* metres */
     double coarse_threshold, fine_threshold, cluster_tolerance; /* metres, as used */
-    double seconds[AG_SEGMENT_CLOUD_STAGES];
+    double seconds[AG_SEGMENT_CLOUD_STAGES];     /* wall clock */
+    double cpu_seconds[AG_SEGMENT_CLOUD_STAGES]; /* this thread's processor time */
 } ag_segment_cloud_result;
 
 /* Segments c. When c has no normals, the computed ones are stored in it. */
