@@ -83,8 +83,9 @@ ag_cloud_format ag_cloud_format_sniff(const uint8_t *data, size_t len, const cha
         return AG_CLOUD_FORMAT_XYZ;
     const char *dot = filename ? strrchr(filename, '.') : NULL;
     ag_cloud_format f = dot ? ag_cloud_format_from_name(dot + 1) : AG_CLOUD_FORMAT_UNKNOWN;
-    /* an extension alone only stands for the text format: binary ones have signatures */
-    return f == AG_CLOUD_FORMAT_XYZ ? f : AG_CLOUD_FORMAT_UNKNOWN;
+    /* an extension alone only names an empty text cloud (so that its error says so): binary
+     * formats have signatures, and text that is not numbers is not a cloud */
+    return f == AG_CLOUD_FORMAT_XYZ && len == 0 ? f : AG_CLOUD_FORMAT_UNKNOWN;
 }
 
 int ag_cloud_import_is_cloud(const uint8_t *data, size_t len, const char *filename)

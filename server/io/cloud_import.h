@@ -26,7 +26,7 @@ ag_cloud_format ag_cloud_format_from_name(const char *name);
 const char *ag_cloud_format_name(ag_cloud_format f);
 
 /* From the content (LASF signature and the compression bit; ply magic; lines of 3, 6 or 9
- * numbers), and only then from the file name's extension. */
+ * numbers); the file name's extension only for an empty .xyz/.txt/.pts file. */
 ag_cloud_format ag_cloud_format_sniff(const uint8_t *data, size_t len, const char *filename);
 
 /* Whether a file is a point cloud rather than a mesh: LAS, LAZ and XYZ always, PLY when it

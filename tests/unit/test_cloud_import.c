@@ -30,6 +30,7 @@ static void test_sniff(void **state)
     /* an extension alone does not make a binary format */
     assert_int_equal(sniff("garbage", "x.las"), AG_CLOUD_FORMAT_UNKNOWN);
     assert_int_equal(sniff("", "x.xyz"), AG_CLOUD_FORMAT_XYZ);
+    assert_int_equal(sniff("grammar text, not numbers\n", "notes.txt"), AG_CLOUD_FORMAT_UNKNOWN);
     assert_int_equal(ag_cloud_format_from_name("LAZ"), AG_CLOUD_FORMAT_LAZ);
     assert_int_equal(ag_cloud_format_from_name("txt"), AG_CLOUD_FORMAT_XYZ);
     assert_int_equal(ag_cloud_format_from_name("obj"), AG_CLOUD_FORMAT_UNKNOWN);
