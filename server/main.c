@@ -91,9 +91,9 @@ static char *read_token_file(const char *path)
     buf[n] = '\0';
     while (n && (buf[n - 1] == '\n' || buf[n - 1] == '\r' || buf[n - 1] == ' '))
         buf[--n] = '\0';
-    if (more || n == 0) {
-        fprintf(stderr, "archgramd: --admin-token-file %s must hold one token (32 to 256 "
-                        "characters)\n",
+    if (more || n == 0 || ag_tokens_check_text(buf, NULL) != AG_OK) {
+        fprintf(stderr, "archgramd: --admin-token-file %s must hold one token: 32 to 256 "
+                        "characters of A-Z a-z 0-9 . _ ~ + -\n",
                 path);
         return NULL;
     }
