@@ -59,7 +59,7 @@ ag_status ag_accounts_bootstrap(ag_db *db, const char *chosen, char *token, int 
     } else if (s == AG_OK) {
         int64_t owner = 0;
         int removed = 0;
-        if (ag_tokens_verify(db, chosen, &owner, &id, NULL) != AG_OK)
+        if (ag_tokens_verify(db, chosen, &owner, &id, NULL, NULL) != AG_OK)
             s = ag_tokens_add(db, admin.id, chosen, AG_ACCOUNTS_FILE_LABEL, &id, err);
         else if (owner != admin.id)
             s = ag_error_set(err, AG_ERR_CONFLICT, 0,
@@ -206,5 +206,7 @@ ag_status ag_accounts_revoke(ag_app *app, const ag_identity *who, int64_t token,
     ag_status s = ag_db_begin(db, err);
     if (s == AG_OK)
         s = commit_or_rollback(db, ag_tokens_delete(db, who->user, token, err), err);
+    if (s == AG_OK)
+        ag_auth_forget(app); /* a revoked token signs nobody in from now on */
     return s;
 }

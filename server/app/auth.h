@@ -41,8 +41,22 @@ typedef enum {
  * a local admin named "local". */
 void ag_auth_local(ag_identity *who);
 
-/* The account a token stands for. AG_ERR_UNAUTHORIZED when no account has this token. */
+/* The account a token stands for. AG_ERR_UNAUTHORIZED when no account has this token.
+ *
+ * What a check finds is remembered for AG_AUTH_REMEMBER_S seconds — a token's account (by the
+ * token's hash, compared in constant time) and an account's role on a model — so most requests
+ * cost a hash and no query (a query is about a third of what GET /api/v1/models/{id} costs:
+ * bench/auth.c). ag_auth_forget drops it all: this process calls it after every revocation,
+ * sharing change and deletion, so they count at once; a change another process makes to the
+ * database (none but archgramd's own change these tables) counts within those seconds. */
+#define AG_AUTH_REMEMBER_S 5
 ag_status ag_auth_token(ag_app *app, const char *token, ag_identity *who, ag_error *err);
+void ag_auth_forget(ag_app *app);
+
+/* What ag_auth_token remembers, one per app (app.c makes it). */
+typedef struct ag_auth_cache ag_auth_cache;
+ag_auth_cache *ag_auth_cache_create(void);
+void ag_auth_cache_free(ag_auth_cache *cache);
 
 /* Checks need for who on the model or job id (ignored by needs without one); *role (may be
  * NULL) gets who's role on the model for the model needs (owner for admins). */

@@ -5,6 +5,7 @@
 #include "../store/members.h"
 #include "../store/models.h"
 #include "../store/users.h"
+#include "auth.h"
 
 #define MEMBERS_MAX 10000
 
@@ -95,6 +96,7 @@ static ag_status run(ag_app *app, const change *c, json_t **doc, ag_error *err)
         *doc = NULL;
         return s;
     }
+    ag_auth_forget(app); /* before the room is told: its roles are read again */
     ag_event ev = {.kind = AG_EVENT_ACCESS, .model = c->model};
     ag_events_publish(ag_app_events(app), &ev);
     return AG_OK;

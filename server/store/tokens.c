@@ -135,8 +135,17 @@ ag_status ag_tokens_add(ag_db *db, int64_t user, const char *text, const char *l
     return s != AG_OK ? s : insert(db, user, text, label, id, err);
 }
 
+int ag_tokens_hash(const char *text, unsigned char hash[32])
+{
+    int64_t lookup;
+    if (need_sodium(NULL) != AG_OK || !well_formed(text, 1))
+        return 0;
+    hash_text(text, hash, &lookup);
+    return 1;
+}
+
 ag_status ag_tokens_verify(ag_db *db, const char *text, int64_t *user, int64_t *token,
-                           ag_error *err)
+                           ag_user_row *account, ag_error *err)
 {
     *user = *token = 0;
     ag_status s = need_sodium(err);
@@ -148,7 +157,9 @@ ag_status ag_tokens_verify(ag_db *db, const char *text, int64_t *user, int64_t *
     int64_t lookup;
     hash_text(text, hash, &lookup);
     sqlite3_stmt *st;
-    if ((s = ag_db_prepared(db, &st, "SELECT id, user_id, hash FROM tokens WHERE lookup = ?",
+    if ((s = ag_db_prepared(db, &st,
+                            "SELECT t.id, t.user_id, t.hash, u.name, u.role, u.created_at "
+                            "FROM tokens t JOIN users u ON u.id = t.user_id WHERE t.lookup = ?",
                             err)) != AG_OK)
         return s;
     sqlite3_bind_int64(st, 1, lookup);
@@ -160,6 +171,15 @@ ag_status ag_tokens_verify(ag_db *db, const char *text, int64_t *user, int64_t *
         if (match) {
             *token = sqlite3_column_int64(st, 0);
             *user = sqlite3_column_int64(st, 1);
+        }
+        if (match && account) {
+            memset(account, 0, sizeof *account);
+            account->id = *user;
+            ag_db_column_copy(st, 3, account->name, sizeof account->name);
+            if (ag_users_role_parse((const char *)sqlite3_column_text(st, 4), &account->role,
+                                    NULL) != AG_OK)
+                account->role = AG_ACCOUNT_VIEWER;
+            ag_db_column_copy(st, 5, account->created_at, sizeof account->created_at);
         }
         s = match ? AG_OK
                   : ag_error_set(err, AG_ERR_UNAUTHORIZED, 0,

@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "db.h"
+#include "users.h"
 
 #define AG_TOKEN_TEXT_MAX 256
 #define AG_TOKEN_LABEL_MAX 100
@@ -30,10 +31,12 @@ ag_status ag_tokens_create(ag_db *db, int64_t user, const char *label, char *tex
  * characters; AG_ERR_CONFLICT when it is stored already). */
 ag_status ag_tokens_add(ag_db *db, int64_t user, const char *text, const char *label,
                         int64_t *id, ag_error *err);
-/* Whose token text is: *user and *token (its row). AG_ERR_UNAUTHORIZED when no stored token
- * has this text. */
+/* Whose token text is: *user and *token (its row), and in *account (may be NULL) the account
+ * itself, read in the same query. AG_ERR_UNAUTHORIZED when no stored token has this text. */
 ag_status ag_tokens_verify(ag_db *db, const char *text, int64_t *user, int64_t *token,
-                           ag_error *err);
+                           ag_user_row *account, ag_error *err);
+/* The hash a token is kept as (32 bytes); 0 when text is not a well-formed token. */
+int ag_tokens_hash(const char *text, unsigned char hash[32]);
 /* A user's tokens, oldest first, at most limit; *rows is malloc'd. */
 ag_status ag_tokens_list(ag_db *db, int64_t user, size_t limit, ag_token_row **rows,
                          size_t *count, ag_error *err);

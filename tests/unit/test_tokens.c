@@ -98,10 +98,10 @@ static void tokens_are_random_and_kept_as_hashes(void **state)
     /* and each text finds its own row */
     int64_t who, which;
     ag_error err;
-    assert_int_equal(ag_tokens_verify(f->db, a, &who, &which, &err), AG_OK);
+    assert_int_equal(ag_tokens_verify(f->db, a, &who, &which, NULL, &err), AG_OK);
     assert_int_equal(who, ana);
     assert_int_equal(which, ida);
-    assert_int_equal(ag_tokens_verify(f->db, b, &who, &which, &err), AG_OK);
+    assert_int_equal(ag_tokens_verify(f->db, b, &who, &which, NULL, &err), AG_OK);
     assert_int_equal(which, idb);
 }
 
@@ -119,20 +119,20 @@ static void a_changed_token_is_refused(void **state)
         char c[AG_TOKEN_TEXT_MAX + 1];
         memcpy(c, t, n + 1);
         c[i] = c[i] == 'A' ? 'B' : 'A';
-        assert_int_equal(ag_tokens_verify(f->db, c, &who, &which, &err), AG_ERR_UNAUTHORIZED);
+        assert_int_equal(ag_tokens_verify(f->db, c, &who, &which, NULL, &err), AG_ERR_UNAUTHORIZED);
         assert_int_equal(who, 0);
     }
     char shorter[AG_TOKEN_TEXT_MAX + 1];
     memcpy(shorter, t, n - 1);
     shorter[n - 1] = '\0';
-    assert_int_equal(ag_tokens_verify(f->db, shorter, &who, &which, &err), AG_ERR_UNAUTHORIZED);
+    assert_int_equal(ag_tokens_verify(f->db, shorter, &who, &which, NULL, &err), AG_ERR_UNAUTHORIZED);
     char longer[AG_TOKEN_TEXT_MAX + 2];
     snprintf(longer, sizeof longer, "%sx", t);
-    assert_int_equal(ag_tokens_verify(f->db, longer, &who, &which, &err), AG_ERR_UNAUTHORIZED);
-    assert_int_equal(ag_tokens_verify(f->db, "", &who, &which, &err), AG_ERR_UNAUTHORIZED);
-    assert_int_equal(ag_tokens_verify(f->db, "agt_\n", &who, &which, &err), AG_ERR_UNAUTHORIZED);
-    assert_int_equal(ag_tokens_verify(f->db, NULL, &who, &which, &err), AG_ERR_UNAUTHORIZED);
-    assert_int_equal(ag_tokens_verify(f->db, t, &who, &which, &err), AG_OK);
+    assert_int_equal(ag_tokens_verify(f->db, longer, &who, &which, NULL, &err), AG_ERR_UNAUTHORIZED);
+    assert_int_equal(ag_tokens_verify(f->db, "", &who, &which, NULL, &err), AG_ERR_UNAUTHORIZED);
+    assert_int_equal(ag_tokens_verify(f->db, "agt_\n", &who, &which, NULL, &err), AG_ERR_UNAUTHORIZED);
+    assert_int_equal(ag_tokens_verify(f->db, NULL, &who, &which, NULL, &err), AG_ERR_UNAUTHORIZED);
+    assert_int_equal(ag_tokens_verify(f->db, t, &who, &which, NULL, &err), AG_OK);
 }
 
 static void revoking_takes_effect_at_once(void **state)
@@ -146,10 +146,10 @@ static void revoking_takes_effect_at_once(void **state)
     ag_error err;
     /* another account cannot revoke it */
     assert_int_equal(ag_tokens_delete(f->db, dee, id1, &err), AG_ERR_NOT_FOUND);
-    assert_int_equal(ag_tokens_verify(f->db, t1, &who, &which, &err), AG_OK);
+    assert_int_equal(ag_tokens_verify(f->db, t1, &who, &which, NULL, &err), AG_OK);
     assert_int_equal(ag_tokens_delete(f->db, cy, id1, &err), AG_OK);
-    assert_int_equal(ag_tokens_verify(f->db, t1, &who, &which, &err), AG_ERR_UNAUTHORIZED);
-    assert_int_equal(ag_tokens_verify(f->db, t2, &who, &which, &err), AG_OK);
+    assert_int_equal(ag_tokens_verify(f->db, t1, &who, &which, NULL, &err), AG_ERR_UNAUTHORIZED);
+    assert_int_equal(ag_tokens_verify(f->db, t2, &who, &which, NULL, &err), AG_OK);
     ag_token_row *rows;
     size_t n;
     assert_int_equal(ag_tokens_list(f->db, cy, 10, &rows, &n, &err), AG_OK);
@@ -160,7 +160,7 @@ static void revoking_takes_effect_at_once(void **state)
     assert_int_equal(sqlite3_exec(ag_db_handle(f->db), "DELETE FROM users WHERE name = 'cy'", NULL,
                                   NULL, NULL),
                      SQLITE_OK);
-    assert_int_equal(ag_tokens_verify(f->db, t2, &who, &which, &err), AG_ERR_UNAUTHORIZED);
+    assert_int_equal(ag_tokens_verify(f->db, t2, &who, &which, NULL, &err), AG_ERR_UNAUTHORIZED);
 }
 
 static void chosen_tokens_must_be_long_and_plain(void **state)
@@ -179,7 +179,7 @@ static void chosen_tokens_must_be_long_and_plain(void **state)
     assert_int_equal(ag_tokens_add(f->db, admin, good, "file", &id, &err), AG_ERR_CONFLICT);
     assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
     assert_false(stored_anywhere(f->db, good, strlen(good)));
-    assert_int_equal(ag_tokens_verify(f->db, good, &who, &which, &err), AG_OK);
+    assert_int_equal(ag_tokens_verify(f->db, good, &who, &which, NULL, &err), AG_OK);
     assert_int_equal(who, admin);
     /* rotation: tokens of a label but the one kept are revoked */
     char other[AG_TOKEN_TEXT_MAX + 1];
@@ -188,8 +188,8 @@ static void chosen_tokens_must_be_long_and_plain(void **state)
     int removed = 0;
     assert_int_equal(ag_tokens_delete_label(f->db, admin, "file", kept, &removed, &err), AG_OK);
     assert_int_equal(removed, 1);
-    assert_int_equal(ag_tokens_verify(f->db, good, &who, &which, &err), AG_ERR_UNAUTHORIZED);
-    assert_int_equal(ag_tokens_verify(f->db, other, &who, &which, &err), AG_OK);
+    assert_int_equal(ag_tokens_verify(f->db, good, &who, &which, NULL, &err), AG_ERR_UNAUTHORIZED);
+    assert_int_equal(ag_tokens_verify(f->db, other, &who, &which, NULL, &err), AG_OK);
 }
 
 static void account_names_and_roles(void **state)
