@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <sodium.h>
+
 #define LIST_MAX 10000
 
 static json_t *user_view(const ag_user_row *u)
@@ -75,8 +77,10 @@ ag_status ag_accounts_bootstrap(ag_db *db, const char *chosen, char *token, int 
     return s;
 }
 
-ag_status ag_accounts_create_in(ag_db *db, const char *name, ag_account_role role,
-                                const char *label, json_t **view, ag_error *err)
+/* In one transaction: the account name (made first when make) gets a new token; *view the
+ * answer that shows it. */
+static ag_status token_for(ag_db *db, const char *name, int make, ag_account_role role,
+                           const char *label, json_t **view, ag_error *err)
 {
     *view = NULL;
     ag_status s = ag_db_begin(db, err);
@@ -85,41 +89,33 @@ ag_status ag_accounts_create_in(ag_db *db, const char *name, ag_account_role rol
     int64_t user = 0, id = 0;
     char token[AG_TOKEN_TEXT_MAX + 1] = "";
     ag_user_row row;
-    if ((s = ag_users_insert(db, name, role, &user, err)) == AG_OK &&
-        (s = ag_tokens_create(db, user, label, token, &id, err)) == AG_OK &&
-        (s = ag_users_get(db, user, &row, err)) == AG_OK &&
-        !(*view = token_view(&row, token, id, label)))
+    if (make)
+        s = ag_users_insert(db, name, role, &user, err);
+    if (s == AG_OK)
+        s = ag_users_find(db, name, &row, err);
+    if (s == AG_OK)
+        s = ag_tokens_create(db, row.id, label, token, &id, err);
+    if (s == AG_OK && !(*view = token_view(&row, token, id, label)))
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     s = commit_or_rollback(db, s, err);
     if (s != AG_OK) {
         json_decref(*view);
         *view = NULL;
     }
-    memset(token, 0, sizeof token);
+    sodium_memzero(token, sizeof token);
     return s;
+}
+
+ag_status ag_accounts_create_in(ag_db *db, const char *name, ag_account_role role,
+                                const char *label, json_t **view, ag_error *err)
+{
+    return token_for(db, name, 1, role, label, view, err);
 }
 
 ag_status ag_accounts_new_token_in(ag_db *db, const char *name, const char *label,
                                    json_t **view, ag_error *err)
 {
-    *view = NULL;
-    ag_status s = ag_db_begin(db, err);
-    if (s != AG_OK)
-        return s;
-    ag_user_row row;
-    int64_t id = 0;
-    char token[AG_TOKEN_TEXT_MAX + 1] = "";
-    if ((s = ag_users_find(db, name, &row, err)) == AG_OK &&
-        (s = ag_tokens_create(db, row.id, label, token, &id, err)) == AG_OK &&
-        !(*view = token_view(&row, token, id, label)))
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    s = commit_or_rollback(db, s, err);
-    if (s != AG_OK) {
-        json_decref(*view);
-        *view = NULL;
-    }
-    memset(token, 0, sizeof token);
-    return s;
+    return token_for(db, name, 0, AG_ACCOUNT_VIEWER, label, view, err);
 }
 
 #define DB_OR_RETURN(db, app, err)                                                              \

@@ -7,24 +7,13 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { daemonAndBrowser, openPage } from './browser.js';
 import { facadeObj } from './facade.js';
-import { versionOf, WAIT } from './page.js';
+import { versionOf, WAIT, waitJob } from './page.js';
 
 const env = daemonAndBrowser();
 
 const asAccount = (token) => (p, init = {}) => fetch(`${env.daemon.url}api/v1${p}`, {
   ...init, headers: { ...(init.headers || {}), Authorization: `Bearer ${token}` },
 });
-
-async function waitJob(api, job) {
-  const deadline = Date.now() + 60000;
-  while (!['succeeded', 'failed', 'cancelled'].includes(job.status)) {
-    assert.ok(Date.now() < deadline, `job ${job.id} did not finish`);
-    await new Promise((r) => setTimeout(r, 100));
-    job = await (await api(`/jobs/${job.id}`)).json();
-  }
-  assert.equal(job.status, 'succeeded', JSON.stringify(job.error));
-  return job;
-}
 
 const hidden = (page, testid) => page.getByTestId(testid).isHidden();
 

@@ -23,16 +23,6 @@ typedef struct {
     int64_t ana, bo, cy, m1, m2, m3;
 } fixture;
 
-static int64_t user(ag_db *db, const char *name, ag_account_role role)
-{
-    ag_error err;
-    int64_t id = 0;
-    assert_int_equal(ag_db_begin(db, &err), AG_OK);
-    assert_int_equal(ag_users_insert(db, name, role, &id, &err), AG_OK);
-    assert_int_equal(ag_db_commit(db, &err), AG_OK);
-    return id;
-}
-
 static int64_t model(ag_db *db, const char *name)
 {
     ag_model_new m = {.name = name, .mesh = "m", .mesh_len = 1};
@@ -50,12 +40,10 @@ static void put(ag_db *db, int64_t m, int64_t u, ag_model_role role)
 static int setup(void **state)
 {
     fixture *f = calloc(1, sizeof *f);
-    f->path = temp_db();
-    ag_error err;
-    assert_int_equal(ag_db_open(f->path, NULL, &f->db, &err), AG_OK);
-    f->ana = user(f->db, "ana", AG_ACCOUNT_EDITOR);
-    f->bo = user(f->db, "bo", AG_ACCOUNT_EDITOR);
-    f->cy = user(f->db, "cy", AG_ACCOUNT_VIEWER);
+    f->db = open_temp_db(&f->path);
+    f->ana = insert_user(f->db, "ana", AG_ACCOUNT_EDITOR);
+    f->bo = insert_user(f->db, "bo", AG_ACCOUNT_EDITOR);
+    f->cy = insert_user(f->db, "cy", AG_ACCOUNT_VIEWER);
     f->m1 = model(f->db, "one");
     f->m2 = model(f->db, "two");
     f->m3 = model(f->db, "three");
@@ -66,8 +54,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     fixture *f = *state;
-    ag_db_close(f->db);
-    remove_db(f->path);
+    close_temp_db(f->db, f->path);
     free(f);
     return 0;
 }
@@ -245,7 +232,7 @@ static void a_database_from_before_accounts(void **state)
     assert_int_equal(count(db, "SELECT count(*) FROM users"), 0);
     assert_int_equal(count(db, "SELECT public_read FROM models WHERE id = 5"), 0);
     assert_int_equal(count(db, "SELECT count(*) FROM jobs WHERE user_id IS NOT NULL"), 0);
-    int64_t ana = user(db, "ana", AG_ACCOUNT_EDITOR);
+    int64_t ana = insert_user(db, "ana", AG_ACCOUNT_EDITOR);
     assert_int_equal(listed(db, ana, ids, NULL), 0);
     ag_db_close(db);
     remove_db(path);

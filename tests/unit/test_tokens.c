@@ -24,9 +24,7 @@ typedef struct {
 static int setup(void **state)
 {
     fixture *f = calloc(1, sizeof *f);
-    f->path = temp_db();
-    ag_error err;
-    assert_int_equal(ag_db_open(f->path, NULL, &f->db, &err), AG_OK);
+    f->db = open_temp_db(&f->path);
     *state = f;
     return 0;
 }
@@ -34,20 +32,9 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     fixture *f = *state;
-    ag_db_close(f->db);
-    remove_db(f->path);
+    close_temp_db(f->db, f->path);
     free(f);
     return 0;
-}
-
-static int64_t user(ag_db *db, const char *name, ag_account_role role)
-{
-    ag_error err;
-    int64_t id = 0;
-    assert_int_equal(ag_db_begin(db, &err), AG_OK);
-    assert_int_equal(ag_users_insert(db, name, role, &id, &err), AG_OK);
-    assert_int_equal(ag_db_commit(db, &err), AG_OK);
-    return id;
 }
 
 static void new_token(ag_db *db, int64_t owner, const char *label, char *text, int64_t *id)
@@ -82,7 +69,7 @@ static int stored_anywhere(ag_db *db, const void *needle, size_t n)
 static void tokens_are_random_and_kept_as_hashes(void **state)
 {
     fixture *f = *state;
-    int64_t ana = user(f->db, "ana", AG_ACCOUNT_EDITOR);
+    int64_t ana = insert_user(f->db, "ana", AG_ACCOUNT_EDITOR);
     char a[AG_TOKEN_TEXT_MAX + 1], b[AG_TOKEN_TEXT_MAX + 1];
     int64_t ida, idb;
     new_token(f->db, ana, "laptop", a, &ida);
@@ -108,7 +95,7 @@ static void tokens_are_random_and_kept_as_hashes(void **state)
 static void a_changed_token_is_refused(void **state)
 {
     fixture *f = *state;
-    int64_t bo = user(f->db, "bo", AG_ACCOUNT_VIEWER);
+    int64_t bo = insert_user(f->db, "bo", AG_ACCOUNT_VIEWER);
     char t[AG_TOKEN_TEXT_MAX + 1];
     int64_t id, who, which;
     new_token(f->db, bo, NULL, t, &id);
@@ -138,7 +125,8 @@ static void a_changed_token_is_refused(void **state)
 static void revoking_takes_effect_at_once(void **state)
 {
     fixture *f = *state;
-    int64_t cy = user(f->db, "cy", AG_ACCOUNT_EDITOR), dee = user(f->db, "dee", AG_ACCOUNT_EDITOR);
+    int64_t cy = insert_user(f->db, "cy", AG_ACCOUNT_EDITOR);
+    int64_t dee = insert_user(f->db, "dee", AG_ACCOUNT_EDITOR);
     char t1[AG_TOKEN_TEXT_MAX + 1], t2[AG_TOKEN_TEXT_MAX + 1];
     int64_t id1, id2, who, which;
     new_token(f->db, cy, "one", t1, &id1);
@@ -166,7 +154,7 @@ static void revoking_takes_effect_at_once(void **state)
 static void chosen_tokens_must_be_long_and_plain(void **state)
 {
     fixture *f = *state;
-    int64_t admin = user(f->db, "admin", AG_ACCOUNT_ADMIN);
+    int64_t admin = insert_user(f->db, "admin", AG_ACCOUNT_ADMIN);
     ag_error err;
     int64_t id, who, which;
     const char *good = "0123456789abcdef0123456789abcdef-from-a-secret";
@@ -212,7 +200,7 @@ static void account_names_and_roles(void **state)
     assert_int_equal(ag_users_role_parse("admin", &r, &err), AG_OK);
     assert_int_equal(r, AG_ACCOUNT_ADMIN);
     assert_int_equal(ag_users_role_parse("root", &r, &err), AG_ERR_INVALID);
-    int64_t id = user(f->db, "eve", AG_ACCOUNT_VIEWER);
+    int64_t id = insert_user(f->db, "eve", AG_ACCOUNT_VIEWER);
     assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
     assert_int_equal(ag_users_insert(f->db, "eve", AG_ACCOUNT_EDITOR, &id, &err), AG_ERR_CONFLICT);
     ag_db_rollback(f->db);
