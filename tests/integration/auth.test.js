@@ -132,8 +132,9 @@ describe('accounts, tokens and roles', () => {
     const tree = (await http(d, 'GET', `/api/v1/models/${id}/tree`, { token: t.alice })).json;
     const box = [...tree.nodes[0].box];
     box[3] = box[0] + 0.9 * (box[3] - box[0]);
+    // (alice names herself too, as a client of a server without accounts would)
     const e = await http(d, 'POST', `/api/v1/models/${id}/ops`, {
-      token: t.alice, body: { cid: 'a-1', op: { kind: 'resize', node: 'root', box } }, headers: { 'If-Match': `"${model.version}"` }, timeout: 60000,
+      token: t.alice, body: { cid: 'a-1', op: { kind: 'resize', node: 'root', box } }, headers: { 'If-Match': `"${model.version}"`, 'X-Archgram-User': 'alice' }, timeout: 60000,
     });
     assert.equal(e.status, 200, e.text);
     // bob claims to be alice over REST and over the websocket: both undo bob's own history
