@@ -90,6 +90,7 @@ test('share a model: the viewer reads only, an editor made live gets the tools, 
   assert.equal(await vic.getByTestId('model-name').getAttribute('contenteditable'), 'false');
   assert.equal(await vic.getByTestId('grammar-text').evaluate((t) => t.readOnly), true);
   assert.ok(await hidden(vic, 'grammar-apply'));
+  assert.equal(await vic.evaluate(() => document.body.hasAttribute('data-read-only')), true, 'tool bars of the extrusion panes');
   const root = await vic.evaluate(() => window.archgram.tree.root);
   await vic.locator(`[data-testid="tree-node"][data-node="${root}"]`).click();
   await vic.getByTestId('picked-component').filter({ hasText: `node ${root}` }).waitFor(WAIT);
@@ -106,6 +107,7 @@ test('share a model: the viewer reads only, an editor made live gets the tools, 
   await vic.getByTestId('model-role').filter({ hasText: 'editor' }).waitFor(WAIT);
   await vic.locator('#edit .edit-body').waitFor({ state: 'visible', ...WAIT });
   assert.ok(await hidden(vic, 'read-only'));
+  assert.equal(await vic.evaluate(() => document.body.hasAttribute('data-read-only')), false);
   await vic.waitForFunction(() => window.archgramTools.handles.group.children.length > 0, null, WAIT);
   assert.equal(await vic.getByTestId('model-name').getAttribute('contenteditable'), 'plaintext-only');
   const renamed = await vic.evaluate(() => window.archgram.execute({ kind: 'rename', name: 'renamed by vic' }));

@@ -59,6 +59,11 @@ new SplitTreePanel(editor, procedural, $('tree'));
 new GrammarPanel(editor, procedural, $('grammar'));
 collapsible(document.querySelectorAll('section[id]'));
 
+// Viewers see the extrusion panes without their tool bars (style.css: [data-read-only]).
+const markReadOnly = () => document.body.toggleAttribute('data-read-only', !!editor.model && !editor.canEdit);
+editor.signals.roleChanged.add(markReadOnly);
+editor.signals.modelOpened.add(markReadOnly);
+
 window.addEventListener('unhandledrejection', (e) => {
   editor.fail(e.reason);
 });
