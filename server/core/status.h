@@ -30,7 +30,9 @@
     X(AG_ERR_METHOD_NOT_ALLOWED,     -17, 405, "method-not-allowed",    "method not allowed")       \
     X(AG_ERR_NOT_PROCEDURALIZED,     -18, 409, "not-proceduralized",    "the model is not proceduralized") \
     X(AG_ERR_UNDO_CONFLICT,          -19, 409, "undo-conflict",         "nothing can be undone or redone here") \
-    X(AG_ERR_EXTERNAL_REF,           -20, 422, "external-reference",    "the file refers to another file")
+    X(AG_ERR_EXTERNAL_REF,           -20, 422, "external-reference",    "the file refers to another file") \
+    X(AG_ERR_UNAUTHORIZED,           -40, 401, "unauthorized",          "sign in first")             \
+    X(AG_ERR_FORBIDDEN,              -41, 403, "forbidden",             "not allowed for this account")
 
 typedef enum {
 #define AG__STATUS_ENUM(name, value, http, slug, msg) name = value,

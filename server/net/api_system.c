@@ -12,6 +12,8 @@ enum MHD_Result ag_api_health(ag_request *r)
     json_t *body = ag_app_query_health(r->cfg->app, r->cfg->ws_port, &err);
     if (!body)
         return ag_reply_problem(r, err.code, &err);
+    /* the web client asks for a token only when there are accounts */
+    json_object_set_new(body, "auth", json_boolean(!r->cfg->no_auth));
     return ag_reply_json(r, 200, body, NULL);
 }
 

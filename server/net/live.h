@@ -1,5 +1,8 @@
 /* The live layer: websocket rooms per model on their own port (libwebsockets), fed by the
- * app's event bus. The protocol is documented in schema/websocket.md; its handlers are in
+ * app's event bus. The handshake carries the caller's token (an Authorization: Bearer header,
+ * or from a browser a second subprotocol "archgram.bearer.<token>"), whose account is the
+ * session's identity for good, and an Origin that must be the web client's (the HTTP port on
+ * the host the socket was opened on) or one allowed by --cors; other handshakes are refused. The protocol is documented in schema/websocket.md; its handlers are in
  * live_protocol.c, rooms and presence in live_rooms.c, structural ops and previews run on the
  * app's fast lane. Stop the app (ag_app_shutdown, which drops the fast lane's waiting work)
  * before the live layer. */
@@ -13,6 +16,10 @@ typedef struct ag_live ag_live;
 typedef struct {
     const char *bind; /* NULL = 127.0.0.1 */
     int port;
+    int http_port;    /* the web client's origin is this port on the host the client named */
+    int no_auth;      /* everyone is the local admin (loopback only, see net/http.h) */
+    const char *const *origins; /* other origins allowed to connect ("*": any); copied */
+    int norigins;
 } ag_live_options;
 
 ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, ag_error *err);

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "../app/app.h"
+#include "../app/auth.h"
 #include "../core/status.h"
 
 struct ag_route;
@@ -19,6 +20,9 @@ typedef struct {
     size_t max_json;     /* JSON request bodies */
     int ws_port;
     const char *web_dir; /* NULL: no client served */
+    int no_auth;         /* everyone is the local admin (loopback only) */
+    const char *const *cors; /* origins allowed to call the API from a browser ("*": any) */
+    int ncors;
 } ag_http_config;
 
 typedef struct ag_request {
@@ -28,6 +32,13 @@ typedef struct ag_request {
     const char *method;
     const char *url;
     int64_t ids[2];          /* the {id} segments of the matched route, in order */
+    char name[AG_USER_NAME_MAX + 1]; /* its {name} segment, "" when none */
+    /* who asks (from the bearer token; the local admin with --no-auth), set before the
+     * handler runs for every route that needs more than nothing; and for routes on a model,
+     * that account's role on it */
+    ag_identity who;
+    ag_model_role model_role;
+    char origin[256];        /* the Origin header when --cors allows it, else "" */
     /* body */
     char *body;              /* small bodies (JSON), NUL-terminated */
     size_t body_len, body_cap;
@@ -39,7 +50,7 @@ typedef struct ag_request {
     struct {
         char name[32];
         char value[256];
-    } headers[4];
+    } headers[8];
     int nheaders;
 } ag_request;
 
@@ -59,8 +70,11 @@ void ag_reply_header(ag_request *r, const char *name, const char *value);
 enum MHD_Result ag_reply_new_job(ag_request *r, ag_status s, int64_t job, const ag_error *err);
 /* Answers with job's view; a 202 also names it in Location. */
 enum MHD_Result ag_reply_job(ag_request *r, int64_t job, unsigned status);
-/* Who makes a change over REST: the X-Archgram-User header, else "api". */
+/* Who makes a change over REST: the name of the caller's account (never a header it sends). */
 const char *ag_request_author(ag_request *r);
+/* The token of an Authorization header "Bearer <token>" (scheme in any case), NULL when the
+ * header is something else. */
+const char *ag_request_bearer(const char *authorization);
 /* A client id for a REST change that brings none, "<prefix>-…": unique within this process
  * and across restarts (time-based), so the op log's (author, cid) uniqueness holds. */
 void ag_request_fresh_cid(const char *prefix, char *buf, size_t len);
