@@ -1,0 +1,174 @@
+/* The sweep's state: active edges and corners, the shell they build, and the virtual
+ * height in which horizontal profile segments get an interval of their own. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "skel.h"
+
+int ag__skel_grow(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap)
+        return 1;
+    size_t c = *cap ? *cap : 64;
+    while (c < need)
+        c *= 2;
+    void *n = realloc(*p, c * elem);
+    if (!n)
+        return 0;
+    *p = n;
+    *cap = c;
+    return 1;
+}
+
+int ag__skel_vpush(sk_u32vec *v, uint32_t x)
+{
+    if (!ag__skel_grow((void **)&v->arr, &v->cap, v->n + 1, sizeof(uint32_t)))
+        return 0;
+    v->arr[v->n++] = x;
+    return 1;
+}
+
+void ag__skel_fail(sk *S, ag_status st)
+{
+    if (S->st == AG_OK)
+        S->st = st;
+}
+
+/* Real height of virtual height v. */
+double ag__skel_real_z(const sk *S, double v)
+{
+    for (size_t k = 0; k < S->nflat; k++) {
+        double vs = S->flat_h[k] + (double)k;
+        if (v < vs)
+            return v - (double)k;
+        if (v <= vs + 1)
+            return S->flat_h[k];
+    }
+    return v - (double)S->nflat;
+}
+
+/* Virtual height of real height z: `after` places z behind a flat interval at z. */
+double ag__skel_virtual_z(const sk *S, double z, int after)
+{
+    size_t k = 0;
+    while (k < S->nflat && (S->flat_h[k] < z || (after && S->flat_h[k] == z)))
+        k++;
+    return z + (double)k;
+}
+
+uint32_t ag__skel_vertex(sk *S, double x, double y, double z)
+{
+    z = ag__skel_real_z(S, z);
+    uint32_t id = 0;
+    if (ag_shell_add_vertex(S->shell, x + S->ox, y + S->oy, z, &id) != AG_OK)
+        ag__skel_fail(S, AG_ERR_NOMEM);
+    return id;
+}
+
+void ag__skel_seg(sk *S, uint32_t face, uint32_t a, uint32_t b)
+{
+    if (ag_shell_add_segment(S->shell, face, a, b) != AG_OK)
+        ag__skel_fail(S, AG_ERR_NOMEM);
+}
+
+uint32_t ag__skel_new_face(sk *S, const sk_edge *e)
+{
+    ag_shell_face f = {AG_SHELL_FACE_SIDE, e->loop, e->edge, e->profile, e->seg, 0, 0};
+    if (e->growing)
+        f.segment = -1; /* the flat growth of a plan edit */
+    uint32_t id = 0;
+    if (ag_shell_add_face(S->shell, &f, &id) != AG_OK)
+        ag__skel_fail(S, AG_ERR_NOMEM);
+    return id;
+}
+
+uint32_t ag__skel_add_edge(sk *S)
+{
+    if (!ag__skel_grow((void **)&S->e, &S->cap_e, S->ne + 1, sizeof(sk_edge)) ||
+        !ag__skel_grow((void **)&S->live_e, &S->cap_live_e, S->nlive_e + 1, sizeof(uint32_t))) {
+        ag__skel_fail(S, AG_ERR_NOMEM);
+        return NONE;
+    }
+    memset(&S->e[S->ne], 0, sizeof(sk_edge));
+    S->e[S->ne].alive = 1;
+    S->e[S->ne].start = S->e[S->ne].end = NONE;
+    S->live_e[S->nlive_e++] = (uint32_t)S->ne;
+    return (uint32_t)S->ne++;
+}
+
+/* A corner joining edge `in` to edge `out` at (x, y, z); velocity is set by settle(). */
+uint32_t ag__skel_add_corner(sk *S, uint32_t in, uint32_t out, double x, double y, double z,
+                           uint32_t vert)
+{
+    if (!ag__skel_grow((void **)&S->c, &S->cap_c, S->nc + 1, sizeof(sk_corner)) ||
+        !ag__skel_grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1, sizeof(uint32_t)) ||
+        !ag__skel_grow((void **)&S->live_c, &S->cap_live_c, S->nlive_c + 1, sizeof(uint32_t))) {
+        ag__skel_fail(S, AG_ERR_NOMEM);
+        return NONE;
+    }
+    uint32_t k = (uint32_t)S->nc++;
+    sk_corner *c = &S->c[k];
+    memset(c, 0, sizeof *c);
+    c->x = x;
+    c->y = y;
+    c->z = z;
+    c->in = in;
+    c->out = out;
+    c->vert = vert;
+    c->alive = 1;
+    S->e[in].end = k;
+    S->e[in].ver++;
+    S->e[out].start = k;
+    S->e[out].ver++;
+    S->touched[S->ntouched++] = k;
+    S->live_c[S->nlive_c++] = k;
+    return k;
+}
+
+/* The corner stops at vertex v: its arc closes the faces on both sides. */
+void ag__skel_retire(sk *S, uint32_t k, uint32_t v)
+{
+    sk_corner *c = &S->c[k];
+    if (!c->alive)
+        return;
+    ag__skel_seg(S, S->e[c->in].face, c->vert, v);
+    ag__skel_seg(S, S->e[c->out].face, v, c->vert);
+    c->alive = 0;
+}
+
+void ag__skel_kill_edge(sk *S, uint32_t e)
+{
+    S->e[e].alive = 0;
+    S->e[e].ver++;
+}
+void ag__skel_push(sk *S, const ag_event *ev)
+{
+    if (ag_eventq_push(&S->q, ev) != AG_OK)
+        ag__skel_fail(S, AG_ERR_NOMEM);
+}
+void ag__skel_compact_live(sk *S)
+{
+    size_t w = 0;
+    for (size_t i = 0; i < S->nlive_c; i++)
+        if (S->c[S->live_c[i]].alive)
+            S->live_c[w++] = S->live_c[i];
+    S->nlive_c = w;
+    w = 0;
+    for (size_t i = 0; i < S->nlive_e; i++)
+        if (S->e[S->live_e[i]].alive)
+            S->live_e[w++] = S->live_e[i];
+    S->nlive_e = w;
+}
+double ag__skel_seg_slope(const ag_profile *p, int32_t seg)
+{
+    const ag_profile_point *a = &p->points[seg], *b = &p->points[seg + 1];
+    if (b->z == a->z)
+        return b->w - a->w;
+    return (b->w - a->w) / (b->z - a->z);
+}
+
+int ag__skel_seg_flat(const ag_profile *p, int32_t seg)
+{
+    return p->points[seg + 1].z == p->points[seg].z;
+}
