@@ -584,8 +584,8 @@ ag_status ag_plan_validate(ag_plan *p, ag_plan_fixes *fixes, double *extent, ag_
     double ext = hypot(hi[0] - lo[0], hi[1] - lo[1]);
     if (extent)
         *extent = ext;
-    double scale = ag_extrude_scale(ext);
-    double d2 = AG_EXTRUDE_DELTA2 * scale;
+    double mag = fmax(fmax(fabs(lo[0]), fabs(hi[0])), fmax(fabs(lo[1]), fabs(hi[1])));
+    double d2 = ag_extrude_tolerances(ext, mag).point;
 
     long **orig = calloc(p->nloops, sizeof *orig);
     if (!orig)

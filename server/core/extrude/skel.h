@@ -69,8 +69,12 @@ typedef struct {
     sk_u32vec C, E, splits;
     sk_ray *rays;
     size_t cap_rays;
-    uint32_t *uf; /* clustering: union-find parents */
+    ag_event *batch; /* clustering: the events within delta1 of the lowest */
+    size_t cap_batch;
+    uint32_t *uf; /* clustering: membership of the lowest event's cluster */
     size_t cap_uf;
+    double *speed; /* clustering: each event's fastest corner */
+    size_t cap_speed;
 } sk_scratch;
 
 typedef struct {
@@ -104,6 +108,11 @@ typedef struct {
      * (merged, zipped) only after all of them, so a collinear merge made at one point
      * cannot run along the line over another point of the same height before it is met */
     int defer_settle;
+    /* corners made by the intersections of one height level and left unsettled until
+     * every event of that level has been handled (see defer_settle) */
+    sk_u32vec deferred;
+    double level; /* the height of that level */
+    size_t nprocessed; /* events taken from the queue, valid or not */
     sk_scratch W;
 } sk;
 
@@ -139,15 +148,20 @@ int ag__skel_seg_flat(const ag_profile *p, int32_t seg);
 /* --- skel_event.c ------------------------------------------------------------------------ */
 void ag__skel_schedule_touched(sk *S);
 int ag__skel_event_valid(sk *S, const ag_event *ev);
-/* Clusters a batch of intersection events (within delta1 in height) in plan and handles
- * each cluster as one generalized intersection, lowest first. */
-void ag__skel_intersections(sk *S, ag_event *batch, size_t nb);
+/* Handles the cluster of ev0, the lowest intersection event (valid, taken from the queue):
+ * the valid events within delta1 above it whose plan points chain to its point within
+ * the cluster radius are one generalized intersection (§4.4); the other events taken
+ * while looking go back into the queue, to be handled after this one's consequences. */
+void ag__skel_next_cluster(sk *S, const ag_event *ev0);
 
 /* --- skel_intersection.c ----------------------------------------------------------------- */
 void ag__skel_intersection(sk *S, ag_event *evs, size_t n);
 
 /* --- skel_merge.c ------------------------------------------------------------------------ */
 void ag__skel_settle(sk *S, uint32_t k);
+/* Settles corner k unless it needs a collinear merge or a ridge zip and `defer` is set:
+ * then it is left unsettled and 0 is returned (see sk.deferred). */
+int ag__skel_settle_or_defer(sk *S, uint32_t k, int defer);
 
 /* --- skel_profile.c ---------------------------------------------------------------------- */
 void ag__skel_direction(sk *S, ag_event *evs, size_t n);

@@ -137,36 +137,6 @@ void ag__skel_schedule_touched(sk *S)
     S->ntouched = 0;
 }
 
-static int cmp_event_x(const void *a, const void *b)
-{
-    double x = ((const ag_event *)a)->x, y = ((const ag_event *)b)->x;
-    return x < y ? -1 : x > y;
-}
-
-typedef struct {
-    double z;
-    uint32_t root, i;
-} gsort;
-
-static int cmp_gsort(const void *a, const void *b)
-{
-    const gsort *x = a, *y = b;
-    if (x->z != y->z)
-        return x->z < y->z ? -1 : 1;
-    if (x->root != y->root)
-        return x->root < y->root ? -1 : 1;
-    return x->i < y->i ? -1 : x->i > y->i;
-}
-
-static uint32_t uf_find(uint32_t *p, uint32_t x)
-{
-    while (p[x] != x) {
-        p[x] = p[p[x]];
-        x = p[x];
-    }
-    return x;
-}
-
 /* Plan speed of the fastest corner an intersection event moves (m per unit of height). */
 static double event_speed(const sk *S, const ag_event *ev)
 {
@@ -191,85 +161,73 @@ int ag__skel_event_valid(sk *S, const ag_event *ev)
     return 1;
 }
 
-void ag__skel_intersections(sk *S, ag_event *batch, size_t nb)
+/* Two events of one batch are one point when their plan points are within the cluster
+ * radius; events a little apart in height (within delta1) are compared where their points
+ * would be at one height: a fast corner (nearly parallel edges) moves its point by its
+ * speed times the height difference (bounded). */
+static int same_point(const sk *S, const ag_event *a, const ag_event *b, double sa, double sb)
 {
-    uint32_t *uf;
-    /* cluster in plan: union of events closer than delta2 (sorted by x) */
-    qsort(batch, nb, sizeof *batch, cmp_event_x);
-    if (!ag__skel_grow((void **)&S->W.uf, &S->W.cap_uf, nb, sizeof *S->W.uf)) {
+    double tol = AG_EXTRUDE_CLUSTER_POINTS * S->d2 +
+                 fmin((sa + sb) * fabs(a->z - b->z), AG_EXTRUDE_DRIFT_ALONG * S->d3);
+    return fabs(a->y - b->y) <= tol && hypot(a->x - b->x, a->y - b->y) <= tol;
+}
+
+void ag__skel_next_cluster(sk *S, const ag_event *ev0)
+{
+    sk_scratch *W = &S->W;
+    /* the batch: ev0 and every valid intersection event within delta1 above it */
+    size_t nb = 0;
+    if (!ag__skel_grow((void **)&W->batch, &W->cap_batch, 1, sizeof *W->batch)) {
         ag__skel_fail(S, AG_ERR_NOMEM);
         return;
     }
-    uf = S->W.uf;
-    for (size_t i = 0; i < nb; i++)
-        uf[i] = (uint32_t)i;
-    double r = 10 * S->d2;
-    /* events a little apart in height (within delta1) are compared where their points
-     * would be at one height: a fast corner (nearly parallel edges) moves its point
-     * by its speed times the height difference (bounded: 0.2 mm at building scale) */
-    double *sp = malloc(nb * sizeof *sp), maxsp = 0, zlo = INFINITY, zhi = -INFINITY;
-    if (!sp) {
-        ag__skel_fail(S, AG_ERR_NOMEM);
-        return;
-    }
-    for (size_t i = 0; i < nb; i++) {
-        sp[i] = event_speed(S, &batch[i]);
-        maxsp = fmax(maxsp, sp[i]);
-        zlo = fmin(zlo, batch[i].z);
-        zhi = fmax(zhi, batch[i].z);
-    }
-    double rmax = r + fmin(2 * maxsp * (zhi - zlo), 20 * S->d3);
-    /* a window of 64 suffices: points of one cluster chain each other */
-    for (size_t i = 0; i < nb; i++)
-        for (size_t j = i + 1; j < nb && j < i + 64 && batch[j].x - batch[i].x <= rmax; j++) {
-            double tol = r + fmin((sp[i] + sp[j]) * fabs(batch[j].z - batch[i].z), 20 * S->d3);
-            if (fabs(batch[j].y - batch[i].y) <= tol &&
-                hypot(batch[j].x - batch[i].x, batch[j].y - batch[i].y) <= tol) {
-                uint32_t a = uf_find(uf, (uint32_t)i), b = uf_find(uf, (uint32_t)j);
-                if (a != b)
-                    uf[a > b ? a : b] = a < b ? a : b;
-            }
+    W->batch[nb++] = *ev0;
+    const ag_event *top;
+    while ((top = ag_eventq_peek(&S->q)) && top->z <= ev0->z + S->d1 &&
+           (top->type == AG_EVENT_EDGE || top->type == AG_EVENT_SPLIT)) {
+        ag_event nx;
+        ag_eventq_pop(&S->q, &nx);
+        S->nprocessed++;
+        if (!ag__skel_event_valid(S, &nx))
+            continue;
+        if (!ag__skel_grow((void **)&W->batch, &W->cap_batch, nb + 1, sizeof *W->batch) ||
+            !ag__skel_grow((void **)&W->uf, &W->cap_uf, nb + 1, sizeof *W->uf)) {
+            ag__skel_fail(S, AG_ERR_NOMEM);
+            return;
         }
-    free(sp);
-    /* handle groups lowest first: order events by (group's lowest z, group) */
-    gsort *gs = malloc(nb * sizeof *gs);
-    double *gz = malloc(nb * sizeof *gz);
-    ag_event *grp = malloc(nb * sizeof *grp);
-    if (!gs || !gz || !grp) {
-        free(gs);
-        free(gz);
-        free(grp);
+        W->batch[nb++] = nx;
+    }
+    if (!ag__skel_grow((void **)&W->uf, &W->cap_uf, nb, sizeof *W->uf) ||
+        !ag__skel_grow((void **)&W->speed, &W->cap_speed, nb, sizeof *W->speed)) {
         ag__skel_fail(S, AG_ERR_NOMEM);
         return;
     }
-    for (size_t i = 0; i < nb; i++)
-        gz[i] = INFINITY;
+    ag_event *batch = W->batch;
+    /* ev0's cluster: the events whose points chain to its point (uf marks members) */
+    uint32_t *in = W->uf;
+    double *sp = W->speed;
     for (size_t i = 0; i < nb; i++) {
-        uint32_t rt = uf_find(uf, (uint32_t)i);
-        if (batch[i].z < gz[rt])
-            gz[rt] = batch[i].z;
+        in[i] = i == 0;
+        sp[i] = event_speed(S, &batch[i]);
     }
+    for (int grew = 1; grew;) {
+        grew = 0;
+        for (size_t i = 0; i < nb; i++) {
+            if (!in[i])
+                continue;
+            for (size_t j = 1; j < nb; j++)
+                if (!in[j] && same_point(S, &batch[i], &batch[j], sp[i], sp[j])) {
+                    in[j] = 1;
+                    grew = 1;
+                }
+        }
+    }
+    size_t ng = 0;
     for (size_t i = 0; i < nb; i++) {
-        gs[i].root = uf_find(uf, (uint32_t)i);
-        gs[i].z = gz[gs[i].root];
-        gs[i].i = (uint32_t)i;
+        if (in[i])
+            batch[ng++] = batch[i];
+        else
+            ag__skel_push(S, &batch[i]); /* a later cluster: after this one's consequences */
     }
-    qsort(gs, nb, sizeof *gs, cmp_gsort);
-    size_t first_new = S->ntouched;
-    S->defer_settle = 1;
-    for (size_t i = 0; i < nb && S->st == AG_OK;) {
-        size_t j = i, ng = 0;
-        while (j < nb && gs[j].root == gs[i].root)
-            grp[ng++] = batch[gs[j++].i];
-        ag__skel_intersection(S, grp, ng);
-        i = j;
-    }
-    S->defer_settle = 0;
-    for (size_t i = first_new; i < S->ntouched && S->st == AG_OK; i++)
-        if (S->c[S->touched[i]].alive && !S->c[S->touched[i]].settled)
-            ag__skel_settle(S, S->touched[i]);
-    free(gs);
-    free(gz);
-    free(grp);
-    ag__skel_schedule_touched(S);
+    ag__skel_intersection(S, batch, ng);
 }

@@ -312,6 +312,9 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
     free(pairs);
     free(keep);
     size_t last_new = S->ntouched;
-    for (size_t i = first_new; i < last_new && S->st == AG_OK && !S->defer_settle; i++)
-        ag__skel_settle(S, S->touched[i]);
+    for (size_t i = first_new; i < last_new && S->st == AG_OK; i++) {
+        if (!ag__skel_settle_or_defer(S, S->touched[i], S->defer_settle) &&
+            !ag__skel_vpush(&S->deferred, S->touched[i]))
+            ag__skel_fail(S, AG_ERR_NOMEM);
+    }
 }

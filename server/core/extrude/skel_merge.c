@@ -137,34 +137,41 @@ static void zip(sk *S, uint32_t k)
 
 void ag__skel_settle(sk *S, uint32_t k)
 {
+    ag__skel_settle_or_defer(S, k, 0);
+}
+
+int ag__skel_settle_or_defer(sk *S, uint32_t k, int defer)
+{
     if (S->st != AG_OK)
-        return;
+        return 1;
     sk_corner *c = &S->c[k];
     if (!c->alive)
-        return;
+        return 1;
     if (c->in == c->out) {
         /* a loop of one edge: it has closed */
         ag__skel_kill_edge(S, c->in);
         c->alive = 0;
-        return;
+        return 1;
     }
     if (velocity(S, c)) {
         c->settled = 1;
-        return;
+        return 1;
     }
     const sk_edge *a = &S->e[c->in], *b = &S->e[c->out];
     double dot = a->nx * b->nx + a->ny * b->ny;
-    if (dot > 0) {
-        if (fabs(a->s - b->s) <= AG_EXTRUDE_SAME_SLOPE) {
-            /* collinear, same slope: the corner moves with the common plane */
-            double nx = a->nx + b->nx, ny = a->ny + b->ny, l = hypot(nx, ny);
-            c->vx = a->s * nx / l;
-            c->vy = a->s * ny / l;
-            c->settled = 1;
-            return;
-        }
-        merge(S, k);
-    } else {
-        zip(S, k);
+    if (dot > 0 && fabs(a->s - b->s) <= AG_EXTRUDE_SAME_SLOPE) {
+        /* collinear, same slope: the corner moves with the common plane */
+        double nx = a->nx + b->nx, ny = a->ny + b->ny, l = hypot(nx, ny);
+        c->vx = a->s * nx / l;
+        c->vy = a->s * ny / l;
+        c->settled = 1;
+        return 1;
     }
+    if (defer)
+        return 0;
+    if (dot > 0)
+        merge(S, k);
+    else
+        zip(S, k);
+    return 1;
 }

@@ -9,6 +9,26 @@
 
 #include "tolerance.h"
 
+/* Settles the corners the intersections of one height level left unsettled. */
+static void settle_deferred(sk *S)
+{
+    for (size_t i = 0; i < S->deferred.n && S->st == AG_OK; i++) {
+        uint32_t k = S->deferred.arr[i];
+        if (!S->c[k].alive || S->c[k].settled)
+            continue;
+        ag__skel_settle(S, k);
+        /* its events are scheduled with the corners its settling made */
+        if (S->c[k].alive &&
+            !ag__skel_grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1,
+                           sizeof *S->touched))
+            ag__skel_fail(S, AG_ERR_NOMEM);
+        else if (S->c[k].alive)
+            S->touched[S->ntouched++] = k;
+    }
+    S->deferred.n = 0;
+    ag__skel_schedule_touched(S);
+}
+
 ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleton_options *opt,
                             ag_shell **out, ag_skeleton_stats *stats, ag_error *err)
 {
@@ -17,10 +37,11 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     memset(&S, 0, sizeof S);
     S.plan = plan;
     S.err = err;
-    double scale = ag_extrude_scale(extent);
-    S.d1 = AG_EXTRUDE_DELTA1 * scale;
-    S.d2 = AG_EXTRUDE_DELTA2 * scale;
-    S.d3 = AG_EXTRUDE_DELTA3 * scale;
+    /* the sweep runs in a frame at the plan's first corner: coordinates up to the extent */
+    ag_extrude_tol tol = ag_extrude_tolerances(extent, extent);
+    S.d1 = tol.height;
+    S.d2 = tol.point;
+    S.d3 = tol.along;
     S.shell = ag_shell_create();
     if (!S.shell)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
@@ -238,19 +259,27 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     ag__skel_schedule_touched(&S);
 
     size_t max_events = opt && opt->max_events ? opt->max_events : 64 * ncorners + 10000;
-    size_t handled = 0;
     double limit = plan->cap_height > 0 ? ag__skel_virtual_z(&S, plan->cap_height, 0) : INFINITY;
     ag_event *batch = NULL;
     size_t cap_batch = 0;
     while (S.st == AG_OK) {
         ag_event ev;
-        if (!ag_eventq_pop(&S.q, &ev))
-            break;
-        if (!ag__skel_event_valid(&S, &ev))
+        int more = ag_eventq_pop(&S.q, &ev);
+        if (more)
+            S.nprocessed++;
+        if (more && !ag__skel_event_valid(&S, &ev))
             continue;
-        if (ev.z > limit)
+        int intersection = more && (ev.type == AG_EVENT_EDGE || ev.type == AG_EVENT_SPLIT);
+        if (S.deferred.n && (!intersection || ev.z > S.level + S.d1)) {
+            /* every event of the level is handled: settle the corners it left */
+            if (more)
+                ag__skel_push(&S, &ev);
+            settle_deferred(&S);
+            continue;
+        }
+        if (!more || ev.z > limit)
             break;
-        if (++handled > max_events) {
+        if (S.nprocessed > max_events) {
             ag_error_set(err, AG_ERR_INTERNAL, 0,
                          "the sweep did not finish after %zu events (height %.4f)", max_events,
                          S.zcur);
@@ -265,6 +294,15 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         }
         if (ev.z > S.zcur)
             S.zcur = ev.z;
+        if (intersection) {
+            if (!S.deferred.n)
+                S.level = ev.z;
+            S.defer_settle = 1;
+            ag__skel_next_cluster(&S, &ev);
+            S.defer_settle = 0;
+            ag__skel_schedule_touched(&S);
+            continue;
+        }
         size_t nb = 0;
         if (!ag__skel_grow((void **)&batch, &cap_batch, 1, sizeof *batch)) {
             ag__skel_fail(&S, AG_ERR_NOMEM);
@@ -272,43 +310,39 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         }
         batch[nb++] = ev;
         const ag_event *top;
-        int is_dir = ev.type == AG_EVENT_DIRECTION;
+        /* direction events at one height are one event (their heights come from the
+         * profiles' points, equal heights are equal numbers) */
         while ((top = ag_eventq_peek(&S.q)) && top->z <= ev.z + S.d1 &&
-               top->type != AG_EVENT_ANCHOR && (top->type == AG_EVENT_DIRECTION) == is_dir) {
+               top->type == AG_EVENT_DIRECTION) {
             ag_event nx;
             ag_eventq_pop(&S.q, &nx);
-            if (!ag__skel_event_valid(&S, &nx))
-                continue;
+            S.nprocessed++;
             if (!ag__skel_grow((void **)&batch, &cap_batch, nb + 1, sizeof *batch)) {
                 ag__skel_fail(&S, AG_ERR_NOMEM);
                 break;
             }
             batch[nb++] = nx;
         }
-        if (is_dir) {
-            int only_forced = 1;
-            for (size_t i = 0; i < nb; i++)
-                only_forced &= batch[i].a == FORCED_MARK;
-            if (!only_forced)
-                ag__skel_direction(&S, batch, nb);
-            for (size_t i = 0; i < nb && S.st == AG_OK; i++)
-                if (batch[i].a == OFFSET_MARK) {
-                    S.stats.offsets++;
-                    ag__skel_insert_sides(&S, batch[i].b);
-                }
-            for (size_t i = 0; i < nb; i++)
-                if (batch[i].a == FLAT_MARK && batch[i].b == 0)
-                    ag__skel_insert_steps(&S, batch[i].z);
-            for (size_t i = 0; i < nb && S.st == AG_OK; i++)
-                if (batch[i].a == FORCED_MARK)
-                    ag__skel_forced_step(&S, batch[i].b, batch[i].z);
-            for (size_t i = 0; i < nb && S.st == AG_OK; i++)
-                if (batch[i].a == GAP_MARK)
-                    ag__skel_insert_gap(&S, batch[i].b, batch[i].z);
-            ag__skel_schedule_touched(&S);
-            continue;
-        }
-        ag__skel_intersections(&S, batch, nb);
+        int only_forced = 1;
+        for (size_t i = 0; i < nb; i++)
+            only_forced &= batch[i].a == FORCED_MARK;
+        if (!only_forced)
+            ag__skel_direction(&S, batch, nb);
+        for (size_t i = 0; i < nb && S.st == AG_OK; i++)
+            if (batch[i].a == OFFSET_MARK) {
+                S.stats.offsets++;
+                ag__skel_insert_sides(&S, batch[i].b);
+            }
+        for (size_t i = 0; i < nb; i++)
+            if (batch[i].a == FLAT_MARK && batch[i].b == 0)
+                ag__skel_insert_steps(&S, batch[i].z);
+        for (size_t i = 0; i < nb && S.st == AG_OK; i++)
+            if (batch[i].a == FORCED_MARK)
+                ag__skel_forced_step(&S, batch[i].b, batch[i].z);
+        for (size_t i = 0; i < nb && S.st == AG_OK; i++)
+            if (batch[i].a == GAP_MARK)
+                ag__skel_insert_gap(&S, batch[i].b, batch[i].z);
+        ag__skel_schedule_touched(&S);
     }
     if (S.st == AG_OK) {
         double zc = plan->cap_height > 0 ? limit : fmax(S.zcur, top_profile);
@@ -323,6 +357,9 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     free(S.W.splits.arr);
     free(S.W.rays);
     free(S.W.uf);
+    free(S.W.batch);
+    free(S.W.speed);
+    free(S.deferred.arr);
     ag_status st = S.st;
     if (st == AG_OK)
         st = ag_shell_finish(S.shell, S.d1);
