@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/extrude/building.h"
 #include "../core/extrude/extrude.h"
 
 #define EARTH_RADIUS 6371008.8
@@ -354,20 +355,26 @@ ag_status ag_footprints_read_file(const char *path, const ag_footprints_options 
     return st;
 }
 
+static void free_issues(ag_footprint_issue *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        free(v[i].id);
+    free(v);
+}
+
 void ag_footprints_report_free(ag_footprints_report *r)
 {
     if (!r)
         return;
-    for (size_t i = 0; i < r->nfailed; i++)
-        free(r->failed[i].id);
-    for (size_t i = 0; i < r->nnot_watertight; i++)
-        free(r->not_watertight[i].id);
-    free(r->failed);
-    free(r->not_watertight);
+    free_issues(r->failed, r->nfailed);
+    free_issues(r->fallbacks, r->nfallbacks);
+    free_issues(r->not_watertight, r->nnot_watertight);
+    free_issues(r->fixed, r->nfixed);
     memset(r, 0, sizeof *r);
 }
 
-static int add_issue(ag_footprint_issue **list, size_t *n, const char *id, const char *reason)
+static int add_issue(ag_footprint_issue **list, size_t *n, const char *id, const char *reason,
+                     ag_built built, double moved)
 {
     ag_footprint_issue *nl = realloc(*list, (*n + 1) * sizeof *nl);
     if (!nl)
@@ -377,45 +384,59 @@ static int add_issue(ag_footprint_issue **list, size_t *n, const char *id, const
     if (!nl[*n].id)
         return 0;
     snprintf(nl[*n].reason, sizeof nl[*n].reason, "%s", reason);
+    nl[*n].built = built;
+    nl[*n].moved = moved;
     (*n)++;
     return 1;
 }
 
-ag_status ag_footprints_extrude(const ag_footprints *f, const ag_style *style, ag_mesh *m,
-                                ag_footprints_report *report, ag_error *err)
+ag_status ag_footprints_report_add(ag_footprints_report *r, const ag_footprint *fp,
+                                   const ag_building_result *b)
+{
+    int ok = 1;
+    if (b->built == AG_BUILT_STYLED)
+        r->succeeded++;
+    else if (b->built == AG_BUILT_NONE)
+        ok = add_issue(&r->failed, &r->nfailed, fp->id, b->reason, b->built, 0);
+    else
+        ok = add_issue(&r->fallbacks, &r->nfallbacks, fp->id, b->reason, b->built, b->moved);
+    if (ok && (b->nfixes || fp->fixes[0])) {
+        char text[sizeof r->fixed[0].reason];
+        snprintf(text, sizeof text, "%.100s%s%.150s", fp->fixes,
+                 fp->fixes[0] && b->nfixes ? "; " : "", b->nfixes ? b->fixes : "");
+        ok = add_issue(&r->fixed, &r->nfixed, fp->id, text, b->built, 0);
+    }
+    r->triangles += b->triangles;
+    r->events += b->events;
+    return ok ? AG_OK : AG_ERR_NOMEM;
+}
+
+ag_status ag_footprints_extrude_with(const ag_footprints *f, const ag_style *style,
+                                     const ag_extrude_options *opt, ag_mesh *m,
+                                     ag_footprints_report *report, ag_error *err)
 {
     memset(report, 0, sizeof *report);
     report->footprints = f->n;
     for (size_t i = 0; i < f->n; i++) {
         const ag_footprint *fp = &f->items[i];
-        ag_error e = {0};
-        ag_plan *plan = NULL;
-        ag_status st = ag_style_apply(style, (const double *const *)fp->loops, fp->sizes,
-                                      fp->nloops, fp->height, i, &plan, &e);
         size_t group = 0;
+        ag_building_result b;
+        ag_status st = ag_mesh_add_group(m, fp->id, &group);
         if (st == AG_OK)
-            st = ag_mesh_add_group(m, fp->id, &group);
-        ag_extrude_result res;
+            st = ag_building_extrude(style, (const double *const *)fp->loops, fp->sizes,
+                                     fp->nloops, fp->height, i, opt, m, (int32_t)group, &b, err);
         if (st == AG_OK)
-            st = ag_extrude_plan(plan, m, (int32_t)group, &res, NULL, &e);
-        ag_plan_free(plan);
+            st = ag_footprints_report_add(report, fp, &b);
         if (st == AG_ERR_NOMEM)
             return ag_error_set(err, st, 0, "out of memory");
-        if (st != AG_OK) {
-            if (!add_issue(&report->failed, &report->nfailed, fp->id,
-                           e.text[0] ? e.text : ag_status_message(st)))
-                return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-            continue;
-        }
-        report->succeeded++;
-        report->triangles += res.triangles;
-        if (res.failing_faces) {
-            char why[200];
-            snprintf(why, sizeof why, "%zu face(s) fail; face %d: %s", res.failing_faces,
-                     (int)res.problems[0].face, res.problems[0].reason);
-            if (!add_issue(&report->not_watertight, &report->nnot_watertight, fp->id, why))
-                return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
+        if (st != AG_OK)
+            return st;
     }
     return AG_OK;
+}
+
+ag_status ag_footprints_extrude(const ag_footprints *f, const ag_style *style, ag_mesh *m,
+                                ag_footprints_report *report, ag_error *err)
+{
+    return ag_footprints_extrude_with(f, style, NULL, m, report, err);
 }

@@ -82,10 +82,14 @@ ag_status ag_shell_add_segment(ag_shell *s, uint32_t face, uint32_t from, uint32
 
 /* --- welding --------------------------------------------------------------------------- */
 
-static const double *g_sort_pos;
+typedef struct {
+    double x;
+    uint32_t v;
+} by_x;
+
 static int cmp_by_x(const void *a, const void *b)
 {
-    double x = g_sort_pos[3 * *(const uint32_t *)a], y = g_sort_pos[3 * *(const uint32_t *)b];
+    double x = ((const by_x *)a)->x, y = ((const by_x *)b)->x;
     return x < y ? -1 : x > y;
 }
 
@@ -101,27 +105,28 @@ static uint32_t find(uint32_t *par, uint32_t x)
 static ag_status weld(ag_shell *s, double tol, uint32_t *map)
 {
     size_t n = s->nverts;
-    uint32_t *order = malloc((n ? n : 1) * sizeof *order);
+    by_x *order = malloc((n ? n : 1) * sizeof *order);
     uint32_t *par = malloc((n ? n : 1) * sizeof *par);
     if (!order || !par) {
         free(order);
         free(par);
         return AG_ERR_NOMEM;
     }
-    for (size_t i = 0; i < n; i++)
-        order[i] = par[i] = (uint32_t)i;
-    g_sort_pos = s->pos;
+    for (size_t i = 0; i < n; i++) {
+        par[i] = (uint32_t)i;
+        order[i] = (by_x){s->pos[3 * i], (uint32_t)i};
+    }
     qsort(order, n, sizeof *order, cmp_by_x);
     double t2 = tol * tol;
     for (size_t i = 0; i < n; i++) {
-        const double *a = &s->pos[3 * order[i]];
+        const double *a = &s->pos[3 * order[i].v];
         for (size_t j = i + 1; j < n; j++) {
-            const double *b = &s->pos[3 * order[j]];
+            const double *b = &s->pos[3 * order[j].v];
             if (b[0] - a[0] > tol)
                 break;
             double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
             if (dx * dx + dy * dy + dz * dz <= t2) {
-                uint32_t ra = find(par, order[i]), rb = find(par, order[j]);
+                uint32_t ra = find(par, order[i].v), rb = find(par, order[j].v);
                 if (ra != rb)
                     par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
             }

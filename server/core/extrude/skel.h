@@ -112,7 +112,7 @@ typedef struct {
      * every event of that level has been handled (see defer_settle) */
     sk_u32vec deferred;
     double level; /* the height of that level */
-    size_t nprocessed; /* events taken from the queue, valid or not */
+    ag_budget *budget; /* events, time, memory, cancel (ag_budget_spend on every push/pop) */
     sk_scratch W;
 } sk;
 
@@ -141,6 +141,9 @@ uint32_t ag__skel_add_corner(sk *S, uint32_t in, uint32_t out, double x, double 
 void ag__skel_retire(sk *S, uint32_t k, uint32_t v);
 void ag__skel_kill_edge(sk *S, uint32_t e);
 void ag__skel_push(sk *S, const ag_event *ev);
+/* Takes the lowest event from the queue (counted against the budget); 0 when empty or
+ * when the budget has run out (S->st is then set). */
+int ag__skel_pop(sk *S, ag_event *ev);
 void ag__skel_compact_live(sk *S);
 double ag__skel_seg_slope(const ag_profile *p, int32_t seg);
 int ag__skel_seg_flat(const ag_profile *p, int32_t seg);
@@ -167,6 +170,7 @@ int ag__skel_settle_or_defer(sk *S, uint32_t k, int defer);
 void ag__skel_direction(sk *S, ag_event *evs, size_t n);
 void ag__skel_insert_sides(sk *S, size_t k);
 void ag__skel_insert_gap(sk *S, size_t k, double v);
+void ag__skel_insert_bevels(sk *S, double v);
 
 /* --- skel_step.c ------------------------------------------------------------------------- */
 uint32_t ag__skel_make_edge(sk *S, double ax, double ay, double bx, double by, double slope,

@@ -186,8 +186,8 @@ void ag__skel_next_cluster(sk *S, const ag_event *ev0)
     while ((top = ag_eventq_peek(&S->q)) && top->z <= ev0->z + S->d1 &&
            (top->type == AG_EVENT_EDGE || top->type == AG_EVENT_SPLIT)) {
         ag_event nx;
-        ag_eventq_pop(&S->q, &nx);
-        S->nprocessed++;
+        if (!ag__skel_pop(S, &nx))
+            return;
         if (!ag__skel_event_valid(S, &nx))
             continue;
         if (!ag__skel_grow((void **)&W->batch, &W->cap_batch, nb + 1, sizeof *W->batch) ||

@@ -363,7 +363,10 @@ static ag_status inset_plan(sk *S, double v, const double *dist, const uint32_t 
         P->cap_height = 1;
         st = ag_plan_validate(P, NULL, &extent, &e2);
         if (st == AG_OK)
-            st = ag_skeleton_build(P, extent, NULL, &sh, NULL, &e2);
+            {
+            ag_skeleton_options so = {S->budget, NULL};
+            st = ag_skeleton_build(P, extent, &so, &sh, NULL, &e2);
+        }
     }
     if (st != AG_OK && !why[0])
         snprintf(why, nwhy, "%.120s", e2.text[0] ? e2.text : "out of memory");
@@ -452,6 +455,12 @@ void ag__skel_insert_gap(sk *S, size_t k, double v)
         st = inset_plan(S, v, d, slot, &ins[0], why, sizeof why);
     if (st == AG_OK)
         st = inset_plan(S, v, d + n, slot, &ins[1], why, sizeof why);
+    if (st != AG_OK && S->budget->st != AG_OK) {
+        ag_error_set(S->err, S->budget->st, (long)k + 1, "the extrusion was %s, opening the "
+                     "inside boundary of offset %zu", S->budget->why, k);
+        ag__skel_fail(S, S->budget->st);
+        goto out;
+    }
     if (st != AG_OK) {
         ag_error_set(S->err, st == AG_ERR_NOMEM ? AG_ERR_NOMEM : AG_ERR_INVALID, (long)k + 1,
                      "offset %zu at height %g: the inside boundary could not be made (%s)", k,
@@ -537,4 +546,69 @@ out:
     free(d);
     free(pin);
     free(slot);
+}
+
+/* --- outward offsets: bevels at sharp corners ---------------------------------------------- */
+
+/* At the start of a flat interval (a soffit, an offset event moving edges out): a convex
+ * corner sharper than the mitre limit between two edges moving outwards would shoot out
+ * by width / sin(angle / 2) (20 m for a 0.5 m eave on a 3° spike of digitising noise). A
+ * bevel edge is put in there, perpendicular to the corner's bisector and moving out with
+ * its edges, so the eave is cut square to the bisector as eaves are built; it carries on
+ * with the profile of the corner's incoming edge. */
+void ag__skel_insert_bevels(sk *S, double v)
+{
+    ag__skel_compact_live(S);
+    size_t nlive = S->nlive_c;
+    double limit = 1 / AG_EXTRUDE_BEVEL_MITRE; /* sin(angle / 2) below this: bevel */
+    for (size_t i = 0; i < nlive && S->st == AG_OK; i++) {
+        uint32_t ck = S->live_c[i];
+        sk_corner *c = &S->c[ck];
+        if (!c->alive || !c->settled || fabs(c->z - v) > S->d1)
+            continue;
+        const sk_edge *A = &S->e[c->in], *B = &S->e[c->out];
+        if (!(A->s < 0 && B->s < 0) || A->paused || B->paused || A->growing || B->growing)
+            continue;
+        /* convex (turning left) and sharp: the normals nearly opposite */
+        double turn = ag__skel_edx(A) * ag__skel_edy(B) - ag__skel_edy(A) * ag__skel_edx(B);
+        double nx = A->nx + B->nx, ny = A->ny + B->ny, nl = hypot(nx, ny);
+        if (!(turn > 0) || !(nl > 0) || nl / 2 >= limit)
+            continue; /* |n_a + n_b| / 2 = sin(angle / 2) */
+        nx /= nl;
+        ny /= nl;
+        double px = c->x, py = c->y;
+        uint32_t be = ag__skel_add_edge(S);
+        if (be == NONE)
+            return;
+        c = &S->c[ck];
+        A = &S->e[c->in];
+        sk_edge *e = &S->e[be];
+        e->nx = nx;
+        e->ny = ny;
+        e->s = (A->s + S->e[c->out].s) / 2;
+        e->c = nx * px + ny * py - e->s * v;
+        e->loop = A->loop;
+        e->edge = A->edge;
+        e->profile = A->profile;
+        e->seg = A->seg;
+        e->step = A->step;
+        e->clock = A->clock;
+        e->face = ag__skel_new_face(S, e);
+        uint32_t other = c->out;
+        c->out = be;
+        e->start = ck;
+        S->e[other].ver++;
+        if (!ag__skel_grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1,
+                           sizeof(uint32_t))) {
+            ag__skel_fail(S, AG_ERR_NOMEM);
+            return;
+        }
+        S->touched[S->ntouched++] = ck;
+        size_t first = S->ntouched - 1;
+        ag__skel_add_corner(S, be, other, px, py, c->z, c->vert);
+        size_t last = S->ntouched;
+        for (size_t t = first; t < last && S->st == AG_OK; t++)
+            ag__skel_settle(S, S->touched[t]);
+        S->stats.bevels++;
+    }
 }

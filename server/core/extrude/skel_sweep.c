@@ -6,6 +6,8 @@
 
 #include "skel.h"
 
+#include <stdio.h>
+
 int ag__skel_grow(void **p, size_t *cap, size_t need, size_t elem)
 {
     if (need <= *cap)
@@ -142,10 +144,36 @@ void ag__skel_kill_edge(sk *S, uint32_t e)
     S->e[e].alive = 0;
     S->e[e].ver++;
 }
+/* Bytes held by the sweep's state and its shell so far (for the memory budget). */
+static size_t state_bytes(const sk *S)
+{
+    const ag_shell *sh = S->shell;
+    return S->cap_e * sizeof(sk_edge) + S->cap_c * sizeof(sk_corner) +
+           (S->cap_live_c + S->cap_live_e + S->cap_touched) * sizeof(uint32_t) +
+           S->q.cap * sizeof(ag_event) + sh->cap_verts * 3 * sizeof(double) +
+           sh->cap_faces * sizeof(ag_shell_face) + sh->cap_segs * 3 * sizeof(uint32_t);
+}
+
+static void spend(sk *S)
+{
+    if (S->st == AG_OK && ag_budget_spend(S->budget, 1, state_bytes(S)) != AG_OK) {
+        ag_error_set(S->err, S->budget->st, 0, "the extrusion was %s, at height %.4g m",
+                     S->budget->why, ag__skel_real_z(S, S->zcur));
+        ag__skel_fail(S, S->budget->st);
+    }
+}
+
 void ag__skel_push(sk *S, const ag_event *ev)
 {
-    if (ag_eventq_push(&S->q, ev) != AG_OK)
+    spend(S);
+    if (S->st == AG_OK && ag_eventq_push(&S->q, ev) != AG_OK)
         ag__skel_fail(S, AG_ERR_NOMEM);
+}
+
+int ag__skel_pop(sk *S, ag_event *ev)
+{
+    spend(S);
+    return S->st == AG_OK && ag_eventq_pop(&S->q, ev);
 }
 void ag__skel_compact_live(sk *S)
 {

@@ -37,6 +37,17 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     memset(&S, 0, sizeof S);
     S.plan = plan;
     S.err = err;
+    ag_budget own;
+    if (opt && opt->budget) {
+        S.budget = opt->budget;
+    } else {
+        size_t corners = 0;
+        for (size_t L = 0; L < plan->nloops; L++)
+            corners += plan->loops[L].n;
+        ag_budget_start(&own, NULL, corners);
+        S.budget = &own;
+    }
+    size_t events0 = S.budget->events;
     /* the sweep runs in a frame at the plan's first corner: coordinates up to the extent */
     ag_extrude_tol tol = ag_extrude_tolerances(extent, extent);
     S.d1 = tol.height;
@@ -48,7 +59,6 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     /* local origin: the first corner */
     S.ox = plan->loops[0].xy[0];
     S.oy = plan->loops[0].xy[1];
-    size_t ncorners = 0;
     ag_shell_face ff = {AG_SHELL_FACE_FLOOR, -1, -1, -1, -1, 0, 0};
     uint32_t floor_face = 0;
     if (ag_shell_add_face(S.shell, &ff, &floor_face) != AG_OK)
@@ -224,7 +234,6 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     for (size_t L = 0; L < plan->nloops && S.st == AG_OK; L++) {
         const ag_plan_loop *lp = &plan->loops[L];
         size_t n = lp->n;
-        ncorners += n;
         uint32_t e0 = (uint32_t)S.ne;
         uint32_t v0 = (uint32_t)S.shell->nverts;
         for (size_t i = 0; i < n; i++)
@@ -258,15 +267,14 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         ag__skel_settle(&S, S.touched[i]);
     ag__skel_schedule_touched(&S);
 
-    size_t max_events = opt && opt->max_events ? opt->max_events : 64 * ncorners + 10000;
     double limit = plan->cap_height > 0 ? ag__skel_virtual_z(&S, plan->cap_height, 0) : INFINITY;
     ag_event *batch = NULL;
     size_t cap_batch = 0;
     while (S.st == AG_OK) {
         ag_event ev;
-        int more = ag_eventq_pop(&S.q, &ev);
-        if (more)
-            S.nprocessed++;
+        int more = ag__skel_pop(&S, &ev);
+        if (S.st != AG_OK)
+            break;
         if (more && !ag__skel_event_valid(&S, &ev))
             continue;
         int intersection = more && (ev.type == AG_EVENT_EDGE || ev.type == AG_EVENT_SPLIT);
@@ -279,13 +287,6 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         }
         if (!more || ev.z > limit)
             break;
-        if (S.nprocessed > max_events) {
-            ag_error_set(err, AG_ERR_INTERNAL, 0,
-                         "the sweep did not finish after %zu events (height %.4f)", max_events,
-                         S.zcur);
-            ag__skel_fail(&S, AG_ERR_INTERNAL);
-            break;
-        }
         if (ev.type == AG_EVENT_ANCHOR) {
             /* only observes: the sweep height stays where the last event left it */
             ag__skel_compact_live(&S);
@@ -315,8 +316,8 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         while ((top = ag_eventq_peek(&S.q)) && top->z <= ev.z + S.d1 &&
                top->type == AG_EVENT_DIRECTION) {
             ag_event nx;
-            ag_eventq_pop(&S.q, &nx);
-            S.nprocessed++;
+            if (!ag__skel_pop(&S, &nx))
+                break;
             if (!ag__skel_grow((void **)&batch, &cap_batch, nb + 1, sizeof *batch)) {
                 ag__skel_fail(&S, AG_ERR_NOMEM);
                 break;
@@ -336,6 +337,11 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         for (size_t i = 0; i < nb; i++)
             if (batch[i].a == FLAT_MARK && batch[i].b == 0)
                 ag__skel_insert_steps(&S, batch[i].z);
+        for (size_t i = 0; i < nb && S.st == AG_OK; i++)
+            if ((batch[i].a == FLAT_MARK && batch[i].b == 0) || batch[i].a == OFFSET_MARK) {
+                ag__skel_insert_bevels(&S, batch[i].z);
+                break;
+            }
         for (size_t i = 0; i < nb && S.st == AG_OK; i++)
             if (batch[i].a == FORCED_MARK)
                 ag__skel_forced_step(&S, batch[i].b, batch[i].z);
@@ -370,6 +376,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     free(S.live_e);
     free(S.touched);
     free(S.flat_h);
+    S.stats.events = S.budget->events - events0;
     if (stats)
         *stats = S.stats;
     if (st != AG_OK) {

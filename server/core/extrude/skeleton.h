@@ -21,11 +21,14 @@
 #include <stddef.h>
 
 #include "../status.h"
+#include "budget.h"
 #include "plan.h"
 #include "shell.h"
 
 typedef struct {
-    size_t max_events; /* 0 = a bound proportional to the plan size */
+    /* the running budget account (shared with nested sweeps), or NULL: the defaults of
+     * ag_extrude_budget for this plan */
+    ag_budget *budget;
     /* plan->nanchors entries to locate (usually plan->anchors), or NULL */
     ag_anchor *anchors;
 } ag_skeleton_options;
@@ -41,7 +44,9 @@ typedef struct {
     size_t steps, steps_skipped; /* plan edits made / not made (anchor not on the plan) */
     size_t offsets, offset_sides; /* offset events handled, side edges they made */
     size_t offset_gaps;   /* inside boundaries (gaps) opened by offset events */
+    size_t bevels;        /* sharp corners of outward offsets cut by a bevel edge */
     int capped;           /* the top was closed flat */
+    size_t events;        /* events taken from and put into the queue */
     double top;           /* highest height reached */
 } ag_skeleton_stats;
 

@@ -76,6 +76,17 @@
 /* Natural steps: width and |depth| of at least this (m). */
 #define AG_EXTRUDE_STEP_MIN 2e-3
 
+/* An outward flat offset (a soffit) bevels a convex corner whose mitre would lead out
+ * more than this many times the offset (corners sharper than 60°). */
+#define AG_EXTRUDE_BEVEL_MITRE 2.0
+
+/* Building check (verify.c): an outward offset of `reach` may put a convex corner's
+ * mitre this many times reach away from the footprint (a 47° corner); sharper corners
+ * with an overhang fail the check and are retried or fall back. */
+#define AG_VERIFY_MITRE 2.5
+/* ... plus this fraction of the plan's size (and its point tolerance) of slack. */
+#define AG_VERIFY_REACH_REL 1e-6
+
 /* Ear clipping: a corner whose doubled area is below this fraction of the loop's squared
  * extent is flat. */
 #define AG_EXTRUDE_EAR_FLAT 1e-14
