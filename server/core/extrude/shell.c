@@ -593,7 +593,7 @@ static double loop_area(const tri_pt *p, size_t n)
 static int seg_cross(const tri_pt *a, const tri_pt *b, const tri_pt *c, const tri_pt *d)
 {
     double p1[2] = {a->x, a->y}, p2[2] = {b->x, b->y}, p3[2] = {c->x, c->y}, p4[2] = {d->x, d->y};
-    return ag_pred_segments_touch(p1, p2, p3, p4, 0.0);
+    return ag_pred_segments_touch(p1, p2, p3, p4);
 }
 
 /* Ear clipping of one simple polygon (CCW) into m. Falls back to clipping the most convex corner when no clean ear is found,
@@ -743,6 +743,36 @@ static ag_status bridge_hole(tri_pt **poly, size_t *n, const tri_pt *h, size_t h
     return AG_OK;
 }
 
+/* A hole that shares a corner with the polygon (touching it at a point, as OGC allows) is
+ * spliced in at that corner: the polygon runs around the hole and back to the shared
+ * corner, a zero-length bridge. Returns 1 when spliced, 0 when they share no corner. */
+static int splice_hole(tri_pt **poly, size_t *n, const tri_pt *h, size_t hn, ag_status *st)
+{
+    tri_pt *P = *poly;
+    for (size_t i = 0; i < *n; i++)
+        for (size_t k = 0; k < hn; k++) {
+            if (P[i].v != h[k].v)
+                continue;
+            tri_pt *np = malloc((*n + hn) * sizeof *np);
+            if (!np) {
+                *st = AG_ERR_NOMEM;
+                return 1;
+            }
+            size_t m = 0;
+            for (size_t a = 0; a <= i; a++)
+                np[m++] = P[a];
+            for (size_t b = 1; b < hn; b++)
+                np[m++] = h[(k + b) % hn];
+            for (size_t a = i; a < *n; a++)
+                np[m++] = P[a];
+            free(P);
+            *poly = np;
+            *n = m;
+            return 1;
+        }
+    return 0;
+}
+
 static int cmp_hole_x(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -866,7 +896,8 @@ static ag_status triangulate_face(const ag_shell *s, size_t f, ag_mesh *m, uint3
         qsort(hx, nh, 2 * sizeof(double), cmp_hole_x);
         for (size_t h = 0; h < nh && st == AG_OK; h++) {
             uint32_t j = (uint32_t)hx[2 * h + 1];
-            st = bridge_hole(&poly, &n, loops[j], ln[j], ln, nl, (const tri_pt *const *)loops);
+            if (!splice_hole(&poly, &n, loops[j], ln[j], &st))
+                st = bridge_hole(&poly, &n, loops[j], ln[j], ln, nl, (const tri_pt *const *)loops);
         }
         free(hx);
         if (st == AG_OK)

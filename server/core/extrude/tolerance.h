@@ -58,6 +58,12 @@
 /* Two ridge edges closing from both ends count as ending at one point when their lengths
  * differ by less than this many delta2. */
 #define AG_EXTRUDE_ZIP_EQUAL 10.0
+/* Loops touching at a point (OGC-valid holes touching the outer ring, parts meeting at a
+ * corner) are moved this far apart, relative to the plan's size (1e-4 m at 10 m), so that
+ * walls on both never share an edge; well above the point tolerance and the 1e-6 m grids
+ * outside checks weld on. */
+#define AG_EXTRUDE_TOUCH_GAP 1e-5
+
 /* Forced steps and natural steps keep this many delta3 away from the active boundary. */
 #define AG_EXTRUDE_STEP_CLEARANCE 10.0
 /* Side of the protrusion a natural step grows from (m). */
