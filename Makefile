@@ -23,7 +23,7 @@ DB      ?= var/archgram.db
 # Debian packages: to build and run, and in addition to test.
 DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libwebsockets-dev \
              libsqlite3-dev libsuitesparse-dev libassimp-dev
-DEB_TEST  := libcmocka-dev chromium curl
+DEB_TEST  := libcmocka-dev chromium curl libcgal-dev g++
 DEB_BENCH := wrk
 
 # Sources: every .c below a layer directory is part of the library, except the two mains.
@@ -137,8 +137,16 @@ test: deps-test all
 	@$(MAKE) --no-print-directory test-integration
 	@$(MAKE) --no-print-directory test-browser
 
+# The CGAL straight-skeleton oracle of the extrusion tests and benchmark, built from
+# ../shared/tools/cgal_skeleton when that exists (libcgal-dev, g++: test packages); tests
+# that need it skip, naming it, when it is absent or could not be built.
+ORACLE_SRC := $(wildcard ../shared/tools/cgal_skeleton/main.cpp)
+ORACLE     := $(if $(ORACLE_SRC),$(BUILD)/oracle/cgal_skeleton)
+$(BUILD)/oracle/cgal_skeleton: $(ORACLE_SRC)
+	-$(MAKE) --no-print-directory -C $(dir $<) BUILD=$(CURDIR)/$(BUILD)/oracle
+
 # Each suite gets 10 minutes: a hang is a failure with a name, not a stuck CI.
-test-unit: $(UNIT_BIN)
+test-unit: $(UNIT_BIN) $(ORACLE)
 	@pass=0; fail=0; for t in $(UNIT_BIN); do \
 	  if timeout 600 $$t; then pass=$$((pass+1)); else fail=$$((fail+1)); echo "FAILED: $$t"; fi; \
 	done; echo "unit: $$pass passed, $$fail failed"; [ $$fail = 0 ]
@@ -150,7 +158,7 @@ test-browser: $(BUILD)/archgramd web
 	node --test --test-concurrency=1 tests/browser/
 
 # --- benchmarks ---------------------------------------------------------------------------
-bench: deps-bench all
+bench: deps-bench all $(ORACLE)
 	@for b in bench/*.sh; do [ -f "$$b" ] && sh "$$b"; done; true
 	@for b in bench/*.js; do [ -f "$$b" ] && node "$$b"; done; true
 	@for b in $(BENCH_BIN); do $$b; done

@@ -27,6 +27,14 @@ static long peak_kb(void)
     return ru.ru_maxrss;
 }
 
+/* Why a building is not good (a failing shell face or a defect of its triangles), or NULL. */
+static const char *not_good(const ag_extrude_result *r)
+{
+    if (r->failing_faces)
+        return r->problems[0].reason;
+    return r->defect[0] ? r->defect : NULL;
+}
+
 static void print_issues(const ag_footprints_report *r)
 {
     for (size_t i = 0; i < r->nfailed; i++)
@@ -173,10 +181,9 @@ static void generated_batch(size_t count)
             printf("    failed %s: %s\n", id, err.text);
         } else {
             tris += r.triangles;
-            if (r.failing_faces) {
+            if (not_good(&r)) {
                 leaky++;
-                printf("    not watertight %s: face %d: %s\n", id, (int)r.problems[0].face,
-                       r.problems[0].reason);
+                printf("    not good %s: %s\n", id, not_good(&r));
             }
         }
         ag_plan_free(p);
@@ -228,10 +235,9 @@ static void inside_batch(size_t count)
         } else {
             tris += r.triangles;
             gaps += r.stats.offset_gaps;
-            if (r.failing_faces) {
+            if (not_good(&r)) {
                 leaky++;
-                printf("    not watertight inside%zu: face %d: %s\n", i, (int)r.problems[0].face,
-                       r.problems[0].reason);
+                printf("    not good inside%zu: %s\n", i, not_good(&r));
             }
         }
         ag_mesh_free(m);
@@ -450,10 +456,9 @@ static void grid_stress(size_t count)
         } else if (st != AG_OK) {
             failed++;
             printf("    failed grid%zu: %s\n", i, err.text);
-        } else if (r.failing_faces) {
+        } else if (not_good(&r)) {
             leaky++;
-            printf("    not watertight grid%zu: face %d: %s\n", i, (int)r.problems[0].face,
-                   r.problems[0].reason);
+            printf("    not good grid%zu: %s\n", i, not_good(&r));
         }
         ag_mesh_free(m);
         ag_plan_free(p);

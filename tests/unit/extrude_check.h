@@ -19,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "core/mesh.h"
 
@@ -258,6 +259,194 @@ static double xc_top(const ag_mesh *m, long component)
             for (int k = 0; k < 3; k++)
                 top = fmax(top, m->pos[3 * m->tri[3 * t + k] + 2]);
     return top;
+}
+
+/* --- the CGAL oracle (../shared/tools/cgal_skeleton, built into build/oracle) --------------- */
+
+/* The oracle binary, or NULL (with a line saying why, so the caller can skip). */
+static const char *xc_oracle(void)
+{
+    static const char *path = AG_REPO_DIR "/build/oracle/cgal_skeleton";
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        printf("the CGAL oracle %s is absent (make builds it from ../shared/tools/cgal_skeleton "
+               "with libcgal-dev and g++): its checks are skipped\n", path);
+        return NULL;
+    }
+    fclose(f);
+    return path;
+}
+
+typedef struct {
+    size_t nloops;
+    const double *const *loops; /* outer ring counter-clockwise first, then its holes */
+    const size_t *sizes;
+} xc_polygon;
+
+/* CGAL's roof of one polygon, read from the oracle's OBJ (y up: x, height, -y): faces as
+ * plan polygons with the height of each corner. */
+typedef struct {
+    size_t nfaces;
+    size_t *start; /* nfaces + 1 into pts */
+    double *pts;   /* x, y, z per corner */
+} xc_roof;
+
+static void xc_roof_free(xc_roof *r)
+{
+    free(r->start);
+    free(r->pts);
+    memset(r, 0, sizeof *r);
+}
+
+static int xc_roof_read(const char *path, xc_roof *r)
+{
+    memset(r, 0, sizeof *r);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return 0;
+    double *v = NULL;
+    size_t nv = 0, cv = 0, np = 0, cp = 0, cf = 0;
+    char line[4096];
+    while (fgets(line, sizeof line, f)) {
+        if (line[0] == 'v' && line[1] == ' ') {
+            if (nv == cv) {
+                cv = cv ? 2 * cv : 256;
+                v = realloc(v, 3 * cv * sizeof *v);
+            }
+            double x, h, ny;
+            sscanf(line + 2, "%lf %lf %lf", &x, &h, &ny);
+            v[3 * nv] = x;
+            v[3 * nv + 1] = -ny;
+            v[3 * nv + 2] = h;
+            nv++;
+        } else if (line[0] == 'f' && line[1] == ' ') {
+            if (r->nfaces + 2 > cf) {
+                cf = cf ? 2 * cf : 64;
+                r->start = realloc(r->start, cf * sizeof *r->start);
+            }
+            if (!r->nfaces)
+                r->start[0] = 0;
+            char *s = line + 2, *end;
+            for (long k; (k = strtol(s, &end, 10)), end != s; s = end) {
+                if (np == cp) {
+                    cp = cp ? 2 * cp : 256;
+                    r->pts = realloc(r->pts, 3 * cp * sizeof *r->pts);
+                }
+                memcpy(&r->pts[3 * np++], &v[3 * (k - 1)], 3 * sizeof *v);
+            }
+            r->start[++r->nfaces] = np;
+        }
+    }
+    fclose(f);
+    free(v);
+    return r->nfaces > 0;
+}
+
+/* The height of CGAL's roof over (x, y): the plane of the face whose plan polygon holds
+ * it; NAN when none does. */
+static double xc_roof_height(const xc_roof *r, double x, double y)
+{
+    for (size_t f = 0; f < r->nfaces; f++) {
+        const double *p = &r->pts[3 * r->start[f]];
+        size_t n = r->start[f + 1] - r->start[f];
+        int in = 0;
+        double dmin = INFINITY;
+        for (size_t i = 0, j = n - 1; i < n; j = i++) {
+            const double *a = &p[3 * j], *b = &p[3 * i];
+            if ((b[1] > y) != (a[1] > y) &&
+                x < a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1]))
+                in = !in;
+            double ab[2] = {a[0], a[1]}, bb[2] = {b[0], b[1]};
+            dmin = fmin(dmin, xc_seg_dist(x, y, ab, bb));
+        }
+        if (!in && dmin > 2e-6) /* the oracle writes 6 decimals */
+            continue;
+        /* the face's plane through its corners, by least squares on z = ax + by + c */
+        double S[3][3] = {{0}}, B[3] = {0};
+        for (size_t i = 0; i < n; i++) {
+            double row[3] = {p[3 * i] - p[0], p[3 * i + 1] - p[1], 1};
+            for (int a = 0; a < 3; a++) {
+                B[a] += row[a] * p[3 * i + 2];
+                for (int b = 0; b < 3; b++)
+                    S[a][b] += row[a] * row[b];
+            }
+        }
+        double det = S[0][0] * (S[1][1] * S[2][2] - S[1][2] * S[2][1]) -
+                     S[0][1] * (S[1][0] * S[2][2] - S[1][2] * S[2][0]) +
+                     S[0][2] * (S[1][0] * S[2][1] - S[1][1] * S[2][0]);
+        if (!(fabs(det) > 0))
+            continue;
+        double sol[3];
+        for (int c = 0; c < 3; c++) {
+            double M[3][3];
+            memcpy(M, S, sizeof M);
+            for (int a = 0; a < 3; a++)
+                M[a][c] = B[a];
+            sol[c] = (M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) -
+                      M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+                      M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0])) / det;
+        }
+        return sol[0] * (x - p[0]) + sol[1] * (y - p[1]) + sol[2];
+    }
+    return NAN;
+}
+
+/* CGAL's highest offset time (the 45° roof's rise) of each polygon, into rise[]; NAN where
+ * CGAL did not build it. With objdir, CGAL also writes each roof to objdir/p<i>.obj.
+ * Returns 0 when the oracle could not be run. */
+static int xc_cgal_run(const char *oracle, const xc_polygon *p, size_t n, double *rise,
+                       const char *objdir)
+{
+    const char *dir = getenv("TMPDIR");
+    char path[512];
+    snprintf(path, sizeof path, "%s/ag_oracle_XXXXXX", dir && dir[0] ? dir : P_tmpdir);
+    int fd = mkstemp(path);
+    if (fd < 0)
+        return 0;
+    FILE *f = fdopen(fd, "w");
+    if (!f) {
+        close(fd);
+        remove(path);
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++) {
+        rise[i] = NAN;
+        fprintf(f, "P p%zu\n", i);
+        for (size_t l = 0; l < p[i].nloops; l++) {
+            fprintf(f, "L %zu\n", p[i].sizes[l]);
+            for (size_t k = 0; k < p[i].sizes[l]; k++)
+                fprintf(f, "%.17g %.17g 45\n", p[i].loops[l][2 * k], p[i].loops[l][2 * k + 1]);
+        }
+        fprintf(f, "E\n");
+    }
+    fclose(f);
+    char cmd[1200];
+    if (objdir)
+        snprintf(cmd, sizeof cmd, "'%s' --obj '%s' '%s'", oracle, objdir, path);
+    else
+        snprintf(cmd, sizeof cmd, "'%s' '%s'", oracle, path);
+    FILE *pp = popen(cmd, "r");
+    if (!pp) {
+        remove(path);
+        return 0;
+    }
+    char line[512];
+    while (fgets(line, sizeof line, pp)) {
+        size_t k;
+        char status[64];
+        double h;
+        if (sscanf(line, "p%zu,%*[^,],%*[^,],%*[^,],%*[^,],%*[^,],%63[^,],%lf", &k, status, &h) == 3 &&
+            k < n && strcmp(status, "ok") == 0)
+            rise[k] = h;
+    }
+    int rc = pclose(pp);
+    remove(path);
+    return rc == 0;
+}
+
+static int xc_cgal_rises(const char *oracle, const xc_polygon *p, size_t n, double *rise)
+{
+    return xc_cgal_run(oracle, p, n, rise, NULL);
 }
 
 #endif

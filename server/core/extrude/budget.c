@@ -37,6 +37,7 @@ ag_status ag_budget_poll(ag_budget *m, size_t bytes)
     if (m->st != AG_OK)
         return m->st;
     m->since_poll = 0;
+    m->work_since_poll = 0;
     if (m->cancelled && m->cancelled(m->user)) {
         m->st = AG_ERR_CANCELLED;
         snprintf(m->why, sizeof m->why, "cancelled after %.3f s and %zu events",
@@ -69,4 +70,15 @@ ag_status ag_budget_spend(ag_budget *m, size_t n, size_t bytes)
     if (m->since_poll >= AG_BUDGET_POLL_EVENTS)
         return ag_budget_poll(m, bytes);
     return AG_OK;
+}
+
+ag_status ag_budget_work(ag_budget *m, size_t n)
+{
+    if (m->st != AG_OK)
+        return m->st;
+    m->work_since_poll += n;
+    if (m->work_since_poll < AG_BUDGET_POLL_WORK)
+        return AG_OK;
+    m->work_since_poll = 0;
+    return ag_budget_poll(m, 0);
 }

@@ -46,6 +46,7 @@ typedef struct {
 #define AG_BUDGET_BYTES_PER_CORNER (128 * 1024)
 #define AG_BUDGET_BYTES_BASE ((size_t)64 << 20)
 #define AG_BUDGET_POLL_EVENTS 256
+#define AG_BUDGET_POLL_WORK 65536
 
 /* The running account of one extrusion against its budget. */
 typedef struct {
@@ -55,6 +56,7 @@ typedef struct {
     int (*cancelled)(void *user);
     void *user;
     unsigned since_poll;
+    size_t work_since_poll;
     ag_status st; /* AG_OK until a budget runs out */
     char why[160];
 } ag_budget;
@@ -64,6 +66,9 @@ void ag_budget_start(ag_budget *m, const ag_extrude_budget *b, size_t corners);
 /* Counts n events and, every AG_BUDGET_POLL_EVENTS, checks the clock, the callback and
  * `bytes` (the current state's size, 0: not known). Returns m->st. */
 ag_status ag_budget_spend(ag_budget *m, size_t n, size_t bytes);
+/* Counts n units of other work (e.g. candidate pairs tested) and polls the clock and the
+ * callback every AG_BUDGET_POLL_WORK of them. Returns m->st. */
+ag_status ag_budget_work(ag_budget *m, size_t n);
 /* Checks the clock and the callback now (between stages). */
 ag_status ag_budget_poll(ag_budget *m, size_t bytes);
 /* Seconds since ag_budget_start. */

@@ -1,11 +1,13 @@
 #include "shell.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "predicates.h"
+#include "tolerance.h"
 
 #define NONE UINT32_MAX
 
@@ -152,16 +154,24 @@ static int cmp_key(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-/* Newell normal (not normalised) of face f's loops. */
+/* Newell normal (not normalised) of face f's loops, computed relative to the face's first
+ * corner: shells lie at their plan's real coordinates (RD, UTM: millions of metres), where
+ * sums of coordinates would drown the face's own size. */
 static void face_normal(const ag_shell *s, size_t f, double *n)
 {
     n[0] = n[1] = n[2] = 0;
     const ag_shell_face *fc = &s->faces[f];
-    for (uint32_t l = fc->first_loop; l < fc->first_loop + (fc->nloops & 0x7fffffffu); l++) {
+    uint32_t nl = fc->nloops & 0x7fffffffu;
+    if (!nl)
+        return;
+    const double *o = &s->pos[3 * s->idx[s->loop_start[fc->first_loop]]];
+    for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++) {
         uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
         for (uint32_t i = a; i < b; i++) {
-            const double *p = &s->pos[3 * s->idx[i]];
-            const double *q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
+            const double *P = &s->pos[3 * s->idx[i]];
+            const double *Q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
+            double p[3] = {P[0] - o[0], P[1] - o[1], P[2] - o[2]};
+            double q[3] = {Q[0] - o[0], Q[1] - o[1], Q[2] - o[2]};
             n[0] += (p[1] - q[1]) * (p[2] + q[2]);
             n[1] += (p[2] - q[2]) * (p[0] + q[0]);
             n[2] += (p[0] - q[0]) * (p[1] + q[1]);
@@ -505,39 +515,39 @@ size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max)
                 }
             }
         if (!why[0] && nl) {
-            /* planarity: distance of every corner from the face's Newell plane */
-            double nx = 0, ny = 0, nz = 0, cx = 0, cy = 0, cz = 0, cnt = 0, lo = INFINITY, hi = -INFINITY;
-            for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++) {
-                uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
-                for (uint32_t i = a; i < b; i++) {
+            /* planarity: every corner within a fraction of the face's diameter of its
+             * Newell plane (relative to its first corner: shells lie at real coordinates) */
+            double n[3];
+            face_normal(s, f, n);
+            double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            const double *o = &s->pos[3 * s->idx[s->loop_start[fc->first_loop]]];
+            double c[3] = {0, 0, 0}, cnt = 0, lo = INFINITY, hi = -INFINITY, size = 0, mag = 0;
+            for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++)
+                for (uint32_t i = s->loop_start[l]; i < s->loop_start[l + 1]; i++) {
                     const double *p = &s->pos[3 * s->idx[i]];
-                    const double *q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
-                    nx += (p[1] - q[1]) * (p[2] + q[2]);
-                    ny += (p[2] - q[2]) * (p[0] + q[0]);
-                    nz += (p[0] - q[0]) * (p[1] + q[1]);
-                    cx += p[0];
-                    cy += p[1];
-                    cz += p[2];
+                    for (int k = 0; k < 3; k++) {
+                        c[k] += p[k] - o[k];
+                        mag = fmax(mag, fabs(p[k]));
+                    }
                     cnt++;
                 }
-            }
-            double len = sqrt(nx * nx + ny * ny + nz * nz);
             if (len > 0) {
-                cx /= cnt;
-                cy /= cnt;
-                cz /= cnt;
-                double size = 0;
+                for (int k = 0; k < 3; k++)
+                    c[k] /= cnt;
                 for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++)
                     for (uint32_t i = s->loop_start[l]; i < s->loop_start[l + 1]; i++) {
                         const double *p = &s->pos[3 * s->idx[i]];
-                        double d = ((p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz) / len;
+                        double q[3] = {p[0] - o[0] - c[0], p[1] - o[1] - c[1], p[2] - o[2] - c[2]};
+                        double d = (q[0] * n[0] + q[1] * n[1] + q[2] * n[2]) / len;
                         lo = fmin(lo, d);
                         hi = fmax(hi, d);
-                        size = fmax(size, fabs(p[0] - cx) + fabs(p[1] - cy) + fabs(p[2] - cz));
+                        size = fmax(size, sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]));
                     }
-                if (hi - lo > 1e-6 * (1 + size))
-                    snprintf(why, sizeof why, "face is not planar (corners %.3g m off its plane)",
-                             hi - lo);
+                double allowed = AG_EXTRUDE_PLANAR_REL * 2 * size + AG_EXTRUDE_PLANAR_ABS +
+                                 AG_EXTRUDE_COORD_ULPS * DBL_EPSILON * mag;
+                if (hi - lo > allowed)
+                    snprintf(why, sizeof why, "face is not planar (corners %.3g m off its plane, "
+                             "%.3g m allowed for its size)", hi - lo, allowed);
             }
         }
         if (why[0]) {
@@ -555,16 +565,25 @@ size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max)
 
 double ag_shell_volume(const ag_shell *s)
 {
-    /* divergence theorem over fan triangles of every loop */
+    /* divergence theorem over fan triangles of every loop, relative to the first vertex
+     * (a closed shell's volume does not depend on the origin; its precision does) */
+    if (!s->nloops)
+        return 0;
+    const double *o = &s->pos[3 * s->idx[0]];
     long double v = 0;
     for (size_t l = 0; l < s->nloops; l++) {
         uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
-        const double *p0 = &s->pos[3 * s->idx[a]];
+        const double *P0 = &s->pos[3 * s->idx[a]];
+        long double p0[3] = {(long double)P0[0] - o[0], (long double)P0[1] - o[1],
+                             (long double)P0[2] - o[2]};
         for (uint32_t i = a + 1; i + 1 < b; i++) {
-            const double *p1 = &s->pos[3 * s->idx[i]], *p2 = &s->pos[3 * s->idx[i + 1]];
-            v += (long double)p0[0] * (p1[1] * p2[2] - p1[2] * p2[1]) -
-                 (long double)p0[1] * (p1[0] * p2[2] - p1[2] * p2[0]) +
-                 (long double)p0[2] * (p1[0] * p2[1] - p1[1] * p2[0]);
+            const double *P1 = &s->pos[3 * s->idx[i]], *P2 = &s->pos[3 * s->idx[i + 1]];
+            long double p1[3] = {(long double)P1[0] - o[0], (long double)P1[1] - o[1],
+                                 (long double)P1[2] - o[2]};
+            long double p2[3] = {(long double)P2[0] - o[0], (long double)P2[1] - o[1],
+                                 (long double)P2[2] - o[2]};
+            v += p0[0] * (p1[1] * p2[2] - p1[2] * p2[1]) - p0[1] * (p1[0] * p2[2] - p1[2] * p2[0]) +
+                 p0[2] * (p1[0] * p2[1] - p1[1] * p2[0]);
         }
     }
     return (double)(v / 6);
@@ -616,7 +635,7 @@ static ag_status ear_clip(tri_pt *p, size_t n, ag_mesh *m, uint32_t base, uint32
     double ext = 0;
     for (size_t i = 0; i < n; i++)
         ext = fmax(ext, fmax(fabs(p[i].x - p[0].x), fabs(p[i].y - p[0].y)));
-    double eps = 1e-14 * ext * ext;
+    double eps = AG_EXTRUDE_EAR_FLAT * ext * ext;
     size_t left = n;
     uint32_t cur = 0;
     size_t misses = 0;
@@ -786,20 +805,13 @@ static ag_status triangulate_face(const ag_shell *s, size_t f, ag_mesh *m, uint3
     uint32_t nl = fc->nloops & 0x7fffffffu;
     if (!nl)
         return AG_OK;
-    /* Newell normal over all loops */
-    double nx = 0, ny = 0, nz = 0;
-    for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++) {
-        uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
-        for (uint32_t i = a; i < b; i++) {
-            const double *p = &s->pos[3 * s->idx[i]];
-            const double *q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
-            nx += (p[1] - q[1]) * (p[2] + q[2]);
-            ny += (p[2] - q[2]) * (p[0] + q[0]);
-            nz += (p[0] - q[0]) * (p[1] + q[1]);
-        }
-    }
+    /* Newell normal over all loops; the projection relative to the face's first corner */
+    double nn[3];
+    face_normal(s, f, nn);
+    double nx = nn[0], ny = nn[1], nz = nn[2];
+    const double *org = &s->pos[3 * s->idx[s->loop_start[fc->first_loop]]];
     double len = sqrt(nx * nx + ny * ny + nz * nz);
-    if (!(len > 1e-18))
+    if (!(len > AG_EXTRUDE_NO_AREA))
         return AG_OK; /* no area */
     nx /= len;
     ny /= len;
@@ -838,8 +850,9 @@ static ag_status triangulate_face(const ag_shell *s, size_t f, ag_mesh *m, uint3
         for (uint32_t k = a; k < b; k++) {
             const double *p = &s->pos[3 * s->idx[k]];
             /* u, v basis with u x v = n: loops CCW about n have positive area */
-            loops[i][k - a].x = p[0] * ux + p[1] * uy + p[2] * uz;
-            loops[i][k - a].y = p[0] * vx + p[1] * vy + p[2] * vz;
+            double q[3] = {p[0] - org[0], p[1] - org[1], p[2] - org[2]};
+            loops[i][k - a].x = q[0] * ux + q[1] * uy + q[2] * uz;
+            loops[i][k - a].y = q[0] * vx + q[1] * vy + q[2] * vz;
             loops[i][k - a].v = s->idx[k];
         }
         areas[i] = loop_area(loops[i], ln[i]);

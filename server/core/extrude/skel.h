@@ -35,6 +35,7 @@ typedef struct {
     uint32_t face;
     int32_t loop, edge, profile, seg;
     uint32_t ver;
+    uint32_t mark;   /* stamp of the last scheduling that visited it */
     uint8_t alive;
     uint8_t paused;  /* held still while other edges make a horizontal face */
     uint8_t growing; /* a plan edit's edge, growing to its size in a flat interval */
@@ -50,6 +51,8 @@ typedef struct {
     uint32_t vert; /* shell vertex where it was made */
     uint32_t stamp;
     uint8_t alive, settled;
+    uint8_t passive; /* convex, both edges moving in or waiting: it splits no edge that does */
+    double cond;     /* 1 / |sin| of the angle between its edges: how ill-known its motion is */
 } sk_corner;
 
 typedef struct {
@@ -73,7 +76,7 @@ typedef struct {
     size_t cap_batch;
     uint32_t *uf; /* clustering: membership of the lowest event's cluster */
     size_t cap_uf;
-    double *speed; /* clustering: each event's fastest corner */
+    double *speed; /* clustering: each event's fastest corner and its height's uncertainty */
     size_t cap_speed;
 } sk_scratch;
 
@@ -94,6 +97,7 @@ typedef struct {
     uint32_t stamp;
     double ox, oy; /* local origin */
     double d1, d2, d3;
+    double size; /* the plan's size the tolerances were scaled by */
     double zcur;
     /* Horizontal profile segments: the sweep runs in a virtual height in which each
      * height H with a horizontal segment is stretched to an interval [vs, vs + 1] of
@@ -144,8 +148,19 @@ void ag__skel_push(sk *S, const ag_event *ev);
 /* Takes the lowest event from the queue (counted against the budget); 0 when empty or
  * when the budget has run out (S->st is then set). */
 int ag__skel_pop(sk *S, ag_event *ev);
+/* Counts n units of work that are not events (candidate pairs tested) so that the time
+ * budget and the cancel callback are polled during long schedulings too. */
+void ag__skel_work(sk *S, size_t n);
 void ag__skel_compact_live(sk *S);
 double ag__skel_seg_slope(const ag_profile *p, int32_t seg);
+/* The point where the planes of three edges meet (local plan coordinates, virtual
+ * height); 0 when they do not meet in one point. Taken in a fixed order of the planes'
+ * coefficients, so the same planes give the same numbers whichever event asks (an edge
+ * event and a split event of one vertex event coincide exactly): events are computed
+ * from planes, never from corners propagated along (a corner between nearly parallel
+ * edges moves at millions of metres per metre of height). */
+int ag__skel_meet3(const sk *S, uint32_t e1, uint32_t e2, uint32_t e3, double *x, double *y,
+                   double *z);
 int ag__skel_seg_flat(const ag_profile *p, int32_t seg);
 
 /* --- skel_event.c ------------------------------------------------------------------------ */

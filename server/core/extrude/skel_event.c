@@ -1,6 +1,7 @@
 /* Intersection events: computed from the corners' motion, scheduled for the corners and
  * edges an event changed, and clustered (delta1 in height, delta2 in plan, §4.4) into
  * generalized intersections. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,6 +37,15 @@ static void edge_event(sk *S, uint32_t ei)
     ag__skel_cpos(b, ev.z, &bx, &by);
     ev.x = (ax + bx) / 2;
     ev.y = (ay + by) / 2;
+    /* where the planes of the edge and its two neighbours meet: exact for fast corners */
+    uint32_t p = a->in, q = b->out;
+    double px, py, pz;
+    if (p != ei && q != ei && p != q && ag__skel_meet3(S, p, ei, q, &px, &py, &pz) &&
+        pz >= z0 && fabs(pz - ev.z) <= AG_EXTRUDE_MEET_AGREE * S->size) {
+        ev.x = px;
+        ev.y = py;
+        ev.z = pz;
+    }
     ev.a = ei;
     ev.ver = e->ver;
     if (isfinite(ev.z))
@@ -66,6 +76,10 @@ static void split_event(sk *S, uint32_t k, uint32_t fi)
 {
     const sk_corner *c = &S->c[k];
     const sk_edge *f = &S->e[fi];
+    /* a convex corner whose edges move inwards (or wait) opens towards any edge moving in
+     * on it: that edge meets the corner's sides, or its own corners meet them, first */
+    if (c->passive && f->s >= 0)
+        return;
     if (!c->alive || !c->settled || !f->alive || fi == c->in || fi == c->out)
         return;
     if (f->start == NONE || f->end == NONE)
@@ -93,6 +107,14 @@ static void split_event(sk *S, uint32_t k, uint32_t fi)
         return;
     double x, y, ax, ay, bx, by;
     ag__skel_cpos(c, z, &x, &y);
+    /* the point where the corner's two planes meet the edge's: exact for fast corners */
+    double mx, my, mz;
+    if (ag__skel_meet3(S, c->in, c->out, fi, &mx, &my, &mz) && mz >= z0 &&
+        fabs(mz - z) <= AG_EXTRUDE_MEET_AGREE * S->size) {
+        x = mx;
+        y = my;
+        z = mz;
+    }
     ag__skel_cpos(fa, z, &ax, &ay);
     ag__skel_cpos(fb, z, &bx, &by);
     double dx = ag__skel_edx(f), dy = ag__skel_edy(f);
@@ -116,40 +138,56 @@ void ag__skel_schedule_touched(sk *S)
     if (S->st != AG_OK)
         return;
     ag__skel_compact_live(S);
-    S->stamp++;
-    for (size_t i = 0; i < S->ntouched; i++) {
+    uint32_t mark = ++S->stamp;
+    for (size_t i = 0; i < S->ntouched && S->st == AG_OK; i++) {
         sk_corner *c = &S->c[S->touched[i]];
         if (!c->alive)
             continue;
         uint32_t es[2] = {c->in, c->out};
         for (int j = 0; j < 2; j++) {
             sk_edge *e = &S->e[es[j]];
-            if (!e->alive)
+            if (!e->alive || e->mark == mark)
                 continue;
+            e->mark = mark; /* both its corners may have been touched */
             /* the edge changed: its collapse and every corner's hit on it are new */
             edge_event(S, es[j]);
             for (size_t q = 0; q < S->nlive_c; q++)
                 split_event(S, S->live_c[q], es[j]);
+            ag__skel_work(S, S->nlive_c);
         }
-        for (size_t q = 0; q < S->nlive_e; q++)
-            split_event(S, S->touched[i], S->live_e[q]);
+        if (c->passive)
+            for (size_t q = 0; q < S->nlive_e; q++) {
+                if (S->e[S->live_e[q]].s < 0)
+                    split_event(S, S->touched[i], S->live_e[q]);
+            }
+        else
+            for (size_t q = 0; q < S->nlive_e; q++)
+                split_event(S, S->touched[i], S->live_e[q]);
+        ag__skel_work(S, S->nlive_e);
     }
     S->ntouched = 0;
 }
 
 /* Plan speed of the fastest corner an intersection event moves (m per unit of height). */
-static double event_speed(const sk *S, const ag_event *ev)
+/* Plan speed of the fastest corner an intersection event moves (m per unit of height),
+ * and how far off its height may be: a corner between nearly parallel edges (an angle
+ * of sin = 1 / cond) has its velocity, hence its position, known only to about
+ * cond * eps * height, and the event's height with it. */
+static void event_speed(const sk *S, const ag_event *ev, double *speed, double *sigma)
 {
     uint32_t ks[2] = {ev->a, NONE};
     if (ev->type == AG_EVENT_EDGE) {
         ks[0] = S->e[ev->a].start;
         ks[1] = S->e[ev->a].end;
     }
-    double v = 0;
+    double v = 0, cond = 1;
     for (int j = 0; j < 2; j++)
-        if (ks[j] != NONE)
+        if (ks[j] != NONE) {
             v = fmax(v, hypot(S->c[ks[j]].vx, S->c[ks[j]].vy));
-    return v;
+            cond = fmax(cond, S->c[ks[j]].cond);
+        }
+    *speed = v;
+    *sigma = AG_EXTRUDE_HEIGHT_ULPS * DBL_EPSILON * (fabs(ev->z) + S->size) * cond;
 }
 
 int ag__skel_event_valid(sk *S, const ag_event *ev)
@@ -161,15 +199,19 @@ int ag__skel_event_valid(sk *S, const ag_event *ev)
     return 1;
 }
 
-/* Two events of one batch are one point when their plan points are within the cluster
- * radius; events a little apart in height (within delta1) are compared where their points
- * would be at one height: a fast corner (nearly parallel edges) moves its point by its
- * speed times the height difference (bounded). */
-static int same_point(const sk *S, const ag_event *a, const ag_event *b, double sa, double sb)
+/* Two events of one batch (within delta1 in height) are one point when their plan points
+ * are within the cluster radius and their corners move less than that radius between
+ * their heights: a fast corner (between nearly parallel edges) crosses metres within
+ * delta1, so two events at one spot but apart in height are two events, with others
+ * (elsewhere along its way) between them. */
+static int same_point(const sk *S, const ag_event *a, const ag_event *b, const double *sa,
+                      const double *sb)
 {
-    double tol = AG_EXTRUDE_CLUSTER_POINTS * S->d2 +
-                 fmin((sa + sb) * fabs(a->z - b->z), AG_EXTRUDE_DRIFT_ALONG * S->d3);
-    return fabs(a->y - b->y) <= tol && hypot(a->x - b->x, a->y - b->y) <= tol;
+    double tol = AG_EXTRUDE_CLUSTER_POINTS * S->d2, dz = fabs(a->z - b->z);
+    /* apart in height by less than the corners move within the radius, or by less than
+     * the heights are known (then they are one event computed twice) */
+    int same_height = fmax(sa[0] + sb[0], 1) * dz <= tol || dz <= sa[1] + sb[1];
+    return same_height && fabs(a->y - b->y) <= tol && hypot(a->x - b->x, a->y - b->y) <= tol;
 }
 
 void ag__skel_next_cluster(sk *S, const ag_event *ev0)
@@ -198,7 +240,7 @@ void ag__skel_next_cluster(sk *S, const ag_event *ev0)
         W->batch[nb++] = nx;
     }
     if (!ag__skel_grow((void **)&W->uf, &W->cap_uf, nb, sizeof *W->uf) ||
-        !ag__skel_grow((void **)&W->speed, &W->cap_speed, nb, sizeof *W->speed)) {
+        !ag__skel_grow((void **)&W->speed, &W->cap_speed, 2 * nb, sizeof *W->speed)) {
         ag__skel_fail(S, AG_ERR_NOMEM);
         return;
     }
@@ -208,7 +250,7 @@ void ag__skel_next_cluster(sk *S, const ag_event *ev0)
     double *sp = W->speed;
     for (size_t i = 0; i < nb; i++) {
         in[i] = i == 0;
-        sp[i] = event_speed(S, &batch[i]);
+        event_speed(S, &batch[i], &sp[2 * i], &sp[2 * i + 1]);
     }
     for (int grew = 1; grew;) {
         grew = 0;
@@ -216,7 +258,7 @@ void ag__skel_next_cluster(sk *S, const ag_event *ev0)
             if (!in[i])
                 continue;
             for (size_t j = 1; j < nb; j++)
-                if (!in[j] && same_point(S, &batch[i], &batch[j], sp[i], sp[j])) {
+                if (!in[j] && same_point(S, &batch[i], &batch[j], &sp[2 * i], &sp[2 * j])) {
                     in[j] = 1;
                     grew = 1;
                 }

@@ -308,10 +308,10 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
     for (size_t p = 0; p < np; p++)
         if (pairs[2 * p] != NONE)
             ag__skel_add_corner(S, pairs[2 * p], pairs[2 * p + 1], lx, ly, z, vl);
+    size_t last_new = S->ntouched;
     free(stack);
     free(pairs);
     free(keep);
-    size_t last_new = S->ntouched;
     for (size_t i = first_new; i < last_new && S->st == AG_OK; i++) {
         if (!ag__skel_settle_or_defer(S, S->touched[i], S->defer_settle) &&
             !ag__skel_vpush(&S->deferred, S->touched[i]))

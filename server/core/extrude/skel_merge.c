@@ -16,6 +16,22 @@ static int velocity(sk *S, sk_corner *c)
         return 0;
     c->vx = (a->s * b->ny - b->s * a->ny) / det;
     c->vy = (a->nx * b->s - b->nx * a->s) / det;
+    c->cond = 1 / fabs(det);
+    /* Put the corner on its trajectory, the line where its two planes meet: the point of
+     * that line nearest to where it was made (an event's point, which may be off the
+     * planes by the cluster's spread). A corner between nearly parallel edges moves
+     * fast; made a nanometre off its line, it would be off its planes and meet the next
+     * edges at the wrong time. q is the line's point at the corner's height, t how much
+     * higher the nearest point lies (nearest in plan and height). */
+    double ca = a->c + a->s * c->z, cb = b->c + b->s * c->z;
+    double qx = (ca * b->ny - cb * a->ny) / det, qy = (a->nx * cb - b->nx * ca) / det;
+    double dx = qx - c->x, dy = qy - c->y, v2 = c->vx * c->vx + c->vy * c->vy;
+    double t = -(dx * c->vx + dy * c->vy) / (v2 + 1);
+    if (isfinite(t) && hypot(dx + t * c->vx, dy + t * c->vy) + fabs(t) <= AG_EXTRUDE_ANCHOR * S->d3) {
+        c->x = qx + t * c->vx;
+        c->y = qy + t * c->vy;
+        c->z += t;
+    }
     return 1;
 }
 
@@ -153,17 +169,22 @@ int ag__skel_settle_or_defer(sk *S, uint32_t k, int defer)
         c->alive = 0;
         return 1;
     }
+    const sk_edge *a = &S->e[c->in], *b = &S->e[c->out];
+    c->passive = 0;
     if (velocity(S, c)) {
         c->settled = 1;
+        /* convex (the edges turn left: their normals' cross product is positive, and not
+         * near zero here) with both edges moving in or waiting */
+        c->passive = a->nx * b->ny - a->ny * b->nx > 0 && a->s >= 0 && b->s >= 0;
         return 1;
     }
-    const sk_edge *a = &S->e[c->in], *b = &S->e[c->out];
     double dot = a->nx * b->nx + a->ny * b->ny;
     if (dot > 0 && fabs(a->s - b->s) <= AG_EXTRUDE_SAME_SLOPE) {
         /* collinear, same slope: the corner moves with the common plane */
         double nx = a->nx + b->nx, ny = a->ny + b->ny, l = hypot(nx, ny);
         c->vx = a->s * nx / l;
         c->vy = a->s * ny / l;
+        c->cond = 1;
         c->settled = 1;
         return 1;
     }

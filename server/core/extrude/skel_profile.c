@@ -550,30 +550,33 @@ out:
 
 /* --- outward offsets: bevels at sharp corners ---------------------------------------------- */
 
-/* At the start of a flat interval (a soffit, an offset event moving edges out): a convex
- * corner sharper than the mitre limit between two edges moving outwards would shoot out
- * by width / sin(angle / 2) (20 m for a 0.5 m eave on a 3° spike of digitising noise). A
- * bevel edge is put in there, perpendicular to the corner's bisector and moving out with
- * its edges, so the eave is cut square to the bisector as eaves are built; it carries on
- * with the profile of the corner's incoming edge. */
+/* After direction events (a soffit's flat interval starts, an offset event moves edges
+ * out, a profile leans outwards): a sharp convex corner of an edge moving outwards would
+ * shoot out by width / sin(angle / 2) (20 m for a 0.5 m eave on a 3° spike of digitising
+ * noise), or slide that far along a waiting neighbour's line. Where the corner would move
+ * faster than the mitre limit times the outward speed, a bevel edge is put in,
+ * perpendicular to the corner's bisector and moving out as fast as the outward edge, so
+ * the eave is cut square to the bisector as eaves are built; it carries on with the
+ * profile of the corner's incoming edge. */
 void ag__skel_insert_bevels(sk *S, double v)
 {
     ag__skel_compact_live(S);
     size_t nlive = S->nlive_c;
-    double limit = 1 / AG_EXTRUDE_BEVEL_MITRE; /* sin(angle / 2) below this: bevel */
     for (size_t i = 0; i < nlive && S->st == AG_OK; i++) {
         uint32_t ck = S->live_c[i];
         sk_corner *c = &S->c[ck];
         if (!c->alive || !c->settled || fabs(c->z - v) > S->d1)
             continue;
         const sk_edge *A = &S->e[c->in], *B = &S->e[c->out];
-        if (!(A->s < 0 && B->s < 0) || A->paused || B->paused || A->growing || B->growing)
+        double out = fmin(A->s, B->s); /* the outward speed (negative) */
+        if (!(out < 0) || A->growing || B->growing)
             continue;
-        /* convex (turning left) and sharp: the normals nearly opposite */
+        /* a convex corner moving outwards faster than the mitre limit allows */
         double turn = ag__skel_edx(A) * ag__skel_edy(B) - ag__skel_edy(A) * ag__skel_edx(B);
         double nx = A->nx + B->nx, ny = A->ny + B->ny, nl = hypot(nx, ny);
-        if (!(turn > 0) || !(nl > 0) || nl / 2 >= limit)
-            continue; /* |n_a + n_b| / 2 = sin(angle / 2) */
+        if (!(turn > 0) || !(nl > 0) || c->vx * nx + c->vy * ny >= 0 ||
+            hypot(c->vx, c->vy) <= -out * AG_EXTRUDE_BEVEL_MITRE)
+            continue;
         nx /= nl;
         ny /= nl;
         double px = c->x, py = c->y;
@@ -585,7 +588,7 @@ void ag__skel_insert_bevels(sk *S, double v)
         sk_edge *e = &S->e[be];
         e->nx = nx;
         e->ny = ny;
-        e->s = (A->s + S->e[c->out].s) / 2;
+        e->s = out;
         e->c = nx * px + ny * py - e->s * v;
         e->loop = A->loop;
         e->edge = A->edge;

@@ -1,12 +1,12 @@
 /* The sweep's state: active edges and corners, the shell they build, and the virtual
  * height in which horizontal profile segments get an interval of their own. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "skel.h"
-
-#include <stdio.h>
+#include "tolerance.h"
 
 int ag__skel_grow(void **p, size_t *cap, size_t need, size_t elem)
 {
@@ -163,6 +163,15 @@ static void spend(sk *S)
     }
 }
 
+void ag__skel_work(sk *S, size_t n)
+{
+    if (S->st == AG_OK && ag_budget_work(S->budget, n) != AG_OK) {
+        ag_error_set(S->err, S->budget->st, 0, "the extrusion was %s, at height %.4g m",
+                     S->budget->why, ag__skel_real_z(S, S->zcur));
+        ag__skel_fail(S, S->budget->st);
+    }
+}
+
 void ag__skel_push(sk *S, const ag_event *ev)
 {
     spend(S);
@@ -199,4 +208,69 @@ double ag__skel_seg_slope(const ag_profile *p, int32_t seg)
 int ag__skel_seg_flat(const ag_profile *p, int32_t seg)
 {
     return p->points[seg + 1].z == p->points[seg].z;
+}
+
+/* Plane order by coefficients: the same three planes always come in the same order. */
+static int plane_before(const sk_edge *a, const sk_edge *b)
+{
+    if (a->nx != b->nx)
+        return a->nx < b->nx;
+    if (a->ny != b->ny)
+        return a->ny < b->ny;
+    if (a->s != b->s)
+        return a->s < b->s;
+    return a->c < b->c;
+}
+
+int ag__skel_meet3(const sk *S, uint32_t e1, uint32_t e2, uint32_t e3, double *x, double *y,
+                   double *z)
+{
+    const sk_edge *p[3] = {&S->e[e1], &S->e[e2], &S->e[e3]};
+    for (int i = 1; i < 3; i++)
+        for (int j = i; j > 0 && plane_before(p[j], p[j - 1]); j--) {
+            const sk_edge *t = p[j];
+            p[j] = p[j - 1];
+            p[j - 1] = t;
+        }
+    /* nx x + ny y - s z = c, by Gaussian elimination with partial pivoting in extended
+     * precision */
+    long double A[3][4];
+    for (int i = 0; i < 3; i++) {
+        A[i][0] = p[i]->nx;
+        A[i][1] = p[i]->ny;
+        A[i][2] = -p[i]->s;
+        A[i][3] = p[i]->c;
+    }
+    for (int col = 0; col < 3; col++) {
+        int piv = col;
+        for (int r = col + 1; r < 3; r++)
+            if (fabsl(A[r][col]) > fabsl(A[piv][col]))
+                piv = r;
+        if (!(fabsl(A[piv][col]) > AG_EXTRUDE_MEET_PIVOT))
+            return 0;
+        if (piv != col)
+            for (int k = 0; k < 4; k++) {
+                long double t = A[col][k];
+                A[col][k] = A[piv][k];
+                A[piv][k] = t;
+            }
+        for (int r = col + 1; r < 3; r++) {
+            long double f = A[r][col] / A[col][col];
+            for (int k = col; k < 4; k++)
+                A[r][k] -= f * A[col][k];
+        }
+    }
+    long double r[3];
+    for (int i = 2; i >= 0; i--) {
+        long double v = A[i][3];
+        for (int k = i + 1; k < 3; k++)
+            v -= A[i][k] * r[k];
+        r[i] = v / A[i][i];
+    }
+    if (!isfinite((double)r[0]) || !isfinite((double)r[1]) || !isfinite((double)r[2]))
+        return 0;
+    *x = (double)r[0];
+    *y = (double)r[1];
+    *z = (double)r[2];
+    return 1;
 }

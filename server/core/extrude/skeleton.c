@@ -53,6 +53,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     S.d1 = tol.height;
     S.d2 = tol.point;
     S.d3 = tol.along;
+    S.size = tol.size;
     S.shell = ag_shell_create();
     if (!S.shell)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
@@ -337,11 +338,8 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         for (size_t i = 0; i < nb; i++)
             if (batch[i].a == FLAT_MARK && batch[i].b == 0)
                 ag__skel_insert_steps(&S, batch[i].z);
-        for (size_t i = 0; i < nb && S.st == AG_OK; i++)
-            if ((batch[i].a == FLAT_MARK && batch[i].b == 0) || batch[i].a == OFFSET_MARK) {
-                ag__skel_insert_bevels(&S, batch[i].z);
-                break;
-            }
+        if (S.st == AG_OK)
+            ag__skel_insert_bevels(&S, batch[0].z);
         for (size_t i = 0; i < nb && S.st == AG_OK; i++)
             if (batch[i].a == FORCED_MARK)
                 ag__skel_forced_step(&S, batch[i].b, batch[i].z);

@@ -33,8 +33,16 @@
 #define AG_EXTRUDE_COORD_ULPS 64.0
 /* |sin| of the angle between two edges below which they count as parallel (collinear or
  * antiparallel) for a corner's velocity: a corner between them would move faster than
- * 1e9 m per metre of height, beyond what a double position can follow. */
+ * 1e9 m per metre of height. Faster corners than a double height can place are still
+ * swept right because their events are computed from the planes that meet there
+ * (ag__skel_meet3), not from where the corner is said to be. */
 #define AG_EXTRUDE_PARALLEL 1e-9
+/* An event's height from its three planes replaces the one from its corners' motion
+ * when they agree to this fraction of the size (else the corners' motion is kept: the
+ * planes then meet somewhere the event is not). */
+#define AG_EXTRUDE_MEET_AGREE 1e-6
+/* Three planes whose elimination meets a pivot below this do not meet in one point. */
+#define AG_EXTRUDE_MEET_PIVOT 1e-12
 /* Slopes (dw/dz) closer than this are equal (collinear neighbours move as one plane). */
 #define AG_EXTRUDE_SAME_SLOPE 1e-9
 /* Rates (m of length per m of height) below this do not make an edge shrink or a corner
@@ -45,6 +53,10 @@
 #define AG_EXTRUDE_RAY_TIE 1e-12
 /* Intersection events whose points are within this many delta2 are one point. */
 #define AG_EXTRUDE_CLUSTER_POINTS 10.0
+/* Two intersection events at one point whose heights differ by less than this many units
+ * in the last place (of height plus size), times their corners' condition (1 / sin of
+ * the angle between a corner's edges), are one event computed twice. */
+#define AG_EXTRUDE_HEIGHT_ULPS 16.0
 /* A corner arrives at an intersection point when it is within this many delta2 of it
  * (plus its drift, up to AG_EXTRUDE_DRIFT_MAX delta3). */
 #define AG_EXTRUDE_NEAR_POINTS 2.0
@@ -52,6 +64,9 @@
 /* A cluster's points may spread by the speed of its fastest corner times its height
  * spread, up to this many delta3 (a corner between nearly parallel edges is fast). */
 #define AG_EXTRUDE_DRIFT_ALONG 20.0
+/* A new corner is moved onto the line where its two planes meet when that line passes
+ * within this many delta3 of where it was made (else it keeps its point). */
+#define AG_EXTRUDE_ANCHOR 100.0
 /* Relative weight that pulls the least-squares apex of an intersection towards the
  * events' mean along directions no plane fixes (parallel planes). */
 #define AG_EXTRUDE_APEX_DAMPING 1e-6
@@ -92,6 +107,10 @@
 #define AG_VERIFY_MITRE 2.5
 /* ... plus this fraction of the plan's size (and its point tolerance) of slack. */
 #define AG_VERIFY_REACH_REL 1e-6
+
+/* A face whose Newell normal (twice its area, m²) is shorter than this has no area and
+ * is not triangulated. */
+#define AG_EXTRUDE_NO_AREA 1e-18
 
 /* Ear clipping: a corner whose doubled area is below this fraction of the loop's squared
  * extent is flat. */
