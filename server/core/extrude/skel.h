@@ -65,6 +65,7 @@ typedef struct {
     double ang;
     uint32_t edge;
     int out;
+    double s; /* its edge's slope: how it turns just above the point */
 } sk_ray;
 
 /* Buffers of the intersection handler, kept across events. */

@@ -10,13 +10,27 @@
 
 #include "tolerance.h"
 
+/* Rays in counter-clockwise order around the point, by angle. Ties between an outgoing
+ * and an incoming ray (antiparallel edges through the point): the outgoing ray first, so
+ * the thin region between them counts as inside and is zipped when their corner settles:
+ * a ridge closing, or two parts of a growing plan meeting from outside and merging. Only
+ * two edges that both stand still (walls of two parts touching along a line) keep the
+ * outside between them: the incoming ray first. Two rays the same way (collinear edges, e.g. pieces of one line with different
+ * profiles) by where their edges are a little higher (the chains' predicted positions,
+ * §4.4): an edge leaving the point moves towards its inside, the left, so it turns
+ * counter-clockwise by its slope; one arriving turns clockwise by its slope. */
 static int cmp_ray(const void *a, const void *b)
 {
     const sk_ray *x = a, *y = b;
-    if (x->ang != y->ang)
+    if (fabs(x->ang - y->ang) > AG_EXTRUDE_RAY_TIE)
         return x->ang < y->ang ? -1 : 1;
-    if (x->out != y->out)
-        return y->out - x->out; /* outgoing first on ties */
+    if (x->out != y->out) {
+        int out_first = x->s != 0 || y->s != 0;
+        return (x->out == out_first) ? -1 : 1;
+    }
+    double tx = x->out ? x->s : -x->s, ty = y->out ? y->s : -y->s;
+    if (tx != ty)
+        return tx < ty ? -1 : 1;
     /* the same way along one line: a fixed order, so that handling the point again pairs
      * the same edges (and keeps the corners) instead of swapping them for ever */
     return x->edge < y->edge ? -1 : x->edge > y->edge;
@@ -178,9 +192,9 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
         if (st && en) {
             ag__skel_kill_edge(S, W->E.arr[i]);
         } else if (st) {
-            W->rays[nrays++] = (sk_ray){a, W->E.arr[i], 1};
+            W->rays[nrays++] = (sk_ray){a, W->E.arr[i], 1, e->s};
         } else if (en) {
-            W->rays[nrays++] = (sk_ray){a > 0 ? a - M_PI : a + M_PI, W->E.arr[i], 0};
+            W->rays[nrays++] = (sk_ray){a > 0 ? a - M_PI : a + M_PI, W->E.arr[i], 0, e->s};
         }
     }
     for (size_t i = 0; i < W->splits.n; i++) {
@@ -218,8 +232,8 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
         f->end = NONE;
         f->ver++;
         double a = atan2(dy, dx);
-        W->rays[nrays++] = (sk_ray){a > 0 ? a - M_PI : a + M_PI, fi, 0};
-        W->rays[nrays++] = (sk_ray){a, f2, 1};
+        W->rays[nrays++] = (sk_ray){a > 0 ? a - M_PI : a + M_PI, fi, 0, S->e[fi].s};
+        W->rays[nrays++] = (sk_ray){a, f2, 1, S->e[f2].s};
     }
     if (!nrays) {
         for (size_t i = 0; i < W->C.n; i++)
@@ -227,23 +241,16 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
         return;
     }
     qsort(W->rays, nrays, sizeof(sk_ray), cmp_ray);
-    /* near-ties: an outgoing sk_ray goes before an incoming one (a ridge, zipped later) */
-    for (size_t i = 0; i + 1 < nrays; i++)
-        if (!W->rays[i].out && W->rays[i + 1].out && W->rays[i + 1].ang - W->rays[i].ang < 1e-9) {
-            sk_ray t = W->rays[i];
-            W->rays[i] = W->rays[i + 1];
-            W->rays[i + 1] = t;
-        }
-    if (nrays >= 2 && !W->rays[nrays - 1].out && W->rays[0].out &&
-        W->rays[0].ang + 2 * M_PI - W->rays[nrays - 1].ang < 1e-9) {
-        /* wrap-around tie: rotate the last (incoming) sk_ray behind the first */
-        sk_ray t = W->rays[nrays - 1];
+    /* a tie across the cut at -pi: the last rays belong before the first ones */
+    for (size_t turn = 0; turn < nrays && nrays >= 2 &&
+                          W->rays[nrays - 1].ang - 2 * M_PI >= W->rays[0].ang - AG_EXTRUDE_RAY_TIE;
+         turn++) {
+        sk_ray r = W->rays[nrays - 1];
+        r.ang -= 2 * M_PI;
+        if (cmp_ray(&r, &W->rays[0]) >= 0)
+            break;
         memmove(&W->rays[1], &W->rays[0], (nrays - 1) * sizeof(sk_ray));
-        W->rays[0] = t;
-        W->rays[0].ang -= 2 * M_PI;
-        t = W->rays[0];
-        W->rays[0] = W->rays[1];
-        W->rays[1] = t;
+        W->rays[0] = r;
     }
     /* pair each outgoing sk_ray with the next incoming one counter-clockwise */
     long bal = 0, minbal = 0;

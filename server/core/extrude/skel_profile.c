@@ -557,7 +557,7 @@ out:
  * faster than the mitre limit times the outward speed, a bevel edge is put in,
  * perpendicular to the corner's bisector and moving out as fast as the outward edge, so
  * the eave is cut square to the bisector as eaves are built; it carries on with the
- * profile of the corner's incoming edge. */
+ * profile of the edge moving outwards (the faster one). */
 void ag__skel_insert_bevels(sk *S, double v)
 {
     ag__skel_compact_live(S);
@@ -580,22 +580,24 @@ void ag__skel_insert_bevels(sk *S, double v)
         nx /= nl;
         ny /= nl;
         double px = c->x, py = c->y;
+        /* the bevel moves and carries on as the edge moving outwards (the faster one) */
+        uint32_t mover = A->s <= B->s ? c->in : c->out;
         uint32_t be = ag__skel_add_edge(S);
         if (be == NONE)
             return;
         c = &S->c[ck];
-        A = &S->e[c->in];
+        const sk_edge *M = &S->e[mover];
         sk_edge *e = &S->e[be];
         e->nx = nx;
         e->ny = ny;
         e->s = out;
         e->c = nx * px + ny * py - e->s * v;
-        e->loop = A->loop;
-        e->edge = A->edge;
-        e->profile = A->profile;
-        e->seg = A->seg;
-        e->step = A->step;
-        e->clock = A->clock;
+        e->loop = M->loop;
+        e->edge = M->edge;
+        e->profile = M->profile;
+        e->seg = M->seg;
+        e->step = M->step;
+        e->clock = M->clock;
         e->face = ag__skel_new_face(S, e);
         uint32_t other = c->out;
         c->out = be;
