@@ -28,7 +28,7 @@ typedef struct {
     uint32_t a, b;
 } xc_edge;
 
-static int xc_cmp_edge(const void *x, const void *y)
+static inline int xc_cmp_edge(const void *x, const void *y)
 {
     const xc_edge *p = x, *q = y;
     if (p->a != q->a)
@@ -36,7 +36,7 @@ static int xc_cmp_edge(const void *x, const void *y)
     return p->b < q->b ? -1 : p->b > q->b;
 }
 
-static int xc_cmp_u32x3(const void *x, const void *y)
+static inline int xc_cmp_u32x3(const void *x, const void *y)
 {
     const uint32_t *p = x, *q = y;
     for (int k = 0; k < 3; k++)
@@ -50,7 +50,7 @@ typedef struct {
     uint32_t v;
 } xc_cell;
 
-static int xc_cmp_cell(const void *x, const void *y)
+static inline int xc_cmp_cell(const void *x, const void *y)
 {
     const xc_cell *p = x, *q = y;
     if (p->cx != q->cx)
@@ -62,7 +62,7 @@ static int xc_cmp_cell(const void *x, const void *y)
     return p->v < q->v ? -1 : p->v > q->v;
 }
 
-static uint32_t xc_find(uint32_t *par, uint32_t x)
+static inline uint32_t xc_find(uint32_t *par, uint32_t x)
 {
     while (par[x] != x)
         x = par[x] = par[par[x]];
@@ -72,7 +72,7 @@ static uint32_t xc_find(uint32_t *par, uint32_t x)
 /* Welds the vertices used by triangles of `component` (-1: all) within tol: id[v] gets the
  * welded id (a representative vertex index). Cells of side tol; vertices in the same or a
  * neighbouring cell closer than tol are one. */
-static void xc_weld(const ag_mesh *m, long component, double tol, uint32_t *id)
+static inline void xc_weld(const ag_mesh *m, long component, double tol, uint32_t *id)
 {
     size_t n = m->nverts;
     xc_cell *c = malloc((n ? n : 1) * sizeof *c);
@@ -132,7 +132,7 @@ static void xc_weld(const ag_mesh *m, long component, double tol, uint32_t *id)
 
 /* 1 when the triangles of `component` (-1: all) form a closed 2-manifold after welding
  * at tol; else 0 with the first reason in why. */
-static int xc_closed_manifold(const ag_mesh *m, long component, double tol, char *why,
+static inline int xc_closed_manifold(const ag_mesh *m, long component, double tol, char *why,
                               size_t nwhy)
 {
     uint32_t *id = malloc((m->nverts ? m->nverts : 1) * sizeof *id);
@@ -205,7 +205,7 @@ static int xc_closed_manifold(const ag_mesh *m, long component, double tol, char
 }
 
 /* Distance from (x, y) to the segment a-b. */
-static double xc_seg_dist(double x, double y, const double *a, const double *b)
+static inline double xc_seg_dist(double x, double y, const double *a, const double *b)
 {
     double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
     double t = l2 > 0 ? ((x - a[0]) * dx + (y - a[1]) * dy) / l2 : 0;
@@ -215,7 +215,7 @@ static double xc_seg_dist(double x, double y, const double *a, const double *b)
 
 /* How far the triangles of `component` (-1: all) reach outside the footprint (loops of
  * xy pairs, even-odd inside): 0 when every vertex is inside; also below z0. */
-static double xc_outside(const ag_mesh *m, long component, const double *const *loops,
+static inline double xc_outside(const ag_mesh *m, long component, const double *const *loops,
                          const size_t *sizes, size_t nloops, double z0)
 {
     double worst = 0;
@@ -251,7 +251,7 @@ static double xc_outside(const ag_mesh *m, long component, const double *const *
 }
 
 /* Highest z of the triangles of `component` (-1: all). */
-static double xc_top(const ag_mesh *m, long component)
+static inline double xc_top(const ag_mesh *m, long component)
 {
     double top = -INFINITY;
     for (size_t t = 0; t < m->ntris; t++)
@@ -264,7 +264,7 @@ static double xc_top(const ag_mesh *m, long component)
 /* --- the CGAL oracle (../shared/tools/cgal_skeleton, built into build/oracle) --------------- */
 
 /* The oracle binary, or NULL (with a line saying why, so the caller can skip). */
-static const char *xc_oracle(void)
+static inline const char *xc_oracle(void)
 {
     static const char *path = AG_REPO_DIR "/build/oracle/cgal_skeleton";
     FILE *f = fopen(path, "rb");
@@ -291,14 +291,14 @@ typedef struct {
     double *pts;   /* x, y, z per corner */
 } xc_roof;
 
-static void xc_roof_free(xc_roof *r)
+static inline void xc_roof_free(xc_roof *r)
 {
     free(r->start);
     free(r->pts);
     memset(r, 0, sizeof *r);
 }
 
-static int xc_roof_read(const char *path, xc_roof *r)
+static inline int xc_roof_read(const char *path, xc_roof *r)
 {
     memset(r, 0, sizeof *r);
     FILE *f = fopen(path, "r");
@@ -344,7 +344,7 @@ static int xc_roof_read(const char *path, xc_roof *r)
 
 /* The height of CGAL's roof over (x, y): the plane of the face whose plan polygon holds
  * it; NAN when none does. */
-static double xc_roof_height(const xc_roof *r, double x, double y)
+static inline double xc_roof_height(const xc_roof *r, double x, double y)
 {
     for (size_t f = 0; f < r->nfaces; f++) {
         const double *p = &r->pts[3 * r->start[f]];
@@ -394,7 +394,7 @@ static double xc_roof_height(const xc_roof *r, double x, double y)
 /* CGAL's highest offset time (the 45° roof's rise) of each polygon, into rise[]; NAN where
  * CGAL did not build it. With objdir, CGAL also writes each roof to objdir/p<i>.obj.
  * Returns 0 when the oracle could not be run. */
-static int xc_cgal_run(const char *oracle, const xc_polygon *p, size_t n, double *rise,
+static inline int xc_cgal_run(const char *oracle, const xc_polygon *p, size_t n, double *rise,
                        const char *objdir)
 {
     const char *dir = getenv("TMPDIR");
@@ -444,7 +444,7 @@ static int xc_cgal_run(const char *oracle, const xc_polygon *p, size_t n, double
     return rc == 0;
 }
 
-static int xc_cgal_rises(const char *oracle, const xc_polygon *p, size_t n, double *rise)
+static inline int xc_cgal_rises(const char *oracle, const xc_polygon *p, size_t n, double *rise)
 {
     return xc_cgal_run(oracle, p, n, rise, NULL);
 }

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "keysort.h"
 #include "predicates.h"
 #include "tolerance.h"
 
@@ -84,17 +85,6 @@ ag_status ag_shell_add_segment(ag_shell *s, uint32_t face, uint32_t from, uint32
 
 /* --- welding --------------------------------------------------------------------------- */
 
-typedef struct {
-    double x;
-    uint32_t v;
-} by_x;
-
-static int cmp_by_x(const void *a, const void *b)
-{
-    double x = ((const by_x *)a)->x, y = ((const by_x *)b)->x;
-    return x < y ? -1 : x > y;
-}
-
 static uint32_t find(uint32_t *par, uint32_t x)
 {
     while (par[x] != x) {
@@ -107,7 +97,7 @@ static uint32_t find(uint32_t *par, uint32_t x)
 static ag_status weld(ag_shell *s, double tol, uint32_t *map)
 {
     size_t n = s->nverts;
-    by_x *order = malloc((n ? n : 1) * sizeof *order);
+    ag_keyed *order = malloc((n ? n : 1) * sizeof *order);
     uint32_t *par = malloc((n ? n : 1) * sizeof *par);
     if (!order || !par) {
         free(order);
@@ -116,19 +106,23 @@ static ag_status weld(ag_shell *s, double tol, uint32_t *map)
     }
     for (size_t i = 0; i < n; i++) {
         par[i] = (uint32_t)i;
-        order[i] = (by_x){s->pos[3 * i], (uint32_t)i};
+        order[i] = (ag_keyed){ag_keysort_double(s->pos[3 * i]), (uint32_t)i};
     }
-    qsort(order, n, sizeof *order, cmp_by_x);
+    if (ag_keysort(order, n, NULL) != AG_OK) {
+        free(order);
+        free(par);
+        return AG_ERR_NOMEM;
+    }
     double t2 = tol * tol;
     for (size_t i = 0; i < n; i++) {
-        const double *a = &s->pos[3 * order[i].v];
+        const double *a = &s->pos[3 * order[i].val];
         for (size_t j = i + 1; j < n; j++) {
-            const double *b = &s->pos[3 * order[j].v];
+            const double *b = &s->pos[3 * order[j].val];
             if (b[0] - a[0] > tol)
                 break;
             double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
             if (dx * dx + dy * dy + dz * dz <= t2) {
-                uint32_t ra = find(par, order[i].v), rb = find(par, order[j].v);
+                uint32_t ra = find(par, order[i].val), rb = find(par, order[j].val);
                 if (ra != rb)
                     par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
             }
@@ -143,16 +137,8 @@ static ag_status weld(ag_shell *s, double tol, uint32_t *map)
 
 /* --- linking ---------------------------------------------------------------------------- */
 
-typedef struct {
-    uint64_t key; /* from << 32 | to */
-    uint32_t seg;
-} seg_key;
-
-static int cmp_key(const void *a, const void *b)
-{
-    uint64_t x = ((const seg_key *)a)->key, y = ((const seg_key *)b)->key;
-    return x < y ? -1 : x > y;
-}
+/* A directed segment or half-edge by its key from << 32 | to (val: its index). */
+typedef ag_keyed seg_key;
 
 /* Newell normal (not normalised) of face f's loops, computed relative to the face's first
  * corner: shells lie at their plan's real coordinates (RD, UTM: millions of metres), where
@@ -215,7 +201,7 @@ static void pair_radial(ag_shell *s, const seg_key *hk, size_t lo, size_t n, con
         b1[k] /= bl;
     double b2[3] = {a[1] * b1[2] - a[2] * b1[1], a[2] * b1[0] - a[0] * b1[2], a[0] * b1[1] - a[1] * b1[0]};
     for (size_t i = 0; i < n; i++) {
-        uint32_t h = hk[lo + i].seg;
+        uint32_t h = hk[lo + i].val;
         const double *nf = &fn[3 * s->he_face[h]];
         /* into the face from the edge: n x direction of the half-edge */
         double sg = s->idx[h] == u ? 1 : -1;
@@ -268,8 +254,9 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
     uint32_t *ord = malloc((ns ? ns : 1) * sizeof *ord);
     uint8_t *dead = calloc(ns ? ns : 1, 1);
     seg_key *keys = malloc((ns ? ns : 1) * sizeof *keys);
+    seg_key *sorttmp = malloc((ns ? ns : 1) * sizeof *sorttmp);
     uint32_t *fstart = calloc(s->nfaces + 1, sizeof *fstart);
-    if (!ord || !dead || !keys || !fstart) {
+    if (!ord || !dead || !keys || !sorttmp || !fstart) {
         st = AG_ERR_NOMEM;
         goto out;
     }
@@ -307,12 +294,12 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
         for (uint32_t i = 0; i < k; i++) {
             uint32_t sg = ord[a + i];
             keys[i].key = (uint64_t)g[3 * sg + 1] << 32 | g[3 * sg + 2];
-            keys[i].seg = sg;
+            keys[i].val = sg;
         }
-        qsort(keys, k, sizeof *keys, cmp_key);
+        ag_keysort(keys, k, sorttmp);
         /* cancel u->v against v->u within the face (zero-width slits) */
         for (uint32_t i = 0; i < k; i++) {
-            uint32_t sg = keys[i].seg;
+            uint32_t sg = keys[i].val;
             if (dead[sg])
                 continue;
             uint64_t rev = (uint64_t)g[3 * sg + 2] << 32 | g[3 * sg + 1];
@@ -325,8 +312,8 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
                     hi = mid;
             }
             for (uint32_t j = lo; j < k && keys[j].key == rev; j++)
-                if (!dead[keys[j].seg]) {
-                    dead[keys[j].seg] = 1;
+                if (!dead[keys[j].val]) {
+                    dead[keys[j].val] = 1;
                     dead[sg] = 1;
                     break;
                 }
@@ -334,7 +321,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
         /* link: keys sorted by from-vertex; walk from each unused segment */
         s->faces[f].first_loop = (uint32_t)s->nloops;
         for (uint32_t i = 0; i < k; i++) {
-            uint32_t sg = keys[i].seg;
+            uint32_t sg = keys[i].val;
             if (dead[sg])
                 continue;
             uint32_t start = g[3 * sg + 1], cur = sg;
@@ -359,8 +346,8 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
                 }
                 uint32_t next = NONE;
                 for (uint32_t j = lo; j < k && (keys[j].key >> 32) == to; j++)
-                    if (!dead[keys[j].seg]) {
-                        next = keys[j].seg;
+                    if (!dead[keys[j].val]) {
+                        next = keys[j].val;
                         break;
                     }
                 if (next == NONE)
@@ -406,9 +393,13 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
     }
     for (size_t i = 0; i < nidx; i++) {
         hk[i].key = (uint64_t)s->idx[i] << 32 | s->idx[s->he_next[i]];
-        hk[i].seg = (uint32_t)i;
+        hk[i].val = (uint32_t)i;
     }
-    qsort(hk, nidx, sizeof *hk, cmp_key);
+    st = ag_keysort(hk, nidx, NULL);
+    if (st != AG_OK) {
+        free(hk);
+        goto out;
+    }
     for (size_t i = 0; i < nidx; i++) {
         uint32_t h = (uint32_t)i;
         uint64_t rev = (uint64_t)s->idx[s->he_next[h]] << 32 | s->idx[h];
@@ -422,7 +413,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
         }
         /* exactly one opposite half-edge: twin; more than one: paired around the edge below */
         if (lo < nidx && hk[lo].key == rev && (lo + 1 >= nidx || hk[lo + 1].key != rev))
-            s->he_twin[h] = hk[lo].seg;
+            s->he_twin[h] = hk[lo].val;
     }
     /* edges used k > 1 times each way */
     double *fn = NULL;
@@ -473,6 +464,7 @@ out:
     free(ord);
     free(dead);
     free(keys);
+    free(sorttmp);
     free(fstart);
     return st;
 }
@@ -486,12 +478,12 @@ size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max)
     if (hk && dup) {
         for (size_t i = 0; i < s->nhalf; i++) {
             hk[i].key = (uint64_t)s->idx[i] << 32 | s->idx[s->he_next[i]];
-            hk[i].seg = (uint32_t)i;
+            hk[i].val = (uint32_t)i;
         }
-        qsort(hk, s->nhalf, sizeof *hk, cmp_key);
-        for (size_t i = 1; i < s->nhalf; i++)
-            if (hk[i].key == hk[i - 1].key)
-                dup[hk[i].seg] = dup[hk[i - 1].seg] = 1;
+        if (ag_keysort(hk, s->nhalf, NULL) == AG_OK)
+            for (size_t i = 1; i < s->nhalf; i++)
+                if (hk[i].key == hk[i - 1].key)
+                    dup[hk[i].val] = dup[hk[i - 1].val] = 1;
     }
     for (size_t f = 0; f < s->nfaces; f++) {
         const ag_shell_face *fc = &s->faces[f];

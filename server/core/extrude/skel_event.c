@@ -40,7 +40,8 @@ static void edge_event(sk *S, uint32_t ei)
     /* where the planes of the edge and its two neighbours meet: exact for fast corners */
     uint32_t p = a->in, q = b->out;
     double px, py, pz;
-    if (p != ei && q != ei && p != q && ag__skel_meet3(S, p, ei, q, &px, &py, &pz) &&
+    if (fmax(a->cond, b->cond) > AG_EXTRUDE_MEET_COND && p != ei && q != ei && p != q &&
+        ag__skel_meet3(S, p, ei, q, &px, &py, &pz) &&
         pz >= z0 && fabs(pz - ev.z) <= AG_EXTRUDE_MEET_AGREE * S->size) {
         ev.x = px;
         ev.y = py;
@@ -109,7 +110,8 @@ static void split_event(sk *S, uint32_t k, uint32_t fi)
     ag__skel_cpos(c, z, &x, &y);
     /* the point where the corner's two planes meet the edge's: exact for fast corners */
     double mx, my, mz;
-    if (ag__skel_meet3(S, c->in, c->out, fi, &mx, &my, &mz) && mz >= z0 &&
+    if (c->cond > AG_EXTRUDE_MEET_COND && ag__skel_meet3(S, c->in, c->out, fi, &mx, &my, &mz) &&
+        mz >= z0 &&
         fabs(mz - z) <= AG_EXTRUDE_MEET_AGREE * S->size) {
         x = mx;
         y = my;

@@ -41,6 +41,9 @@
  * when they agree to this fraction of the size (else the corners' motion is kept: the
  * planes then meet somewhere the event is not). */
 #define AG_EXTRUDE_MEET_AGREE 1e-6
+/* ... which is done when a corner involved is ill-conditioned: its edges' angle has a sine
+ * below 1 / this (else the corners' motion is as exact and cheaper). */
+#define AG_EXTRUDE_MEET_COND 100.0
 /* Three planes whose elimination meets a pivot below this do not meet in one point. */
 #define AG_EXTRUDE_MEET_PIVOT 1e-12
 /* Slopes (dw/dz) closer than this are equal (collinear neighbours move as one plane). */

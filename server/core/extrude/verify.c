@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "keysort.h"
 #include "tolerance.h"
 
 /* How far outwards profile p leads (m, >= 0) and, when its last segment leans inwards,
@@ -68,38 +69,6 @@ void ag_verify_reach(const ag_plan *plan, double *outwards, double *height)
 
 /* --- closed 2-manifold -------------------------------------------------------------------- */
 
-typedef struct {
-    uint32_t a, b;
-} dedge;
-
-static int cmp_dedge(const void *x, const void *y)
-{
-    const dedge *p = x, *q = y;
-    if (p->a != q->a)
-        return p->a < q->a ? -1 : 1;
-    return p->b < q->b ? -1 : p->b > q->b;
-}
-
-static int cmp_tri(const void *x, const void *y)
-{
-    const uint32_t *p = x, *q = y;
-    for (int k = 0; k < 3; k++)
-        if (p[k] != q[k])
-            return p[k] < q[k] ? -1 : 1;
-    return 0;
-}
-
-typedef struct {
-    double x;
-    uint32_t v;
-} by_x;
-
-static int cmp_by_x(const void *p, const void *q)
-{
-    double a = ((const by_x *)p)->x, b = ((const by_x *)q)->x;
-    return a < b ? -1 : a > b;
-}
-
 static uint32_t root(uint32_t *par, uint32_t x)
 {
     while (par[x] != x)
@@ -107,39 +76,52 @@ static uint32_t root(uint32_t *par, uint32_t x)
     return x;
 }
 
-/* Welded ids of the vertices the triangles use (sorted sweep along x, union-find). */
-static int weld(const ag_mesh *m, size_t t0, size_t t1, double tol, uint32_t *id)
+/* Welded ids of the vertices the triangles use (a sweep along sorted x, union-find). */
+static int weld(const ag_mesh *m, size_t t0, size_t t1, double tol, uint32_t *id,
+                ag_keyed *vs)
 {
     size_t nv = 0;
-    by_x *vs = malloc((3 * (t1 - t0) + 1) * sizeof *vs);
-    if (!vs)
-        return 0;
     for (size_t t = t0; t < t1; t++)
         for (int k = 0; k < 3; k++) {
             uint32_t v = m->tri[3 * t + k];
-            vs[nv++] = (by_x){m->pos[3 * v], v};
+            vs[nv++] = (ag_keyed){ag_keysort_double(m->pos[3 * v]), v};
         }
-    qsort(vs, nv, sizeof *vs, cmp_by_x);
+    if (ag_keysort(vs, nv, NULL) != AG_OK)
+        return 0;
     for (size_t i = 0; i < nv; i++)
-        id[vs[i].v] = vs[i].v;
+        id[vs[i].val] = vs[i].val;
     for (size_t i = 0; i < nv; i++) {
-        const double *p = &m->pos[3 * vs[i].v];
+        const double *p = &m->pos[3 * vs[i].val];
         for (size_t j = i + 1; j < nv; j++) {
-            const double *q = &m->pos[3 * vs[j].v];
+            const double *q = &m->pos[3 * vs[j].val];
             if (q[0] - p[0] > tol)
                 break;
-            if (vs[j].v != vs[i].v && fabs(q[1] - p[1]) <= tol && fabs(q[2] - p[2]) <= tol &&
-                hypot(hypot(q[0] - p[0], q[1] - p[1]), q[2] - p[2]) <= tol) {
-                uint32_t a = root(id, vs[i].v), b = root(id, vs[j].v);
+            if (vs[j].val != vs[i].val && fabs(q[1] - p[1]) <= tol && fabs(q[2] - p[2]) <= tol &&
+                (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
+                        (q[2] - p[2]) * (q[2] - p[2]) <= tol * tol) {
+                uint32_t a = root(id, vs[i].val), b = root(id, vs[j].val);
                 if (a != b)
                     id[a > b ? a : b] = a < b ? a : b;
             }
         }
     }
     for (size_t i = 0; i < nv; i++)
-        id[vs[i].v] = root(id, vs[i].v);
-    free(vs);
+        id[vs[i].val] = root(id, vs[i].val);
     return 1;
+}
+
+/* Index of key in sorted e[0..n), or n. */
+static size_t find_key(const ag_keyed *e, size_t n, uint64_t key)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (e[mid].key < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && e[lo].key == key ? lo : n;
 }
 
 static int closed_manifold(const ag_mesh *m, size_t t0, size_t t1, double tol, char *why,
@@ -147,9 +129,9 @@ static int closed_manifold(const ag_mesh *m, size_t t0, size_t t1, double tol, c
 {
     size_t nt = t1 - t0;
     uint32_t *id = malloc((m->nverts ? m->nverts : 1) * sizeof *id);
-    dedge *e = malloc((3 * nt + 1) * sizeof *e);
-    uint32_t *tv = malloc((3 * nt + 1) * sizeof *tv);
-    int ok = id && e && tv && weld(m, t0, t1, tol, id);
+    ag_keyed *e = malloc((3 * nt + 1) * sizeof *e);
+    ag_keyed *tv = malloc((nt + 1) * sizeof *tv);
+    int ok = id && e && tv && weld(m, t0, t1, tol, id, e);
     if (!ok)
         snprintf(why, nwhy, "out of memory checking the building");
     size_t ne = 0, ntv = 0;
@@ -158,7 +140,7 @@ static int closed_manifold(const ag_mesh *m, size_t t0, size_t t1, double tol, c
         if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
             continue; /* shorter than the weld tolerance: no edges of its own */
         for (int k = 0; k < 3; k++)
-            e[ne++] = (dedge){v[k], v[(k + 1) % 3]};
+            e[ne++] = (ag_keyed){(uint64_t)v[k] << 32 | v[(k + 1) % 3], (uint32_t)t};
         for (int a = 0; a < 2; a++)
             for (int b = 0; b < 2 - a; b++)
                 if (v[b] > v[b + 1]) {
@@ -166,40 +148,57 @@ static int closed_manifold(const ag_mesh *m, size_t t0, size_t t1, double tol, c
                     v[b] = v[b + 1];
                     v[b + 1] = x;
                 }
-        memcpy(&tv[3 * ntv++], v, sizeof v);
+        /* the triple sorted: the two smallest as the key, the largest as the value */
+        tv[ntv++] = (ag_keyed){(uint64_t)v[0] << 32 | v[1], v[2]};
     }
     if (ok && !ne) {
         ok = 0;
         snprintf(why, nwhy, "the building has no triangles");
     }
-    if (ok) {
-        qsort(e, ne, sizeof *e, cmp_dedge);
-        for (size_t i = 0; i < ne && ok; i++) {
-            if (i + 1 < ne && !cmp_dedge(&e[i], &e[i + 1])) {
-                ok = 0;
-                const double *p = &m->pos[3 * e[i].a];
-                snprintf(why, nwhy, "an edge at (%.3f, %.3f, %.3f) is shared by more than two "
-                         "faces (not a closed 2-manifold)", p[0], p[1], p[2]);
-                break;
-            }
-            dedge r = {e[i].b, e[i].a};
-            if (!bsearch(&r, e, ne, sizeof *e, cmp_dedge)) {
-                ok = 0;
-                const double *p = &m->pos[3 * e[i].a];
-                snprintf(why, nwhy, "the building is open at an edge from (%.3f, %.3f, %.3f)",
-                         p[0], p[1], p[2]);
-            }
+    if (ok && ag_keysort(e, ne, NULL) != AG_OK) {
+        ok = 0;
+        snprintf(why, nwhy, "out of memory checking the building");
+    }
+    for (size_t i = 0; ok && i < ne; i++) {
+        if (i + 1 < ne && e[i].key == e[i + 1].key) {
+            ok = 0;
+            const double *p = &m->pos[3 * (e[i].key >> 32)];
+            snprintf(why, nwhy, "an edge at (%.3f, %.3f, %.3f) is shared by more than two faces "
+                     "(not a closed 2-manifold)", p[0], p[1], p[2]);
+            break;
+        }
+        uint64_t rev = (e[i].key << 32) | (e[i].key >> 32);
+        if (find_key(e, ne, rev) == ne) {
+            ok = 0;
+            const double *p = &m->pos[3 * (e[i].key >> 32)];
+            snprintf(why, nwhy, "the building is open at an edge from (%.3f, %.3f, %.3f)", p[0],
+                     p[1], p[2]);
         }
     }
     if (ok) {
-        qsort(tv, ntv, 3 * sizeof *tv, cmp_tri);
-        for (size_t i = 0; i + 1 < ntv && ok; i++)
-            if (!cmp_tri(&tv[3 * i], &tv[3 * i + 3])) {
+        /* by the largest vertex, then (stably) by the two smallest: triples in order */
+        for (size_t i = 0; i < ntv; i++) {
+            uint64_t k = tv[i].key;
+            tv[i].key = tv[i].val;
+            tv[i].val = (uint32_t)i;
+            e[i] = (ag_keyed){k, 0};
+        }
+        ok = ag_keysort(tv, ntv, NULL) == AG_OK;
+        ag_keyed *by = malloc((ntv + 1) * sizeof *by);
+        ok = ok && by;
+        for (size_t i = 0; ok && i < ntv; i++)
+            by[i] = (ag_keyed){e[tv[i].val].key, (uint32_t)tv[i].key};
+        ok = ok && ag_keysort(by, ntv, NULL) == AG_OK;
+        if (!ok)
+            snprintf(why, nwhy, "out of memory checking the building");
+        for (size_t i = 0; ok && i + 1 < ntv; i++)
+            if (by[i].key == by[i + 1].key && by[i].val == by[i + 1].val) {
                 ok = 0;
-                const double *p = &m->pos[3 * tv[3 * i]];
+                const double *p = &m->pos[3 * (by[i].key >> 32)];
                 snprintf(why, nwhy, "two faces lie on each other near (%.3f, %.3f, %.3f) (a "
                          "double-sided sliver)", p[0], p[1], p[2]);
             }
+        free(by);
     }
     free(id);
     free(e);
@@ -209,46 +208,59 @@ static int closed_manifold(const ag_mesh *m, size_t t0, size_t t1, double tol, c
 
 /* --- within reach of the footprint ------------------------------------------------------- */
 
-static double seg_dist(double x, double y, const double *a, const double *b)
+static double seg_dist2(double x, double y, const double *a, const double *b)
 {
     double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
     double t = l2 > 0 ? ((x - a[0]) * dx + (y - a[1]) * dy) / l2 : 0;
     t = t < 0 ? 0 : t > 1 ? 1 : t;
-    return hypot(a[0] + t * dx - x, a[1] + t * dy - y);
+    double ex = a[0] + t * dx - x, ey = a[1] + t * dy - y;
+    return ex * ex + ey * ey;
 }
 
-/* Distance of (x, y) outside the union of the loops (even-odd) and the plan-frame forced
- * polygons (each alone); 0 inside. */
-static double outside_by(const ag_plan *plan, double x, double y)
+static int inside_ring(const double *xy, size_t n, double x, double y)
 {
     int in = 0;
-    double d = INFINITY;
+    for (size_t i = 0, j = n - 1; i < n; j = i++) {
+        const double *a = &xy[2 * j], *b = &xy[2 * i];
+        if ((b[1] > y) != (a[1] > y) && x < a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1]))
+            in = !in;
+    }
+    return in;
+}
+
+/* Is (x, y) within `allowed` of the union of the loops (even-odd) and the plan-frame
+ * forced polygons (each alone)? *dist gets the distance when it is not. */
+static int within(const ag_plan *plan, double x, double y, double allowed, double *dist)
+{
+    int in = 0;
+    double d2 = INFINITY, a2 = allowed * allowed;
+    for (size_t L = 0; L < plan->nloops; L++) {
+        const ag_plan_loop *l = &plan->loops[L];
+        in ^= inside_ring(l->xy, l->n, x, y);
+    }
+    if (in)
+        return 1;
     for (size_t L = 0; L < plan->nloops; L++) {
         const ag_plan_loop *l = &plan->loops[L];
         for (size_t i = 0, j = l->n - 1; i < l->n; j = i++) {
-            const double *a = &l->xy[2 * j], *b = &l->xy[2 * i];
-            if ((b[1] > y) != (a[1] > y) && x < a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1]))
-                in = !in;
-            d = fmin(d, seg_dist(x, y, a, b));
+            d2 = fmin(d2, seg_dist2(x, y, &l->xy[2 * j], &l->xy[2 * i]));
+            if (d2 <= a2)
+                return 1;
         }
     }
-    if (in)
-        return 0;
     for (size_t k = 0; k < plan->nsteps; k++) {
         const ag_plan_step *s = &plan->steps[k];
         if (!s->npoints || !s->plan_frame)
             continue;
-        int inq = 0;
-        for (size_t i = 0, j = s->npoints - 1; i < s->npoints; j = i++) {
-            const double *a = &s->points[2 * j], *b = &s->points[2 * i];
-            if ((b[1] > y) != (a[1] > y) && x < a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1]))
-                inq = !inq;
-            d = fmin(d, seg_dist(x, y, a, b));
-        }
-        if (inq)
-            return 0;
+        if (inside_ring(s->points, s->npoints, x, y))
+            return 1;
+        for (size_t i = 0, j = s->npoints - 1; i < s->npoints; j = i++)
+            d2 = fmin(d2, seg_dist2(x, y, &s->points[2 * j], &s->points[2 * i]));
+        if (d2 <= a2)
+            return 1;
     }
-    return d;
+    *dist = sqrt(d2);
+    return 0;
 }
 
 int ag_verify_building(const ag_mesh *m, size_t t0, size_t t1, const ag_plan *plan, char *why,
@@ -292,8 +304,8 @@ int ag_verify_building(const ag_mesh *m, size_t t0, size_t t1, const ag_plan *pl
             const double *p = &m->pos[3 * v];
             zmin = fmin(zmin, p[2]);
             zmax = fmax(zmax, p[2]);
-            double d = outside_by(plan, p[0], p[1]);
-            if (d > worst) {
+            double d = 0;
+            if (!within(plan, p[0], p[1], allowed, &d) && d > worst) {
                 worst = d;
                 wx = p[0];
                 wy = p[1];
