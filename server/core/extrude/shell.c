@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "keysort.h"
+#include "weld.h"
 #include "predicates.h"
 #include "tolerance.h"
 
@@ -85,54 +86,19 @@ ag_status ag_shell_add_segment(ag_shell *s, uint32_t face, uint32_t from, uint32
 
 /* --- welding --------------------------------------------------------------------------- */
 
-static uint32_t find(uint32_t *par, uint32_t x)
-{
-    while (par[x] != x) {
-        par[x] = par[par[x]];
-        x = par[x];
-    }
-    return x;
-}
-
 static ag_status weld(ag_shell *s, double tol, uint32_t *map)
 {
     size_t n = s->nverts;
     ag_keyed *order = malloc((n ? n : 1) * sizeof *order);
-    uint32_t *par = malloc((n ? n : 1) * sizeof *par);
-    if (!order || !par) {
-        free(order);
-        free(par);
+    if (!order)
         return AG_ERR_NOMEM;
-    }
     for (size_t i = 0; i < n; i++) {
-        par[i] = (uint32_t)i;
+        map[i] = (uint32_t)i;
         order[i] = (ag_keyed){ag_keysort_double(s->pos[3 * i]), (uint32_t)i};
     }
-    if (ag_keysort(order, n, NULL) != AG_OK) {
-        free(order);
-        free(par);
-        return AG_ERR_NOMEM;
-    }
-    double t2 = tol * tol;
-    for (size_t i = 0; i < n; i++) {
-        const double *a = &s->pos[3 * order[i].val];
-        for (size_t j = i + 1; j < n; j++) {
-            const double *b = &s->pos[3 * order[j].val];
-            if (b[0] - a[0] > tol)
-                break;
-            double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
-            if (dx * dx + dy * dy + dz * dz <= t2) {
-                uint32_t ra = find(par, order[i].val), rb = find(par, order[j].val);
-                if (ra != rb)
-                    par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
-            }
-        }
-    }
-    for (size_t i = 0; i < n; i++)
-        map[i] = find(par, (uint32_t)i);
+    ag_status st = ag_weld_points(s->pos, order, n, tol, map);
     free(order);
-    free(par);
-    return AG_OK;
+    return st;
 }
 
 /* --- linking ---------------------------------------------------------------------------- */

@@ -135,6 +135,7 @@ static void split_event(sk *S, uint32_t k, uint32_t fi)
     ev.ver = f->ver;
     ag__skel_push(S, &ev);
 }
+
 void ag__skel_schedule_touched(sk *S)
 {
     if (S->st != AG_OK)

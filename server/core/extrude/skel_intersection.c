@@ -35,6 +35,7 @@ static int cmp_ray(const void *a, const void *b)
      * the same edges (and keeps the corners) instead of swapping them for ever */
     return x->edge < y->edge ? -1 : x->edge > y->edge;
 }
+
 static int near_l(sk *S, uint32_t k, double z, double lx, double ly, double spread)
 {
     const sk_corner *c = &S->c[k];

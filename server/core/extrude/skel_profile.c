@@ -184,6 +184,30 @@ out:
     free(ch.arr);
     free(ks.arr);
 }
+
+/* Puts the new edge `ne` (of no length yet) into the active plan right after corner ck, at
+ * the corner's point (px, py) where it was made: ck now leads into ne, and a new corner
+ * leads from ne into ck's former out-edge; both are settled again. */
+static void insert_after(sk *S, uint32_t ck, uint32_t ne, double px, double py)
+{
+    sk_corner *c = &S->c[ck];
+    uint32_t other = c->out;
+    c->out = ne;
+    S->e[ne].start = ck;
+    S->e[other].ver++;
+    if (!ag__skel_grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1,
+                       sizeof(uint32_t))) {
+        ag__skel_fail(S, AG_ERR_NOMEM);
+        return;
+    }
+    S->touched[S->ntouched++] = ck;
+    size_t first = S->ntouched - 1;
+    ag__skel_add_corner(S, ne, other, px, py, c->z, c->vert);
+    size_t last = S->ntouched;
+    for (size_t t = first; t < last && S->st == AG_OK; t++)
+        ag__skel_settle(S, S->touched[t]);
+}
+
 /* --- profile offset events: side edges ---------------------------------------------------- */
 
 /* After an offset event's interval has started: where a moving edge A meets a waiting
@@ -252,23 +276,11 @@ void ag__skel_insert_sides(sk *S, size_t k)
         e->clock = (int32_t)(S->plan->nsteps + 1 + k);
         e->paused = 1; /* released with the others at the interval's end */
         e->face = ag__skel_new_face(S, e);
-        uint32_t other = c->out;
-        c->out = se;
-        e->start = ck;
-        S->e[other].ver++;
-        if (!ag__skel_grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1, sizeof(uint32_t))) {
-            ag__skel_fail(S, AG_ERR_NOMEM);
-            return;
-        }
-        S->touched[S->ntouched++] = ck;
-        size_t first = S->ntouched - 1;
-        ag__skel_add_corner(S, se, other, px, py, c->z, c->vert);
-        size_t last = S->ntouched;
-        for (size_t t = first; t < last && S->st == AG_OK; t++)
-            ag__skel_settle(S, S->touched[t]);
+        insert_after(S, ck, se, px, py);
         S->stats.offset_sides++;
     }
 }
+
 /* --- profile offset events: the inside boundary ------------------------------------------- */
 
 #define GAP_MARK (UINT32_MAX - 3)
@@ -599,21 +611,7 @@ void ag__skel_insert_bevels(sk *S, double v)
         e->step = M->step;
         e->clock = M->clock;
         e->face = ag__skel_new_face(S, e);
-        uint32_t other = c->out;
-        c->out = be;
-        e->start = ck;
-        S->e[other].ver++;
-        if (!ag__skel_grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1,
-                           sizeof(uint32_t))) {
-            ag__skel_fail(S, AG_ERR_NOMEM);
-            return;
-        }
-        S->touched[S->ntouched++] = ck;
-        size_t first = S->ntouched - 1;
-        ag__skel_add_corner(S, be, other, px, py, c->z, c->vert);
-        size_t last = S->ntouched;
-        for (size_t t = first; t < last && S->st == AG_OK; t++)
-            ag__skel_settle(S, S->touched[t]);
+        insert_after(S, ck, be, px, py);
         S->stats.bevels++;
     }
 }

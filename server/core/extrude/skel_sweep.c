@@ -144,6 +144,7 @@ void ag__skel_kill_edge(sk *S, uint32_t e)
     S->e[e].alive = 0;
     S->e[e].ver++;
 }
+
 /* Bytes held by the sweep's state and its shell so far (for the memory budget). */
 static size_t state_bytes(const sk *S)
 {
@@ -184,6 +185,7 @@ int ag__skel_pop(sk *S, ag_event *ev)
     spend(S);
     return S->st == AG_OK && ag_eventq_pop(&S->q, ev);
 }
+
 void ag__skel_compact_live(sk *S)
 {
     size_t w = 0;
@@ -197,6 +199,7 @@ void ag__skel_compact_live(sk *S)
             S->live_e[w++] = S->live_e[i];
     S->nlive_e = w;
 }
+
 double ag__skel_seg_slope(const ag_profile *p, int32_t seg)
 {
     const ag_profile_point *a = &p->points[seg], *b = &p->points[seg + 1];

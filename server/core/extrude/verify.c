@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "keysort.h"
+#include "weld.h"
 #include "tolerance.h"
 
 /* How far outwards profile p leads (m, >= 0) and, when its last segment leans inwards,
@@ -69,14 +70,7 @@ void ag_verify_reach(const ag_plan *plan, double *outwards, double *height)
 
 /* --- closed 2-manifold -------------------------------------------------------------------- */
 
-static uint32_t root(uint32_t *par, uint32_t x)
-{
-    while (par[x] != x)
-        x = par[x] = par[par[x]];
-    return x;
-}
-
-/* Welded ids of the vertices the triangles use (a sweep along sorted x, union-find). */
+/* Welded ids of the vertices the triangles use. */
 static int weld(const ag_mesh *m, size_t t0, size_t t1, double tol, uint32_t *id,
                 ag_keyed *vs)
 {
@@ -84,30 +78,10 @@ static int weld(const ag_mesh *m, size_t t0, size_t t1, double tol, uint32_t *id
     for (size_t t = t0; t < t1; t++)
         for (int k = 0; k < 3; k++) {
             uint32_t v = m->tri[3 * t + k];
+            id[v] = v;
             vs[nv++] = (ag_keyed){ag_keysort_double(m->pos[3 * v]), v};
         }
-    if (ag_keysort(vs, nv, NULL) != AG_OK)
-        return 0;
-    for (size_t i = 0; i < nv; i++)
-        id[vs[i].val] = vs[i].val;
-    for (size_t i = 0; i < nv; i++) {
-        const double *p = &m->pos[3 * vs[i].val];
-        for (size_t j = i + 1; j < nv; j++) {
-            const double *q = &m->pos[3 * vs[j].val];
-            if (q[0] - p[0] > tol)
-                break;
-            if (vs[j].val != vs[i].val && fabs(q[1] - p[1]) <= tol && fabs(q[2] - p[2]) <= tol &&
-                (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
-                        (q[2] - p[2]) * (q[2] - p[2]) <= tol * tol) {
-                uint32_t a = root(id, vs[i].val), b = root(id, vs[j].val);
-                if (a != b)
-                    id[a > b ? a : b] = a < b ? a : b;
-            }
-        }
-    }
-    for (size_t i = 0; i < nv; i++)
-        id[vs[i].val] = root(id, vs[i].val);
-    return 1;
+    return ag_weld_points(m->pos, vs, nv, tol, id) == AG_OK;
 }
 
 /* Index of key in sorted e[0..n), or n. */
