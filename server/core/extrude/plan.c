@@ -685,17 +685,21 @@ static ag_status check_crossings(const ag_plan *p, long **orig, const long *oloo
                 ea_ = eb_;
                 eb_ = x;
             }
-            if (same)
+            /* (the rule, in the words earlier messages used, ends every message) */
+            if (same && how == MEET_CROSS)
                 st = ag_error_set(err, AG_ERR_INVALID, la_ + 1, "loop %ld: edge %ld crosses "
-                                  "edge %ld at (%.6g, %.6g)", la_, ea_, eb_, at[0], at[1]);
+                                  "edge %ld at (%.6g, %.6g); an edge that crosses or touches "
+                                  "another is refused", la_, ea_, eb_, at[0], at[1]);
+            else if (same)
+                st = ag_error_set(err, AG_ERR_INVALID, la_ + 1, "loop %ld: edge %ld %s edge %ld "
+                                  "at (%.6g, %.6g); a ring may not touch itself: an edge that "
+                                  "crosses or touches another is refused", la_, ea_, verb, eb_,
+                                  at[0], at[1]);
             else
                 st = ag_error_set(err, AG_ERR_INVALID, la_ + 1, "loop %ld edge %ld %s loop %ld "
-                                  "edge %ld at (%.6g, %.6g)", la_, ea_, verb, lb_, eb_, at[0],
-                                  at[1]);
-            if (same && how != MEET_CROSS)
-                ag_error_set(err, AG_ERR_INVALID, la_ + 1, "loop %ld: edge %ld %s edge %ld at "
-                             "(%.6g, %.6g) (a ring may not touch itself)", la_, ea_, verb, eb_,
-                             at[0], at[1]);
+                                  "edge %ld at (%.6g, %.6g); an edge that crosses or touches "
+                                  "another is refused (loops may meet at single points)", la_,
+                                  ea_, verb, lb_, eb_, at[0], at[1]);
             break;
         }
     }
