@@ -298,7 +298,7 @@ int ag_cli_extrude(int argc, char **argv)
             if (strcmp(a, "--max-events") == 0)
                 bo.extrude.budget.max_events = (size_t)v;
             else if (strcmp(a, "--timeout") == 0)
-                bo.extrude.budget.max_seconds = v;
+                bo.extrude.budget.max_seconds = v > 0 ? v : -1; /* 0: none */
             else
                 bo.threads = (size_t)v;
         } else if (a[0] != '-' && !input)

@@ -21,7 +21,8 @@ void ag_budget_start(ag_budget *m, const ag_extrude_budget *b, size_t corners)
                                        : AG_BUDGET_EVENTS_BASE + AG_BUDGET_EVENTS_PER_CORNER * corners;
     m->max_bytes = b && b->max_bytes ? b->max_bytes
                                      : AG_BUDGET_BYTES_BASE + AG_BUDGET_BYTES_PER_CORNER * corners;
-    m->deadline = b && b->max_seconds > 0 ? m->start + b->max_seconds : INFINITY;
+    double seconds = b && b->max_seconds ? b->max_seconds : AG_BUDGET_SECONDS;
+    m->deadline = seconds > 0 ? m->start + seconds : INFINITY;
     m->cancelled = b ? b->cancelled : NULL;
     m->user = b ? b->user : NULL;
     m->st = AG_OK;

@@ -8,7 +8,7 @@
  * The service wires it like this (one extrusion, e.g. a REST preview or one building of
  * a job):
  *
- *     ag_extrude_budget b = {0};          // defaults: events and memory by plan size
+ *     ag_extrude_budget b = {0};          // defaults: events and memory by plan size, 60 s
  *     b.max_seconds = 10;                 // the request's or the job's share
  *     b.cancelled = my_cancelled;         // job cancelled, client gone, SIGTERM seen
  *     b.user = ctx;
@@ -31,7 +31,8 @@ typedef struct {
      * inside boundaries included); 0: AG_BUDGET_EVENTS_PER_CORNER per plan corner plus
      * AG_BUDGET_EVENTS_BASE */
     size_t max_events;
-    /* wall-clock seconds from the start of the extrusion; 0: no limit */
+    /* wall-clock seconds from the start of the extrusion; 0: AG_BUDGET_SECONDS, negative:
+     * no limit */
     double max_seconds;
     /* bytes of the sweep's state and the shell; 0: AG_BUDGET_BYTES_BASE plus
      * AG_BUDGET_BYTES_PER_CORNER per plan corner */
@@ -41,6 +42,7 @@ typedef struct {
     void *user;
 } ag_extrude_budget;
 
+#define AG_BUDGET_SECONDS 60.0
 #define AG_BUDGET_EVENTS_PER_CORNER 4000
 #define AG_BUDGET_EVENTS_BASE 100000
 #define AG_BUDGET_BYTES_PER_CORNER (128 * 1024)
