@@ -502,7 +502,7 @@ static void test_budgets(void **state)
         ag_extrude_budget b;
         ag_status st;
     } cases[] = {
-        {"events", "event budget (5000 events)", {.max_events = 5000}, AG_ERR_TOO_LARGE},
+        {"events", "event budget (500 events)", {.max_events = 500}, AG_ERR_TOO_LARGE},
         {"time", "time budget", {.max_seconds = 0.05}, AG_ERR_TOO_LARGE},
         {"memory", "memory budget", {.max_bytes = 1 << 20}, AG_ERR_TOO_LARGE},
         {"cancel", "cancelled", {.cancelled = cancel_after}, AG_ERR_CANCELLED},
@@ -551,7 +551,7 @@ static void test_batch_budget_falls_back(void **state)
     ag_style s;
     ag_style_builtin("hip", &s, NULL);
     /* enough for a rectangle's hip roof and for flat roofs, not for the comb's hip roof */
-    ag_extrude_options o = {.budget = {.max_events = 400}};
+    ag_extrude_options o = {.budget = {.max_events = 100}};
     ag_mesh *m = ag_mesh_create();
     ag_footprints_report r;
     assert_int_equal(ag_footprints_extrude_with(f, &s, &o, m, &r, &err), AG_OK);

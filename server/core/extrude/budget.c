@@ -73,7 +73,7 @@ ag_status ag_budget_spend(ag_budget *m, size_t n, size_t bytes)
     return AG_OK;
 }
 
-ag_status ag_budget_work(ag_budget *m, size_t n)
+ag_status ag_budget_work(ag_budget *m, size_t n, size_t bytes)
 {
     if (m->st != AG_OK)
         return m->st;
@@ -81,5 +81,5 @@ ag_status ag_budget_work(ag_budget *m, size_t n)
     if (m->work_since_poll < AG_BUDGET_POLL_WORK)
         return AG_OK;
     m->work_since_poll = 0;
-    return ag_budget_poll(m, 0);
+    return ag_budget_poll(m, bytes);
 }

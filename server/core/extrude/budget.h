@@ -68,9 +68,9 @@ void ag_budget_start(ag_budget *m, const ag_extrude_budget *b, size_t corners);
 /* Counts n events and, every AG_BUDGET_POLL_EVENTS, checks the clock, the callback and
  * `bytes` (the current state's size, 0: not known). Returns m->st. */
 ag_status ag_budget_spend(ag_budget *m, size_t n, size_t bytes);
-/* Counts n units of other work (e.g. candidate pairs tested) and polls the clock and the
- * callback every AG_BUDGET_POLL_WORK of them. Returns m->st. */
-ag_status ag_budget_work(ag_budget *m, size_t n);
+/* Counts n units of other work (e.g. candidate pairs tested) and polls the clock, the
+ * callback and `bytes` every AG_BUDGET_POLL_WORK of them. Returns m->st. */
+ag_status ag_budget_work(ag_budget *m, size_t n, size_t bytes);
 /* Checks the clock and the callback now (between stages). */
 ag_status ag_budget_poll(ag_budget *m, size_t bytes);
 /* Seconds since ag_budget_start. */

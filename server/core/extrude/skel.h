@@ -53,6 +53,7 @@ typedef struct {
     uint8_t alive, settled;
     uint8_t passive; /* convex, both edges moving in or waiting: it splits no edge that does */
     double cond;     /* 1 / |sin| of the angle between its edges: how ill-known its motion is */
+    double next_split; /* height of the first hit on an edge queued for it (INFINITY: none) */
 } sk_corner;
 
 typedef struct {
@@ -78,6 +79,8 @@ typedef struct {
     uint32_t *uf; /* clustering: membership of the lowest event's cluster */
     size_t cap_uf;
     double *speed; /* clustering: each event's fastest corner and its height's uncertainty */
+    ag_event *cand; /* scheduling: a corner's candidate hits */
+    size_t cap_cand;
     size_t cap_speed;
 } sk_scratch;
 
@@ -166,6 +169,12 @@ int ag__skel_seg_flat(const ag_profile *p, int32_t seg);
 
 /* --- skel_event.c ------------------------------------------------------------------------ */
 void ag__skel_schedule_touched(sk *S);
+/* An event taken from the queue turned out stale: a corner whose first hit it was gets
+ * its next one scheduled. */
+void ag__skel_event_dropped(sk *S, const ag_event *ev);
+/* Schedules corner k's first hit on an edge later than height `after` (a corner kept
+ * through an intersection it only touched: that touch is not found again). */
+void ag__skel_schedule_corner_after(sk *S, uint32_t k, double after);
 int ag__skel_event_valid(sk *S, const ag_event *ev);
 /* Handles the cluster of ev0, the lowest intersection event (valid, taken from the queue):
  * the valid events within delta1 above it whose plan points chain to its point within

@@ -73,39 +73,40 @@ static int zero_gap(const sk *S, uint32_t k, uint32_t fi, double z)
     return hypot(bx - ax, by - ay) <= S->d2;
 }
 
-static void split_event(sk *S, uint32_t k, uint32_t fi)
+/* Where corner k would hit edge fi, if it does: 1 with ev filled. */
+static int split_event(sk *S, uint32_t k, uint32_t fi, ag_event *out)
 {
     const sk_corner *c = &S->c[k];
     const sk_edge *f = &S->e[fi];
     /* a convex corner whose edges move inwards (or wait) opens towards any edge moving in
      * on it: that edge meets the corner's sides, or its own corners meet them, first */
     if (c->passive && f->s >= 0)
-        return;
+        return 0;
     if (!c->alive || !c->settled || !f->alive || fi == c->in || fi == c->out)
-        return;
+        return 0;
     if (f->start == NONE || f->end == NONE)
-        return;
+        return 0;
     const sk_corner *fa = &S->c[f->start], *fb = &S->c[f->end];
     if (!fa->settled || !fb->settled)
-        return;
+        return 0;
     double z0 = fmax(c->z, S->zcur), px, py;
     ag__skel_cpos(c, z0, &px, &py);
     double dist = f->nx * px + f->ny * py - (f->c + f->s * z0);
     double closing = f->s - (f->nx * c->vx + f->ny * c->vy);
-    if (dist < -S->d2 && f->s < 0 && closing < -1e-12) {
+    if (dist < -S->d2 && f->s < 0 && closing < -AG_EXTRUDE_MIN_RATE) {
         /* an edge moving outwards (a soffit) meets a part of the plan growing towards it
          * from outside: parts of a growing plan collide from the outside */
         dist = -dist;
         closing = -closing;
-    } else if (!(closing > 1e-12) || dist < -S->d2) {
-        return;
+    } else if (!(closing > AG_EXTRUDE_MIN_RATE) || dist < -S->d2) {
+        return 0;
     }
     double dz = dist > 0 ? dist / closing : 0;
     if (dz <= 0 && zero_gap(S, k, fi, z0))
-        return;
+        return 0;
     double z = z0 + dz;
     if (!isfinite(z))
-        return;
+        return 0;
     double x, y, ax, ay, bx, by;
     ag__skel_cpos(c, z, &x, &y);
     /* the point where the corner's two planes meet the edge's: exact for fast corners */
@@ -124,16 +125,63 @@ static void split_event(sk *S, uint32_t k, uint32_t fi)
     double t = dx * (x - ax) + dy * (y - ay);
     /* an edge that has shrunk to a point by then is handled by its edge event */
     if (len <= S->d3 || t < -S->d3 || t > len + S->d3)
+        return 0;
+    memset(out, 0, sizeof *out);
+    out->type = AG_EVENT_SPLIT;
+    out->z = z;
+    out->x = x;
+    out->y = y;
+    out->a = k;
+    out->b = fi;
+    out->ver = f->ver;
+    return 1;
+}
+
+/* Schedules corner k's next hits on edges: of all the live edges it would hit, only the
+ * first (and any within delta1 of it, one vertex event's other edges) go into the queue,
+ * so the queue holds a few events per corner, not one per corner and edge (a 20,000-corner
+ * plan would hold hundreds of millions). When that event turns out stale, the corner is
+ * scheduled again (ag__skel_event_dropped). */
+static void schedule_corner(sk *S, uint32_t k, double after)
+{
+    sk_corner *c = &S->c[k];
+    sk_scratch *W = &S->W;
+    size_t n = 0;
+    double best = INFINITY;
+    for (size_t q = 0; q < S->nlive_e && S->st == AG_OK; q++) {
+        if (c->passive && S->e[S->live_e[q]].s >= 0)
+            continue;
+        ag_event ev;
+        if (!split_event(S, k, S->live_e[q], &ev) || ev.z > best + S->d1 || ev.z <= after)
+            continue;
+        if (!ag__skel_grow((void **)&W->cand, &W->cap_cand, n + 1, sizeof *W->cand)) {
+            ag__skel_fail(S, AG_ERR_NOMEM);
+            return;
+        }
+        W->cand[n++] = ev;
+        best = fmin(best, ev.z);
+    }
+    ag__skel_work(S, S->nlive_e);
+    S->c[k].next_split = best;
+    for (size_t i = 0; i < n; i++)
+        if (W->cand[i].z <= best + S->d1)
+            ag__skel_push(S, &W->cand[i]);
+}
+
+void ag__skel_event_dropped(sk *S, const ag_event *ev)
+{
+    if (ev->type != AG_EVENT_SPLIT)
         return;
-    ag_event ev = {0};
-    ev.type = AG_EVENT_SPLIT;
-    ev.z = z;
-    ev.x = x;
-    ev.y = y;
-    ev.a = k;
-    ev.b = fi;
-    ev.ver = f->ver;
-    ag__skel_push(S, &ev);
+    const sk_corner *c = &S->c[ev->a];
+    /* the corner's first hit went stale: find its next one (later ones were never queued) */
+    if (c->alive && c->settled && ev->z <= c->next_split + S->d1)
+        schedule_corner(S, ev->a, -INFINITY);
+}
+
+void ag__skel_schedule_corner_after(sk *S, uint32_t k, double after)
+{
+    ag__skel_compact_live(S);
+    schedule_corner(S, k, after);
 }
 
 void ag__skel_schedule_touched(sk *S)
@@ -141,6 +189,11 @@ void ag__skel_schedule_touched(sk *S)
     if (S->st != AG_OK)
         return;
     ag__skel_compact_live(S);
+    /* the touched corners' own first hits */
+    for (size_t i = 0; i < S->ntouched && S->st == AG_OK; i++)
+        if (S->c[S->touched[i]].alive)
+            schedule_corner(S, S->touched[i], -INFINITY);
+    /* the changed edges: their collapse, and hits on them earlier than a corner's first */
     uint32_t mark = ++S->stamp;
     for (size_t i = 0; i < S->ntouched && S->st == AG_OK; i++) {
         sk_corner *c = &S->c[S->touched[i]];
@@ -152,21 +205,17 @@ void ag__skel_schedule_touched(sk *S)
             if (!e->alive || e->mark == mark)
                 continue;
             e->mark = mark; /* both its corners may have been touched */
-            /* the edge changed: its collapse and every corner's hit on it are new */
             edge_event(S, es[j]);
-            for (size_t q = 0; q < S->nlive_c; q++)
-                split_event(S, S->live_c[q], es[j]);
+            for (size_t q = 0; q < S->nlive_c; q++) {
+                uint32_t k = S->live_c[q];
+                ag_event ev;
+                if (split_event(S, k, es[j], &ev) && ev.z <= S->c[k].next_split + S->d1) {
+                    ag__skel_push(S, &ev);
+                    S->c[k].next_split = fmin(S->c[k].next_split, ev.z);
+                }
+            }
             ag__skel_work(S, S->nlive_c);
         }
-        if (c->passive)
-            for (size_t q = 0; q < S->nlive_e; q++) {
-                if (S->e[S->live_e[q]].s < 0)
-                    split_event(S, S->touched[i], S->live_e[q]);
-            }
-        else
-            for (size_t q = 0; q < S->nlive_e; q++)
-                split_event(S, S->touched[i], S->live_e[q]);
-        ag__skel_work(S, S->nlive_e);
     }
     S->ntouched = 0;
 }
@@ -233,8 +282,10 @@ void ag__skel_next_cluster(sk *S, const ag_event *ev0)
         ag_event nx;
         if (!ag__skel_pop(S, &nx))
             return;
-        if (!ag__skel_event_valid(S, &nx))
+        if (!ag__skel_event_valid(S, &nx)) {
+            ag__skel_event_dropped(S, &nx);
             continue;
+        }
         if (!ag__skel_grow((void **)&W->batch, &W->cap_batch, nb + 1, sizeof *W->batch) ||
             !ag__skel_grow((void **)&W->uf, &W->cap_uf, nb + 1, sizeof *W->uf)) {
             ag__skel_fail(S, AG_ERR_NOMEM);

@@ -312,6 +312,8 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
     for (size_t i = 0; i < W->C.n; i++)
         if (!keep[i])
             ag__skel_retire(S, W->C.arr[i], vl);
+        else
+            ag__skel_schedule_corner_after(S, W->C.arr[i], z + S->d1);
     size_t first_new = S->ntouched;
     for (size_t p = 0; p < np; p++)
         if (pairs[2 * p] != NONE)

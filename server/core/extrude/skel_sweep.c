@@ -112,6 +112,7 @@ uint32_t ag__skel_add_corner(sk *S, uint32_t in, uint32_t out, double x, double 
     uint32_t k = (uint32_t)S->nc++;
     sk_corner *c = &S->c[k];
     memset(c, 0, sizeof *c);
+    c->next_split = INFINITY;
     c->x = x;
     c->y = y;
     c->z = z;
@@ -166,7 +167,7 @@ static void spend(sk *S)
 
 void ag__skel_work(sk *S, size_t n)
 {
-    if (S->st == AG_OK && ag_budget_work(S->budget, n) != AG_OK) {
+    if (S->st == AG_OK && ag_budget_work(S->budget, n, state_bytes(S)) != AG_OK) {
         ag_error_set(S->err, S->budget->st, 0, "the extrusion was %s, at height %.4g m",
                      S->budget->why, ag__skel_real_z(S, S->zcur));
         ag__skel_fail(S, S->budget->st);

@@ -276,8 +276,10 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         int more = ag__skel_pop(&S, &ev);
         if (S.st != AG_OK)
             break;
-        if (more && !ag__skel_event_valid(&S, &ev))
+        if (more && !ag__skel_event_valid(&S, &ev)) {
+            ag__skel_event_dropped(&S, &ev);
             continue;
+        }
         int intersection = more && (ev.type == AG_EVENT_EDGE || ev.type == AG_EVENT_SPLIT);
         if (S.deferred.n && (!intersection || ev.z > S.level + S.d1)) {
             /* every event of the level is handled: settle the corners it left */
@@ -363,6 +365,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     free(S.W.uf);
     free(S.W.batch);
     free(S.W.speed);
+    free(S.W.cand);
     free(S.deferred.arr);
     ag_status st = S.st;
     if (st == AG_OK)
