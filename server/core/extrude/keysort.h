@@ -1,8 +1,8 @@
-/* Sorting of (64-bit key, 32-bit value) pairs by key, stable, without a comparison
- * callback: the shell's linking, welding and the building check sort many small arrays
- * per building, where qsort's indirect comparisons were a tenth of a city's time. Radix
- * sort (byte digits, passes where every key has the same digit skipped), insertion sort
- * for short arrays. */
+/* Sorting of (64-bit key, 32-bit value) pairs by key, without a comparison callback: the
+ * shell's linking, welding and the building check sort many small arrays per building,
+ * where qsort's indirect comparisons were a tenth of a city's time. Insertion sort for
+ * short arrays, quicksort (median of three) for medium ones, radix sort (byte digits,
+ * passes where every key has the same digit skipped) for long ones. Not stable. */
 #ifndef AG_EXTRUDE_KEYSORT_H
 #define AG_EXTRUDE_KEYSORT_H
 
@@ -16,8 +16,8 @@ typedef struct {
     uint32_t val;
 } ag_keyed;
 
-/* Sorts v (n entries) by key, keeping the order of equal keys; tmp must hold n entries
- * (may be NULL: then it is allocated, and AG_ERR_NOMEM is possible). */
+/* Sorts v (n entries) by key; tmp must hold n entries (may be NULL: then it is allocated
+ * when needed, and AG_ERR_NOMEM is possible). */
 ag_status ag_keysort(ag_keyed *v, size_t n, ag_keyed *tmp);
 
 /* A key that orders doubles as numbers (NaN after everything). */

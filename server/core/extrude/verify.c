@@ -150,29 +150,18 @@ static int closed_manifold(const ag_mesh *m, size_t t0, size_t t1, double tol, c
         }
     }
     if (ok) {
-        /* by the largest vertex, then (stably) by the two smallest: triples in order */
-        for (size_t i = 0; i < ntv; i++) {
-            uint64_t k = tv[i].key;
-            tv[i].key = tv[i].val;
-            tv[i].val = (uint32_t)i;
-            e[i] = (ag_keyed){k, 0};
-        }
+        /* by the two smallest vertices; a run of equal keys holds the largest ones */
         ok = ag_keysort(tv, ntv, NULL) == AG_OK;
-        ag_keyed *by = malloc((ntv + 1) * sizeof *by);
-        ok = ok && by;
-        for (size_t i = 0; ok && i < ntv; i++)
-            by[i] = (ag_keyed){e[tv[i].val].key, (uint32_t)tv[i].key};
-        ok = ok && ag_keysort(by, ntv, NULL) == AG_OK;
         if (!ok)
             snprintf(why, nwhy, "out of memory checking the building");
-        for (size_t i = 0; ok && i + 1 < ntv; i++)
-            if (by[i].key == by[i + 1].key && by[i].val == by[i + 1].val) {
-                ok = 0;
-                const double *p = &m->pos[3 * (by[i].key >> 32)];
-                snprintf(why, nwhy, "two faces lie on each other near (%.3f, %.3f, %.3f) (a "
-                         "double-sided sliver)", p[0], p[1], p[2]);
-            }
-        free(by);
+        for (size_t i = 0; ok && i < ntv; i++)
+            for (size_t j = i + 1; ok && j < ntv && tv[j].key == tv[i].key; j++)
+                if (tv[j].val == tv[i].val) {
+                    ok = 0;
+                    const double *p = &m->pos[3 * (tv[i].key >> 32)];
+                    snprintf(why, nwhy, "two faces lie on each other near (%.3f, %.3f, %.3f) "
+                             "(a double-sided sliver)", p[0], p[1], p[2]);
+                }
     }
     free(id);
     free(e);
