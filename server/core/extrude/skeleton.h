@@ -4,10 +4,13 @@
  * A plane rises from z = 0; every active plan edge moves inwards by its profile
  * segment's slope per metre of height. Events are kept in a heap: edge events (an
  * edge shrinks to nothing), split events (a corner reaches another edge) and profile
- * direction events (a profile changes slope). Intersection events within delta1 in
- * height and delta2 in plan are handled together as one generalized intersection: the
- * corners that arrive are retired, edges passing through the point are split, and the
- * edges leaving the point are paired around it into new corners. Neighbouring edges
+ * direction events (a profile changes slope). Each event is computed from the planes
+ * that meet there; the lowest one and the events at its point (within delta2 in plan, and
+ * in height within what its corners move in delta2 or within the uncertainty of their
+ * heights) are handled together as one generalized intersection, then the consequences are
+ * scheduled before any later event: the corners that arrive are retired, edges passing
+ * through the point are split, and the edges leaving the point are paired around it into
+ * new corners (in the order their edges take just above the point). Neighbouring edges
  * that become collinear are resolved by the plan's priority scheme (the winner's plane
  * takes over), antiparallel neighbours (a ridge) are zipped. Horizontal profile segments,
  * profile offset events and natural steps each get a stretched interval of sweep height in
