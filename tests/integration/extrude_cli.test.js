@@ -83,7 +83,7 @@ test('a batch reports fallbacks, fixes and refusals building by building', () =>
       feature('court', 'Polygon', [[[0, 0], [10, 0], [10, 10], [0, 10], [0, 0]], [[3, 3], [7, 3], [7, 7], [3, 7], [3, 3]]]),
       feature('bowtie', 'Polygon', [[[200, 0], [210, 0], [200, 10], [210, 10], [200, 0]]]),
     ]);
-    const r = run('extrude', input, '--style', 'hip', '--out', out, '--report', rep, '--max-events', '100');
+    const r = run('extrude', input, '--style', 'hip', '--out', out, '--report', rep, '--max-events', '200');
     assert.equal(r.status, 0, r.stderr);
     const report = JSON.parse(fs.readFileSync(rep, 'utf8'));
     assert.equal(report.footprints, 3);
