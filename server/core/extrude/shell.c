@@ -269,14 +269,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
             if (dead[sg])
                 continue;
             uint64_t rev = (uint64_t)g[3 * sg + 2] << 32 | g[3 * sg + 1];
-            uint32_t lo = 0, hi = k;
-            while (lo < hi) {
-                uint32_t mid = (lo + hi) / 2;
-                if (keys[mid].key < rev)
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
+            uint32_t lo = (uint32_t)ag_keysort_lower_bound(keys, k, rev);
             for (uint32_t j = lo; j < k && keys[j].key == rev; j++)
                 if (!dead[keys[j].val]) {
                     dead[keys[j].val] = 1;
@@ -302,14 +295,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
                     break;
                 }
                 uint64_t want = (uint64_t)to << 32;
-                uint32_t lo = 0, hi = k;
-                while (lo < hi) {
-                    uint32_t mid = (lo + hi) / 2;
-                    if (keys[mid].key < want)
-                        lo = mid + 1;
-                    else
-                        hi = mid;
-                }
+                uint32_t lo = (uint32_t)ag_keysort_lower_bound(keys, k, want);
                 uint32_t next = NONE;
                 for (uint32_t j = lo; j < k && (keys[j].key >> 32) == to; j++)
                     if (!dead[keys[j].val]) {
@@ -369,14 +355,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
     for (size_t i = 0; i < nidx; i++) {
         uint32_t h = (uint32_t)i;
         uint64_t rev = (uint64_t)s->idx[s->he_next[h]] << 32 | s->idx[h];
-        size_t lo = 0, hi = nidx;
-        while (lo < hi) {
-            size_t mid = (lo + hi) / 2;
-            if (hk[mid].key < rev)
-                lo = mid + 1;
-            else
-                hi = mid;
-        }
+        size_t lo = ag_keysort_lower_bound(hk, nidx, rev);
         /* exactly one opposite half-edge: twin; more than one: paired around the edge below */
         if (lo < nidx && hk[lo].key == rev && (lo + 1 >= nidx || hk[lo + 1].key != rev))
             s->he_twin[h] = hk[lo].val;
@@ -389,14 +368,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
             j++;
         uint64_t key = hk[i].key, rev = (key << 32) | (key >> 32);
         if (j - i > 1 && key < rev) {
-            size_t lo = 0, hi = nidx;
-            while (lo < hi) {
-                size_t mid = (lo + hi) / 2;
-                if (hk[mid].key < rev)
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
+            size_t lo = ag_keysort_lower_bound(hk, nidx, rev);
             size_t m = lo;
             while (m < nidx && hk[m].key == rev)
                 m++;

@@ -87,14 +87,7 @@ static int weld(const ag_mesh *m, size_t t0, size_t t1, double tol, uint32_t *id
 /* Index of key in sorted e[0..n), or n. */
 static size_t find_key(const ag_keyed *e, size_t n, uint64_t key)
 {
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (e[mid].key < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
+    size_t lo = ag_keysort_lower_bound(e, n, key);
     return lo < n && e[lo].key == key ? lo : n;
 }
 
