@@ -29,7 +29,7 @@ DB      ?= var/archgram.db
 # to benchmark.
 DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libwebsockets-dev \
              libsqlite3-dev libsuitesparse-dev libassimp-dev libssl-dev libsodium-dev
-DEB_TEST  := libcmocka-dev chromium curl sqlite3 python3 binutils libasan8 libubsan1
+DEB_TEST  := libcmocka-dev chromium curl sqlite3 python3 binutils libasan8 libubsan1 libcgal-dev g++
 DEB_BENCH := wrk
 
 # --- layers -------------------------------------------------------------------------------
@@ -182,8 +182,16 @@ check-layers: $(ARCHIVES) | deps-test
 	python3 tools/check_layers.py --lib $(LIBDIR)
 	node --test tests/tools/
 
+# The CGAL straight-skeleton oracle of the extrusion tests and benchmark, built from
+# ../shared/tools/cgal_skeleton when that exists (libcgal-dev, g++: test packages); tests
+# that need it skip, naming it, when it is absent or could not be built.
+ORACLE_SRC := $(wildcard ../shared/tools/cgal_skeleton/main.cpp)
+ORACLE     := $(if $(ORACLE_SRC),$(BUILD)/oracle/cgal_skeleton)
+$(BUILD)/oracle/cgal_skeleton: $(ORACLE_SRC)
+	-$(MAKE) --no-print-directory -C $(dir $<) BUILD=$(CURDIR)/$(BUILD)/oracle
+
 # Each suite gets 10 minutes: a hang is a failure with a name, not a stuck CI.
-test-unit: $(UNIT_BIN)
+test-unit: $(UNIT_BIN) $(ORACLE)
 	@pass=0; fail=0; for t in $(UNIT_BIN); do \
 	  if timeout 600 $$t; then pass=$$((pass+1)); else fail=$$((fail+1)); echo "FAILED: $$t"; fi; \
 	done; echo "unit: $$pass passed, $$fail failed"; [ $$fail = 0 ]
@@ -212,7 +220,7 @@ test-asan: deps-test $(NPM_STAMP)
 	  test-integration
 
 # --- benchmarks ---------------------------------------------------------------------------
-bench: deps-bench all $(BENCH_BIN)
+bench: deps-bench all $(BENCH_BIN) $(ORACLE)
 	@for b in bench/*.sh; do [ -f "$$b" ] && sh "$$b"; done; true
 	@for b in bench/*.js; do [ -f "$$b" ] && node "$$b"; done; true
 	@for b in $(BENCH_BIN); do $$b; done
