@@ -15,14 +15,14 @@ CFLAGS  += -std=c11 -D_GNU_SOURCE -Wall -Wextra -Wno-unused-parameter -MMD -MP \
 # Tests and benchmarks find tests/data and ../shared relative to the checkout they are built in.
 TEST_CFLAGS := -Iserver -DAG_REPO_DIR=\"$(CURDIR)\"
 LDLIBS  := -lwebsockets -lmicrohttpd -ljansson -lsqlite3 -lcholmod -lspqr -lsuitesparseconfig \
-           -lassimp -lcrypto -lpthread -lm
+           -lassimp -lcrypto -lpng -lpthread -lm
 
 PORT    ?= 8080
 DB      ?= var/archgram.db
 
 # Debian packages: to build and run, and in addition to test.
 DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libwebsockets-dev \
-             libsqlite3-dev libsuitesparse-dev libassimp-dev libssl-dev
+             libsqlite3-dev libsuitesparse-dev libassimp-dev libssl-dev libpng-dev
 DEB_TEST  := libcmocka-dev chromium curl
 DEB_BENCH := wrk
 
