@@ -174,6 +174,32 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
     return s;
 }
 
+ag_status ag_model_state_from_grammar(ag_grammar *g, ag_model_state *out, ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    ag_grammar *back = NULL;
+    long col = 0;
+    ag_error e;
+    ag_error_clear(&e);
+    ag_status s = ag_terminals_collect(g, &out->terms, err);
+    if (s == AG_OK)
+        s = ag_grammar_text_print(g, &out->text, &out->text_len, err);
+    if (s == AG_OK &&
+        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms, &back,
+                         &out->derived, &e, &col)) != AG_OK)
+        s = ag_error_set(err, s == AG_ERR_NOMEM || s == AG_ERR_TOO_LARGE ? s : AG_ERR_INTERNAL,
+                         0, "the grammar does not read back (line %ld, column %ld): %s",
+                         e.element, col, e.text);
+    ag_grammar_free(back);
+    if (s == AG_OK && !out->derived->ntris)
+        s = ag_error_set(err, AG_ERR_EMPTY, 0, "the grammar derives no geometry");
+    if (s == AG_OK)
+        s = ag_model_state_reload(out->derived, &out->em, err);
+    if (s != AG_OK)
+        ag_model_state_clear(out);
+    return s;
+}
+
 ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_lookup lookup,
                                    void *user, ag_model_state *out, ag_error *err, long *col)
 {

@@ -1,0 +1,81 @@
+#include "usecase_compose.h"
+
+#include <string.h>
+#include <time.h>
+
+#include "model_tree.h"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                  ag_model_state *st, ag_usecase_compose_result *out,
+                                  ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    memset(st, 0, sizeof *st);
+    if (p->op.mode < AG_COMPOSE_REPLACE || p->op.mode > AG_COMPOSE_FILL)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "mode: replace, insert or fill");
+    if (p->op.scope != AG_COMPOSE_NODE && p->op.scope != AG_COMPOSE_RULE)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "scope: node or rule");
+    double t0 = now_ms();
+    ag_edit_model *em = NULL;
+    const ag_edit_model *source = NULL;
+    int64_t source_version = 0;
+    ag_status s = ag_workspace_open_models(ws, NULL, &em, &source, &source_version, err);
+    if (s == AG_OK)
+        s = ag_model_tree_check_node(em, p->op.target, "target", err);
+    const ag_part *part = NULL;
+    if (s == AG_OK)
+        s = ag_workspace_open_part(ws, p->part, &part, err);
+    if (s != AG_OK)
+        return s;
+    out->load_ms = now_ms() - t0;
+    out->part = part;
+    t0 = now_ms();
+    ag_grammar *g = NULL;
+    if ((s = ag_compose(em->proc, part, &p->op, &g, &out->report, err)) != AG_OK)
+        return s;
+    s = ag_model_state_from_grammar(g, st, err);
+    ag_grammar_free(g);
+    out->compose_ms = now_ms() - t0;
+    return s;
+}
+
+ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                 ag_usecase_compose_result *out, ag_error *err)
+{
+    ag_model_state st;
+    ag_status s = ag_usecase_compose_make(ws, p, &st, out, err);
+    if (s != AG_OK)
+        return s;
+    ag_compose_outcome o = {.op = &p->op,
+                            .part = out->part,
+                            .report = out->report,
+                            .load_ms = out->load_ms,
+                            .compose_ms = out->compose_ms};
+    return ag_workspace_save_composed(ws, &st, &o, err);
+}
+
+json_t *ag_usecase_compose_report_json(const ag_compose_outcome *o)
+{
+    const ag_compose_report *r = &o->report;
+    return json_pack(
+        "{s:{s:s,s:I,s:s},s:s,s:s,s:I,s:[I,I,I],s:i,s:[f,f,f],"
+        "s:{s:I,s:I,s:I,s:I,s:I,s:I,s:I},s:{s:I,s:I,s:I,s:I},s:s}",
+        "part", "name", o->part->name, "version", (json_int_t)o->part->version, "root",
+        o->part->root, "root_rule", r->root, "target_rule", r->target_rule, "instances",
+        (json_int_t)r->instances, "counts", (json_int_t)r->counts[0], (json_int_t)r->counts[1],
+        (json_int_t)r->counts[2], "turn", 90 * r->turn, "fitted", r->fitted[0], r->fitted[1],
+        r->fitted[2], "grammar", "rules_added", (json_int_t)r->rules_added, "rules_shared",
+        (json_int_t)r->rules_shared, "terminals_added", (json_int_t)r->terminals_added,
+        "terminals_shared", (json_int_t)r->terminals_shared, "renamed", (json_int_t)r->renamed,
+        "cloned", (json_int_t)r->cloned, "expanded_cells", (json_int_t)r->expanded_cells, "fit",
+        "elements", (json_int_t)r->fit.elements, "equations", (json_int_t)r->fit.equations,
+        "rigid", (json_int_t)r->fit.rigid, "rigid_relaxed", (json_int_t)r->fit.rigid_relaxed,
+        "message", r->message);
+}

@@ -1,0 +1,42 @@
+/* Composing a part into a building (paper section 4.2), over any workspace (app/workspace.h):
+ * the workspace's model and the part it names → the target's grammar rewritten
+ * (core/parts/compose.h) → the new model state: the composed grammar as it was made, its
+ * terminals, and the tree of what it derives (app/model_state.h) → saved. The target is an id
+ * of the workspace's tree (app/model_tree.h), checked before anything is computed. `archgram
+ * part compose` runs it between folders, the "compose" op (app/compose_ops.h) on the store.
+ * A preview (the service's, before the op is sent) runs the same steps without the save. */
+#ifndef AG_USECASE_COMPOSE_H
+#define AG_USECASE_COMPOSE_H
+
+#include <jansson.h>
+
+#include "workspace.h"
+
+typedef struct {
+    const ag_part_ref *part;
+    ag_compose_op op;
+} ag_usecase_compose_params;
+
+typedef struct {
+    ag_compose_report report;
+    const ag_part *part;     /* the part composed (the workspace's until it closes) */
+    double load_ms, compose_ms;
+} ag_usecase_compose_result;
+
+/* Problems naming the target or the mode are AG_ERR_INVALID or AG_ERR_NOT_FOUND ("target:
+ * ..."); a part that cannot be read is the workspace's (a bundle's problem names its
+ * element). */
+ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                 ag_usecase_compose_result *out, ag_error *err);
+
+/* The composition without saving: *st receives the state the run would save (clear it). */
+ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                  ag_model_state *st, ag_usecase_compose_result *out,
+                                  ag_error *err);
+
+/* What a composition did, as the folder's summary.json and the store's op log report it:
+ * {"part":{"name","version","root"},"root_rule","target_rule","instances","counts","turn",
+ * "fitted","grammar":{...},"fit":{...}} (a new object). */
+json_t *ag_usecase_compose_report_json(const ag_compose_outcome *o);
+
+#endif
