@@ -12,12 +12,12 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,
-                                  ag_model_state *st, ag_usecase_compose_result *out,
-                                  ag_error *err)
+/* The composed grammar (resolved, terminals with geometry). */
+static ag_status compose_grammar(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                 ag_grammar **g, ag_usecase_compose_result *out, ag_error *err)
 {
     memset(out, 0, sizeof *out);
-    memset(st, 0, sizeof *st);
+    *g = NULL;
     if (p->op.mode < AG_COMPOSE_REPLACE || p->op.mode > AG_COMPOSE_FILL)
         return ag_error_set(err, AG_ERR_INVALID, 0, "mode: replace, insert or fill");
     if (p->op.scope != AG_COMPOSE_NODE && p->op.scope != AG_COMPOSE_RULE)
@@ -37,12 +37,41 @@ ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_par
     out->load_ms = now_ms() - t0;
     out->part = part;
     t0 = now_ms();
+    s = ag_compose(em->proc, part, &p->op, g, &out->report, err);
+    out->compose_ms = now_ms() - t0;
+    return s;
+}
+
+ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                  ag_model_state *st, ag_usecase_compose_result *out,
+                                  ag_error *err)
+{
+    memset(st, 0, sizeof *st);
     ag_grammar *g = NULL;
-    if ((s = ag_compose(em->proc, part, &p->op, &g, &out->report, err)) != AG_OK)
+    ag_status s = compose_grammar(ws, p, &g, out, err);
+    if (s != AG_OK)
         return s;
+    double t0 = now_ms();
     s = ag_model_state_from_grammar(g, st, err);
     ag_grammar_free(g);
-    out->compose_ms = now_ms() - t0;
+    out->compose_ms += now_ms() - t0;
+    return s;
+}
+
+ag_status ag_usecase_compose_preview(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                     ag_mesh **mesh, ag_usecase_compose_result *out,
+                                     ag_error *err)
+{
+    *mesh = NULL;
+    ag_grammar *g = NULL;
+    ag_status s = compose_grammar(ws, p, &g, out, err);
+    if (s != AG_OK)
+        return s;
+    double t0 = now_ms();
+    ag_grammar_derive_options o = {.max_triangles = AG_GRAMMAR_MAX_TRIANGLES};
+    s = ag_grammar_derive(g, &o, mesh, err);
+    ag_grammar_free(g);
+    out->compose_ms += now_ms() - t0;
     return s;
 }
 

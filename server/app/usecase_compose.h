@@ -20,7 +20,8 @@ typedef struct {
 typedef struct {
     ag_compose_report report;
     const ag_part *part;     /* the part composed (the workspace's until it closes) */
-    double load_ms, compose_ms;
+    double load_ms;          /* reading the model and the part */
+    double compose_ms;       /* rewriting the grammar and making the new state (or deriving) */
 } ag_usecase_compose_result;
 
 /* Problems naming the target or the mode are AG_ERR_INVALID or AG_ERR_NOT_FOUND ("target:
@@ -33,6 +34,12 @@ ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_para
 ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,
                                   ag_model_state *st, ag_usecase_compose_result *out,
                                   ag_error *err);
+
+/* The composition derived, for a preview: *mesh (one component per placed terminal, grouped
+ * by label) is what the saved model would show; nothing is saved. */
+ag_status ag_usecase_compose_preview(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                     ag_mesh **mesh, ag_usecase_compose_result *out,
+                                     ag_error *err);
 
 /* What a composition did, as the folder's summary.json and the store's op log report it:
  * {"part":{"name","version","root"},"root_rule","target_rule","instances","counts","turn",

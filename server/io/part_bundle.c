@@ -117,17 +117,37 @@ ag_status ag_part_bundle_entry(const ag_part *p, json_t *terminals, json_t **out
     return AG_OK;
 }
 
+static int by_string(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
 ag_status ag_part_bundle_print(json_t *parts, json_t *terminals, char **out, size_t *len,
                                ag_error *err)
 {
     *out = NULL;
     *len = 0;
-    json_t *root = json_object();
-    json_object_set_new(root, "format", json_string(AG_PART_BUNDLE_FORMAT));
-    json_object_set_new(root, "version", json_integer(AG_PART_BUNDLE_VERSION));
-    json_object_set(root, "parts", parts);
-    json_object_set(root, "terminals", terminals);
-    char *s = json_dumps(root, JSON_INDENT(1) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
+    /* terminals in the order of their hashes, however they were gathered */
+    size_t nt = json_object_size(terminals);
+    const char **keys = malloc((nt ? nt : 1) * sizeof *keys);
+    json_t *sorted = json_object(), *root = json_object();
+    char *s = NULL;
+    if (keys && sorted && root) {
+        size_t k = 0;
+        const char *key;
+        json_t *v;
+        json_object_foreach(terminals, key, v) keys[k++] = key;
+        qsort(keys, nt, sizeof *keys, by_string);
+        for (k = 0; k < nt; k++)
+            json_object_set(sorted, keys[k], json_object_get(terminals, keys[k]));
+        json_object_set_new(root, "format", json_string(AG_PART_BUNDLE_FORMAT));
+        json_object_set_new(root, "version", json_integer(AG_PART_BUNDLE_VERSION));
+        json_object_set(root, "parts", parts);
+        json_object_set(root, "terminals", sorted);
+        s = json_dumps(root, JSON_INDENT(1) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
+    }
+    free(keys);
+    json_decref(sorted);
     json_decref(root);
     if (!s)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");

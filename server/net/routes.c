@@ -25,6 +25,20 @@ const ag_route ag_routes[] = {
     {"POST", "/api/v1/extrusions", ag_api_extrusions_create, AG_BODY_UPLOAD},
     {"POST", "/api/v1/extrusions/preview", ag_api_extrusions_preview, AG_BODY_JSON},
     {"GET", "/api/v1/models/{id}/plan", ag_api_model_plan, AG_BODY_NONE},
+    /* what the client needs to select and compose (api_parts.c); composing is an op */
+    {"GET", "/api/v1/models/{id}/selection", ag_api_model_selection, AG_BODY_NONE},
+    {"POST", "/api/v1/models/{id}/compose-preview", ag_api_model_compose_preview, AG_BODY_JSON},
+    /* the parts library; bundles are spooled like uploads */
+    {"GET", "/api/v1/parts", ag_api_parts_list, AG_BODY_NONE},
+    {"POST", "/api/v1/parts", ag_api_parts_create, AG_BODY_JSON},
+    {"POST", "/api/v1/parts:import", ag_api_parts_import, AG_BODY_UPLOAD},
+    {"GET", "/api/v1/parts:export", ag_api_parts_export, AG_BODY_NONE},
+    {"GET", "/api/v1/parts/{id}", ag_api_part_get, AG_BODY_NONE},
+    {"DELETE", "/api/v1/parts/{id}", ag_api_part_delete, AG_BODY_NONE},
+    {"POST", "/api/v1/parts/{id}/versions", ag_api_part_versions_create, AG_BODY_JSON},
+    {"GET", "/api/v1/parts/{id}/thumbnail.png", ag_api_part_thumbnail, AG_BODY_NONE},
+    {"GET", "/api/v1/parts/{id}/mesh.glb", ag_api_part_mesh_glb, AG_BODY_NONE},
+    {"GET", "/api/v1/parts/{id}/bundle", ag_api_part_bundle, AG_BODY_NONE},
     {"GET", "/api/v1/jobs/{id}", ag_api_job_get, AG_BODY_NONE},
     {"DELETE", "/api/v1/jobs/{id}", ag_api_job_cancel, AG_BODY_NONE},
 };
