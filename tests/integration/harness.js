@@ -524,8 +524,10 @@ export function facadeObj(cols = 6, rows = 4, wall = [15, 13]) {
 
 // A wall (z-up OBJ text) with a grid of windows set into it, the parts library's building: a
 // window is a casing holding four frame bars of width `frame`, a glass pane and `mullions`
-// mullions, every piece its own group. Returns the text and each window's box (slots).
-export function windowWallObj({ cols, rows, ww, wh, frame, mullions }) {
+// mullions, every piece its own group; `front` is the window's front face (0.1: set into the
+// 0.3 m wall, hidden by its face; below 0: standing proud of it, in view from the front).
+// Returns the text and each window's box (slots).
+export function windowWallObj({ cols, rows, ww, wh, frame, mullions, front = 0.1 }) {
   const out = [];
   let nv = 0, n = 0;
   const box = (a, b) => {
@@ -540,7 +542,7 @@ export function windowWallObj({ cols, rows, ww, wh, frame, mullions }) {
   const slots = [];
   for (let j = 0; j < rows; j++) {
     for (let i = 0; i < cols; i++) {
-      const u = 0.9 + i * (ww + 1), w = 1 + j * (wh + 1.2), v0 = 0.1, v1 = 0.26;
+      const u = 0.9 + i * (ww + 1), w = 1 + j * (wh + 1.2), v0 = front, v1 = front + 0.16;
       box([u, v0, w], [u + ww, v1, w + wh]);
       box([u, v0, w], [u + ww, v1, w + frame]);
       box([u, v0, w + wh - frame], [u + ww, v1, w + wh]);

@@ -200,4 +200,44 @@ export class Api {
     const res = await this.request('POST', '/extrusions/preview', { body: plan, raw: true, headers: { Accept: 'model/gltf-binary' } });
     return res.arrayBuffer();
   }
+
+  // --- the parts library ----------------------------------------------------------------------
+  // A page of parts: q (words), tag, pageToken.
+  listParts({ q = '', tag = '', pageToken = null, pageSize = 50 } = {}) {
+    const p = new URLSearchParams({ page_size: String(pageSize) });
+    if (q) p.set('q', q);
+    if (tag) p.set('tag', tag);
+    if (pageToken) p.set('page_token', pageToken);
+    return this.request('GET', `/parts?${p}`);
+  }
+
+  getPart(id) {
+    return this.request('GET', `/parts/${id}`);
+  }
+
+  // Saves a node (or a selection's common ancestor) of a model at a version as a part.
+  savePart(body) {
+    return this.request('POST', '/parts', { body });
+  }
+
+  deletePart(id, version) {
+    return this.request('DELETE', `/parts/${id}`, { headers: { 'If-Match': `"${version}"` } });
+  }
+
+  // The common ancestors of selected nodes: {tree, rule: [...]} (server/core/parts/select.h).
+  selectionOf(model, version, nodes) {
+    const p = new URLSearchParams({ nodes: nodes.join(','), version: String(version) });
+    return this.request('GET', `/models/${model}/selection?${p}`);
+  }
+
+  // A compose op run without storing it: the GLB bytes of what it would make and how many
+  // instances it changes.
+  async previewCompose(model, version, op) {
+    const res = await this.request('POST', `/models/${model}/compose-preview`, {
+      body: { op },
+      raw: true,
+      headers: { Accept: 'model/gltf-binary', 'If-Match': `"${version}"` },
+    });
+    return { buffer: await res.arrayBuffer(), instances: Number(res.headers.get('X-Archgram-Instances') ?? NaN) };
+  }
 }
