@@ -4,8 +4,10 @@
 -- saved from: provenance is recorded, not referenced, so deleting the model leaves the part
 -- whole. Terminal geometry is kept once per content (SHA-256) for the whole library.
 
+-- AUTOINCREMENT: a deleted part's id is never given again, so an op log naming a part never
+-- comes to name another one.
 CREATE TABLE parts (
-    id          INTEGER PRIMARY KEY,
+    id          INTEGER PRIMARY KEY AUTOINCREMENT,
     name        TEXT    NOT NULL CHECK (length(name) BETWEEN 1 AND 200),
     description TEXT    NOT NULL DEFAULT '',
     version     INTEGER NOT NULL CHECK (version >= 1),  -- the newest version

@@ -80,7 +80,7 @@ ag_status ag_compose_ops_run(const ag_store_env *env, const ag_op_request *rq, i
         *version = seen;
         return s;
     }
-    ag_usecase_compose_params p;
+    ag_usecase_compose_params p = {0};
     ag_part_ref ref;
     if ((s = ag_compose_ops_parse(rq->op, &ref, &p.op, err)) != AG_OK)
         return s;
@@ -112,7 +112,7 @@ ag_status ag_compose_ops_preview(const ag_store_env *env, int64_t model, int64_t
     const char *kind = json_string_value(json_object_get(op, "kind"));
     if (!json_is_object(op) || !kind || strcmp(kind, "compose") != 0)
         return ag_error_set(err, AG_ERR_INVALID, 0, "a compose preview carries a compose op");
-    ag_usecase_compose_params p;
+    ag_usecase_compose_params p = {0};
     ag_part_ref ref;
     ag_status s = ag_compose_ops_parse(op, &ref, &p.op, err);
     if (s != AG_OK)
@@ -123,10 +123,13 @@ ag_status ag_compose_ops_preview(const ag_store_env *env, int64_t model, int64_t
     ag_usecase_compose_result r;
     if ((s = ag_usecase_compose_preview(&w.ws, &p, mesh, &r, err)) == AG_OK) {
         ag_compose_outcome o = {.op = &p.op, .part = r.part, .report = r.report,
-                                .load_ms = r.load_ms, .compose_ms = r.compose_ms};
+                                .load_ms = r.load_ms, .compose_ms = r.compose_ms,
+                                .state_ms = r.state_ms};
         *report = ag_usecase_compose_report_json(&o);
-        if (*report)
+        if (*report) {
             json_object_set_new(*report, "compose_ms", json_real(r.compose_ms));
+            json_object_set_new(*report, "state_ms", json_real(r.state_ms));
+        }
         else
             s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }

@@ -10,7 +10,7 @@
  * with the composed grammar, its terminals and the tree of what it derives, logged as the op
  * with the part version it used ("version" filled in) and the composition's report
  * ({"part","root_rule","target_rule","instances","counts","turn","fitted","grammar","fit",
- * "message","compose_ms"}), undone like an edit. */
+ * "message","compose_ms","state_ms"}), undone like an edit. */
 #ifndef AG_COMPOSE_OPS_H
 #define AG_COMPOSE_OPS_H
 

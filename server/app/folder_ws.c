@@ -406,8 +406,9 @@ static json_t *compose_summary(const ag_model_state *st, const ag_compose_outcom
                                                ag_compose_mode_name(o->op->mode), "scope",
                                                ag_compose_scope_name(o->op->scope)));
         json_object_set_new(j, "tree", ag_model_tree_folder_stats(st->em));
-        json_object_set_new(j, "seconds", json_pack("{s:f,s:f}", "load", o->load_ms / 1e3,
-                                                    "compose", o->compose_ms / 1e3));
+        json_object_set_new(j, "seconds", json_pack("{s:f,s:f,s:f}", "load", o->load_ms / 1e3,
+                                                    "compose", o->compose_ms / 1e3, "state",
+                                                    o->state_ms / 1e3));
     }
     return j;
 }

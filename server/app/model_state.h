@@ -46,8 +46,9 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
  * geometry): the grammar itself printed with its terminals (g's terminal paths are set as
  * they will be kept), checked to read back, and the edit model of what it derives, so the
  * text kept is the grammar as it was made while the tree numbers the derived mesh as a reload
- * does. */
-ag_status ag_model_state_from_grammar(ag_grammar *g, ag_model_state *out, ag_error *err);
+ * does. A derivation past max_triangles (0: AG_GRAMMAR_MAX_TRIANGLES) is AG_ERR_TOO_LARGE. */
+ag_status ag_model_state_from_grammar(ag_grammar *g, size_t max_triangles, ag_model_state *out,
+                                      ag_error *err);
 
 /* OBJ text of the terminal kept under path: AG_OK with *obj malloc'd, AG_ERR_NOT_FOUND when
  * there is none. */

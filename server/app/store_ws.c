@@ -365,8 +365,10 @@ static ag_status save_composed(ag_workspace *ws, ag_model_state *st, const ag_co
     json_t *body = json_deep_copy(w->o.op);
     char *summary = change_summary("compose", "compose", st);
     ag_status s = AG_OK;
-    if (report)
+    if (report) {
         json_object_set_new(report, "compose_ms", json_real(o->compose_ms));
+        json_object_set_new(report, "state_ms", json_real(o->state_ms));
+    }
     if (!report || !body || !summary || !w->target ||
         json_object_set_new(body, "version", json_integer((json_int_t)o->part->version)) ||
         json_object_set(body, "report", report))

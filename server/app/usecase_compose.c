@@ -42,6 +42,22 @@ static ag_status compose_grammar(ag_workspace *ws, const ag_usecase_compose_para
     return s;
 }
 
+static size_t budget(const ag_usecase_compose_params *p)
+{
+    return p->max_triangles ? p->max_triangles : AG_USECASE_COMPOSE_MAX_TRIANGLES;
+}
+
+/* A result past the budget, said as the composition's. */
+static ag_status over_budget(ag_status s, const ag_usecase_compose_params *p, ag_error *err)
+{
+    if (s == AG_ERR_TOO_LARGE)
+        ag_error_set(err, s, 0,
+                     "the composition makes more than %zu triangles (at most that in one op): "
+                     "compose a larger part, or into a smaller target",
+                     budget(p));
+    return s;
+}
+
 ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,
                                   ag_model_state *st, ag_usecase_compose_result *out,
                                   ag_error *err)
@@ -52,9 +68,9 @@ ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_par
     if (s != AG_OK)
         return s;
     double t0 = now_ms();
-    s = ag_model_state_from_grammar(g, st, err);
+    s = over_budget(ag_model_state_from_grammar(g, budget(p), st, err), p, err);
     ag_grammar_free(g);
-    out->compose_ms += now_ms() - t0;
+    out->state_ms = now_ms() - t0;
     return s;
 }
 
@@ -68,10 +84,10 @@ ag_status ag_usecase_compose_preview(ag_workspace *ws, const ag_usecase_compose_
     if (s != AG_OK)
         return s;
     double t0 = now_ms();
-    ag_grammar_derive_options o = {.max_triangles = AG_GRAMMAR_MAX_TRIANGLES};
-    s = ag_grammar_derive(g, &o, mesh, err);
+    ag_grammar_derive_options o = {.max_triangles = budget(p)};
+    s = over_budget(ag_grammar_derive(g, &o, mesh, err), p, err);
     ag_grammar_free(g);
-    out->compose_ms += now_ms() - t0;
+    out->state_ms = now_ms() - t0;
     return s;
 }
 
@@ -86,7 +102,8 @@ ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_para
                             .part = out->part,
                             .report = out->report,
                             .load_ms = out->load_ms,
-                            .compose_ms = out->compose_ms};
+                            .compose_ms = out->compose_ms,
+                            .state_ms = out->state_ms};
     return ag_workspace_save_composed(ws, &st, &o, err);
 }
 

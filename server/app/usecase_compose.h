@@ -12,21 +12,28 @@
 
 #include "workspace.h"
 
+/* The budget of one composition: what it derives (the whole model afterwards) is proceduralized
+ * again before it is saved, so the new state is bounded (a fill with a small part can ask for
+ * a million cells). */
+#define AG_USECASE_COMPOSE_MAX_TRIANGLES ((size_t)1000000)
+
 typedef struct {
     const ag_part_ref *part;
     ag_compose_op op;
+    size_t max_triangles; /* 0: AG_USECASE_COMPOSE_MAX_TRIANGLES */
 } ag_usecase_compose_params;
 
 typedef struct {
     ag_compose_report report;
     const ag_part *part;     /* the part composed (the workspace's until it closes) */
     double load_ms;          /* reading the model and the part */
-    double compose_ms;       /* rewriting the grammar and making the new state (or deriving) */
+    double compose_ms;       /* rewriting the grammar (core/parts/compose.h) */
+    double state_ms;         /* the new state: its derivation proceduralized (a preview: derived) */
 } ag_usecase_compose_result;
 
 /* Problems naming the target or the mode are AG_ERR_INVALID or AG_ERR_NOT_FOUND ("target:
  * ..."); a part that cannot be read is the workspace's (a bundle's problem names its
- * element). */
+ * element); a result past the budget is AG_ERR_TOO_LARGE. */
 ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_params *p,
                                  ag_usecase_compose_result *out, ag_error *err);
 

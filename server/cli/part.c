@@ -189,7 +189,8 @@ static int cmd_compose(int argc, char **argv)
         ag_cli_report(w.blamed ? w.blame : dir, &err);
         return 1;
     }
-    printf("part compose: %s; %.1f ms -> %s\n", r.report.message, r.compose_ms, out);
+    printf("part compose: %s; rewrite %.1f ms, new state %.1f ms -> %s\n", r.report.message,
+           r.compose_ms, r.state_ms, out);
     return 0;
 }
 

@@ -383,6 +383,27 @@ describe('parts library', () => {
     }
   });
 
+  it('refuses a composition past its budget, storing nothing', async () => {
+    // a blank wall of 240 × 120 m filled with the 1.2 × 1.8 m window: 200 × 67 cells of 84
+    // triangles, past the million one op may make
+    const wall = await importModel(d, Buffer.from([
+      'v 0 0 0', 'v 240 0 0', 'v 240 0.3 0', 'v 0 0.3 0', 'v 0 0 120', 'v 240 0 120', 'v 240 0.3 120', 'v 0 0.3 120',
+      'f 1 3 2', 'f 1 4 3', 'f 5 6 7', 'f 5 7 8', 'f 1 2 6', 'f 1 6 5', 'f 4 8 7', 'f 4 7 3', 'f 1 5 8', 'f 1 8 4', 'f 2 3 7', 'f 2 7 6', '',
+    ].join('\n')), { name: 'wall', up: 'z' });
+    const r0 = await http(d, 'POST', `/api/v1/models/${wall.id}/proceduralize`, {});
+    assert.equal((await waitJob(d, r0.json.id, { timeout: 60000 })).status, 'succeeded');
+    const t = await tree(wall.id);
+    const slab = t.nodes.find((n) => n.visible).id;
+    const fill = { kind: 'compose', part: window.id, version: 1, target: slab, mode: 'fill' };
+    let r = await http(d, 'POST', `/api/v1/models/${wall.id}/compose-preview`, { body: { op: fill }, headers: { 'If-Match': `"${t.version}"` } });
+    assertProblem(r, 413, 'too-large', 'a preview past the budget');
+    assert.match(r.json.detail, /1000000 triangles/);
+    r = await op(wall.id, t.version, fill);
+    assertProblem(r, 413, 'too-large', 'an op past the budget');
+    assert.equal(await version(wall.id), t.version);
+    assert.equal((await http(d, 'GET', `/api/v1/models/${wall.id}/ops?since=${t.version}`)).json.items.length, 0);
+  });
+
   it('deletes with If-Match, and a part outlives the model it came from', async () => {
     // the model goes; the part stays whole and still composes
     const v = await version(a.id);
