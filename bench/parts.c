@@ -262,10 +262,11 @@ static void service_compose(service *sv, int64_t part, int which, const char *mo
         sv->version = v;
     }
     printf("service compose %-34s %-7s %-4s %6lld instances: preview %8.2f ms, op %8.2f ms "
-           "(rewrite %.1f ms, derivation %.1f ms in the preview; the op adds the new state's "
-           "proceduralization)\n",
+           "(in the preview: loading %.1f ms, rewrite %.1f ms, derivation %.1f ms; the op makes "
+           "the new state: its derivation proceduralized)\n",
            what, mode, scope, (long long)json_integer_value(json_object_get(rep, "instances")),
-           median(pv, RUNS), median(op, RUNS), json_real_value(json_object_get(rep, "compose_ms")),
+           median(pv, RUNS), median(op, RUNS), json_real_value(json_object_get(rep, "load_ms")),
+           json_real_value(json_object_get(rep, "compose_ms")),
            json_real_value(json_object_get(rep, "state_ms")));
     json_decref(rep);
 }
@@ -427,7 +428,7 @@ int main(void)
     int64_t facade_part = service_save(&sv, sk.big, "a facade with its windows");
     service_compose(&sv, piece, 0, "replace", "rule", "window piece into its rule");
     service_compose(&sv, piece, 0, "replace", "node", "window piece into one node");
-    service_compose(&sv, facade_part, 2, "fill", "node", "facade filling the blank wall");
+    service_compose(&sv, facade_part, 2, "replace", "node", "facade onto the blank wall");
     service_compose(&sv, piece, 2, "fill", "node", "window piece filling a wall");
     bench_search(&sv);
     service_close(&sv);

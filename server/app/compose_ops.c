@@ -86,13 +86,7 @@ ag_status ag_compose_ops_run(const ag_store_env *env, const ag_op_request *rq, i
         return s;
     p.part = &ref;
     ag_store_ws w;
-    ag_store_ws_init(&w, &(ag_store_ws_options){.env = *env,
-                                                .model = rq->model,
-                                                .base = rq->base,
-                                                .author = rq->author,
-                                                .cid = rq->cid,
-                                                .origin = rq->origin,
-                                                .op = rq->op});
+    ag_store_ws_init_op(&w, env, rq);
     ag_usecase_compose_result r;
     s = ag_usecase_compose_run(&w.ws, &p, &r, err);
     ag_store_ws_end(&w, s);
@@ -127,6 +121,7 @@ ag_status ag_compose_ops_preview(const ag_store_env *env, int64_t model, int64_t
                                 .state_ms = r.state_ms};
         *report = ag_usecase_compose_report_json(&o);
         if (*report) {
+            json_object_set_new(*report, "load_ms", json_real(r.load_ms));
             json_object_set_new(*report, "compose_ms", json_real(r.compose_ms));
             json_object_set_new(*report, "state_ms", json_real(r.state_ms));
         }

@@ -579,6 +579,17 @@ void ag_store_ws_init(ag_store_ws *w, const ag_store_ws_options *o)
     w->o = *o;
 }
 
+void ag_store_ws_init_op(ag_store_ws *w, const ag_store_env *env, const ag_op_request *rq)
+{
+    ag_store_ws_init(w, &(ag_store_ws_options){.env = *env,
+                                               .model = rq->model,
+                                               .base = rq->base,
+                                               .author = rq->author,
+                                               .cid = rq->cid,
+                                               .origin = rq->origin,
+                                               .op = rq->op});
+}
+
 void ag_store_ws_end(ag_store_ws *w, ag_status outcome)
 {
     if (w->target && outcome != AG_OK && outcome != AG_ERR_STALE && outcome != AG_ERR_INVALID &&

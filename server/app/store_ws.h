@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "jobqueue.h"
+#include "optable.h"
 #include "store_env.h"
 #include "workspace.h"
 
@@ -42,6 +43,9 @@ typedef struct {
 } ag_store_ws;
 
 void ag_store_ws_init(ag_store_ws *w, const ag_store_ws_options *o);
+/* The workspace of a client's op (a structural kind's run): its model, base, author, cid,
+ * origin and the op as logged. */
+void ag_store_ws_init_op(ag_store_ws *w, const ag_store_env *env, const ag_op_request *rq);
 /* Gives the sessions back; after a failure that is not the op's or the model's fault the
  * target's kept model is dropped (it is loaded afresh next time). */
 void ag_store_ws_end(ag_store_ws *w, ag_status outcome);

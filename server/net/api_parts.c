@@ -268,26 +268,30 @@ static enum MHD_Result reply_file(ag_request *r, ag_status s, ag_app_bytes *b, c
     return ag_reply_bytes(r, 200, type, b->data, b->len, b->etag);
 }
 
-enum MHD_Result ag_api_part_thumbnail(ag_request *r)
+typedef ag_status (*part_file)(ag_app *app, int64_t id, int64_t version,
+                               int (*fresh)(void *user, const char *etag), void *user,
+                               ag_app_bytes *out, ag_error *err);
+
+/* A file of one part version (?version=, else the newest), 304 when the client has it. */
+static enum MHD_Result reply_part_file(ag_request *r, part_file read, const char *type)
 {
     ag_error err;
     int64_t version;
     ag_app_bytes b = {0};
     ag_status s = query_version(r, &version, &err);
     if (s == AG_OK)
-        s = ag_app_parts_thumbnail(r->cfg->app, r->ids[0], version, client_has, r, &b, &err);
-    return reply_file(r, s, &b, "image/png", &err);
+        s = read(r->cfg->app, r->ids[0], version, client_has, r, &b, &err);
+    return reply_file(r, s, &b, type, &err);
+}
+
+enum MHD_Result ag_api_part_thumbnail(ag_request *r)
+{
+    return reply_part_file(r, ag_app_parts_thumbnail, "image/png");
 }
 
 enum MHD_Result ag_api_part_mesh_glb(ag_request *r)
 {
-    ag_error err;
-    int64_t version;
-    ag_app_bytes b = {0};
-    ag_status s = query_version(r, &version, &err);
-    if (s == AG_OK)
-        s = ag_app_parts_glb(r->cfg->app, r->ids[0], version, client_has, r, &b, &err);
-    return reply_file(r, s, &b, "model/gltf-binary", &err);
+    return reply_part_file(r, ag_app_parts_glb, "model/gltf-binary");
 }
 
 static enum MHD_Result reply_bundle(ag_request *r, ag_status s, ag_app_bytes *b,

@@ -410,6 +410,21 @@ static ag_status resolve_version(ag_db *db, int64_t id, int64_t *version, ag_err
     return s;
 }
 
+/* A statement about one version (0: the newest) with the part and the version bound as ?1 and
+ * ?2; *version becomes the one meant. */
+static ag_status version_statement(ag_db *db, int64_t id, int64_t *version, const char *sql,
+                                   sqlite3_stmt **st, ag_error *err)
+{
+    ag_status s = resolve_version(db, id, version, err);
+    if (s == AG_OK)
+        s = ag_db_prepared(db, st, sql, err);
+    if (s == AG_OK) {
+        sqlite3_bind_int64(*st, 1, id);
+        sqlite3_bind_int64(*st, 2, *version);
+    }
+    return s;
+}
+
 static ag_status no_version(int64_t id, int64_t version, ag_error *err)
 {
     return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "part %lld has no version %lld", (long long)id,
@@ -420,19 +435,16 @@ ag_status ag_parts_get_version(ag_db *db, int64_t id, int64_t version, int with_
                                ag_part_version_row *row, ag_error *err)
 {
     memset(row, 0, sizeof *row);
-    ag_status s = resolve_version(db, id, &version, err);
     sqlite3_stmt *st;
-    if (s == AG_OK)
-        s = ag_db_prepared(db, &st,
-                           with_entry ? "SELECT " VERSION_COLUMNS ", entry FROM part_versions "
-                                        "WHERE part_id = ? AND version = ?"
-                                      : "SELECT " VERSION_COLUMNS " FROM part_versions "
-                                        "WHERE part_id = ? AND version = ?",
-                           err);
+    ag_status s = version_statement(
+        db, id, &version,
+        with_entry ? "SELECT " VERSION_COLUMNS ", entry FROM part_versions "
+                     "WHERE part_id = ?1 AND version = ?2"
+                   : "SELECT " VERSION_COLUMNS " FROM part_versions "
+                     "WHERE part_id = ?1 AND version = ?2",
+        &st, err);
     if (s != AG_OK)
         return s;
-    sqlite3_bind_int64(st, 1, id);
-    sqlite3_bind_int64(st, 2, version);
     int rc = sqlite3_step(st);
     if (rc == SQLITE_ROW)
         s = read_version(st, with_entry ? 9 : -1, row, err);
@@ -449,18 +461,14 @@ ag_status ag_parts_each_terminal(ag_db *db, int64_t id, int64_t version,
                                                    const char *obj, size_t len),
                                  void *user, ag_error *err)
 {
-    ag_status s = resolve_version(db, id, &version, err);
     sqlite3_stmt *st;
-    if (s == AG_OK)
-        s = ag_db_prepared(db, &st,
-                           "SELECT t.sha256, t.obj FROM part_version_terminals v "
-                           "JOIN part_terminals t ON t.sha256 = v.sha256 "
-                           "WHERE v.part_id = ? AND v.version = ? ORDER BY t.sha256",
-                           err);
+    ag_status s = version_statement(db, id, &version,
+                                    "SELECT t.sha256, t.obj FROM part_version_terminals v "
+                                    "JOIN part_terminals t ON t.sha256 = v.sha256 "
+                                    "WHERE v.part_id = ?1 AND v.version = ?2 ORDER BY t.sha256",
+                                    &st, err);
     if (s != AG_OK)
         return s;
-    sqlite3_bind_int64(st, 1, id);
-    sqlite3_bind_int64(st, 2, version);
     int rc;
     while (s == AG_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
         const char *sha = (const char *)sqlite3_column_text(st, 0);
@@ -479,16 +487,12 @@ ag_status ag_parts_thumbnail(ag_db *db, int64_t id, int64_t version, void **png,
 {
     *png = NULL;
     *len = 0;
-    ag_status s = resolve_version(db, id, &version, err);
     sqlite3_stmt *st;
-    if (s == AG_OK)
-        s = ag_db_prepared(db, &st,
-                           "SELECT thumbnail FROM part_versions WHERE part_id = ? AND version = ?",
-                           err);
+    ag_status s = version_statement(
+        db, id, &version,
+        "SELECT thumbnail FROM part_versions WHERE part_id = ?1 AND version = ?2", &st, err);
     if (s != AG_OK)
         return s;
-    sqlite3_bind_int64(st, 1, id);
-    sqlite3_bind_int64(st, 2, version);
     int rc = sqlite3_step(st);
     if (rc == SQLITE_ROW) {
         size_t n = (size_t)sqlite3_column_bytes(st, 0);

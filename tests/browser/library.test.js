@@ -9,21 +9,12 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { windowWallObj } from '../integration/harness.js';
 import { daemonAndBrowser, openPage } from './browser.js';
-import { WAIT, versionOf, waitMesh, waitVersion } from './page.js';
+import { WAIT, versionOf, waitJobOver, waitMesh, waitVersion } from './page.js';
 
 const env = daemonAndBrowser();
 const api = async (p, init) => fetch(`${env.daemon.url}api/v1${p}`, init);
 
-async function waitJob(job) {
-  const deadline = Date.now() + 60000;
-  while (!['succeeded', 'failed', 'cancelled'].includes(job.status)) {
-    assert.ok(Date.now() < deadline, `job ${job.id} did not finish`);
-    await new Promise((r) => setTimeout(r, 100));
-    job = await (await api(`/jobs/${job.id}`)).json();
-  }
-  assert.equal(job.status, 'succeeded', JSON.stringify(job.error));
-  return job;
-}
+const waitJob = (job) => waitJobOver(api, job);
 
 async function proceduralized(opt, name) {
   const { obj, slots } = windowWallObj(opt);

@@ -1,6 +1,20 @@
 // What the browser tests wait for on a page: the model version in the toolbar, the mesh of a
-// version on screen, an uploaded file's model opened.
+// version on screen, an uploaded file's model opened, a job followed over REST.
+import assert from 'node:assert/strict';
+
 export const WAIT = { timeout: 30000 };
+
+// Follows a job over REST (api(path) fetches below /api/v1) until it ends; it must succeed.
+export async function waitJobOver(api, job) {
+  const deadline = Date.now() + 60000;
+  while (!['succeeded', 'failed', 'cancelled'].includes(job.status)) {
+    assert.ok(Date.now() < deadline, `job ${job.id} did not finish`);
+    await new Promise((r) => setTimeout(r, 100));
+    job = await (await api(`/jobs/${job.id}`)).json();
+  }
+  assert.equal(job.status, 'succeeded', JSON.stringify(job.error));
+  return job;
+}
 
 export const versionOf = async (page) => Number((await page.getByTestId('model-version').textContent()).replace(/\D/g, ''));
 

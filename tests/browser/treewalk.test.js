@@ -4,20 +4,9 @@
 // against the tree the generator built, independently of the walk's own code.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
+import { rng } from '../integration/harness.js';
 import { SplitTree } from '../../web/src/splittree.js';
 import { describeNode, walkChildren, walkParent, walkSibling } from '../../web/src/treewalk.js';
-
-// Deterministic pseudo-random numbers (mulberry32).
-function rng(seed) {
-  let a = seed >>> 0;
-  return () => {
-    a = (a + 0x6d2b79f5) >>> 0;
-    let t = a;
-    t = Math.imul(t ^ (t >>> 15), t | 1);
-    t ^= t + Math.imul(t ^ (t >>> 7), t | 61);
-    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
-  };
-}
 
 // A random tree of walked nodes; between a node and each of its children a chain of 0 to 3
 // split nodes. Returns the served JSON and, per walked node, its walked parent and children.

@@ -18,6 +18,19 @@ export const PROBLEM = 'urn:archgram:problem:';
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
+// Deterministic pseudo-random numbers (mulberry32).
+export function rng(seed) {
+  let a = seed >>> 0;
+  return () => {
+    a = (a + 0x6d2b79f5) >>> 0;
+    let t = a;
+    t = Math.imul(t ^ (t >>> 15), t | 1);
+    t ^= t + Math.imul(t ^ (t >>> 7), t | 61);
+    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+  };
+}
+
+
 export function fixture(name) {
   return fs.readFileSync(path.join(DATA, name));
 }
