@@ -108,8 +108,7 @@ ag_status ag_app_parts_save(ag_app *app, const ag_app_part_save *rq, json_t **vi
     if (rq->update && (s = ag_parts_get(env.db, rq->update, &old, err)) != AG_OK)
         return s;
     ag_part_meta meta = {.name = rq->name ? rq->name : old.name,
-                         .description = rq->name || rq->description ? rq->description
-                                                                    : old.description,
+                         .description = rq->description ? rq->description : old.description,
                          .tags = rq->tags ? rq->tags : (const char *const *)old.tags,
                          .ntags = rq->tags ? rq->ntags : old.ntags};
     if (meta.description && !meta.description[0])
