@@ -12,9 +12,11 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-/* The composed grammar (resolved, terminals with geometry). */
+/* The composed grammar (resolved, terminals with geometry) and the budget of what it may
+ * derive. */
 static ag_status compose_grammar(ag_workspace *ws, const ag_usecase_compose_params *p,
-                                 ag_grammar **g, ag_usecase_compose_result *out, ag_error *err)
+                                 ag_grammar **g, size_t *budget, ag_usecase_compose_result *out,
+                                 ag_error *err)
 {
     memset(out, 0, sizeof *out);
     *g = NULL;
@@ -36,25 +38,24 @@ static ag_status compose_grammar(ag_workspace *ws, const ag_usecase_compose_para
         return s;
     out->load_ms = now_ms() - t0;
     out->part = part;
+    size_t own = 2 * em->proc->mesh->ntris;
+    *budget = p->max_triangles                       ? p->max_triangles
+              : own > AG_USECASE_COMPOSE_MAX_TRIANGLES ? own
+                                                       : AG_USECASE_COMPOSE_MAX_TRIANGLES;
     t0 = now_ms();
     s = ag_compose(em->proc, part, &p->op, g, &out->report, err);
     out->compose_ms = now_ms() - t0;
     return s;
 }
 
-static size_t budget(const ag_usecase_compose_params *p)
-{
-    return p->max_triangles ? p->max_triangles : AG_USECASE_COMPOSE_MAX_TRIANGLES;
-}
-
 /* A result past the budget, said as the composition's. */
-static ag_status over_budget(ag_status s, const ag_usecase_compose_params *p, ag_error *err)
+static ag_status over_budget(ag_status s, size_t budget, ag_error *err)
 {
     if (s == AG_ERR_TOO_LARGE)
         ag_error_set(err, s, 0,
                      "the composition makes more than %zu triangles (at most that in one op): "
                      "compose a larger part, or into a smaller target",
-                     budget(p));
+                     budget);
     return s;
 }
 
@@ -64,11 +65,12 @@ ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_par
 {
     memset(st, 0, sizeof *st);
     ag_grammar *g = NULL;
-    ag_status s = compose_grammar(ws, p, &g, out, err);
+    size_t budget = 0;
+    ag_status s = compose_grammar(ws, p, &g, &budget, out, err);
     if (s != AG_OK)
         return s;
     double t0 = now_ms();
-    s = over_budget(ag_model_state_from_grammar(g, budget(p), st, err), p, err);
+    s = over_budget(ag_model_state_from_grammar(g, budget, st, err), budget, err);
     ag_grammar_free(g);
     out->state_ms = now_ms() - t0;
     return s;
@@ -80,12 +82,13 @@ ag_status ag_usecase_compose_preview(ag_workspace *ws, const ag_usecase_compose_
 {
     *mesh = NULL;
     ag_grammar *g = NULL;
-    ag_status s = compose_grammar(ws, p, &g, out, err);
+    size_t budget = 0;
+    ag_status s = compose_grammar(ws, p, &g, &budget, out, err);
     if (s != AG_OK)
         return s;
     double t0 = now_ms();
-    ag_grammar_derive_options o = {.max_triangles = budget(p)};
-    s = over_budget(ag_grammar_derive(g, &o, mesh, err), p, err);
+    ag_grammar_derive_options o = {.max_triangles = budget};
+    s = over_budget(ag_grammar_derive(g, &o, mesh, err), budget, err);
     ag_grammar_free(g);
     out->state_ms = now_ms() - t0;
     return s;

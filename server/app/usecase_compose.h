@@ -13,14 +13,14 @@
 #include "workspace.h"
 
 /* The budget of one composition: what it derives (the whole model afterwards) is proceduralized
- * again before it is saved, so the new state is bounded (a fill with a small part can ask for
- * a million cells). */
+ * again before it is saved, so its growth is bounded (a fill with a small part can ask for a
+ * million cells): at most this many triangles, or twice the model's own if that is more. */
 #define AG_USECASE_COMPOSE_MAX_TRIANGLES ((size_t)1000000)
 
 typedef struct {
     const ag_part_ref *part;
     ag_compose_op op;
-    size_t max_triangles; /* 0: AG_USECASE_COMPOSE_MAX_TRIANGLES */
+    size_t max_triangles; /* 0: the budget above */
 } ag_usecase_compose_params;
 
 typedef struct {
