@@ -49,9 +49,11 @@ static void find_declaration(const char *text, size_t len, const char *name, lon
     }
 }
 
-/* Parses text, loads every terminal through lookup and derives the mesh. */
+/* Parses text, loads every terminal through lookup and derives the mesh (at most
+ * max_triangles). */
 static ag_status derive_text(const char *text, size_t len, ag_terminal_lookup lookup, void *user,
-                             ag_grammar **g, ag_mesh **mesh, ag_error *err, long *col)
+                             size_t max_triangles, ag_grammar **g, ag_mesh **mesh, ag_error *err,
+                             long *col)
 {
     *g = NULL;
     *mesh = NULL;
@@ -91,7 +93,7 @@ static ag_status derive_text(const char *text, size_t len, ag_terminal_lookup lo
         }
         free(obj);
     }
-    ag_grammar_derive_options dopt = {.max_triangles = AG_GRAMMAR_MAX_TRIANGLES};
+    ag_grammar_derive_options dopt = {.max_triangles = max_triangles};
     if (s == AG_OK)
         s = ag_grammar_derive(*g, &dopt, mesh, err);
     if (s != AG_OK) {
@@ -152,8 +154,8 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
     if (s == AG_OK)
         s = ag_grammar_text_print(m->proc->grammar, &out->text, &out->text_len, err);
     if (s == AG_OK &&
-        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms, &back,
-                         &out->derived, &e, &col)) != AG_OK)
+        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms,
+                         AG_GRAMMAR_MAX_TRIANGLES, &back, &out->derived, &e, &col)) != AG_OK)
         s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
                          "the grammar does not read back (line %ld, column %ld): %s", e.element,
                          col, e.text);
@@ -174,12 +176,46 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
     return s;
 }
 
+ag_status ag_model_state_from_grammar(ag_grammar *g, size_t max_triangles, ag_model_state *out,
+                                      ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    ag_grammar *back = NULL;
+    long col = 0;
+    ag_error e;
+    ag_error_clear(&e);
+    ag_status s = ag_terminals_collect(g, &out->terms, err);
+    if (s == AG_OK)
+        s = ag_grammar_text_print(g, &out->text, &out->text_len, err);
+    if (s == AG_OK &&
+        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms,
+                         max_triangles ? max_triangles : AG_GRAMMAR_MAX_TRIANGLES, &back,
+                         &out->derived, &e, &col)) != AG_OK) {
+        if (s == AG_ERR_TOO_LARGE)
+            ag_error_set(err, s, 0, "the grammar derives more than %zu triangles",
+                         max_triangles ? max_triangles : AG_GRAMMAR_MAX_TRIANGLES);
+        else
+            s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
+                             "the grammar does not read back (line %ld, column %ld): %s",
+                             e.element, col, e.text);
+    }
+    ag_grammar_free(back);
+    if (s == AG_OK && !out->derived->ntris)
+        s = ag_error_set(err, AG_ERR_EMPTY, 0, "the grammar derives no geometry");
+    if (s == AG_OK)
+        s = ag_model_state_reload(out->derived, &out->em, err);
+    if (s != AG_OK)
+        ag_model_state_clear(out);
+    return s;
+}
+
 ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_lookup lookup,
                                    void *user, ag_model_state *out, ag_error *err, long *col)
 {
     memset(out, 0, sizeof *out);
     ag_grammar *g = NULL;
-    ag_status s = derive_text(text, len, lookup, user, &g, &out->derived, err, col);
+    ag_status s = derive_text(text, len, lookup, user, AG_GRAMMAR_MAX_TRIANGLES, &g,
+                              &out->derived, err, col);
     if (s != AG_OK)
         return s;
     if (!(out->text = malloc(len + 1)))

@@ -93,44 +93,6 @@ enum MHD_Result ag_api_model_grammar_get(ag_request *r)
     return ag_reply_bytes(r, 200, "text/plain; charset=utf-8", text, len, etag);
 }
 
-/* The spooled body, whole, as NUL-terminated text (the file is removed). */
-static ag_status read_body(ag_request *r, char **text, size_t *len, ag_error *err)
-{
-    *text = NULL;
-    *len = 0;
-    size_t n = r->upload ? ag_upload_bytes(r->upload) : 0;
-    size_t max = ag_app_change_grammar_max();
-    if (n > max)
-        return ag_error_set(err, AG_ERR_TOO_LARGE, 0,
-                            "the grammar has %zu bytes; at most %zu are accepted", n, max);
-    if (n == 0)
-        return ag_error_set(err, AG_ERR_INVALID, 0, "the body must hold the grammar text");
-    const char *path = ag_upload_take_path(r->upload);
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    char *buf = malloc(n + 1);
-    size_t got = 0;
-    while (fd >= 0 && buf && got < n) {
-        ssize_t k = read(fd, buf + got, n - got);
-        if (k <= 0)
-            break;
-        got += (size_t)k;
-    }
-    int e = errno;
-    if (fd >= 0)
-        close(fd);
-    unlink(path);
-    if (!buf)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory reading the body");
-    if (got != n) {
-        free(buf);
-        return ag_error_set(err, AG_ERR_IO, 0, "cannot read the body back: %s", strerror(e));
-    }
-    buf[n] = '\0';
-    *text = buf;
-    *len = n;
-    return AG_OK;
-}
-
 /* A parse problem with "line" and "column" as members, and in the detail. */
 static enum MHD_Result reply_parse_problem(ag_request *r, ag_error *err, long col)
 {
@@ -163,7 +125,8 @@ enum MHD_Result ag_api_model_grammar_put(ag_request *r)
     char *text = NULL;
     size_t len = 0;
     if (s == AG_OK)
-        s = read_body(r, &text, &len, &err);
+        s = ag_upload_read_all(r, ag_app_change_grammar_max(), "grammar text", &text, &len,
+                               &err);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
     char cid[64];

@@ -151,6 +151,23 @@ const char *ag_request_query(ag_request *r, const char *name)
     return MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, name);
 }
 
+ag_status ag_request_query_int(ag_request *r, const char *name, long long lo, long long hi,
+                               long long def, long long *out, ag_error *err)
+{
+    const char *v = ag_request_query(r, name);
+    if (!v) {
+        *out = def;
+        return AG_OK;
+    }
+    char *end;
+    long long n = strtoll(v, &end, 10);
+    if (!*v || *end || n < lo || n > hi)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "%s must be a whole number from %lld to %lld",
+                            name, lo, hi);
+    *out = n;
+    return AG_OK;
+}
+
 const char *ag_request_header(ag_request *r, const char *name)
 {
     return MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, name);

@@ -83,6 +83,9 @@ int ag_request_none_match(ag_request *r, const char *etag);
 
 /* Query parameter or NULL. */
 const char *ag_request_query(ag_request *r, const char *name);
+/* A decimal query parameter within [lo, hi]; absent gives def; AG_ERR_INVALID naming it. */
+ag_status ag_request_query_int(ag_request *r, const char *name, long long lo, long long hi,
+                               long long def, long long *out, ag_error *err);
 const char *ag_request_header(ag_request *r, const char *name);
 /* The body parsed as a JSON object; AG_ERR_INVALID with the parse position otherwise. */
 ag_status ag_request_json(ag_request *r, json_t **out, ag_error *err);
