@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/base/array.h"
 #include "../core/proc/gframe.h"
 
 enum { K_ROOT, K_SPLIT, K_COMPONENT, K_PATTERN };
@@ -41,15 +42,9 @@ static int32_t add_node(walk *w, int32_t parent, int kind, const ag_box *box)
                              "the split tree would have more than %zu nodes", w->max_nodes);
         return -1;
     }
-    if (w->n == w->cap) {
-        size_t cap = w->cap ? w->cap * 2 : 256;
-        tnode *grown = realloc(w->nodes, cap * sizeof *grown);
-        if (!grown) {
-            w->st = ag_error_set(w->err, AG_ERR_NOMEM, 0, "out of memory building the tree");
-            return -1;
-        }
-        w->nodes = grown;
-        w->cap = cap;
+    if (AG_ARRAY_RESERVE(w->nodes, w->cap, w->n + 1)) {
+        w->st = ag_error_set(w->err, AG_ERR_NOMEM, 0, "out of memory building the tree");
+        return -1;
     }
     int32_t id = (int32_t)w->n++;
     tnode *t = &w->nodes[id];
@@ -79,11 +74,9 @@ static ag_box world_box(const ag_gframe *f, const ag_box *b)
     double lo[3], hi[3];
     ag_gframe_apply(f, b->min, lo);
     ag_gframe_apply(f, b->max, hi);
-    ag_box o;
-    for (int a = 0; a < 3; a++) {
-        o.min[a] = fmin(lo[a], hi[a]);
-        o.max[a] = fmax(lo[a], hi[a]);
-    }
+    ag_box o = ag_box_empty();
+    ag_box_extend_point(&o, lo);
+    ag_box_extend_point(&o, hi);
     return o;
 }
 

@@ -24,6 +24,8 @@
 #include "place.h"
 
 #define PASTE_MAX_TRIANGLES 50000000.0
+/* A fill needing more copies per axis is refused before its triangles are even counted. */
+#define PASTE_MAX_COPIES 1e7
 
 ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op, ag_mesh **out,
                         ag_edit_report *rep, ag_error *err)
@@ -65,10 +67,7 @@ ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
     size_t ns = 0, stris = 0;
     for (size_t i = 0; i < op->nnodes; i++) {
         const ag_box *nb = &ts->nodes[op->nodes[i]].box;
-        for (int a = 0; a < 3; a++) {
-            Bs.min[a] = fmin(Bs.min[a], nb->min[a]);
-            Bs.max[a] = fmax(Bs.max[a], nb->max[a]);
-        }
+        ag_box_extend_box(&Bs, nb);
         ns += ag_place_mark_subtree(ts, op->nodes[i], smark);
     }
     if (ns == 0) {
@@ -84,10 +83,8 @@ ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
     int fd = ag_place_facing(&Bd, &td->nodes[AG_EDIT_ROOT].box);
     int k = (fd - fs) & 3;
     double S[3], D[3];
-    for (int a = 0; a < 3; a++) {
-        S[a] = Bs.max[a] - Bs.min[a];
-        D[a] = Bd.max[a] - Bd.min[a];
-    }
+    ag_box_extents(&Bs, S);
+    ag_box_extents(&Bd, D);
     if (k & 1) {
         double x = S[0];
         S[0] = S[1];
@@ -111,12 +108,13 @@ ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
         for (int i = 0; i < 2; i++) {
             int a = ax[i];
             double r = S[a] > 0 ? D[a] / S[a] : 1.0;
-            if (!(r < 1e7)) {
+            if (!(r < PASTE_MAX_COPIES)) {
                 st = ag_error_set(err, AG_ERR_TOO_LARGE, op->node,
                                   "the source is too small to fill node %d", (int)op->node);
                 goto done;
             }
-            counts[a] = r < 1.5 ? 1u : (unsigned)lround(r);
+            long nearest = lround(r);
+            counts[a] = nearest < 1 ? 1u : (unsigned)nearest; /* at least one copy */
             step[a] = D[a] / counts[a];
             cell0.max[a] = cell0.min[a] + step[a];
             total *= counts[a];
@@ -136,7 +134,7 @@ ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
         } else if (a == facing_axis) {
             cell0.max[a] = Bd.min[a] + size; /* faces -x / -y */
         } else {
-            double c = 0.5 * (Bd.min[a] + Bd.max[a]);
+            double c = ag_box_centre_axis(&Bd, a);
             cell0.min[a] = c - 0.5 * size;
             cell0.max[a] = c + 0.5 * size;
         }
