@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "core/base/array.h"
+#include "random_fixture.h"
 
 /* Address sanitizer builds: a refused huge allocation must return NULL, not abort, since
  * that is what the out-of-memory cases below exercise. */
@@ -24,15 +25,6 @@ typedef struct {
     double value;
     char tag[5];
 } record;
-
-/* A small deterministic generator (xorshift64*), so a failure names a reproducible case. */
-static uint64_t next_random(uint64_t *s)
-{
-    *s ^= *s >> 12;
-    *s ^= *s << 25;
-    *s ^= *s >> 27;
-    return *s * 0x2545F4914F6CDD1DULL;
-}
 
 static void test_push_keeps_contents(void **state)
 {

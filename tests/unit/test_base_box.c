@@ -10,19 +10,7 @@
 #include <cmocka.h>
 
 #include "core/base/box.h"
-
-static uint64_t next_random(uint64_t *s)
-{
-    *s ^= *s >> 12;
-    *s ^= *s << 25;
-    *s ^= *s >> 27;
-    return *s * 0x2545F4914F6CDD1DULL;
-}
-
-static double uniform(uint64_t *s, double lo, double hi)
-{
-    return lo + (hi - lo) * (double)(next_random(s) >> 11) / 9007199254740992.0;
-}
+#include "random_fixture.h"
 
 /* Site origins the boxes are placed around: local, and UTM easting/northing sized. */
 static const double origins[][3] = {{0, 0, 0}, {4.6e5, 5.7e6, 12}, {-3.1e5, 6.2e6, -40}};

@@ -11,14 +11,7 @@
 #include <cmocka.h>
 
 #include "core/base/search.h"
-
-static uint64_t next_random(uint64_t *s)
-{
-    *s ^= *s >> 12;
-    *s ^= *s << 25;
-    *s ^= *s >> 27;
-    return *s * 0x2545F4914F6CDD1DULL;
-}
+#include "random_fixture.h"
 
 typedef struct {
     uint32_t tag;

@@ -10,14 +10,7 @@
 #include <cmocka.h>
 
 #include "core/base/uf.h"
-
-static uint64_t next_random(uint64_t *s)
-{
-    *s ^= *s >> 12;
-    *s ^= *s << 25;
-    *s ^= *s >> 27;
-    return *s * 0x2545F4914F6CDD1DULL;
-}
+#include "random_fixture.h"
 
 /* Oracle: label[i] is i's set; a union relabels every member of one set (O(n) each). */
 static void oracle_union(uint32_t *label, size_t n, uint32_t a, uint32_t b)

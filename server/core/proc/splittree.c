@@ -73,6 +73,29 @@ void ag_splittree_attach(ag_splittree *t, int32_t parent, int32_t child)
     p->last_child = child;
 }
 
+/* A pivot (relative to the parent's min corner) kept within the parent's extent. */
+static double pivot_within(double pivot, double size)
+{
+    if (pivot < 0)
+        pivot = 0;
+    if (pivot > size)
+        pivot = size;
+    return pivot;
+}
+
+/* A child of parent cut by (pivot, octant q + 1), of the given kind; -1 when out of memory. */
+static int32_t add_split(ag_splittree *t, int32_t parent, const double piv[3], int q, int kind)
+{
+    int32_t n = new_node(t, kind);
+    if (n < 0)
+        return -1;
+    memcpy(t->nodes[n].pivot, piv, sizeof t->nodes[n].pivot);
+    t->nodes[n].octant = (uint8_t)(q + 1);
+    t->nodes[n].box = ag_splittree_child_box(&t->nodes[parent].box, piv, q + 1);
+    ag_splittree_attach(t, parent, n);
+    return n;
+}
+
 int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *c, int kind)
 {
     assert(parent >= 0 && (size_t)parent < t->nnodes);
@@ -95,20 +118,10 @@ int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *c, in
             done[a] = 0;
             single = 0;
         }
-        double size = ag_box_extent(&P, a);
-        if (piv[a] < 0)
-            piv[a] = 0;
-        if (piv[a] > size)
-            piv[a] = size;
+        piv[a] = pivot_within(piv[a], ag_box_extent(&P, a));
     }
-    int32_t n = new_node(t, single ? kind : AG_NODE_SPLIT);
-    if (n < 0)
-        return -1;
-    memcpy(t->nodes[n].pivot, piv, sizeof piv);
-    t->nodes[n].octant = (uint8_t)(q + 1);
-    t->nodes[n].box = ag_splittree_child_box(&t->nodes[parent].box, piv, q + 1);
-    ag_splittree_attach(t, parent, n);
-    if (single)
+    int32_t n = add_split(t, parent, piv, q, single ? kind : AG_NODE_SPLIT);
+    if (n < 0 || single)
         return n;
     const ag_box I = t->nodes[n].box;
     q = 0;
@@ -117,22 +130,10 @@ int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *c, in
             piv[a] = 0;
             q |= 1 << a;
         } else {
-            piv[a] = c->max[a] - I.min[a];
-            double size = ag_box_extent(&I, a);
-            if (piv[a] < 0)
-                piv[a] = 0;
-            if (piv[a] > size)
-                piv[a] = size;
+            piv[a] = pivot_within(c->max[a] - I.min[a], ag_box_extent(&I, a));
         }
     }
-    int32_t m = new_node(t, kind);
-    if (m < 0)
-        return -1;
-    memcpy(t->nodes[m].pivot, piv, sizeof piv);
-    t->nodes[m].octant = (uint8_t)(q + 1);
-    t->nodes[m].box = ag_splittree_child_box(&t->nodes[n].box, piv, q + 1);
-    ag_splittree_attach(t, n, m);
-    return m;
+    return add_split(t, n, piv, q, kind);
 }
 
 typedef struct {
