@@ -15,8 +15,9 @@
 
 #include "../status.h"
 
-/* The smallest capacity a growing array gets. */
-#define AG_ARRAY_MIN_CAP 16
+/* The smallest capacity a growing array gets: small, since some structures hold thousands of
+ * short arrays (a grammar's rule bodies of a few statements each). */
+#define AG_ARRAY_MIN_CAP 8
 
 /* The capacity an array of capacity cap that needs need elements of elem bytes grows to: cap
  * when it suffices, else at least double it (never below AG_ARRAY_MIN_CAP, never more than
