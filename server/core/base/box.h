@@ -20,7 +20,13 @@ static inline ag_box ag_box_empty(void)
 }
 
 /* Non-zero when min <= max fails on some axis (the empty box, or a NaN). */
-int ag_box_is_empty(const ag_box *b);
+static inline int ag_box_is_empty(const ag_box *b)
+{
+    for (int a = 0; a < 3; a++)
+        if (!(b->min[a] <= b->max[a]))
+            return 1;
+    return 0;
+}
 
 static inline void ag_box_extend_point(ag_box *b, const double p[3])
 {
@@ -78,19 +84,54 @@ static inline void ag_box_set_coord(ag_box *b, int c, double v)
 
 /* Length of the diagonal; 0 for an empty box. */
 double ag_box_diagonal(const ag_box *b);
+
 /* Product of the extents; 0 for an empty box. */
 double ag_box_volume(const ag_box *b);
+
 /* Product of the extents, each raised to at least min_extent: orders flat boxes by area. */
-double ag_box_volume_floor(const ag_box *b, double min_extent);
+static inline double ag_box_volume_floor(const ag_box *b, double min_extent)
+{
+    double v = 1;
+    for (int a = 0; a < 3; a++) {
+        double d = b->max[a] - b->min[a];
+        v *= d > min_extent ? d : min_extent;
+    }
+    return v;
+}
 
 /* Non-zero when inner lies within outer grown by eps. */
-int ag_box_contains(const ag_box *outer, const ag_box *inner, double eps);
+static inline int ag_box_contains(const ag_box *outer, const ag_box *inner, double eps)
+{
+    for (int a = 0; a < 3; a++)
+        if (inner->min[a] < outer->min[a] - eps || inner->max[a] > outer->max[a] + eps)
+            return 0;
+    return 1;
+}
+
+/* Non-zero when p lies within b grown by eps. */
 int ag_box_contains_point(const ag_box *b, const double p[3], double eps);
+
 /* Non-zero when a and b overlap or touch within eps on every axis / on one axis. */
-int ag_box_meets(const ag_box *a, const ag_box *b, double eps);
-int ag_box_meets_axis(const ag_box *a, const ag_box *b, int axis, double eps);
+static inline int ag_box_meets(const ag_box *a, const ag_box *b, double eps)
+{
+    for (int k = 0; k < 3; k++)
+        if (a->min[k] > b->max[k] + eps || b->min[k] > a->max[k] + eps)
+            return 0;
+    return 1;
+}
+
+static inline int ag_box_meets_axis(const ag_box *a, const ag_box *b, int axis, double eps)
+{
+    return a->min[axis] <= b->max[axis] + eps && b->min[axis] <= a->max[axis] + eps;
+}
+
 /* Length of the overlap of a and b on one axis: negative for the gap between them. */
-double ag_box_overlap_axis(const ag_box *a, const ag_box *b, int axis);
+static inline double ag_box_overlap_axis(const ag_box *a, const ag_box *b, int axis)
+{
+    double lo = a->min[axis] > b->min[axis] ? a->min[axis] : b->min[axis];
+    double hi = a->max[axis] < b->max[axis] ? a->max[axis] : b->max[axis];
+    return hi - lo;
+}
 
 /* The common part of a and b (an empty box when they are disjoint). */
 ag_box ag_box_intersect(const ag_box *a, const ag_box *b);

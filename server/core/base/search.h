@@ -5,16 +5,78 @@
  * function serves every array of structs sorted by such a field:
  *     size_t i = ag_search_lower_u64(&rows[0].key, n, sizeof *rows, want);
  * A result of n means every key is smaller (lower) or not greater (upper). The keys must be
- * sorted ascending (for doubles: no NaN). */
+ * sorted ascending (for doubles: no NaN).
+ *
+ * Inline, and only here: the searches run in innermost loops (triangle matching probes 27
+ * cells per triangle), where a call and a stride not known at compile time cost more than
+ * the search itself. */
 #ifndef AG_SEARCH_H
 #define AG_SEARCH_H
 
+#include <assert.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
-size_t ag_search_lower_u64(const void *key, size_t n, size_t stride, uint64_t want);
-size_t ag_search_upper_u64(const void *key, size_t n, size_t stride, uint64_t want);
-size_t ag_search_lower_double(const void *key, size_t n, size_t stride, double want);
-size_t ag_search_upper_double(const void *key, size_t n, size_t stride, double want);
+/* The first index whose key is not below want (or_equal: not at or below want). Keys are
+ * read with memcpy: records need not align their key to its type. lo + hi cannot overflow:
+ * records of at least 8 bytes number far fewer than SIZE_MAX / 2. */
+static inline size_t ag__search_u64(const void *key, size_t n, size_t stride, uint64_t want,
+                                    int or_equal)
+{
+    assert(key || n == 0);
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        uint64_t v;
+        memcpy(&v, (const char *)key + mid * stride, sizeof v);
+        if (v < want || (or_equal && v == want))
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+static inline size_t ag__search_double(const void *key, size_t n, size_t stride, double want,
+                                       int or_equal)
+{
+    assert(key || n == 0);
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        double v;
+        memcpy(&v, (const char *)key + mid * stride, sizeof v);
+        if (v < want || (or_equal && v == want))
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+static inline size_t ag_search_lower_u64(const void *key, size_t n, size_t stride,
+                                         uint64_t want)
+{
+    return ag__search_u64(key, n, stride, want, 0);
+}
+
+static inline size_t ag_search_upper_u64(const void *key, size_t n, size_t stride,
+                                         uint64_t want)
+{
+    return ag__search_u64(key, n, stride, want, 1);
+}
+
+static inline size_t ag_search_lower_double(const void *key, size_t n, size_t stride,
+                                            double want)
+{
+    return ag__search_double(key, n, stride, want, 0);
+}
+
+static inline size_t ag_search_upper_double(const void *key, size_t n, size_t stride,
+                                            double want)
+{
+    return ag__search_double(key, n, stride, want, 1);
+}
 
 #endif

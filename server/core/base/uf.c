@@ -38,21 +38,28 @@ uint32_t ag_uf_find(ag_uf *uf, uint32_t x)
     uint32_t *p = uf->parent;
     /* two passes: find the root (and x's offset from it), then point the path at the root */
     uint32_t r = x;
-    double acc = 0;
+    if (!uf->offset) {
+        while (p[r] != r)
+            r = p[r];
+        while (p[x] != r) {
+            uint32_t next = p[x];
+            p[x] = r;
+            x = next;
+        }
+        return r;
+    }
+    double *off = uf->offset, acc = 0;
     while (p[r] != r) {
-        if (uf->offset)
-            acc += uf->offset[r];
+        acc += off[r];
         r = p[r];
     }
     double rest = acc;
     while (p[x] != x) {
         uint32_t next = p[x];
+        double o = off[x];
         p[x] = r;
-        if (uf->offset) {
-            double o = uf->offset[x];
-            uf->offset[x] = rest;
-            rest -= o;
-        }
+        off[x] = rest;
+        rest -= o;
         x = next;
     }
     return r;
