@@ -32,7 +32,7 @@ void ag_uf_free(ag_uf *uf)
     *uf = (ag_uf){0};
 }
 
-uint32_t ag_uf_find(ag_uf *uf, uint32_t x)
+uint32_t ag__uf_find_path(ag_uf *uf, uint32_t x)
 {
     assert(x < uf->n);
     uint32_t *p = uf->parent;

@@ -6,6 +6,7 @@
 #ifndef AG_UF_H
 #define AG_UF_H
 
+#include <assert.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -22,8 +23,20 @@ typedef struct {
 ag_status ag_uf_init(ag_uf *uf, size_t n, int with_offsets);
 void ag_uf_free(ag_uf *uf);
 
-/* The root of x's set (compressing the path, offsets kept). */
-uint32_t ag_uf_find(ag_uf *uf, uint32_t x);
+/* The root of x's set, for a path longer than one step (compressing it, offsets kept). */
+uint32_t ag__uf_find_path(ag_uf *uf, uint32_t x);
+
+/* The root of x's set (compressing the path, offsets kept). Inline for the usual case of a
+ * root or a path compressed already: finds run in the innermost loops of segmentation and of
+ * the resize system. */
+static inline uint32_t ag_uf_find(ag_uf *uf, uint32_t x)
+{
+    assert(x < uf->n);
+    uint32_t p = uf->parent[x];
+    if (p == x || uf->parent[p] == p)
+        return p;
+    return ag__uf_find_path(uf, x);
+}
 /* value(x) - value(root of x); call ag_uf_find(x) first. 0 without offsets. */
 double ag_uf_offset(const ag_uf *uf, uint32_t x);
 /* Joins the sets of a and b; returns the root of the joined set. With offsets the two roots
