@@ -18,42 +18,30 @@
 #include <stdint.h>
 #include <string.h>
 
-/* The first index whose key is not below want (or_equal: not at or below want). Keys are
- * read with memcpy: records need not align their key to its type. lo + hi cannot overflow:
- * records of at least 8 bytes number far fewer than SIZE_MAX / 2. */
-static inline size_t ag__search_u64(const void *key, size_t n, size_t stride, uint64_t want,
-                                    int or_equal)
-{
-    assert(key || n == 0);
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        uint64_t v;
-        memcpy(&v, (const char *)key + mid * stride, sizeof v);
-        if (v < want || (or_equal && v == want))
-            lo = mid + 1;
-        else
-            hi = mid;
+/* ag__search_u64 / ag__search_double: the first index whose key is not below want
+ * (or_equal: not at or below want), one body for both key types. Keys are read with memcpy:
+ * records need not align their key to its type. lo + hi cannot overflow: records of at
+ * least 8 bytes number far fewer than SIZE_MAX / 2. */
+#define AG__SEARCH_PARTITION(name, type)                                                   \
+    static inline size_t name(const void *key, size_t n, size_t stride, type want,         \
+                              int or_equal)                                                \
+    {                                                                                      \
+        assert(key || n == 0);                                                             \
+        size_t lo = 0, hi = n;                                                             \
+        while (lo < hi) {                                                                  \
+            size_t mid = (lo + hi) / 2;                                                    \
+            type v;                                                                        \
+            memcpy(&v, (const char *)key + mid * stride, sizeof v);                        \
+            if (v < want || (or_equal && v == want))                                       \
+                lo = mid + 1;                                                              \
+            else                                                                           \
+                hi = mid;                                                                  \
+        }                                                                                  \
+        return lo;                                                                         \
     }
-    return lo;
-}
 
-static inline size_t ag__search_double(const void *key, size_t n, size_t stride, double want,
-                                       int or_equal)
-{
-    assert(key || n == 0);
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        double v;
-        memcpy(&v, (const char *)key + mid * stride, sizeof v);
-        if (v < want || (or_equal && v == want))
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
+AG__SEARCH_PARTITION(ag__search_u64, uint64_t)
+AG__SEARCH_PARTITION(ag__search_double, double)
 
 static inline size_t ag_search_lower_u64(const void *key, size_t n, size_t stride,
                                          uint64_t want)
