@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/base/array.h"
 #include "../core/extrude/building.h"
 #include "../core/extrude/extrude.h"
 #include "../core/extrude/predicates.h"
@@ -595,15 +596,10 @@ ag_status ag_footprints_read_file(const char *path, const ag_footprints_options 
     char *buf = NULL;
     size_t len = 0, cap = 0;
     for (;;) {
-        if (len + 65536 > cap) {
-            cap = cap ? 2 * cap : 1 << 20;
-            char *nb = realloc(buf, cap);
-            if (!nb) {
-                free(buf);
-                fclose(fp);
-                return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-            }
-            buf = nb;
+        if (AG_ARRAY_RESERVE_MORE(buf, cap, len, 65536)) { /* room for a read of 64 KiB */
+            free(buf);
+            fclose(fp);
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         }
         size_t r = fread(buf + len, 1, cap - len, fp);
         len += r;
