@@ -388,6 +388,27 @@ ag_status ag_app_query_extrusion_preview(const char *plan_json, size_t len, ag_a
     return s;
 }
 
+ag_status ag_app_query_extrusion_preview_budgeted(const char *plan_json, size_t len,
+                                                  ag_task_budget *budget, ag_app_bytes *out,
+                                                  size_t *failing_faces, ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    *failing_faces = 0;
+    if (ag_task_budget_exhausted(budget))
+        return ag_task_budget_explain(budget, AG_ERR_CANCELLED, "the extrusion preview", err);
+    /* The sweep itself takes the budget once the extrusion options have one (their
+     * cancel callback is ag_task_budget_exhausted with this budget, their time what
+     * ag_task_budget_left says); until then it runs to its end, and an answer nobody waits
+     * for any more is dropped (a late one is still worth sending). */
+    ag_status s = ag_app_query_extrusion_preview(plan_json, len, out, failing_faces, err);
+    if (s == AG_OK && ag_task_budget_exhausted(budget) && budget->why != AG_ERR_DEADLINE) {
+        free(out->data);
+        memset(out, 0, sizeof *out);
+        s = ag_task_budget_explain(budget, AG_ERR_CANCELLED, "the extrusion preview", err);
+    }
+    return s;
+}
+
 json_t *ag_app_query_health(ag_app *app, int ws_port, ag_error *err)
 {
     ag_db *db = db_of(app, err);

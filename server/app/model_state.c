@@ -49,9 +49,11 @@ static void find_declaration(const char *text, size_t len, const char *name, lon
     }
 }
 
-/* Parses text, loads every terminal through lookup and derives the mesh. */
+/* Parses text, loads every terminal through lookup and derives the mesh (at most
+ * max_triangles of it). */
 static ag_status derive_text(const char *text, size_t len, ag_terminal_lookup lookup, void *user,
-                             ag_grammar **g, ag_mesh **mesh, ag_error *err, long *col)
+                             size_t max_triangles, ag_grammar **g, ag_mesh **mesh, ag_error *err,
+                             long *col)
 {
     *g = NULL;
     *mesh = NULL;
@@ -91,7 +93,7 @@ static ag_status derive_text(const char *text, size_t len, ag_terminal_lookup lo
         }
         free(obj);
     }
-    ag_grammar_derive_options dopt = {.max_triangles = AG_GRAMMAR_MAX_TRIANGLES};
+    ag_grammar_derive_options dopt = {.max_triangles = max_triangles};
     if (s == AG_OK)
         s = ag_grammar_derive(*g, &dopt, mesh, err);
     if (s != AG_OK) {
@@ -152,7 +154,8 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
     if (s == AG_OK)
         s = ag_grammar_text_print(m->proc->grammar, &out->text, &out->text_len, err);
     if (s == AG_OK &&
-        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms, &back,
+        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms,
+                         AG_GRAMMAR_MAX_TRIANGLES, &back,
                          &out->derived, &e, &col)) != AG_OK)
         s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
                          "the grammar does not read back (line %ld, column %ld): %s", e.element,
@@ -174,12 +177,38 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
     return s;
 }
 
+static int budget_stage(void *budget, ag_stage stage)
+{
+    (void)stage;
+    return ag_edit_budget_cancelled(budget);
+}
+
 ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_lookup lookup,
-                                   void *user, ag_model_state *out, ag_error *err, long *col)
+                                   void *user, const ag_edit_budget *budget,
+                                   ag_model_state *out, ag_error *err, long *col)
 {
     memset(out, 0, sizeof *out);
     ag_grammar *g = NULL;
-    ag_status s = derive_text(text, len, lookup, user, &g, &out->derived, err, col);
+    size_t max_tris = budget && budget->max_triangles && budget->max_triangles <
+                                                             AG_GRAMMAR_MAX_TRIANGLES
+                          ? budget->max_triangles
+                          : AG_GRAMMAR_MAX_TRIANGLES;
+    ag_status s = derive_text(text, len, lookup, user, max_tris, &g, &out->derived, err, col);
+    if (s == AG_ERR_TOO_LARGE && max_tris < AG_GRAMMAR_MAX_TRIANGLES)
+        s = ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, err ? err->element : 0,
+                         "the grammar derives more than %zu triangles, the most this server "
+                         "takes",
+                         max_tris);
+    if (s == AG_OK && budget && budget->max_components &&
+        out->derived->ncomponents > budget->max_components)
+        s = ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, 0,
+                         "the grammar places %zu terminals; this server takes at most %zu",
+                         out->derived->ncomponents, budget->max_components);
+    if (s != AG_OK) {
+        ag_grammar_free(g);
+        ag_model_state_clear(out);
+        return s;
+    }
     if (s != AG_OK)
         return s;
     if (!(out->text = malloc(len + 1)))
@@ -190,8 +219,12 @@ ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_loo
         out->text_len = len;
     }
     ag_grammar_free(g);
-    if (s == AG_OK)
+    if (s == AG_OK && budget && budget->cancelled) {
+        ag_proceduralize_options po = {.progress = budget_stage, .user = (void *)budget};
+        s = ag_edit_model_create(out->derived, &po, &out->em, err);
+    } else if (s == AG_OK) {
         s = ag_model_state_reload(out->derived, &out->em, err);
+    }
     if (s != AG_OK)
         ag_model_state_clear(out);
     return s;

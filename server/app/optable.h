@@ -22,6 +22,7 @@
 #include <stdint.h>
 
 #include "../core/status.h"
+#include "task_budget.h"
 
 /* declared, not included: the live layer reads the table without seeing the store */
 struct ag_db;
@@ -43,6 +44,7 @@ typedef struct {
     const char *cid;    /* the client's id of the op: one use per author and model */
     const json_t *op;
     uint64_t origin;    /* the live session it came from, 0 = none */
+    ag_task_budget *budget; /* the time it may take and whether to stop; NULL = no limit */
 } ag_op_request;
 
 typedef struct {

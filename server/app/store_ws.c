@@ -500,7 +500,8 @@ void ag_store_ws_end(ag_store_ws *w, ag_status outcome)
 {
     if (w->target && outcome != AG_OK && outcome != AG_ERR_STALE && outcome != AG_ERR_INVALID &&
         outcome != AG_ERR_NOT_FOUND && outcome != AG_ERR_CONFLICT && outcome != AG_ERR_PARSE &&
-        outcome != AG_ERR_NOT_PROCEDURALIZED)
+        outcome != AG_ERR_NOT_PROCEDURALIZED && outcome != AG_ERR_RESULT_TOO_LARGE &&
+        outcome != AG_ERR_DEADLINE && outcome != AG_ERR_CANCELLED)
         ag_edit_session_reset(w->target); /* an unexpected failure: load afresh next time */
     ag_edit_session_release(w->o.env.sessions, w->source);
     ag_edit_session_release(w->o.env.sessions, w->target);

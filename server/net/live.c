@@ -38,9 +38,11 @@ struct ag_live {
     pthread_mutex_t lock; /* guards the pending list */
     pending *head, *tail;
     ag_live_rooms rooms;  /* service thread only */
+    ag_ratelimit *messages;
 };
 
 ag_app *ag__live_app(ag_live *live) { return live->app; }
+ag_ratelimit *ag__live_message_limit(ag_live *live) { return live->messages; }
 ag_live_rooms *ag__live_rooms(ag_live *live) { return &live->rooms; }
 
 static void pending_free(pending *p)
@@ -202,9 +204,13 @@ static int on_lws(struct lws *wsi, enum lws_callback_reasons reason, void *user,
     ag_live *live = ctx ? lws_context_user(ctx) : NULL;
     ag_live_session *s = user;
     switch (reason) {
-    case LWS_CALLBACK_ESTABLISHED:
+    case LWS_CALLBACK_ESTABLISHED: {
         ag_live_rooms_add(&live->rooms, s, wsi);
+        char peer[48] = "?";
+        lws_get_peer_simple(wsi, peer, sizeof peer);
+        snprintf(s->rate_key, sizeof s->rate_key, "addr:%s", peer);
         break;
+    }
     case LWS_CALLBACK_RECEIVE:
         return receive(live, s, wsi, in, len);
     case LWS_CALLBACK_SERVER_WRITEABLE:
@@ -252,6 +258,10 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
     if (!live)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     live->app = app;
+    if (!(live->messages = ag_ratelimit_create(opt->message_rate, 8192))) {
+        free(live);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
     pthread_mutex_init(&live->lock, NULL);
     lws_set_log_level(LLL_ERR, log_lws);
     struct lws_context_creation_info info;
@@ -266,6 +276,7 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
     live->context = lws_create_context(&info);
     if (!live->context) {
         pthread_mutex_destroy(&live->lock);
+        ag_ratelimit_free(live->messages);
         free(live);
         return ag_error_set(err, AG_ERR_IO, 0,
                             "cannot listen for websockets on %s:%d (is the port in use?)",
@@ -276,6 +287,7 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
         ag_events_unsubscribe(ag_app_events(app), on_event, live);
         lws_context_destroy(live->context);
         pthread_mutex_destroy(&live->lock);
+        ag_ratelimit_free(live->messages);
         free(live);
         return ag_error_set(err, AG_ERR_INTERNAL, 0, "cannot start the websocket thread");
     }
@@ -297,5 +309,6 @@ void ag_live_stop(ag_live *live)
         pending_free(p);
     }
     pthread_mutex_destroy(&live->lock);
+    ag_ratelimit_free(live->messages);
     free(live);
 }

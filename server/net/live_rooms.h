@@ -27,6 +27,7 @@ typedef struct ag_live_session {
     int64_t model; /* 0: in no room */
     int64_t seen;  /* the newest model version this session has been told of */
     char user[801];
+    char rate_key[64];  /* what its message rate limit counts under: "addr:<peer address>" */
     char *presence; /* last state, JSON text */
     char *rx;
     size_t rx_len;

@@ -5,28 +5,29 @@
 #include <string.h>
 
 const ag_route ag_routes[] = {
-    {"GET", "/api/v1/health", ag_api_health, AG_BODY_NONE},
-    {"GET", "/api/v1/openapi.json", ag_api_openapi, AG_BODY_NONE},
-    {"GET", "/api/v1/models", ag_api_models_list, AG_BODY_NONE},
-    {"POST", "/api/v1/models", ag_api_models_create, AG_BODY_UPLOAD},
-    {"GET", "/api/v1/models/{id}", ag_api_model_get, AG_BODY_NONE},
-    {"PATCH", "/api/v1/models/{id}", ag_api_model_patch, AG_BODY_JSON},
-    {"DELETE", "/api/v1/models/{id}", ag_api_model_delete, AG_BODY_NONE},
+    {"GET", "/api/v1/health", ag_api_health, AG_BODY_NONE, 0},
+    {"GET", "/api/v1/openapi.json", ag_api_openapi, AG_BODY_NONE, 0},
+    {"GET", "/api/v1/models", ag_api_models_list, AG_BODY_NONE, 0},
+    {"POST", "/api/v1/models", ag_api_models_create, AG_BODY_UPLOAD, AG_ROUTE_SUBMITS_JOB},
+    {"GET", "/api/v1/models/{id}", ag_api_model_get, AG_BODY_NONE, 0},
+    {"PATCH", "/api/v1/models/{id}", ag_api_model_patch, AG_BODY_JSON, 0},
+    {"DELETE", "/api/v1/models/{id}", ag_api_model_delete, AG_BODY_NONE, 0},
     /* label and split-tree node per component once the model is proceduralized */
-    {"GET", "/api/v1/models/{id}/mesh.glb", ag_api_model_mesh_glb, AG_BODY_NONE},
-    {"GET", "/api/v1/models/{id}/ops", ag_api_model_ops_list, AG_BODY_NONE},
-    {"POST", "/api/v1/models/{id}/ops", ag_api_model_ops_create, AG_BODY_JSON},
-    {"POST", "/api/v1/models/{id}/proceduralize", ag_api_model_proceduralize, AG_BODY_JSON},
-    {"GET", "/api/v1/models/{id}/tree", ag_api_model_tree, AG_BODY_NONE},
-    {"GET", "/api/v1/models/{id}/grammar", ag_api_model_grammar_get, AG_BODY_NONE},
+    {"GET", "/api/v1/models/{id}/mesh.glb", ag_api_model_mesh_glb, AG_BODY_NONE, 0},
+    {"GET", "/api/v1/models/{id}/ops", ag_api_model_ops_list, AG_BODY_NONE, 0},
+    {"POST", "/api/v1/models/{id}/ops", ag_api_model_ops_create, AG_BODY_JSON, 0},
+    {"POST", "/api/v1/models/{id}/proceduralize", ag_api_model_proceduralize, AG_BODY_JSON,
+     AG_ROUTE_SUBMITS_JOB},
+    {"GET", "/api/v1/models/{id}/tree", ag_api_model_tree, AG_BODY_NONE, 0},
+    {"GET", "/api/v1/models/{id}/grammar", ag_api_model_grammar_get, AG_BODY_NONE, 0},
     /* spooled like an upload; api_grammar.c takes at most 8 MiB of it */
-    {"PUT", "/api/v1/models/{id}/grammar", ag_api_model_grammar_put, AG_BODY_UPLOAD},
+    {"PUT", "/api/v1/models/{id}/grammar", ag_api_model_grammar_put, AG_BODY_UPLOAD, 0},
     /* a building description or GeoJSON footprints, spooled like model uploads */
-    {"POST", "/api/v1/extrusions", ag_api_extrusions_create, AG_BODY_UPLOAD},
-    {"POST", "/api/v1/extrusions/preview", ag_api_extrusions_preview, AG_BODY_JSON},
-    {"GET", "/api/v1/models/{id}/plan", ag_api_model_plan, AG_BODY_NONE},
-    {"GET", "/api/v1/jobs/{id}", ag_api_job_get, AG_BODY_NONE},
-    {"DELETE", "/api/v1/jobs/{id}", ag_api_job_cancel, AG_BODY_NONE},
+    {"POST", "/api/v1/extrusions", ag_api_extrusions_create, AG_BODY_UPLOAD, AG_ROUTE_SUBMITS_JOB},
+    {"POST", "/api/v1/extrusions/preview", ag_api_extrusions_preview, AG_BODY_JSON, 0},
+    {"GET", "/api/v1/models/{id}/plan", ag_api_model_plan, AG_BODY_NONE, 0},
+    {"GET", "/api/v1/jobs/{id}", ag_api_job_get, AG_BODY_NONE, 0},
+    {"DELETE", "/api/v1/jobs/{id}", ag_api_job_cancel, AG_BODY_NONE, 0},
 };
 const size_t ag_routes_count = sizeof ag_routes / sizeof ag_routes[0];
 
