@@ -14,6 +14,7 @@
 #include "../store/models.h"
 #include "../store/ops.h"
 #include "edit_session.h"
+#include "jobqueue.h"
 #include "model_tree.h"
 #include "store_env.h"
 #include "views.h"
@@ -414,8 +415,17 @@ json_t *ag_app_query_health(ag_app *app, int ws_port, ag_error *err)
     ag_db *db = db_of(app, err);
     if (!db)
         return NULL;
-    return json_pack("{s:s, s:s, s:{s:s, s:i}, s:i, s:i}", "status", "ok", "version",
-                     AG_VERSION, "db", "path", ag_db_path(db), "schema_version",
-                     ag_db_schema_version(db), "ws_port", ws_port, "workers",
-                     ag_app_workers(app));
+    const ag_work_limits *l = ag_app_limits(app);
+    ag_jobqueue_stats q = ag_jobqueue_stats_now(ag__app_jobqueue(app));
+    return json_pack("{s:s, s:s, s:{s:s, s:i}, s:i, s:i, s:{s:I, s:I, s:f, s:f, s:f}, "
+                     "s:{s:I, s:I, s:I, s:I}}",
+                     "status", "ok", "version", AG_VERSION, "db", "path", ag_db_path(db),
+                     "schema_version", ag_db_schema_version(db), "ws_port", ws_port, "workers",
+                     ag_app_workers(app), "limits", "max_triangles",
+                     (json_int_t)l->max_triangles, "max_nodes", (json_int_t)l->max_nodes,
+                     "op_seconds", l->op_seconds, "job_seconds", l->job_seconds,
+                     "preview_seconds", l->preview_seconds, "work", "jobs_waiting",
+                     (json_int_t)q.jobs_waiting, "jobs_running", (json_int_t)q.jobs_running,
+                     "tasks_waiting", (json_int_t)q.tasks_waiting, "tasks_running",
+                     (json_int_t)q.tasks_running);
 }

@@ -5,6 +5,8 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -193,10 +195,18 @@ typedef struct {
     int index;
 } worker_arg;
 
+/* Workers run below the threads that answer requests: a busy machine still answers
+ * GET /api/v1/health and small requests at once (jobs lowest, interactive tasks between). */
+static void lower_priority(int steps)
+{
+    setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), steps);
+}
+
 static void *normal_main(void *arg)
 {
     worker_arg *w = arg;
     ag_jobqueue *q = w->q;
+    lower_priority(10);
     for (;;) {
         pthread_mutex_lock(&q->lock);
         while (!q->normal.head && !q->stopping)
@@ -247,6 +257,7 @@ static void *task_main(void *arg)
 {
     worker_arg *w = arg;
     ag_jobqueue *q = w->q;
+    lower_priority(5);
     task_slot *slot = &q->slots[w->index];
     for (;;) {
         pthread_mutex_lock(&q->lock);
@@ -552,6 +563,20 @@ ag_status ag_jobqueue_cancel(ag_jobqueue *q, int64_t job, ag_error *err)
         ag_jobqueue_publish(q, job);
     }
     return AG_OK;
+}
+
+ag_jobqueue_stats ag_jobqueue_stats_now(ag_jobqueue *q)
+{
+    ag_jobqueue_stats st = {0};
+    pthread_mutex_lock(&q->lock);
+    st.jobs_waiting = q->normal.length;
+    for (ag_jobctx *c = q->running; c; c = c->next_running)
+        st.jobs_running++;
+    st.tasks_waiting = q->tasks.length;
+    for (int i = 0; i < q->tasks.nthreads; i++)
+        st.tasks_running += q->slots[i].busy != 0;
+    pthread_mutex_unlock(&q->lock);
+    return st;
 }
 
 int ag_jobctx_cancelled(const ag_jobctx *ctx)

@@ -83,6 +83,12 @@ ag_status ag_jobqueue_run_task(ag_jobqueue *q, int64_t key, double seconds,
                                void (*run)(void *user, ag_task_budget *budget),
                                void (*drop)(void *user), void *user, ag_error *err);
 
+/* What the queue holds now (for GET /api/v1/health). */
+typedef struct {
+    size_t jobs_waiting, jobs_running, tasks_waiting, tasks_running;
+} ag_jobqueue_stats;
+ag_jobqueue_stats ag_jobqueue_stats_now(ag_jobqueue *q);
+
 /* Returns non-zero when the job should stop (cancelled or shutting down). Progress is
  * stored and announced at most every 2% or on a stage change. */
 int ag_jobctx_progress(ag_jobctx *ctx, double fraction, const char *stage);

@@ -35,6 +35,7 @@ struct ag_http {
     char *web_dir;
     int listen_fd; /* after ag_http_quiesce: the listening socket, closed at the stop */
     ag_ratelimit *rest_limit, *job_limit;
+    atomic_size_t abandoned;
 };
 
 static void http_free(ag_http *http)
@@ -303,6 +304,7 @@ ag_status ag_http_start(ag_app *app, const ag_http_options *opt, ag_http **out, 
     http->cfg.rest_limit = http->rest_limit;
     http->cfg.job_limit = http->job_limit;
     http->cfg.rate_key = opt->rate_key;
+    http->cfg.abandoned = &http->abandoned;
     unsigned max_conns = opt->max_connections ? opt->max_connections : 4096;
     unsigned per_address = opt->max_per_address ? opt->max_per_address : 64;
     unsigned idle = opt->idle_timeout ? opt->idle_timeout : 60;

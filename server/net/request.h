@@ -4,6 +4,7 @@
 
 #include <jansson.h>
 #include <microhttpd.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -30,6 +31,7 @@ typedef struct {
     struct ag_ratelimit *rest_limit, *job_limit; /* NULL: none */
     ag_rate_key_fn rate_key;                     /* NULL: ag_request_address_key */
     struct ag_connguard *guard;
+    atomic_size_t *abandoned; /* deferred requests dropped: their client went away first */
 } ag_http_config;
 
 /* The answer a deferred request's work made on a task worker (net/defer.h), sent by the
