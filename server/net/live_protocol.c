@@ -144,7 +144,8 @@ static json_t *op_reply(ag_app *app, int64_t model, const char *user, uint64_t o
                             .cid = cid,
                             .op = json_object_get(msg, "op"),
                             .origin = origin,
-                            .budget = budget};
+                            .budget = budget,
+                            .rebase = 1};
         st = ag_app_change_op(app, &rq, &version, &dup, &err);
     }
     if (st == AG_OK)
