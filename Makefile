@@ -1,37 +1,57 @@
 # archgram — build, run and test.
 #
-#   make run    install what is missing, build, start archgramd with demo content
-#   make test   every test tier: C unit, service integration, browser
-#   make bench  benchmarks (print figures; not tests)
+#   make / make run   install the build packages, build archgramd, archgram and the web client
+#                     (run: then start archgramd with demo content)
+#   make test         install the test packages too, then check-layers and every test tier
+#   make test-asan    the unit and integration tiers against an ASan+UBSan build (build/asan)
+#   make bench        benchmarks (print figures; not tests)
 #
 # Every target installs the Debian and npm packages it needs when they are missing,
 # so a fresh clone on a fresh Debian 12 machine needs nothing but these commands.
+# CI=true (or WERROR=1) builds with -Werror.
 
 CC      ?= cc
 BUILD   := build
 CFLAGS  ?= -O2 -g
-CFLAGS  += -std=c11 -D_GNU_SOURCE -Wall -Wextra -Wno-unused-parameter -MMD -MP \
-           -I/usr/include/suitesparse
+# SANITIZE is set by test-asan for its own build directory.
+SANITIZE :=
+WERROR  ?= $(if $(filter true,$(CI)),1,0)
+ALL_CFLAGS := $(CFLAGS) $(SANITIZE) -std=c11 -D_GNU_SOURCE -Wall -Wextra -Wno-unused-parameter \
+              $(if $(filter 1,$(WERROR)),-Werror) -MMD -MP -I/usr/include/suitesparse
+ALL_LDFLAGS := $(LDFLAGS) $(SANITIZE)
 # Tests and benchmarks find tests/data and ../shared relative to the checkout they are built in.
 TEST_CFLAGS := -Iserver -DAG_REPO_DIR=\"$(CURDIR)\"
-LDLIBS  := -lwebsockets -lmicrohttpd -ljansson -lsqlite3 -lcholmod -lspqr -lsuitesparseconfig \
-           -lassimp -lcrypto -lpthread -lm
 
 PORT    ?= 8080
 DB      ?= var/archgram.db
 
-# Debian packages: to build and run, and in addition to test.
+# Debian packages: to build and run; in addition to test (and to run the sanitizer build);
+# to benchmark.
 DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libwebsockets-dev \
              libsqlite3-dev libsuitesparse-dev libassimp-dev libssl-dev
-DEB_TEST  := libcmocka-dev chromium curl
+DEB_TEST  := libcmocka-dev chromium curl sqlite3 python3 binutils libasan8 libubsan1
 DEB_BENCH := wrk
 
-# Sources: every .c below a layer directory is part of the library, except the two mains.
-LIB_SRC   := $(shell find server/core server/io server/store server/app server/net -name '*.c' | sort)
-LIB_OBJ   := $(LIB_SRC:%.c=$(BUILD)/obj/%.o)
+# --- layers -------------------------------------------------------------------------------
+# One archive per layer, core → io → store → app → net; programs link them highest first, so
+# a layer that reaches up fails to link. Which layers, headers and system libraries each layer
+# may use is written once, in tools/check_layers.py (make check-layers).
+LAYERS     := core io store app net
+LIBDIR     := $(BUILD)/lib
+layer_src   = $(shell find server/$(1) -name '*.c' | sort)
+layer_obj   = $(patsubst %.c,$(BUILD)/obj/%.o,$(call layer_src,$(1)))
+# Generated sources go with the layer that uses them: migrations → store, OpenAPI → net.
+GEN_OBJ_store := $(BUILD)/gen/migrations.o
+GEN_OBJ_net   := $(BUILD)/gen/openapi.o
 GEN_SRC   := $(BUILD)/gen/migrations.c $(BUILD)/gen/openapi.c
-GEN_OBJ   := $(GEN_SRC:%.c=%.o)
-LIB       := $(BUILD)/libarchgram.a
+ARCHIVES  := $(foreach l,$(LAYERS),$(LIBDIR)/libag_$(l).a)
+# Link order: the highest layer first, each followed by what it may use.
+LINK_ARCHIVES := $(foreach l,net app store io core,$(LIBDIR)/libag_$(l).a)
+# The system libraries, in the same order: net's, app's, store's, io's, core's.
+LDLIBS    := -lwebsockets -lmicrohttpd -lpthread -lsqlite3 -ljansson -lassimp -lcrypto \
+             -lcholmod -lspqr -lsuitesparseconfig -lm
+LIB_OBJ   := $(foreach l,$(LAYERS),$(call layer_obj,$(l)))
+
 # The command-line tool: a dispatcher (server/cli.c) and one file per subcommand.
 CLI_SRC   := server/cli.c $(sort $(wildcard server/cli/*.c))
 CLI_OBJ   := $(CLI_SRC:%.c=$(BUILD)/obj/%.o)
@@ -40,36 +60,49 @@ UNIT_BIN  := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 BENCH_SRC := $(sort $(wildcard bench/*.c))
 BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 WEB_SRC   := $(shell find web -type f 2>/dev/null | sort)
+NPM_STAMP := node_modules/.archgram-stamp
 
 .PHONY: all deps deps-test deps-bench npm run test test-unit test-integration test-browser \
-        bench clean web
+        test-asan check-layers bench clean web programs unit-tests
 
-all: deps $(BUILD)/archgramd $(BUILD)/archgram $(UNIT_BIN) $(BENCH_BIN) web
+# Running needs the two programs and the web client, nothing built for tests.
+all: programs web
+
+programs: $(BUILD)/archgramd $(BUILD)/archgram
 
 # --- packages -----------------------------------------------------------------------------
+# apt waits for a lock another apt holds (up to 10 minutes), and a failed round is tried again
+# a few times: on a shared machine or a CI runner something else may be installing too.
+APT_GET := apt-get -q -o DPkg::Lock::Timeout=600
+define apt_install
+	SUDO=; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+	for try in 1 2 3 4 5; do \
+	  $$SUDO $(APT_GET) update && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO $(APT_GET) install -y --no-install-recommends $(1) && break; \
+	  [ $$try = 5 ] && exit 1; echo "archgram: apt-get failed, trying again in 20 s"; sleep 20; \
+	done
+endef
 define install_missing
 	@missing=$$(for p in $(1); do \
 	    dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q 'install ok installed' || echo $$p; \
 	  done); \
 	if [ -n "$$missing" ]; then \
 	  echo "archgram: installing Debian packages:" $$missing; \
-	  SUDO=; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
-	  $$SUDO apt-get update -q && \
-	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y --no-install-recommends $$missing; \
+	  $(call apt_install,$$missing); \
 	fi
 endef
 
+# deps (build and run packages, node and npm) is an order-only prerequisite of every object
+# and generated source, and deps-test of every test binary, so under make -j no compile starts
+# before the headers are installed. npm ci runs from one rule only (the stamp).
 deps:
 	$(call install_missing,$(DEB_BUILD))
 	@# Node may come from Debian (nodejs + npm) or from a nodejs build that bundles npm and
 	@# conflicts with Debian's npm package: ask for the commands, not the packages.
 	@if ! command -v node >/dev/null || ! command -v npm >/dev/null; then \
 	  echo "archgram: installing Node.js and npm"; \
-	  SUDO=; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
-	  $$SUDO apt-get update -q && \
-	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y --no-install-recommends nodejs npm; \
+	  $(call apt_install,nodejs npm); \
 	fi
-	@$(MAKE) --no-print-directory npm
 
 deps-test: deps
 	$(call install_missing,$(DEB_TEST))
@@ -77,50 +110,56 @@ deps-test: deps
 deps-bench: deps
 	$(call install_missing,$(DEB_BENCH))
 
-npm: node_modules/.archgram-stamp
+npm: $(NPM_STAMP)
 
-node_modules/.archgram-stamp: package.json package-lock.json
+$(NPM_STAMP): package.json package-lock.json | deps
 	npm ci --no-audit --no-fund
 	@touch $@
 
 # --- C ------------------------------------------------------------------------------------
-$(BUILD)/obj/%.o: %.c
+$(BUILD)/obj/%.o: %.c | deps
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -c $< -o $@
+	$(CC) $(ALL_CFLAGS) -c $< -o $@
 
-$(BUILD)/gen/migrations.c: $(sort $(wildcard migrations/*.sql)) server/embed.sh
+$(BUILD)/gen/migrations.c: $(sort $(wildcard migrations/*.sql)) server/embed.sh | deps
 	@mkdir -p $(dir $@)
-	sh server/embed.sh migrations $(sort $(wildcard migrations/*.sql)) > $@
+	sh server/embed.sh migrations $(sort $(wildcard migrations/*.sql)) > $@.tmp && mv $@.tmp $@
 
-$(BUILD)/gen/openapi.c: schema/openapi.json server/embed.sh
+$(BUILD)/gen/openapi.c: schema/openapi.json server/embed.sh | deps
 	@mkdir -p $(dir $@)
-	sh server/embed.sh openapi schema/openapi.json > $@
+	sh server/embed.sh openapi schema/openapi.json > $@.tmp && mv $@.tmp $@
 
-$(BUILD)/gen/%.o: $(BUILD)/gen/%.c
-	$(CC) $(CFLAGS) -c $< -o $@
+$(BUILD)/gen/%.o: $(BUILD)/gen/%.c | deps
+	$(CC) $(ALL_CFLAGS) -c $< -o $@
 
-$(LIB): $(LIB_OBJ) $(GEN_OBJ)
-	@rm -f $@
-	ar rcs $@ $^
+define layer_archive
+$(LIBDIR)/libag_$(1).a: $(call layer_obj,$(1)) $(GEN_OBJ_$(1))
+	@mkdir -p $$(dir $$@)
+	@rm -f $$@
+	ar rcs $$@ $$^
+endef
+$(foreach l,$(LAYERS),$(eval $(call layer_archive,$(l))))
 
-$(BUILD)/archgramd: $(BUILD)/obj/server/main.o $(LIB)
-	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+$(BUILD)/archgramd: $(BUILD)/obj/server/main.o $(ARCHIVES)
+	$(CC) $(ALL_CFLAGS) $(ALL_LDFLAGS) -o $@ $< $(LINK_ARCHIVES) $(LDLIBS)
 
-$(BUILD)/archgram: $(CLI_OBJ) $(LIB)
-	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+$(BUILD)/archgram: $(CLI_OBJ) $(ARCHIVES)
+	$(CC) $(ALL_CFLAGS) $(ALL_LDFLAGS) -o $@ $(CLI_OBJ) $(LINK_ARCHIVES) $(LDLIBS)
 
-$(BUILD)/tests/%: tests/unit/%.c $(LIB)
+unit-tests: $(UNIT_BIN)
+
+$(BUILD)/tests/%: tests/unit/%.c $(ARCHIVES) | deps-test
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(TEST_CFLAGS) -o $@ $< $(LIB) $(LDLIBS) -lcmocka
+	$(CC) $(ALL_CFLAGS) $(TEST_CFLAGS) $(ALL_LDFLAGS) -o $@ $< $(LINK_ARCHIVES) $(LDLIBS) -lcmocka
 
-$(BUILD)/bench/%: bench/%.c $(LIB)
+$(BUILD)/bench/%: bench/%.c $(ARCHIVES) | deps-bench
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(TEST_CFLAGS) -o $@ $< $(LIB) $(LDLIBS)
+	$(CC) $(ALL_CFLAGS) $(TEST_CFLAGS) $(ALL_LDFLAGS) -o $@ $< $(LINK_ARCHIVES) $(LDLIBS)
 
 # --- web client ---------------------------------------------------------------------------
 web: $(BUILD)/web/app.js
 
-$(BUILD)/web/app.js: $(WEB_SRC) node_modules/.archgram-stamp
+$(BUILD)/web/app.js: $(WEB_SRC) $(NPM_STAMP)
 	@mkdir -p $(BUILD)/web
 	cp web/index.html web/style.css $(BUILD)/web/
 	node_modules/.bin/esbuild web/src/main.js --bundle --format=esm --minify --sourcemap \
@@ -132,10 +171,16 @@ run: all
 	$(BUILD)/archgramd --port $(PORT) --db $(DB) --demo
 
 # --- tests --------------------------------------------------------------------------------
-test: deps-test all
+# The tiers run one after the other (they share two cores); each is also a target of its own.
+test: deps-test
+	@$(MAKE) --no-print-directory check-layers
 	@$(MAKE) --no-print-directory test-unit
 	@$(MAKE) --no-print-directory test-integration
 	@$(MAKE) --no-print-directory test-browser
+
+check-layers: $(ARCHIVES) | deps-test
+	python3 tools/check_layers.py --lib $(LIBDIR)
+	node --test tests/tools/
 
 # Each suite gets 10 minutes: a hang is a failure with a name, not a stuck CI.
 test-unit: $(UNIT_BIN)
@@ -143,14 +188,31 @@ test-unit: $(UNIT_BIN)
 	  if timeout 600 $$t; then pass=$$((pass+1)); else fail=$$((fail+1)); echo "FAILED: $$t"; fi; \
 	done; echo "unit: $$pass passed, $$fail failed"; [ $$fail = 0 ]
 
-test-integration: $(BUILD)/archgramd $(BUILD)/archgram
-	node --test --test-concurrency=1 tests/integration/
+# ARCHGRAMD / ARCHGRAM point the tiers at other builds (test-asan sets them).
+test-integration: programs $(NPM_STAMP) | deps-test
+	ARCHGRAMD=$${ARCHGRAMD:-$(BUILD)/archgramd} ARCHGRAM=$${ARCHGRAM:-$(BUILD)/archgram} \
+	  node --test --test-concurrency=1 tests/integration/
 
-test-browser: $(BUILD)/archgramd web
+test-browser: $(BUILD)/archgramd web | deps-test
 	node --test --test-concurrency=1 tests/browser/
 
+# AddressSanitizer and UndefinedBehaviorSanitizer (any report fails: UB aborts, ASan and
+# LeakSanitizer exit non-zero, the integration harness rejects a daemon that printed one).
+ASAN_DIR   := $(BUILD)/asan
+ASAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+test-asan: deps-test $(NPM_STAMP)
+	@$(MAKE) --no-print-directory BUILD=$(ASAN_DIR) SANITIZE="$(ASAN_FLAGS)" CFLAGS="-O1 -g" \
+	  programs unit-tests
+	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1 \
+	  $(MAKE) --no-print-directory BUILD=$(ASAN_DIR) SANITIZE="$(ASAN_FLAGS)" CFLAGS="-O1 -g" \
+	  test-unit
+	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1 \
+	  ARCHGRAMD=$(ASAN_DIR)/archgramd ARCHGRAM=$(ASAN_DIR)/archgram \
+	  $(MAKE) --no-print-directory BUILD=$(ASAN_DIR) SANITIZE="$(ASAN_FLAGS)" CFLAGS="-O1 -g" \
+	  test-integration
+
 # --- benchmarks ---------------------------------------------------------------------------
-bench: deps-bench all
+bench: deps-bench all $(BENCH_BIN)
 	@for b in bench/*.sh; do [ -f "$$b" ] && sh "$$b"; done; true
 	@for b in bench/*.js; do [ -f "$$b" ] && node "$$b"; done; true
 	@for b in $(BENCH_BIN); do $$b; done
@@ -158,4 +220,4 @@ bench: deps-bench all
 clean:
 	rm -rf $(BUILD)
 
--include $(shell find $(BUILD)/obj $(BUILD)/tests $(BUILD)/bench -name '*.d' 2>/dev/null)
+-include $(shell find $(BUILD)/obj $(BUILD)/gen $(BUILD)/tests $(BUILD)/bench -name '*.d' 2>/dev/null)

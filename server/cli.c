@@ -81,7 +81,8 @@ int ag_cli_load_mesh(const char *path, ag_up_axis up, ag_mesh **out, size_t *byt
 {
     ag_error err;
     ag_error_clear(&err);
-    ag_mesh_source src = {.path = path, .up = up};
+    /* the person's own file: what it refers to is read from next to it */
+    ag_mesh_source src = {.path = path, .up = up, .own_file = 1};
     ag_mesh_file file;
     ag_status st = ag_usecase_import_read(&src, NULL, NULL, out, &file, &err);
     *bytes = file.len;

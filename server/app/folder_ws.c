@@ -69,7 +69,7 @@ static ag_status input_mesh(ag_workspace *ws, ag_mesh **mesh, ag_error *err)
 {
     ag_folder_ws *w = (ag_folder_ws *)ws;
     double t0 = now();
-    ag_mesh_source src = {.path = w->o.mesh_path, .up = w->o.up};
+    ag_mesh_source src = {.path = w->o.mesh_path, .up = w->o.up, .own_file = 1};
     ag_mesh_file file;
     blame(w, w->o.mesh_path);
     ag_status s = ag_usecase_import_read(&src, NULL, NULL, mesh, &file, err);

@@ -64,7 +64,11 @@ ag_status ag_usecase_import_read(const ag_mesh_source *src, int (*progress)(void
         s = ag_error_set(err, AG_ERR_UNSUPPORTED, 0, "the file's format could not be recognised; %s",
                          src->format_hint);
     if (s == AG_OK) {
-        ag_import_options iopt = {.up = src->up, .progress = progress, .user = user};
+        ag_import_options iopt = {.up = src->up,
+                                  .progress = progress,
+                                  .user = user,
+                                  .allow_external_files = src->own_file,
+                                  .source_path = src->own_file ? src->path : NULL};
         s = ag_import_buffer(data, len, format, &iopt, mesh, err);
     }
     file->data = data;

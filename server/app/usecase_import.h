@@ -23,6 +23,9 @@ typedef struct {
     /* Appended when the format is not recognised ("name it with ?format="); NULL: the
      * importer's own message for content it cannot place. */
     const char *format_hint;
+    /* Non-zero for a person's own file (the CLI): the files it refers to (an OBJ's mtllib, a
+     * glTF's buffers) are read from next to it. Zero (uploads): no other file is ever read. */
+    int own_file;
 } ag_mesh_source;
 
 /* The file, mapped, while its mesh is used. */

@@ -126,6 +126,7 @@ ag_status ag_import_buffer(const uint8_t *data, size_t len, ag_format fmt,
             o.up = opt->up;
             o.progress = opt->progress;
             o.user = opt->user;
+            o.allow_external_files = opt->allow_external_files;
         }
         return ag_obj_read_buffer((const char *)data, len, &o, out, err);
     }

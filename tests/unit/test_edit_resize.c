@@ -386,7 +386,7 @@ static ag_edit_model *plain_siblings(unsigned n, int32_t *wall)
     assert_non_null(m);
     add_box(m, "wall", (double[]){0, 0, 0}, (double[]){8, 0.3, 3});
     for (unsigned i = 0; i < n; i++) {
-        char name[16];
+        char name[24]; /* "window" and any unsigned */
         snprintf(name, sizeof name, "window%u", i);
         double x = 0.4 + 2.0 * i;
         add_box(m, name, (double[]){x, 0, 1}, (double[]){x + 1.2, 0.1, 2});
