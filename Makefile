@@ -177,6 +177,7 @@ test: deps-test
 	@$(MAKE) --no-print-directory test-unit
 	@$(MAKE) --no-print-directory test-integration
 	@$(MAKE) --no-print-directory test-browser
+	@$(MAKE) --no-print-directory test-fuzz
 
 check-layers: $(ARCHIVES) | deps-test
 	python3 tools/check_layers.py --lib $(LIBDIR)
@@ -216,6 +217,8 @@ bench: deps-bench all $(BENCH_BIN)
 	@for b in bench/*.sh; do [ -f "$$b" ] && sh "$$b"; done; true
 	@for b in bench/*.js; do [ -f "$$b" ] && node "$$b"; done; true
 	@for b in $(BENCH_BIN); do $$b; done
+
+include tests/fuzz/fuzz.mk
 
 clean:
 	rm -rf $(BUILD)

@@ -45,6 +45,8 @@ static void usage(FILE *to)
             "                      preview (default 60)\n"
             "  --job-seconds S     time budget of one job (default 3600)\n"
             "  --preview-seconds S time budget of one extrusion preview (default 10)\n"
+            "  --import-seconds S  time to read one uploaded glTF, PLY, STL, FBX or DAE file\n"
+            "                      (default 120)\n"
             "  --task-workers N    threads for ops and previews, one model at a time each\n"
             "                      (default: 2 x cores, at least 4)\n"
             "  --db-max-bytes N    let the database grow to N bytes; changes past it are\n"
@@ -149,9 +151,9 @@ int main(int argc, char **argv)
 {
     enum { O_PORT = 1, O_WS_PORT, O_BIND, O_DB, O_WORKERS, O_WEB, O_NO_WEB, O_MAX_BODY, O_DEMO,
            O_HELP, O_VERSION, O_MAX_TRIANGLES, O_MAX_NODES, O_OP_SECONDS, O_JOB_SECONDS,
-           O_PREVIEW_SECONDS, O_TASK_WORKERS, O_DB_MAX_BYTES, O_STOP_GRACE, O_RATE_REST,
-           O_RATE_JOBS, O_RATE_WS, O_MAX_CONNECTIONS, O_MAX_PER_ADDRESS, O_HEADER_TIMEOUT,
-           O_IDLE_TIMEOUT };
+           O_PREVIEW_SECONDS, O_IMPORT_SECONDS, O_TASK_WORKERS, O_DB_MAX_BYTES, O_STOP_GRACE,
+           O_RATE_REST, O_RATE_JOBS, O_RATE_WS, O_MAX_CONNECTIONS, O_MAX_PER_ADDRESS,
+           O_HEADER_TIMEOUT, O_IDLE_TIMEOUT };
     static const struct option options[] = {
         {"port", required_argument, NULL, O_PORT},
         {"ws-port", required_argument, NULL, O_WS_PORT},
@@ -172,6 +174,7 @@ int main(int argc, char **argv)
         {"task-workers", required_argument, NULL, O_TASK_WORKERS},
         {"db-max-bytes", required_argument, NULL, O_DB_MAX_BYTES},
         {"stop-grace", required_argument, NULL, O_STOP_GRACE},
+        {"import-seconds", required_argument, NULL, O_IMPORT_SECONDS},
         {"rate-rest", required_argument, NULL, O_RATE_REST},
         {"rate-jobs", required_argument, NULL, O_RATE_JOBS},
         {"rate-ws", required_argument, NULL, O_RATE_WS},
@@ -183,7 +186,8 @@ int main(int argc, char **argv)
     };
     long long port = 8080, ws_port = 0, workers = 0, max_body = 512LL << 20;
     long long max_triangles = 0, max_nodes = 0, task_workers = 0, db_max_bytes = 0;
-    double op_seconds = 0, job_seconds = 0, preview_seconds = 0, stop_grace = 0.5;
+    double op_seconds = 0, job_seconds = 0, preview_seconds = 0, import_seconds = 0;
+    double stop_grace = 0.5;
     ag_rate rate_rest = {200, 2000}, rate_jobs = {1, 60}, rate_ws = {200, 2000};
     long long max_connections = 4096, max_per_address = 64, idle_timeout = 60;
     double header_timeout = 10;
@@ -217,6 +221,9 @@ int main(int argc, char **argv)
             break;
         case O_PREVIEW_SECONDS:
             if (parse_seconds("--preview-seconds", optarg, 0.01, 3600, &preview_seconds)) return 2;
+            break;
+        case O_IMPORT_SECONDS:
+            if (parse_seconds("--import-seconds", optarg, 0.01, 86400, &import_seconds)) return 2;
             break;
         case O_STOP_GRACE:
             if (parse_seconds("--stop-grace", optarg, 0, 60, &stop_grace)) return 2;
@@ -290,7 +297,8 @@ int main(int argc, char **argv)
                                       .max_nodes = (size_t)max_nodes,
                                       .op_seconds = op_seconds,
                                       .job_seconds = job_seconds,
-                                      .preview_seconds = preview_seconds}};
+                                      .preview_seconds = preview_seconds,
+                                      .import_seconds = import_seconds}};
     if (ag_app_create(&aopt, &app, &err) != AG_OK) {
         fprintf(stderr, "archgramd: %s\n", err.text);
         free(web_dir);
@@ -325,7 +333,8 @@ int main(int argc, char **argv)
 
     int sig = 0;
     sigwait(&sigs, &sig);
-    fprintf(stderr, "archgramd: %s received, shutting down\n", sig == SIGINT ? "SIGINT" : "SIGTERM");
+    fprintf(stderr, "archgramd: %s received, shutting down\n",
+            sig == SIGINT ? "SIGINT" : "SIGTERM");
     /* Order: stop taking connections, then stop the work (jobs recorded as cancelled, which
      * the live layer may still announce; requests and ops waiting on the task lanes answered
      * 503), then the REST and live layers, then the store. Work inside a stage that cannot be

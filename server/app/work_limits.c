@@ -13,5 +13,7 @@ ag_work_limits ag_work_limits_resolved(const ag_work_limits *l)
         r.job_seconds = AG_WORK_LIMITS_JOB_SECONDS;
     if (!(r.preview_seconds > 0))
         r.preview_seconds = AG_WORK_LIMITS_PREVIEW_SECONDS;
+    if (!(r.import_seconds > 0))
+        r.import_seconds = AG_WORK_LIMITS_IMPORT_SECONDS;
     return r;
 }
