@@ -25,6 +25,8 @@ static const struct {
     {"part", ag_cli_part, "part save|compose|info ...          the parts library (archgram part --help)"},
     {"fmt", ag_cli_fmt, "fmt GRAMMAR                     print a grammar in canonical form"},
     {"extrude", ag_cli_extrude, "extrude --plan PLAN.json | FOOTPRINTS.geojson --style S --out OUT  roofs and shells"},
+    {"segment", ag_cli_segment, "segment CLOUD --out SEG.ply [--roi BOX] [--threshold F]  planes and clusters of a point cloud"},
+    {"cut", ag_cli_cut, "cut TILE --footprints F.geojson --out DIR   one point cloud per building footprint"},
 };
 
 #define NCOMMANDS (sizeof commands / sizeof commands[0])

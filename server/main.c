@@ -13,9 +13,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "app/accounts.h"
 #include "app/app.h"
 #include "net/http.h"
 #include "net/live.h"
+#include "store/db.h"
 
 static void usage(FILE *to)
 {
@@ -66,6 +68,22 @@ static void usage(FILE *to)
             "  --header-timeout S  seconds a client has to send a request's headers\n"
             "                      (default 10)\n"
             "  --idle-timeout S    seconds a connection may stay silent (default 60)\n"
+            "accounts (every request but the health check needs an account's API token):\n"
+            "  --cors ORIGIN    let web pages of ORIGIN (e.g. https://app.example.org; \"*\" for\n"
+            "                   any) call the API and open websockets; repeatable; off by default\n"
+            "  --admin-token-file PATH\n"
+            "                   the account \"admin\" signs in with the token in PATH (a docker\n"
+            "                   secret: 32..256 characters of A-Z a-z 0-9 . _ ~ + -)\n"
+            "  --no-auth        no accounts: everyone is a local admin; only with a loopback\n"
+            "                   --bind (a change still needs an Authorization header)\n"
+            "  --create-user NAME [--role admin|editor|viewer]\n"
+            "                   make an account (role editor by default) in --db, print its\n"
+            "                   first token, and exit (the service may be running)\n"
+            "  --create-token NAME\n"
+            "                   print a new token of the account NAME and exit\n"
+            "On a first start with no account, archgramd makes the admin account \"admin\" and\n"
+            "prints a sign-in link with its token, once.\n"
+            "\n"
             "  --help           this text\n"
             "  --version        print the version\n");
 }
@@ -120,6 +138,86 @@ static int parse_int(const char *flag, const char *text, long long lo, long long
     return 0;
 }
 
+#define MAX_CORS 16
+
+/* --admin-token-file: the token, without the line end; NULL with a message when unreadable. */
+static char *read_token_file(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "archgramd: cannot read --admin-token-file %s: %s\n", path,
+                strerror(errno));
+        return NULL;
+    }
+    char buf[1024];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    int more = fgetc(f) != EOF;
+    fclose(f);
+    buf[n] = '\0';
+    while (n && (buf[n - 1] == '\n' || buf[n - 1] == '\r' || buf[n - 1] == ' '))
+        buf[--n] = '\0';
+    if (more || n == 0 || ag_tokens_check_text(buf, NULL) != AG_OK) {
+        fprintf(stderr, "archgramd: --admin-token-file %s must hold one token: 32 to 256 "
+                        "characters of A-Z a-z 0-9 . _ ~ + -\n",
+                path);
+        return NULL;
+    }
+    return strdup(buf);
+}
+
+/* An allowed origin: "*" or scheme://host[:port], nothing after. */
+static int check_origin(const char *o)
+{
+    if (strcmp(o, "*") == 0)
+        return 0;
+    const char *rest = strncmp(o, "http://", 7) == 0    ? o + 7
+                       : strncmp(o, "https://", 8) == 0 ? o + 8
+                                                        : NULL;
+    if (!rest || !*rest || strpbrk(rest, "/?#@ ")) {
+        fprintf(stderr, "archgramd: --cors takes an origin such as https://app.example.org or "
+                        "http://localhost:5173 (no path), or *, not \"%s\"\n",
+                o);
+        return -1;
+    }
+    return 0;
+}
+
+/* --create-user and --create-token: on the database alone (a running service keeps serving
+ * it), the token on stdout, what it is on stderr. */
+static int account_command(const char *db_path, const char *create_user, const char *role_name,
+                           const char *create_token)
+{
+    ag_error err;
+    ag_error_clear(&err);
+    ag_account_role role = AG_ACCOUNT_EDITOR;
+    if (role_name && ag_users_role_parse(role_name, &role, &err) != AG_OK) {
+        fprintf(stderr, "archgramd: --role: %s\n", err.text);
+        return 2;
+    }
+    ag_db *db = NULL;
+    if (ag_db_open(db_path, NULL, &db, &err) != AG_OK) {
+        fprintf(stderr, "archgramd: %s\n", err.text);
+        return 1;
+    }
+    json_t *view = NULL;
+    ag_status s = create_user ? ag_accounts_create_in(db, create_user, role, "command line", &view,
+                                                      &err)
+                              : ag_accounts_new_token_in(db, create_token, "command line", &view,
+                                                         &err);
+    ag_db_close(db);
+    if (s != AG_OK) {
+        fprintf(stderr, "archgramd: %s\n", err.text);
+        return 1;
+    }
+    json_t *user = json_object_get(view, "user");
+    fprintf(stderr, "archgramd: %s token of %s (%s); it is shown only now:\n",
+            create_user ? "the first" : "a new", json_string_value(json_object_get(user, "name")),
+            json_string_value(json_object_get(user, "role")));
+    printf("%s\n", json_string_value(json_object_get(view, "token")));
+    json_decref(view);
+    return 0;
+}
+
 /* The built client lives in build/web next to build/archgramd. */
 static char *default_web_dir(const char *argv0)
 {
@@ -150,7 +248,8 @@ static char *default_web_dir(const char *argv0)
 int main(int argc, char **argv)
 {
     enum { O_PORT = 1, O_WS_PORT, O_BIND, O_DB, O_WORKERS, O_WEB, O_NO_WEB, O_MAX_BODY, O_DEMO,
-           O_HELP, O_VERSION, O_MAX_TRIANGLES, O_MAX_NODES, O_OP_SECONDS, O_JOB_SECONDS,
+           O_HELP, O_VERSION, O_CORS, O_ADMIN_TOKEN_FILE, O_NO_AUTH, O_CREATE_USER, O_ROLE,
+           O_CREATE_TOKEN, O_MAX_TRIANGLES, O_MAX_NODES, O_OP_SECONDS, O_JOB_SECONDS,
            O_PREVIEW_SECONDS, O_IMPORT_SECONDS, O_TASK_WORKERS, O_DB_MAX_BYTES, O_STOP_GRACE,
            O_RATE_REST, O_RATE_JOBS, O_RATE_WS, O_MAX_CONNECTIONS, O_MAX_PER_ADDRESS,
            O_HEADER_TIMEOUT, O_IDLE_TIMEOUT };
@@ -164,6 +263,12 @@ int main(int argc, char **argv)
         {"no-web", no_argument, NULL, O_NO_WEB},
         {"max-body", required_argument, NULL, O_MAX_BODY},
         {"demo", no_argument, NULL, O_DEMO},
+        {"cors", required_argument, NULL, O_CORS},
+        {"admin-token-file", required_argument, NULL, O_ADMIN_TOKEN_FILE},
+        {"no-auth", no_argument, NULL, O_NO_AUTH},
+        {"create-user", required_argument, NULL, O_CREATE_USER},
+        {"role", required_argument, NULL, O_ROLE},
+        {"create-token", required_argument, NULL, O_CREATE_TOKEN},
         {"help", no_argument, NULL, O_HELP},
         {"version", no_argument, NULL, O_VERSION},
         {"max-triangles", required_argument, NULL, O_MAX_TRIANGLES},
@@ -192,7 +297,9 @@ int main(int argc, char **argv)
     long long max_connections = 4096, max_per_address = 64, idle_timeout = 60;
     double header_timeout = 10;
     const char *bind = "127.0.0.1", *db = "var/archgram.db", *web = NULL;
-    int no_web = 0, demo = 0, opt;
+    int no_web = 0, demo = 0, no_auth = 0, ncors = 0, opt;
+    const char *cors[MAX_CORS];
+    const char *token_file = NULL, *create_user = NULL, *create_token = NULL, *role = NULL;
     while ((opt = getopt_long(argc, argv, "", options, NULL)) != -1) {
         switch (opt) {
         case O_PORT: if (parse_int("--port", optarg, 1, 65535, &port)) return 2; break;
@@ -255,6 +362,19 @@ int main(int argc, char **argv)
         case O_WEB: web = optarg; break;
         case O_NO_WEB: no_web = 1; break;
         case O_DEMO: demo = 1; break;
+        case O_CORS:
+            if (check_origin(optarg)) return 2;
+            if (ncors == MAX_CORS) {
+                fprintf(stderr, "archgramd: at most %d --cors origins\n", MAX_CORS);
+                return 2;
+            }
+            cors[ncors++] = optarg;
+            break;
+        case O_ADMIN_TOKEN_FILE: token_file = optarg; break;
+        case O_NO_AUTH: no_auth = 1; break;
+        case O_CREATE_USER: create_user = optarg; break;
+        case O_ROLE: role = optarg; break;
+        case O_CREATE_TOKEN: create_token = optarg; break;
         case O_HELP: usage(stdout); return 0;
         case O_VERSION: printf("archgramd %s\n", AG_VERSION); return 0;
         default: usage(stderr); return 2;
@@ -265,6 +385,29 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
+    if (create_user && create_token) {
+        fprintf(stderr, "archgramd: --create-user and --create-token go one at a time\n");
+        return 2;
+    }
+    if (role && !create_user) {
+        fprintf(stderr, "archgramd: --role goes with --create-user\n");
+        return 2;
+    }
+    if (create_user || create_token)
+        return account_command(db, create_user, role, create_token);
+    if (no_auth && !ag_http_is_loopback(bind)) {
+        fprintf(stderr, "archgramd: --no-auth serves only a loopback address (127.x.x.x): "
+                        "--bind %s would let anyone on the network in without an account\n",
+                bind);
+        return 2;
+    }
+    if (no_auth && token_file) {
+        fprintf(stderr, "archgramd: --admin-token-file and --no-auth contradict each other\n");
+        return 2;
+    }
+    char *admin_token = token_file ? read_token_file(token_file) : NULL;
+    if (token_file && !admin_token)
+        return 2;
     if (!ws_port)
         ws_port = port < 65535 ? port + 1 : port - 1;
     if (ws_port == port) {
@@ -302,7 +445,28 @@ int main(int argc, char **argv)
     if (ag_app_create(&aopt, &app, &err) != AG_OK) {
         fprintf(stderr, "archgramd: %s\n", err.text);
         free(web_dir);
+        free(admin_token);
         return 1;
+    }
+    /* the first start makes the admin account; its token is shown once, below */
+    char first_token[AG_TOKEN_TEXT_MAX + 1] = "";
+    int made = 0;
+    if (!no_auth) {
+        ag_db *adb = ag_app_db(app, &err);
+        ag_status s = adb ? ag_accounts_bootstrap(adb, admin_token, first_token, &made, &err)
+                          : err.code;
+        if (admin_token) {
+            memset(admin_token, 0, strlen(admin_token));
+            free(admin_token);
+            admin_token = NULL;
+        }
+        if (s != AG_OK) {
+            fprintf(stderr, "archgramd: %s\n", err.text);
+            ag_app_shutdown(app, -1);
+            ag_app_free(app);
+            free(web_dir);
+            return 1;
+        }
     }
     ag_http *http = NULL;
     ag_http_options hopt = {.bind = bind,
@@ -315,9 +479,18 @@ int main(int argc, char **argv)
                             .max_connections = (unsigned)max_connections,
                             .max_per_address = (unsigned)max_per_address,
                             .header_timeout = header_timeout,
-                            .idle_timeout = (unsigned)idle_timeout};
+                            .idle_timeout = (unsigned)idle_timeout,
+                            .no_auth = no_auth,
+                            .cors = cors,
+                            .ncors = ncors};
     ag_live *live = NULL;
-    ag_live_options lopt = {.bind = bind, .port = (int)ws_port, .message_rate = rate_ws};
+    ag_live_options lopt = {.bind = bind,
+                            .port = (int)ws_port,
+                            .http_port = (int)port,
+                            .no_auth = no_auth,
+                            .origins = cors,
+                            .norigins = ncors,
+                            .message_rate = rate_ws};
     if (ag_http_start(app, &hopt, &http, &err) != AG_OK ||
         ag_live_start(app, &lopt, &live, &err) != AG_OK) {
         fprintf(stderr, "archgramd: %s\n", err.text);
@@ -329,6 +502,20 @@ int main(int argc, char **argv)
     }
     printf("archgramd: listening on http://%s:%lld/ (websocket ws://%s:%lld/)\n", bind, port, bind,
            ws_port);
+    const char *host = strcmp(bind, "0.0.0.0") == 0 ? "localhost" : bind;
+    if (no_auth) {
+        printf("archgramd: no accounts (--no-auth): everyone on this machine is an admin\n");
+    } else if (made) {
+        printf("archgramd: first start: made the admin account \"%s\". Sign in with this link; "
+               "it is shown only now (archgramd keeps a hash of the token):\n"
+               "archgramd:   http://%s:%lld/#token=%s\n",
+               AG_ACCOUNTS_ADMIN, host, port, first_token);
+        memset(first_token, 0, sizeof first_token);
+    } else {
+        printf("archgramd: sign in with an API token (a new one: archgramd --db %s "
+               "--create-token NAME)\n",
+               db);
+    }
     fflush(stdout);
 
     int sig = 0;

@@ -28,11 +28,11 @@ LAYERS = {
     "core": {"uses": [], "headers": [], "libs": SUITESPARSE},
     "io": {"uses": ["core"], "headers": [], "libs": SUITESPARSE + ["jansson", "assimp", "crypto"]},
     "store": {"uses": ["core", "io"], "headers": [],
-              "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "sqlite3"]},
+              "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "sqlite3", "sodium"]},
     "app": {"uses": ["core", "io", "store"], "headers": [],
-            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "sqlite3", "pthread"]},
+            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "sqlite3", "sodium", "pthread"]},
     "net": {"uses": ["app"], "headers": ["core/status.h"],
-            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "sqlite3", "pthread", "microhttpd",
+            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "sqlite3", "sodium", "pthread", "microhttpd",
                                    "websockets"]},
 }
 ORDER = ["core", "io", "store", "app", "net"]
@@ -47,6 +47,7 @@ SYSTEM_HEADERS = [
     (re.compile(r"^jansson\.h$"), "jansson"),
     (re.compile(r"^assimp/"), "assimp"),
     (re.compile(r"^openssl/"), "crypto"),
+    (re.compile(r"^sodium\.h$|^sodium/"), "sodium"),
     (re.compile(r"^sqlite3\.h$"), "sqlite3"),
     (re.compile(r"^pthread\.h$"), "pthread"),
     (re.compile(r"^microhttpd\.h$"), "microhttpd"),

@@ -11,6 +11,7 @@
 #include "../core/utf8.h"
 #include "../store/jobs.h"
 #include "../store/models.h"
+#include "auth.h"
 #include "demo.h"
 #include "extrude_job.h"
 #include "import_job.h"
@@ -25,6 +26,7 @@ struct ag_app {
     ag_events *events;
     ag_store_services services; /* the pool, the sequencer, the kept edit models */
     ag_jobqueue *jobs;
+    ag_auth_cache *auth; /* tokens found lately (app/auth.h) */
 };
 
 ag_status ag__app_env(ag_app *app, ag_store_env *env, ag_error *err)
@@ -37,6 +39,7 @@ ag_events *ag_app_events(ag_app *app) { return app->events; }
 const char *ag_app_upload_dir(const ag_app *app) { return app->upload_dir; }
 int ag_app_workers(const ag_app *app) { return app->workers; }
 struct ag_jobqueue *ag__app_jobqueue(ag_app *app) { return app->jobs; }
+struct ag_auth_cache *ag__app_auth_cache(ag_app *app) { return app->auth; }
 
 ag_status ag_app_check_name(const char *name, ag_error *err)
 {
@@ -110,7 +113,8 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
     app->events = ag_events_create();
     app->services.seq = app->events ? ag_sequencer_create(app->events) : NULL;
     app->services.sessions = ag_edit_sessions_create();
-    if (!app->upload_dir || !app->services.seq || !app->services.sessions) {
+    app->auth = ag_auth_cache_create();
+    if (!app->upload_dir || !app->services.seq || !app->services.sessions || !app->auth) {
         ag_app_free(app);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
@@ -191,6 +195,7 @@ void ag_app_free(ag_app *app)
     ag_dbpool_free(app->services.pool);
     ag_sequencer_free(app->services.seq);
     ag_events_free(app->events);
+    ag_auth_cache_free(app->auth);
     free(app->upload_dir);
     free(app);
 }

@@ -77,5 +77,7 @@ struct ag_jobqueue;
 ag_status ag__app_env(ag_app *app, struct ag_store_env *env, ag_error *err);
 struct ag_db *ag_app_db(ag_app *app, ag_error *err);
 struct ag_jobqueue *ag__app_jobqueue(ag_app *app);
+/* The tokens app/auth.c remembers (NULL when it could not be made: nothing is remembered). */
+struct ag_auth_cache *ag__app_auth_cache(ag_app *app);
 
 #endif

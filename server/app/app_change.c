@@ -1,5 +1,6 @@
 #include "app_change.h"
 
+#include "auth.h"
 #include "edit_ops.h"
 #include "grammar_edit.h"
 #include "modelops.h"
@@ -19,7 +20,9 @@ ag_status ag_app_change_delete(ag_app *app, int64_t model, int64_t version, ag_e
 {
     ag_store_env env;
     ag_status s = ag__app_env(app, &env, err);
-    return s != AG_OK ? s : ag_sequencer_delete(env.seq, env.db, model, version, err);
+    if (s == AG_OK && (s = ag_sequencer_delete(env.seq, env.db, model, version, err)) == AG_OK)
+        ag_auth_forget(app); /* its id may come back for another model */
+    return s;
 }
 
 ag_status ag_app_change_grammar(ag_app *app, int64_t model, int64_t base, const char *author,

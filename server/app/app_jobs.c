@@ -31,7 +31,8 @@ ag_status ag_app_jobs_check_import(const ag_import_job *p, ag_error *err)
     return s;
 }
 
-ag_status ag_app_jobs_import(ag_app *app, const ag_import_job *p, int64_t *job, ag_error *err)
+ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_import_job *p,
+                             int64_t *job, ag_error *err)
 {
     ag_status s = ag_app_jobs_check_import(p, err);
     if (s != AG_OK) {
@@ -39,12 +40,12 @@ ag_status ag_app_jobs_import(ag_app *app, const ag_import_job *p, int64_t *job, 
             unlink(p->upload);
         return s;
     }
-    ag_job_params jp = {.type = AG_JOB_IMPORT, .u.import = *p};
+    ag_job_params jp = {.type = AG_JOB_IMPORT, .user = who->user, .u.import = *p};
     return submit(app, &jp, p->upload, job, err);
 }
 
-ag_status ag_app_jobs_proceduralize(ag_app *app, int64_t model, const int64_t *if_match,
-                                    const char *author, int64_t *job, ag_error *err)
+ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
+                                    const int64_t *if_match, int64_t *job, ag_error *err)
 {
     int64_t current;
     ag_status s = ag_app_query_version(app, model, &current, err);
@@ -55,8 +56,9 @@ ag_status ag_app_jobs_proceduralize(ag_app *app, int64_t model, const int64_t *i
                             "model %lld is at version %lld, not %lld", (long long)model,
                             (long long)current, (long long)*if_match);
     ag_job_params jp = {.type = AG_JOB_PROCEDURALIZE,
+                        .user = who->user,
                         .u.proceduralize = {.model = model, .base = current,
-                                            .author = (char *)author}};
+                                            .author = (char *)who->name}};
     return submit(app, &jp, NULL, job, err);
 }
 
@@ -77,7 +79,8 @@ ag_status ag_app_jobs_check_extrude(const ag_extrude_job *p, ag_error *err)
     return s;
 }
 
-ag_status ag_app_jobs_extrude(ag_app *app, const ag_extrude_job *p, int64_t *job, ag_error *err)
+ag_status ag_app_jobs_extrude(ag_app *app, const ag_identity *who, const ag_extrude_job *p,
+                              int64_t *job, ag_error *err)
 {
     ag_status s = ag_app_jobs_check_extrude(p, err);
     if (s != AG_OK) {
@@ -85,7 +88,7 @@ ag_status ag_app_jobs_extrude(ag_app *app, const ag_extrude_job *p, int64_t *job
             unlink(p->upload);
         return s;
     }
-    ag_job_params jp = {.type = AG_JOB_EXTRUDE, .u.extrude = *p};
+    ag_job_params jp = {.type = AG_JOB_EXTRUDE, .user = who->user, .u.extrude = *p};
     if (!jp.u.extrude.style)
         jp.u.extrude.style = "hip";
     return submit(app, &jp, p->upload, job, err);

@@ -6,6 +6,7 @@
 #include <stdint.h>
 
 #include "app.h"
+#include "auth.h"
 #include "job_params.h"
 
 /* An import of an uploaded file: the name, format ("obj", …, or NULL) and up axis ("y", "z"
@@ -15,15 +16,17 @@
 ag_status ag_app_jobs_check_import(const ag_import_job *p, ag_error *err);
 ag_status ag_app_jobs_check_extrude(const ag_extrude_job *p, ag_error *err);
 
-ag_status ag_app_jobs_import(ag_app *app, const ag_import_job *p, int64_t *job, ag_error *err);
-/* Proceduralizing a model at its current version; if_match (NULL: none; -1: any) must be the
- * current version (AG_ERR_STALE otherwise). */
-ag_status ag_app_jobs_proceduralize(ag_app *app, int64_t model, const int64_t *if_match,
-                                    const char *author, int64_t *job, ag_error *err);
+/* who asks for the job: it may read and cancel it and owns the model it makes. */
+ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_import_job *p,
+                             int64_t *job, ag_error *err);
+/* Proceduralizing a model at its current version, the op authored by who; if_match (NULL:
+ * none; -1: any) must be the current version (AG_ERR_STALE otherwise). */
+ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
+                                    const int64_t *if_match, int64_t *job, ag_error *err);
 /* An extrusion of an uploaded description or GeoJSON: the name, format and style are checked.
  * The upload is removed when the job cannot be queued. */
-ag_status ag_app_jobs_extrude(ag_app *app, const ag_extrude_job *p, int64_t *job,
-                              ag_error *err);
+ag_status ag_app_jobs_extrude(ag_app *app, const ag_identity *who, const ag_extrude_job *p,
+                              int64_t *job, ag_error *err);
 ag_status ag_app_jobs_cancel(ag_app *app, int64_t job, ag_error *err);
 
 #endif

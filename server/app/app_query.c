@@ -37,16 +37,17 @@ static void decorate(ag_db *db, json_t *model, const ag_model_row *row)
         json_object_set_new(model, "proceduralized", json_boolean(yes));
 }
 
-ag_status ag_app_query_models(ag_app *app, int64_t after, size_t limit, json_t **items,
-                              int *more, ag_error *err)
+ag_status ag_app_query_models(ag_app *app, const ag_identity *who, int64_t after, size_t limit,
+                              json_t **items, int *more, ag_error *err)
 {
     *items = NULL;
     *more = 0;
     DB_OR_RETURN(db, app, err);
     ag_model_row *rows;
     size_t n;
-    /* One extra row tells whether another page follows. */
-    ag_status s = ag_models_list(db, after, limit + 1, &rows, &n, err);
+    /* One extra row tells whether another page follows; admins see every model. */
+    int64_t visible_to = who->role == AG_ACCOUNT_ADMIN ? 0 : who->user;
+    ag_status s = ag_models_list(db, visible_to, after, limit + 1, &rows, &n, err);
     if (s != AG_OK)
         return s;
     json_t *list = json_array();
@@ -54,6 +55,13 @@ ag_status ag_app_query_models(ag_app *app, int64_t after, size_t limit, json_t *
     for (size_t i = 0; i < shown; i++) {
         json_t *m = ag_view_model(&rows[i]);
         decorate(db, m, &rows[i]);
+        ag_model_role member = AG_ROLE_NONE;
+        if (rows[i].member_role[0] &&
+            ag_members_role_parse(rows[i].member_role, &member, NULL) != AG_OK)
+            member = AG_ROLE_NONE;
+        json_object_set_new(
+            m, "role", json_string(ag_members_role_name(ag_auth_role(who, member,
+                                                                     rows[i].public_read))));
         json_array_append_new(list, m);
     }
     *more = n > limit;

@@ -8,11 +8,13 @@
 #include <stdint.h>
 
 #include "app.h"
+#include "auth.h"
 
-/* Models with id > after, ascending, at most limit, each with "proceduralized"; *more says
- * whether another page follows (its token is the last item's id). */
-ag_status ag_app_query_models(ag_app *app, int64_t after, size_t limit, json_t **items,
-                              int *more, ag_error *err);
+/* The models who may see with id > after, ascending, at most limit, each with
+ * "proceduralized" and who's "role" on it (app/auth.h); *more says whether another page
+ * follows (its token is the last item's id). */
+ag_status ag_app_query_models(ag_app *app, const ag_identity *who, int64_t after, size_t limit,
+                              json_t **items, int *more, ag_error *err);
 /* One model's view (with "proceduralized") and its version. */
 ag_status ag_app_query_model(ag_app *app, int64_t id, json_t **view, int64_t *version,
                              ag_error *err);

@@ -87,7 +87,11 @@ ag_status ag_demo_load_if_empty(ag_db *db, ag_jobqueue *jobs, ag_error *err)
             if (!m)
                 break;
             s = ag_store_ws_insert_model(db, ag_demo_building_name(i), m, NULL, 0, NULL,
-                                         &ids[n++], err);
+                                         &ids[n], err);
+            /* the server's own content: every account may look at it */
+            if (s == AG_OK)
+                s = ag_models_set_public_read(db, ids[n], 1, err);
+            n++;
             ag_mesh_free(m);
         }
     }

@@ -10,6 +10,7 @@ typedef enum {
     AG_EVENT_OP,          /* model, version, author, cid, json = the op */
     AG_EVENT_JOB,         /* job, json = the job resource (any status) */
     AG_EVENT_MODEL_GONE,  /* model */
+    AG_EVENT_ACCESS,      /* model: who may use it changed (members, public-read) */
 } ag_event_kind;
 
 typedef struct {

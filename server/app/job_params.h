@@ -45,6 +45,9 @@ typedef struct {
 
 typedef struct {
     ag_job_type type;
+    /* the account that asks for the job (0: the server itself); kept in the job's row, not
+     * in its params: it may read and cancel the job and owns the model the job makes */
+    int64_t user;
     union {
         ag_import_job import;
         ag_proceduralize_job proceduralize;

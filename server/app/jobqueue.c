@@ -478,7 +478,7 @@ ag_status ag_jobqueue_submit(ag_jobqueue *q, const char *kind, const ag_job_para
         if (!db)
             s = err ? err->code : AG_ERR_DB;
         else if ((s = ag_db_begin(db, err)) == AG_OK) {
-            s = ag_jobs_insert(db, kind, text, &item->job, err);
+            s = ag_jobs_insert(db, kind, text, item->params.user, &item->job, err);
             s = s == AG_OK ? ag_db_commit(db, err) : (ag_db_rollback(db), s);
         }
     }

@@ -10,6 +10,7 @@
 #include "../store/extrusions.h"
 #include "../store/grammars.h"
 #include "../store/jobs.h"
+#include "../store/members.h"
 #include "../store/models.h"
 #include "../store/states.h"
 #include "extrusion.h"
@@ -383,6 +384,8 @@ static ag_status add_model(ag_workspace *ws, const char *name, const ag_mesh *me
     if (s != AG_OK)
         return s;
     s = ag_store_ws_insert_model(db, name, mesh, source, source_len, source_format, model, err);
+    if (s == AG_OK && w->o.job_id)
+        s = ag_members_own_from_job(db, *model, w->o.job_id, err);
     if (s == AG_OK && w->o.job && ag_jobctx_cancelled(w->o.job))
         s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
     if (s == AG_OK && w->o.job_id) {
@@ -426,6 +429,8 @@ static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extr
     int64_t model = 0;
     s = ag_models_insert(db, &m, &model, err);
     *model_out = model;
+    if (s == AG_OK && w->o.job_id)
+        s = ag_members_own_from_job(db, model, w->o.job_id, err);
     if (s == AG_OK)
         s = ag_extrusions_put(db, model, strcmp(b->format, "plan") != 0, meta, err);
     for (size_t i = 0; s == AG_OK && i < b->n; i++) {

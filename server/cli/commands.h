@@ -12,6 +12,8 @@ int ag_cli_fmt(int argc, char **argv);
 int ag_cli_extrude(int argc, char **argv);
 int ag_cli_edit(int argc, char **argv);
 int ag_cli_part(int argc, char **argv);
+int ag_cli_segment(int argc, char **argv);
+int ag_cli_cut(int argc, char **argv);
 
 /* Shared by the subcommands (defined in server/cli.c). */
 #include "../core/mesh.h"
@@ -27,5 +29,19 @@ double ag_cli_seconds(void);
 /* Reads a mesh file of any importable format; on failure reports it and returns 1.
  * *bytes receives the file size. */
 int ag_cli_load_mesh(const char *path, ag_up_axis up, ag_mesh **out, size_t *bytes);
+
+/* Point clouds (server/cli/cloud.c). */
+#include "../core/points/cloud.h"
+/* Whether a file is a point cloud (LAS, LAZ, XYZ, or a PLY without faces). */
+int ag_cli_is_cloud_file(const char *path);
+/* Whether an output name is a cloud format (.ply, .las, .laz, .xyz, .txt). */
+int ag_cli_is_cloud_output(const char *path);
+/* Reads a cloud of any format; on failure reports it and returns 1. */
+int ag_cli_load_cloud(const char *path, ag_cloud **out);
+/* Writes by extension (.ply binary, .las, .xyz); reports and returns 1 (2: bad name). */
+int ag_cli_write_cloud(const ag_cloud *c, const char *path, int double_xyz);
+/* The cloud branches of `info` and `convert`. */
+int ag_cli_cloud_info(const char *file, int as_json);
+int ag_cli_cloud_convert(const char *in, const char *out, int double_xyz);
 
 #endif

@@ -46,6 +46,8 @@ int ag_cli_convert(int argc, char **argv)
     }
     if (!in || !out)
         return usage();
+    if (ag_cli_is_cloud_file(in)) /* point clouds: PLY, LAS, XYZ out */
+        return ag_cli_cloud_convert(in, out, 0);
     int glb = ends_with(out, ".glb");
     if (!glb && !ends_with(out, ".obj")) {
         fprintf(stderr, "archgram: %s: cannot tell the output format (use .obj or .glb)\n",

@@ -40,6 +40,8 @@ int ag_cli_info(int argc, char **argv)
     }
     if (!file)
         return usage();
+    if (ag_cli_is_cloud_file(file)) /* point clouds have their own summary */
+        return ag_cli_cloud_info(file, as_json);
     ag_mesh *m;
     size_t bytes;
     if (ag_cli_load_mesh(file, up, &m, &bytes))

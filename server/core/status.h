@@ -38,7 +38,9 @@
     X(AG_ERR_STORAGE_FULL,           -24, 507, "storage-full",          "the database is full")      \
     X(AG_ERR_STORE_UNAVAILABLE,      -25, 503, "store-unavailable",     "the database cannot be read or written") \
     X(AG_ERR_URI_TOO_LONG,           -26, 414, "uri-too-long",          "the URL is too long")       \
-    X(AG_ERR_HEADERS_TOO_LARGE,      -27, 431, "headers-too-large",     "the request headers are too large")
+    X(AG_ERR_HEADERS_TOO_LARGE,      -27, 431, "headers-too-large",     "the request headers are too large") \
+    X(AG_ERR_UNAUTHORIZED,           -40, 401, "unauthorized",          "sign in first")             \
+    X(AG_ERR_FORBIDDEN,              -41, 403, "forbidden",             "not allowed for this account")
 
 typedef enum {
 #define AG__STATUS_ENUM(name, value, http, slug, msg) name = value,

@@ -63,7 +63,7 @@ enum MHD_Result ag_api_extrusions_create(ag_request *r)
         return ag_reply_problem(r, s, &err);
     p.upload = (char *)ag_upload_take_path(r->upload);
     int64_t job = 0;
-    s = ag_app_jobs_extrude(r->cfg->app, &p, &job, &err);
+    s = ag_app_jobs_extrude(r->cfg->app, &r->who, &p, &job, &err);
     return ag_reply_new_job(r, s, job, &err);
 }
 

@@ -55,8 +55,7 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
     int64_t job = 0;
-    s = ag_app_jobs_proceduralize(r->cfg->app, r->ids[0], &current, ag_request_author(r), &job,
-                                  &err);
+    s = ag_app_jobs_proceduralize(r->cfg->app, &r->who, r->ids[0], &current, &job, &err);
     return ag_reply_new_job(r, s, job, &err);
 }
 

@@ -58,7 +58,8 @@ enum MHD_Result ag_api_models_list(ag_request *r)
     }
     json_t *items;
     int more;
-    if ((s = ag_app_query_models(r->cfg->app, after, (size_t)size, &items, &more, &err)) != AG_OK)
+    if ((s = ag_app_query_models(r->cfg->app, &r->who, after, (size_t)size, &items, &more,
+                                   &err)) != AG_OK)
         return ag_reply_problem(r, s, &err);
     json_t *next = json_null();
     size_t n = json_array_size(items);
@@ -92,7 +93,7 @@ enum MHD_Result ag_api_models_create(ag_request *r)
     }
     p.upload = (char *)ag_upload_take_path(r->upload);
     int64_t job = 0;
-    s = ag_app_jobs_import(r->cfg->app, &p, &job, &err);
+    s = ag_app_jobs_import(r->cfg->app, &r->who, &p, &job, &err);
     return ag_reply_new_job(r, s, job, &err);
 }
 
@@ -104,6 +105,8 @@ enum MHD_Result ag_api_reply_model(ag_request *r, int64_t id, unsigned status)
     ag_status s = ag_app_query_model(r->cfg->app, id, &body, &version, &err);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
+    /* the caller's role, found by the route's access check */
+    json_object_set_new(body, "role", json_string(ag_auth_model_role_name(r->model_role)));
     char etag[32];
     version_etag(etag, sizeof etag, version);
     return ag_reply_json(r, status, body, etag);

@@ -19,6 +19,8 @@ enum MHD_Result ag_api_health(ag_request *r)
                                   (json_int_t)ag_connguard_open(r->cfg->guard), "slow_cut",
                                   (json_int_t)ag_connguard_cut(r->cfg->guard), "abandoned",
                                   (json_int_t)atomic_load(r->cfg->abandoned)));
+    /* the web client asks for a token only when there are accounts */
+    json_object_set_new(body, "auth", json_boolean(!r->cfg->no_auth));
     return ag_reply_json(r, 200, body, NULL);
 }
 

@@ -36,6 +36,7 @@ struct ag_http {
     int listen_fd; /* after ag_http_quiesce: the listening socket, closed at the stop */
     ag_ratelimit *rest_limit, *job_limit;
     atomic_size_t abandoned;
+    char **cors; /* owned copies of the allowed origins */
 };
 
 static void http_free(ag_http *http)
@@ -43,8 +44,99 @@ static void http_free(ag_http *http)
     ag_connguard_stop(http->cfg.guard);
     ag_ratelimit_free(http->rest_limit);
     ag_ratelimit_free(http->job_limit);
+    for (int i = 0; i < http->cfg.ncors; i++)
+        free(http->cors[i]);
+    free(http->cors);
     free(http->web_dir);
     free(http);
+}
+
+int ag_http_is_loopback(const char *addr)
+{
+    struct in_addr a;
+    if (inet_pton(AF_INET, addr ? addr : "127.0.0.1", &a) != 1)
+        return 0;
+    return (ntohl(a.s_addr) >> 24) == 127;
+}
+
+static int is_read(const char *method)
+{
+    return strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
+}
+
+/* Sets r->origin when the request's Origin is allowed to read the answer. */
+static void cors_origin(const ag_http *http, ag_request *r)
+{
+    const char *origin = ag_request_header(r, "Origin");
+    if (!origin || strlen(origin) >= sizeof r->origin)
+        return;
+    for (int i = 0; i < http->cfg.ncors; i++)
+        if (strcmp(http->cfg.cors[i], "*") == 0 || strcmp(http->cfg.cors[i], origin) == 0) {
+            snprintf(r->origin, sizeof r->origin, "%s", origin);
+            return;
+        }
+}
+
+/* OPTIONS: a CORS preflight (Access-Control-Request-Method) from an allowed origin gets the
+ * methods and headers it may use; any other OPTIONS gets the path's methods in Allow. */
+static enum MHD_Result preflight(ag_request *r)
+{
+    ag_error err;
+    char allow[64], name[AG_USER_NAME_MAX + 1];
+    const ag_route *route = NULL;
+    int64_t ids[2];
+    ag_match m = ag_routes_find("OPTIONS", r->url, &route, ids, name, allow, sizeof allow);
+    if (m == AG_MATCH_NONE) {
+        ag_error_set(&err, AG_ERR_NOT_FOUND, 0, "no resource at %s", r->url);
+        return ag_reply_problem(r, AG_ERR_NOT_FOUND, &err);
+    }
+    const char *want = ag_request_header(r, MHD_HTTP_HEADER_ACCESS_CONTROL_REQUEST_METHOD);
+    if (!want) {
+        ag_reply_header(r, MHD_HTTP_HEADER_ALLOW, allow);
+        return ag_reply_empty(r, 204, NULL);
+    }
+    if (!r->origin[0]) {
+        const char *origin = ag_request_header(r, "Origin");
+        ag_error_set(&err, AG_ERR_FORBIDDEN, 0,
+                     "origin %.100s may not call this API (archgramd --cors ORIGIN allows one)",
+                     origin ? origin : "(none)");
+        return ag_reply_problem(r, AG_ERR_FORBIDDEN, &err);
+    }
+    ag_reply_header(r, MHD_HTTP_HEADER_ACCESS_CONTROL_ALLOW_METHODS, allow);
+    ag_reply_header(r, MHD_HTTP_HEADER_ACCESS_CONTROL_ALLOW_HEADERS,
+                    "Authorization, Content-Type, If-Match, If-None-Match");
+    ag_reply_header(r, MHD_HTTP_HEADER_ACCESS_CONTROL_MAX_AGE, "600");
+    return ag_reply_empty(r, 204, NULL);
+}
+
+/* Who asks, and may they: the route's need against the bearer token's account. */
+static ag_status authorize(const ag_http *http, ag_request *r, ag_error *err)
+{
+    ag_need need = r->route->need;
+    if (need == AG_NEED_NOTHING)
+        return AG_OK;
+    const char *header = ag_request_header(r, MHD_HTTP_HEADER_AUTHORIZATION);
+    if (http->cfg.no_auth) {
+        /* No accounts, yet a change still needs the header a cross-site page cannot send. */
+        if (!header && !is_read(r->method))
+            return ag_error_set(err, AG_ERR_UNAUTHORIZED, 0,
+                                "a change needs an Authorization header, even without "
+                                "accounts (any Bearer value): a cross-site form cannot send "
+                                "one");
+        ag_auth_local(&r->who);
+    } else {
+        if (!header)
+            return ag_error_set(err, AG_ERR_UNAUTHORIZED, 0,
+                                "sign in: send Authorization: Bearer <token>");
+        const char *token = ag_request_bearer(header);
+        if (!token)
+            return ag_error_set(err, AG_ERR_UNAUTHORIZED, 0,
+                                "Authorization must be \"Bearer <token>\"");
+        ag_status s = ag_auth_token(http->cfg.app, token, &r->who, err);
+        if (s != AG_OK)
+            return s;
+    }
+    return ag_auth_check(http->cfg.app, &r->who, need, r->ids[0], &r->model_role, err);
 }
 
 static ag_request *request_new(ag_http *http, struct MHD_Connection *conn, const char *url,
@@ -149,6 +241,8 @@ static enum MHD_Result begin(ag_http *http, struct MHD_Connection *conn, const c
     ag_error err;
     ag_error_clear(&err);
     enum MHD_Result rc;
+    if (strncmp(url, "/api/", 5) == 0)
+        cors_origin(http, r); /* a 429 to an allowed page is readable by it */
     if (!within_rate(r, http->cfg.rest_limit, "requests", &rc))
         return rc;
     size_t url_len = strlen(url), headers = 0;
@@ -173,8 +267,10 @@ static enum MHD_Result begin(ag_http *http, struct MHD_Connection *conn, const c
     if (strncmp(url, "/api/", 5) != 0)
         return MHD_YES; /* static files: answered once the (empty) body is in */
 
+    if (strcmp(method, "OPTIONS") == 0)
+        return preflight(r);
     char allow[64];
-    ag_match m = ag_routes_match(method, url, &r->route, r->ids, allow, sizeof allow);
+    ag_match m = ag_routes_find(method, url, &r->route, r->ids, r->name, allow, sizeof allow);
     if (m == AG_MATCH_NONE) {
         ag_error_set(&err, AG_ERR_NOT_FOUND, 0, "no resource at %s", url);
         return ag_reply_problem(r, AG_ERR_NOT_FOUND, &err);
@@ -184,6 +280,11 @@ static enum MHD_Result begin(ag_http *http, struct MHD_Connection *conn, const c
         ag_error_set(&err, AG_ERR_METHOD_NOT_ALLOWED, 0, "%s does not accept %s; it accepts %s",
                      url, method, allow);
         return ag_reply_problem(r, AG_ERR_METHOD_NOT_ALLOWED, &err);
+    }
+    ag_status checked = authorize(http, r, &err);
+    if (checked != AG_OK) {
+        r->route = NULL; /* a body that still comes is dropped */
+        return ag_reply_problem(r, checked, &err);
     }
     if ((r->route->flags & AG_ROUTE_SUBMITS_JOB) &&
         !within_rate(r, http->cfg.job_limit, "job submissions", &rc))
@@ -277,6 +378,24 @@ ag_status ag_http_start(ag_app *app, const ag_http_options *opt, ag_http **out, 
     http->cfg.max_body = opt->max_body ? opt->max_body : (size_t)512 << 20;
     http->cfg.max_json = AG_MAX_JSON_BODY;
     http->cfg.ws_port = opt->ws_port;
+    if (opt->no_auth && !ag_http_is_loopback(opt->bind)) {
+        http_free(http);
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "--no-auth only serves a loopback address; %s would let anyone on "
+                            "the network in without an account",
+                            opt->bind);
+    }
+    http->cfg.no_auth = opt->no_auth;
+    if (opt->ncors > 0 && !(http->cors = calloc((size_t)opt->ncors, sizeof *http->cors))) {
+        http_free(http);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (int i = 0; i < opt->ncors; i++, http->cfg.ncors++)
+        if (!(http->cors[i] = strdup(opt->cors[i]))) {
+            http_free(http);
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        }
+    http->cfg.cors = (const char *const *)http->cors;
     if (opt->web_dir) {
         http->web_dir = strdup(opt->web_dir);
         http->cfg.web_dir = http->web_dir;

@@ -11,9 +11,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "live_protocol.h"
 #include "live_rooms.h"
+#include "request.h"
 
 typedef enum {
     PENDING_EVENT,      /* an event of the app's bus (ev_kind) */
@@ -32,6 +34,9 @@ typedef struct pending {
 
 struct ag_live {
     ag_app *app;
+    int http_port, no_auth;
+    char **origins; /* owned copies */
+    int norigins;
     struct lws_context *context;
     pthread_t thread;
     atomic_int stop;
@@ -108,6 +113,15 @@ static void on_event(void *user, const ag_event *ev)
     post(live, p);
 }
 
+static ag_model_role role_of(void *user, ag_live_session *s)
+{
+    ag_live *live = user;
+    ag_model_role role = AG_ROLE_NONE;
+    if (ag_auth_check(live->app, &s->who, AG_NEED_MODEL_VIEWER, s->model, &role, NULL) != AG_OK)
+        role = AG_ROLE_NONE;
+    return role;
+}
+
 static void deliver(ag_live *live, pending *p)
 {
     ag_live_rooms *r = &live->rooms;
@@ -124,6 +138,8 @@ static void deliver(ag_live *live, pending *p)
         ag_live_rooms_deliver_job(r, p->job, p->json);
     } else if (p->ev_kind == AG_EVENT_MODEL_GONE) {
         ag_live_rooms_deliver_gone(r, p->model);
+    } else if (p->ev_kind == AG_EVENT_ACCESS) {
+        ag_live_rooms_deliver_access(r, p->model, role_of, live);
     }
 }
 
@@ -139,6 +155,115 @@ static void drain(ag_live *live)
         pending_free(p);
         p = next;
     }
+}
+
+/* --- the handshake -------------------------------------------------------------------------- */
+
+#define BEARER_PROTOCOL "archgram.bearer."
+
+/* A header's text into buf ("" when absent or longer than buf). */
+static const char *header(struct lws *wsi, enum lws_token_indexes h, char *buf, int len)
+{
+    buf[0] = '\0';
+    if (lws_hdr_total_length(wsi, h) >= len || lws_hdr_copy(wsi, buf, len, h) < 0)
+        buf[0] = '\0';
+    return buf;
+}
+
+/* The token of the handshake: Authorization: Bearer, else the subprotocol list's
+ * "archgram.bearer.<token>" (a browser cannot set headers on a websocket); NULL when none. */
+static const char *handshake_token(struct lws *wsi, char *buf, int len)
+{
+    const char *bearer = ag_request_bearer(header(wsi, WSI_TOKEN_HTTP_AUTHORIZATION, buf, len));
+    if (bearer)
+        return bearer;
+    header(wsi, WSI_TOKEN_PROTOCOL, buf, len);
+    for (char *save = NULL, *item = strtok_r(buf, ",", &save); item;
+         item = strtok_r(NULL, ",", &save)) {
+        while (*item == ' ')
+            item++;
+        char *end = item + strlen(item);
+        while (end > item && end[-1] == ' ')
+            *--end = '\0';
+        if (strncmp(item, BEARER_PROTOCOL, strlen(BEARER_PROTOCOL)) == 0)
+            return item + strlen(BEARER_PROTOCOL);
+    }
+    return NULL;
+}
+
+/* The default port of an origin's scheme, 0 for schemes a web client is not served over. */
+static int scheme_port(const char *scheme, size_t n)
+{
+    if (n == 4 && strncasecmp(scheme, "http", 4) == 0)
+        return 80;
+    if (n == 5 && strncasecmp(scheme, "https", 5) == 0)
+        return 443;
+    return 0;
+}
+
+/* Is origin the web client's: scheme://host[:port] with the host the socket was opened on
+ * (its Host header without the port) and the HTTP port? */
+static int served_origin(const ag_live *live, const char *origin, const char *host)
+{
+    const char *sep = strstr(origin, "://");
+    if (!sep)
+        return 0;
+    int port = scheme_port(origin, (size_t)(sep - origin));
+    const char *ohost = sep + 3, *ocolon = strrchr(ohost, ':');
+    if (ocolon && strchr(ocolon, ']'))
+        ocolon = NULL; /* an IPv6 literal without a port */
+    size_t ohost_len = ocolon ? (size_t)(ocolon - ohost) : strlen(ohost);
+    if (ocolon) {
+        char *end;
+        long p = strtol(ocolon + 1, &end, 10);
+        port = *end || p < 1 || p > 65535 ? 0 : (int)p;
+    }
+    const char *hcolon = strrchr(host, ':');
+    if (hcolon && strchr(hcolon, ']'))
+        hcolon = NULL;
+    size_t host_len = hcolon ? (size_t)(hcolon - host) : strlen(host);
+    return port == live->http_port && host_len && ohost_len == host_len &&
+           strncasecmp(ohost, host, host_len) == 0 && !strpbrk(ohost, "/?#@");
+}
+
+static int origin_allowed(const ag_live *live, struct lws *wsi)
+{
+    char origin[256], host[256];
+    if (lws_hdr_total_length(wsi, WSI_TOKEN_ORIGIN) == 0)
+        return 1; /* not a browser: the token alone decides */
+    header(wsi, WSI_TOKEN_ORIGIN, origin, sizeof origin);
+    header(wsi, WSI_TOKEN_HOST, host, sizeof host);
+    if (origin[0] && served_origin(live, origin, host))
+        return 1;
+    for (int i = 0; origin[0] && i < live->norigins; i++)
+        if (strcmp(live->origins[i], "*") == 0 || strcmp(live->origins[i], origin) == 0)
+            return 1;
+    return 0;
+}
+
+/* Before the handshake is answered: a foreign Origin or a missing or unknown token refuses
+ * the connection; otherwise the token's account is the session's identity. */
+static int admit(ag_live *live, ag_live_session *s, struct lws *wsi)
+{
+    const char *why = NULL;
+    char buf[1024];
+    if (!origin_allowed(live, wsi)) {
+        why = "origin not allowed";
+    } else if (live->no_auth) {
+        ag_auth_local(&s->who);
+    } else {
+        const char *token = handshake_token(wsi, buf, sizeof buf);
+        if (!token || ag_auth_token(live->app, token, &s->who, NULL) != AG_OK)
+            why = "no valid token";
+    }
+    if (why) {
+        memset(&s->who, 0, sizeof s->who);
+        lws_return_http_status(wsi, why[0] == 'o' ? HTTP_STATUS_FORBIDDEN : HTTP_STATUS_UNAUTHORIZED,
+                               why);
+        return -1;
+    }
+    snprintf(s->user, sizeof s->user, "%s", s->who.name);
+    return 0;
 }
 
 /* --- libwebsockets ------------------------------------------------------------------------ */
@@ -204,6 +329,8 @@ static int on_lws(struct lws *wsi, enum lws_callback_reasons reason, void *user,
     ag_live *live = ctx ? lws_context_user(ctx) : NULL;
     ag_live_session *s = user;
     switch (reason) {
+    case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+        return live && s ? admit(live, s, wsi) : -1;
     case LWS_CALLBACK_ESTABLISHED: {
         ag_live_rooms_add(&live->rooms, s, wsi);
         char peer[48] = "?";
@@ -251,6 +378,13 @@ static void log_lws(int level, const char *line)
     fprintf(stderr, "archgramd: websocket: %s", line);
 }
 
+static void free_origins(ag_live *live)
+{
+    for (int i = 0; i < live->norigins; i++)
+        free(live->origins[i]);
+    free(live->origins);
+}
+
 ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, ag_error *err)
 {
     *out = NULL;
@@ -262,6 +396,20 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
         free(live);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
+    live->http_port = opt->http_port;
+    live->no_auth = opt->no_auth;
+    if (opt->norigins > 0 && !(live->origins = calloc((size_t)opt->norigins, sizeof *live->origins))) {
+        ag_ratelimit_free(live->messages);
+        free(live);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (int i = 0; i < opt->norigins; i++, live->norigins++)
+        if (!(live->origins[i] = strdup(opt->origins[i]))) {
+            free_origins(live);
+            ag_ratelimit_free(live->messages);
+            free(live);
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        }
     pthread_mutex_init(&live->lock, NULL);
     lws_set_log_level(LLL_ERR, log_lws);
     struct lws_context_creation_info info;
@@ -277,6 +425,7 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
     if (!live->context) {
         pthread_mutex_destroy(&live->lock);
         ag_ratelimit_free(live->messages);
+        free_origins(live);
         free(live);
         return ag_error_set(err, AG_ERR_IO, 0,
                             "cannot listen for websockets on %s:%d (is the port in use?)",
@@ -288,6 +437,7 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
         lws_context_destroy(live->context);
         pthread_mutex_destroy(&live->lock);
         ag_ratelimit_free(live->messages);
+        free_origins(live);
         free(live);
         return ag_error_set(err, AG_ERR_INTERNAL, 0, "cannot start the websocket thread");
     }
@@ -310,5 +460,6 @@ void ag_live_stop(ag_live *live)
     }
     pthread_mutex_destroy(&live->lock);
     ag_ratelimit_free(live->messages);
+    free_origins(live);
     free(live);
 }

@@ -8,6 +8,7 @@
 
 #include "../app/app_change.h"
 #include "../app/app_query.h"
+#include "../app/auth.h"
 #include "../app/optable.h"
 #include "../app/problem.h"
 #include "ratelimit.h"
@@ -40,16 +41,17 @@ static void on_hello(ag_live *live, ag_live_session *s, json_t *msg)
         (!json_is_integer(jsince) || json_integer_value(jsince) < 0))
         return ag_live_rooms_send_error(s, AG_ERR_INVALID,
                                         "\"since\" must be a version (0 or more)%s", "");
-    const char *user = juser ? json_string_value(juser) : "guest";
-    if (!user)
+    /* identity comes from the handshake's token: a "user" the client names is ignored */
+    if (juser && !json_is_string(juser))
         return ag_live_rooms_send_error(s, AG_ERR_INVALID, "\"user\" must be a string%s", "");
-    ag_status st = ag_app_check_name(user, &err);
-    if (st != AG_OK)
-        return ag_live_rooms_send_problem(s, st, &err);
 
     ag_app *app = ag__live_app(live);
     int64_t model = json_integer_value(jmodel), version;
-    if ((st = ag_app_query_version(app, model, &version, &err)) != AG_OK)
+    ag_model_role role;
+    ag_status st = ag_auth_check(app, &s->who, AG_NEED_MODEL_VIEWER, model, &role, &err);
+    if (st == AG_OK)
+        st = ag_app_query_version(app, model, &version, &err);
+    if (st != AG_OK)
         return ag_live_rooms_send_problem(s, st, &err);
     json_t *ops = NULL;
     int more = 0;
@@ -69,13 +71,15 @@ static void on_hello(ag_live *live, ag_live_session *s, json_t *msg)
     }
     if (!ops)
         ops = json_array();
-    json_t *peers = ag_live_rooms_join(ag__live_rooms(live), s, model, version, user);
+    json_t *peers = ag_live_rooms_join(ag__live_rooms(live), s, model, version);
+    s->role = role;
     char you[32];
     ag_live_rooms_peer_name(s, you, sizeof you);
-    ag_live_rooms_send_json(s, json_pack("{s:s, s:I, s:I, s:s, s:o, s:b, s:o}", "type",
+    ag_live_rooms_send_json(s, json_pack("{s:s, s:I, s:I, s:s, s:o, s:b, s:o, s:s, s:s}", "type",
                                          "welcome", "model", (json_int_t)model, "version",
                                          (json_int_t)version, "you", you, "ops", ops, "more",
-                                         more, "peers", peers));
+                                         more, "peers", peers, "user", s->who.name, "role",
+                                         ag_auth_model_role_name(role)));
 }
 
 static void on_presence(ag_live *live, ag_live_session *s, json_t *msg)
@@ -86,6 +90,9 @@ static void on_presence(ag_live *live, ag_live_session *s, json_t *msg)
     if (!json_is_object(state))
         return ag_live_rooms_send_error(s, AG_ERR_INVALID, "presence needs a \"state\" object%s",
                                         "");
+    /* the name others see is the account's, whatever the state says */
+    if (json_object_get(state, "name"))
+        json_object_set_new(state, "name", json_string(s->who.name));
     char *text = json_dumps(state, JSON_COMPACT);
     if (!text)
         return;
@@ -106,7 +113,9 @@ static void on_watch(ag_live *live, ag_live_session *s, json_t *msg)
     json_t *view = NULL;
     int done = 0;
     int64_t id = json_integer_value(jjob);
-    ag_status st = ag_app_query_job(ag__live_app(live), id, &view, &done, &err);
+    ag_status st = ag_auth_check(ag__live_app(live), &s->who, AG_NEED_JOB, id, NULL, &err);
+    if (st == AG_OK)
+        st = ag_app_query_job(ag__live_app(live), id, &view, &done, &err);
     if (st == AG_OK && !done)
         st = ag_live_rooms_watch(s, id, json_number_value(json_object_get(view, "progress")),
                                  &err);
@@ -317,10 +326,29 @@ static void run_on_task_lane(ag_live *live, ag_live_session *s, json_t *msg, int
     send_nack(s, msg, st, &err);
 }
 
+/* May s change its room's model now? Checked on every op and preview, so a role taken away
+ * counts at once; otherwise the problem is in err. */
+static ag_status may_edit(ag_live *live, ag_live_session *s, ag_error *err)
+{
+    return ag_auth_check(ag__live_app(live), &s->who, AG_NEED_MODEL_EDITOR, s->model, &s->role,
+                         err);
+}
+
 static void on_op(ag_live *live, ag_live_session *s, json_t *msg)
 {
     if (!s->model)
         return ag_live_rooms_send_error(s, AG_ERR_INVALID, "send hello before ops%s", "");
+    ag_error err;
+    ag_status st = may_edit(live, s, &err);
+    if (st != AG_OK) {
+        int64_t current = 0;
+        if (ag_app_query_version(ag__live_app(live), s->model, &current, NULL) != AG_OK)
+            current = 0;
+        return ag_live_rooms_send_json(
+            s, json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid",
+                         json_object_get(msg, "cid"), "version", (json_int_t)current, "problem",
+                         ag_problem_json(st, &err)));
+    }
     const ag_op_kind *row =
         ag_optable_find(json_string_value(json_object_get(json_object_get(msg, "op"), "kind")));
     /* structural kinds a client may send go to the model's task lane; the rest (and every refusal
@@ -357,6 +385,13 @@ static void on_preview(ag_live *live, ag_live_session *s, json_t *msg)
     if (jm && (!json_is_integer(jm) || json_integer_value(jm) != s->model))
         return ag_live_rooms_send_error(
             s, AG_ERR_INVALID, "a preview is for the model of the connection's room%s", "");
+    ag_error err;
+    ag_status st = may_edit(live, s, &err);
+    if (st != AG_OK)
+        return ag_live_rooms_send_json(
+            s, json_pack("{s:s, s:O?, s:I, s:o}", "type", "preview.error", "base",
+                         json_object_get(msg, "base"), "version", (json_int_t)0, "problem",
+                         ag_problem_json(st, &err)));
     double wait = s->preview_at + 1000.0 / AG_LIVE_PREVIEW_HZ - mono_ms();
     if (wait <= 0 && !s->preview_next)
         return send_preview(live, s, msg);

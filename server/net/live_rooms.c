@@ -142,13 +142,13 @@ void ag_live_rooms_remove(ag_live_rooms *r, ag_live_session *s)
     memset(s, 0, sizeof *s);
 }
 
-json_t *ag_live_rooms_join(ag_live_rooms *r, ag_live_session *s, int64_t model, int64_t version,
-                           const char *user)
+json_t *ag_live_rooms_join(ag_live_rooms *r, ag_live_session *s, int64_t model,
+                           int64_t version)
 {
     ag_live_rooms_leave(r, s);
     s->model = model;
     s->seen = version;
-    snprintf(s->user, sizeof s->user, "%s", user);
+    snprintf(s->user, sizeof s->user, "%s", s->who.name);
     json_t *peers = json_array();
     for (ag_live_session *o = r->sessions; o; o = o->next) {
         if (o == s || o->model != model)
@@ -273,5 +273,21 @@ void ag_live_rooms_deliver_gone(ag_live_rooms *r, int64_t model)
         s->model = 0;
         ag_live_rooms_send_json(s, json_pack("{s:s, s:I}", "type", "gone", "model",
                                              (json_int_t)model));
+    }
+}
+
+void ag_live_rooms_deliver_access(ag_live_rooms *r, int64_t model,
+                                  ag_model_role (*role_of)(void *user, ag_live_session *s),
+                                  void *user)
+{
+    for (ag_live_session *s = r->sessions; s; s = s->next) {
+        if (s->model != model)
+            continue;
+        s->role = role_of(user, s);
+        ag_live_rooms_send_json(s, json_pack("{s:s, s:I, s:s}", "type", "access", "model",
+                                             (json_int_t)model, "role",
+                                             ag_auth_model_role_name(s->role)));
+        if (s->role == AG_ROLE_NONE)
+            ag_live_rooms_leave(r, s);
     }
 }

@@ -10,6 +10,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "../app/auth.h"
 #include "../core/status.h"
 
 #define AG_LIVE_MAX_OUTBOX 4096
@@ -26,7 +27,9 @@ typedef struct ag_live_session {
     uint64_t id;
     int64_t model; /* 0: in no room */
     int64_t seen;  /* the newest model version this session has been told of */
-    char user[801];
+    ag_identity who;    /* from the handshake's token, for the session's life */
+    ag_model_role role; /* who's role on the room's model, as last checked */
+    char user[801];     /* the name the room sees: the account's */
     char rate_key[64];  /* what its message rate limit counts under: "addr:<peer address>" */
     char *presence; /* last state, JSON text */
     char *rx;
@@ -67,10 +70,11 @@ void ag_live_rooms_broadcast_json(ag_live_rooms *r, int64_t model,
 /* "p<id>", the name a session has for the others. */
 void ag_live_rooms_peer_name(const ag_live_session *s, char *buf, size_t len);
 
-/* Moves s into the room of model (told of versions up to `version`) as user: leaves its old
- * room (announced), returns the others' {"peer","user","state"} and announces the join. */
-json_t *ag_live_rooms_join(ag_live_rooms *r, ag_live_session *s, int64_t model, int64_t version,
-                           const char *user);
+/* Moves s into the room of model (told of versions up to `version`) under its account's
+ * name: leaves its old room (announced), returns the others' {"peer","user","state"} and
+ * announces the join. */
+json_t *ag_live_rooms_join(ag_live_rooms *r, ag_live_session *s, int64_t model,
+                           int64_t version);
 void ag_live_rooms_leave(ag_live_rooms *r, ag_live_session *s);
 /* Keeps s's presence state (JSON text, taken) and shows it to the room. */
 void ag_live_rooms_presence(ag_live_rooms *r, ag_live_session *s, char *state_text,
@@ -86,6 +90,12 @@ void ag_live_rooms_deliver_op(ag_live_rooms *r, int64_t model, int64_t version,
                               uint64_t origin);
 void ag_live_rooms_deliver_job(ag_live_rooms *r, int64_t job, const char *job_json);
 void ag_live_rooms_deliver_gone(ag_live_rooms *r, int64_t model);
+/* Who may use model changed: each session in its room gets its role checked again by
+ * role_of(user, session) and is told {"type":"access","model","role"}; one left without a role
+ * leaves the room. */
+void ag_live_rooms_deliver_access(ag_live_rooms *r, int64_t model,
+                                  ag_model_role (*role_of)(void *user, ag_live_session *s),
+                                  void *user);
 
 /* job.progress or job.done from a job resource (NULL when it has no status). */
 json_t *ag_live_rooms_job_message(const json_t *job);

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -34,6 +35,13 @@ static enum MHD_Result queue(ag_request *r, unsigned status, struct MHD_Response
     } else if (strncmp(r->url, "/api/", 5) == 0) {
         MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
     }
+    if (r->origin[0]) {
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_ACCESS_CONTROL_ALLOW_ORIGIN, r->origin);
+        MHD_add_response_header(resp, "Access-Control-Expose-Headers",
+                                "ETag, Location, Retry-After, WWW-Authenticate, X-Archgram-Failing-Faces");
+    }
+    if (r->cfg && r->cfg->ncors && strncmp(r->url, "/api/", 5) == 0)
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_VARY, "Origin");
     for (int i = 0; i < r->nheaders; i++)
         MHD_add_response_header(resp, r->headers[i].name, r->headers[i].value);
     r->nheaders = 0;
@@ -66,6 +74,8 @@ enum MHD_Result ag_reply_json(ag_request *r, unsigned status, json_t *body, cons
 enum MHD_Result ag_reply_problem(ag_request *r, ag_status s, const ag_error *err)
 {
     char *text = ag_problem_text(s, err);
+    if (s == AG_ERR_UNAUTHORIZED)
+        ag_reply_header(r, MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"archgram\"");
     if (text)
         return ag_reply_bytes(r, (unsigned)ag_status_http(s), "application/problem+json", text,
                               strlen(text), NULL);
@@ -105,8 +115,17 @@ enum MHD_Result ag_reply_new_job(ag_request *r, ag_status s, int64_t job, const 
 
 const char *ag_request_author(ag_request *r)
 {
-    const char *user = ag_request_header(r, "X-Archgram-User");
-    return user && *user ? user : "api";
+    return r->who.name;
+}
+
+const char *ag_request_bearer(const char *authorization)
+{
+    if (!authorization || strncasecmp(authorization, "Bearer ", 7) != 0)
+        return NULL;
+    const char *token = authorization + 7;
+    while (*token == ' ')
+        token++;
+    return *token ? token : NULL;
 }
 
 void ag_request_fresh_cid(const char *prefix, char *buf, size_t len)
@@ -151,6 +170,8 @@ void ag_request_rate_key(ag_request *r, char *buf, size_t len)
 {
     if (r->cfg->rate_key)
         r->cfg->rate_key(r, buf, len);
+    else if (r->who.user) /* signed in: the account's budget, wherever it calls from */
+        snprintf(buf, len, "user:%lld", (long long)r->who.user);
     else
         ag_request_address_key(r, buf, len);
 }

@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "../app/app.h"
+#include "../app/auth.h"
 #include "../core/status.h"
 
 struct ag_route;
@@ -18,8 +19,7 @@ struct ag_ratelimit;
 struct ag_connguard;
 struct ag_request;
 
-/* Writes the key a request's rate limits are counted under into buf (len bytes): by default
- * "addr:<client address>"; an account's key once requests carry one. */
+/* Writes the key a request's rate limits are counted under into buf (len bytes). */
 typedef void (*ag_rate_key_fn)(struct ag_request *r, char *buf, size_t len);
 
 typedef struct {
@@ -32,6 +32,9 @@ typedef struct {
     ag_rate_key_fn rate_key;                     /* NULL: ag_request_address_key */
     struct ag_connguard *guard;
     atomic_size_t *abandoned; /* deferred requests dropped: their client went away first */
+    int no_auth;         /* everyone is the local admin (loopback only) */
+    const char *const *cors; /* origins allowed to call the API from a browser ("*": any) */
+    int ncors;
 } ag_http_config;
 
 /* The answer a deferred request's work made on a task worker (net/defer.h), sent by the
@@ -54,6 +57,13 @@ typedef struct ag_request {
     const char *method;
     const char *url;
     int64_t ids[2];          /* the {id} segments of the matched route, in order */
+    char name[AG_USER_NAME_MAX + 1]; /* its {name} segment, "" when none */
+    /* who asks (from the bearer token; the local admin with --no-auth), set before the
+     * handler runs for every route that needs more than nothing; and for routes on a model,
+     * that account's role on it */
+    ag_identity who;
+    ag_model_role model_role;
+    char origin[256];        /* the Origin header when --cors allows it, else "" */
     /* body */
     char *body;              /* small bodies (JSON), NUL-terminated */
     size_t body_len, body_cap;
@@ -72,7 +82,7 @@ typedef struct ag_request {
     struct {
         char name[32];
         char value[256];
-    } headers[4];
+    } headers[8];
     int nheaders;
 } ag_request;
 
@@ -92,8 +102,11 @@ void ag_reply_header(ag_request *r, const char *name, const char *value);
 enum MHD_Result ag_reply_new_job(ag_request *r, ag_status s, int64_t job, const ag_error *err);
 /* Answers with job's view; a 202 also names it in Location. */
 enum MHD_Result ag_reply_job(ag_request *r, int64_t job, unsigned status);
-/* Who makes a change over REST: the X-Archgram-User header, else "api". */
+/* Who makes a change over REST: the name of the caller's account (never a header it sends). */
 const char *ag_request_author(ag_request *r);
+/* The token of an Authorization header "Bearer <token>" (scheme in any case), NULL when the
+ * header is something else. */
+const char *ag_request_bearer(const char *authorization);
 /* A client id for a REST change that brings none, "<prefix>-…": unique within this process
  * and across restarts (time-based), so the op log's (author, cid) uniqueness holds. */
 void ag_request_fresh_cid(const char *prefix, char *buf, size_t len);
@@ -102,7 +115,9 @@ int ag_request_none_match(ag_request *r, const char *etag);
 
 /* "addr:<the client's IP address>" into buf: the default rate-limit key. */
 void ag_request_address_key(ag_request *r, char *buf, size_t len);
-/* The key r's rate limits count under (cfg->rate_key, else the address). */
+/* The key r's rate limits count under: cfg->rate_key when set, else "user:<id>" once the
+ * request is signed in (job submissions are counted after that), else the address (REST
+ * requests are counted before it, so a flood of bad tokens is limited too). */
 void ag_request_rate_key(ag_request *r, char *buf, size_t len);
 
 /* Query parameter or NULL. */

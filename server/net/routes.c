@@ -4,35 +4,67 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define NONE AG_BODY_NONE
+#define JSON AG_BODY_JSON
+#define UPLOAD AG_BODY_UPLOAD
+#define JOB AG_ROUTE_SUBMITS_JOB
+
 const ag_route ag_routes[] = {
-    {"GET", "/api/v1/health", ag_api_health, AG_BODY_NONE, 0},
-    {"GET", "/api/v1/openapi.json", ag_api_openapi, AG_BODY_NONE, 0},
-    {"GET", "/api/v1/models", ag_api_models_list, AG_BODY_NONE, 0},
-    {"POST", "/api/v1/models", ag_api_models_create, AG_BODY_UPLOAD, AG_ROUTE_SUBMITS_JOB},
-    {"GET", "/api/v1/models/{id}", ag_api_model_get, AG_BODY_NONE, 0},
-    {"PATCH", "/api/v1/models/{id}", ag_api_model_patch, AG_BODY_JSON, 0},
-    {"DELETE", "/api/v1/models/{id}", ag_api_model_delete, AG_BODY_NONE, 0},
+    /* method  pattern  handler  body  need  flags */
+    {"GET", "/api/v1/health", ag_api_health, NONE, AG_NEED_NOTHING, 0},
+    {"GET", "/api/v1/openapi.json", ag_api_openapi, NONE, AG_NEED_NOTHING, 0},
+    /* the models the caller may see */
+    {"GET", "/api/v1/models", ag_api_models_list, NONE, AG_NEED_ACCOUNT, 0},
+    {"POST", "/api/v1/models", ag_api_models_create, UPLOAD, AG_NEED_EDITOR, JOB},
+    {"GET", "/api/v1/models/{id}", ag_api_model_get, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"PATCH", "/api/v1/models/{id}", ag_api_model_patch, JSON, AG_NEED_MODEL_EDITOR, 0},
+    {"DELETE", "/api/v1/models/{id}", ag_api_model_delete, NONE, AG_NEED_MODEL_OWNER, 0},
     /* label and split-tree node per component once the model is proceduralized */
-    {"GET", "/api/v1/models/{id}/mesh.glb", ag_api_model_mesh_glb, AG_BODY_NONE, 0},
-    {"GET", "/api/v1/models/{id}/ops", ag_api_model_ops_list, AG_BODY_NONE, 0},
-    {"POST", "/api/v1/models/{id}/ops", ag_api_model_ops_create, AG_BODY_JSON, 0},
-    {"POST", "/api/v1/models/{id}/proceduralize", ag_api_model_proceduralize, AG_BODY_JSON,
-     AG_ROUTE_SUBMITS_JOB},
-    {"GET", "/api/v1/models/{id}/tree", ag_api_model_tree, AG_BODY_NONE, 0},
-    {"GET", "/api/v1/models/{id}/grammar", ag_api_model_grammar_get, AG_BODY_NONE, 0},
+    {"GET", "/api/v1/models/{id}/mesh.glb", ag_api_model_mesh_glb, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"GET", "/api/v1/models/{id}/ops", ag_api_model_ops_list, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"POST", "/api/v1/models/{id}/ops", ag_api_model_ops_create, JSON, AG_NEED_MODEL_EDITOR, 0},
+    {"POST", "/api/v1/models/{id}/proceduralize", ag_api_model_proceduralize, JSON,
+     AG_NEED_MODEL_EDITOR, JOB},
+    {"GET", "/api/v1/models/{id}/tree", ag_api_model_tree, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"GET", "/api/v1/models/{id}/grammar", ag_api_model_grammar_get, NONE, AG_NEED_MODEL_VIEWER, 0},
     /* spooled like an upload; api_grammar.c takes at most 8 MiB of it */
-    {"PUT", "/api/v1/models/{id}/grammar", ag_api_model_grammar_put, AG_BODY_UPLOAD, 0},
+    {"PUT", "/api/v1/models/{id}/grammar", ag_api_model_grammar_put, UPLOAD,
+     AG_NEED_MODEL_EDITOR, 0},
+    /* who may use the model */
+    {"GET", "/api/v1/models/{id}/members", ag_api_model_members, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"PUT", "/api/v1/models/{id}/members/{name}", ag_api_model_member_put, JSON,
+     AG_NEED_MODEL_OWNER, 0},
+    {"DELETE", "/api/v1/models/{id}/members/{name}", ag_api_model_member_delete, NONE,
+     AG_NEED_MODEL_OWNER, 0},
+    {"PUT", "/api/v1/models/{id}/public", ag_api_model_public_put, JSON, AG_NEED_MODEL_OWNER, 0},
     /* a building description or GeoJSON footprints, spooled like model uploads */
-    {"POST", "/api/v1/extrusions", ag_api_extrusions_create, AG_BODY_UPLOAD, AG_ROUTE_SUBMITS_JOB},
-    {"POST", "/api/v1/extrusions/preview", ag_api_extrusions_preview, AG_BODY_JSON, 0},
-    {"GET", "/api/v1/models/{id}/plan", ag_api_model_plan, AG_BODY_NONE, 0},
-    {"GET", "/api/v1/jobs/{id}", ag_api_job_get, AG_BODY_NONE, 0},
-    {"DELETE", "/api/v1/jobs/{id}", ag_api_job_cancel, AG_BODY_NONE, 0},
+    {"POST", "/api/v1/extrusions", ag_api_extrusions_create, UPLOAD, AG_NEED_EDITOR, JOB},
+    /* stores nothing: editors of a shared extrusion model preview their plan edits */
+    {"POST", "/api/v1/extrusions/preview", ag_api_extrusions_preview, JSON, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/models/{id}/plan", ag_api_model_plan, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"GET", "/api/v1/jobs/{id}", ag_api_job_get, NONE, AG_NEED_JOB, 0},
+    {"DELETE", "/api/v1/jobs/{id}", ag_api_job_cancel, NONE, AG_NEED_JOB, 0},
+    /* the caller's own account and tokens */
+    {"GET", "/api/v1/me", ag_api_me, NONE, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/me/tokens", ag_api_me_tokens_list, NONE, AG_NEED_ACCOUNT, 0},
+    {"POST", "/api/v1/me/tokens", ag_api_me_tokens_create, JSON, AG_NEED_ACCOUNT, 0},
+    {"DELETE", "/api/v1/me/tokens/{id}", ag_api_me_token_delete, NONE, AG_NEED_ACCOUNT, 0},
+    /* accounts, for admins */
+    {"GET", "/api/v1/users", ag_api_users_list, NONE, AG_NEED_ADMIN, 0},
+    {"POST", "/api/v1/users", ag_api_users_create, JSON, AG_NEED_ADMIN, 0},
+    {"POST", "/api/v1/users/{name}/tokens", ag_api_user_tokens_create, JSON, AG_NEED_ADMIN, 0},
 };
 const size_t ag_routes_count = sizeof ag_routes / sizeof ag_routes[0];
 
-/* Segment by segment; {id} takes 1..18 digits without a leading zero. */
-static int path_matches(const char *pattern, const char *path, int64_t ids[2])
+static int name_char(char c, int first)
+{
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+           (!first && (c == '.' || c == '_' || c == '-'));
+}
+
+/* Segment by segment; {id} takes 1..18 digits without a leading zero, {name} an account
+ * name. */
+static int path_matches(const char *pattern, const char *path, int64_t ids[2], char *name)
 {
     int nid = 0;
     while (*pattern && *path) {
@@ -47,6 +79,18 @@ static int path_matches(const char *pattern, const char *path, int64_t ids[2])
             pattern += 4;
             continue;
         }
+        if (strncmp(pattern, "{name}", 6) == 0) {
+            const char *start = path;
+            while (name_char(*path, path == start))
+                path++;
+            size_t n = (size_t)(path - start);
+            if (n == 0 || n > AG_USER_NAME_MAX)
+                return 0;
+            memcpy(name, start, n);
+            name[n] = '\0';
+            pattern += 6;
+            continue;
+        }
         if (*pattern != *path)
             return 0;
         pattern++;
@@ -55,20 +99,23 @@ static int path_matches(const char *pattern, const char *path, int64_t ids[2])
     return *pattern == '\0' && *path == '\0';
 }
 
-ag_match ag_routes_match(const char *method, const char *path, const ag_route **route,
-                         int64_t ids[2], char *allow, size_t allow_len)
+ag_match ag_routes_find(const char *method, const char *path, const ag_route **route,
+                        int64_t ids[2], char *name, char *allow, size_t allow_len)
 {
     ag_match found = AG_MATCH_NONE;
     if (allow_len)
         allow[0] = '\0';
+    name[0] = '\0';
     for (size_t i = 0; i < ag_routes_count; i++) {
         int64_t tmp[2] = {0, 0};
-        if (!path_matches(ag_routes[i].pattern, path, tmp))
+        char seg[AG_USER_NAME_MAX + 1] = "";
+        if (!path_matches(ag_routes[i].pattern, path, tmp, seg))
             continue;
         if (strcmp(ag_routes[i].method, method) == 0) {
             *route = &ag_routes[i];
             ids[0] = tmp[0];
             ids[1] = tmp[1];
+            memcpy(name, seg, sizeof seg);
             return AG_MATCH_OK;
         }
         found = AG_MATCH_PATH_ONLY;
@@ -76,4 +123,11 @@ ag_match ag_routes_match(const char *method, const char *path, const ag_route **
         snprintf(allow + used, allow_len - used, "%s%s", used ? ", " : "", ag_routes[i].method);
     }
     return found;
+}
+
+ag_match ag_routes_match(const char *method, const char *path, const ag_route **route,
+                         int64_t ids[2], char *allow, size_t allow_len)
+{
+    char name[AG_USER_NAME_MAX + 1];
+    return ag_routes_find(method, path, route, ids, name, allow, allow_len);
 }

@@ -1,5 +1,8 @@
-/* The REST route table: one static list that the dispatcher, the 405 answers and the
- * OpenAPI consistency test all read. Patterns use {id} for a positive integer segment. */
+/* The REST route table: one static list that the dispatcher, the 405 answers, the access
+ * checks and the OpenAPI consistency test all read. Patterns use {id} for a positive integer
+ * segment and {name} for an account name (A-Z a-z 0-9 . _ -, 1..64, beginning with a letter
+ * or a digit). Each row declares what its caller needs (app/auth.h); http.c checks it before
+ * the body is read, so a row that says nothing is for admins only. */
 #ifndef AG_ROUTES_H
 #define AG_ROUTES_H
 
@@ -22,6 +25,7 @@ typedef struct ag_route {
     const char *pattern;
     ag_handler handler;
     ag_body_kind body;
+    ag_need need; /* of the caller: a token, an account role, a role on the model of {id} */
     unsigned flags;
 } ag_route;
 
@@ -34,6 +38,10 @@ typedef enum { AG_MATCH_NONE, AG_MATCH_PATH_ONLY, AG_MATCH_OK } ag_match;
  * AG_MATCH_PATH_ONLY allow gets the comma-separated methods the path accepts. */
 ag_match ag_routes_match(const char *method, const char *path, const ag_route **route,
                          int64_t ids[2], char *allow, size_t allow_len);
+/* The same, also giving the {name} segment (name: AG_USER_NAME_MAX + 1 bytes; "" when the
+ * pattern has none). */
+ag_match ag_routes_find(const char *method, const char *path, const ag_route **route,
+                        int64_t ids[2], char *name, char *allow, size_t allow_len);
 
 /* Handlers (api_*.c). */
 enum MHD_Result ag_api_health(ag_request *r);
@@ -55,6 +63,18 @@ enum MHD_Result ag_api_extrusions_preview(ag_request *r);
 enum MHD_Result ag_api_model_plan(ag_request *r);
 enum MHD_Result ag_api_job_get(ag_request *r);
 enum MHD_Result ag_api_job_cancel(ag_request *r);
+/* accounts and tokens (api_accounts.c), sharing (api_sharing.c) */
+enum MHD_Result ag_api_me(ag_request *r);
+enum MHD_Result ag_api_me_tokens_list(ag_request *r);
+enum MHD_Result ag_api_me_tokens_create(ag_request *r);
+enum MHD_Result ag_api_me_token_delete(ag_request *r);
+enum MHD_Result ag_api_users_list(ag_request *r);
+enum MHD_Result ag_api_users_create(ag_request *r);
+enum MHD_Result ag_api_user_tokens_create(ag_request *r);
+enum MHD_Result ag_api_model_members(ag_request *r);
+enum MHD_Result ag_api_model_member_put(ag_request *r);
+enum MHD_Result ag_api_model_member_delete(ag_request *r);
+enum MHD_Result ag_api_model_public_put(ag_request *r);
 
 /* Shared by the handlers (api_models.c): a model's view with its ETag; the If-Match version
  * of a change ("*" = the current one; not required: 0 when absent). */

@@ -18,14 +18,19 @@ void ag_jobs_row_clear(ag_job_row *row)
     row->params_json = row->result_json = row->error_json = NULL;
 }
 
-ag_status ag_jobs_insert(ag_db *db, const char *kind, const char *params_json, int64_t *id,
-                         ag_error *err)
+ag_status ag_jobs_insert(ag_db *db, const char *kind, const char *params_json, int64_t user,
+                         int64_t *id, ag_error *err)
 {
-    sqlite3_stmt *st = ag_db_prepare(db, "INSERT INTO jobs (kind, params) VALUES (?, ?)", err);
+    sqlite3_stmt *st =
+        ag_db_prepare(db, "INSERT INTO jobs (kind, params, user_id) VALUES (?, ?, ?)", err);
     if (!st)
         return err ? err->code : AG_ERR_DB;
     sqlite3_bind_text(st, 1, kind, -1, SQLITE_STATIC);
     sqlite3_bind_text(st, 2, params_json ? params_json : "{}", -1, SQLITE_STATIC);
+    if (user > 0)
+        sqlite3_bind_int64(st, 3, user);
+    else
+        sqlite3_bind_null(st, 3);
     ag_status done = ag_db_step_done(db, st, "creating a job", err);
     if (done != AG_OK)
         return done;
@@ -39,7 +44,7 @@ ag_status ag_jobs_get(ag_db *db, int64_t id, ag_job_row *row, ag_error *err)
     sqlite3_stmt *st = ag_db_prepare(db,
                                      "SELECT id, kind, status, progress, coalesce(stage, ''), "
                                      "params, result, error, coalesce(model_id, 0), created_at, "
-                                     "updated_at FROM jobs WHERE id = ?",
+                                     "updated_at, coalesce(user_id, 0) FROM jobs WHERE id = ?",
                                      err);
     if (!st)
         return err ? err->code : AG_ERR_DB;
@@ -58,6 +63,7 @@ ag_status ag_jobs_get(ag_db *db, int64_t id, ag_job_row *row, ag_error *err)
         row->model = sqlite3_column_int64(st, 8);
         ag_db_column_copy(st, 9, row->created_at, sizeof row->created_at);
         ag_db_column_copy(st, 10, row->updated_at, sizeof row->updated_at);
+        row->user = sqlite3_column_int64(st, 11);
     } else if (rc == SQLITE_DONE) {
         s = ag_error_set(err, AG_ERR_NOT_FOUND, 0, "there is no job %lld", (long long)id);
     } else {

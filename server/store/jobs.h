@@ -16,14 +16,16 @@ typedef struct {
     char *result_json; /* NULL when none */
     char *error_json;  /* NULL when none */
     int64_t model;     /* 0 when none */
+    int64_t user;      /* the account that asked for it; 0: the server itself */
     char created_at[32];
     char updated_at[32];
 } ag_job_row;
 
 void ag_jobs_row_clear(ag_job_row *row);
 
-ag_status ag_jobs_insert(ag_db *db, const char *kind, const char *params_json, int64_t *id,
-                         ag_error *err);
+/* user: the account that asks for the job (0: the server itself). */
+ag_status ag_jobs_insert(ag_db *db, const char *kind, const char *params_json, int64_t user,
+                         int64_t *id, ag_error *err);
 ag_status ag_jobs_get(ag_db *db, int64_t id, ag_job_row *row, ag_error *err);
 /* Status, progress and stage (stage may be NULL to keep it). Only unfinished jobs change. */
 ag_status ag_jobs_update(ag_db *db, int64_t id, const char *status, double progress,

@@ -101,7 +101,7 @@ ag_status ag_models_insert(ag_db *db, const ag_model_new *m, int64_t *id, ag_err
 
 #define MODEL_COLUMNS                                                                     \
     "id, name, kind, version, mesh_blob, coalesce(source_blob, 0), coalesce(source_format, " \
-    "''), created_at, updated_at, stats"
+    "''), created_at, updated_at, stats, public_read"
 
 static ag_status read_row(sqlite3_stmt *st, ag_model_row *row)
 {
@@ -115,6 +115,7 @@ static ag_status read_row(sqlite3_stmt *st, ag_model_row *row)
     ag_db_column_copy(st, 6, row->source_format, sizeof row->source_format);
     ag_db_column_copy(st, 7, row->created_at, sizeof row->created_at);
     ag_db_column_copy(st, 8, row->updated_at, sizeof row->updated_at);
+    row->public_read = sqlite3_column_int(st, 10) != 0;
     const unsigned char *stats = sqlite3_column_text(st, 9);
     row->stats_json = strdup(stats ? (const char *)stats : "{}");
     return row->stats_json ? AG_OK : AG_ERR_NOMEM;
@@ -138,26 +139,33 @@ ag_status ag_models_get(ag_db *db, int64_t id, ag_model_row *row, ag_error *err)
     return s;
 }
 
-ag_status ag_models_list(ag_db *db, int64_t after_id, size_t limit, ag_model_row **rows,
-                         size_t *count, ag_error *err)
+ag_status ag_models_list(ag_db *db, int64_t visible_to, int64_t after_id, size_t limit,
+                         ag_model_row **rows, size_t *count, ag_error *err)
 {
     *rows = NULL;
     *count = 0;
     sqlite3_stmt *st = ag_db_prepare(
-        db, "SELECT " MODEL_COLUMNS " FROM models WHERE id > ? ORDER BY id LIMIT ?", err);
+        db,
+        "SELECT " MODEL_COLUMNS ", (SELECT role FROM model_members WHERE model_id = models.id "
+        "AND user_id = ?1) FROM models WHERE id > ?2 AND (?1 = 0 OR public_read = 1 OR "
+        "EXISTS (SELECT 1 FROM model_members WHERE model_id = models.id AND user_id = ?1)) "
+        "ORDER BY id LIMIT ?3",
+        err);
     if (!st)
         return err ? err->code : AG_ERR_DB;
-    sqlite3_bind_int64(st, 1, after_id);
-    sqlite3_bind_int64(st, 2, (sqlite3_int64)limit);
+    sqlite3_bind_int64(st, 1, visible_to);
+    sqlite3_bind_int64(st, 2, after_id);
+    sqlite3_bind_int64(st, 3, (sqlite3_int64)limit);
     ag_model_row *out = calloc(limit ? limit : 1, sizeof *out);
     if (!out)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory listing models");
     size_t n = 0;
-    int rc;
+    int rc = SQLITE_DONE;
     ag_status s = AG_OK;
     while (n < limit && (rc = sqlite3_step(st)) == SQLITE_ROW) {
         if ((s = read_row(st, &out[n])) != AG_OK)
             break;
+        ag_db_column_copy(st, 11, out[n].member_role, sizeof out[n].member_role);
         n++;
     }
     if (s == AG_OK && n < limit && rc != SQLITE_DONE)
@@ -248,6 +256,19 @@ ag_status ag_models_set_name(ag_db *db, int64_t id, const char *name, ag_error *
     sqlite3_bind_text(st, 1, name, -1, SQLITE_STATIC);
     sqlite3_bind_int64(st, 2, id);
     return ag_db_step_done(db, st, "renaming a model", err);
+}
+
+ag_status ag_models_set_public_read(ag_db *db, int64_t id, int on, ag_error *err)
+{
+    sqlite3_stmt *st = ag_db_prepare(db, "UPDATE models SET public_read = ? WHERE id = ?", err);
+    if (!st)
+        return err ? err->code : AG_ERR_DB;
+    sqlite3_bind_int(st, 1, on ? 1 : 0);
+    sqlite3_bind_int64(st, 2, id);
+    ag_status s = ag_db_step_done(db, st, "changing who may read a model", err);
+    if (s == AG_OK && sqlite3_changes(ag_db_handle(db)) == 0)
+        s = ag_error_set(err, AG_ERR_NOT_FOUND, 0, "there is no model %lld", (long long)id);
+    return s;
 }
 
 ag_status ag_models_set_mesh(ag_db *db, int64_t id, const void *mesh, size_t mesh_len,

@@ -20,6 +20,8 @@ typedef struct {
     char created_at[32];
     char updated_at[32];
     char *stats_json; /* malloc'd; ag_models_row_clear frees it */
+    int public_read;  /* readable by every account */
+    char member_role[8]; /* ag_models_list: the role of its visible_to on it ("" none) */
 } ag_model_row;
 
 void ag_models_row_clear(ag_model_row *row);
@@ -39,15 +41,19 @@ typedef struct {
 /* Inside the caller's transaction. */
 ag_status ag_models_insert(ag_db *db, const ag_model_new *m, int64_t *id, ag_error *err);
 ag_status ag_models_get(ag_db *db, int64_t id, ag_model_row *row, ag_error *err);
-/* Rows with id > after_id, ascending, at most limit; *rows is malloc'd (clear each). */
-ag_status ag_models_list(ag_db *db, int64_t after_id, size_t limit, ag_model_row **rows,
-                         size_t *count, ag_error *err);
+/* Rows with id > after_id, ascending, at most limit; *rows is malloc'd (clear each). With
+ * visible_to (an account id; 0 = every model) only the models that account has a role on or
+ * that are public-read, each with its role in member_role. */
+ag_status ag_models_list(ag_db *db, int64_t visible_to, int64_t after_id, size_t limit,
+                         ag_model_row **rows, size_t *count, ag_error *err);
 size_t ag_models_count(ag_db *db);
 /* Raises the version by one if it is base; AG_ERR_STALE (current version in err->element)
  * otherwise, AG_ERR_NOT_FOUND when there is no such model. Inside the caller's transaction. */
 ag_status ag_models_bump_version(ag_db *db, int64_t id, int64_t base, int64_t *new_version,
                                  ag_error *err);
 ag_status ag_models_set_name(ag_db *db, int64_t id, const char *name, ag_error *err);
+/* The public-read flag (AG_ERR_NOT_FOUND when there is no such model). */
+ag_status ag_models_set_public_read(ag_db *db, int64_t id, int on, ag_error *err);
 /* Replaces the model's mesh by a new stored file (the old file is removed by a trigger, see
  * migration 0002) and its stats JSON (NULL = "{}"); *blob (may be NULL) gets the new file's id.
  * AG_ERR_NOT_FOUND when there is no such model. Inside the caller's transaction. */

@@ -2,7 +2,7 @@
 import { existsSync } from 'node:fs';
 import { after, before } from 'node:test';
 import { chromium } from 'playwright-core';
-import { startDaemon } from './daemon.js';
+import { currentDaemon, DEFAULT_USER, startDaemon } from './daemon.js';
 
 const CHROMIUM = '/usr/bin/chromium';
 
@@ -27,12 +27,14 @@ export async function launchBrowser() {
   });
 }
 
-// A page in its own context whose user name is preset; page.problems collects uncaught
-// exceptions and console errors.
-export async function openPage(browser, { user, viewport = { width: 1280, height: 800 } } = {}) {
+// A page in its own context, signed in as user (an admin account of that name, made on first
+// use; "api" when none is named) on the daemon started last, unless token is given (null: not
+// signed in); page.problems collects uncaught exceptions and console errors.
+export async function openPage(browser, { user, token, viewport = { width: 1280, height: 800 } } = {}) {
   const context = await browser.newContext({ viewport });
-  if (user) {
-    await context.addInitScript((name) => localStorage.setItem('archgram.user', name), user);
+  const t = token === undefined ? await currentDaemon().tokenFor(user ?? DEFAULT_USER) : token;
+  if (t) {
+    await context.addInitScript((value) => localStorage.setItem('archgram.token', value), t);
   }
   const page = await context.newPage();
   page.problems = [];

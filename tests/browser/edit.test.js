@@ -9,7 +9,7 @@ import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { daemonAndBrowser, openPage } from './browser.js';
 import { facadeObj } from './facade.js';
-import { versionOf, WAIT, waitMesh, waitVersion } from './page.js';
+import { versionOf, WAIT, waitJob as waitJobOver, waitMesh, waitVersion } from './page.js';
 import { countChanged, countWhere, hueOf, readCanvas } from './pixels.js';
 
 const COLS = 6;
@@ -19,16 +19,7 @@ const env = daemonAndBrowser();
 
 const api = async (p, init) => fetch(`${env.daemon.url}api/v1${p}`, init);
 
-async function waitJob(job) {
-  const deadline = Date.now() + 60000;
-  while (!['succeeded', 'failed', 'cancelled'].includes(job.status)) {
-    assert.ok(Date.now() < deadline, `job ${job.id} did not finish`);
-    await new Promise((r) => setTimeout(r, 100));
-    job = await (await api(`/jobs/${job.id}`)).json();
-  }
-  assert.equal(job.status, 'succeeded', JSON.stringify(job.error));
-  return job;
-}
+const waitJob = (job) => waitJobOver(api, job);
 
 // Imports the facade and proceduralizes it over REST, as a pipeline would.
 async function proceduralizedFacade() {

@@ -1,5 +1,7 @@
 // What the browser tests wait for on a page: the model version in the toolbar, the mesh of a
-// version on screen, an uploaded file's model opened.
+// version on screen, an uploaded file's model opened; and a job over REST.
+import assert from 'node:assert/strict';
+
 export const WAIT = { timeout: 30000 };
 
 export const versionOf = async (page) => Number((await page.getByTestId('model-version').textContent()).replace(/\D/g, ''));
@@ -22,4 +24,16 @@ export async function uploadAndOpen(page, testid, file) {
   await page.locator('[data-testid="job"][data-status="succeeded"]').waitFor(WAIT);
   await page.waitForFunction(() => /^#model=\d+$/.test(location.hash), null, WAIT);
   return Number((await page.evaluate(() => location.hash)).replace(/\D/g, ''));
+}
+
+// Polls a job through api (path under /api/v1 → fetch Response) until it ends; it must succeed.
+export async function waitJob(api, job) {
+  const deadline = Date.now() + 60000;
+  while (!['succeeded', 'failed', 'cancelled'].includes(job.status)) {
+    assert.ok(Date.now() < deadline, `job ${job.id} did not finish`);
+    await new Promise((r) => setTimeout(r, 100));
+    job = await (await api(`/jobs/${job.id}`)).json();
+  }
+  assert.equal(job.status, 'succeeded', JSON.stringify(job.error));
+  return job;
 }

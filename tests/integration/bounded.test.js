@@ -135,8 +135,9 @@ describe('bounded work', () => {
     const before = (await http(d, 'GET', '/api/v1/health')).json.http.abandoned;
     // previews run on all but one task worker; the rest wait their turn, then their clients leave
     const ctls = [...Array(12).keys()].map(() => new AbortController());
+    const auth = `Bearer ${await d.tokenFor()}`;
     const sent = ctls.map((ctl) => fetch(d.url('/api/v1/extrusions/preview'), {
-      method: 'POST', body, headers: { 'Content-Type': 'application/json' }, signal: ctl.signal,
+      method: 'POST', body, headers: { 'Content-Type': 'application/json', Authorization: auth }, signal: ctl.signal,
     }).then((r) => r.arrayBuffer()).catch(() => null));
     let waiting = 0;
     for (let i = 0; i < 400 && waiting < 6; i++) {
@@ -146,12 +147,15 @@ describe('bounded work', () => {
     assert.ok(waiting >= 6, `${waiting} previews waiting`);
     for (const c of ctls) c.abort();
     await Promise.all(sent);
+    // the waiting ones are dropped when their turn comes (a worker may have taken one or
+    // two between the count and the aborts: previews run on up to three at once)
+    const expected = Math.max(3, waiting - 3);
     let abandoned = before;
-    for (let i = 0; i < 400 && abandoned - before < waiting; i++) {
+    for (let i = 0; i < 400 && abandoned - before < expected; i++) {
       await sleep(25);
       abandoned = (await http(d, 'GET', '/api/v1/health')).json.http.abandoned;
     }
-    assert.ok(abandoned - before >= waiting, `abandoned ${abandoned - before}, ${waiting} were waiting`);
+    assert.ok(abandoned - before >= expected, `abandoned ${abandoned - before}, ${waiting} were waiting`);
     const h = (await http(d, 'GET', '/api/v1/health')).json;
     assert.equal(h.work.tasks_waiting, 0);
     const r = await http(d, 'POST', '/api/v1/extrusions/preview', { body, headers: { 'Content-Type': 'application/json' }, timeout: 60000 });
@@ -175,8 +179,12 @@ describe('bounded work', () => {
     const { ms } = await d.stop(5000);
     console.log(`# SIGTERM during an edit: stopped in ${ms} ms`);
     assert.ok(ms < 1000, `stopped after ${ms} ms`);
+    // answered (applied, or stopped by the shutdown) or cut off with the connection
     const answer = await pending;
-    if (!answer.error) assert.ok([200, 503].includes(answer.status), `${answer.status} ${answer.text}`);
+    if (!answer.error) {
+      assert.ok([200, 409, 503].includes(answer.status), `${answer.status} ${answer.text}`);
+      if (answer.status !== 200) assert.match(answer.json.detail, /shutting down/);
+    }
     assert.deepEqual(sql(d.db, 'PRAGMA integrity_check'), [['ok']]);
     const rows = sql(d.db, `SELECT version FROM models WHERE id = ${t.id}`);
     assert.ok(Number(rows[0][0]) === t.version || Number(rows[0][0]) === t.version + 1);

@@ -1,6 +1,14 @@
 // Shared helpers for the service integration tests: start a real archgramd on free
 // loopback ports with a temp database, talk REST and websocket to it, inspect the
 // database file with the sqlite3 command-line tool. Every wait has a timeout.
+//
+// Signing in happens here, in one place: the first start of a database prints the admin's
+// token, which is kept per database file (a restart reuses it), and every request a test
+// makes carries an API token — of the account the test names (X-Archgram-User on REST, "user"
+// in a websocket hello: names the server itself ignores now), else of the account "api". These
+// accounts are admins, made on first use, so the tests keep their authors and see every model.
+// A test about accounts passes its own token (`token:` on http, `{ token }` on WsClient.open,
+// an Authorization header of its own), or `token: null` for none.
 import assert from 'node:assert/strict';
 import { spawn, spawnSync } from 'node:child_process';
 import fs from 'node:fs';
@@ -46,6 +54,28 @@ export async function freePorts(n = 2) {
   } finally {
     await Promise.all(servers.map((s) => new Promise((r) => s.close(r))));
   }
+}
+
+// --- accounts ------------------------------------------------------------------------------
+
+export const DEFAULT_USER = 'api';
+const accountsByDb = new Map(); // database path -> { admin, tokens: Map(name -> Promise<token>) }
+const daemonsByPort = new Map(); // HTTP port and websocket URL -> Daemon
+
+function accountsOf(db) {
+  if (!accountsByDb.has(db)) accountsByDb.set(db, { admin: null, tokens: new Map() });
+  return accountsByDb.get(db);
+}
+
+// The first-start line of archgramd: "... http://host:port/#token=<token>".
+export function printedToken(out) {
+  const m = /#token=([A-Za-z0-9._~+-]+)/.exec(out);
+  return m ? m[1] : null;
+}
+
+function headerOf(headers, name) {
+  const k = Object.keys(headers).find((h) => h.toLowerCase() === name);
+  return k === undefined ? undefined : headers[k];
 }
 
 // Children still alive when the test process exits are killed, so a failed test never
@@ -154,6 +184,43 @@ class Daemon {
   url(p) {
     return this.base + p;
   }
+
+  // The admin token of this database: printed by its first start, kept for its restarts.
+  adminToken() {
+    const accounts = accountsOf(this.db);
+    const printed = printedToken(this.out);
+    if (printed) accounts.admin = printed;
+    if (!accounts.admin) throw new Error(`no admin token for ${this.db}: archgramd printed none\n${this.out}`);
+    return accounts.admin;
+  }
+
+  // A token of the admin account `name`, made on first use.
+  tokenFor(name = DEFAULT_USER) {
+    const accounts = accountsOf(this.db);
+    if (!accounts.tokens.has(name)) {
+      const made = this.makeAccount(name).catch((e) => {
+        accounts.tokens.delete(name);
+        throw e;
+      });
+      accounts.tokens.set(name, made);
+    }
+    return accounts.tokens.get(name);
+  }
+
+  async makeAccount(name, role = 'admin') {
+    const admin = this.adminToken();
+    const post = (p, body) => fetch(this.url(p), {
+      method: 'POST',
+      headers: { Authorization: `Bearer ${admin}`, 'Content-Type': 'application/json' },
+      body: JSON.stringify(body),
+      signal: AbortSignal.timeout(10000),
+    });
+    let res = await post('/api/v1/users', { name, role, label: 'tests' });
+    if (res.status === 409) res = await post(`/api/v1/users/${name}/tokens`, { label: 'tests' });
+    const text = await res.text();
+    if (res.status !== 201) throw new Error(`cannot sign in as ${name}: ${res.status} ${text}`);
+    return JSON.parse(text).token;
+  }
 }
 
 // Start archgramd. opts: dir (temp dir to use; created when absent), db (defaults to
@@ -175,6 +242,9 @@ export async function startDaemon(opts = {}) {
     const d = new Daemon(proc, { port, wsPort, db, dir });
     try {
       await d.ready(10000);
+      if (opts.signIn !== false) d.adminToken();
+      daemonsByPort.set(port, d);
+      daemonsByPort.set(d.wsUrl, d);
       return d;
     } catch (e) {
       lastError = e;
@@ -189,9 +259,14 @@ export async function startDaemon(opts = {}) {
 // --- REST ---------------------------------------------------------------------------------
 
 // fetch with a timeout; returns { status, headers, body (Buffer), text, json }.
-// json is the parsed body when it parses, else undefined.
-export async function http(d, method, p, { body, headers = {}, timeout = 15000 } = {}) {
+// json is the parsed body when it parses, else undefined. Signs in as the X-Archgram-User the
+// headers name (else "api") unless they carry an Authorization or `token` is given (null: none).
+export async function http(d, method, p, { body, headers = {}, timeout = 15000, token } = {}) {
   const init = { method, headers: { ...headers }, signal: AbortSignal.timeout(timeout) };
+  if (token !== null && headerOf(headers, 'authorization') === undefined) {
+    const t = token ?? await d.tokenFor(headerOf(headers, 'x-archgram-user') ?? DEFAULT_USER);
+    init.headers.Authorization = `Bearer ${t}`;
+  }
   if (body !== undefined) {
     init.body = (typeof body === 'object' && !(body instanceof Uint8Array) &&
       !(body instanceof FormData) && !(body instanceof Blob) && !(body instanceof ReadableStream))
@@ -279,7 +354,17 @@ export async function listModels(d, pageSize = 200) {
 // A hand-written HTTP/1.1 exchange over a raw socket, for what fetch hides: bodies without
 // Content-Length, servers that answer before reading the body. `chunks` are written in
 // order (each a Buffer/string); returns { status, headers (lower-case keys), body }.
-export function rawRequest(port, head, chunks = [], { timeout = 10000 } = {}) {
+// A head without an Authorization header gets the token of "api" of the daemon on that port.
+export async function rawRequest(port, head, chunks = [], opts = {}) {
+  const d = daemonsByPort.get(port);
+  if (d && !/\r\nauthorization:/i.test(head)) {
+    const line = head.indexOf('\r\n');
+    head = `${head.slice(0, line)}\r\nAuthorization: Bearer ${await d.tokenFor()}${head.slice(line)}`;
+  }
+  return rawExchange(port, head, chunks, opts);
+}
+
+function rawExchange(port, head, chunks, { timeout = 10000 } = {}) {
   return new Promise((resolve, reject) => {
     const sock = net.connect(port, '127.0.0.1');
     const got = [];
@@ -355,28 +440,55 @@ function parseResponse(buf) {
 // --- websocket ----------------------------------------------------------------------------
 
 // A websocket client that buffers every message; next() takes the first buffered or
-// future message matching a predicate.
+// future message matching a predicate. It signs in on the handshake (Authorization: Bearer)
+// as "api"; a hello naming another user reconnects as that user first (see the top).
 export class WsClient {
-  static open(url, { protocol = 'archgram', timeout = 5000 } = {}) {
+  static async open(url, { protocol = 'archgram', timeout = 5000, token, headers = {}, origin } = {}) {
+    const d = daemonsByPort.get(url);
+    const user = token === undefined && d ? DEFAULT_USER : null;
+    const t = token === undefined ? (d ? await d.tokenFor(user) : null) : token;
+    const connect = () => WsClient.socket(url, { protocol, timeout, token: t, headers, origin });
+    const c = new WsClient(await connect());
+    c.daemon = user ? d : null; // only clients the harness signed in follow hello's user
+    c.user = user;
+    c.connectOptions = { url, protocol, timeout, headers, origin };
+    return c;
+  }
+
+  static socket(url, { protocol, timeout, token, headers, origin }) {
     return new Promise((resolve, reject) => {
-      const ws = protocol ? new WebSocket(url, protocol) : new WebSocket(url);
+      const options = { headers: { ...headers } };
+      if (token) options.headers.Authorization = `Bearer ${token}`;
+      if (origin) options.origin = origin;
+      const ws = protocol ? new WebSocket(url, protocol, options) : new WebSocket(url, options);
       const timer = setTimeout(() => {
         ws.terminate();
         reject(new Error(`websocket ${url} did not open within ${timeout} ms`));
       }, timeout);
-      ws.once('open', () => { clearTimeout(timer); resolve(new WsClient(ws)); });
+      ws.once('open', () => { clearTimeout(timer); resolve(ws); });
+      ws.once('unexpected-response', (req, res) => {
+        clearTimeout(timer);
+        ws.terminate();
+        reject(Object.assign(new Error(`websocket ${url} refused: HTTP ${res.statusCode}`), { status: res.statusCode }));
+      });
       ws.once('error', (e) => { clearTimeout(timer); reject(e); });
     });
   }
 
   constructor(ws) {
-    this.ws = ws;
     this.inbox = [];
     this.waiters = [];
     this.all = [];
+    this.sending = Promise.resolve();
+    this.attach(ws);
+  }
+
+  attach(ws) {
+    this.ws = ws;
     this.closed = new Promise((resolve) => ws.once('close', (code, reason) => resolve({ code, reason: String(reason) })));
     ws.on('error', () => {}); // surfaced through close and timeouts
     ws.on('message', (data, isBinary) => {
+      if (this.ws !== ws) return;
       let msg;
       try { msg = JSON.parse(data.toString('utf8')); } catch { msg = { type: '<non-json>', raw: data.toString('utf8'), isBinary }; }
       this.all.push(msg);
@@ -391,8 +503,20 @@ export class WsClient {
     });
   }
 
+  // Messages go out in order; a hello naming a user other than the one signed in first
+  // reconnects with that user's token.
   send(msg) {
-    this.ws.send(typeof msg === 'string' || Buffer.isBuffer(msg) ? msg : JSON.stringify(msg));
+    const user = msg && typeof msg === 'object' && !Buffer.isBuffer(msg) && msg.type === 'hello' &&
+      typeof msg.user === 'string' ? msg.user : null;
+    this.sending = this.sending.then(async () => {
+      if (user && this.daemon && user !== this.user) {
+        const old = this.ws;
+        old.close();
+        this.attach(await WsClient.socket(this.connectOptions.url, { ...this.connectOptions, token: await this.daemon.tokenFor(user) }));
+        this.user = user;
+      }
+      this.ws.send(typeof msg === 'string' || Buffer.isBuffer(msg) ? msg : JSON.stringify(msg));
+    }).catch((e) => { this.sendError = e; });
   }
 
   // The next message with the given predicate (a function, or a type string).
@@ -434,6 +558,7 @@ export class WsClient {
   }
 
   async close(timeout = 3000) {
+    await this.sending;
     if (this.ws.readyState === WebSocket.CLOSED) return;
     this.ws.close();
     await withTimeout(this.closed, timeout, 'websocket close').catch(() => this.ws.terminate());

@@ -14,6 +14,7 @@
 #include "store/db.h"
 #include "store/migrate.h"
 #include "store/models.h"
+#include "store/users.h"
 
 /* A fresh path for a database that does not exist yet; free it with remove_db. */
 static inline char *temp_db(void)
@@ -36,6 +37,33 @@ static inline void remove_db(char *path)
     snprintf(side, sizeof side, "%s-shm", path);
     unlink(side);
     free(path);
+}
+
+/* A fresh database at a temp path, migrated; close it with close_temp_db. */
+static inline ag_db *open_temp_db(char **path)
+{
+    ag_db *db;
+    ag_error err;
+    *path = temp_db();
+    assert_int_equal(ag_db_open(*path, NULL, &db, &err), AG_OK);
+    return db;
+}
+
+static inline void close_temp_db(ag_db *db, char *path)
+{
+    ag_db_close(db);
+    remove_db(path);
+}
+
+/* Makes an account in a transaction of its own; returns its id. */
+static inline int64_t insert_user(ag_db *db, const char *name, ag_account_role role)
+{
+    ag_error err;
+    int64_t id = 0;
+    assert_int_equal(ag_db_begin(db, &err), AG_OK);
+    assert_int_equal(ag_users_insert(db, name, role, &id, &err), AG_OK);
+    assert_int_equal(ag_db_commit(db, &err), AG_OK);
+    return id;
 }
 
 /* The one integer a `SELECT count(*) ...` returns. */

@@ -7,6 +7,7 @@
 
 #include <jansson.h>
 #include <string.h>
+#include <stdio.h>
 #include <strings.h>
 
 #include "embedded.h"
@@ -87,9 +88,75 @@ static void openapi_and_route_table_agree(void **state)
     json_decref(doc);
 }
 
+/* Who may call a route is declared by its row: every row declares it, only the health check
+ * and the API document are open, a route under a model needs a role on that model (or is an
+ * admin's), and nothing that changes state is open to everyone. */
+static void every_route_declares_who_may_call_it(void **state)
+{
+    (void)state;
+    int open = 0;
+    for (size_t i = 0; i < ag_routes_count; i++) {
+        const ag_route *r = &ag_routes[i];
+        if (r->need == AG_NEED_UNDECLARED)
+            fail_msg("%s %s declares no need", r->method, r->pattern);
+        int reads = strcmp(r->method, "GET") == 0;
+        if (r->need == AG_NEED_NOTHING) {
+            open++;
+            if (!reads)
+                fail_msg("%s %s changes state without a token", r->method, r->pattern);
+        }
+        if (strncmp(r->pattern, "/api/v1/models/{id}", 19) == 0 &&
+            r->need != AG_NEED_MODEL_VIEWER && r->need != AG_NEED_MODEL_EDITOR &&
+            r->need != AG_NEED_MODEL_OWNER && r->need != AG_NEED_ADMIN)
+            fail_msg("%s %s is on a model but needs no role on it", r->method, r->pattern);
+        if (strncmp(r->pattern, "/api/v1/models/{id}", 19) == 0 && !reads &&
+            r->need == AG_NEED_MODEL_VIEWER)
+            fail_msg("%s %s lets viewers change the model", r->method, r->pattern);
+        if (strncmp(r->pattern, "/api/v1/jobs/{id}", 17) == 0 && r->need != AG_NEED_JOB)
+            fail_msg("%s %s is on a job but not its asker's", r->method, r->pattern);
+    }
+    assert_int_equal(open, 2);
+}
+
+static void name_segments_match_account_names_only(void **state)
+{
+    (void)state;
+    const ag_route *route = NULL;
+    int64_t ids[2];
+    char name[AG_USER_NAME_MAX + 1], allow[64];
+    assert_int_equal(ag_routes_find("PUT", "/api/v1/models/7/members/ana.b-c_d", &route, ids,
+                                    name, allow, sizeof allow),
+                     AG_MATCH_OK);
+    assert_string_equal(route->pattern, "/api/v1/models/{id}/members/{name}");
+    assert_int_equal(ids[0], 7);
+    assert_string_equal(name, "ana.b-c_d");
+    assert_int_equal(route->need, AG_NEED_MODEL_OWNER);
+    for (const char *const *p = (const char *const[]){"/api/v1/models/7/members/..",
+                                                      "/api/v1/models/7/members/",
+                                                      "/api/v1/models/7/members/a%20b",
+                                                      "/api/v1/models/7/members/a/b", NULL};
+         *p; p++)
+        assert_int_equal(ag_routes_find("PUT", *p, &route, ids, name, allow, sizeof allow),
+                         AG_MATCH_NONE);
+    char long_path[200];
+    char long_name[AG_USER_NAME_MAX + 2];
+    memset(long_name, 'a', sizeof long_name - 1);
+    long_name[sizeof long_name - 1] = '\0';
+    snprintf(long_path, sizeof long_path, "/api/v1/users/%s/tokens", long_name);
+    assert_int_equal(ag_routes_find("POST", long_path, &route, ids, name, allow, sizeof allow),
+                     AG_MATCH_NONE);
+    long_name[AG_USER_NAME_MAX] = '\0';
+    snprintf(long_path, sizeof long_path, "/api/v1/users/%s/tokens", long_name);
+    assert_int_equal(ag_routes_find("POST", long_path, &route, ids, name, allow, sizeof allow),
+                     AG_MATCH_OK);
+    assert_string_equal(name, long_name);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(every_route_declares_who_may_call_it),
+        cmocka_unit_test(name_segments_match_account_names_only),
         cmocka_unit_test(matches_ids_and_rejects_non_ids),
         cmocka_unit_test(wrong_method_lists_the_allowed_ones),
         cmocka_unit_test(openapi_and_route_table_agree),

@@ -1,5 +1,7 @@
 // REST client for /api/v1. Every failure becomes an ApiError carrying an RFC 9457 problem
-// ({type, title, status, detail, line?, element?}), whether the server sent one or not.
+// ({type, title, status, detail, line?, element?}), whether the server sent one or not. Every
+// request carries the signed-in person's token (auth.js): the server knows who asks from it
+// alone.
 const BASE = '/api/v1';
 
 export class ApiError extends Error {
@@ -40,13 +42,26 @@ function networkProblem(err, what) {
 }
 
 export class Api {
-  constructor(user = () => 'api') {
-    this.user = user; // named in X-Archgram-User so REST edits carry an author
+  constructor() {
+    this.auth = null; // auth.js: the token, and what to do when the server refuses it
     this.health = null;
   }
 
+  useAuth(auth) {
+    this.auth = auth;
+  }
+
+  authHeaders() {
+    const token = this.auth?.token;
+    return token ? { Authorization: `Bearer ${token}` } : {};
+  }
+
+  refused(res) {
+    if (res.status === 401 && this.auth) this.auth.refused();
+  }
+
   async request(method, path, { body, headers = {}, raw = false } = {}) {
-    const init = { method, headers: { Accept: 'application/json', ...headers } };
+    const init = { method, headers: { Accept: 'application/json', ...this.authHeaders(), ...headers } };
     if (body !== undefined) {
       if (body instanceof Blob || body instanceof ArrayBuffer || typeof body === 'string') {
         init.body = body;
@@ -55,14 +70,16 @@ export class Api {
         init.headers['Content-Type'] = 'application/json';
       }
     }
-    if (method !== 'GET') init.headers['X-Archgram-User'] = this.user();
     let res;
     try {
       res = await fetch(BASE + path, init);
     } catch (err) {
       throw new ApiError(networkProblem(err, `${method} ${path}`));
     }
-    if (!res.ok) throw new ApiError(await problemFrom(res));
+    if (!res.ok) {
+      this.refused(res);
+      throw new ApiError(await problemFrom(res));
+    }
     if (raw) return res;
     if (res.status === 204) return null;
     const text = await res.text();
@@ -76,6 +93,28 @@ export class Api {
   async getHealth() {
     if (!this.health) this.health = await this.request('GET', '/health');
     return this.health;
+  }
+
+  // --- the account and sharing ------------------------------------------------------------------
+  getMe() {
+    return this.request('GET', '/me');
+  }
+
+  // {model, public_read, items: [{user, role}]}
+  getMembers(id) {
+    return this.request('GET', `/models/${id}/members`);
+  }
+
+  share(id, user, role) {
+    return this.request('PUT', `/models/${id}/members/${encodeURIComponent(user)}`, { body: { role } });
+  }
+
+  unshare(id, user) {
+    return this.request('DELETE', `/models/${id}/members/${encodeURIComponent(user)}`);
+  }
+
+  setPublicRead(id, on) {
+    return this.request('PUT', `/models/${id}/public`, { body: { public_read: on } });
   }
 
   listModels(pageToken = null, pageSize = 50) {
@@ -154,7 +193,7 @@ export class Api {
       xhr.open('POST', BASE + path);
       xhr.setRequestHeader('Content-Type', 'application/octet-stream');
       xhr.setRequestHeader('Accept', 'application/json');
-      xhr.setRequestHeader('X-Archgram-User', this.user());
+      for (const [k, v] of Object.entries(this.authHeaders())) xhr.setRequestHeader(k, v);
       xhr.upload.onprogress = (e) => {
         if (e.lengthComputable) onProgress(e.loaded / e.total);
       };
@@ -167,6 +206,7 @@ export class Api {
           headers,
         });
         if (!res.ok) {
+          this.refused(res);
           problemFrom(res).then((p) => reject(new ApiError(p)));
           return;
         }

@@ -239,5 +239,9 @@ export class NewExtrusionPanel {
       if (f) upload.extrusion(f, this.style.value);
     });
     container.append(el('h2', {}, 'Extrude'), el('div.import', {}, drop, this.style));
+    // viewer accounts make no models
+    editor.signals.accountChanged.add((a) => {
+      container.hidden = a?.role === 'viewer';
+    });
   }
 }

@@ -7,26 +7,8 @@ import { OP, REMESHING, isSendable } from './opkinds.js';
 import { Selection } from './selection.js';
 import { Signal } from './signal.js';
 
-const USER_KEY = 'archgram.user';
-
-function defaultUser() {
-  const chars = 'abcdefghijklmnopqrstuvwxyz0123456789';
-  let s = '';
-  for (let i = 0; i < 4; i++) s += chars[Math.floor(Math.random() * chars.length)];
-  return `guest-${s}`;
-}
-
-function loadUser() {
-  try {
-    const saved = localStorage.getItem(USER_KEY);
-    if (saved && saved.trim()) return saved.trim();
-    const user = defaultUser();
-    localStorage.setItem(USER_KEY, user);
-    return user;
-  } catch {
-    return defaultUser(); // storage disabled: a fresh name per visit
-  }
-}
+// Roles on a model that may change it (the server checks again; this only spares refusals).
+const EDITING_ROLES = new Set(['editor', 'owner']);
 
 export class Editor {
   constructor() {
@@ -43,7 +25,8 @@ export class Editor {
       grammarChanged: new Signal(),    // grammar {text, version} (or null)
       procJobChanged: new Signal(),    // proceduralize job of the open model (or null)
       connectionChanged: new Signal(), // 'offline' | 'connecting' | 'online' | 'lost'
-      userChanged: new Signal(),
+      accountChanged: new Signal(),    // {name, role} of the signed-in account
+      roleChanged: new Signal(),       // the account's role on the open model (or null)
       cameraChanged: new Signal(),     // {position, target} from the viewport
       problem: new Signal(),           // {title, detail, ...}: shown to the person
       notice: new Signal(),            // short informational message
@@ -61,7 +44,8 @@ export class Editor {
     this.ops = new Map();   // version -> op entry of the open model
     this.job = null;
     this.connection = 'offline';
-    this.user = loadUser();
+    this.account = null;    // {name, role, auth} from GET /api/v1/me (auth.js)
+    this.role = null;       // 'owner' | 'editor' | 'viewer' on the open model
     this.camera = null;
     this.transport = null;  // sends ops: the live connection (REST while it is down)
     this.extrusion = new ExtrusionEditor(this);
@@ -70,6 +54,16 @@ export class Editor {
   // The selection's value ({component, group, node?, nodes?, components?} or null).
   get selection() {
     return this.selected.value;
+  }
+
+  // The signed-in account's name: the author of its ops, the name others see.
+  get user() {
+    return this.account?.name ?? '';
+  }
+
+  // May the person change the open model? Viewers get no edit tools and send no ops.
+  get canEdit() {
+    return !!this.model && EDITING_ROLES.has(this.role);
   }
 
   // --- ops ----------------------------------------------------------------------------------
@@ -88,6 +82,10 @@ export class Editor {
     }
     if (!this.model || !this.transport) {
       this.fail({ title: 'Edit not sent', detail: this.model ? 'not connected to the server' : 'no model is open' });
+      return null;
+    }
+    if (!this.canEdit) {
+      this.fail({ title: 'Read only', detail: `You are a ${this.role ?? 'guest'} of this model: ask an owner to make you an editor.` });
       return null;
     }
     try {
@@ -114,6 +112,7 @@ export class Editor {
   // --- the open model -----------------------------------------------------------------------
   openModel(model) {
     this.model = model ? { ...model } : null;
+    this.role = model?.role ?? null;
     this.selected.reset();
     this.tree = null;
     this.grammar = null;
@@ -121,6 +120,7 @@ export class Editor {
     this.peers.clear();
     this.ops.clear();
     this.signals.modelOpened.dispatch(this.model);
+    this.signals.roleChanged.dispatch(this.role);
     this.signals.treeChanged.dispatch(null);
     this.signals.grammarChanged.dispatch(null);
     this.signals.procJobChanged.dispatch(null);
@@ -217,17 +217,20 @@ export class Editor {
     if (this.peers.delete(peer)) this.signals.peersChanged.dispatch(this.peers);
   }
 
-  // --- misc ---------------------------------------------------------------------------------
-  setUser(name) {
-    const user = String(name).trim();
-    if (!user || user === this.user) return;
-    this.user = user;
-    try {
-      localStorage.setItem(USER_KEY, user);
-    } catch {
-      // storage disabled: the name lasts for this visit
-    }
-    this.signals.userChanged.dispatch(user);
+  // --- the account ----------------------------------------------------------------------------
+  setAccount(account) {
+    this.account = account ? { ...account } : null;
+    this.signals.accountChanged.dispatch(this.account);
+  }
+
+  // The role on the open model changed (the room told us, or a share did).
+  setRole(role) {
+    if (!this.model || role === this.role) return;
+    this.role = role;
+    this.model.role = role;
+    const listed = this.models.find((m) => m.id === this.model.id);
+    if (listed) listed.role = role;
+    this.signals.roleChanged.dispatch(role);
   }
 
   setJob(job) {

@@ -76,9 +76,11 @@ export class EditTools {
       this.clipText,
     );
     this.empty = el('div.empty', {}, 'Proceduralize the model to edit it.');
-    container.append(el('h2', {}, 'Edit'), this.empty, this.body);
+    this.readOnly = el('div.empty.read-only', { 'data-testid': 'read-only' }, 'Read only: you are a viewer of this model.');
+    container.append(el('h2', {}, 'Edit'), this.empty, this.readOnly, this.body);
 
     const s = editor.signals;
+    s.roleChanged.add(() => this.render());
     s.selectionChanged.add(() => this.render());
     s.treeChanged.add(() => this.render());
     s.modelOpened.add(() => this.render());
@@ -177,7 +179,7 @@ export class EditTools {
   }
 
   key(e) {
-    if (isTyping(e.target) || !(e.ctrlKey || e.metaKey) || e.altKey) return;
+    if (isTyping(e.target) || !(e.ctrlKey || e.metaKey) || e.altKey || !this.editor.canEdit) return;
     const k = e.key.toLowerCase();
     if (k === 'c' && this.editor.selected.nodeIds().length && !window.getSelection()?.toString()) {
       this.copy();
@@ -199,8 +201,11 @@ export class EditTools {
   render() {
     const ed = this.editor;
     const ready = !!(ed.model && ed.tree);
-    this.body.hidden = !ready;
-    this.empty.hidden = ready || !ed.model;
+    // viewers get no edit tools at all (and no undo: they have no edits)
+    if (ed.model && !ed.canEdit && this.splitting) this.splitting = false;
+    this.readOnly.hidden = !ed.model || ed.canEdit;
+    this.body.hidden = !ready || !ed.canEdit;
+    this.empty.hidden = ready || !ed.model || !ed.canEdit;
     const nodes = ed.selected.nodeIds();
     const one = this.single();
     this.regionSel.hidden = this.mode !== 'local';

@@ -58,6 +58,7 @@ export class GrammarPanel {
       this.conflict = false;
     });
     s.grammarChanged.add((g) => this.received(g));
+    s.roleChanged.add(() => this.renderState());
     this.received(editor.grammar);
   }
 
@@ -100,7 +101,7 @@ export class GrammarPanel {
   }
 
   async apply() {
-    if (this.busy || !this.dirty || !this.editor.grammar) return;
+    if (this.busy || !this.dirty || !this.editor.grammar || !this.editor.canEdit) return;
     this.busy = true;
     this.renderState();
     const sent = this.text.value;
@@ -155,6 +156,11 @@ export class GrammarPanel {
   renderState() {
     const g = this.editor.grammar;
     const changedOnServer = this.dirty && g && g.version !== this.base;
+    // viewers read the grammar; only editors change it
+    const editable = this.editor.canEdit;
+    this.text.readOnly = !editable;
+    this.applyButton.hidden = !editable;
+    this.reloadButton.hidden = !editable;
     this.applyButton.disabled = !this.dirty || this.busy;
     this.reloadButton.disabled = !this.dirty && !this.conflict;
     this.reloadButton.textContent = changedOnServer || this.conflict ? 'Reload' : 'Revert';

@@ -59,6 +59,7 @@ export class Handles {
     s.selectionChanged.add(() => this.sync());
     s.treeChanged.add(() => this.sync());
     s.modelOpened.add(() => this.sync());
+    s.roleChanged.add(() => this.sync()); // viewers get no drag handles
     s.cameraChanged.add(() => this.scale());
   }
 
@@ -67,7 +68,7 @@ export class Handles {
     if (this.drag) this.cancel();
     const tree = this.editor.tree;
     const id = this.editor.selected.single();
-    const n = id !== null && tree ? tree.node(id) : null;
+    const n = id !== null && tree && this.editor.canEdit ? tree.node(id) : null;
     if (!n || !Array.isArray(n.box) || n.box.length !== 6) {
       this.node = null;
       this.box = null;

@@ -84,6 +84,7 @@ export class HistoryPanel {
     editor.signals.historyChanged.add(() => this.render());
     editor.signals.modelOpened.add(() => this.render());
     editor.signals.modelChanged.add(() => this.render());
+    editor.signals.roleChanged.add(() => this.render());
     this.render();
   }
 
@@ -94,7 +95,7 @@ export class HistoryPanel {
 
   render() {
     const ed = this.editor;
-    this.form.hidden = !ed.model;
+    this.form.hidden = !ed.model || !ed.canEdit;
     const all = ed.history();
     const ops = all.slice(-SHOWN).reverse();
     if (!ed.model) {
@@ -116,7 +117,7 @@ export class HistoryPanel {
           el('span.op-kind', {}, e.op?.kind || '?'),
           el('span.op-summary', {}, summary(e.op)),
           el('span.op-time', {}, e.at ? timeAgo(e.at) : ''),
-          e.version < ed.model.version && ed.model.proceduralized
+          e.version < ed.model.version && ed.model.proceduralized && ed.canEdit
             ? el('button.op-restore', {
               type: 'button',
               title: `Make v${e.version} the current state again (a new edit)`,

@@ -66,7 +66,9 @@ export class Live {
     await new Promise((resolve, reject) => {
       let ws;
       try {
-        ws = new WebSocket(url, 'archgram');
+        // a browser cannot set headers on a websocket: the token rides as a second subprotocol
+        const token = this.api.auth?.token;
+        ws = new WebSocket(url, token ? ['archgram', `archgram.bearer.${token}`] : 'archgram');
       } catch (err) {
         reject(err);
         return;
@@ -146,7 +148,7 @@ export class Live {
   hello() {
     const ed = this.editor;
     if (this.room === null || !ed.model || ed.model.id !== this.room) return;
-    this.send({ type: 'hello', model: this.room, since: ed.model.version, user: ed.user });
+    this.send({ type: 'hello', model: this.room, since: ed.model.version });
   }
 
   // Sends an op made against the current version; resolves with the version it got, rejects
@@ -222,6 +224,7 @@ export class Live {
     switch (msg.type) {
       case 'welcome':
         if (!inRoom || msg.model !== ed.model.id) return;
+        if (msg.role) ed.setRole(msg.role);
         ed.setPeers(msg.peers);
         this.applyOps(msg.ops || []);
         // A long absence is replayed in slices: ask for the next one from where we are now.
@@ -272,6 +275,19 @@ export class Live {
         if (cb) cb(msg);
         break;
       }
+      case 'access':
+        // an owner changed who may use the model
+        if (!inRoom || msg.model !== ed.model.id) return;
+        if (msg.role === 'none') {
+          this.room = null;
+          ed.fail({ title: 'No access', detail: 'An owner took your access to this model away.' });
+          ed.openModel(null);
+          history.replaceState(null, '', location.pathname);
+        } else {
+          ed.setRole(msg.role);
+          ed.notify(`You are now a${msg.role === 'owner' ? 'n' : ''} ${msg.role} of this model`);
+        }
+        break;
       case 'error':
         ed.fail(msg.problem || { title: 'Live connection error' });
         break;

@@ -24,18 +24,22 @@ import { PreviewLayer } from './previewlayer.js';
 import { EditTools } from './edittools.js';
 import { Handles } from './handles.js';
 import { Undo } from './undo.js';
+import { Auth } from './auth.js';
+import { ShareDialog } from './share.js';
 
+const $ = (id) => document.getElementById(id);
 const editor = new Editor();
-const api = new Api(() => editor.user);
+const api = new Api();
+const auth = new Auth(editor, api, $('overlays'));
+const share = new ShareDialog(editor, api, $('overlays'));
 const live = new Live(editor, api);
 editor.useTransport(live); // editor.execute sends every op through the live connection
 const session = new Session(editor, api, live);
 const upload = new Upload(editor, api, live, session);
 const procedural = new Procedural(editor, api, live);
 
-const $ = (id) => document.getElementById(id);
 new Toast(editor, $('toasts'));
-new Toolbar(editor, session, $('toolbar'));
+new Toolbar(editor, session, $('toolbar'), { auth, share });
 new ModelsPanel(editor, session, upload, $('models'));
 const viewport = new Viewport(editor, api, $('viewport'));
 const preview = new PreviewLayer(editor, viewport, live);
@@ -55,11 +59,17 @@ new SplitTreePanel(editor, procedural, $('tree'));
 new GrammarPanel(editor, procedural, $('grammar'));
 collapsible(document.querySelectorAll('section[id]'));
 
+// Viewers see the extrusion panes without their tool bars (style.css: [data-read-only]).
+const markReadOnly = () => document.body.toggleAttribute('data-read-only', !!editor.model && !editor.canEdit);
+editor.signals.roleChanged.add(markReadOnly);
+editor.signals.modelOpened.add(markReadOnly);
+
 window.addEventListener('unhandledrejection', (e) => {
   editor.fail(e.reason);
 });
 
 window.archgram = editor; // for poking at state from the console
+window.archgramAuth = auth;
 window.archgramTools = { viewport, preview, editTools, handles }; // and at the edit tools (tests drive handles)
 
 function modelFromHash() {
@@ -73,6 +83,7 @@ window.addEventListener('hashchange', () => {
 });
 
 editor.openModel(null);
+await auth.start(); // the sign-in link, the kept token, or the sign-in form
 await session.loadModels();
 const initial = modelFromHash();
 if (initial !== null) await session.open(initial);

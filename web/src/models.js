@@ -49,9 +49,11 @@ export class ModelsPanel {
     this.more = el('button.more', { type: 'button', 'data-testid': 'load-more', hidden: true }, 'Load more');
     this.more.addEventListener('click', () => session.loadModels(true));
 
+    // viewer accounts make no models: no import for them
+    this.importRow = el('div.import', {}, this.drop, this.up);
     container.append(
       el('h2', {}, 'Models'),
-      el('div.import', {}, this.drop, this.up),
+      this.importRow,
       this.job,
       this.list,
       this.more,
@@ -62,6 +64,9 @@ export class ModelsPanel {
     s.modelOpened.add(() => this.renderList());
     s.modelChanged.add(() => this.renderList());
     s.jobChanged.add((job) => this.renderJob(job));
+    s.accountChanged.add((a) => {
+      this.importRow.hidden = a?.role === 'viewer';
+    });
   }
 
   renderList() {

@@ -339,6 +339,7 @@ export class PlanEditor {
     e.stopPropagation();
     this.svg.focus({ preventScroll: true });
     this.select({ kind: 'corner', loop, index });
+    if (!this.editor.canEdit) return; // viewers look at corners, they do not drag them
     const target = this.svg; // the pressed element is redrawn; the svg keeps the capture
     target.setPointerCapture?.(e.pointerId);
     const start = { x: e.clientX, y: e.clientY };
@@ -387,7 +388,7 @@ export class PlanEditor {
     if (e.button !== 0) return;
     e.stopPropagation();
     this.svg.focus({ preventScroll: true });
-    const tool = this.ext.tool;
+    const tool = this.editor.canEdit ? this.ext.tool : null;
     if (tool === 'anchor') this.addAnchor(e, loop, index);
     else if (tool === 'step') this.addStep(e, loop, index);
     else if (tool === 'offset') this.toggleOffset(loop, index);
@@ -410,7 +411,7 @@ export class PlanEditor {
   insertCorner(e, loop, index) {
     e.preventDefault();
     e.stopPropagation();
-    if (this.ext.tool) return; // the clicks were for the tool
+    if (this.ext.tool || !this.editor.canEdit) return; // the clicks were for the tool
     const foot = this.footOn(e, loop, index);
     if (foot.t < 0.02 || foot.t > 0.98) return; // on a corner: nothing to insert
     const draft = clone(this.plan);

@@ -364,7 +364,7 @@ export class ProfileEditor {
     this.svg.focus({ preventScroll: true });
     this.sel = index;
     this.render();
-    if (index === 0) return; // the profile starts at the plan edge on the ground
+    if (index === 0 || !this.editor.canEdit) return; // the first point stays; viewers only look
     const target = this.svg; // the pressed element is redrawn; the svg keeps the capture
     target.setPointerCapture?.(e.pointerId);
     const start = { x: e.clientX, y: e.clientY };
@@ -397,6 +397,7 @@ export class ProfileEditor {
 
   insertPoint(e, i) {
     e.preventDefault();
+    if (!this.editor.canEdit) return;
     const pts = this.points().map((p) => p.slice());
     const [w, z] = this.eventPoint(e);
     const [aw, az] = pts[i];

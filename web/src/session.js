@@ -9,7 +9,6 @@ export class Session {
     this.live = live;
     editor.signals.selectionChanged.add(() => live.presence());
     editor.signals.cameraChanged.add(() => live.presence());
-    editor.signals.userChanged.add(() => live.hello()); // re-introduce ourselves under the new name
   }
 
   async loadModels(more = false) {

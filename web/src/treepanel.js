@@ -42,6 +42,7 @@ export class SplitTreePanel {
 
     const s = editor.signals;
     s.modelOpened.add(() => this.renderActions());
+    s.roleChanged.add(() => this.renderActions());
     s.modelChanged.add(() => this.renderActions());
     s.procJobChanged.add(() => {
       this.renderJob();
@@ -62,7 +63,7 @@ export class SplitTreePanel {
     const ed = this.editor;
     const running = this.procedural.running;
     this.run.disabled = !ed.model || running;
-    this.run.hidden = !ed.model;
+    this.run.hidden = !ed.model || !ed.canEdit;
     this.run.textContent = ed.model?.proceduralized ? 'Proceduralize again' : 'Proceduralize';
     this.cancel.hidden = !running || !ed.procJob?.id;
   }

@@ -1,0 +1,607 @@
+#include "segment_cloud.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "../base/kdtree.h"
+#include "cluster.h"
+#include "normals.h"
+
+#define DEFAULT_SEED 0x61726368677261ull /* "archgra" */
+/* pieces at least this share of their plane's largest piece stay in its segment */
+#define MAIN_PIECE_SHARE 0.2
+
+static const char *const stage_names[AG_SEGMENT_CLOUD_STAGES] = {
+    "index", "normals", "coarse", "refine", "components", "cluster", "label"};
+
+const char *ag_segment_cloud_stage_name(ag_segment_cloud_stage s)
+{
+    return (unsigned)s < AG_SEGMENT_CLOUD_STAGES ? stage_names[s] : "?";
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+void ag_segment_cloud_free(ag_segment_cloud_result *r)
+{
+    if (!r)
+        return;
+    free(r->segment);
+    free(r->label);
+    free(r->piece);
+    free(r->segments);
+    free(r->member_start);
+    free(r->members);
+    free(r);
+}
+
+typedef struct {
+    const ag_segment_cloud_options *o;
+    ag_segment_cloud_stage stage;
+} progress_ctx;
+
+static int stage_progress(void *user, double fraction)
+{
+    progress_ctx *p = user;
+    return p->o->progress ? p->o->progress(p->o->user, p->stage, fraction) : 0;
+}
+
+/* Members of each segment (CSR) from the per-point segment ids. */
+static ag_status build_members(ag_segment_cloud_result *r, ag_error *err)
+{
+    free(r->member_start);
+    free(r->members);
+    r->member_start = calloc(r->nsegments + 1, sizeof *r->member_start);
+    size_t total = 0;
+    for (size_t i = 0; i < r->n; i++)
+        total += r->segment[i] >= 0;
+    r->members = malloc((total ? total : 1) * sizeof *r->members);
+    if (!r->member_start || !r->members)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    for (size_t i = 0; i < r->n; i++)
+        if (r->segment[i] >= 0)
+            r->member_start[r->segment[i] + 1]++;
+    for (size_t s = 0; s < r->nsegments; s++)
+        r->member_start[s + 1] += r->member_start[s];
+    uint32_t *fill = malloc((r->nsegments + 1) * sizeof *fill);
+    if (!fill)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    memcpy(fill, r->member_start, (r->nsegments + 1) * sizeof *fill);
+    for (size_t i = 0; i < r->n; i++)
+        if (r->segment[i] >= 0)
+            r->members[fill[r->segment[i]]++] = (uint32_t)i;
+    free(fill);
+    return AG_OK;
+}
+
+static void cross3(const double a[3], const double b[3], double o[3])
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* The largest principal direction of the points' covariance projected on the plane with
+ * normal `normal` (unit): the in-plane axis of a flat segment. */
+static void in_plane_axis(const ag_cloud *c, const uint32_t *idx, size_t m, const double mean[3],
+                          const double normal[3], double axis[3])
+{
+    double cov[6] = {0, 0, 0, 0, 0, 0};
+    for (size_t j = 0; j < m; j++) {
+        const double *p = c->xyz + 3 * (size_t)idx[j];
+        double d[3] = {p[0] - mean[0], p[1] - mean[1], p[2] - mean[2]};
+        double h = d[0] * normal[0] + d[1] * normal[1] + d[2] * normal[2];
+        for (int a = 0; a < 3; a++)
+            d[a] -= h * normal[a];
+        cov[0] -= d[0] * d[0];
+        cov[1] -= d[0] * d[1];
+        cov[2] -= d[0] * d[2];
+        cov[3] -= d[1] * d[1];
+        cov[4] -= d[1] * d[2];
+        cov[5] -= d[2] * d[2];
+    }
+    /* the smallest eigenvector of -cov is the largest of cov */
+    ag_normals_smallest_eigenvector(cov, axis, NULL);
+}
+
+/* A segment's frame and extents. The frame follows the building rather than the points'
+ * principal axes, which turn freely for nearly square shapes: a wall or roof plane has its
+ * horizontal direction and its slope line as axes, a level plane and a cluster the vertical
+ * and the principal direction of their plan. */
+static void describe(const ag_cloud *c, const uint32_t *idx, size_t m, ag_segment_cloud_item *s)
+{
+    double mean[3], cov[6];
+    ag_normals_covariance(c->xyz, idx, m, mean, cov);
+    double small[3], ev[3];
+    ag_normals_smallest_eigenvector(cov, small, ev);
+    double a0[3], a1[3], a2[3];
+    const double up[3] = {0, 0, 1};
+    if (s->kind == AG_SEGMENT_CLOUD_PLANE && fabs(small[2]) < 0.9) {
+        /* walls and roof planes: horizontal in-plane axis, then the slope line */
+        cross3(up, small, a0);
+        double l = sqrt(a0[0] * a0[0] + a0[1] * a0[1] + a0[2] * a0[2]);
+        for (int a = 0; a < 3; a++)
+            a0[a] /= l;
+        cross3(small, a0, a1);
+        memcpy(a2, small, sizeof a2);
+    } else if (s->kind == AG_SEGMENT_CLOUD_PLANE) {
+        /* level planes: the principal direction of the plan */
+        in_plane_axis(c, idx, m, mean, small, a0);
+        cross3(small, a0, a1);
+        memcpy(a2, small, sizeof a2);
+    } else {
+        /* clusters: vertical, and the principal direction of the plan */
+        in_plane_axis(c, idx, m, mean, up, a0);
+        cross3(up, a0, a1);
+        memcpy(a2, up, sizeof a2);
+    }
+    memcpy(s->centroid, mean, sizeof mean);
+    memcpy(s->axes[0], a0, sizeof a0);
+    memcpy(s->axes[1], a1, sizeof a1);
+    memcpy(s->axes[2], a2, sizeof a2);
+    for (int k = 0; k < 3; k++) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t j = 0; j < m; j++) {
+            const double *p = c->xyz + 3 * (size_t)idx[j];
+            double v = (p[0] - mean[0]) * s->axes[k][0] + (p[1] - mean[1]) * s->axes[k][1] +
+                       (p[2] - mean[2]) * s->axes[k][2];
+            if (v < lo)
+                lo = v;
+            if (v > hi)
+                hi = v;
+        }
+        s->extent[k] = m ? hi - lo : 0;
+    }
+    memcpy(s->plane.n, small, sizeof small);
+    s->plane.d = -(small[0] * mean[0] + small[1] * mean[1] + small[2] * mean[2]);
+    s->plane.count = m;
+    s->count = m;
+}
+
+static int cmp_double_desc(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x < y) - (x > y);
+}
+
+/* §3.2: same kind, sorted box dimensions within 5 %, point counts within 10 %. A small
+ * absolute slack (two point spacings) keeps noise from splitting thin dimensions. */
+static int similar(const ag_segment_cloud_item *a, const ag_segment_cloud_item *b, double slack)
+{
+    if (a->kind != b->kind)
+        return 0;
+    double ca = (double)a->count, cb = (double)b->count;
+    if (fabs(ca - cb) > 0.1 * (ca > cb ? ca : cb))
+        return 0;
+    double ea[3], eb[3];
+    memcpy(ea, a->extent, sizeof ea);
+    memcpy(eb, b->extent, sizeof eb);
+    qsort(ea, 3, sizeof ea[0], cmp_double_desc);
+    qsort(eb, 3, sizeof eb[0], cmp_double_desc);
+    for (int k = 0; k < 3; k++)
+        if (fabs(ea[k] - eb[k]) > 0.05 * (ea[k] > eb[k] ? ea[k] : eb[k]) + slack)
+            return 0;
+    return 1;
+}
+
+/* Segment table, members and labels from r->segment; nplanes first ids are planes. */
+static ag_status finish(const ag_cloud *c, ag_segment_cloud_result *r, size_t nplanes,
+                        ag_error *err)
+{
+    ag_status st = build_members(r, err);
+    if (st != AG_OK)
+        return st;
+    free(r->segments);
+    r->segments = calloc(r->nsegments ? r->nsegments : 1, sizeof *r->segments);
+    int32_t *rep = malloc((r->nsegments ? r->nsegments : 1) * sizeof *rep);
+    if (!r->segments || !rep) {
+        free(rep);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    r->nplanes = nplanes;
+    r->nclusters = r->nsegments - nplanes;
+    size_t nlabels = 0;
+    for (size_t s = 0; s < r->nsegments; s++) {
+        ag_segment_cloud_item *it = &r->segments[s];
+        it->kind = s < nplanes ? AG_SEGMENT_CLOUD_PLANE : AG_SEGMENT_CLOUD_CLUSTERED;
+        describe(c, r->members + r->member_start[s], r->member_start[s + 1] - r->member_start[s], it);
+        it->label = -1;
+        for (size_t l = 0; l < nlabels; l++)
+            if (similar(&r->segments[rep[l]], it, 2 * r->spacing)) {
+                it->label = (int32_t)l;
+                break;
+            }
+        if (it->label < 0) {
+            rep[nlabels] = (int32_t)s;
+            it->label = (int32_t)nlabels++;
+        }
+    }
+    free(rep);
+    r->nlabels = nlabels;
+    for (size_t i = 0; i < r->n; i++)
+        r->label[i] = r->segment[i] >= 0 ? r->segments[r->segment[i]].label : -1;
+    return AG_OK;
+}
+
+static ag_status alloc_result(size_t n, ag_segment_cloud_result **out, ag_error *err)
+{
+    ag_segment_cloud_result *r = calloc(1, sizeof *r);
+    if (r) {
+        r->n = n;
+        r->segment = malloc((n ? n : 1) * sizeof *r->segment);
+        r->label = malloc((n ? n : 1) * sizeof *r->label);
+        r->piece = malloc((n ? n : 1) * sizeof *r->piece);
+    }
+    if (!r || !r->segment || !r->label || !r->piece) {
+        ag_segment_cloud_free(r);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t i = 0; i < n; i++)
+        r->segment[i] = r->label[i] = r->piece[i] = -1;
+    *out = r;
+    return AG_OK;
+}
+
+ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
+                               ag_segment_cloud_result **out, ag_error *err)
+{
+    *out = NULL;
+    ag_segment_cloud_options o = opt ? *opt : (ag_segment_cloud_options){0};
+    size_t n = c->n;
+    ag_segment_cloud_result *r = NULL;
+    ag_status st = alloc_result(n, &r, err);
+    if (st != AG_OK)
+        return st;
+    if (n >= UINT32_MAX / 2) {
+        ag_segment_cloud_free(r);
+        return ag_error_set(err, AG_ERR_TOO_LARGE, 0, "%zu points are too many to segment at once", n);
+    }
+    double coarse = o.coarse_threshold ? o.coarse_threshold : 0.025;
+    double fine = o.fine_threshold > 0 ? o.fine_threshold : 0.01;
+    double angle = o.max_angle > 0 ? o.max_angle : 20;
+    double tol = o.cluster_tolerance > 0 ? o.cluster_tolerance : 0.01;
+    size_t min_plane = o.min_plane_points ? o.min_plane_points : (n / 10000 > 10 ? n / 10000 : 10);
+    size_t min_cluster = o.min_cluster_points ? o.min_cluster_points : min_plane;
+    unsigned k = o.k ? o.k : 16;
+    if (k < 4)
+        k = 4;
+    if (k > 64)
+        k = 64;
+    r->diagonal = ag_cloud_diagonal(c);
+    *out = r;
+    if (n < 3 || !(r->diagonal > 0)) {
+        /* nothing to fit: a point, a duplicate pile or no points at all */
+        return finish(c, r, 0, err);
+    }
+    r->fine_threshold = fine * r->diagonal;
+    r->coarse_threshold = coarse > 0 ? coarse * r->diagonal : 0;
+    progress_ctx pc = {&o, AG_SEGMENT_CLOUD_INDEX};
+
+    double t = now(), tc = cpu_now();
+    ag_kdtree *tree = NULL;
+    float *variation = malloc(n * sizeof *variation);
+    uint32_t *graph = malloc(n * (size_t)k * sizeof *graph);
+    int32_t *plane_of = malloc(n * sizeof *plane_of);
+    uint32_t *idx = malloc(n * sizeof *idx);
+    ag_plane_list planes = {0}, coarse_planes = {0};
+    ag_cloud view = *c; /* the cloud as the segmentation sees it (its normals) */
+    view.normals = NULL;
+    if (!variation || !graph || !plane_of || !idx) {
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        goto done;
+    }
+    st = ag_kdtree_build(c->xyz, NULL, n, &tree, err);
+    if (st != AG_OK)
+        goto done;
+    r->seconds[AG_SEGMENT_CLOUD_INDEX] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_INDEX] = cpu_now() - tc;
+
+    t = now();
+
+    tc = cpu_now();
+    pc.stage = AG_SEGMENT_CLOUD_NORMALS;
+    ag_normals_options no = {k, o.progress ? stage_progress : NULL, &pc};
+    ag_normals_info info;
+    st = ag_normals_compute(&view, tree, &no, variation, graph, &info, err);
+    if (st != AG_OK)
+        goto done;
+    r->spacing = info.spacing > 0 ? info.spacing : r->diagonal * 1e-3;
+    if (!c->normals) {
+        c->normals = view.normals; /* the cloud keeps the normals it lacked */
+    } else if (!o.recompute_normals) {
+        free(view.normals);
+        view.normals = c->normals;
+    }
+    ag_ransac_graph g = {graph, k};
+    r->seconds[AG_SEGMENT_CLOUD_NORMALS] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_NORMALS] = cpu_now() - tc;
+
+    for (size_t i = 0; i < n; i++) {
+        plane_of[i] = -1;
+        idx[i] = (uint32_t)i;
+    }
+    t = now();
+    tc = cpu_now();
+    if (coarse > 0) {
+        pc.stage = AG_SEGMENT_CLOUD_COARSE;
+        ag_ransac_options ro = {.threshold = r->coarse_threshold,
+                                .min_points = min_plane > n / 200 ? min_plane : n / 200,
+                                .seed = o.seed ? o.seed : DEFAULT_SEED,
+                                .progress = o.progress ? stage_progress : NULL,
+                                .user = &pc};
+        st = ag_ransac_global(&view, idx, n, NULL, 0, &ro, plane_of, &planes, err);
+        if (st != AG_OK)
+            goto done;
+        r->ncoarse = planes.n;
+        coarse_planes = planes;
+        memset(&planes, 0, sizeof planes);
+        for (size_t i = 0; i < n; i++)
+            plane_of[i] = -1;
+    }
+    r->seconds[AG_SEGMENT_CLOUD_COARSE] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_COARSE] = cpu_now() - tc;
+
+    t = now();
+
+    tc = cpu_now();
+    pc.stage = AG_SEGMENT_CLOUD_REFINE;
+    double radius = 4 * r->spacing;
+    ag_ransac_options lo = {.threshold = r->fine_threshold,
+                            .max_angle = angle,
+                            .adaptive = 1,
+                            .min_points = min_plane,
+                            .radius = radius,
+                            .progress = o.progress ? stage_progress : NULL,
+                            .user = &pc};
+    {
+        /* the dominant planes at the fine threshold with the normal test, over the whole
+         * cloud, best first; the coarse planes are candidates in every round, so each
+         * dominant plane is refined whole rather than cut at the borders of its slab */
+        ag_ransac_options go = lo;
+        go.min_points = min_plane > n / 1000 ? min_plane : n / 1000;
+        go.seed = (o.seed ? o.seed : DEFAULT_SEED) + 1;
+        go.extra = coarse_planes.items;
+        go.nextra = coarse_planes.n;
+        st = ag_ransac_global(&view, idx, n, NULL, 0, &go, plane_of, &planes, err);
+        if (st != AG_OK)
+            goto done;
+        /* then the small planes in what is left: connected support from flat seeds */
+        size_t m = 0;
+        for (size_t i = 0; i < n; i++)
+            if (plane_of[i] < 0)
+                idx[m++] = (uint32_t)i;
+        st = ag_ransac_local(&view, &g, variation, idx, m, NULL, 0, &lo, plane_of, &planes, err);
+        if (st != AG_OK)
+            goto done;
+    }
+    r->seconds[AG_SEGMENT_CLOUD_REFINE] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_REFINE] = cpu_now() - tc;
+
+    t = now();
+
+    tc = cpu_now();
+    size_t ncomp = 0;
+    {
+        /* pieces of each plane; stray pieces leave their plane (for the clustering) */
+        double gap = o.plane_gap ? o.plane_gap : 0.02;
+        if (gap < 0) {
+            for (size_t i = 0; i < n; i++)
+                r->piece[i] = plane_of[i];
+            r->npieces = planes.n;
+        } else {
+            st = ag_cluster_pieces(c, plane_of, gap * r->diagonal, min_plane, r->piece,
+                                   &r->npieces, err);
+            if (st != AG_OK)
+                goto done;
+        }
+        /* A plane's big pieces stay one segment (coplanar parts of one facade on both sides
+         * of a recess); a piece much smaller than the plane's largest is a segment of its
+         * own (a ledge coplanar with a far-away roof edge, bits of other surfaces). */
+        size_t np = r->npieces;
+        uint32_t *psize = calloc(np + 1, sizeof *psize);
+        int32_t *pplane = malloc((np + 1) * sizeof *pplane);
+        uint32_t *largest = calloc(planes.n + 1, sizeof *largest);
+        int32_t *main_id = malloc((planes.n + 1) * sizeof *main_id);
+        int32_t *pseg = malloc((np + 1) * sizeof *pseg);
+        if (!psize || !pplane || !largest || !main_id || !pseg) {
+            free(psize);
+            free(pplane);
+            free(largest);
+            free(main_id);
+            free(pseg);
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            goto done;
+        }
+        for (size_t i = 0; i < n; i++)
+            if (plane_of[i] >= 0) {
+                psize[r->piece[i]]++;
+                pplane[r->piece[i]] = plane_of[i];
+            }
+        for (size_t p = 0; p < np; p++)
+            if (psize[p] > largest[pplane[p]])
+                largest[pplane[p]] = psize[p];
+        for (size_t p = 0; p < planes.n; p++)
+            main_id[p] = -1;
+        size_t big_piece = min_plane > n / 1000 ? min_plane : n / 1000;
+        for (size_t p = 0; p < np; p++) {
+            int32_t pl = pplane[p];
+            if (psize[p] >= MAIN_PIECE_SHARE * largest[pl] && psize[p] >= big_piece) {
+                if (main_id[pl] < 0)
+                    main_id[pl] = (int32_t)ncomp++;
+                pseg[p] = main_id[pl];
+            } else {
+                pseg[p] = (int32_t)ncomp++;
+            }
+        }
+        for (size_t i = 0; i < n; i++)
+            if (plane_of[i] >= 0)
+                plane_of[i] = pseg[r->piece[i]];
+        free(psize);
+        free(pplane);
+        free(largest);
+        free(main_id);
+        free(pseg);
+    }
+    r->seconds[AG_SEGMENT_CLOUD_COMPONENTS] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_COMPONENTS] = cpu_now() - tc;
+
+    t = now();
+
+    tc = cpu_now();
+    {
+        size_t m = 0;
+        for (size_t i = 0; i < n; i++) {
+            r->segment[i] = plane_of[i];
+            if (plane_of[i] < 0)
+                idx[m++] = (uint32_t)i;
+        }
+        r->cluster_tolerance = tol * r->diagonal;
+        if (r->cluster_tolerance < 2 * r->spacing)
+            r->cluster_tolerance = 2 * r->spacing;
+        size_t ncl = 0;
+        st = ag_cluster_euclidean(c, idx, m, r->cluster_tolerance, min_cluster, (int32_t)ncomp,
+                                  r->segment, &ncl, err);
+        if (st != AG_OK)
+            goto done;
+        r->nsegments = ncomp + ncl;
+        /* a cluster is one piece */
+        for (size_t j = 0; j < m; j++)
+            if (r->segment[idx[j]] >= 0)
+                r->piece[idx[j]] = (int32_t)r->npieces + (r->segment[idx[j]] - (int32_t)ncomp);
+        r->npieces += ncl;
+    }
+    r->seconds[AG_SEGMENT_CLOUD_CLUSTER] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_CLUSTER] = cpu_now() - tc;
+
+    t = now();
+
+    tc = cpu_now();
+    st = finish(c, r, ncomp, err);
+    r->seconds[AG_SEGMENT_CLOUD_LABEL] = now() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_LABEL] = cpu_now() - tc;
+
+done:
+    if (view.normals && view.normals != c->normals)
+        free(view.normals);
+    ag_kdtree_free(tree);
+    free(variation);
+    free(graph);
+    free(plane_of);
+    free(idx);
+    ag_plane_list_free(&planes);
+    ag_plane_list_free(&coarse_planes);
+    if (st != AG_OK) {
+        ag_segment_cloud_free(r);
+        *out = NULL;
+    }
+    return st;
+}
+
+ag_status ag_segment_cloud_refine(ag_cloud *c, ag_segment_cloud_result *r, const double min[3],
+                                  const double max[3], const ag_segment_cloud_options *opt,
+                                  ag_error *err)
+{
+    if (r->n != c->n)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "the segmentation is of another cloud");
+    uint32_t *inside = malloc((c->n ? c->n : 1) * sizeof *inside);
+    if (!inside)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    size_t m = 0;
+    for (size_t i = 0; i < c->n; i++) {
+        const double *p = c->xyz + 3 * i;
+        if (p[0] >= min[0] && p[0] <= max[0] && p[1] >= min[1] && p[1] <= max[1] &&
+            p[2] >= min[2] && p[2] <= max[2])
+            inside[m++] = (uint32_t)i;
+    }
+    ag_cloud *sub = NULL;
+    ag_segment_cloud_result *rs = NULL;
+    ag_status st = ag_cloud_subset(c, inside, m, &sub, err);
+    if (st == AG_OK) {
+        ag_segment_cloud_options o = opt ? *opt : (ag_segment_cloud_options){0};
+        o.recompute_normals = 0; /* the whole cloud's normals, computed with more context */
+        st = ag_segment_cloud_run(sub, &o, &rs, err);
+    }
+    if (st != AG_OK) {
+        ag_cloud_free(sub);
+        free(inside);
+        return st;
+    }
+    /* old segments keep their order (minus the points inside), new ones follow; planes
+     * first so that the plane/cluster split of the ids stays */
+    size_t old = r->nsegments, nnew = rs->nsegments;
+    int32_t *map = malloc((old + nnew + 1) * sizeof *map);
+    size_t *count = calloc(old + 1, sizeof *count);
+    if (!map || !count) {
+        free(map);
+        free(count);
+        ag_cloud_free(sub);
+        free(inside);
+        ag_segment_cloud_free(rs);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t j = 0; j < m; j++)
+        r->segment[inside[j]] = r->piece[inside[j]] = -1;
+    for (size_t i = 0; i < c->n; i++)
+        if (r->segment[i] >= 0)
+            count[r->segment[i]]++;
+    /* new ids: surviving old planes, new planes, surviving old clusters, new clusters */
+    int32_t next = 0;
+    for (size_t s = 0; s < r->nplanes; s++)
+        map[s] = count[s] ? next++ : -1;
+    for (size_t s = 0; s < rs->nplanes; s++)
+        map[old + s] = next++;
+    size_t planes = (size_t)next;
+    for (size_t s = r->nplanes; s < old; s++)
+        map[s] = count[s] ? next++ : -1;
+    for (size_t s = rs->nplanes; s < nnew; s++)
+        map[old + s] = next++;
+    for (size_t i = 0; i < c->n; i++)
+        if (r->segment[i] >= 0)
+            r->segment[i] = map[r->segment[i]];
+    for (size_t j = 0; j < m; j++) {
+        r->segment[inside[j]] = rs->segment[j] >= 0 ? map[old + (size_t)rs->segment[j]] : -1;
+        r->piece[inside[j]] = rs->piece[j] >= 0 ? (int32_t)r->npieces + rs->piece[j] : -1;
+    }
+    r->nsegments = (size_t)next;
+    /* pieces renumbered densely */
+    size_t np = r->npieces + rs->npieces;
+    int32_t *pmap = malloc((np ? np : 1) * sizeof *pmap);
+    if (!pmap) {
+        free(map);
+        free(count);
+        free(inside);
+        ag_cloud_free(sub);
+        ag_segment_cloud_free(rs);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t p = 0; p < np; p++)
+        pmap[p] = -1;
+    int32_t pn = 0;
+    for (size_t i = 0; i < c->n; i++)
+        if (r->piece[i] >= 0) {
+            if (pmap[r->piece[i]] < 0)
+                pmap[r->piece[i]] = pn++;
+            r->piece[i] = pmap[r->piece[i]];
+        }
+    r->npieces = (size_t)pn;
+    free(pmap);
+    free(map);
+    free(count);
+    free(inside);
+    ag_cloud_free(sub);
+    ag_segment_cloud_free(rs);
+    return finish(c, r, planes, err);
+}

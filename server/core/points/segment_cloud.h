@@ -1,0 +1,106 @@
+/* Segment decomposition of a point cloud (§3.1 of "Procedural editing of building point
+ * clouds") in one call: spatial index → kNN normals → a global RANSAC pass at the paper's
+ * 2.5 % of the diagonal (the dominant planes) → a refinement pass inside each of them and
+ * then over what is left (smaller threshold, normal-angle test, connected support) →
+ * connected pieces of each plane (stray bits dropped) → Euclidean clustering (tolerance T_C)
+ * of the rest →
+ * labels (§3.2: same kind, box dimensions within 5 %, point counts within 10 %).
+ *
+ * Thresholds are fractions of the cloud's diagonal, so one set of defaults serves a
+ * chimney and a church; the options' zero value means the defaults. A region of interest
+ * can be segmented again at a finer granularity (ag_segment_cloud_refine), replacing only
+ * the segments inside it. Deterministic: the random choices come from a seeded generator.
+ * The seconds of each stage are reported. Segments list their members (CSR) for the stages
+ * that come after (consensus models, split tree). */
+#ifndef AG_POINTS_SEGMENT_CLOUD_H
+#define AG_POINTS_SEGMENT_CLOUD_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../status.h"
+#include "cloud.h"
+#include "ransac.h"
+
+typedef enum {
+    AG_SEGMENT_CLOUD_INDEX,      /* kd-tree */
+    AG_SEGMENT_CLOUD_NORMALS,    /* kNN PCA normals and the neighbour graph */
+    AG_SEGMENT_CLOUD_COARSE,     /* global RANSAC at the coarse threshold */
+    AG_SEGMENT_CLOUD_REFINE,     /* local RANSAC with the normal test */
+    AG_SEGMENT_CLOUD_COMPONENTS, /* connected components of the planes */
+    AG_SEGMENT_CLOUD_CLUSTER,    /* Euclidean clustering of the rest */
+    AG_SEGMENT_CLOUD_LABEL,      /* segment boxes and labels */
+    AG_SEGMENT_CLOUD_STAGES
+} ag_segment_cloud_stage;
+
+const char *ag_segment_cloud_stage_name(ag_segment_cloud_stage s);
+
+typedef struct {
+    double coarse_threshold;  /* fraction of the diagonal; 0 = 0.025; < 0 skips the pass */
+    double fine_threshold;    /* fraction of the diagonal; 0 = 0.01 */
+    double max_angle;         /* degrees between point and plane normals; 0 = 20 */
+    double cluster_tolerance; /* T_C, fraction of the diagonal; 0 = 0.01 */
+    double plane_gap;         /* a plane's inliers are split into pieces where they are
+                               * farther apart than this (fraction of the diagonal; 0 =
+                               * 0.02; < 0: one piece per plane); pieces smaller than the
+                               * plane minimum are dropped, the others stay one segment */
+    size_t min_plane_points;  /* 0 = max(10, n / 10000) */
+    size_t min_cluster_points;/* 0 = the plane minimum */
+    unsigned k;               /* neighbours for normals and the graph; 0 = 16 */
+    int recompute_normals;    /* segment with kNN normals even when the cloud has its own
+                               * (by default a cloud's own normals, from the scanner or the
+                               * mesh it was sampled from, are used: they are better) */
+    uint64_t seed;            /* 0 = a fixed default */
+    /* Called at each stage with the fraction of that stage done; non-zero cancels. */
+    int (*progress)(void *user, ag_segment_cloud_stage stage, double fraction);
+    void *user;
+} ag_segment_cloud_options;
+
+typedef enum { AG_SEGMENT_CLOUD_PLANE, AG_SEGMENT_CLOUD_CLUSTERED } ag_segment_cloud_kind;
+
+typedef struct {
+    ag_segment_cloud_kind kind;
+    size_t count;
+    ag_plane plane;         /* least-squares plane (also for clusters: their flattest axis) */
+    double centroid[3];
+    /* The box frame: walls and roof planes have their horizontal direction, their slope line
+     * and their normal; level planes the principal direction of their plan, the direction
+     * across it and the normal; clusters the principal plan direction, across, vertical. */
+    double axes[3][3];
+    double extent[3];       /* size along each axis */
+    int32_t label;
+} ag_segment_cloud_item;
+
+typedef struct {
+    size_t n;                  /* points of the cloud */
+    int32_t *segment;          /* per point: its segment, or -1 */
+    int32_t *label;            /* per point: its segment's label, or -1 */
+    int32_t *piece;            /* per point: the connected piece of its segment, or -1 */
+    size_t npieces;
+    size_t nsegments;
+    ag_segment_cloud_item *segments;
+    uint32_t *member_start;    /* nsegments + 1 offsets into members */
+    uint32_t *members;         /* point indices of each segment, ascending */
+    size_t nlabels;
+    size_t ncoarse;            /* planes of the coarse pass */
+    size_t nplanes, nclusters; /* segments of each kind */
+    double diagonal, spacing;  /* metres */
+    double coarse_threshold, fine_threshold, cluster_tolerance; /* metres, as used */
+    double seconds[AG_SEGMENT_CLOUD_STAGES];     /* wall clock */
+    double cpu_seconds[AG_SEGMENT_CLOUD_STAGES]; /* this thread's processor time */
+} ag_segment_cloud_result;
+
+/* Segments c. When c has no normals, the computed ones are stored in it. */
+ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
+                               ag_segment_cloud_result **out, ag_error *err);
+
+/* Segments the points inside the box [min, max] again, with thresholds relative to the
+ * diagonal of those points, and replaces the segments they had (a segment reaching out of
+ * the box keeps its points outside). Segments and labels are renumbered. */
+ag_status ag_segment_cloud_refine(ag_cloud *c, ag_segment_cloud_result *r, const double min[3],
+                                  const double max[3], const ag_segment_cloud_options *opt,
+                                  ag_error *err);
+
+void ag_segment_cloud_free(ag_segment_cloud_result *r);
+
+#endif
