@@ -23,7 +23,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ag_error err;
     ag_error_clear(&err);
     ag_import_options opt = {0};
-    ag_status s = ag_import_sandbox_read(data + 1, size - 1, fmt, &opt, 3.0, &m, &err);
+    ag_status s = ag_import_sandbox_read(data + 1, size - 1, fmt, &opt, 1.0, &m, &err);
     if (s != AG_OK) {
         fuzz_check_refusal(s, &err, "import");
         return 0;
