@@ -5,11 +5,12 @@
 //   - how long archgramd takes to stop after SIGTERM while a long edit runs.
 // Needs about 2,100 file descriptors (ulimit -n).
 import fs from 'node:fs';
-import net from 'node:net';
 import { performance } from 'node:perf_hooks';
 import {
   DAEMON, http, removeDir, sleep, startDaemon, waitJob,
 } from '../tests/integration/harness.js';
+import { healthFrom, partialRequest } from '../tests/integration/clients.js';
+import { plan838 } from '../tests/integration/generated.js';
 
 if (!fs.existsSync(DAEMON)) {
   console.log(`bench/robustness.js: ${DAEMON} is missing (make build/archgramd); skipped`);
@@ -22,37 +23,19 @@ function summary(v) {
   return `median ${ms(s[Math.floor(s.length / 2)])}, max ${ms(s.at(-1))}`;
 }
 
-function rawHealth(port, localAddress) {
-  return new Promise((resolve, reject) => {
-    const t0 = performance.now();
-    const s = net.connect({ port, host: '127.0.0.1', localAddress }, () => {
-      s.write('GET /api/v1/health HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n');
-    });
-    let got = '';
-    s.on('data', (b) => { got += b; });
-    s.on('end', () => (got.startsWith('HTTP/1.1 200') ? resolve(performance.now() - t0) : reject(new Error(got.slice(0, 80)))));
-    s.on('error', reject);
-  });
-}
 
 async function slowloris() {
   const d = await startDaemon({ args: ['--no-web', '--rate-rest', '0', '--header-timeout', '10'] });
   const sockets = [];
   try {
     for (let a = 10; a < 50; a++) {
-      await Promise.all([...Array(50).keys()].map(() => new Promise((resolve) => {
-        const s = net.connect({ port: d.port, host: '127.0.0.1', localAddress: `127.0.0.${a}` });
-        s.on('error', () => {});
-        s.on('connect', () => { s.write('GET /api/v1/health HTTP/1.1\r\nHost: x\r\n'); resolve(); });
-        setTimeout(resolve, 3000);
-        sockets.push(s);
-      })));
+      sockets.push(...await Promise.all([...Array(50).keys()].map(() => partialRequest(d.port, `127.0.0.${a}`))));
     }
     const trickle = setInterval(() => { for (const s of sockets) if (!s.destroyed) s.write('X'); }, 1000);
     await sleep(500);
     const held = (await http(d, 'GET', '/api/v1/health')).json.http.connections;
     const t = [];
-    for (let i = 0; i < 20; i++) t.push(await rawHealth(d.port, '127.0.0.2'));
+    for (let i = 0; i < 20; i++) t.push((await healthFrom(d.port, '127.0.0.2')).ms);
     clearInterval(trickle);
     console.log(`slowloris: ${sockets.length} partial requests sent, ${held} held by the server; ` +
       `a new client's health: ${summary(t)}`);
@@ -63,17 +46,6 @@ async function slowloris() {
   }
 }
 
-function plan838() {
-  const pts = [];
-  let seed = 7;
-  const rnd = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
-  for (let i = 0; i < 838; i++) {
-    const a = (2 * Math.PI * i) / 838;
-    const r = 40 + 3 * Math.sin(17 * a) + 1.5 * Math.sin(41 * a) + (rnd() - 0.5) * 0.6;
-    pts.push([+(r * Math.cos(a)).toFixed(4), +(r * Math.sin(a)).toFixed(4)]);
-  }
-  return { profiles: { hip: { points: [[0, 0], [0, 6], [1, 7]] } }, default_profile: 'hip', loops: [{ points: pts }] };
-}
 
 async function previews() {
   const d = await startDaemon({ args: ['--no-web', '--rate-rest', '0'] });

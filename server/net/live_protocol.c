@@ -187,6 +187,26 @@ static void nack_fallback(const json_t *msg, char *buf, size_t cap)
 }
 #define NACK_FALLBACK_MAX (AG_PROBLEM_FALLBACK_MAX + 160)
 
+/* The text of an op's answer (reply stolen): its JSON, or, when that could not be built, the
+ * fallback nack written into buf. *heap is what to free afterwards (NULL when buf is used). */
+static const char *answer_text(json_t *reply, const json_t *msg, char *buf, size_t cap,
+                               char **heap)
+{
+    *heap = reply ? json_dumps(reply, JSON_COMPACT) : NULL;
+    json_decref(reply);
+    if (*heap)
+        return *heap;
+    nack_fallback(msg, buf, cap);
+    return buf;
+}
+
+/* A nack refused before any model was read. */
+static json_t *nack_json(const json_t *msg, ag_status st, const ag_error *err)
+{
+    return json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid", json_object_get(msg, "cid"),
+                     "version", (json_int_t)0, "problem", ag_problem_json(st, err));
+}
+
 /* Solves a drag preview (any thread): the message for the whole room (the author too: the
  * server's solve is what everyone sees), or with *to_room = 0 a problem for the author only.
  * Nothing is stored. */
@@ -243,37 +263,26 @@ static void task_run(void *user, ag_task_budget *budget)
     int to_room = 0;
     json_t *reply = t->preview ? preview_message(app, t->model, t->user, t->peer, t->msg, &to_room)
                                : op_reply(app, t->model, t->user, t->session, t->msg, budget);
-    char *text = reply ? json_dumps(reply, JSON_COMPACT) : NULL;
-    json_decref(reply);
-    if (text && to_room) {
-        ag__live_post_to_room(t->live, t->model, text);
-    } else if (text) {
-        ag__live_post_to_session(t->live, t->session, text);
-    } else if (!t->preview) { /* an op is always answered */
-        char fallback[NACK_FALLBACK_MAX];
-        nack_fallback(t->msg, fallback, sizeof fallback);
-        ag__live_post_to_session(t->live, t->session, fallback);
+    char fallback[NACK_FALLBACK_MAX], *heap;
+    if (!reply && t->preview) {
+        task_free(t); /* a preview is only worth its newest position */
+        return;
     }
-    free(text);
+    const char *text = answer_text(reply, t->msg, fallback, sizeof fallback, &heap);
+    if (to_room)
+        ag__live_post_to_room(t->live, t->model, text);
+    else
+        ag__live_post_to_session(t->live, t->session, text); /* an op is always answered */
+    free(heap);
     task_free(t);
 }
 
-/* A nack sent from the service thread (refused before any model was read). */
-static void send_nack(ag_live_session *s, const json_t *msg, ag_status st, const ag_error *err)
+/* Sends the answer to an op from the service thread. */
+static void send_answer(ag_live_session *s, const json_t *msg, json_t *reply /* stolen */)
 {
-    json_t *nack = json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid",
-                             json_object_get(msg, "cid"), "version", (json_int_t)0, "problem",
-                             ag_problem_json(st, err));
-    char *text = nack ? json_dumps(nack, JSON_COMPACT) : NULL;
-    json_decref(nack);
-    if (text) {
-        ag_live_rooms_send(s, text);
-    } else {
-        char fallback[NACK_FALLBACK_MAX];
-        nack_fallback(msg, fallback, sizeof fallback);
-        ag_live_rooms_send(s, fallback);
-    }
-    free(text);
+    char fallback[NACK_FALLBACK_MAX], *heap;
+    ag_live_rooms_send(s, answer_text(reply, msg, fallback, sizeof fallback, &heap));
+    free(heap);
 }
 
 /* A task the queue dropped at a stop: an op is still answered. */
@@ -284,14 +293,11 @@ static void task_drop(void *user)
         ag_error err;
         ag_error_set(&err, AG_ERR_CANCELLED, 0,
                      "archgramd is shutting down; the op was not applied");
-        json_t *nack = json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid",
-                                 json_object_get(t->msg, "cid"), "version", (json_int_t)0,
-                                 "problem", ag_problem_json(AG_ERR_CANCELLED, &err));
-        char *text = nack ? json_dumps(nack, JSON_COMPACT) : NULL;
-        json_decref(nack);
-        if (text)
-            ag__live_post_to_session(t->live, t->session, text);
-        free(text);
+        char fallback[NACK_FALLBACK_MAX], *heap;
+        ag__live_post_to_session(t->live, t->session,
+                                 answer_text(nack_json(t->msg, AG_ERR_CANCELLED, &err), t->msg,
+                                             fallback, sizeof fallback, &heap));
+        free(heap);
     }
     task_free(t);
 }
@@ -323,7 +329,7 @@ static void run_on_task_lane(ag_live *live, ag_live_session *s, json_t *msg, int
         return; /* a preview is only worth its newest position: drop it */
     if (st == AG_ERR_BUSY)
         ag_error_set(&err, AG_ERR_BUSY, 0, "too many edits are waiting; send it again later");
-    send_nack(s, msg, st, &err);
+    send_answer(s, msg, nack_json(msg, st, &err));
 }
 
 /* May s change its room's model now? Checked on every op and preview, so a role taken away
@@ -344,29 +350,19 @@ static void on_op(ag_live *live, ag_live_session *s, json_t *msg)
         int64_t current = 0;
         if (ag_app_query_version(ag__live_app(live), s->model, &current, NULL) != AG_OK)
             current = 0;
-        return ag_live_rooms_send_json(
-            s, json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid",
-                         json_object_get(msg, "cid"), "version", (json_int_t)current, "problem",
-                         ag_problem_json(st, &err)));
+        return send_answer(s, msg,
+                           json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid",
+                                     json_object_get(msg, "cid"), "version",
+                                     (json_int_t)current, "problem", ag_problem_json(st, &err)));
     }
     const ag_op_kind *row =
         ag_optable_find(json_string_value(json_object_get(json_object_get(msg, "op"), "kind")));
-    /* structural kinds a client may send go to the model's task lane; the rest (and every refusal
-     * that needs no model) is answered here */
+    /* structural kinds a client may send go to the model's task lane; the rest (and every
+     * refusal that needs no model) is answered here */
     if (row && row->lane == AG_OP_STRUCTURAL && (row->flags & AG_OP_CLIENT) &&
         json_is_string(json_object_get(msg, "cid")))
         return run_on_task_lane(live, s, msg, 0);
-    json_t *reply = op_reply(ag__live_app(live), s->model, s->user, s->id, msg, NULL);
-    char *text = reply ? json_dumps(reply, JSON_COMPACT) : NULL;
-    json_decref(reply);
-    if (text) {
-        ag_live_rooms_send(s, text);
-    } else {
-        char fallback[NACK_FALLBACK_MAX];
-        nack_fallback(msg, fallback, sizeof fallback);
-        ag_live_rooms_send(s, fallback);
-    }
-    free(text);
+    send_answer(s, msg, op_reply(ag__live_app(live), s->model, s->user, s->id, msg, NULL));
 }
 
 /* --- previews ------------------------------------------------------------------------------ */

@@ -9,6 +9,7 @@ import { after, before, describe, it } from 'node:test';
 import {
   assertProblem, http, removeDir, sleep, sql, startDaemon, tempDir, waitJob, WsClient,
 } from './harness.js';
+import { plan838 } from './generated.js';
 
 // Peak resident memory of a process (kB), from Linux's /proc.
 function peakKb(pid) {
@@ -32,18 +33,6 @@ async function resize(d, id, scale, node = 'root', timeout = 120000) {
   });
 }
 
-// A ring of 838 corners with a hip profile: a few hundred milliseconds of sweep each.
-function plan838() {
-  const pts = [];
-  let seed = 7;
-  const rnd = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
-  for (let i = 0; i < 838; i++) {
-    const a = (2 * Math.PI * i) / 838;
-    const r = 40 + 3 * Math.sin(17 * a) + 1.5 * Math.sin(41 * a) + (rnd() - 0.5) * 0.6;
-    pts.push([+(r * Math.cos(a)).toFixed(4), +(r * Math.sin(a)).toFixed(4)]);
-  }
-  return { profiles: { hip: { points: [[0, 0], [0, 6], [1, 7]] } }, default_profile: 'hip', loops: [{ points: pts }] };
-}
 
 describe('bounded work', () => {
   const dir = tempDir();

@@ -3,11 +3,11 @@
 // client address, and a flood of partial requests (slowloris) neither locks other clients out
 // nor keeps its connections: they are cut at the header timeout.
 import assert from 'node:assert/strict';
-import net from 'node:net';
 import { after, before, describe, it } from 'node:test';
 import {
   assertProblem, http, removeDir, sleep, startDaemon, waitJob, WsClient,
 } from './harness.js';
+import { healthFrom, partialRequest } from './clients.js';
 
 const OBJ = 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n';
 
@@ -55,15 +55,7 @@ describe('rate limits', () => {
     const r = await http(d, 'GET', '/api/v1/models');
     assertProblem(r, 429, 'rate-limited');
     // a client at another loopback address has a bucket of its own
-    const other = await new Promise((resolve, reject) => {
-      const s = net.connect({ port: d.port, host: '127.0.0.1', localAddress: '127.0.0.9' }, () => {
-        s.write('GET /api/v1/health HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n');
-      });
-      let got = '';
-      s.on('data', (b) => { got += b; });
-      s.on('end', () => resolve(got));
-      s.on('error', reject);
-    });
+    const other = (await healthFrom(d.port, '127.0.0.9')).head;
     assert.match(other, /^HTTP\/1\.1 200/);
     await sleep(1200);
     assert.equal((await http(d, 'GET', '/api/v1/health')).status, 200, 'tokens come back');
@@ -99,17 +91,6 @@ describe('rate limits', () => {
   });
 });
 
-// Opens a socket from a loopback address and sends the start of a request, never its end.
-function partial(port, localAddress) {
-  return new Promise((resolve) => {
-    const s = net.connect({ port, host: '127.0.0.1', localAddress });
-    s.on('error', () => {});
-    s.on('connect', () => { s.write('GET /api/v1/health HTTP/1.1\r\nHost: x\r\n'); resolve(s); });
-    s.on('close', () => { s.closedAt = Date.now(); });
-    setTimeout(() => resolve(s), 3000);
-  });
-}
-
 describe('slow clients', () => {
   let d;
   after(() => stopAll(d));
@@ -122,7 +103,7 @@ describe('slow clients', () => {
     // 10 addresses × 60 attempts: 40 each are kept open (the per-address limit), the rest
     // refused at once
     for (let a = 10; a < 20; a++) {
-      const batch = await Promise.all([...Array(60).keys()].map(() => partial(d.port, `127.0.0.${a}`)));
+      const batch = await Promise.all([...Array(60).keys()].map(() => partialRequest(d.port, `127.0.0.${a}`)));
       sockets.push(...batch);
     }
     // keep trickling a header byte every 300 ms: the idle timeout alone would never fire
@@ -137,18 +118,9 @@ describe('slow clients', () => {
       // a new client from yet another address
       const times = [];
       for (let i = 0; i < 5; i++) {
-        const t0 = performance.now();
-        const r = await new Promise((resolve, reject) => {
-          const s = net.connect({ port: d.port, host: '127.0.0.1', localAddress: '127.0.0.2' }, () => {
-            s.write('GET /api/v1/health HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n');
-          });
-          let got = '';
-          s.on('data', (b) => { got += b; });
-          s.on('end', () => resolve(got));
-          s.on('error', reject);
-        });
-        times.push(performance.now() - t0);
-        assert.match(r, /^HTTP\/1\.1 200/);
+        const r = await healthFrom(d.port, '127.0.0.2');
+        times.push(r.ms);
+        assert.match(r.head, /^HTTP\/1\.1 200/);
       }
       console.log(`# a new client beside ${h.http.connections} partial connections: ${times.map((t) => t.toFixed(1)).join(', ')} ms`);
       assert.ok(Math.min(...times) < 250, times.join(' '));
