@@ -21,8 +21,9 @@ try {
   const model = await soakModel(d, clients);
   const r = await runSoak(d, model, { clients, seconds, seed: 7 });
   console.log(`soak: ${r.clients} clients, ${r.seconds.toFixed(0)} s, ${r.ops} ops (${r.versions} versions, ` +
-    `${(r.versions / r.seconds).toFixed(1)}/s); structural ${r.structural}, acked on the first send ` +
-    `${r.firstAcked} (${((100 * r.firstAcked) / r.structural).toFixed(1)} %); notes and renames ` +
+    `${(r.versions / r.seconds).toFixed(1)}/s); structural ${r.structural} (${r.conflicts} true conflicts), ` +
+    `acked on the first send ${r.firstAcked} (${((100 * r.firstAcked) / (r.structural - r.conflicts)).toFixed(1)} % ` +
+    `of those that did not conflict); notes and renames ` +
     `${r.notes + r.renames}, nacked (same-kind conflicts) ${r.fastNacked}; every client ends with the database`);
   for (const detail of r.nackDetails.slice(0, 5)) console.log(`  nack: ${detail}`);
 } finally {

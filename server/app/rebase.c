@@ -230,7 +230,9 @@ ag_status ag_rebase_op(const ag_store_env *env, const ag_op_request *rq, const a
             break;
         {
             json_t *copy = json_deep_copy(rq->op);
-            json_t *ta = tree_of(env->db, rq->model, rq->base, &s, err);
+            /* the tree at the base is the one before the first geometry op: only ops that
+             * leave the geometry alone lie between, and that op kept its state before it */
+            json_t *ta = tree_of(env->db, rq->model, first_geometry->version - 1, &s, err);
             if (!copy && s == AG_OK)
                 s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
             if (s == AG_OK && !ta)

@@ -335,7 +335,11 @@ static int on_lws(struct lws *wsi, enum lws_callback_reasons reason, void *user,
         ag_live_rooms_add(&live->rooms, s, wsi);
         char peer[48] = "?";
         lws_get_peer_simple(wsi, peer, sizeof peer);
-        snprintf(s->rate_key, sizeof s->rate_key, "addr:%s", peer);
+        /* an account's messages count together, wherever it connects from */
+        if (s->who.user)
+            snprintf(s->rate_key, sizeof s->rate_key, "user:%lld", (long long)s->who.user);
+        else
+            snprintf(s->rate_key, sizeof s->rate_key, "addr:%s", peer);
         break;
     }
     case LWS_CALLBACK_RECEIVE:
