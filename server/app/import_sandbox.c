@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -71,8 +72,18 @@ static size_t vm_size(void)
 }
 
 static void child(int fd, const uint8_t *data, size_t len, ag_format fmt, ag_up_axis up,
-                  size_t cap)
+                  size_t cap, double seconds, pid_t parent)
 {
+    /* never outlive the parent (it would hold the service's sockets), nor the deadline's
+     * worth of processor time should the parent stop watching */
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent)
+        _exit(4); /* the parent went before the signal was asked for */
+    if (seconds > 0) {
+        rlim_t cpu = (rlim_t)seconds + 2;
+        struct rlimit rl = {cpu, cpu};
+        setrlimit(RLIMIT_CPU, &rl);
+    }
     if (SANDBOX_CAP && cap) {
         struct rlimit rl = {cap, cap};
         setrlimit(RLIMIT_AS, &rl);
@@ -107,7 +118,7 @@ ag_status ag_import_sandbox_read(const uint8_t *data, size_t len, ag_format fmt,
                             strerror(errno));
     size_t cap = vm_size() + AG_IMPORT_SANDBOX_EXTRA_BYTES;
     fflush(NULL);
-    pid_t pid = fork();
+    pid_t parent = getpid(), pid = fork();
     if (pid < 0) {
         int e = errno;
         close(fds[0]);
@@ -117,7 +128,7 @@ ag_status ag_import_sandbox_read(const uint8_t *data, size_t len, ag_format fmt,
     }
     if (pid == 0) {
         close(fds[0]);
-        child(fds[1], data, len, fmt, opt ? opt->up : AG_UP_DEFAULT, cap);
+        child(fds[1], data, len, fmt, opt ? opt->up : AG_UP_DEFAULT, cap, seconds, parent);
     }
     close(fds[1]);
     /* read the reply until the child closes the pipe, within the deadline */

@@ -179,3 +179,30 @@ describe('bounded work', () => {
     assert.ok(Number(rows[0][0]) === t.version || Number(rows[0][0]) === t.version + 1);
   });
 });
+
+describe('uploads assimp cannot finish', () => {
+  let d;
+  after(async () => { if (d) { try { await d.stop(); } finally { await d.kill(); removeDir(d.dir); } } });
+
+  it('a PLY that loops assimp fails its job at --import-seconds; the service goes on', async () => {
+    d = await startDaemon({ args: ['--no-web', '--import-seconds', '1', '--workers', '1'] });
+    const loops = fs.readFileSync(new URL('../data/import_sandbox/loops.ply', import.meta.url));
+    const t0 = Date.now();
+    const up = await http(d, 'POST', '/api/v1/models?name=loops&format=ply', {
+      body: loops, headers: { 'Content-Type': 'application/octet-stream' },
+    });
+    assert.equal(up.status, 202, up.text);
+    const job = await waitJob(d, up.json.id, { timeout: 30000 });
+    assert.equal(job.status, 'failed', JSON.stringify(job));
+    assert.equal(job.error.type, 'urn:archgram:problem:deadline');
+    assert.match(job.error.detail, /longer than 1 s/);
+    assert.ok(Date.now() - t0 < 10000, `${Date.now() - t0} ms`);
+    // the one worker is free again: a good PLY imports
+    const good = fs.readFileSync(new URL('../data/proc/quad.ply', import.meta.url));
+    const up2 = await http(d, 'POST', '/api/v1/models?name=quad&format=ply', {
+      body: good, headers: { 'Content-Type': 'application/octet-stream' },
+    });
+    const job2 = await waitJob(d, up2.json.id, { timeout: 30000 });
+    assert.equal(job2.status, 'succeeded', JSON.stringify(job2));
+  });
+});
