@@ -28,8 +28,8 @@ DB      ?= var/archgram.db
 # Debian packages: to build and run; in addition to test (and to run the sanitizer build);
 # to benchmark.
 DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libwebsockets-dev \
-             libsqlite3-dev libsuitesparse-dev libassimp-dev libssl-dev libsodium-dev
-DEB_TEST  := libcmocka-dev chromium curl sqlite3 python3 binutils libasan8 libubsan1
+             libsqlite3-dev libsuitesparse-dev libassimp-dev libssl-dev libsodium-dev libpng-dev
+DEB_TEST  := libcmocka-dev chromium curl sqlite3 python3 binutils libasan8 libubsan1 libcgal-dev g++
 DEB_BENCH := wrk
 
 # --- layers -------------------------------------------------------------------------------
@@ -48,7 +48,7 @@ ARCHIVES  := $(foreach l,$(LAYERS),$(LIBDIR)/libag_$(l).a)
 # Link order: the highest layer first, each followed by what it may use.
 LINK_ARCHIVES := $(foreach l,net app store io core,$(LIBDIR)/libag_$(l).a)
 # The system libraries, in the same order: net's, app's, store's, io's, core's.
-LDLIBS    := -lwebsockets -lmicrohttpd -lpthread -lsodium -lsqlite3 -ljansson -lassimp -lcrypto \
+LDLIBS    := -lwebsockets -lmicrohttpd -lpthread -lsodium -lsqlite3 -lpng -ljansson -lassimp -lcrypto \
              -lcholmod -lspqr -lsuitesparseconfig -lm
 LIB_OBJ   := $(foreach l,$(LAYERS),$(call layer_obj,$(l)))
 
@@ -183,8 +183,16 @@ check-layers: $(ARCHIVES) | deps-test
 	python3 tools/check_layers.py --lib $(LIBDIR)
 	node --test tests/tools/
 
+# The CGAL straight-skeleton oracle of the extrusion tests and benchmark, built from
+# ../shared/tools/cgal_skeleton when that exists (libcgal-dev, g++: test packages); tests
+# that need it skip, naming it, when it is absent or could not be built.
+ORACLE_SRC := $(wildcard ../shared/tools/cgal_skeleton/main.cpp)
+ORACLE     := $(if $(ORACLE_SRC),$(BUILD)/oracle/cgal_skeleton)
+$(BUILD)/oracle/cgal_skeleton: $(ORACLE_SRC)
+	-$(MAKE) --no-print-directory -C $(dir $<) BUILD=$(CURDIR)/$(BUILD)/oracle
+
 # Each suite gets 10 minutes: a hang is a failure with a name, not a stuck CI.
-test-unit: $(UNIT_BIN)
+test-unit: $(UNIT_BIN) $(ORACLE)
 	@pass=0; fail=0; for t in $(UNIT_BIN); do \
 	  if timeout 600 $$t; then pass=$$((pass+1)); else fail=$$((fail+1)); echo "FAILED: $$t"; fi; \
 	done; echo "unit: $$pass passed, $$fail failed"; [ $$fail = 0 ]
@@ -213,7 +221,7 @@ test-asan: deps-test $(NPM_STAMP)
 	  test-integration
 
 # --- benchmarks ---------------------------------------------------------------------------
-bench: deps-bench all $(BENCH_BIN)
+bench: deps-bench all $(BENCH_BIN) $(ORACLE)
 	@for b in bench/*.sh; do [ -f "$$b" ] && sh "$$b"; done; true
 	@for b in bench/*.js; do [ -f "$$b" ] && node "$$b"; done; true
 	@for b in $(BENCH_BIN); do $$b; done

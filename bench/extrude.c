@@ -1,15 +1,19 @@
-/* Extrusion benchmark: real Den Haag footprints with built-in styles, generated batches
- * with per-edge profiles, an adversarial integer-grid stress batch, and single large
- * footprints. Prints seconds, failures (each
- * with id and reason) and peak memory. */
+/* Extrusion benchmark: real Den Haag footprints with built-in styles (one thread and every
+ * core) and against CGAL's skeleton of the same polygons (the oracle, when built: whole
+ * process and skeletons alone, as ratios), generated batches with per-edge profiles, an
+ * adversarial integer-grid stress batch, and single large footprints. Prints seconds,
+ * buildings that fell back or failed (each with id and reason) and peak memory. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
 #include <time.h>
+#include <unistd.h>
 
+#include "app/extrude_batch.h"
 #include "core/extrude/extrude.h"
+#include "core/extrude/predicates.h"
 #include "core/extrude/style.h"
 #include "io/footprints.h"
 
@@ -27,33 +31,174 @@ static long peak_kb(void)
     return ru.ru_maxrss;
 }
 
+/* Why a building is not good (a failing shell face or a defect of its triangles), or NULL. */
+static const char *not_good(const ag_extrude_result *r)
+{
+    if (r->failing_faces)
+        return r->problems[0].reason;
+    return r->defect[0] ? r->defect : NULL;
+}
+
 static void print_issues(const ag_footprints_report *r)
 {
     for (size_t i = 0; i < r->nfailed; i++)
         printf("    failed %s: %s\n", r->failed[i].id, r->failed[i].reason);
+    for (size_t i = 0; i < r->nfallbacks; i++)
+        printf("    fell back %s (%s): %s\n", r->fallbacks[i].id, ag_built_name(r->fallbacks[i].built),
+               r->fallbacks[i].reason);
     for (size_t i = 0; i < r->nnot_watertight; i++)
         printf("    not watertight %s: %s\n", r->not_watertight[i].id, r->not_watertight[i].reason);
 }
 
-static void run_style(const ag_footprints *f, const char *label, const ag_style *s)
+/* One batch with `threads` threads (0: every core); returns the seconds. */
+static double run_style(const ag_footprints *f, const char *label, const ag_style *s,
+                        size_t threads)
 {
     ag_mesh *m = ag_mesh_create();
     ag_footprints_report r;
     ag_error err = {0};
+    ag_extrude_batch_options bo = {.threads = threads};
     double t0 = now();
-    ag_status st = ag_footprints_extrude(f, s, m, &r, &err);
+    ag_status st = ag_extrude_batch(f, s, &bo, m, &r, &err);
     double dt = now() - t0;
     if (st != AG_OK) {
         printf("  %-22s error: %s\n", label, err.text);
     } else {
-        printf("  %-22s %5zu footprints  %.3f s  failed %zu (%.3f%%)  not watertight %zu  "
-               "triangles %zu  peak RSS %ld MB\n",
-               label, r.footprints, dt, r.nfailed, 100.0 * r.nfailed / (r.footprints ? r.footprints : 1),
-               r.nnot_watertight, r.triangles, peak_kb() / 1024);
+        printf("  %-22s %5zu footprints  %.3f s  as styled %zu  fell back %zu  failed %zu  "
+               "not watertight %zu  triangles %zu  events %zu  peak RSS %ld MB\n",
+               label, r.footprints, dt, r.succeeded, r.nfallbacks, r.nfailed, r.nnot_watertight,
+               r.triangles, r.events, peak_kb() / 1024);
         print_issues(&r);
     }
     ag_footprints_report_free(&r);
     ag_mesh_free(m);
+    return dt;
+}
+
+/* --- against CGAL ------------------------------------------------------------------------- */
+
+/* Wall-clock seconds of a command (best of `runs`), -1 when it fails. */
+static double time_command(const char *cmd, int runs)
+{
+    double best = -1;
+    for (int i = 0; i < runs; i++) {
+        double t0 = now();
+        int rc = system(cmd);
+        double dt = now() - t0;
+        if (rc != 0)
+            return -1;
+        if (best < 0 || dt < best)
+            best = dt;
+    }
+    return best;
+}
+
+/* The oracle's own loop time (its summary line's loop_wall_s) for a polygon file. */
+static double oracle_loop(const char *oracle, const char *polys)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "'%s' '%s'", oracle, polys);
+    FILE *p = popen(cmd, "r");
+    if (!p)
+        return -1;
+    char line[1024];
+    double loop = -1;
+    while (fgets(line, sizeof line, p)) {
+        const char *k = strstr(line, "loop_wall_s=");
+        if (line[0] == '#' && k)
+            loop = atof(k + strlen("loop_wall_s="));
+    }
+    pclose(p);
+    return loop;
+}
+
+/* Den Haag with uniform 45° roofs against CGAL's unweighted skeleton of the same polygons
+ * (the footprints as read, each outer ring with its holes): the whole process (archgram
+ * reading GeoJSON and writing OBJ; CGAL reading its polygon text), and the skeletons
+ * alone (our batch in process; CGAL's own loop). */
+static void against_cgal(const char *geojson, const ag_footprints *f)
+{
+    const char *oracle = AG_REPO_DIR "/build/oracle/cgal_skeleton";
+    const char *cli = AG_REPO_DIR "/build/archgram";
+    FILE *probe = fopen(oracle, "rb");
+    if (!probe) {
+        printf("  against CGAL: %s is not built (make builds it from ../shared/tools/"
+               "cgal_skeleton): skipped\n", oracle);
+        return;
+    }
+    fclose(probe);
+    const char *tmp = getenv("TMPDIR");
+    char polys[512], out[512];
+    snprintf(polys, sizeof polys, "%s/ag_bench_polys_%d.txt", tmp && tmp[0] ? tmp : P_tmpdir,
+             (int)getpid());
+    snprintf(out, sizeof out, "%s/ag_bench_out_%d.obj", tmp && tmp[0] ? tmp : P_tmpdir,
+             (int)getpid());
+    FILE *pf = fopen(polys, "w");
+    if (!pf)
+        return;
+    size_t npoly = 0;
+    for (size_t i = 0; i < f->n; i++) {
+        const ag_footprint *fp = &f->items[i];
+        for (size_t L = 0; L < fp->nloops; L++) {
+            double a = 0;
+            const double *xy = fp->loops[L];
+            for (size_t k = 0, j = fp->sizes[L] - 1; k < fp->sizes[L]; j = k++)
+                a += xy[2 * j] * xy[2 * k + 1] - xy[2 * k] * xy[2 * j + 1];
+            if (a <= 0)
+                continue; /* holes follow their outer ring */
+            fprintf(pf, "P p%zu_%zu\n", i, L);
+            for (size_t H = L; H < fp->nloops; H++) {
+                if (H != L) {
+                    double b = 0;
+                    const double *h = fp->loops[H];
+                    for (size_t k = 0, j = fp->sizes[H] - 1; k < fp->sizes[H]; j = k++)
+                        b += h[2 * j] * h[2 * k + 1] - h[2 * k] * h[2 * j + 1];
+                    if (b >= 0 || !ag_pred_point_in_polygon(xy, fp->sizes[L], h[0], h[1]))
+                        continue;
+                }
+                fprintf(pf, "L %zu\n", fp->sizes[H]);
+                for (size_t k = 0; k < fp->sizes[H]; k++)
+                    fprintf(pf, "%.17g %.17g 45\n", fp->loops[H][2 * k], fp->loops[H][2 * k + 1]);
+            }
+            fprintf(pf, "E\n");
+            npoly++;
+        }
+    }
+    fclose(pf);
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "'%s' '%s' > /dev/null", oracle, polys);
+    double cg = time_command(cmd, 3);
+    double cg_loop = oracle_loop(oracle, polys);
+    double ours[2];
+    for (int t = 0; t < 2; t++) {
+        snprintf(cmd, sizeof cmd, "'%s' extrude '%s' --style hip --threads %d --out '%s' > /dev/null 2>&1",
+                 cli, geojson, t ? 0 : 1, out);
+        ours[t] = time_command(cmd, 3);
+    }
+    ag_style s;
+    ag_style_builtin("hip", &s, NULL);
+    double batch[2];
+    for (int t = 0; t < 2; t++) {
+        ag_mesh *m = ag_mesh_create();
+        ag_footprints_report r;
+        ag_error err = {0};
+        ag_extrude_batch_options bo = {.threads = t ? 0 : 1};
+        double t0 = now();
+        ag_extrude_batch(f, &s, &bo, m, &r, &err);
+        batch[t] = now() - t0;
+        ag_footprints_report_free(&r);
+        ag_mesh_free(m);
+    }
+    long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+    printf("  against CGAL 5.5 (unweighted skeleton, EPICK) on the same %zu Den Haag polygons, "
+           "best of 3:\n", npoly);
+    printf("    whole process: CGAL %.3f s; archgram hip, 1 thread %.3f s (ratio %.2f), %ld "
+           "cores %.3f s (ratio %.2f)\n", cg, ours[0], ours[0] / cg, cpus, ours[1], ours[1] / cg);
+    printf("    skeletons alone: CGAL's loop %.3f s; archgram's batch (with its checks), 1 thread "
+           "%.3f s (ratio %.2f), %ld cores %.3f s (ratio %.2f)\n", cg_loop, batch[0],
+           batch[0] / cg_loop, cpus, batch[1], batch[1] / cg_loop);
+    remove(polys);
+    remove(out);
 }
 
 /* --- generated batches ------------------------------------------------------------------- */
@@ -173,10 +318,9 @@ static void generated_batch(size_t count)
             printf("    failed %s: %s\n", id, err.text);
         } else {
             tris += r.triangles;
-            if (r.failing_faces) {
+            if (not_good(&r)) {
                 leaky++;
-                printf("    not watertight %s: face %d: %s\n", id, (int)r.problems[0].face,
-                       r.problems[0].reason);
+                printf("    not good %s: %s\n", id, not_good(&r));
             }
         }
         ag_plan_free(p);
@@ -228,10 +372,9 @@ static void inside_batch(size_t count)
         } else {
             tris += r.triangles;
             gaps += r.stats.offset_gaps;
-            if (r.failing_faces) {
+            if (not_good(&r)) {
                 leaky++;
-                printf("    not watertight inside%zu: face %d: %s\n", i, (int)r.problems[0].face,
-                       r.problems[0].reason);
+                printf("    not good inside%zu: %s\n", i, not_good(&r));
             }
         }
         ag_mesh_free(m);
@@ -450,10 +593,9 @@ static void grid_stress(size_t count)
         } else if (st != AG_OK) {
             failed++;
             printf("    failed grid%zu: %s\n", i, err.text);
-        } else if (r.failing_faces) {
+        } else if (not_good(&r)) {
             leaky++;
-            printf("    not watertight grid%zu: face %d: %s\n", i, (int)r.problems[0].face,
-                   r.problems[0].reason);
+            printf("    not good grid%zu: %s\n", i, not_good(&r));
         }
         ag_mesh_free(m);
         ag_plan_free(p);
@@ -488,8 +630,11 @@ int main(void)
                 ag_style_builtin(styles[i], &s, NULL);
                 char label[64];
                 snprintf(label, sizeof label, "Den Haag %s", styles[i]);
-                run_style(f, label, &s);
+                run_style(f, label, &s, 1);
+                snprintf(label, sizeof label, "Den Haag %s, all cores", styles[i]);
+                run_style(f, label, &s, 0);
             }
+            against_cgal(path, f);
             ag_footprints_free(f);
         }
     }

@@ -26,13 +26,13 @@ import sys
 SUITESPARSE = ["m", "cholmod", "spqr", "suitesparseconfig"]
 LAYERS = {
     "core": {"uses": [], "headers": [], "libs": SUITESPARSE},
-    "io": {"uses": ["core"], "headers": [], "libs": SUITESPARSE + ["jansson", "assimp", "crypto"]},
+    "io": {"uses": ["core"], "headers": [], "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "png"]},
     "store": {"uses": ["core", "io"], "headers": [],
-              "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "sqlite3", "sodium"]},
+              "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "png", "sqlite3", "sodium"]},
     "app": {"uses": ["core", "io", "store"], "headers": [],
-            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "sqlite3", "sodium", "pthread"]},
+            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "png", "sqlite3", "sodium", "pthread"]},
     "net": {"uses": ["app"], "headers": ["core/status.h"],
-            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "sqlite3", "sodium", "pthread", "microhttpd",
+            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "png", "sqlite3", "sodium", "pthread", "microhttpd",
                                    "websockets"]},
 }
 ORDER = ["core", "io", "store", "app", "net"]
@@ -47,6 +47,7 @@ SYSTEM_HEADERS = [
     (re.compile(r"^jansson\.h$"), "jansson"),
     (re.compile(r"^assimp/"), "assimp"),
     (re.compile(r"^openssl/"), "crypto"),
+    (re.compile(r"^png\.h$|^libpng"), "png"),
     (re.compile(r"^sodium\.h$|^sodium/"), "sodium"),
     (re.compile(r"^sqlite3\.h$"), "sqlite3"),
     (re.compile(r"^pthread\.h$"), "pthread"),

@@ -81,13 +81,7 @@ ag_status ag_edit_ops_run_edit(const ag_store_env *env, const ag_op_request *rq,
     ag_edit_budget budget = edit_budget(env, rq->budget);
     e.budget = &budget;
     ag_store_ws w;
-    ag_store_ws_init(&w, &(ag_store_ws_options){.env = *env,
-                                                .model = rq->model,
-                                                .base = rq->base,
-                                                .author = rq->author,
-                                                .cid = rq->cid,
-                                                .origin = rq->origin,
-                                                .op = rq->op});
+    ag_store_ws_init_op(&w, env, rq);
     ag_usecase_edit_result r;
     s = ag_usecase_edit_run(&w.ws, &(ag_usecase_edit_params){&e, &from}, &r, err);
     s = ag_task_budget_explain(rq->budget, s, "the edit", err);

@@ -10,6 +10,8 @@
 
 #include "../io/grammar_text.h"
 #include "../io/import.h"
+#include "../io/part_bundle.h"
+#include "usecase_compose.h"
 #include "model_tree.h"
 #include "usecase_import.h"
 
@@ -325,6 +327,108 @@ static json_t *edit_summary(const ag_model_state *st, const ag_edit_outcome *o)
     return j;
 }
 
+/* --- parts ------------------------------------------------------------------------------- */
+
+static ag_status open_part(ag_workspace *ws, const ag_part_ref *ref, const ag_part **part,
+                           ag_error *err)
+{
+    ag_folder_ws *w = (ag_folder_ws *)ws;
+    if (!ref->path) {
+        blame(w, "");
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "a folder composes a part from a bundle file; name one");
+    }
+    if (!w->parts) {
+        ag_status s = ag_part_bundle_read_file(ref->path, &w->parts, &w->nparts, err);
+        if (s != AG_OK) {
+            blame(w, ref->path);
+            if (err)
+                err->element = 0; /* the message names the place in the bundle */
+            return s;
+        }
+    }
+    const ag_part *found = NULL;
+    for (size_t i = 0; i < w->nparts && !found; i++)
+        if (ref->name ? !strcmp(w->parts[i]->name, ref->name) : w->nparts == 1)
+            found = w->parts[i];
+    if (!found) {
+        blame(w, ref->path);
+        if (ref->name)
+            return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "no part named '%s'", ref->name);
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "the bundle holds %zu parts; name one with --name", w->nparts);
+    }
+    *part = found;
+    return AG_OK;
+}
+
+/* The folder's own name: provenance names the model, never a path of this machine. */
+static void folder_name(const char *dir, char *out, size_t cap)
+{
+    size_t n = strlen(dir);
+    while (n > 1 && dir[n - 1] == '/')
+        n--;
+    size_t b = n;
+    while (b > 0 && dir[b - 1] != '/')
+        b--;
+    snprintf(out, cap, "%.*s", (int)(n - b), dir + b);
+}
+
+static ag_status save_part(ag_workspace *ws, ag_part *part, const ag_part_outcome *o,
+                           ag_error *err)
+{
+    ag_folder_ws *w = (ag_folder_ws *)ws;
+    (void)o;
+    char name[1024];
+    folder_name(w->o.in_dir ? w->o.in_dir : "", name, sizeof name);
+    free(part->source);
+    part->source = name[0] ? strdup(name) : NULL;
+    part->source_version = 0;
+    ag_status s = AG_OK;
+    if (name[0] && !part->source)
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    const ag_part *one[1] = {part};
+    if (s == AG_OK && !w->o.bundle_out)
+        s = ag_error_set(err, AG_ERR_INVALID, 0, "no bundle file to save the part in");
+    if (s == AG_OK && (s = ag_part_bundle_write_file(one, 1, w->o.bundle_out, err)) != AG_OK)
+        blame(w, w->o.bundle_out);
+    ag_part_free(part);
+    return s;
+}
+
+/* summary.json of `archgram part compose`. */
+static json_t *compose_summary(const ag_model_state *st, const ag_compose_outcome *o)
+{
+    json_t *j = ag_usecase_compose_report_json(o);
+    if (j) {
+        json_object_set_new(j, "op", json_pack("{s:s,s:I,s:s,s:s}", "kind", "compose", "target",
+                                               (json_int_t)o->op->target, "mode",
+                                               ag_compose_mode_name(o->op->mode), "scope",
+                                               ag_compose_scope_name(o->op->scope)));
+        json_object_set_new(j, "tree", ag_model_tree_folder_stats(st->em));
+        json_object_set_new(j, "seconds", json_pack("{s:f,s:f,s:f}", "load", o->load_ms / 1e3,
+                                                    "compose", o->compose_ms / 1e3, "state",
+                                                    o->state_ms / 1e3));
+    }
+    return j;
+}
+
+static ag_status save_composed(ag_workspace *ws, ag_model_state *st, const ag_compose_outcome *o,
+                               ag_error *err)
+{
+    ag_folder_ws *w = (ag_folder_ws *)ws;
+    ag_status s = write_model(w, st, err);
+    if (s == AG_OK) {
+        char path[4200];
+        snprintf(path, sizeof path, "%s/summary.json", w->o.out_dir);
+        json_t *j = compose_summary(st, o);
+        s = write_json(w, path, j, JSON_INDENT(1) | JSON_REAL_PRECISION(12), err);
+        json_decref(j);
+    }
+    ag_model_state_clear(st);
+    return s;
+}
+
 static ag_status save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
                       const ag_edit_outcome *edit, ag_error *err)
 {
@@ -352,12 +456,18 @@ static void close_ws(ag_workspace *ws)
     ag_edit_model_free(w->em);
     ag_edit_model_free(w->source);
     w->em = w->source = NULL;
+    ag_part_bundle_free(w->parts, w->nparts);
+    w->parts = NULL;
+    w->nparts = 0;
 }
 
 static const ag_workspace_ops folder_ops = {
     .input_mesh = input_mesh,
     .open_models = open_models,
     .save = save,
+    .open_part = open_part,
+    .save_part = save_part,
+    .save_composed = save_composed,
     .close = close_ws,
     .state_flags = AG_MODEL_READ_BACK,
 };

@@ -4,8 +4,12 @@
  *   DIR/grammar.txt   the grammar (schema/grammar.md)
  *   DIR/terminals/    the terminal OBJ files it names
  *   DIR/tree.json     the split tree with the node ids edit ops name (app/model_tree.h)
- *   DIR/summary.json  what the proceduralization or the edit found and how long it took
+ *   DIR/summary.json  what the proceduralization, the edit or the composition found and how
+ *                     long it took
  *
+ * Parts are bundle files (schema/part_bundle.md): a composition reads the one its ref names
+ * (ag_part_ref.path, .name), a part save writes `bundle_out` through a temporary file, so a
+ * failed save leaves nothing; a part's provenance is the folder's name, not a path.
  * A folder keeps only the grammar: a model is read as its grammar derived and proceduralized
  * anew, and the use cases save the model they read back (AG_MODEL_READ_BACK), so the ids in
  * tree.json are the ids the next load gives. The mesh to proceduralize comes from a mesh file
@@ -27,12 +31,15 @@ typedef struct {
     const char *in_dir;    /* edit: the proceduralized folder to edit */
     const char *op_path;   /* edit: the op file; a paste's source_dir is relative to its folder */
     const char *out_dir;   /* where saves go (created with its parents) */
+    const char *bundle_out; /* part save: the bundle file to write */
 } ag_folder_ws_options;
 
 typedef struct {
     ag_workspace ws;
     ag_folder_ws_options o;
     ag_edit_model *em, *source;
+    ag_part **parts;       /* the bundle a composition read */
+    size_t nparts;
     size_t input_bytes;    /* the mesh file's size */
     double import_s;       /* reading it */
     int blamed;

@@ -13,6 +13,8 @@ const char *ag_job_params_kind(ag_job_type type)
         return "proceduralize";
     case AG_JOB_EXTRUDE:
         return "extrude";
+    case AG_JOB_DEMO_PARTS:
+        return "demo-parts";
     default:
         return NULL;
     }
@@ -41,6 +43,13 @@ char *ag_job_params_encode(const ag_job_params *p)
                       e->height_property, "seed",
                       e->seed >= 0 ? json_integer((json_int_t)e->seed) : json_null(), "lonlat",
                       e->lonlat > 0 ? json_true() : e->lonlat < 0 ? json_false() : json_null());
+        break;
+    }
+    case AG_JOB_DEMO_PARTS: {
+        j = json_pack("{s:[]}", "models");
+        for (size_t i = 0; j && i < p->u.demo_parts.n; i++)
+            json_array_append_new(json_object_get(j, "models"),
+                                  json_integer((json_int_t)p->u.demo_parts.models[i]));
         break;
     }
     default:
@@ -102,6 +111,16 @@ ag_status ag_job_params_decode(const char *kind, const char *json, ag_job_params
         bad = take(o, "upload", 1, &e->upload) | take(o, "name", 1, &e->name) |
               take(o, "format", 0, &e->format) | take(o, "style", 1, &e->style) |
               take(o, "height_property", 0, &e->height_property);
+    } else if (strcmp(kind, "demo-parts") == 0) {
+        out->type = AG_JOB_DEMO_PARTS;
+        ag_demo_parts_job *dp = &out->u.demo_parts;
+        json_t *m = json_object_get(o, "models");
+        bad = !json_is_array(m) || json_array_size(m) > AG_DEMO_PARTS_MAX_MODELS;
+        for (size_t i = 0; !bad && i < json_array_size(m); i++) {
+            json_t *id = json_array_get(m, i);
+            bad = !json_is_integer(id) || json_integer_value(id) <= 0;
+            dp->models[dp->n++] = json_integer_value(id);
+        }
     } else {
         out->type = AG_JOB_TEST;
     }

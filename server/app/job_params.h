@@ -13,6 +13,7 @@ typedef enum {
     AG_JOB_IMPORT = 1,
     AG_JOB_PROCEDURALIZE,
     AG_JOB_EXTRUDE,
+    AG_JOB_DEMO_PARTS,
     AG_JOB_TEST, /* job kinds of tests: no parameters */
 } ag_job_type;
 
@@ -43,6 +44,13 @@ typedef struct {
     int lonlat;            /* 1 lon/lat, -1 metres, 0 decided by the coordinates */
 } ag_extrude_job;
 
+/* The demo content's parts, saved from demo models once they are proceduralized. */
+#define AG_DEMO_PARTS_MAX_MODELS 8
+typedef struct {
+    int64_t models[AG_DEMO_PARTS_MAX_MODELS];
+    size_t n;
+} ag_demo_parts_job;
+
 typedef struct {
     ag_job_type type;
     /* the account that asks for the job (0: the server itself); kept in the job's row, not
@@ -52,10 +60,12 @@ typedef struct {
         ag_import_job import;
         ag_proceduralize_job proceduralize;
         ag_extrude_job extrude;
+        ag_demo_parts_job demo_parts;
     } u;
 } ag_job_params;
 
-/* The kind name a job of this type is stored under ("import", "proceduralize", "extrude");
+/* The kind name a job of this type is stored under ("import", "proceduralize", "extrude",
+ * "demo-parts");
  * test jobs name their own kind. */
 const char *ag_job_params_kind(ag_job_type type);
 

@@ -50,7 +50,7 @@ static void find_declaration(const char *text, size_t len, const char *name, lon
 }
 
 /* Parses text, loads every terminal through lookup and derives the mesh (at most
- * max_triangles of it). */
+ * max_triangles). */
 static ag_status derive_text(const char *text, size_t len, ag_terminal_lookup lookup, void *user,
                              size_t max_triangles, ag_grammar **g, ag_mesh **mesh, ag_error *err,
                              long *col)
@@ -155,8 +155,7 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
         s = ag_grammar_text_print(m->proc->grammar, &out->text, &out->text_len, err);
     if (s == AG_OK &&
         (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms,
-                         AG_GRAMMAR_MAX_TRIANGLES, &back,
-                         &out->derived, &e, &col)) != AG_OK)
+                         AG_GRAMMAR_MAX_TRIANGLES, &back, &out->derived, &e, &col)) != AG_OK)
         s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
                          "the grammar does not read back (line %ld, column %ld): %s", e.element,
                          col, e.text);
@@ -181,6 +180,39 @@ static int budget_stage(void *budget, ag_stage stage)
 {
     (void)stage;
     return ag_edit_budget_cancelled(budget);
+}
+
+ag_status ag_model_state_from_grammar(ag_grammar *g, size_t max_triangles, ag_model_state *out,
+                                      ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    ag_grammar *back = NULL;
+    long col = 0;
+    ag_error e;
+    ag_error_clear(&e);
+    ag_status s = ag_terminals_collect(g, &out->terms, err);
+    if (s == AG_OK)
+        s = ag_grammar_text_print(g, &out->text, &out->text_len, err);
+    if (s == AG_OK &&
+        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms,
+                         max_triangles ? max_triangles : AG_GRAMMAR_MAX_TRIANGLES, &back,
+                         &out->derived, &e, &col)) != AG_OK) {
+        if (s == AG_ERR_TOO_LARGE)
+            ag_error_set(err, s, 0, "the grammar derives more than %zu triangles",
+                         max_triangles ? max_triangles : AG_GRAMMAR_MAX_TRIANGLES);
+        else
+            s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
+                             "the grammar does not read back (line %ld, column %ld): %s",
+                             e.element, col, e.text);
+    }
+    ag_grammar_free(back);
+    if (s == AG_OK && !out->derived->ntris)
+        s = ag_error_set(err, AG_ERR_EMPTY, 0, "the grammar derives no geometry");
+    if (s == AG_OK)
+        s = ag_model_state_reload(out->derived, &out->em, err);
+    if (s != AG_OK)
+        ag_model_state_clear(out);
+    return s;
 }
 
 ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_lookup lookup,

@@ -42,6 +42,14 @@ enum { AG_MODEL_READ_BACK = 1 };
 ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_state *out,
                               ag_error *err);
 
+/* The state of a model given as a grammar (a composition's result, resolved, terminals with
+ * geometry): the grammar itself printed with its terminals (g's terminal paths are set as
+ * they will be kept), checked to read back, and the edit model of what it derives, so the
+ * text kept is the grammar as it was made while the tree numbers the derived mesh as a reload
+ * does. A derivation past max_triangles (0: AG_GRAMMAR_MAX_TRIANGLES) is AG_ERR_TOO_LARGE. */
+ag_status ag_model_state_from_grammar(ag_grammar *g, size_t max_triangles, ag_model_state *out,
+                                      ag_error *err);
+
 /* OBJ text of the terminal kept under path: AG_OK with *obj malloc'd, AG_ERR_NOT_FOUND when
  * there is none. */
 typedef ag_status (*ag_terminal_lookup)(void *user, const char *path, char **obj, size_t *len,

@@ -2,6 +2,7 @@
 
 #include <string.h>
 
+#include "compose_ops.h"
 #include "edit_ops.h"
 #include "modelops.h"
 #include "plan_edit.h"
@@ -17,6 +18,7 @@ const ag_op_kind ag_optable[] = {
     {"join",        ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL, AG_REBASE_NODES},
     {"paste",       ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL, AG_REBASE_NODES},
     {"remove",      ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL, AG_REBASE_NODES},
+    {"compose",     ag_compose_ops_validate,       NULL,                       ag_compose_ops_run,      EDIT,                         AG_OP_STRUCTURAL, NULL, AG_REBASE_NODES},
     /* undo and redo are logged as the restore they become; they name no version's content */
     {"undo",        ag_edit_ops_validate_history,  NULL,                       ag_edit_ops_run_restore, AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL, AG_REBASE_ALWAYS},
     {"redo",        ag_edit_ops_validate_history,  NULL,                       ag_edit_ops_run_restore, AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL, AG_REBASE_ALWAYS},

@@ -1,6 +1,6 @@
 /* The op table: every kind of op a model's log can hold, once, with what the REST and live
- * layers need to know about it (the model is Redis's command table). A new kind (compose,
- * point-cloud ops) is a new row.
+ * layers need to know about it (the model is Redis's command table). A new kind (point-cloud
+ * ops) is a new row.
  *
  *   kind       the "kind" member of the op JSON
  *   validate   the op's shape, without a model (parsers name the offending field)

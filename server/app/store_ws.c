@@ -15,6 +15,8 @@
 #include "../store/states.h"
 #include "extrusion.h"
 #include "model_tree.h"
+#include "part_library.h"
+#include "usecase_compose.h"
 #include "usecase_extrude.h"
 
 /* --- reading --------------------------------------------------------------------------- */
@@ -277,24 +279,70 @@ static ag_status save_proc(ag_store_ws *w, ag_model_state *st, const ag_proc_out
     return s;
 }
 
+/* Commits a structural change of the model (an edit, a composition): the state before and
+ * after are kept for undo, st is stored with the version the op raises, body is logged. */
+static ag_status commit_change(ag_store_ws *w, ag_model_state *st, json_t *body,
+                               const char *summary, ag_error *err)
+{
+    ag_seq_txn t;
+    int64_t seen = 0;
+    ag_status s = ag_sequencer_begin(w->o.env.seq, w->o.env.db, w->o.model, w->o.base,
+                                     w->o.author, w->o.cid, &t, &seen, err);
+    if (s != AG_OK)
+        return s;
+    if (seen) { /* the same op came in meanwhile: answered, not applied again */
+        w->duplicate = 1;
+        w->version = seen;
+        return AG_OK;
+    }
+    t.origin = w->o.origin;
+    s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
+    if (s == AG_OK)
+        s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, err);
+    for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
+        s = ag_grammars_put_terminal(t.db, w->o.model, st->terms.path[i], st->terms.obj[i],
+                                     st->terms.len[i], err);
+    if (s == AG_OK)
+        s = ag_states_keep(t.db, w->o.model, t.version, err);
+    int64_t v = t.version;
+    if (s == AG_OK)
+        s = ag_sequencer_commit(&t, w->o.author, w->o.cid, body, err);
+    else
+        ag_sequencer_abort(&t);
+    if (s == AG_OK) {
+        w->version = v;
+        /* the next edit starts from this one's model */
+        ag_edit_session_replace(w->target, v, st->em);
+        st->em = NULL;
+    }
+    return s;
+}
+
+/* The summary GET …/tree serves for an edited or composed model. */
+static char *change_summary(const char *source, const char *kind, const ag_model_state *st)
+{
+    const ag_grammar *g = st->em->proc->grammar;
+    json_t *sj = json_pack("{s:s, s:s, s:I, s:I, s:I, s:I, s:I}", "source", source, "op", kind,
+                           "rules", (json_int_t)g->nrules, "terminals", (json_int_t)g->nterminals,
+                           "grammar_bytes", (json_int_t)st->text_len, "triangles",
+                           (json_int_t)st->derived->ntris, "components",
+                           (json_int_t)st->derived->ncomponents);
+    char *summary = sj ? json_dumps(sj, JSON_COMPACT | JSON_PRESERVE_ORDER) : NULL;
+    json_decref(sj);
+    return summary;
+}
+
 static ag_status save_edit(ag_store_ws *w, ag_model_state *st, const ag_edit_outcome *o,
                            ag_error *err)
 {
-    const ag_grammar *g = st->em->proc->grammar;
     json_t *report = ag_edit_op_json_report(&o->report);
     json_t *body = json_deep_copy(w->o.op);
     if (report)
         json_object_set_new(report, "edit_ms", json_real(o->edit_ms));
     if (report && o->source_version) /* the version of the source model whose nodes were copied */
         json_object_set_new(report, "source_version", json_integer((json_int_t)o->source_version));
-    json_t *sj = json_pack("{s:s, s:s, s:I, s:I, s:I, s:I, s:I}", "source", "edit", "op",
-                           json_string_value(json_object_get(w->o.op, "kind")), "rules",
-                           (json_int_t)g->nrules, "terminals", (json_int_t)g->nterminals,
-                           "grammar_bytes", (json_int_t)st->text_len, "triangles",
-                           (json_int_t)st->derived->ntris, "components",
-                           (json_int_t)st->derived->ncomponents);
-    char *summary = sj ? json_dumps(sj, JSON_COMPACT | JSON_PRESERVE_ORDER) : NULL;
-    json_decref(sj);
+    char *summary =
+        change_summary("edit", json_string_value(json_object_get(w->o.op, "kind")), st);
     ag_status s = AG_OK;
     if (!report || !body || !summary) {
         json_decref(report);
@@ -302,38 +350,70 @@ static ag_status save_edit(ag_store_ws *w, ag_model_state *st, const ag_edit_out
     } else if (json_object_set_new(body, "report", report) != 0) {
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
-    ag_seq_txn t;
-    int64_t seen = 0;
     if (s == AG_OK)
-        s = ag_sequencer_begin(w->o.env.seq, w->o.env.db, w->o.model, w->o.base, w->o.author,
-                               w->o.cid, &t, &seen, err);
-    if (s == AG_OK && seen) { /* the same op came in meanwhile: answered, not applied again */
-        w->duplicate = 1;
-        w->version = seen;
-    } else if (s == AG_OK) {
-        t.origin = w->o.origin;
-        s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
-        if (s == AG_OK)
-            s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, err);
-        for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
-            s = ag_grammars_put_terminal(t.db, w->o.model, st->terms.path[i], st->terms.obj[i],
-                                         st->terms.len[i], err);
-        if (s == AG_OK)
-            s = ag_states_keep(t.db, w->o.model, t.version, err);
-        int64_t v = t.version;
-        if (s == AG_OK)
-            s = ag_sequencer_commit(&t, w->o.author, w->o.cid, body, err);
-        else
-            ag_sequencer_abort(&t);
-        if (s == AG_OK) {
-            w->version = v;
-            /* the next edit starts from this one's model */
-            ag_edit_session_replace(w->target, v, st->em);
-            st->em = NULL;
-        }
-    }
+        s = commit_change(w, st, body, summary, err);
     json_decref(body);
     free(summary);
+    return s;
+}
+
+static ag_status save_composed(ag_workspace *ws, ag_model_state *st, const ag_compose_outcome *o,
+                               ag_error *err)
+{
+    ag_store_ws *w = (ag_store_ws *)ws;
+    /* logged: the op as sent, with the part version it used and the composition's report */
+    json_t *report = ag_usecase_compose_report_json(o);
+    json_t *body = json_deep_copy(w->o.op);
+    char *summary = change_summary("compose", "compose", st);
+    ag_status s = AG_OK;
+    if (report) {
+        json_object_set_new(report, "compose_ms", json_real(o->compose_ms));
+        json_object_set_new(report, "state_ms", json_real(o->state_ms));
+    }
+    if (!report || !body || !summary || !w->target ||
+        json_object_set_new(body, "version", json_integer((json_int_t)o->part->version)) ||
+        json_object_set(body, "report", report))
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    if (s == AG_OK)
+        s = commit_change(w, st, body, summary, err);
+    json_decref(report);
+    json_decref(body);
+    free(summary);
+    ag_model_state_clear(st);
+    return s;
+}
+
+static ag_status open_part(ag_workspace *ws, const ag_part_ref *ref, const ag_part **part,
+                           ag_error *err)
+{
+    ag_store_ws *w = (ag_store_ws *)ws;
+    if (!w->part) {
+        if (ref->id < 1)
+            return ag_error_set(err, AG_ERR_INVALID, 0, "part: the id of a part of the library");
+        ag_status s = ag_part_library_load(w->o.env.db, ref->id, ref->version, &w->part, err);
+        if (s != AG_OK)
+            return s;
+    }
+    *part = w->part;
+    return AG_OK;
+}
+
+static ag_status save_part(ag_workspace *ws, ag_part *part, const ag_part_outcome *o,
+                           ag_error *err)
+{
+    ag_store_ws *w = (ag_store_ws *)ws;
+    (void)o;
+    ag_model_row row;
+    ag_status s = ag_models_get(w->o.env.db, w->o.model, &row, err);
+    if (s == AG_OK) {
+        ag_part_library_source from = {.model = w->o.model,
+                                       .name = row.name,
+                                       .version = w->target ? w->target->version : w->o.base};
+        s = ag_part_library_save(w->o.env.db, part, &from, w->o.part_update, w->o.part_base,
+                                 &w->part_id, &w->part_version, err);
+        ag_models_row_clear(&row);
+    }
+    ag_part_free(part);
     return s;
 }
 
@@ -489,6 +569,9 @@ static const ag_workspace_ops store_ops = {
     .input_mesh = input_mesh,
     .open_models = open_models,
     .save = save,
+    .open_part = open_part,
+    .save_part = save_part,
+    .save_composed = save_composed,
     .cancelled = cancelled,
     .progress = progress,
     .state_flags = 0, /* the mesh is kept: a reload gives the saved model itself */
@@ -501,14 +584,28 @@ void ag_store_ws_init(ag_store_ws *w, const ag_store_ws_options *o)
     w->o = *o;
 }
 
+void ag_store_ws_init_op(ag_store_ws *w, const ag_store_env *env, const ag_op_request *rq)
+{
+    ag_store_ws_init(w, &(ag_store_ws_options){.env = *env,
+                                               .model = rq->model,
+                                               .base = rq->base,
+                                               .author = rq->author,
+                                               .cid = rq->cid,
+                                               .origin = rq->origin,
+                                               .op = rq->op});
+}
+
 void ag_store_ws_end(ag_store_ws *w, ag_status outcome)
 {
     if (w->target && outcome != AG_OK && outcome != AG_ERR_STALE && outcome != AG_ERR_INVALID &&
         outcome != AG_ERR_NOT_FOUND && outcome != AG_ERR_CONFLICT && outcome != AG_ERR_PARSE &&
-        outcome != AG_ERR_NOT_PROCEDURALIZED && outcome != AG_ERR_RESULT_TOO_LARGE &&
+        outcome != AG_ERR_NOT_PROCEDURALIZED && outcome != AG_ERR_TOO_LARGE &&
+        outcome != AG_ERR_EMPTY && outcome != AG_ERR_RESULT_TOO_LARGE &&
         outcome != AG_ERR_DEADLINE && outcome != AG_ERR_CANCELLED)
         ag_edit_session_reset(w->target); /* an unexpected failure: load afresh next time */
     ag_edit_session_release(w->o.env.sessions, w->source);
     ag_edit_session_release(w->o.env.sessions, w->target);
     w->source = w->target = NULL;
+    ag_part_free(w->part);
+    w->part = NULL;
 }

@@ -4,7 +4,9 @@
  * op raises, the op is logged and announced, in one transaction; a job doing the work records
  * its success in the same transaction after a last cancellation check. The saved edit model
  * is kept in the environment's edit sessions for the next edit. Imports and extrusions add
- * a new model. */
+ * a new model. Parts come from and go to the store's parts library (app/part_library.h): a
+ * composition is saved like an edit (logged with its report and the part version it used),
+ * a part saved from the model gets the model's name and version as its provenance. */
 #ifndef AG_STORE_WS_H
 #define AG_STORE_WS_H
 
@@ -12,6 +14,7 @@
 #include <stdint.h>
 
 #include "jobqueue.h"
+#include "optable.h"
 #include "store_env.h"
 #include "workspace.h"
 
@@ -25,6 +28,8 @@ typedef struct {
     const json_t *op;   /* an edit: the client's op, logged with the edit's report */
     ag_jobctx *job;     /* the job doing the work (progress, cancellation, its outcome), or NULL */
     int64_t job_id;
+    int64_t part_update; /* a part save: the part it makes a new version of (0: a new part) */
+    int64_t part_base;   /* and the version that replaces */
 } ag_store_ws_options;
 
 typedef struct {
@@ -33,9 +38,14 @@ typedef struct {
     ag_edit_state *target, *source; /* borrowed edit sessions */
     int64_t version;                /* what the save got (or the duplicate's version) */
     int duplicate;                  /* the cid was used before: nothing was applied */
+    ag_part *part;                  /* the part a composition read */
+    int64_t part_id, part_version;  /* where a part save went */
 } ag_store_ws;
 
 void ag_store_ws_init(ag_store_ws *w, const ag_store_ws_options *o);
+/* The workspace of a client's op (a structural kind's run): its model, base, author, cid,
+ * origin and the op as logged. */
+void ag_store_ws_init_op(ag_store_ws *w, const ag_store_env *env, const ag_op_request *rq);
 /* Gives the sessions back; after a failure that is not the op's or the model's fault the
  * target's kept model is dropped (it is loaded afresh next time). */
 void ag_store_ws_end(ag_store_ws *w, ag_status outcome);

@@ -54,6 +54,34 @@ ag_status ag_workspace_save(ag_workspace *ws, ag_model_state *st, const ag_proc_
     return ws->ops->save(ws, st, proc, edit, err);
 }
 
+ag_status ag_workspace_open_part(ag_workspace *ws, const ag_part_ref *ref, const ag_part **part,
+                                 ag_error *err)
+{
+    *part = NULL;
+    return ws->ops->open_part ? ws->ops->open_part(ws, ref, part, err)
+                              : unsupported("give a part to compose", err);
+}
+
+ag_status ag_workspace_save_part(ag_workspace *ws, ag_part *part, const ag_part_outcome *o,
+                                 ag_error *err)
+{
+    if (!ws->ops->save_part) {
+        ag_part_free(part);
+        return unsupported("save a part", err);
+    }
+    return ws->ops->save_part(ws, part, o, err);
+}
+
+ag_status ag_workspace_save_composed(ag_workspace *ws, ag_model_state *st,
+                                     const ag_compose_outcome *o, ag_error *err)
+{
+    if (!ws->ops->save_composed) {
+        ag_model_state_clear(st);
+        return unsupported("save a composed model", err);
+    }
+    return ws->ops->save_composed(ws, st, o, err);
+}
+
 int ag_workspace_cancelled(ag_workspace *ws)
 {
     return ws->ops->cancelled ? ws->ops->cancelled(ws) : 0;

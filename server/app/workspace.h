@@ -8,8 +8,11 @@
  *                                 tree.json, summary.json; it keeps only the grammar, so its
  *                                 models are read back (grammar derived and proceduralized)
  *
+ * Parts (app/usecase_save_part.h, app/usecase_compose.h) go through it too: a folder reads and
+ * writes part bundle files, the store its parts library (app/part_library.h).
+ *
  * A workspace that cannot do something answers AG_ERR_UNSUPPORTED. Segmenting point clouds
- * and composing parts will be use cases over the same interface. */
+ * will be a use case over the same interface. */
 #ifndef AG_WORKSPACE_H
 #define AG_WORKSPACE_H
 
@@ -18,6 +21,8 @@
 #include <stdint.h>
 
 #include "../core/edit/edit.h"
+#include "../core/parts/compose.h"
+#include "../core/parts/part.h"
 #include "../core/status.h"
 #include "../io/edit_op_json.h"
 #include "model_state.h"
@@ -43,6 +48,28 @@ typedef struct {
     int64_t source_version; /* a paste from another model of the store: its version */
 } ag_edit_outcome;
 
+/* Which part a composition brings, as the workspace knows parts. */
+typedef struct {
+    const char *path;  /* a folder: the bundle file */
+    const char *name;  /* its part of that name; NULL: the bundle's only part */
+    int64_t id;        /* the store: the library's part */
+    int64_t version;   /* its version; 0: the newest */
+} ag_part_ref;
+
+/* What a part save did. */
+typedef struct {
+    int32_t node;      /* the node saved (a selection's common ancestor) */
+    double load_ms, save_ms;
+} ag_part_outcome;
+
+/* What a composition did, for the saved summary and the log. */
+typedef struct {
+    const ag_compose_op *op;
+    const ag_part *part;          /* its name and version */
+    ag_compose_report report;
+    double load_ms, compose_ms, state_ms; /* reading; the rewrite; the new state */
+} ag_compose_outcome;
+
 typedef struct {
     /* Stores a mesh as a new model (an import); source (the file as it came, may be NULL) and
      * its format are kept with it. *model gets its id. */
@@ -67,6 +94,16 @@ typedef struct {
      * cleared); exactly one of proc and edit is given. */
     ag_status (*save)(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
                       const ag_edit_outcome *edit, ag_error *err);
+    /* The part a composition brings; the workspace's until close. */
+    ag_status (*open_part)(ag_workspace *ws, const ag_part_ref *ref, const ag_part **part,
+                           ag_error *err);
+    /* Stores a part saved from the workspace's model (taken: the workspace frees it); the
+     * workspace adds the provenance it knows (the model's name, its version). */
+    ag_status (*save_part)(ag_workspace *ws, ag_part *part, const ag_part_outcome *o,
+                           ag_error *err);
+    /* Saves a composed model (st is taken and cleared, as for save). */
+    ag_status (*save_composed)(ag_workspace *ws, ag_model_state *st, const ag_compose_outcome *o,
+                               ag_error *err);
     /* Non-zero when the work should stop (a cancelled job). May be NULL. */
     int (*cancelled)(ag_workspace *ws);
     /* Progress of long work (0..1, stage name); may be NULL. */
@@ -94,6 +131,12 @@ ag_status ag_workspace_open_models(ag_workspace *ws, const ag_edit_op_origin *fr
                                    int64_t *source_version, ag_error *err);
 ag_status ag_workspace_save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
                             const ag_edit_outcome *edit, ag_error *err);
+ag_status ag_workspace_open_part(ag_workspace *ws, const ag_part_ref *ref, const ag_part **part,
+                                 ag_error *err);
+ag_status ag_workspace_save_part(ag_workspace *ws, ag_part *part, const ag_part_outcome *o,
+                                 ag_error *err);
+ag_status ag_workspace_save_composed(ag_workspace *ws, ag_model_state *st,
+                                     const ag_compose_outcome *o, ag_error *err);
 int ag_workspace_cancelled(ag_workspace *ws);
 /* Reports progress; returns ag_workspace_cancelled. */
 int ag_workspace_progress(ag_workspace *ws, double fraction, const char *stage);

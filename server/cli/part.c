@@ -5,25 +5,24 @@
  *                         --mode replace|insert|fill [--scope node|rule] --out DIR2
  *   archgram part info PART.agpart [--json]
  *
- * DIR is a proceduralized model as `archgram proceduralize --out` or `archgram edit --out`
- * writes it (grammar.txt, terminals/, tree.json): it is read as `archgram edit` reads it, so
- * node ids are those of DIR/tree.json. compose writes DIR2 in the same layout, with
- * summary.json describing the composition. A bundle of several parts needs --name. */
+ * save and compose are the app's use cases (app/usecase_save_part.h, app/usecase_compose.h)
+ * over folder workspaces (app/folder_ws.h). DIR is a proceduralized model as `archgram
+ * proceduralize --out` or `archgram edit --out` writes it (grammar.txt, terminals/,
+ * tree.json): it is read as `archgram edit` reads it, so node ids are those of DIR/tree.json.
+ * compose writes DIR2 in the same layout, with summary.json describing the composition. A
+ * bundle of several parts needs --name. */
 #include <errno.h>
 #include <jansson.h>
-#include <libgen.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "../core/edit/edit.h"
+#include "../app/folder_ws.h"
+#include "../app/usecase_compose.h"
+#include "../app/usecase_save_part.h"
 #include "../core/parts/compose.h"
 #include "../core/parts/part.h"
-#include "../app/folder_ws.h"
-#include "../app/model_tree.h"
-#include "../io/grammar_text.h"
 #include "../io/part_bundle.h"
-#include "../io/terminals.h"
 #include "commands.h"
 
 #define SAVE_USAGE "usage: archgram part save DIR --node N --name NAME [--tag T]... " \
@@ -46,28 +45,6 @@ static int parse_node(const char *s, int32_t *out)
     if (errno || *e || e == s || v < 0 || v > INT32_MAX)
         return -1;
     *out = (int32_t)v;
-    return 0;
-}
-
-/* Reads DIR as `archgram edit` does: its grammar derived and proceduralized again. */
-static int load_model(const char *dir, ag_grammar **g, ag_edit_model **model)
-{
-    char path[4200];
-    ag_error err;
-    ag_error_clear(&err);
-    snprintf(path, sizeof path, "%s/grammar.txt", dir);
-    long col = 0;
-    if (ag_grammar_text_read_file(path, g, &err, &col)) {
-        if (err.code == AG_ERR_PARSE)
-            fprintf(stderr, "archgram: %s:%ld:%ld: %s\n", path, err.element, col, err.text);
-        else
-            ag_cli_report(path, &err);
-        return 1;
-    }
-    if (ag_terminals_load(*g, dir, &err) || ag_edit_model_from_grammar(*g, NULL, model, &err)) {
-        ag_cli_report(path, &err);
-        return 1;
-    }
     return 0;
 }
 
@@ -118,46 +95,25 @@ static int cmd_save(int argc, char **argv)
         fputs(SAVE_USAGE, stderr);
         return 2;
     }
-    ag_grammar *g = NULL;
-    ag_edit_model *model = NULL;
-    ag_part *part = NULL;
-    int rc = 1;
-    double t0 = ag_cli_seconds();
-    if (load_model(dir, &g, &model))
-        goto done;
-    double t_load = ag_cli_seconds() - t0;
-    /* provenance names the model by its folder's name, not by a path of this machine */
-    char src[4096];
-    snprintf(src, sizeof src, "%s", dir);
-    size_t sl = strlen(src);
-    while (sl > 1 && src[sl - 1] == '/')
-        src[--sl] = 0;
-    ag_part_meta meta = {.name = name, .description = desc, .tags = tags, .ntags = ntags,
-                         .source = basename(src)};
+    ag_part_meta meta = {.name = name, .description = desc, .tags = tags, .ntags = ntags};
+    ag_folder_ws w;
+    ag_folder_ws_init(&w, &(ag_folder_ws_options){.in_dir = dir, .bundle_out = out});
+    ag_usecase_save_part_result r;
     ag_error err;
     ag_error_clear(&err);
-    t0 = ag_cli_seconds();
-    if (ag_part_extract(model->proc, node, &meta, &part, &err)) {
-        ag_cli_report(dir, &err);
-        goto done;
-    }
-    double t_save = ag_cli_seconds() - t0;
-    const ag_part *one[1] = {part};
-    if (ag_part_bundle_write_file(one, 1, out, &err)) {
-        ag_cli_report(out, &err);
-        goto done;
+    ag_status s = ag_usecase_save_part_run(
+        &w.ws, &(ag_usecase_save_part_params){.nodes = &node, .nnodes = 1, .meta = &meta}, &r,
+        &err);
+    ag_workspace_close(&w.ws);
+    if (s != AG_OK) {
+        ag_cli_report(w.blamed ? w.blame : dir, &err);
+        return 1;
     }
     printf("part save: '%s' from node %d: %zu nodes, %zu rules, %zu terminals, box %.4g x %.4g "
            "x %.4g m; load %.3f s, save %.1f ms -> %s\n",
-           part->name, (int)node, part->nnodes, part->grammar->nrules, part->grammar->nterminals,
-           part->box.max[0] - part->box.min[0], part->box.max[1] - part->box.min[1],
-           part->box.max[2] - part->box.min[2], t_load, 1e3 * t_save, out);
-    rc = 0;
-done:
-    ag_part_free(part);
-    ag_edit_model_free(model);
-    ag_grammar_free(g);
-    return rc;
+           name, (int)r.node, r.nodes, r.rules, r.terminals, r.size[0], r.size[1], r.size[2],
+           r.load_ms / 1e3, r.save_ms, out);
+    return 0;
 }
 
 static int read_bundle(const char *path, ag_part ***parts, size_t *n)
@@ -170,77 +126,6 @@ static int read_bundle(const char *path, ag_part ***parts, size_t *n)
         return 1;
     }
     return 0;
-}
-
-static int write_dir(const char *out, ag_grammar *g, const ag_compose_report *rep,
-                     const ag_compose_op *op, const ag_part *part, double seconds)
-{
-    ag_error err;
-    ag_error_clear(&err);
-    char *text = NULL;
-    size_t tlen = 0;
-    char path[4200];
-    ag_edit_model *back = NULL;
-    json_t *summary = NULL;
-    int rc = 1;
-    if (ag_folder_ws_make_dirs(out)) {
-        fprintf(stderr, "archgram: cannot create %s: %s\n", out, strerror(errno));
-        return 1;
-    }
-    if (ag_terminals_write(g, out, NULL, &err) || ag_grammar_text_print(g, &text, &tlen, &err)) {
-        ag_cli_report(out, &err);
-        goto done;
-    }
-    snprintf(path, sizeof path, "%s/grammar.txt", out);
-    FILE *f = fopen(path, "wb");
-    int ok = f && fwrite(text, 1, tlen, f) == tlen;
-    if (f && fclose(f))
-        ok = 0;
-    if (!ok) {
-        fprintf(stderr, "archgram: cannot write %s: %s\n", path, strerror(errno));
-        goto done;
-    }
-    /* tree.json: the ids a later edit or compose names (the grammar read back) */
-    if (ag_edit_model_from_grammar(g, NULL, &back, &err)) {
-        ag_cli_report(path, &err);
-        goto done;
-    }
-    snprintf(path, sizeof path, "%s/tree.json", out);
-    json_t *tree = ag_model_tree_folder(back);
-    int bad = !tree || json_dump_file(tree, path, JSON_INDENT(1) | JSON_REAL_PRECISION(12));
-    json_decref(tree);
-    if (bad) {
-        fprintf(stderr, "archgram: cannot write %s\n", path);
-        goto done;
-    }
-    summary = json_pack(
-        "{s:{s:s,s:I,s:s,s:s},s:{s:s,s:I,s:s},s:s,s:s,s:I,s:[I,I,I],s:i,s:[f,f,f],"
-        "s:{s:I,s:I,s:I,s:I,s:I,s:I,s:I},s:{s:I,s:I,s:I,s:I},s:o,s:{s:f}}",
-        "op", "kind", "compose", "target", (json_int_t)op->target, "mode",
-        ag_compose_mode_name(op->mode), "scope", ag_compose_scope_name(op->scope), "part",
-        "name", part->name, "version", (json_int_t)part->version, "root", part->root, "root_rule",
-        rep->root, "target_rule", rep->target_rule, "instances", (json_int_t)rep->instances,
-        "counts", (json_int_t)rep->counts[0], (json_int_t)rep->counts[1],
-        (json_int_t)rep->counts[2], "turn", 90 * rep->turn, "fitted", rep->fitted[0],
-        rep->fitted[1], rep->fitted[2], "grammar", "rules_added", (json_int_t)rep->rules_added,
-        "rules_shared", (json_int_t)rep->rules_shared, "terminals_added",
-        (json_int_t)rep->terminals_added, "terminals_shared", (json_int_t)rep->terminals_shared,
-        "renamed", (json_int_t)rep->renamed, "cloned", (json_int_t)rep->cloned,
-        "expanded_cells", (json_int_t)rep->expanded_cells, "fit", "elements",
-        (json_int_t)rep->fit.elements, "equations", (json_int_t)rep->fit.equations, "rigid",
-        (json_int_t)rep->fit.rigid, "rigid_relaxed", (json_int_t)rep->fit.rigid_relaxed, "tree",
-        ag_model_tree_folder_stats(back), "seconds", "compose", seconds);
-    snprintf(path, sizeof path, "%s/summary.json", out);
-    if (!summary || json_dump_file(summary, path, JSON_INDENT(1) | JSON_REAL_PRECISION(12))) {
-        fprintf(stderr, "archgram: cannot write %s\n", path);
-        goto done;
-    }
-    rc = 0;
-done:
-    json_decref(summary);
-    ag_edit_model_free(back);
-    free(text);
-    return rc;
 }
 
 static int cmd_compose(int argc, char **argv)
@@ -290,46 +175,23 @@ static int cmd_compose(int argc, char **argv)
         fputs(COMPOSE_USAGE, stderr);
         return 2;
     }
-    ag_part **parts = NULL;
-    size_t np = 0;
-    ag_grammar *g = NULL, *composed = NULL;
-    ag_edit_model *model = NULL;
-    int rc = 1;
-    if (read_bundle(ppath, &parts, &np))
-        return 1;
-    const ag_part *part = NULL;
-    for (size_t i = 0; i < np; i++)
-        if (pname ? !strcmp(parts[i]->name, pname) : np == 1)
-            part = parts[i];
-    if (!part) {
-        if (pname)
-            fprintf(stderr, "archgram: %s: no part named '%s'\n", ppath, pname);
-        else
-            fprintf(stderr, "archgram: %s: the bundle holds %zu parts; name one with --name\n",
-                    ppath, np);
-        goto done;
-    }
-    if (load_model(dir, &g, &model))
-        goto done;
+    ag_folder_ws w;
+    ag_folder_ws_init(&w, &(ag_folder_ws_options){.in_dir = dir, .out_dir = out});
+    ag_part_ref ref = {.path = ppath, .name = pname};
+    ag_usecase_compose_result r;
     ag_error err;
     ag_error_clear(&err);
-    ag_compose_report rep;
-    double t0 = ag_cli_seconds();
-    if (ag_compose(model->proc, part, &op, &composed, &rep, &err)) {
-        ag_cli_report(dir, &err);
-        goto done;
+    ag_status s =
+        ag_usecase_compose_run(&w.ws, &(ag_usecase_compose_params){.part = &ref, .op = op}, &r,
+                               &err);
+    ag_workspace_close(&w.ws);
+    if (s != AG_OK) {
+        ag_cli_report(w.blamed ? w.blame : dir, &err);
+        return 1;
     }
-    double t = ag_cli_seconds() - t0;
-    if (write_dir(out, composed, &rep, &op, part, t))
-        goto done;
-    printf("part compose: %s; %.1f ms -> %s\n", rep.message, 1e3 * t, out);
-    rc = 0;
-done:
-    ag_grammar_free(composed);
-    ag_edit_model_free(model);
-    ag_grammar_free(g);
-    ag_part_bundle_free(parts, np);
-    return rc;
+    printf("part compose: %s; rewrite %.1f ms, new state %.1f ms -> %s\n", r.report.message,
+           r.compose_ms, r.state_ms, out);
+    return 0;
 }
 
 static int cmd_info(int argc, char **argv)

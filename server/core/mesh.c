@@ -1,29 +1,12 @@
 #include "mesh.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Grows *arr (elements of size elem) so that it holds at least need elements. */
-static int grow(void **arr, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 0;
-    size_t n = *cap ? *cap : 16;
-    while (n < need) {
-        if (n > SIZE_MAX / 2)
-            return -1;
-        n *= 2;
-    }
-    if (n > SIZE_MAX / elem)
-        return -1;
-    void *p = realloc(*arr, n * elem);
-    if (!p)
-        return -1;
-    *arr = p;
-    *cap = n;
-    return 0;
-}
+#include "base/array.h"
+#include "base/uf.h"
 
 ag_mesh *ag_mesh_create(void)
 {
@@ -46,28 +29,18 @@ void ag_mesh_free(ag_mesh *m)
 
 ag_status ag_mesh_reserve(ag_mesh *m, size_t nverts, size_t ntris)
 {
-    if (nverts > m->cap_verts) {
-        if (nverts > SIZE_MAX / (3 * sizeof(double)))
-            return AG_ERR_NOMEM;
-        double *p = realloc(m->pos, nverts * 3 * sizeof(double));
-        if (!p)
-            return AG_ERR_NOMEM;
-        m->pos = p;
-        m->cap_verts = nverts;
-    }
-    if (ntris > m->cap_tris) {
-        if (ntris > SIZE_MAX / (3 * sizeof(uint32_t)))
-            return AG_ERR_NOMEM;
-        uint32_t *t = realloc(m->tri, ntris * 3 * sizeof(uint32_t));
-        if (!t)
-            return AG_ERR_NOMEM;
-        m->tri = t;
-        uint32_t *c = realloc(m->tri_component, ntris * sizeof(uint32_t));
-        if (!c)
-            return AG_ERR_NOMEM;
-        m->tri_component = c;
-        m->cap_tris = ntris;
-    }
+    ag_status st = ag_array_reserve_exact((void **)&m->pos, &m->cap_verts, nverts,
+                                          3 * sizeof *m->pos);
+    if (st || ntris <= m->cap_tris)
+        return st;
+    /* two arrays, one capacity: it moves only once both have grown */
+    size_t cap = m->cap_tris;
+    if ((st = ag_array_reserve_exact((void **)&m->tri, &cap, ntris, 3 * sizeof *m->tri)))
+        return st;
+    cap = m->cap_tris;
+    if ((st = AG_ARRAY_RESERVE_EXACT(m->tri_component, cap, ntris)))
+        return st;
+    m->cap_tris = ntris;
     return AG_OK;
 }
 
@@ -76,9 +49,10 @@ ag_status ag_mesh_add_vertex(ag_mesh *m, double x, double y, double z)
     if (m->nverts >= UINT32_MAX)
         return AG_ERR_TOO_LARGE; /* triangle indices are 32-bit */
     if (m->nverts == m->cap_verts) {
-        size_t n = m->cap_verts ? m->cap_verts * 2 : 64;
-        if (ag_mesh_reserve(m, n, m->cap_tris) != AG_OK)
-            return AG_ERR_NOMEM;
+        size_t n;
+        ag_status st = ag_array_capacity(m->cap_verts, m->nverts + 1, 3 * sizeof *m->pos, &n);
+        if (st || (st = ag_mesh_reserve(m, n, m->cap_tris)))
+            return st;
     }
     double *p = m->pos + 3 * m->nverts++;
     p[0] = x;
@@ -90,9 +64,10 @@ ag_status ag_mesh_add_vertex(ag_mesh *m, double x, double y, double z)
 ag_status ag_mesh_add_triangle(ag_mesh *m, uint32_t a, uint32_t b, uint32_t c, uint32_t component)
 {
     if (m->ntris == m->cap_tris) {
-        size_t n = m->cap_tris ? m->cap_tris * 2 : 64;
-        if (ag_mesh_reserve(m, m->cap_verts, n) != AG_OK)
-            return AG_ERR_NOMEM;
+        size_t n;
+        ag_status st = ag_array_capacity(m->cap_tris, m->ntris + 1, 3 * sizeof *m->tri, &n);
+        if (st || (st = ag_mesh_reserve(m, m->cap_verts, n)))
+            return st;
     }
     uint32_t *t = m->tri + 3 * m->ntris;
     t[0] = a;
@@ -104,8 +79,9 @@ ag_status ag_mesh_add_triangle(ag_mesh *m, uint32_t a, uint32_t b, uint32_t c, u
 
 ag_status ag_mesh_add_group(ag_mesh *m, const char *name, size_t *index)
 {
-    if (grow((void **)&m->group_names, &m->cap_groups, m->ngroups + 1, sizeof(char *)))
-        return AG_ERR_NOMEM;
+    ag_status st = AG_ARRAY_RESERVE(m->group_names, m->cap_groups, m->ngroups + 1);
+    if (st)
+        return st;
     char *copy = strdup(name ? name : "");
     if (!copy)
         return AG_ERR_NOMEM;
@@ -120,9 +96,9 @@ ag_status ag_mesh_add_component(ag_mesh *m, int32_t group, size_t *index)
 {
     if (m->ncomponents >= UINT32_MAX)
         return AG_ERR_TOO_LARGE;
-    if (grow((void **)&m->component_group, &m->cap_components, m->ncomponents + 1,
-             sizeof(int32_t)))
-        return AG_ERR_NOMEM;
+    ag_status st = AG_ARRAY_RESERVE(m->component_group, m->cap_components, m->ncomponents + 1);
+    if (st)
+        return st;
     m->component_group[m->ncomponents] = group;
     if (index)
         *index = m->ncomponents;
@@ -132,30 +108,11 @@ ag_status ag_mesh_add_component(ag_mesh *m, int32_t group, size_t *index)
 
 ag_box ag_mesh_bounds(const ag_mesh *m)
 {
-    ag_box b;
-    for (int k = 0; k < 3; k++) {
-        b.min[k] = INFINITY;
-        b.max[k] = -INFINITY;
-    }
+    ag_box b = ag_box_empty();
     size_t n = 3 * m->ntris;
-    for (size_t i = 0; i < n; i++) {
-        const double *p = m->pos + 3 * (size_t)m->tri[i];
-        for (int k = 0; k < 3; k++) {
-            if (p[k] < b.min[k])
-                b.min[k] = p[k];
-            if (p[k] > b.max[k])
-                b.max[k] = p[k];
-        }
-    }
+    for (size_t i = 0; i < n; i++)
+        ag_box_extend_point(&b, m->pos + 3 * (size_t)m->tri[i]);
     return b;
-}
-
-double ag_box_diagonal(const ag_box *b)
-{
-    if (!(b->min[0] <= b->max[0]) || !(b->min[1] <= b->max[1]) || !(b->min[2] <= b->max[2]))
-        return 0.0;
-    double dx = b->max[0] - b->min[0], dy = b->max[1] - b->min[1], dz = b->max[2] - b->min[2];
-    return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
 void ag_mesh_component_triangle_counts(const ag_mesh *m, size_t *counts)
@@ -163,19 +120,6 @@ void ag_mesh_component_triangle_counts(const ag_mesh *m, size_t *counts)
     memset(counts, 0, m->ncomponents * sizeof *counts);
     for (size_t t = 0; t < m->ntris; t++)
         counts[m->tri_component[t]]++;
-}
-
-static uint32_t uf_find(uint32_t *parent, uint32_t v)
-{
-    uint32_t r = v;
-    while (parent[r] != r)
-        r = parent[r];
-    while (parent[v] != r) { /* path compression */
-        uint32_t next = parent[v];
-        parent[v] = r;
-        v = next;
-    }
-    return r;
 }
 
 #define NONE UINT32_MAX
@@ -190,7 +134,9 @@ ag_status ag_mesh_split_connected(ag_mesh *m)
     /* Triangles grouped by component (counting sort, file order kept within each). */
     size_t *start = calloc(nc + 1, sizeof *start);
     uint32_t *order = malloc(nt * sizeof *order);
-    uint32_t *parent = malloc((nv ? nv : 1) * sizeof *parent);
+    /* connected pieces per component: vertices joined by triangles, reset after each one */
+    ag_uf uf = {0};
+    uint8_t *seen = calloc(nv + 1, 1);
     uint32_t *root_piece = malloc((nv ? nv : 1) * sizeof *root_piece);
     uint32_t *touched = malloc((nv ? nv : 1) * sizeof *touched);
     uint32_t *tri_piece = malloc(nt * sizeof *tri_piece);
@@ -198,8 +144,8 @@ ag_status ag_mesh_split_connected(ag_mesh *m)
     uint32_t *piece_first = malloc(nt * sizeof *piece_first);
     int32_t *piece_group = malloc(nt * sizeof *piece_group);
     ag_status st = AG_ERR_NOMEM;
-    if (!start || !order || !parent || !root_piece || !touched || !tri_piece || !piece_first ||
-        !piece_group)
+    if (ag_uf_init(&uf, nv, 0) || !start || !order || !seen || !root_piece || !touched ||
+        !tri_piece || !piece_first || !piece_group)
         goto out;
 
     for (size_t t = 0; t < nt; t++)
@@ -216,7 +162,7 @@ ag_status ag_mesh_split_connected(ag_mesh *m)
         free(fill);
     }
     for (size_t v = 0; v < nv; v++)
-        parent[v] = root_piece[v] = NONE;
+        root_piece[v] = NONE;
 
     size_t npieces = 0;
     for (size_t c = 0; c < nc; c++) {
@@ -224,20 +170,16 @@ ag_status ag_mesh_split_connected(ag_mesh *m)
         for (size_t i = start[c]; i < start[c + 1]; i++) {
             const uint32_t *tv = m->tri + 3 * (size_t)order[i];
             for (int k = 0; k < 3; k++)
-                if (parent[tv[k]] == NONE) {
-                    parent[tv[k]] = tv[k];
+                if (!seen[tv[k]]) {
+                    seen[tv[k]] = 1;
                     touched[ntouched++] = tv[k];
                 }
-            uint32_t r0 = uf_find(parent, tv[0]);
-            for (int k = 1; k < 3; k++) {
-                uint32_t r = uf_find(parent, tv[k]);
-                if (r != r0)
-                    parent[r] = r0;
-            }
+            ag_uf_union(&uf, tv[0], tv[1]);
+            ag_uf_union(&uf, tv[0], tv[2]);
         }
         for (size_t i = start[c]; i < start[c + 1]; i++) {
             uint32_t t = order[i];
-            uint32_t r = uf_find(parent, m->tri[3 * (size_t)t]);
+            uint32_t r = ag_uf_find(&uf, m->tri[3 * (size_t)t]);
             if (root_piece[r] == NONE) {
                 root_piece[r] = (uint32_t)npieces;
                 piece_first[npieces] = t;
@@ -246,8 +188,11 @@ ag_status ag_mesh_split_connected(ag_mesh *m)
             }
             tri_piece[t] = root_piece[r];
         }
-        for (size_t i = 0; i < ntouched; i++)
-            parent[touched[i]] = root_piece[touched[i]] = NONE;
+        for (size_t i = 0; i < ntouched; i++) {
+            ag_uf_reset(&uf, touched[i]);
+            seen[touched[i]] = 0;
+            root_piece[touched[i]] = NONE;
+        }
     }
 
     /* Renumber pieces by their first triangle: rank[p] via a triangle-indexed table. */
@@ -280,7 +225,8 @@ ag_status ag_mesh_split_connected(ag_mesh *m)
 out:
     free(start);
     free(order);
-    free(parent);
+    ag_uf_free(&uf);
+    free(seen);
     free(root_piece);
     free(touched);
     free(tri_piece);

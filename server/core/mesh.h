@@ -10,12 +10,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "base/box.h"
 #include "status.h"
-
-typedef struct {
-    double min[3];
-    double max[3];
-} ag_box;
 
 typedef struct {
     size_t nverts;
@@ -52,7 +48,6 @@ ag_status ag_mesh_add_component(ag_mesh *m, int32_t group, size_t *index);
 /* Axis-aligned bounds of all vertices that some triangle uses; an empty mesh gives
  * min = +inf, max = -inf. */
 ag_box ag_mesh_bounds(const ag_mesh *m);
-double ag_box_diagonal(const ag_box *b);
 
 /* Per-component triangle counts; counts must hold ncomponents entries. */
 void ag_mesh_component_triangle_counts(const ag_mesh *m, size_t *counts);

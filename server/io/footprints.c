@@ -2,11 +2,16 @@
 
 #include <jansson.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/base/array.h"
+#include "../core/extrude/building.h"
 #include "../core/extrude/extrude.h"
+#include "../core/extrude/predicates.h"
 
 #define EARTH_RADIUS 6371008.8
 
@@ -105,7 +110,27 @@ static void reverse(double *xy, size_t n)
     }
 }
 
-static ag_status add_polygon(ag_footprint *fp, json_t *rings, size_t fi, ag_error *err)
+/* Appends a note to what reading changed in this footprint. */
+static void note(ag_footprint *fp, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void note(ag_footprint *fp, const char *fmt, ...)
+{
+    size_t len = strlen(fp->fixes);
+    if (len + 3 >= sizeof fp->fixes)
+        return;
+    if (len) {
+        memcpy(fp->fixes + len, "; ", 3);
+        len += 2;
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(fp->fixes + len, sizeof fp->fixes - len, fmt, ap);
+    va_end(ap);
+}
+
+/* One polygon (part `part` of the feature, or -1 for a Polygon): rings oriented outer
+ * counter-clockwise, holes clockwise, each reversal noted. */
+static ag_status add_polygon(ag_footprint *fp, json_t *rings, size_t fi, long part,
+                             ag_error *err)
 {
     if (!json_is_array(rings) || json_array_size(rings) == 0)
         return ag_error_set(err, AG_ERR_PARSE, (long)fi + 1,
@@ -122,10 +147,249 @@ static ag_status add_polygon(ag_footprint *fp, json_t *rings, size_t fi, ag_erro
         if (add_ring(fp, ring, i > 0) != AG_OK)
             return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         double a = ring_area(fp->loops[first], fp->sizes[first]);
-        if ((i == 0 && a < 0) || (i > 0 && a > 0))
+        if ((i == 0 && a < 0) || (i > 0 && a > 0)) {
             reverse(fp->loops[first], fp->sizes[first]);
+            char where[32] = "";
+            if (part >= 0)
+                snprintf(where, sizeof where, " of part %ld", part);
+            if (i == 0)
+                note(fp, "outer ring%s was clockwise: reversed", where);
+            else
+                note(fp, "hole %zu%s was counter-clockwise: reversed", i - 1, where);
+        }
     }
     return AG_OK;
+}
+
+/* --- dissolving parts that share edges ---------------------------------------------------- */
+
+typedef struct {
+    double x, y;
+} pt;
+
+typedef struct {
+    uint32_t a, b; /* point indices */
+    uint8_t dead;
+} dedge;
+
+static int cmp_pt(const void *p, const void *q)
+{
+    const pt *a = p, *b = q;
+    if (a->x != b->x)
+        return a->x < b->x ? -1 : 1;
+    return a->y < b->y ? -1 : a->y > b->y;
+}
+
+static int cmp_dedge(const void *p, const void *q)
+{
+    const dedge *a = p, *b = q;
+    if (a->a != b->a)
+        return a->a < b->a ? -1 : 1;
+    return a->b < b->b ? -1 : a->b > b->b;
+}
+
+static uint32_t pt_index(const pt *u, size_t n, double x, double y)
+{
+    pt key = {x, y};
+    const pt *f = bsearch(&key, u, n, sizeof *u, cmp_pt);
+    return (uint32_t)(f - u);
+}
+
+typedef struct {
+    double t;
+    uint32_t p;
+} along;
+
+static int cmp_along(const void *p, const void *q)
+{
+    double a = ((const along *)p)->t, b = ((const along *)q)->t;
+    return a < b ? -1 : a > b;
+}
+
+/* Angle order of direction (dx, dy) counter-clockwise from direction (rx, ry), in [0, 2pi). */
+static double turn_from(double rx, double ry, double dx, double dy)
+{
+    double a = atan2(rx * dy - ry * dx, rx * dx + ry * dy);
+    return a <= 0 ? a + 2 * M_PI : a;
+}
+
+/* The loops of a MultiPolygon whose parts share edges (a triangulated ground surface)
+ * become the boundary of their union: every edge is split where another corner lies on
+ * it, edges used both ways cancel, and what is left is linked into loops, turning at
+ * shared corners so that each loop keeps the inside on its left. Parts that only touch
+ * are left alone. Returns AG_OK (and *dissolved 0 when no edge was shared). */
+static ag_status dissolve(ag_footprint *fp, size_t nparts, int *dissolved)
+{
+    *dissolved = 0;
+    size_t np = 0, ne = 0;
+    for (size_t L = 0; L < fp->nloops; L++)
+        np += fp->sizes[L];
+    pt *u = malloc((np + 1) * sizeof *u);
+    if (!u)
+        return AG_ERR_NOMEM;
+    size_t k = 0;
+    for (size_t L = 0; L < fp->nloops; L++)
+        for (size_t i = 0; i < fp->sizes[L]; i++)
+            u[k++] = (pt){fp->loops[L][2 * i], fp->loops[L][2 * i + 1]};
+    qsort(u, np, sizeof *u, cmp_pt);
+    size_t nu = 0;
+    for (size_t i = 0; i < np; i++)
+        if (!nu || cmp_pt(&u[nu - 1], &u[i]))
+            u[nu++] = u[i];
+    /* edges, split at every point inside them (T-junctions of the triangulation) */
+    size_t cap = 2 * np + 16;
+    dedge *e = malloc(cap * sizeof *e);
+    along *on = malloc((nu + 2) * sizeof *on);
+    ag_status st = e && on ? AG_OK : AG_ERR_NOMEM;
+    for (size_t L = 0; st == AG_OK && L < fp->nloops; L++) {
+        size_t n = fp->sizes[L];
+        const double *xy = fp->loops[L];
+        for (size_t i = 0; st == AG_OK && i < n; i++) {
+            const double *a = &xy[2 * i], *b = &xy[2 * ((i + 1) % n)];
+            size_t non = 0;
+            on[non++] = (along){0, pt_index(u, nu, a[0], a[1])};
+            double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+            for (size_t q = 0; q < nu && l2 > 0; q++) {
+                const double p[2] = {u[q].x, u[q].y};
+                if ((p[0] == a[0] && p[1] == a[1]) || (p[0] == b[0] && p[1] == b[1]) ||
+                    p[0] < fmin(a[0], b[0]) || p[0] > fmax(a[0], b[0]) ||
+                    p[1] < fmin(a[1], b[1]) || p[1] > fmax(a[1], b[1]) ||
+                    ag_pred_orient2d(a, b, p) != 0)
+                    continue;
+                on[non++] = (along){((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2, (uint32_t)q};
+            }
+            qsort(on + 1, non - 1, sizeof *on, cmp_along);
+            on[non++] = (along){1, pt_index(u, nu, b[0], b[1])};
+            for (size_t q = 0; q + 1 < non; q++) {
+                if (on[q].p == on[q + 1].p)
+                    continue;
+                if (ne == cap) {
+                    dedge *ng = realloc(e, 2 * cap * sizeof *e);
+                    if (!ng) {
+                        st = AG_ERR_NOMEM;
+                        break;
+                    }
+                    e = ng;
+                    cap *= 2;
+                }
+                e[ne++] = (dedge){on[q].p, on[q + 1].p, 0};
+            }
+        }
+    }
+    /* edges used both ways are inside the union */
+    size_t shared = 0;
+    if (st == AG_OK) {
+        qsort(e, ne, sizeof *e, cmp_dedge);
+        for (size_t i = 0; i < ne; i++) {
+            if (e[i].dead || e[i].a > e[i].b)
+                continue;
+            dedge key = {e[i].b, e[i].a, 0};
+            dedge *r = bsearch(&key, e, ne, sizeof *e, cmp_dedge);
+            if (!r)
+                continue;
+            while (r > e && !cmp_dedge(r - 1, &key))
+                r--;
+            for (; r < e + ne && !cmp_dedge(r, &key); r++)
+                if (!r->dead) {
+                    r->dead = 1;
+                    e[i].dead = 1;
+                    shared++;
+                    break;
+                }
+        }
+    }
+    if (st != AG_OK || !shared) {
+        free(u);
+        free(e);
+        free(on);
+        return st;
+    }
+    /* link what is left into loops; at a corner with several ways on, turn as far left as
+     * possible (the largest angle counter-clockwise from the way back): each loop keeps
+     * the inside on its left and loops that meet at a corner stay two loops */
+    size_t *start = calloc(nu + 1, sizeof *start);
+    double **loops = NULL;
+    size_t *sizes = NULL, nl = 0;
+    uint8_t *used = calloc(ne ? ne : 1, 1);
+    double *ring = malloc((ne + 1) * 2 * sizeof *ring);
+    if (!start || !used || !ring)
+        st = AG_ERR_NOMEM;
+    for (size_t i = 0; st == AG_OK && i < ne; i++)
+        start[e[i].a + 1]++;
+    for (size_t i = 0; st == AG_OK && i < nu; i++)
+        start[i + 1] += start[i];
+    for (size_t s = 0; st == AG_OK && s < ne; s++) {
+        if (e[s].dead || used[s])
+            continue;
+        size_t n = 0, cur = s;
+        int closed = 0;
+        while (!used[cur]) {
+            used[cur] = 1;
+            ring[2 * n] = u[e[cur].a].x;
+            ring[2 * n + 1] = u[e[cur].a].y;
+            n++;
+            uint32_t v = e[cur].b;
+            if (v == e[s].a) {
+                closed = 1;
+                break;
+            }
+            double rx = u[e[cur].a].x - u[v].x, ry = u[e[cur].a].y - u[v].y;
+            size_t best = ne;
+            double ba = -INFINITY;
+            for (size_t j = start[v]; j < start[v + 1]; j++) {
+                if (e[j].dead || used[j])
+                    continue;
+                double a = turn_from(rx, ry, u[e[j].b].x - u[v].x, u[e[j].b].y - u[v].y);
+                if (a > ba) {
+                    ba = a;
+                    best = j;
+                }
+            }
+            if (best == ne)
+                break;
+            cur = best;
+        }
+        if (!closed || n < 3)
+            continue; /* an open chain cannot happen for parts that tile; dropped */
+        double **nlp = realloc(loops, (nl + 1) * sizeof *nlp);
+        size_t *nsz = realloc(sizes, (nl + 1) * sizeof *nsz);
+        if (nlp)
+            loops = nlp;
+        if (nsz)
+            sizes = nsz;
+        double *copy = malloc(2 * n * sizeof *copy);
+        if (!nlp || !nsz || !copy) {
+            free(copy);
+            st = AG_ERR_NOMEM;
+            break;
+        }
+        memcpy(copy, ring, 2 * n * sizeof *copy);
+        loops[nl] = copy;
+        sizes[nl++] = n;
+    }
+    if (st == AG_OK && nl) {
+        for (size_t L = 0; L < fp->nloops; L++)
+            free(fp->loops[L]);
+        free(fp->loops);
+        free(fp->sizes);
+        fp->loops = loops;
+        fp->sizes = sizes;
+        fp->nloops = nl;
+        *dissolved = 1;
+        note(fp, "%zu parts sharing %zu edge(s) dissolved into %zu loop(s)", nparts, shared, nl);
+    } else {
+        for (size_t L = 0; L < nl; L++)
+            free(loops[L]);
+        free(loops);
+        free(sizes);
+    }
+    free(start);
+    free(used);
+    free(ring);
+    free(u);
+    free(e);
+    free(on);
+    return st;
 }
 
 static char *dupstr(const char *s)
@@ -236,7 +500,7 @@ ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footp
         if (!isfinite(fp->height) || fp->height < 0)
             fp->height = 0;
         if (strcmp(gt, "Polygon") == 0) {
-            st = add_polygon(fp, coords, fi, err);
+            st = add_polygon(fp, coords, fi, -1, err);
         } else if (!json_is_array(coords)) {
             st = ag_error_set(err, AG_ERR_PARSE, (long)fi + 1,
                               "feature %zu: MultiPolygon coordinates must be an array", fi);
@@ -245,10 +509,14 @@ ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footp
             json_t *poly;
             json_array_foreach(coords, pi, poly)
             {
-                st = add_polygon(fp, poly, fi, err);
+                st = add_polygon(fp, poly, fi, (long)pi, err);
                 if (st != AG_OK)
                     break;
             }
+            int dissolved = 0;
+            if (st == AG_OK && json_array_size(coords) > 1 &&
+                dissolve(fp, json_array_size(coords), &dissolved) != AG_OK)
+                st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         }
         f->n++; /* counted even on error so that free() releases it */
         if (st != AG_OK)
@@ -328,15 +596,10 @@ ag_status ag_footprints_read_file(const char *path, const ag_footprints_options 
     char *buf = NULL;
     size_t len = 0, cap = 0;
     for (;;) {
-        if (len + 65536 > cap) {
-            cap = cap ? 2 * cap : 1 << 20;
-            char *nb = realloc(buf, cap);
-            if (!nb) {
-                free(buf);
-                fclose(fp);
-                return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-            }
-            buf = nb;
+        if (AG_ARRAY_RESERVE_MORE(buf, cap, len, 65536)) { /* room for a read of 64 KiB */
+            free(buf);
+            fclose(fp);
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         }
         size_t r = fread(buf + len, 1, cap - len, fp);
         len += r;
@@ -354,20 +617,26 @@ ag_status ag_footprints_read_file(const char *path, const ag_footprints_options 
     return st;
 }
 
+static void free_issues(ag_footprint_issue *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        free(v[i].id);
+    free(v);
+}
+
 void ag_footprints_report_free(ag_footprints_report *r)
 {
     if (!r)
         return;
-    for (size_t i = 0; i < r->nfailed; i++)
-        free(r->failed[i].id);
-    for (size_t i = 0; i < r->nnot_watertight; i++)
-        free(r->not_watertight[i].id);
-    free(r->failed);
-    free(r->not_watertight);
+    free_issues(r->failed, r->nfailed);
+    free_issues(r->fallbacks, r->nfallbacks);
+    free_issues(r->not_watertight, r->nnot_watertight);
+    free_issues(r->fixed, r->nfixed);
     memset(r, 0, sizeof *r);
 }
 
-static int add_issue(ag_footprint_issue **list, size_t *n, const char *id, const char *reason)
+static int add_issue(ag_footprint_issue **list, size_t *n, const char *id, const char *reason,
+                     ag_built built, double moved)
 {
     ag_footprint_issue *nl = realloc(*list, (*n + 1) * sizeof *nl);
     if (!nl)
@@ -377,45 +646,59 @@ static int add_issue(ag_footprint_issue **list, size_t *n, const char *id, const
     if (!nl[*n].id)
         return 0;
     snprintf(nl[*n].reason, sizeof nl[*n].reason, "%s", reason);
+    nl[*n].built = built;
+    nl[*n].moved = moved;
     (*n)++;
     return 1;
 }
 
-ag_status ag_footprints_extrude(const ag_footprints *f, const ag_style *style, ag_mesh *m,
-                                ag_footprints_report *report, ag_error *err)
+ag_status ag_footprints_report_add(ag_footprints_report *r, const ag_footprint *fp,
+                                   const ag_building_result *b)
+{
+    int ok = 1;
+    if (b->built == AG_BUILT_STYLED)
+        r->succeeded++;
+    else if (b->built == AG_BUILT_NONE)
+        ok = add_issue(&r->failed, &r->nfailed, fp->id, b->reason, b->built, 0);
+    else
+        ok = add_issue(&r->fallbacks, &r->nfallbacks, fp->id, b->reason, b->built, b->moved);
+    if (ok && (b->nfixes || fp->fixes[0])) {
+        char text[sizeof r->fixed[0].reason];
+        snprintf(text, sizeof text, "%.100s%s%.150s", fp->fixes,
+                 fp->fixes[0] && b->nfixes ? "; " : "", b->nfixes ? b->fixes : "");
+        ok = add_issue(&r->fixed, &r->nfixed, fp->id, text, b->built, 0);
+    }
+    r->triangles += b->triangles;
+    r->events += b->events;
+    return ok ? AG_OK : AG_ERR_NOMEM;
+}
+
+ag_status ag_footprints_extrude_with(const ag_footprints *f, const ag_style *style,
+                                     const ag_extrude_options *opt, ag_mesh *m,
+                                     ag_footprints_report *report, ag_error *err)
 {
     memset(report, 0, sizeof *report);
     report->footprints = f->n;
     for (size_t i = 0; i < f->n; i++) {
         const ag_footprint *fp = &f->items[i];
-        ag_error e = {0};
-        ag_plan *plan = NULL;
-        ag_status st = ag_style_apply(style, (const double *const *)fp->loops, fp->sizes,
-                                      fp->nloops, fp->height, i, &plan, &e);
         size_t group = 0;
+        ag_building_result b;
+        ag_status st = ag_mesh_add_group(m, fp->id, &group);
         if (st == AG_OK)
-            st = ag_mesh_add_group(m, fp->id, &group);
-        ag_extrude_result res;
+            st = ag_building_extrude(style, (const double *const *)fp->loops, fp->sizes,
+                                     fp->nloops, fp->height, i, opt, m, (int32_t)group, &b, err);
         if (st == AG_OK)
-            st = ag_extrude_plan(plan, m, (int32_t)group, &res, NULL, &e);
-        ag_plan_free(plan);
+            st = ag_footprints_report_add(report, fp, &b);
         if (st == AG_ERR_NOMEM)
             return ag_error_set(err, st, 0, "out of memory");
-        if (st != AG_OK) {
-            if (!add_issue(&report->failed, &report->nfailed, fp->id,
-                           e.text[0] ? e.text : ag_status_message(st)))
-                return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-            continue;
-        }
-        report->succeeded++;
-        report->triangles += res.triangles;
-        if (res.failing_faces) {
-            char why[200];
-            snprintf(why, sizeof why, "%zu face(s) fail; face %d: %s", res.failing_faces,
-                     (int)res.problems[0].face, res.problems[0].reason);
-            if (!add_issue(&report->not_watertight, &report->nnot_watertight, fp->id, why))
-                return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
+        if (st != AG_OK)
+            return st;
     }
     return AG_OK;
+}
+
+ag_status ag_footprints_extrude(const ag_footprints *f, const ag_style *style, ag_mesh *m,
+                                ag_footprints_report *report, ag_error *err)
+{
+    return ag_footprints_extrude_with(f, style, NULL, m, report, err);
 }

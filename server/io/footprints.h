@@ -13,6 +13,7 @@
 
 #include <stddef.h>
 
+#include "../core/extrude/building.h"
 #include "../core/extrude/style.h"
 #include "../core/mesh.h"
 #include "../core/status.h"
@@ -23,6 +24,7 @@ typedef struct {
     size_t nloops;
     size_t *sizes;   /* corners per loop */
     double **loops;  /* xy pairs per loop, local metres */
+    char fixes[200]; /* what reading changed (rings reversed, parts dissolved), or empty */
 } ag_footprint;
 
 typedef struct {
@@ -45,27 +47,46 @@ ag_status ag_footprints_read_file(const char *path, const ag_footprints_options 
                                   ag_footprints **out, ag_error *err);
 void ag_footprints_free(ag_footprints *f);
 
-/* One footprint that failed or came out not watertight. */
+/* One footprint worth a line in the report. */
 typedef struct {
     char *id;
-    char reason[200];
+    char reason[AG_ERROR_TEXT];
+    ag_built built; /* what was built (fallbacks); AG_BUILT_NONE for failed */
+    double moved;   /* a simplified footprint's boundary moved up to this far (m) */
 } ag_footprint_issue;
 
 typedef struct {
-    size_t footprints, succeeded;
+    size_t footprints;
+    size_t succeeded;                   /* built as styled, and good */
+    size_t nfallbacks;
+    ag_footprint_issue *fallbacks;      /* built, but not as styled: reason and what instead */
     size_t nfailed;
-    ag_footprint_issue *failed;        /* extrusion failed: nothing added to the mesh */
+    ag_footprint_issue *failed;         /* nothing built: refused by validation (the reason
+                                         * names loop and edge) or not even a block */
     size_t nnot_watertight;
-    ag_footprint_issue *not_watertight; /* added, but with failing faces (listed in reason) */
+    ag_footprint_issue *not_watertight; /* built and kept although not good: none, since
+                                         * every building is checked and falls back */
+    size_t nfixed;
+    ag_footprint_issue *fixed;          /* footprints validation cleaned (reason: the fixes) */
     size_t triangles;
+    size_t events;                      /* events of all extrusions */
 } ag_footprints_report;
 
 void ag_footprints_report_free(ag_footprints_report *r);
 
-/* Extrudes every footprint with the style into m: one group (named by the footprint id)
- * and one component per footprint. A footprint that fails is reported and skipped; the
- * batch goes on. Fails only on out-of-memory. */
+/* Records footprint fp's outcome in the report (the batch runner's bookkeeping, shared
+ * by the serial and the threaded batches). Returns AG_ERR_NOMEM or AG_OK. */
+ag_status ag_footprints_report_add(ag_footprints_report *r, const ag_footprint *fp,
+                                   const ag_building_result *b);
+
+/* Extrudes every footprint with the style into m, one after another: one group (named
+ * by the footprint id) and one component per footprint, each made good or reported
+ * (ag_building_extrude: retried simplified, else a flat roof, else a block). opt may be
+ * NULL. Fails only on out-of-memory or when the options' budget callback cancels. */
 ag_status ag_footprints_extrude(const ag_footprints *f, const ag_style *style, ag_mesh *m,
                                 ag_footprints_report *report, ag_error *err);
+ag_status ag_footprints_extrude_with(const ag_footprints *f, const ag_style *style,
+                                     const ag_extrude_options *opt, ag_mesh *m,
+                                     ag_footprints_report *report, ag_error *err);
 
 #endif

@@ -140,7 +140,7 @@ ag_status ag_glb_write_meta(const ag_mesh *m, const ag_glb_component_meta *meta,
             continue;
         size_t nvert = 3 * count[c];
         size_t pos_off = off, nrm_off = off + nvert * 12;
-        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        ag_box range = ag_box_empty(); /* of the values actually stored, as the spec requires */
         for (size_t i = 0; i < count[c]; i++) {
             const uint32_t *t = m->tri + 3 * (size_t)order[start[c] + i];
             double v[3][3];
@@ -167,16 +167,14 @@ ag_status ag_glb_write_meta(const ag_mesh *m, const ag_glb_component_meta *meta,
             for (int k = 0; k < 3; k++) {
                 uint8_t *pp = bin + pos_off + (3 * i + (size_t)k) * 12;
                 uint8_t *np = bin + nrm_off + (3 * i + (size_t)k) * 12;
+                double stored[3];
                 for (int a = 0; a < 3; a++) {
                     float f = (float)v[k][a];
-                    /* min/max of the values actually stored, as the spec requires */
-                    if (f < lo[a])
-                        lo[a] = f;
-                    if (f > hi[a])
-                        hi[a] = f;
+                    stored[a] = f;
                     put_f32(pp + 4 * a, f);
                     put_f32(np + 4 * a, (float)n[a]);
                 }
+                ag_box_extend_point(&range, stored);
             }
         }
         size_t acc = json_array_size(accessors);
@@ -192,8 +190,8 @@ ag_status ag_glb_write_meta(const ag_mesh *m, const ag_glb_component_meta *meta,
         json_array_append_new(accessors,
                               json_pack("{s:I,s:i,s:I,s:s,s:o,s:o}", "bufferView",
                                         (json_int_t)view, "componentType", GL_FLOAT, "count",
-                                        (json_int_t)nvert, "type", "VEC3", "min", vec3(lo), "max",
-                                        vec3(hi)));
+                                        (json_int_t)nvert, "type", "VEC3", "min", vec3(range.min),
+                                        "max", vec3(range.max)));
         json_array_append_new(accessors, json_pack("{s:I,s:i,s:I,s:s}", "bufferView",
                                                    (json_int_t)(view + 1), "componentType",
                                                    GL_FLOAT, "count", (json_int_t)nvert, "type",

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/base/array.h"
+
 /* ---- printing --------------------------------------------------------------------------- */
 
 typedef struct {
@@ -34,16 +36,10 @@ static void sput(sbuf *s, const char *fmt, ...)
             s->len += (size_t)n;
             return;
         }
-        size_t nc = s->cap ? s->cap : 4096;
-        while (nc < s->len + (size_t)n + 1)
-            nc *= 2;
-        char *nb = realloc(s->buf, nc);
-        if (!nb) {
+        if (AG_ARRAY_RESERVE_MORE(s->buf, s->cap, s->len, (size_t)n + 1)) {
             s->oom = 1;
             return;
         }
-        s->buf = nb;
-        s->cap = nc;
     }
 }
 
@@ -599,14 +595,11 @@ ag_status ag_grammar_text_read_file(const char *path, ag_grammar **out, ag_error
                 fclose(f);
                 return ag_error_set(err, AG_ERR_TOO_LARGE, 0, "%s is larger than 64 MiB", path);
             }
-            char *nb = realloc(buf, cap * 2);
-            if (!nb) {
+            if (AG_ARRAY_RESERVE(buf, cap, len + 1)) {
                 free(buf);
                 buf = NULL;
                 break;
             }
-            buf = nb;
-            cap *= 2;
         }
     }
     int bad = ferror(f);

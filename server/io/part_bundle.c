@@ -42,8 +42,9 @@ static json_t *box_json(const double *v)
     return a;
 }
 
-static ag_status part_json(const ag_part *p, json_t *terminals, json_t **out, ag_error *err)
+ag_status ag_part_bundle_entry(const ag_part *p, json_t *terminals, json_t **out, ag_error *err)
 {
+    *out = NULL;
     ag_grammar *g = NULL;
     ag_status st = ag_gcopy_grammar(p->grammar, &g, err);
     if (st)
@@ -116,6 +117,45 @@ static ag_status part_json(const ag_part *p, json_t *terminals, json_t **out, ag
     return AG_OK;
 }
 
+static int by_string(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+ag_status ag_part_bundle_print(json_t *parts, json_t *terminals, char **out, size_t *len,
+                               ag_error *err)
+{
+    *out = NULL;
+    *len = 0;
+    /* terminals in the order of their hashes, however they were gathered */
+    size_t nt = json_object_size(terminals);
+    const char **keys = malloc((nt ? nt : 1) * sizeof *keys);
+    json_t *sorted = json_object(), *root = json_object();
+    char *s = NULL;
+    if (keys && sorted && root) {
+        size_t k = 0;
+        const char *key;
+        json_t *v;
+        json_object_foreach(terminals, key, v) keys[k++] = key;
+        qsort(keys, nt, sizeof *keys, by_string);
+        for (k = 0; k < nt; k++)
+            json_object_set(sorted, keys[k], json_object_get(terminals, keys[k]));
+        json_object_set_new(root, "format", json_string(AG_PART_BUNDLE_FORMAT));
+        json_object_set_new(root, "version", json_integer(AG_PART_BUNDLE_VERSION));
+        json_object_set(root, "parts", parts);
+        json_object_set(root, "terminals", sorted);
+        s = json_dumps(root, JSON_INDENT(1) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
+    }
+    free(keys);
+    json_decref(sorted);
+    json_decref(root);
+    if (!s)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    *out = s;
+    *len = strlen(s);
+    return AG_OK;
+}
+
 ag_status ag_part_bundle_write(const ag_part *const *parts, size_t n, char **out, size_t *len,
                                ag_error *err)
 {
@@ -123,28 +163,19 @@ ag_status ag_part_bundle_write(const ag_part *const *parts, size_t n, char **out
     if (n == 0 || n > AG_PART_BUNDLE_MAX_PARTS)
         return ag_error_set(err, AG_ERR_INVALID, 0, "a bundle holds 1 to %d parts",
                             AG_PART_BUNDLE_MAX_PARTS);
-    json_t *root = json_object(), *jp = json_array(), *terms = json_object();
-    json_object_set_new(root, "format", json_string(AG_PART_BUNDLE_FORMAT));
-    json_object_set_new(root, "version", json_integer(AG_PART_BUNDLE_VERSION));
+    json_t *jp = json_array(), *terms = json_object();
     ag_status st = AG_OK;
     for (size_t i = 0; i < n && !st; i++) {
         json_t *o = NULL;
-        if ((st = ag_part_validate(parts[i], err)) || (st = part_json(parts[i], terms, &o, err)))
+        if ((st = ag_part_validate(parts[i], err)) ||
+            (st = ag_part_bundle_entry(parts[i], terms, &o, err)))
             break;
         json_array_append_new(jp, o);
     }
-    json_object_set_new(root, "parts", jp);
-    json_object_set_new(root, "terminals", terms);
-    if (!st) {
-        char *s = json_dumps(root, JSON_INDENT(1) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
-        if (!s)
-            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        else {
-            *out = s;
-            *len = strlen(s);
-        }
-    }
-    json_decref(root);
+    if (!st)
+        st = ag_part_bundle_print(jp, terms, out, len, err);
+    json_decref(jp);
+    json_decref(terms);
     return st;
 }
 

@@ -12,6 +12,7 @@
 #ifndef AG_PART_BUNDLE_H
 #define AG_PART_BUNDLE_H
 
+#include <jansson.h>
 #include <stddef.h>
 
 #include "../core/parts/part.h"
@@ -29,6 +30,15 @@
 
 /* The bundle text of n parts; *out malloc'd, NUL-terminated. */
 ag_status ag_part_bundle_write(const ag_part *const *parts, size_t n, char **out, size_t *len,
+                               ag_error *err);
+/* The pieces of a bundle, for a library that keeps parts one by one (app/part_library.h):
+ * one part's entry of "parts" (a new object) with its terminals added to `terminals` (an
+ * object: SHA-256 hex -> OBJ text, each content once); and the bundle text of a "parts" array
+ * and a "terminals" object, printed as ag_part_bundle_write prints it, terminals in the order
+ * of their hashes (so entries kept and put together again give the same bytes). */
+ag_status ag_part_bundle_entry(const ag_part *p, json_t *terminals, json_t **entry,
+                               ag_error *err);
+ag_status ag_part_bundle_print(json_t *parts, json_t *terminals, char **out, size_t *len,
                                ag_error *err);
 /* Writes the bundle to path through a temporary file renamed into place: on failure nothing
  * is left at path. */

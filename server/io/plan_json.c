@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/base/array.h"
 #include "obj.h"
 
 static ag_status read_points(json_t *arr, const char *what, ag_profile_point **out, size_t *n,
@@ -502,16 +503,11 @@ static char *slurp(const char *path, size_t *len, ag_error *err, ag_status *st)
     char *buf = NULL;
     size_t n = 0, cap = 0;
     for (;;) {
-        if (n + 4096 > cap) {
-            cap = cap ? 2 * cap : 65536;
-            char *nb = realloc(buf, cap);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                *st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-                return NULL;
-            }
-            buf = nb;
+        if (AG_ARRAY_RESERVE_MORE(buf, cap, n, 4096)) { /* room for a read of 4 KiB */
+            free(buf);
+            fclose(f);
+            *st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            return NULL;
         }
         size_t r = fread(buf + n, 1, cap - n, f);
         n += r;

@@ -25,7 +25,8 @@ static ag_status if_match(ag_request *r, int required, int64_t current, int64_t 
         return AG_OK;
     ag_if_match m;
     ag_status s = ag_request_if_match(r, &m, err);
-    return s != AG_OK ? s : ag_request_if_match_check(&m, r->ids[0], current, version, err);
+    return s != AG_OK ? s
+                      : ag_request_if_match_check(&m, "model", r->ids[0], current, version, err);
 }
 
 enum MHD_Result ag_api_model_proceduralize(ag_request *r)
@@ -85,44 +86,6 @@ enum MHD_Result ag_api_model_grammar_get(ag_request *r)
     char etag[32];
     snprintf(etag, sizeof etag, "\"%lld\"", (long long)version);
     return ag_reply_bytes(r, 200, "text/plain; charset=utf-8", text, len, etag);
-}
-
-/* The spooled body, whole, as NUL-terminated text (the file is removed). */
-static ag_status read_body(ag_request *r, char **text, size_t *len, ag_error *err)
-{
-    *text = NULL;
-    *len = 0;
-    size_t n = r->upload ? ag_upload_bytes(r->upload) : 0;
-    size_t max = ag_app_change_grammar_max();
-    if (n > max)
-        return ag_error_set(err, AG_ERR_TOO_LARGE, 0,
-                            "the grammar has %zu bytes; at most %zu are accepted", n, max);
-    if (n == 0)
-        return ag_error_set(err, AG_ERR_INVALID, 0, "the body must hold the grammar text");
-    const char *path = ag_upload_take_path(r->upload);
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    char *buf = malloc(n + 1);
-    size_t got = 0;
-    while (fd >= 0 && buf && got < n) {
-        ssize_t k = read(fd, buf + got, n - got);
-        if (k <= 0)
-            break;
-        got += (size_t)k;
-    }
-    int e = errno;
-    if (fd >= 0)
-        close(fd);
-    unlink(path);
-    if (!buf)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory reading the body");
-    if (got != n) {
-        free(buf);
-        return ag_error_set(err, AG_ERR_IO, 0, "cannot read the body back: %s", strerror(e));
-    }
-    buf[n] = '\0';
-    *text = buf;
-    *len = n;
-    return AG_OK;
 }
 
 /* A parse problem with "line" and "column" as members, and in the detail. */
@@ -191,7 +154,8 @@ enum MHD_Result ag_api_model_grammar_put(ag_request *r)
     if (s == AG_OK && !(g = calloc(1, sizeof *g)))
         s = ag_error_set(&err, AG_ERR_NOMEM, 0, "out of memory");
     if (s == AG_OK)
-        s = read_body(r, &g->text, &g->len, &err);
+        s = ag_upload_read_all(r, ag_app_change_grammar_max(), "grammar text", &g->text,
+                               &g->len, &err);
     if (s != AG_OK) {
         grammar_put_free(g);
         return ag_reply_problem(r, s, &err);

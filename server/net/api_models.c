@@ -19,29 +19,11 @@ static void version_etag(char *buf, size_t len, int64_t version)
     snprintf(buf, len, "\"%lld\"", (long long)version);
 }
 
-/* Parses a decimal query parameter within [lo, hi]; absent gives def. */
-static ag_status query_int(ag_request *r, const char *name, long long lo, long long hi,
-                           long long def, long long *out, ag_error *err)
-{
-    const char *v = ag_request_query(r, name);
-    if (!v) {
-        *out = def;
-        return AG_OK;
-    }
-    char *end;
-    long long n = strtoll(v, &end, 10);
-    if (!*v || *end || n < lo || n > hi)
-        return ag_error_set(err, AG_ERR_INVALID, 0, "%s must be a whole number from %lld to %lld",
-                            name, lo, hi);
-    *out = n;
-    return AG_OK;
-}
-
 enum MHD_Result ag_api_models_list(ag_request *r)
 {
     ag_error err;
     long long size;
-    ag_status s = query_int(r, "page_size", 1, AG_PAGE_MAX, AG_PAGE_DEFAULT, &size, &err);
+    ag_status s = ag_request_query_int(r, "page_size", 1, AG_PAGE_MAX, AG_PAGE_DEFAULT, &size, &err);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
     /* Page tokens are "m" + the last id seen: opaque to clients, cheap to check. */
@@ -147,7 +129,7 @@ ag_status ag_api_precondition(ag_request *r, int required, int64_t *version, ag_
     int64_t current;
     if ((s = ag_app_query_version(r->cfg->app, r->ids[0], &current, err)) != AG_OK)
         return s;
-    return ag_request_if_match_check(&m, r->ids[0], current, version, err);
+    return ag_request_if_match_check(&m, "model", r->ids[0], current, version, err);
 }
 
 /* What every change needs: the JSON body and the If-Match version. Returns 0 after answering
@@ -238,7 +220,7 @@ enum MHD_Result ag_api_model_ops_list(ag_request *r)
 {
     ag_error err;
     long long since;
-    ag_status s = query_int(r, "since", 0, (long long)1 << 62, 0, &since, &err);
+    ag_status s = ag_request_query_int(r, "since", 0, (long long)1 << 62, 0, &since, &err);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
     json_t *items;

@@ -181,6 +181,23 @@ const char *ag_request_query(ag_request *r, const char *name)
     return MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, name);
 }
 
+ag_status ag_request_query_int(ag_request *r, const char *name, long long lo, long long hi,
+                               long long def, long long *out, ag_error *err)
+{
+    const char *v = ag_request_query(r, name);
+    if (!v) {
+        *out = def;
+        return AG_OK;
+    }
+    char *end;
+    long long n = strtoll(v, &end, 10);
+    if (!*v || *end || n < lo || n > hi)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "%s must be a whole number from %lld to %lld",
+                            name, lo, hi);
+    *out = n;
+    return AG_OK;
+}
+
 const char *ag_request_header(ag_request *r, const char *name)
 {
     return MHD_lookup_connection_value(r->conn, MHD_HEADER_KIND, name);
@@ -281,8 +298,8 @@ ag_status ag_request_if_match(ag_request *r, ag_if_match *m, ag_error *err)
     }
 }
 
-ag_status ag_request_if_match_check(const ag_if_match *m, int64_t model, int64_t current,
-                                    int64_t *version, ag_error *err)
+ag_status ag_request_if_match_check(const ag_if_match *m, const char *what, int64_t id,
+                                    int64_t current, int64_t *version, ag_error *err)
 {
     *version = current;
     if (m->any)
@@ -293,9 +310,9 @@ ag_status ag_request_if_match_check(const ag_if_match *m, int64_t model, int64_t
     *version = 0;
     if (m->n == 1 && m->tags == 1)
         return ag_error_set(err, AG_ERR_STALE, (long)current,
-                            "model %lld is at version %lld, not %lld", (long long)model,
+                            "%s %lld is at version %lld, not %lld", what, (long long)id,
                             (long long)current, (long long)m->versions[0]);
     return ag_error_set(err, AG_ERR_STALE, (long)current,
-                        "model %lld is at version %lld, which If-Match does not name",
-                        (long long)model, (long long)current);
+                        "%s %lld is at version %lld, which If-Match does not name", what,
+                        (long long)id, (long long)current);
 }

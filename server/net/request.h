@@ -122,6 +122,9 @@ void ag_request_rate_key(ag_request *r, char *buf, size_t len);
 
 /* Query parameter or NULL. */
 const char *ag_request_query(ag_request *r, const char *name);
+/* A decimal query parameter within [lo, hi]; absent gives def; AG_ERR_INVALID naming it. */
+ag_status ag_request_query_int(ag_request *r, const char *name, long long lo, long long hi,
+                               long long def, long long *out, ag_error *err);
 const char *ag_request_header(ag_request *r, const char *name);
 /* The body parsed as a JSON object; AG_ERR_INVALID with the parse position otherwise. */
 ag_status ag_request_json(ag_request *r, json_t **out, ag_error *err);
@@ -137,9 +140,10 @@ typedef struct {
 /* AG_ERR_PRECONDITION_REQUIRED when the header is absent, AG_ERR_INVALID when it is not
  * "*" or a list of entity tags. */
 ag_status ag_request_if_match(ag_request *r, ag_if_match *m, ag_error *err);
-/* *version = current when m matches a model at `current`, else AG_ERR_STALE (the current
- * version in err->element), whatever the tags' text ("stale-0" is well-formed and stale). */
-ag_status ag_request_if_match_check(const ag_if_match *m, int64_t model, int64_t current,
-                                    int64_t *version, ag_error *err);
+/* *version = current when m matches the resource (`what` id: "model 7", "part 3") at
+ * `current`, else AG_ERR_STALE (the current version in err->element), whatever the tags'
+ * text ("stale-0" is well-formed and stale). */
+ag_status ag_request_if_match_check(const ag_if_match *m, const char *what, int64_t id,
+                                    int64_t current, int64_t *version, ag_error *err);
 
 #endif

@@ -42,6 +42,22 @@ const ag_route ag_routes[] = {
     /* stores nothing: editors of a shared extrusion model preview their plan edits */
     {"POST", "/api/v1/extrusions/preview", ag_api_extrusions_preview, JSON, AG_NEED_ACCOUNT, 0},
     {"GET", "/api/v1/models/{id}/plan", ag_api_model_plan, NONE, AG_NEED_MODEL_VIEWER, 0},
+    /* what the client needs to select and compose (api_parts.c); composing is an op */
+    {"GET", "/api/v1/models/{id}/selection", ag_api_model_selection, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"POST", "/api/v1/models/{id}/compose-preview", ag_api_model_compose_preview, JSON,
+     AG_NEED_MODEL_EDITOR, 0},
+    /* the shared parts library: every account reads it, editors write it; bundles are spooled
+     * like uploads */
+    {"GET", "/api/v1/parts", ag_api_parts_list, NONE, AG_NEED_ACCOUNT, 0},
+    {"POST", "/api/v1/parts", ag_api_parts_create, JSON, AG_NEED_EDITOR, 0},
+    {"POST", "/api/v1/parts:import", ag_api_parts_import, UPLOAD, AG_NEED_EDITOR, 0},
+    {"GET", "/api/v1/parts:export", ag_api_parts_export, NONE, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/parts/{id}", ag_api_part_get, NONE, AG_NEED_ACCOUNT, 0},
+    {"DELETE", "/api/v1/parts/{id}", ag_api_part_delete, NONE, AG_NEED_EDITOR, 0},
+    {"POST", "/api/v1/parts/{id}/versions", ag_api_part_versions_create, JSON, AG_NEED_EDITOR, 0},
+    {"GET", "/api/v1/parts/{id}/thumbnail.png", ag_api_part_thumbnail, NONE, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/parts/{id}/mesh.glb", ag_api_part_mesh_glb, NONE, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/parts/{id}/bundle", ag_api_part_bundle, NONE, AG_NEED_ACCOUNT, 0},
     {"GET", "/api/v1/jobs/{id}", ag_api_job_get, NONE, AG_NEED_JOB, 0},
     {"DELETE", "/api/v1/jobs/{id}", ag_api_job_cancel, NONE, AG_NEED_JOB, 0},
     /* the caller's own account and tokens */

@@ -61,6 +61,18 @@ enum MHD_Result ag_api_model_grammar_put(ag_request *r);
 enum MHD_Result ag_api_extrusions_create(ag_request *r);
 enum MHD_Result ag_api_extrusions_preview(ag_request *r);
 enum MHD_Result ag_api_model_plan(ag_request *r);
+enum MHD_Result ag_api_model_selection(ag_request *r);
+enum MHD_Result ag_api_model_compose_preview(ag_request *r);
+enum MHD_Result ag_api_parts_list(ag_request *r);
+enum MHD_Result ag_api_parts_create(ag_request *r);
+enum MHD_Result ag_api_parts_import(ag_request *r);
+enum MHD_Result ag_api_parts_export(ag_request *r);
+enum MHD_Result ag_api_part_get(ag_request *r);
+enum MHD_Result ag_api_part_delete(ag_request *r);
+enum MHD_Result ag_api_part_versions_create(ag_request *r);
+enum MHD_Result ag_api_part_thumbnail(ag_request *r);
+enum MHD_Result ag_api_part_mesh_glb(ag_request *r);
+enum MHD_Result ag_api_part_bundle(ag_request *r);
 enum MHD_Result ag_api_job_get(ag_request *r);
 enum MHD_Result ag_api_job_cancel(ag_request *r);
 /* accounts and tokens (api_accounts.c), sharing (api_sharing.c) */

@@ -1,6 +1,7 @@
 #include "upload.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -168,4 +169,41 @@ const char *ag_upload_take_path(ag_upload *u)
 {
     u->owned = 0;
     return u->path;
+}
+
+ag_status ag_upload_read_all(ag_request *r, size_t max, const char *what, char **text,
+                             size_t *len, ag_error *err)
+{
+    *text = NULL;
+    *len = 0;
+    size_t n = r->upload ? ag_upload_bytes(r->upload) : 0;
+    if (n > max)
+        return ag_error_set(err, AG_ERR_TOO_LARGE, 0,
+                            "the %s has %zu bytes; at most %zu are accepted", what, n, max);
+    if (n == 0)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "the body must hold the %s", what);
+    const char *path = ag_upload_take_path(r->upload);
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    char *buf = malloc(n + 1);
+    size_t got = 0;
+    while (fd >= 0 && buf && got < n) {
+        ssize_t k = read(fd, buf + got, n - got);
+        if (k <= 0)
+            break;
+        got += (size_t)k;
+    }
+    int e = errno;
+    if (fd >= 0)
+        close(fd);
+    unlink(path);
+    if (!buf)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory reading the body");
+    if (got != n) {
+        free(buf);
+        return ag_error_set(err, AG_ERR_IO, 0, "cannot read the body back: %s", strerror(e));
+    }
+    buf[n] = '\0';
+    *text = buf;
+    *len = n;
+    return AG_OK;
 }

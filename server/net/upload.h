@@ -27,4 +27,9 @@ void ag_upload_name(ag_request *r, const char *fallback, char *buf, size_t len);
 /* The spooled file's path; after this call the file belongs to the caller. */
 const char *ag_upload_take_path(ag_upload *u);
 
+/* The spooled body whole, as NUL-terminated text (*text malloc'd; the file is removed):
+ * AG_ERR_TOO_LARGE past max bytes, AG_ERR_INVALID when empty (both naming `what`). */
+ag_status ag_upload_read_all(ag_request *r, size_t max, const char *what, char **text,
+                             size_t *len, ag_error *err);
+
 #endif

@@ -4,6 +4,7 @@ import assert from 'node:assert/strict';
 
 export const WAIT = { timeout: 30000 };
 
+// Follows a job over REST (api(path) fetches below /api/v1) until it ends; it must succeed.
 export const versionOf = async (page) => Number((await page.getByTestId('model-version').textContent()).replace(/\D/g, ''));
 
 export const waitVersion = (page, v) =>

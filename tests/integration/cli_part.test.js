@@ -4,47 +4,13 @@ import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
-import { REPO, tempDir, removeDir } from './harness.js';
+import { REPO, tempDir, removeDir, windowWallObj } from './harness.js';
 
 const CLI = process.env.ARCHGRAM ? path.resolve(process.env.ARCHGRAM) : path.join(REPO, 'build', 'archgram');
 const run = (...args) => spawnSync(CLI, args, { encoding: 'utf8', timeout: 60000 });
 
-// A wall (z-up) with a grid of windows set into it; a window is a casing holding four frame
-// bars of width `frame`, a glass pane and `mullions` mullions, every piece its own group.
-function buildingObj({ cols, rows, ww, wh, frame, mullions }) {
-  const out = [];
-  let nv = 0, n = 0;
-  const box = (a, b) => {
-    out.push(`g piece_${n++}`);
-    for (let i = 0; i < 8; i++) out.push(`v ${i & 1 ? b[0] : a[0]} ${i & 2 ? b[1] : a[1]} ${i & 4 ? b[2] : a[2]}`);
-    const faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    for (const [p, q, r, s] of faces) out.push(`f ${nv + p + 1} ${nv + q + 1} ${nv + r + 1}`, `f ${nv + p + 1} ${nv + r + 1} ${nv + s + 1}`);
-    nv += 8;
-  };
-  const W = 1.8 + (cols - 1) * (ww + 1) + ww, H = 1 + rows * (wh + 1.2);
-  box([0, 0, 0], [W, 0.3, H]);
-  const slots = [];
-  for (let j = 0; j < rows; j++) {
-    for (let i = 0; i < cols; i++) {
-      const u = 0.9 + i * (ww + 1), w = 1 + j * (wh + 1.2), v0 = 0.1, v1 = 0.26;
-      box([u, v0, w], [u + ww, v1, w + wh]);
-      box([u, v0, w], [u + ww, v1, w + frame]);
-      box([u, v0, w + wh - frame], [u + ww, v1, w + wh]);
-      box([u, v0, w + frame], [u + frame, v1, w + wh - frame]);
-      box([u + ww - frame, v0, w + frame], [u + ww, v1, w + wh - frame]);
-      box([u + frame, v0 + 0.07, w + frame], [u + ww - frame, v0 + 0.08, w + wh - frame]);
-      for (let k = 0; k < mullions; k++) {
-        const c = u + frame + (ww - 2 * frame) * (k + 1) / (mullions + 1);
-        box([c - 0.025, v0 + 0.03, w + frame], [c + 0.025, v0 + 0.13, w + wh - frame]);
-      }
-      slots.push([u, v0, w, u + ww, v1, w + wh]);
-    }
-  }
-  return { obj: out.join('\n') + '\n', slots };
-}
-
 function proceduralized(dir, name, opt) {
-  const { obj, slots } = buildingObj(opt);
+  const { obj, slots } = windowWallObj(opt);
   const file = path.join(dir, `${name}.obj`);
   fs.writeFileSync(file, obj);
   const out = path.join(dir, name);

@@ -4,7 +4,7 @@
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
 import {
-  assertProblem, http, importModel, removeDir, startDaemon, waitJob,
+  assertProblem, http, importModel, removeDir, rng, startDaemon, waitJob,
 } from './harness.js';
 
 // One OBJ group per box (y-up): [name, x0, y0, z0, x1, y1, z1].
@@ -33,18 +33,6 @@ const facade = (cols, rows) => boxesObj([
 ]);
 // A bare 8 m wall on a plinth: nothing to repeat.
 const bareWall = () => boxesObj([['wall', 0, 0, 0, 8, 4, 0.3], ['plinth', 0, 0, 0.3, 8, 0.4, 0.6]]);
-
-// Deterministic pseudo-random numbers (mulberry32).
-function rng(seed) {
-  let a = seed >>> 0;
-  return () => {
-    a = (a + 0x6d2b79f5) >>> 0;
-    let t = a;
-    t = Math.imul(t ^ (t >>> 15), t | 1);
-    t ^= t + Math.imul(t ^ (t >>> 7), t | 61);
-    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
-  };
-}
 
 const area = (n) => (n.box[3] - n.box[0]) * (n.box[4] - n.box[1]) + (n.box[3] - n.box[0]) * (n.box[5] - n.box[2]) +
   (n.box[4] - n.box[1]) * (n.box[5] - n.box[2]);

@@ -26,6 +26,19 @@ export const PROBLEM = 'urn:archgram:problem:';
 
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
+// Deterministic pseudo-random numbers (mulberry32).
+export function rng(seed) {
+  let a = seed >>> 0;
+  return () => {
+    a = (a + 0x6d2b79f5) >>> 0;
+    let t = a;
+    t = Math.imul(t ^ (t >>> 15), t | 1);
+    t ^= t + Math.imul(t ^ (t >>> 7), t | 61);
+    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+  };
+}
+
+
 export function fixture(name) {
   return fs.readFileSync(path.join(DATA, name));
 }
@@ -645,4 +658,41 @@ export function facadeObj(cols = 6, rows = 4, wall = [15, 13]) {
     }
   }
   return `${v.join('\n')}\n${f.join('\n')}\n`;
+}
+
+// A wall (z-up OBJ text) with a grid of windows set into it, the parts library's building: a
+// window is a casing holding four frame bars of width `frame`, a glass pane and `mullions`
+// mullions, every piece its own group; `front` is the window's front face (0.1: set into the
+// 0.3 m wall, hidden by its face; below 0: standing proud of it, in view from the front).
+// Returns the text and each window's box (slots).
+export function windowWallObj({ cols, rows, ww, wh, frame, mullions, front = 0.1 }) {
+  const out = [];
+  let nv = 0, n = 0;
+  const box = (a, b) => {
+    out.push(`g piece_${n++}`);
+    for (let i = 0; i < 8; i++) out.push(`v ${i & 1 ? b[0] : a[0]} ${i & 2 ? b[1] : a[1]} ${i & 4 ? b[2] : a[2]}`);
+    const faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    for (const [p, q, r, s] of faces) out.push(`f ${nv + p + 1} ${nv + q + 1} ${nv + r + 1}`, `f ${nv + p + 1} ${nv + r + 1} ${nv + s + 1}`);
+    nv += 8;
+  };
+  const W = 1.8 + (cols - 1) * (ww + 1) + ww, H = 1 + rows * (wh + 1.2);
+  box([0, 0, 0], [W, 0.3, H]);
+  const slots = [];
+  for (let j = 0; j < rows; j++) {
+    for (let i = 0; i < cols; i++) {
+      const u = 0.9 + i * (ww + 1), w = 1 + j * (wh + 1.2), v0 = front, v1 = front + 0.16;
+      box([u, v0, w], [u + ww, v1, w + wh]);
+      box([u, v0, w], [u + ww, v1, w + frame]);
+      box([u, v0, w + wh - frame], [u + ww, v1, w + wh]);
+      box([u, v0, w + frame], [u + frame, v1, w + wh - frame]);
+      box([u + ww - frame, v0, w + frame], [u + ww, v1, w + wh - frame]);
+      box([u + frame, v0 + 0.07, w + frame], [u + ww - frame, v0 + 0.08, w + wh - frame]);
+      for (let k = 0; k < mullions; k++) {
+        const c = u + frame + (ww - 2 * frame) * (k + 1) / (mullions + 1);
+        box([c - 0.025, v0 + 0.03, w + frame], [c + 0.025, v0 + 0.13, w + wh - frame]);
+      }
+      slots.push([u, v0, w, u + ww, v1, w + wh]);
+    }
+  }
+  return { obj: out.join('\n') + '\n', slots };
 }

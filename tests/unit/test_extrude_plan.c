@@ -127,12 +127,33 @@ static void test_rejects(void **state)
     assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
     assert_non_null(strstr(err.text, "crosses"));
     ag_plan_free(p);
-    /* a hole touching the outer ring */
+    /* a hole crossing the outer ring where it touches it (its corner on the outer edge,
+     * one of its edges outside) */
     const double outer[] = {0, 0, 10, 0, 10, 10, 0, 10};
-    const double hole[] = {0, 5, 5, 4, 5, 6};
+    const double hole[] = {0, 5, 5, 4, -2, 7};
     p = one_loop(outer, 4);
     ag_plan_add_loop(p, hole, 3, NULL, NULL);
     assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "crosses"));
+    ag_plan_free(p);
+    /* a hole running along the outer ring (an overlap, not a point) */
+    const double along[] = {0, 4, 3, 5, 0, 6};
+    p = one_loop(outer, 4);
+    ag_plan_add_loop(p, along, 3, NULL, NULL);
+    assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "overlaps"));
+    ag_plan_free(p);
+    /* a ring touching itself (its corner 4 on its edge 1) */
+    const double pinch[] = {0, 0, 10, 0, 10, 10, 5, 5, 10, 5, 0, 10};
+    p = one_loop(pinch, 6);
+    assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "loop 0: edge"));
+    ag_plan_free(p);
+    /* a symmetric bow tie has no area, but it is refused for crossing, not for that */
+    const double sym[] = {0, 0, 10, 0, 0, 10, 10, 10};
+    p = one_loop(sym, 4);
+    assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "edge 1 crosses edge 3"));
     ag_plan_free(p);
     /* NaN */
     const double bad[] = {0, 0, NAN, 0, 1, 1};
@@ -153,6 +174,47 @@ static void test_rejects(void **state)
     assert_int_equal(ag_plan_validate(p, NULL, NULL, &err), AG_ERR_INVALID);
     assert_non_null(strstr(err.text, "profile"));
     ag_plan_free(p);
+}
+
+/* OGC-valid touches are accepted: a hole touching the outer ring at a point, two outer
+ * rings meeting at a corner. The touching corner is moved a hair off (a reported fix), so
+ * walls on both loops never share an edge, and nothing else changes. */
+static void test_touching_loops_accepted(void **state)
+{
+    (void)state;
+    const double outer[] = {0, 0, 10, 0, 10, 10, 0, 10};
+    const double hole[] = {0, 5, 5, 4, 5, 6};        /* CCW: validation reverses it too */
+    const double other[] = {10, 10, 20, 10, 20, 20, 10, 20};
+    const double *second[] = {hole, other};
+    const size_t n2[] = {3, 4};
+    for (int c = 0; c < 2; c++) {
+        ag_plan *p = one_loop(outer, 4);
+        assert_int_equal(ag_plan_add_loop(p, second[c], n2[c], NULL, NULL), AG_OK);
+        ag_plan_fixes fx = {0};
+        ag_error err = {0};
+        if (ag_plan_validate(p, &fx, NULL, &err) != AG_OK)
+            fail_msg("case %d: %s", c, err.text);
+        assert_int_equal(p->nloops, 2);
+        assert_true(has_fix(&fx, AG_PLAN_FIX_TOUCH, -2));
+        /* the moved corner is off the other loop by a gap well above the weld tolerance
+         * and well below a millimetre; every other corner is where it was */
+        const ag_plan_loop *l = &p->loops[1];
+        double dmin = INFINITY;
+        size_t same = 0;
+        for (size_t i = 0; i < l->n; i++) {
+            for (size_t k = 0; k < n2[c]; k++)
+                same += l->xy[2 * i] == second[c][2 * k] && l->xy[2 * i + 1] == second[c][2 * k + 1];
+            double x = l->xy[2 * i], y = l->xy[2 * i + 1];
+            if (c == 0)
+                dmin = fmin(dmin, x); /* distance to the outer edge x = 0 */
+            else
+                dmin = fmin(dmin, hypot(x - 10, y - 10));
+        }
+        assert_int_equal(same, n2[c] - 1);
+        assert_true(dmin > 1e-5 && dmin < 1e-3);
+        ag_plan_fixes_free(&fx);
+        ag_plan_free(p);
+    }
 }
 
 static void test_profiles_checked(void **state)
@@ -190,6 +252,7 @@ int main(void)
         cmocka_unit_test(test_orientation),
         cmocka_unit_test(test_reversal_keeps_edge_profiles),
         cmocka_unit_test(test_rejects),
+        cmocka_unit_test(test_touching_loops_accepted),
         cmocka_unit_test(test_profiles_checked),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -60,6 +60,25 @@ export class Api {
     if (res.status === 401 && this.auth) this.auth.refused();
   }
 
+  // An image the API serves (href as the server gives it, e.g. a part's versioned thumbnail)
+  // as an object URL: an <img src> cannot send the bearer token. Kept per href.
+  imageUrl(href) {
+    if (!this.images) this.images = new Map();
+    if (!this.images.has(href)) {
+      const url = (async () => {
+        const res = await fetch(href, { headers: this.authHeaders() });
+        if (!res.ok) {
+          this.refused(res);
+          throw new ApiError(await problemFrom(res));
+        }
+        return URL.createObjectURL(await res.blob());
+      })();
+      url.catch(() => this.images.delete(href)); // tried again next time
+      this.images.set(href, url);
+    }
+    return this.images.get(href);
+  }
+
   async request(method, path, { body, headers = {}, raw = false } = {}) {
     const init = { method, headers: { Accept: 'application/json', ...this.authHeaders(), ...headers } };
     if (body !== undefined) {
@@ -239,5 +258,45 @@ export class Api {
   async previewExtrusion(plan) {
     const res = await this.request('POST', '/extrusions/preview', { body: plan, raw: true, headers: { Accept: 'model/gltf-binary' } });
     return res.arrayBuffer();
+  }
+
+  // --- the parts library ----------------------------------------------------------------------
+  // A page of parts: q (words), tag, pageToken.
+  listParts({ q = '', tag = '', pageToken = null, pageSize = 50 } = {}) {
+    const p = new URLSearchParams({ page_size: String(pageSize) });
+    if (q) p.set('q', q);
+    if (tag) p.set('tag', tag);
+    if (pageToken) p.set('page_token', pageToken);
+    return this.request('GET', `/parts?${p}`);
+  }
+
+  getPart(id) {
+    return this.request('GET', `/parts/${id}`);
+  }
+
+  // Saves a node (or a selection's common ancestor) of a model at a version as a part.
+  savePart(body) {
+    return this.request('POST', '/parts', { body });
+  }
+
+  deletePart(id, version) {
+    return this.request('DELETE', `/parts/${id}`, { headers: { 'If-Match': `"${version}"` } });
+  }
+
+  // The common ancestors of selected nodes: {tree, rule: [...]} (server/core/parts/select.h).
+  selectionOf(model, version, nodes) {
+    const p = new URLSearchParams({ nodes: nodes.join(','), version: String(version) });
+    return this.request('GET', `/models/${model}/selection?${p}`);
+  }
+
+  // A compose op run without storing it: the GLB bytes of what it would make and how many
+  // instances it changes.
+  async previewCompose(model, version, op) {
+    const res = await this.request('POST', `/models/${model}/compose-preview`, {
+      body: { op },
+      raw: true,
+      headers: { Accept: 'model/gltf-binary', 'If-Match': `"${version}"` },
+    });
+    return { buffer: await res.arrayBuffer(), instances: Number(res.headers.get('X-Archgram-Instances') ?? NaN) };
   }
 }

@@ -1,8 +1,10 @@
 // The editor: all client state plus the signals that announce its changes, and the one path
 // every op takes (execute). Panels and the viewport read state here and listen to signals;
 // they never talk to each other. Parts with state of their own are sub-editors it owns:
-// the selection (selection.js) and the extrusion being edited (extrusioneditor.js).
+// the selection (selection.js), the extrusion being edited (extrusioneditor.js) and the parts
+// library with the composition being prepared (library.js).
 import { ExtrusionEditor } from './extrusioneditor.js';
+import { PartsLibrary } from './library.js';
 import { OP, REMESHING, isSendable } from './opkinds.js';
 import { Selection } from './selection.js';
 import { Signal } from './signal.js';
@@ -49,6 +51,7 @@ export class Editor {
     this.camera = null;
     this.transport = null;  // sends ops: the live connection (REST while it is down)
     this.extrusion = new ExtrusionEditor(this);
+    this.library = new PartsLibrary(this);
   }
 
   // The selection's value ({component, group, node?, nodes?, components?} or null).

@@ -26,6 +26,10 @@ import { Handles } from './handles.js';
 import { Undo } from './undo.js';
 import { Auth } from './auth.js';
 import { ShareDialog } from './share.js';
+import { WindowSelect } from './windowselect.js';
+import { TreeWalk } from './treewalk.js';
+import { LibraryPanel } from './librarypanel.js';
+import { NodeInfo } from './nodeinfo.js';
 
 const $ = (id) => document.getElementById(id);
 const editor = new Editor();
@@ -56,6 +60,10 @@ new CityView(editor, viewport, $('city'));
 new PeersPanel(editor, $('peers'));
 new HistoryPanel(editor, session, $('history'));
 new SplitTreePanel(editor, procedural, $('tree'));
+const windowSelect = new WindowSelect(editor, viewport);
+const walk = new TreeWalk(editor);
+new NodeInfo(editor, viewport);
+const library = new LibraryPanel(editor, api, viewport, windowSelect, $('library'));
 new GrammarPanel(editor, procedural, $('grammar'));
 collapsible(document.querySelectorAll('section[id]'));
 
@@ -70,7 +78,7 @@ window.addEventListener('unhandledrejection', (e) => {
 
 window.archgram = editor; // for poking at state from the console
 window.archgramAuth = auth;
-window.archgramTools = { viewport, preview, editTools, handles }; // and at the edit tools (tests drive handles)
+window.archgramTools = { viewport, preview, editTools, handles, windowSelect, walk, library }; // and at the edit tools (tests drive handles)
 
 function modelFromHash() {
   const m = /^#model=(\d+)$/.exec(location.hash);

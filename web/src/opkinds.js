@@ -1,7 +1,7 @@
 // Every op kind this client sends (schema/websocket.md), and the groups of kinds it reacts to.
 // The list below stays one array literal of double-quoted strings: a unit test of the service
 // reads it and checks it against the server's op table and the schema documents.
-export const OP_KINDS = ["rename", "note", "resize", "split", "join", "paste", "remove", "undo", "redo", "restore", "plan", "profile"];
+export const OP_KINDS = ["rename", "note", "resize", "split", "join", "paste", "remove", "compose", "undo", "redo", "restore", "plan", "profile"];
 
 // Kinds the server logs itself (a proceduralize job, a grammar PUT); clients never send them.
 export const SERVER_MADE = ['proceduralize', 'grammar'];
@@ -26,8 +26,8 @@ export function kinds(...names) {
 
 export const isSendable = (kind) => OP_KINDS.includes(kind);
 
-// Structural edits of a proceduralized model.
-export const STRUCTURAL = kinds('resize', 'split', 'join', 'paste', 'remove');
+// Structural edits of a proceduralized model (a composition of a part is one too).
+export const STRUCTURAL = kinds('resize', 'split', 'join', 'paste', 'remove', 'compose');
 // After these the model's mesh, tree and grammar must be read again.
 export const REMESHING = kinds('proceduralize', 'grammar', ...STRUCTURAL, 'undo', 'redo', 'restore');
 // The kinds in a person's undo history (the server's undo works on these).

@@ -1,15 +1,13 @@
 #include "attach.h"
 
-static double coord(const ag_box *b, int c) { return c < 3 ? b->min[c] : b->max[c - 3]; }
+#include "../base/tolerance.h"
 
 size_t ag_attach_detect(const ag_box *bi, const ag_box *bj, double eps, ag_attach out[12])
 {
     size_t n = 0;
     int overlap[3], noverlap = 0;
     for (int a = 0; a < 3; a++) {
-        double lo = bi->min[a] > bj->min[a] ? bi->min[a] : bj->min[a];
-        double hi = bi->max[a] < bj->max[a] ? bi->max[a] : bj->max[a];
-        overlap[a] = hi - lo > eps;
+        overlap[a] = ag_box_overlap_axis(bi, bj, a) > eps;
         noverlap += overlap[a];
     }
     for (int a = 0; a < 3; a++) {
@@ -17,7 +15,7 @@ size_t ag_attach_detect(const ag_box *bi, const ag_box *bj, double eps, ag_attac
         for (int s = 0; s < 2; s++)
             for (int t = 0; t < 2; t++) {
                 int ci = a + 3 * s, cj = a + 3 * t;
-                double d = coord(bi, ci) - coord(bj, cj);
+                double d = ag_box_coord(bi, ci) - ag_box_coord(bj, cj);
                 if (d <= eps && d >= -eps) {
                     out[n++] = (ag_attach){.type = AG_ATTACH_CORNER, .ci = ci, .cj = cj, .k = d};
                     equal = 1;
@@ -31,18 +29,18 @@ size_t ag_attach_detect(const ag_box *bi, const ag_box *bj, double eps, ag_attac
                                                                   : AG_ATTACH_VOLUME;
         const ag_box *L = bi, *S = bj;
         int swap = 0;
-        if (bj->max[a] - bj->min[a] > bi->max[a] - bi->min[a]) {
+        if (ag_box_extent(bj, a) > ag_box_extent(bi, a)) {
             L = bj;
             S = bi;
             swap = 1;
         }
-        double len = L->max[a] - L->min[a], slen = S->max[a] - S->min[a];
+        double len = ag_box_extent(L, a), slen = ag_box_extent(S, a);
         if (len <= eps || slen <= eps)
             continue;
         ag_attach r = {.type = type, .ci = a, .cj = a, .swap = swap};
         if (S->min[a] >= L->min[a] - eps && S->max[a] <= L->max[a] + eps) {
             r.form = 0;
-            r.k = (0.5 * (S->min[a] + S->max[a]) - L->min[a]) / len;
+            r.k = (ag_box_centre_axis(S, a) - L->min[a]) / len;
         } else if (S->min[a] < L->min[a]) {
             r.form = 1;
             r.k = (S->max[a] - L->min[a]) / slen;
@@ -60,13 +58,13 @@ double ag_attach_weight(int type)
     switch (type) {
     case AG_ATTACH_EDGE:
     case AG_ATTACH_PLANE:
-        return 1.0;
+        return AG_EDIT_WEIGHT_RATIO;
     case AG_ATTACH_VOLUME:
-        return 0.3;
+        return AG_EDIT_WEIGHT_VOLUME;
     case AG_ATTACH_SIZE:
-        return 3.0; /* an element's own size matters more than where it sits */
+        return AG_EDIT_WEIGHT_SIZE;
     case AG_ATTACH_POSITION:
-        return 1e-3; /* only keeps the system definite: far below every other term */
+        return AG_EDIT_WEIGHT_POSITION;
     default:
         return 0;
     }

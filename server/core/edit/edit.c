@@ -1,10 +1,11 @@
 #include "edit.h"
 
+#include <assert.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "../base/clock.h"
 #include "resize.h"
 
 struct ag_edit_cache {
@@ -239,6 +240,7 @@ ag_status ag_edit_apply(ag_edit_model *m, const ag_edit_op *op, ag_edit_model **
 ag_status ag_edit_apply_ex(ag_edit_model *m, const ag_edit_op *op, unsigned flags,
                            ag_edit_model **out, ag_edit_report *rep, ag_error *err)
 {
+    assert(m && m->proc && op && out);
     *out = NULL;
     ag_edit_report local = {0};
     if (!rep)
@@ -312,9 +314,7 @@ ag_status ag_edit_preview(ag_edit_model *m, const ag_edit_op *op, ag_box **boxes
     ag_status st = ag_edit_check_node(m->proc, op->node, "node", err);
     if (st)
         return st;
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    double t0 = ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+    double t0 = ag_clock_ms();
     if (!ag_edit_resize_solver_matches(m->cache->solver, op)) {
         ag_edit_resize_solver_free(m->cache->solver);
         m->cache->solver = NULL;
@@ -328,10 +328,8 @@ ag_status ag_edit_preview(ag_edit_model *m, const ag_edit_op *op, ag_box **boxes
         free(b);
         return st;
     }
-    if (rep) { /* with the factorization when it was made for this call */
-        clock_gettime(CLOCK_MONOTONIC, &ts);
-        rep->solve_ms = ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6 - t0;
-    }
+    if (rep) /* with the factorization when it was made for this call */
+        rep->solve_ms = ag_clock_ms() - t0;
     *boxes = b;
     return AG_OK;
 }

@@ -24,6 +24,8 @@
 #include "place.h"
 
 #define PASTE_MAX_TRIANGLES 50000000.0
+/* A fill needing more copies per axis is refused before its triangles are even counted. */
+#define PASTE_MAX_COPIES 1e7
 
 ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op, ag_mesh **out,
                         ag_edit_report *rep, ag_error *err)
@@ -65,10 +67,7 @@ ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
     size_t ns = 0, stris = 0;
     for (size_t i = 0; i < op->nnodes; i++) {
         const ag_box *nb = &ts->nodes[op->nodes[i]].box;
-        for (int a = 0; a < 3; a++) {
-            Bs.min[a] = fmin(Bs.min[a], nb->min[a]);
-            Bs.max[a] = fmax(Bs.max[a], nb->max[a]);
-        }
+        ag_box_extend_box(&Bs, nb);
         ns += ag_place_mark_subtree(ts, op->nodes[i], smark);
     }
     if (ns == 0) {
@@ -84,8 +83,7 @@ ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
     int fd = ag_place_facing(&Bd, &td->nodes[AG_EDIT_ROOT].box);
     int k = (fd - fs) & 3;
     double S[3];
-    for (int a = 0; a < 3; a++)
-        S[a] = Bs.max[a] - Bs.min[a];
+    ag_box_extents(&Bs, S);
     if (k & 1) {
         double x = S[0];
         S[0] = S[1];

@@ -1,9 +1,13 @@
 #include "place.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "../base/array.h"
+#include "../base/tolerance.h"
 
 void ag_place_identity(ag_place_map *m)
 {
@@ -16,21 +20,17 @@ void ag_place_boxes(ag_place_map *m, const ag_box *from, const ag_box *to, int k
 {
     k &= 3;
     double S[3], cf[3], ct[3];
-    for (int a = 0; a < 3; a++) {
-        S[a] = from->max[a] - from->min[a];
-        cf[a] = 0.5 * (from->min[a] + from->max[a]);
-        ct[a] = 0.5 * (to->min[a] + to->max[a]);
-    }
+    ag_box_extents(from, S);
+    ag_box_centre(from, cf);
+    ag_box_centre(to, ct);
     double Sr[3] = {S[0], S[1], S[2]};
     if (k & 1) {
         Sr[0] = S[1];
         Sr[1] = S[0];
     }
     double s[3];
-    for (int a = 0; a < 3; a++) {
-        double ts = to->max[a] - to->min[a];
-        s[a] = Sr[a] > 0 ? ts / Sr[a] : 1.0;
-    }
+    for (int a = 0; a < 3; a++)
+        s[a] = Sr[a] > 0 ? ag_box_extent(to, a) / Sr[a] : 1.0;
     double c = k == 0 ? 1 : k == 2 ? -1 : 0, sn = k == 1 ? 1 : k == 3 ? -1 : 0;
     double R[3][3] = {{c, -sn, 0}, {sn, c, 0}, {0, 0, 1}};
     for (int i = 0; i < 3; i++)
@@ -50,15 +50,12 @@ void ag_place_apply(const ag_place_map *m, const double p[3], double q[3])
 
 ag_box ag_place_apply_box(const ag_place_map *m, const ag_box *b)
 {
-    ag_box o = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    ag_box o = ag_box_empty();
     for (int i = 0; i < 8; i++) {
         double p[3] = {i & 1 ? b->max[0] : b->min[0], i & 2 ? b->max[1] : b->min[1],
                        i & 4 ? b->max[2] : b->min[2]};
         ag_place_apply(m, p, p);
-        for (int a = 0; a < 3; a++) {
-            o.min[a] = fmin(o.min[a], p[a]);
-            o.max[a] = fmax(o.max[a], p[a]);
-        }
+        ag_box_extend_point(&o, p);
     }
     return o;
 }
@@ -82,6 +79,7 @@ ag_status ag_place_check_node(const ag_proceduralize_result *r, int32_t node, co
 size_t ag_place_mark_subtree(const ag_splittree *t, int32_t node, uint8_t *mark)
 {
     /* iterative preorder walk over first_child / next_sibling, bounded by the subtree root */
+    assert(node >= 0 && (size_t)node < t->nnodes); /* callers check the node first */
     size_t n = 0;
     int32_t v = node;
     while (v >= 0) {
@@ -105,11 +103,11 @@ size_t ag_place_mark_subtree(const ag_splittree *t, int32_t node, uint8_t *mark)
 
 int ag_place_facing(const ag_box *b, const ag_box *ref)
 {
-    double dx = b->max[0] - b->min[0], dy = b->max[1] - b->min[1];
-    int a = dx < dy ? 0 : 1; /* the thinner horizontal axis is the facing axis */
-    double off = 0.5 * (b->min[a] + b->max[a]) - 0.5 * (ref->min[a] + ref->max[a]);
-    double size = ref->max[a] - ref->min[a];
-    if (fabs(off) <= 1e-9 * (size > 0 ? size : 1.0))
+    /* the thinner horizontal axis is the facing axis */
+    int a = ag_box_extent(b, 0) < ag_box_extent(b, 1) ? 0 : 1;
+    double off = ag_box_centre_axis(b, a) - ag_box_centre_axis(ref, a);
+    double size = ag_box_extent(ref, a);
+    if (fabs(off) <= AG_EDIT_COINCIDENT * (size > 0 ? size : 1.0))
         return a == 0 ? 2 : 3;
     if (a == 0)
         return off > 0 ? 0 : 2;
@@ -215,7 +213,9 @@ void ag_place_builder_free(ag_place_builder *b)
 static ag_status group_index(ag_place_builder *b, const char *name, int32_t *out)
 {
     if (2 * (b->m->ngroups + 1) > b->gcap) {
-        size_t nc = b->gcap ? 2 * b->gcap : 64;
+        size_t nc;
+        if (ag_array_hash_size(b->m->ngroups + 1, &nc))
+            return AG_ERR_TOO_LARGE;
         int32_t *ns = malloc(nc * sizeof *ns);
         if (!ns)
             return AG_ERR_NOMEM;
@@ -267,13 +267,12 @@ ag_status ag_place_add(ag_place_builder *b, const ag_proceduralize_result *r, ui
     if (!b->has_comp || c >= L->ncomponents)
         return AG_ERR_INTERNAL;
     if (src->nverts > b->vcap) {
-        uint32_t *nv = realloc(b->vmap, src->nverts * sizeof *nv);
-        if (!nv)
-            return AG_ERR_NOMEM;
-        for (size_t i = b->vcap; i < src->nverts; i++)
-            nv[i] = UINT32_MAX;
-        b->vmap = nv;
-        b->vcap = src->nverts;
+        size_t old = b->vcap;
+        ag_status st = AG_ARRAY_RESERVE_EXACT(b->vmap, b->vcap, src->nverts);
+        if (st)
+            return st;
+        for (size_t i = old; i < b->vcap; i++)
+            b->vmap[i] = UINT32_MAX;
     }
     ag_status st = AG_OK;
     uint32_t s0 = L->tri_start[c], s1 = L->tri_start[c + 1];

@@ -17,17 +17,15 @@
  *    doubles or halves its count on that axis, recursively, keeping each cell's share of its
  *    period; plain siblings of one rule (not cells of a grid pattern) squeezed under
  *    AG_EDIT_JOIN_RATIO join with their nearest same-rule sibling along that axis, recursively.
- *    Editing the root or an invisible node maps its subtree affinely (no solve). */
+ *    Editing the root or an invisible node maps its subtree affinely (no solve).
+ * The steps live in resize_system.c (1-3, in named phases), resize_solve.c and resize_emit.c
+ * (4); resize_internal.h holds what they share. */
 #ifndef AG_EDIT_RESIZE_H
 #define AG_EDIT_RESIZE_H
 
+#include "../base/tolerance.h" /* AG_EDIT_SPLIT_RATIO, AG_EDIT_JOIN_RATIO */
 #include "../proc/proceduralize.h"
 #include "edit.h"
-
-#define AG_EDIT_SPLIT_RATIO 1.8
-/* The counterpart of the split ratio (1 / 1.8): a pattern stretched then squeezed back
- * returns to its count, and a cell squeezed to half its size joins with its neighbour. */
-#define AG_EDIT_JOIN_RATIO (1.0 / 1.8)
 
 /* Squeezed plain siblings join only under nodes with at most this many children. */
 #define AG_EDIT_JOIN_SIBLINGS_MAX 20000

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "../base/tolerance.h"
 #include "edit.h"
 #include "place.h"
 
@@ -21,8 +22,9 @@ ag_status ag_edit_split(const ag_proceduralize_result *in, const ag_edit_op *op,
     const ag_splittree *t = in->tree;
     const ag_box B = t->nodes[op->node].box;
     int a = op->axis;
-    /* both halves must keep a size the tree can tell from a face coincidence */
-    double eps = t->eps > 0 ? 10 * t->eps : 1e-9;
+    /* both halves must keep a size the tree can tell from a face coincidence (a tree without
+     * one: as if its diagonal were 1 m) */
+    double eps = t->eps > 0 ? AG_EDIT_SPLIT_MARGIN * t->eps : AG_EDIT_COINCIDENT;
     if (!isfinite(op->at) || op->at <= B.min[a] + eps || op->at >= B.max[a] - eps)
         return ag_error_set(err, AG_ERR_INVALID, op->node,
                             "split plane %c = %g is not inside node %d's box (%g .. %g)",

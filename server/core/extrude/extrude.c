@@ -2,8 +2,17 @@
 
 #include <string.h>
 
-ag_status ag_extrude_plan(ag_plan *plan, ag_mesh *m, int32_t group, ag_extrude_result *res,
-                          ag_shell **keep_shell, ag_error *err)
+#include "verify.h"
+
+/* The budget's verdict as the extrusion's error. */
+static ag_status over_budget(const ag_budget *b, const char *stage, ag_error *err)
+{
+    return ag_error_set(err, b->st, 0, "the extrusion was %s, %s", b->why, stage);
+}
+
+ag_status ag_extrude_plan_with(ag_plan *plan, const ag_extrude_options *opt, ag_mesh *m,
+                               int32_t group, ag_extrude_result *res, ag_shell **keep_shell,
+                               ag_error *err)
 {
     ag_extrude_result local;
     if (!res)
@@ -11,15 +20,27 @@ ag_status ag_extrude_plan(ag_plan *plan, ag_mesh *m, int32_t group, ag_extrude_r
     memset(res, 0, sizeof *res);
     if (keep_shell)
         *keep_shell = NULL;
+    size_t corners = 0;
+    for (size_t L = 0; L < plan->nloops; L++)
+        corners += plan->loops[L].n;
+    ag_budget budget;
+    ag_budget_start(&budget, opt ? &opt->budget : NULL, corners);
+    if (ag_budget_poll(&budget, 0) != AG_OK)
+        return over_budget(&budget, "before it started", err);
     ag_plan_fixes fixes = {0};
     double extent = 0;
     ag_status st = ag_plan_validate(plan, &fixes, &extent, err);
     res->nfixes = fixes.n;
-    ag_plan_fixes_free(&fixes);
+    if (opt && opt->fixes)
+        *opt->fixes = fixes;
+    else
+        ag_plan_fixes_free(&fixes);
     if (st != AG_OK)
         return st;
+    if (ag_budget_poll(&budget, 0) != AG_OK)
+        return over_budget(&budget, "after validating the plan", err);
     ag_shell *sh = NULL;
-    ag_skeleton_options so = {0, plan->anchors};
+    ag_skeleton_options so = {&budget, plan->anchors};
     st = ag_skeleton_build(plan, extent, &so, &sh, &res->stats, err);
     if (st != AG_OK)
         return st;
@@ -29,17 +50,36 @@ ag_status ag_extrude_plan(ag_plan *plan, ag_mesh *m, int32_t group, ag_extrude_r
             res->faces++;
     res->top = res->stats.top;
     res->volume = ag_shell_volume(sh);
-    size_t comp = 0;
+    size_t comp = 0, t0 = m->ntris;
+    st = ag_budget_poll(&budget, 0);
+    if (st != AG_OK) {
+        ag_shell_free(sh);
+        return over_budget(&budget, "before triangulating the shell", err);
+    }
     st = ag_mesh_add_component(m, group, &comp);
     if (st == AG_OK)
         st = ag_shell_to_mesh(sh, m, (uint32_t)comp, &res->triangles);
     if (st != AG_OK)
         ag_error_set(err, st, 0, "out of memory");
+    if (st == AG_OK)
+        ag_verify_building(m, t0, m->ntris, plan, res->defect, sizeof res->defect);
     if (keep_shell && st == AG_OK)
         *keep_shell = sh;
     else
         ag_shell_free(sh);
+    res->seconds = ag_budget_elapsed(&budget);
     return st;
+}
+
+int ag_extrude_result_ok(const ag_extrude_result *res)
+{
+    return res->failing_faces == 0 && !res->defect[0];
+}
+
+ag_status ag_extrude_plan(ag_plan *plan, ag_mesh *m, int32_t group, ag_extrude_result *res,
+                          ag_shell **keep_shell, ag_error *err)
+{
+    return ag_extrude_plan_with(plan, NULL, m, group, res, keep_shell, err);
 }
 
 ag_status ag_extrude_place_meshes(const ag_plan *plan, ag_mesh *m, int32_t group, size_t *placed,

@@ -304,7 +304,7 @@ static ag_status check_forced(const ag_plan *p, const ag_plan_step *s, ag_error 
             size_t i2 = (i + 1) % n, j2 = (j + 1) % n;
             if (j == i2 || i == j2)
                 continue; /* neighbours share a corner */
-            if (ag_pred_segments_touch(&q[2 * i], &q[2 * i2], &q[2 * j], &q[2 * j2], 1e-12 * ext))
+            if (ag_pred_segments_touch(&q[2 * i], &q[2 * i2], &q[2 * j], &q[2 * j2]))
                 return ag_error_set(err, AG_ERR_INVALID, idx,
                                     "step %zu: forced polygon edges %zu and %zu cross or touch",
                                     p->nsteps, i, j);
@@ -489,17 +489,155 @@ static int cmp_seg(const void *a, const void *b)
     return x->xmin < y->xmin ? -1 : x->xmin > y->xmin;
 }
 
-static ag_status check_crossings(const ag_plan *p, long **orig, double eps, ag_error *err)
+static int sgn(double v)
+{
+    return v > 0 ? 1 : v < 0 ? -1 : 0;
+}
+
+/* Which half of the plane around the origin direction d lies in (0: angle in [0, pi)). */
+static int half(const double *d)
+{
+    return d[1] < 0 || (d[1] == 0 && d[0] < 0);
+}
+
+/* Exact angular order of two directions (counter-clockwise from +x). */
+static int angle_before(const double *u, const double *v)
+{
+    int hu = half(u), hv = half(v);
+    if (hu != hv)
+        return hu < hv;
+    return ag_pred_cross_sign(u[0], u[1], v[0], v[1]) > 0;
+}
+
+/* Do two loops that meet at point v cross there? a0, a1 are the points the first loop's
+ * boundary goes to from v (its neighbours there), b0, b1 the second's: they cross when,
+ * around v, the directions of one pair separate those of the other. */
+static int cross_at(const double *v, const double *a0, const double *a1, const double *b0,
+                    const double *b1)
+{
+    double d[4][2] = {{a0[0] - v[0], a0[1] - v[1]}, {a1[0] - v[0], a1[1] - v[1]},
+                      {b0[0] - v[0], b0[1] - v[1]}, {b1[0] - v[0], b1[1] - v[1]}};
+    /* a direction shared by both: they run along each other there, an overlap that the
+     * overlapping segments themselves report */
+    for (int i = 0; i < 2; i++)
+        for (int j = 2; j < 4; j++)
+            if (ag_pred_cross_sign(d[i][0], d[i][1], d[j][0], d[j][1]) == 0 &&
+                d[i][0] * d[j][0] + d[i][1] * d[j][1] > 0)
+                return 0;
+    int who[4] = {0, 0, 1, 1}, order[4] = {0, 1, 2, 3};
+    for (int i = 1; i < 4; i++)
+        for (int j = i; j > 0 && angle_before(d[order[j]], d[order[j - 1]]); j--) {
+            int x = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = x;
+        }
+    /* interleaved: A B A B around v */
+    return who[order[0]] != who[order[1]] && who[order[1]] != who[order[2]] &&
+           who[order[2]] != who[order[3]];
+}
+
+/* How segments a0-a1 and b0-b1 meet. */
+typedef enum { MEET_NONE, MEET_CROSS, MEET_OVERLAP, MEET_POINT } meet;
+
+static meet segments_meet(const double *a0, const double *a1, const double *b0,
+                          const double *b1, double *at)
+{
+    int o1 = sgn(ag_pred_orient2d(a0, a1, b0)), o2 = sgn(ag_pred_orient2d(a0, a1, b1));
+    int o3 = sgn(ag_pred_orient2d(b0, b1, a0)), o4 = sgn(ag_pred_orient2d(b0, b1, a1));
+    if (o1 * o2 < 0 && o3 * o4 < 0) {
+        double t = ag_pred_orient2d(b0, b1, a0) /
+                   (ag_pred_orient2d(b0, b1, a0) - ag_pred_orient2d(b0, b1, a1));
+        at[0] = a0[0] + t * (a1[0] - a0[0]);
+        at[1] = a0[1] + t * (a1[1] - a0[1]);
+        return MEET_CROSS;
+    }
+    if (!o1 && !o2) {
+        /* collinear: along the longer axis, do the intervals share more than a point? */
+        int k = fabs(a1[0] - a0[0]) + fabs(b1[0] - b0[0]) >= fabs(a1[1] - a0[1]) + fabs(b1[1] - b0[1])
+                    ? 0 : 1;
+        double alo = fmin(a0[k], a1[k]), ahi = fmax(a0[k], a1[k]);
+        double blo = fmin(b0[k], b1[k]), bhi = fmax(b0[k], b1[k]);
+        double lo = fmax(alo, blo), hi = fmin(ahi, bhi);
+        if (lo > hi)
+            return MEET_NONE;
+        if (lo < hi) {
+            const double *p = a0[k] == lo ? a0 : a1[k] == lo ? a1 : b0[k] == lo ? b0 : b1;
+            at[0] = p[0];
+            at[1] = p[1];
+            return MEET_OVERLAP;
+        }
+        const double *p = alo == lo || ahi == lo ? (a0[k] == lo ? a0 : a1) : (b0[k] == lo ? b0 : b1);
+        at[0] = p[0];
+        at[1] = p[1];
+        return MEET_POINT;
+    }
+    const double *pts[4] = {b0, b1, a0, a1};
+    int os[4] = {o1, o2, o3, o4};
+    for (int i = 0; i < 4; i++) {
+        if (os[i])
+            continue;
+        const double *p = pts[i], *s0 = i < 2 ? a0 : b0, *s1 = i < 2 ? a1 : b1;
+        if (p[0] >= fmin(s0[0], s1[0]) && p[0] <= fmax(s0[0], s1[0]) &&
+            p[1] >= fmin(s0[1], s1[1]) && p[1] <= fmax(s0[1], s1[1])) {
+            at[0] = p[0];
+            at[1] = p[1];
+            return MEET_POINT;
+        }
+    }
+    return MEET_NONE;
+}
+
+/* The points loop l's boundary goes to from point v, where v is corner i (on_edge 0) or
+ * lies inside edge i (on_edge 1). */
+static void neighbours_at(const ag_plan_loop *l, size_t i, int on_edge, const double **n0,
+                          const double **n1)
+{
+    size_t n = l->n;
+    if (on_edge) {
+        *n0 = &l->xy[2 * i];
+        *n1 = &l->xy[2 * ((i + 1) % n)];
+    } else {
+        *n0 = &l->xy[2 * ((i + n - 1) % n)];
+        *n1 = &l->xy[2 * ((i + 1) % n)];
+    }
+}
+
+/* Where boundary `edge` of loop l meets point v: as its corner (v equals one end: the
+ * corner's index and 0) or inside it (edge, 1). */
+static void locate_on(const ag_plan_loop *l, size_t edge, const double *v, size_t *i, int *on_edge)
+{
+    const double *a = &l->xy[2 * edge], *b = &l->xy[2 * ((edge + 1) % l->n)];
+    if (a[0] == v[0] && a[1] == v[1]) {
+        *i = edge;
+        *on_edge = 0;
+    } else if (b[0] == v[0] && b[1] == v[1]) {
+        *i = (edge + 1) % l->n;
+        *on_edge = 0;
+    } else {
+        *i = edge;
+        *on_edge = 1;
+    }
+}
+
+/* Edges that cross, overlap, or touch (within one loop) are refused, naming both edges by
+ * their input numbers; two loops may touch at single points (OGC-valid holes touching the
+ * outer ring, parts of a MultiPolygon meeting at a corner) as long as they do not cross
+ * there. `only` limits the check to loop `only` (>= 0) and to proper crossings. */
+static ag_status check_crossings(const ag_plan *p, long **orig, const long *oloop, long only,
+                                 ag_error *err)
 {
     size_t total = 0;
     for (size_t i = 0; i < p->nloops; i++)
-        total += p->loops[i].n;
+        if (only < 0 || (long)i == only)
+            total += p->loops[i].n;
     seg_box *s = malloc((total ? total : 1) * sizeof *s);
     if (!s)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     size_t k = 0;
     for (size_t i = 0; i < p->nloops; i++) {
         const ag_plan_loop *l = &p->loops[i];
+        if (only >= 0 && (long)i != only)
+            continue;
         for (size_t j = 0; j < l->n; j++) {
             double x0 = l->xy[2 * j], x1 = l->xy[2 * ((j + 1) % l->n)];
             s[k].xmin = x0 < x1 ? x0 : x1;
@@ -517,21 +655,134 @@ static ag_status check_crossings(const ag_plan *p, long **orig, double eps, ag_e
         for (size_t j = i + 1; j < total && s[j].xmin <= s[i].xmax; j++) {
             const ag_plan_loop *lb = &p->loops[s[j].loop];
             size_t b0 = s[j].idx, b1 = (b0 + 1) % lb->n;
-            if (s[i].loop == s[j].loop && (a1 == b0 || b1 == a0))
+            int same = s[i].loop == s[j].loop;
+            if (same && (a1 == b0 || b1 == a0))
                 continue; /* neighbours share a corner */
-            if (ag_pred_segments_touch(&la->xy[2 * a0], &la->xy[2 * a1], &lb->xy[2 * b0],
-                                       &lb->xy[2 * b1], eps)) {
-                st = ag_error_set(err, AG_ERR_INVALID, (long)s[i].loop + 1,
-                                  "loop %u edge %ld (from corner %ld) crosses or touches "
-                                  "loop %u edge %ld (from corner %ld)",
-                                  s[i].loop, orig[s[i].loop][a0], orig[s[i].loop][a0],
-                                  s[j].loop, orig[s[j].loop][b0], orig[s[j].loop][b0]);
-                break;
+            double at[2] = {0, 0};
+            meet how = segments_meet(&la->xy[2 * a0], &la->xy[2 * a1], &lb->xy[2 * b0],
+                                     &lb->xy[2 * b1], at);
+            if (how == MEET_NONE || (only >= 0 && how != MEET_CROSS))
+                continue;
+            if (how == MEET_POINT && !same) {
+                /* a touch between two loops: allowed unless they cross there */
+                size_t ia, ib;
+                int ea, eb;
+                const double *pa0, *pa1, *pb0, *pb1;
+                locate_on(la, a0, at, &ia, &ea);
+                locate_on(lb, b0, at, &ib, &eb);
+                neighbours_at(la, ia, ea, &pa0, &pa1);
+                neighbours_at(lb, ib, eb, &pb0, &pb1);
+                if (!cross_at(at, pa0, pa1, pb0, pb1))
+                    continue;
+                how = MEET_CROSS;
             }
+            const char *verb = how == MEET_CROSS ? "crosses" : how == MEET_OVERLAP ? "overlaps"
+                                                                                   : "touches";
+            long ea_ = orig[s[i].loop][a0], eb_ = orig[s[j].loop][b0];
+            long la_ = oloop[s[i].loop], lb_ = oloop[s[j].loop];
+            if (same && ea_ > eb_) {
+                long x = ea_;
+                ea_ = eb_;
+                eb_ = x;
+            }
+            /* (the rule, in the words earlier messages used, ends every message) */
+            if (same && how == MEET_CROSS)
+                st = ag_error_set(err, AG_ERR_INVALID, la_ + 1, "loop %ld: edge %ld crosses "
+                                  "edge %ld at (%.6g, %.6g); an edge that crosses or touches "
+                                  "another is refused", la_, ea_, eb_, at[0], at[1]);
+            else if (same)
+                st = ag_error_set(err, AG_ERR_INVALID, la_ + 1, "loop %ld: edge %ld %s edge %ld "
+                                  "at (%.6g, %.6g); a ring may not touch itself: an edge that "
+                                  "crosses or touches another is refused", la_, ea_, verb, eb_,
+                                  at[0], at[1]);
+            else
+                st = ag_error_set(err, AG_ERR_INVALID, la_ + 1, "loop %ld edge %ld %s loop %ld "
+                                  "edge %ld at (%.6g, %.6g); an edge that crosses or touches "
+                                  "another is refused (loops may meet at single points)", la_,
+                                  ea_, verb, lb_, eb_, at[0], at[1]);
+            break;
         }
     }
     free(s);
     return st;
+}
+
+/* Is v inside segment a-b (not at its ends)? Exact. */
+static int inside_segment(const double *a, const double *b, const double *v)
+{
+    if ((v[0] == a[0] && v[1] == a[1]) || (v[0] == b[0] && v[1] == b[1]))
+        return 0;
+    return ag_pred_orient2d(a, b, v) == 0 && v[0] >= fmin(a[0], b[0]) &&
+           v[0] <= fmax(a[0], b[0]) && v[1] >= fmin(a[1], b[1]) && v[1] <= fmax(a[1], b[1]);
+}
+
+/* Where two loops touch at a point (a corner of one on the other's edge or corner), the
+ * walls standing on both would share an edge, which no closed 2-manifold may: the touching
+ * corner (of the later loop when both have one there) is moved AG_EXTRUDE_TOUCH_GAP into
+ * the region its own loop encloses, so the two no longer meet. Recorded as a fix. */
+static ag_status separate_touches(ag_plan *p, const long *oloop, long **orig, double gap,
+                                  ag_plan_fixes *fixes)
+{
+    for (size_t b = 0; b < p->nloops; b++) {
+        ag_plan_loop *lb = &p->loops[b];
+        for (size_t i = 0; i < lb->n; i++) {
+            double *v = &lb->xy[2 * i];
+            long other = -1;
+            for (size_t a = 0; a < p->nloops && other < 0; a++) {
+                if (a == b)
+                    continue;
+                const ag_plan_loop *la = &p->loops[a];
+                for (size_t e = 0; e < la->n && other < 0; e++) {
+                    const double *q = &la->xy[2 * e], *r = &la->xy[2 * ((e + 1) % la->n)];
+                    int corner = q[0] == v[0] && q[1] == v[1];
+                    if ((corner && a < b) || inside_segment(q, r, v))
+                        other = (long)a;
+                }
+            }
+            if (other < 0)
+                continue;
+            const double *pv = &lb->xy[2 * ((i + lb->n - 1) % lb->n)];
+            const double *nv = &lb->xy[2 * ((i + 1) % lb->n)];
+            double ux = pv[0] - v[0], uy = pv[1] - v[1], wx = nv[0] - v[0], wy = nv[1] - v[1];
+            double lu = hypot(ux, uy), lw = hypot(wx, wy);
+            double bx = ux / lu + wx / lw, by = uy / lu + wy / lw, bl = hypot(bx, by);
+            if (!(bl > 0)) {
+                bx = -uy / lu; /* a straight corner: perpendicular */
+                by = ux / lu;
+                bl = 1;
+            }
+            double step = gap / fmax(bl / 2, 0.1); /* along the bisector: off both edges by gap */
+            double cand[2] = {v[0] + step * bx / bl, v[1] + step * by / bl};
+            if (!ag_pred_point_in_polygon(lb->xy, lb->n, cand[0], cand[1])) {
+                cand[0] = v[0] - step * bx / bl;
+                cand[1] = v[1] - step * by / bl;
+            }
+            char why[96];
+            snprintf(why, sizeof why, "touches loop %ld at (%.6g, %.6g): moved %.2g m off it",
+                     oloop[other], v[0], v[1], hypot(cand[0] - v[0], cand[1] - v[1]));
+            add_fix(fixes, AG_PLAN_FIX_TOUCH, oloop[b], orig[b][i], why);
+            v[0] = cand[0];
+            v[1] = cand[1];
+        }
+    }
+    return AG_OK;
+}
+
+/* A corner of loop l that is not on loop m's boundary (for testing nesting), or NULL. */
+static const double *free_corner(const ag_plan_loop *l, const ag_plan_loop *m)
+{
+    for (size_t i = 0; i < l->n; i++) {
+        const double *v = &l->xy[2 * i];
+        int on = 0;
+        for (size_t j = 0; j < m->n && !on; j++) {
+            const double *a = &m->xy[2 * j], *b = &m->xy[2 * ((j + 1) % m->n)];
+            on = ag_pred_orient2d(a, b, v) == 0 && v[0] >= fmin(a[0], b[0]) &&
+                 v[0] <= fmax(a[0], b[0]) && v[1] >= fmin(a[1], b[1]) && v[1] <= fmax(a[1], b[1]);
+        }
+        if (!on)
+            return v;
+    }
+    return NULL;
 }
 
 static void reverse_loop(ag_plan_loop *l, long *orig)
@@ -584,16 +835,21 @@ ag_status ag_plan_validate(ag_plan *p, ag_plan_fixes *fixes, double *extent, ag_
     double ext = hypot(hi[0] - lo[0], hi[1] - lo[1]);
     if (extent)
         *extent = ext;
-    double scale = ag_extrude_scale(ext);
-    double d2 = AG_EXTRUDE_DELTA2 * scale;
+    double mag = fmax(fmax(fabs(lo[0]), fabs(hi[0])), fmax(fabs(lo[1]), fabs(hi[1])));
+    double d2 = ag_extrude_tolerances(ext, mag).point;
 
     long **orig = calloc(p->nloops, sizeof *orig);
-    if (!orig)
+    long *oloop = malloc((p->nloops ? p->nloops : 1) * sizeof *oloop);
+    if (!orig || !oloop) {
+        free(orig);
+        free(oloop);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
     ag_status st = AG_OK;
     size_t kept = 0;
     for (size_t i = 0; i < p->nloops; i++) {
         ag_plan_loop *l = &p->loops[i];
+        oloop[i] = (long)i;
         orig[i] = malloc((l->n ? l->n : 1) * sizeof(long));
         if (!orig[i]) {
             st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
@@ -603,6 +859,9 @@ ag_status ag_plan_validate(ag_plan *p, ag_plan_fixes *fixes, double *extent, ag_
             orig[i][j] = (long)j;
         clean_loop(l, (long)i, orig[i], d2, fixes);
         if (l->n < 3 || fabs(ag_plan_loop_area(l)) <= d2 * ext) {
+            /* a loop without area that crosses itself is a bow tie, not nothing */
+            if (l->n >= 3 && (st = check_crossings(p, orig, oloop, (long)i, err)) != AG_OK)
+                goto done;
             add_fix(fixes, AG_PLAN_FIX_DROPPED, (long)i, -1,
                     "loop with fewer than 3 corners or no area removed");
             l->n = 0;
@@ -614,7 +873,7 @@ ag_status ag_plan_validate(ag_plan *p, ag_plan_fixes *fixes, double *extent, ag_
         st = ag_error_set(err, AG_ERR_EMPTY, 0, "no loop of the plan has an area");
         goto done;
     }
-    /* compact the loops (keeping orig aligned) */
+    /* compact the loops (keeping orig and oloop aligned) */
     size_t w = 0;
     for (size_t i = 0; i < p->nloops; i++) {
         if (p->loops[i].n == 0) {
@@ -625,28 +884,40 @@ ag_status ag_plan_validate(ag_plan *p, ag_plan_fixes *fixes, double *extent, ag_
         }
         p->loops[w] = p->loops[i];
         orig[w] = orig[i];
+        oloop[w] = oloop[i];
         w++;
     }
     for (size_t i = w; i < p->nloops; i++)
         orig[i] = NULL;
     p->nloops = w;
 
-    st = check_crossings(p, orig, d2 * d2, err);
+    st = check_crossings(p, orig, oloop, -1, err);
+    if (st == AG_OK && p->nloops > 1) {
+        separate_touches(p, oloop, orig, AG_EXTRUDE_TOUCH_GAP * fmax(ext, AG_EXTRUDE_SIZE_MIN),
+                         fixes);
+        /* the moved corners must not have made anything cross (a gap wider than the
+         * plan's features there) */
+        st = check_crossings(p, orig, oloop, -1, err);
+    }
     if (st != AG_OK)
         goto done;
-    /* orientation by nesting depth: even depth = outer (CCW), odd = hole (CW) */
+    /* orientation by nesting depth: even depth = outer (CCW), odd = hole (CW); tested at
+     * a corner that is not on the other loop (loops may touch at points) */
     for (size_t i = 0; i < p->nloops; i++) {
         ag_plan_loop *l = &p->loops[i];
         int depth = 0;
-        for (size_t j = 0; j < p->nloops; j++)
-            if (j != i && ag_pred_point_in_polygon(p->loops[j].xy, p->loops[j].n, l->xy[0],
-                                                  l->xy[1]))
+        for (size_t j = 0; j < p->nloops; j++) {
+            if (j == i)
+                continue;
+            const double *v = free_corner(l, &p->loops[j]);
+            if (v && ag_pred_point_in_polygon(p->loops[j].xy, p->loops[j].n, v[0], v[1]))
                 depth++;
+        }
         double a = ag_plan_loop_area(l);
         int want_ccw = depth % 2 == 0;
         if ((a > 0) != want_ccw) {
             reverse_loop(l, orig[i]);
-            add_fix(fixes, AG_PLAN_FIX_REVERSED, (long)i, -1,
+            add_fix(fixes, AG_PLAN_FIX_REVERSED, oloop[i], -1,
                     want_ccw ? "outer loop was clockwise: reversed"
                              : "hole was counter-clockwise: reversed");
         }
@@ -655,5 +926,6 @@ done:
     for (size_t i = 0; i < p->nloops; i++)
         free(orig[i]);
     free(orig);
+    free(oloop);
     return st;
 }

@@ -203,6 +203,7 @@ typedef enum {
     AG_PLAN_FIX_SPIKE,         /* corner where the boundary turns back on itself: removed */
     AG_PLAN_FIX_REVERSED,      /* loop with the wrong orientation: reversed */
     AG_PLAN_FIX_DROPPED,       /* loop with no area left: removed */
+    AG_PLAN_FIX_TOUCH,         /* a corner on another loop: moved a hair off it */
 } ag_plan_fix_kind;
 
 typedef struct {
@@ -221,11 +222,15 @@ void ag_plan_fixes_free(ag_plan_fixes *f);
 
 /* Validates and cleans the plan in place. Duplicate, collinear (same profile on both
  * sides) and spike corners are removed and loops are re-oriented (outer rings CCW,
- * holes CW by nesting depth), each change recorded in fixes (may be NULL). Fails with
- * AG_ERR_INVALID naming loop and corner for: NaN/inf coordinates, a profile index out
- * of range, two edges that cross or touch, a loop left with fewer than 3 corners when
- * it is the only one; AG_ERR_EMPTY when no loop is left. `extent` (may be NULL) gets
- * the plan's bounding-box diagonal. */
+ * holes CW by nesting depth), each change recorded in fixes (may be NULL). Two loops
+ * may touch at single points (a hole touching the outer ring, parts meeting at a corner,
+ * as OGC allows): the touching corner is moved AG_EXTRUDE_TOUCH_GAP (relative) off the
+ * other loop, into its own loop's region, so walls on both never share an edge (recorded). Fails
+ * with AG_ERR_INVALID naming loop and edges for: NaN/inf coordinates, a profile index out
+ * of range, two edges that cross (also two loops crossing at a shared point), edges that
+ * overlap, a loop touching itself; AG_ERR_EMPTY when no loop is left ("edge 1 crosses
+ * edge 3" for a bow tie, which has no area). Decisions use the exact predicates.
+ * `extent` (may be NULL) gets the plan's bounding-box diagonal. */
 ag_status ag_plan_validate(ag_plan *p, ag_plan_fixes *fixes, double *extent, ag_error *err);
 
 /* Signed area of a loop (positive = counter-clockwise). */

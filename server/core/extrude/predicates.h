@@ -1,23 +1,38 @@
-/* Geometric predicates for the extrusion sweep, evaluated in long double so that the
- * sign of nearly-degenerate configurations is right far more often than in double. */
+/* Geometric predicates of the extrusion code, exact in their sign.
+ *
+ * ag_pred_orient2d is filtered-then-exact in the style of Shewchuk's adaptive predicates:
+ * the determinant is evaluated in double with a forward error bound; only when its
+ * magnitude is below the bound is it recomputed exactly, as a sum of the six products of
+ * the expanded determinant, each split exactly into two doubles with fma(), added up as a
+ * non-overlapping expansion. Nothing in Debian offers such predicates to a C library
+ * without C++ (CGAL's are C++ templates; Shewchuk's predicates.c is not packaged), so they
+ * are written here; they need only libm.
+ *
+ * Every decision built on them (two segments cross, a point is inside a polygon, three
+ * corners turn left, two directions are ordered around a point) is then exact for the
+ * doubles given: a plan's validity does not depend on rounding. */
 #ifndef AG_EXTRUDE_PREDICATES_H
 #define AG_EXTRUDE_PREDICATES_H
 
-/* Twice the signed area of triangle abc: > 0 when a, b, c turn left. */
-static inline double ag_pred_orient2d(const double *a, const double *b, const double *c)
-{
-    long double abx = (long double)b[0] - a[0], aby = (long double)b[1] - a[1];
-    long double acx = (long double)c[0] - a[0], acy = (long double)c[1] - a[1];
-    return (double)(abx * acy - aby * acx);
-}
+#include <stddef.h>
 
-/* Do the closed segments ab and cd share a point? `eps` is an area tolerance below
- * which three points count as collinear. */
-int ag_pred_segments_touch(const double *a, const double *b, const double *c, const double *d,
-                           double eps);
+/* Twice the signed area of triangle abc: > 0 when a, b, c turn left, < 0 right, 0 exactly
+ * when they are collinear. The sign is exact; the magnitude is a double approximation. */
+double ag_pred_orient2d(const double *a, const double *b, const double *c);
 
-/* Is p inside the polygon (n corners, xy pairs)? Even-odd rule; points on the boundary
- * may go either way. */
+/* The sign (-1, 0, 1) of the cross product u x v of two vectors given by their
+ * components (exact: the same expansion arithmetic). */
+int ag_pred_cross_sign(double ux, double uy, double vx, double vy);
+
+/* Do the closed segments ab and cd share a point? Exact. */
+int ag_pred_segments_touch(const double *a, const double *b, const double *c, const double *d);
+
+/* Do the segments ab and cd cross properly (their interiors meet in one point, no
+ * endpoint on the other segment)? Exact. */
+int ag_pred_segments_cross(const double *a, const double *b, const double *c, const double *d);
+
+/* Is p inside the polygon (n corners, xy pairs)? Even-odd rule, exact; points on the
+ * boundary may go either way. */
 int ag_pred_point_in_polygon(const double *xy, size_t n, double px, double py);
 
 #endif

@@ -1,11 +1,15 @@
 #include "shell.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "keysort.h"
+#include "weld_points.h"
 #include "predicates.h"
+#include "tolerance.h"
 
 #define NONE UINT32_MAX
 
@@ -82,81 +86,44 @@ ag_status ag_shell_add_segment(ag_shell *s, uint32_t face, uint32_t from, uint32
 
 /* --- welding --------------------------------------------------------------------------- */
 
-static const double *g_sort_pos;
-static int cmp_by_x(const void *a, const void *b)
-{
-    double x = g_sort_pos[3 * *(const uint32_t *)a], y = g_sort_pos[3 * *(const uint32_t *)b];
-    return x < y ? -1 : x > y;
-}
-
-static uint32_t find(uint32_t *par, uint32_t x)
-{
-    while (par[x] != x) {
-        par[x] = par[par[x]];
-        x = par[x];
-    }
-    return x;
-}
-
 static ag_status weld(ag_shell *s, double tol, uint32_t *map)
 {
     size_t n = s->nverts;
-    uint32_t *order = malloc((n ? n : 1) * sizeof *order);
-    uint32_t *par = malloc((n ? n : 1) * sizeof *par);
-    if (!order || !par) {
-        free(order);
-        free(par);
+    ag_keyed *order = malloc((n ? n : 1) * sizeof *order);
+    if (!order)
         return AG_ERR_NOMEM;
-    }
-    for (size_t i = 0; i < n; i++)
-        order[i] = par[i] = (uint32_t)i;
-    g_sort_pos = s->pos;
-    qsort(order, n, sizeof *order, cmp_by_x);
-    double t2 = tol * tol;
     for (size_t i = 0; i < n; i++) {
-        const double *a = &s->pos[3 * order[i]];
-        for (size_t j = i + 1; j < n; j++) {
-            const double *b = &s->pos[3 * order[j]];
-            if (b[0] - a[0] > tol)
-                break;
-            double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
-            if (dx * dx + dy * dy + dz * dz <= t2) {
-                uint32_t ra = find(par, order[i]), rb = find(par, order[j]);
-                if (ra != rb)
-                    par[ra > rb ? ra : rb] = ra < rb ? ra : rb;
-            }
-        }
+        map[i] = (uint32_t)i;
+        order[i] = (ag_keyed){ag_keysort_double(s->pos[3 * i]), (uint32_t)i};
     }
-    for (size_t i = 0; i < n; i++)
-        map[i] = find(par, (uint32_t)i);
+    ag_status st = ag_weld_points(s->pos, order, n, tol, map);
     free(order);
-    free(par);
-    return AG_OK;
+    return st;
 }
 
 /* --- linking ---------------------------------------------------------------------------- */
 
-typedef struct {
-    uint64_t key; /* from << 32 | to */
-    uint32_t seg;
-} seg_key;
+/* A directed segment or half-edge by its key from << 32 | to (val: its index). */
+typedef ag_keyed seg_key;
 
-static int cmp_key(const void *a, const void *b)
-{
-    uint64_t x = ((const seg_key *)a)->key, y = ((const seg_key *)b)->key;
-    return x < y ? -1 : x > y;
-}
-
-/* Newell normal (not normalised) of face f's loops. */
+/* Newell normal (not normalised) of face f's loops, computed relative to the face's first
+ * corner: shells lie at their plan's real coordinates (RD, UTM: millions of metres), where
+ * sums of coordinates would drown the face's own size. */
 static void face_normal(const ag_shell *s, size_t f, double *n)
 {
     n[0] = n[1] = n[2] = 0;
     const ag_shell_face *fc = &s->faces[f];
-    for (uint32_t l = fc->first_loop; l < fc->first_loop + (fc->nloops & 0x7fffffffu); l++) {
+    uint32_t nl = fc->nloops & 0x7fffffffu;
+    if (!nl)
+        return;
+    const double *o = &s->pos[3 * s->idx[s->loop_start[fc->first_loop]]];
+    for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++) {
         uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
         for (uint32_t i = a; i < b; i++) {
-            const double *p = &s->pos[3 * s->idx[i]];
-            const double *q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
+            const double *P = &s->pos[3 * s->idx[i]];
+            const double *Q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
+            double p[3] = {P[0] - o[0], P[1] - o[1], P[2] - o[2]};
+            double q[3] = {Q[0] - o[0], Q[1] - o[1], Q[2] - o[2]};
             n[0] += (p[1] - q[1]) * (p[2] + q[2]);
             n[1] += (p[2] - q[2]) * (p[0] + q[0]);
             n[2] += (p[0] - q[0]) * (p[1] + q[1]);
@@ -200,7 +167,7 @@ static void pair_radial(ag_shell *s, const seg_key *hk, size_t lo, size_t n, con
         b1[k] /= bl;
     double b2[3] = {a[1] * b1[2] - a[2] * b1[1], a[2] * b1[0] - a[0] * b1[2], a[0] * b1[1] - a[1] * b1[0]};
     for (size_t i = 0; i < n; i++) {
-        uint32_t h = hk[lo + i].seg;
+        uint32_t h = hk[lo + i].val;
         const double *nf = &fn[3 * s->he_face[h]];
         /* into the face from the edge: n x direction of the half-edge */
         double sg = s->idx[h] == u ? 1 : -1;
@@ -253,8 +220,9 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
     uint32_t *ord = malloc((ns ? ns : 1) * sizeof *ord);
     uint8_t *dead = calloc(ns ? ns : 1, 1);
     seg_key *keys = malloc((ns ? ns : 1) * sizeof *keys);
+    seg_key *sorttmp = malloc((ns ? ns : 1) * sizeof *sorttmp);
     uint32_t *fstart = calloc(s->nfaces + 1, sizeof *fstart);
-    if (!ord || !dead || !keys || !fstart) {
+    if (!ord || !dead || !keys || !sorttmp || !fstart) {
         st = AG_ERR_NOMEM;
         goto out;
     }
@@ -292,26 +260,19 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
         for (uint32_t i = 0; i < k; i++) {
             uint32_t sg = ord[a + i];
             keys[i].key = (uint64_t)g[3 * sg + 1] << 32 | g[3 * sg + 2];
-            keys[i].seg = sg;
+            keys[i].val = sg;
         }
-        qsort(keys, k, sizeof *keys, cmp_key);
+        ag_keysort(keys, k, sorttmp);
         /* cancel u->v against v->u within the face (zero-width slits) */
         for (uint32_t i = 0; i < k; i++) {
-            uint32_t sg = keys[i].seg;
+            uint32_t sg = keys[i].val;
             if (dead[sg])
                 continue;
             uint64_t rev = (uint64_t)g[3 * sg + 2] << 32 | g[3 * sg + 1];
-            uint32_t lo = 0, hi = k;
-            while (lo < hi) {
-                uint32_t mid = (lo + hi) / 2;
-                if (keys[mid].key < rev)
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
+            uint32_t lo = (uint32_t)ag_keysort_lower_bound(keys, k, rev);
             for (uint32_t j = lo; j < k && keys[j].key == rev; j++)
-                if (!dead[keys[j].seg]) {
-                    dead[keys[j].seg] = 1;
+                if (!dead[keys[j].val]) {
+                    dead[keys[j].val] = 1;
                     dead[sg] = 1;
                     break;
                 }
@@ -319,7 +280,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
         /* link: keys sorted by from-vertex; walk from each unused segment */
         s->faces[f].first_loop = (uint32_t)s->nloops;
         for (uint32_t i = 0; i < k; i++) {
-            uint32_t sg = keys[i].seg;
+            uint32_t sg = keys[i].val;
             if (dead[sg])
                 continue;
             uint32_t start = g[3 * sg + 1], cur = sg;
@@ -334,18 +295,11 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
                     break;
                 }
                 uint64_t want = (uint64_t)to << 32;
-                uint32_t lo = 0, hi = k;
-                while (lo < hi) {
-                    uint32_t mid = (lo + hi) / 2;
-                    if (keys[mid].key < want)
-                        lo = mid + 1;
-                    else
-                        hi = mid;
-                }
+                uint32_t lo = (uint32_t)ag_keysort_lower_bound(keys, k, want);
                 uint32_t next = NONE;
                 for (uint32_t j = lo; j < k && (keys[j].key >> 32) == to; j++)
-                    if (!dead[keys[j].seg]) {
-                        next = keys[j].seg;
+                    if (!dead[keys[j].val]) {
+                        next = keys[j].val;
                         break;
                     }
                 if (next == NONE)
@@ -391,23 +345,20 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
     }
     for (size_t i = 0; i < nidx; i++) {
         hk[i].key = (uint64_t)s->idx[i] << 32 | s->idx[s->he_next[i]];
-        hk[i].seg = (uint32_t)i;
+        hk[i].val = (uint32_t)i;
     }
-    qsort(hk, nidx, sizeof *hk, cmp_key);
+    st = ag_keysort(hk, nidx, NULL);
+    if (st != AG_OK) {
+        free(hk);
+        goto out;
+    }
     for (size_t i = 0; i < nidx; i++) {
         uint32_t h = (uint32_t)i;
         uint64_t rev = (uint64_t)s->idx[s->he_next[h]] << 32 | s->idx[h];
-        size_t lo = 0, hi = nidx;
-        while (lo < hi) {
-            size_t mid = (lo + hi) / 2;
-            if (hk[mid].key < rev)
-                lo = mid + 1;
-            else
-                hi = mid;
-        }
+        size_t lo = ag_keysort_lower_bound(hk, nidx, rev);
         /* exactly one opposite half-edge: twin; more than one: paired around the edge below */
         if (lo < nidx && hk[lo].key == rev && (lo + 1 >= nidx || hk[lo + 1].key != rev))
-            s->he_twin[h] = hk[lo].seg;
+            s->he_twin[h] = hk[lo].val;
     }
     /* edges used k > 1 times each way */
     double *fn = NULL;
@@ -417,14 +368,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
             j++;
         uint64_t key = hk[i].key, rev = (key << 32) | (key >> 32);
         if (j - i > 1 && key < rev) {
-            size_t lo = 0, hi = nidx;
-            while (lo < hi) {
-                size_t mid = (lo + hi) / 2;
-                if (hk[mid].key < rev)
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
+            size_t lo = ag_keysort_lower_bound(hk, nidx, rev);
             size_t m = lo;
             while (m < nidx && hk[m].key == rev)
                 m++;
@@ -458,6 +402,7 @@ out:
     free(ord);
     free(dead);
     free(keys);
+    free(sorttmp);
     free(fstart);
     return st;
 }
@@ -471,12 +416,12 @@ size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max)
     if (hk && dup) {
         for (size_t i = 0; i < s->nhalf; i++) {
             hk[i].key = (uint64_t)s->idx[i] << 32 | s->idx[s->he_next[i]];
-            hk[i].seg = (uint32_t)i;
+            hk[i].val = (uint32_t)i;
         }
-        qsort(hk, s->nhalf, sizeof *hk, cmp_key);
-        for (size_t i = 1; i < s->nhalf; i++)
-            if (hk[i].key == hk[i - 1].key)
-                dup[hk[i].seg] = dup[hk[i - 1].seg] = 1;
+        if (ag_keysort(hk, s->nhalf, NULL) == AG_OK)
+            for (size_t i = 1; i < s->nhalf; i++)
+                if (hk[i].key == hk[i - 1].key)
+                    dup[hk[i].val] = dup[hk[i - 1].val] = 1;
     }
     for (size_t f = 0; f < s->nfaces; f++) {
         const ag_shell_face *fc = &s->faces[f];
@@ -500,39 +445,39 @@ size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max)
                 }
             }
         if (!why[0] && nl) {
-            /* planarity: distance of every corner from the face's Newell plane */
-            double nx = 0, ny = 0, nz = 0, cx = 0, cy = 0, cz = 0, cnt = 0, lo = INFINITY, hi = -INFINITY;
-            for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++) {
-                uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
-                for (uint32_t i = a; i < b; i++) {
+            /* planarity: every corner within a fraction of the face's diameter of its
+             * Newell plane (relative to its first corner: shells lie at real coordinates) */
+            double n[3];
+            face_normal(s, f, n);
+            double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            const double *o = &s->pos[3 * s->idx[s->loop_start[fc->first_loop]]];
+            double c[3] = {0, 0, 0}, cnt = 0, lo = INFINITY, hi = -INFINITY, size = 0, mag = 0;
+            for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++)
+                for (uint32_t i = s->loop_start[l]; i < s->loop_start[l + 1]; i++) {
                     const double *p = &s->pos[3 * s->idx[i]];
-                    const double *q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
-                    nx += (p[1] - q[1]) * (p[2] + q[2]);
-                    ny += (p[2] - q[2]) * (p[0] + q[0]);
-                    nz += (p[0] - q[0]) * (p[1] + q[1]);
-                    cx += p[0];
-                    cy += p[1];
-                    cz += p[2];
+                    for (int k = 0; k < 3; k++) {
+                        c[k] += p[k] - o[k];
+                        mag = fmax(mag, fabs(p[k]));
+                    }
                     cnt++;
                 }
-            }
-            double len = sqrt(nx * nx + ny * ny + nz * nz);
             if (len > 0) {
-                cx /= cnt;
-                cy /= cnt;
-                cz /= cnt;
-                double size = 0;
+                for (int k = 0; k < 3; k++)
+                    c[k] /= cnt;
                 for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++)
                     for (uint32_t i = s->loop_start[l]; i < s->loop_start[l + 1]; i++) {
                         const double *p = &s->pos[3 * s->idx[i]];
-                        double d = ((p[0] - cx) * nx + (p[1] - cy) * ny + (p[2] - cz) * nz) / len;
+                        double q[3] = {p[0] - o[0] - c[0], p[1] - o[1] - c[1], p[2] - o[2] - c[2]};
+                        double d = (q[0] * n[0] + q[1] * n[1] + q[2] * n[2]) / len;
                         lo = fmin(lo, d);
                         hi = fmax(hi, d);
-                        size = fmax(size, fabs(p[0] - cx) + fabs(p[1] - cy) + fabs(p[2] - cz));
+                        size = fmax(size, sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]));
                     }
-                if (hi - lo > 1e-6 * (1 + size))
-                    snprintf(why, sizeof why, "face is not planar (corners %.3g m off its plane)",
-                             hi - lo);
+                double allowed = AG_EXTRUDE_PLANAR_REL * 2 * size + AG_EXTRUDE_PLANAR_ABS +
+                                 AG_EXTRUDE_COORD_ULPS * DBL_EPSILON * mag;
+                if (hi - lo > allowed)
+                    snprintf(why, sizeof why, "face is not planar (corners %.3g m off its plane, "
+                             "%.3g m allowed for its size)", hi - lo, allowed);
             }
         }
         if (why[0]) {
@@ -550,16 +495,25 @@ size_t ag_shell_check(const ag_shell *s, ag_shell_problem *out, size_t max)
 
 double ag_shell_volume(const ag_shell *s)
 {
-    /* divergence theorem over fan triangles of every loop */
+    /* divergence theorem over fan triangles of every loop, relative to the first vertex
+     * (a closed shell's volume does not depend on the origin; its precision does) */
+    if (!s->nloops)
+        return 0;
+    const double *o = &s->pos[3 * s->idx[0]];
     long double v = 0;
     for (size_t l = 0; l < s->nloops; l++) {
         uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
-        const double *p0 = &s->pos[3 * s->idx[a]];
+        const double *P0 = &s->pos[3 * s->idx[a]];
+        long double p0[3] = {(long double)P0[0] - o[0], (long double)P0[1] - o[1],
+                             (long double)P0[2] - o[2]};
         for (uint32_t i = a + 1; i + 1 < b; i++) {
-            const double *p1 = &s->pos[3 * s->idx[i]], *p2 = &s->pos[3 * s->idx[i + 1]];
-            v += (long double)p0[0] * (p1[1] * p2[2] - p1[2] * p2[1]) -
-                 (long double)p0[1] * (p1[0] * p2[2] - p1[2] * p2[0]) +
-                 (long double)p0[2] * (p1[0] * p2[1] - p1[1] * p2[0]);
+            const double *P1 = &s->pos[3 * s->idx[i]], *P2 = &s->pos[3 * s->idx[i + 1]];
+            long double p1[3] = {(long double)P1[0] - o[0], (long double)P1[1] - o[1],
+                                 (long double)P1[2] - o[2]};
+            long double p2[3] = {(long double)P2[0] - o[0], (long double)P2[1] - o[1],
+                                 (long double)P2[2] - o[2]};
+            v += p0[0] * (p1[1] * p2[2] - p1[2] * p2[1]) - p0[1] * (p1[0] * p2[2] - p1[2] * p2[0]) +
+                 p0[2] * (p1[0] * p2[1] - p1[1] * p2[0]);
         }
     }
     return (double)(v / 6);
@@ -588,7 +542,7 @@ static double loop_area(const tri_pt *p, size_t n)
 static int seg_cross(const tri_pt *a, const tri_pt *b, const tri_pt *c, const tri_pt *d)
 {
     double p1[2] = {a->x, a->y}, p2[2] = {b->x, b->y}, p3[2] = {c->x, c->y}, p4[2] = {d->x, d->y};
-    return ag_pred_segments_touch(p1, p2, p3, p4, 0.0);
+    return ag_pred_segments_touch(p1, p2, p3, p4);
 }
 
 /* Ear clipping of one simple polygon (CCW) into m. Falls back to clipping the most convex corner when no clean ear is found,
@@ -611,7 +565,7 @@ static ag_status ear_clip(tri_pt *p, size_t n, ag_mesh *m, uint32_t base, uint32
     double ext = 0;
     for (size_t i = 0; i < n; i++)
         ext = fmax(ext, fmax(fabs(p[i].x - p[0].x), fabs(p[i].y - p[0].y)));
-    double eps = 1e-14 * ext * ext;
+    double eps = AG_EXTRUDE_EAR_FLAT * ext * ext;
     size_t left = n;
     uint32_t cur = 0;
     size_t misses = 0;
@@ -738,6 +692,36 @@ static ag_status bridge_hole(tri_pt **poly, size_t *n, const tri_pt *h, size_t h
     return AG_OK;
 }
 
+/* A hole that shares a corner with the polygon (touching it at a point, as OGC allows) is
+ * spliced in at that corner: the polygon runs around the hole and back to the shared
+ * corner, a zero-length bridge. Returns 1 when spliced, 0 when they share no corner. */
+static int splice_hole(tri_pt **poly, size_t *n, const tri_pt *h, size_t hn, ag_status *st)
+{
+    tri_pt *P = *poly;
+    for (size_t i = 0; i < *n; i++)
+        for (size_t k = 0; k < hn; k++) {
+            if (P[i].v != h[k].v)
+                continue;
+            tri_pt *np = malloc((*n + hn) * sizeof *np);
+            if (!np) {
+                *st = AG_ERR_NOMEM;
+                return 1;
+            }
+            size_t m = 0;
+            for (size_t a = 0; a <= i; a++)
+                np[m++] = P[a];
+            for (size_t b = 1; b < hn; b++)
+                np[m++] = h[(k + b) % hn];
+            for (size_t a = i; a < *n; a++)
+                np[m++] = P[a];
+            free(P);
+            *poly = np;
+            *n = m;
+            return 1;
+        }
+    return 0;
+}
+
 static int cmp_hole_x(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -751,20 +735,13 @@ static ag_status triangulate_face(const ag_shell *s, size_t f, ag_mesh *m, uint3
     uint32_t nl = fc->nloops & 0x7fffffffu;
     if (!nl)
         return AG_OK;
-    /* Newell normal over all loops */
-    double nx = 0, ny = 0, nz = 0;
-    for (uint32_t l = fc->first_loop; l < fc->first_loop + nl; l++) {
-        uint32_t a = s->loop_start[l], b = s->loop_start[l + 1];
-        for (uint32_t i = a; i < b; i++) {
-            const double *p = &s->pos[3 * s->idx[i]];
-            const double *q = &s->pos[3 * s->idx[i + 1 < b ? i + 1 : a]];
-            nx += (p[1] - q[1]) * (p[2] + q[2]);
-            ny += (p[2] - q[2]) * (p[0] + q[0]);
-            nz += (p[0] - q[0]) * (p[1] + q[1]);
-        }
-    }
+    /* Newell normal over all loops; the projection relative to the face's first corner */
+    double nn[3];
+    face_normal(s, f, nn);
+    double nx = nn[0], ny = nn[1], nz = nn[2];
+    const double *org = &s->pos[3 * s->idx[s->loop_start[fc->first_loop]]];
     double len = sqrt(nx * nx + ny * ny + nz * nz);
-    if (!(len > 1e-18))
+    if (!(len > AG_EXTRUDE_NO_AREA))
         return AG_OK; /* no area */
     nx /= len;
     ny /= len;
@@ -803,8 +780,9 @@ static ag_status triangulate_face(const ag_shell *s, size_t f, ag_mesh *m, uint3
         for (uint32_t k = a; k < b; k++) {
             const double *p = &s->pos[3 * s->idx[k]];
             /* u, v basis with u x v = n: loops CCW about n have positive area */
-            loops[i][k - a].x = p[0] * ux + p[1] * uy + p[2] * uz;
-            loops[i][k - a].y = p[0] * vx + p[1] * vy + p[2] * vz;
+            double q[3] = {p[0] - org[0], p[1] - org[1], p[2] - org[2]};
+            loops[i][k - a].x = q[0] * ux + q[1] * uy + q[2] * uz;
+            loops[i][k - a].y = q[0] * vx + q[1] * vy + q[2] * vz;
             loops[i][k - a].v = s->idx[k];
         }
         areas[i] = loop_area(loops[i], ln[i]);
@@ -861,7 +839,8 @@ static ag_status triangulate_face(const ag_shell *s, size_t f, ag_mesh *m, uint3
         qsort(hx, nh, 2 * sizeof(double), cmp_hole_x);
         for (size_t h = 0; h < nh && st == AG_OK; h++) {
             uint32_t j = (uint32_t)hx[2 * h + 1];
-            st = bridge_hole(&poly, &n, loops[j], ln[j], ln, nl, (const tri_pt *const *)loops);
+            if (!splice_hole(&poly, &n, loops[j], ln[j], &st))
+                st = bridge_hole(&poly, &n, loops[j], ln[j], ln, nl, (const tri_pt *const *)loops);
         }
         free(hx);
         if (st == AG_OK)

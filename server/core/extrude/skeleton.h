@@ -4,10 +4,13 @@
  * A plane rises from z = 0; every active plan edge moves inwards by its profile
  * segment's slope per metre of height. Events are kept in a heap: edge events (an
  * edge shrinks to nothing), split events (a corner reaches another edge) and profile
- * direction events (a profile changes slope). Intersection events within delta1 in
- * height and delta2 in plan are handled together as one generalized intersection: the
- * corners that arrive are retired, edges passing through the point are split, and the
- * edges leaving the point are paired around it into new corners. Neighbouring edges
+ * direction events (a profile changes slope). Each event is computed from the planes
+ * that meet there; the lowest one and the events at its point (within delta2 in plan, and
+ * in height within what its corners move in delta2 or within the uncertainty of their
+ * heights) are handled together as one generalized intersection, then the consequences are
+ * scheduled before any later event: the corners that arrive are retired, edges passing
+ * through the point are split, and the edges leaving the point are paired around it into
+ * new corners (in the order their edges take just above the point). Neighbouring edges
  * that become collinear are resolved by the plan's priority scheme (the winner's plane
  * takes over), antiparallel neighbours (a ridge) are zipped. Horizontal profile segments,
  * profile offset events and natural steps each get a stretched interval of sweep height in
@@ -21,11 +24,14 @@
 #include <stddef.h>
 
 #include "../status.h"
+#include "budget.h"
 #include "plan.h"
 #include "shell.h"
 
 typedef struct {
-    size_t max_events; /* 0 = a bound proportional to the plan size */
+    /* the running budget account (shared with nested sweeps), or NULL: the defaults of
+     * ag_extrude_budget for this plan */
+    ag_budget *budget;
     /* plan->nanchors entries to locate (usually plan->anchors), or NULL */
     ag_anchor *anchors;
 } ag_skeleton_options;
@@ -41,7 +47,9 @@ typedef struct {
     size_t steps, steps_skipped; /* plan edits made / not made (anchor not on the plan) */
     size_t offsets, offset_sides; /* offset events handled, side edges they made */
     size_t offset_gaps;   /* inside boundaries (gaps) opened by offset events */
+    size_t bevels;        /* sharp corners of outward offsets cut by a bevel edge */
     int capped;           /* the top was closed flat */
+    size_t events;        /* events taken from and put into the queue */
     double top;           /* highest height reached */
 } ag_skeleton_stats;
 

@@ -1,5 +1,7 @@
 #include "gframe.h"
 
+#include "../base/tolerance.h"
+
 const ag_gframe ag_gframe_identity = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
 
 void ag_gframe_apply(const ag_gframe *f, const double x[3], double y[3])
@@ -17,8 +19,7 @@ ag_gframe ag_gframe_place(const ag_gframe *F, const double S[3], int k, const ag
     }
     double s[3];
     for (int a = 0; a < 3; a++) {
-        double bs = B->max[a] - B->min[a];
-        s[a] = Sr[a] > 1e-300 ? bs / Sr[a] : 1.0;
+        s[a] = Sr[a] > AG_PROC_TINY ? ag_box_extent(B, a) / Sr[a] : 1.0;
     }
     /* k quarter turns about z */
     double c = (k & 3) == 0 ? 1 : (k & 3) == 2 ? -1 : 0;
@@ -31,7 +32,7 @@ ag_gframe ag_gframe_place(const ag_gframe *F, const double S[3], int k, const ag
     /* the local box's centre goes to B's centre */
     double h[3] = {S[0] / 2, S[1] / 2, S[2] / 2};
     for (int i = 0; i < 3; i++)
-        L.t[i] = 0.5 * (B->min[i] + B->max[i]) -
+        L.t[i] = ag_box_centre_axis(B, i) -
                  (L.M[i][0] * h[0] + L.M[i][1] * h[1] + L.M[i][2] * h[2]);
     ag_gframe o;
     for (int i = 0; i < 3; i++) {
@@ -58,7 +59,7 @@ void ag_gframe_cells_of(const ag_gstmt *s, const ag_box *B, ag_gframe_cells *c)
         }
     for (int a = 0; a < 3; a++) {
         c->origin[a] = B->min[a] - omin[a];
-        c->size[a] = (B->max[a] - B->min[a]) - (omax[a] - omin[a]);
+        c->size[a] = ag_box_extent(B, a) - (omax[a] - omin[a]);
     }
 }
 

@@ -1,11 +1,21 @@
 #include "grammar.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
+#include "../base/tolerance.h"
 #include "gframe.h"
+
+/* Work limits: a subdivide or repeat of more cells is refused (its derivation would not fit
+ * in memory); a derivation stops past this many triangles (unless the caller sets its own)
+ * or rules nested this deep (a rule calling itself). */
+#define GRAMMAR_MAX_CELLS 1e7
+#define DERIVE_MAX_TRIANGLES 50000000
+#define DERIVE_MAX_DEPTH 512
 
 /* ---- building blocks -------------------------------------------------------------------- */
 
@@ -44,26 +54,12 @@ void ag_grammar_free(ag_grammar *g)
     free(g);
 }
 
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 0;
-    size_t n = *cap ? *cap : 8;
-    while (n < need)
-        n *= 2;
-    void *q = realloc(*p, n * elem);
-    if (!q)
-        return -1;
-    *p = q;
-    *cap = n;
-    return 0;
-}
-
 ag_status ag_grammar_add_terminal(ag_grammar *g, const char *name, const double size[3],
                                   size_t *index)
 {
-    if (grow((void **)&g->terminals, &g->cap_terminals, g->nterminals + 1, sizeof *g->terminals))
-        return AG_ERR_NOMEM;
+    ag_status st = AG_ARRAY_RESERVE(g->terminals, g->cap_terminals, g->nterminals + 1);
+    if (st)
+        return st;
     ag_gterminal *t = &g->terminals[g->nterminals];
     memset(t, 0, sizeof *t);
     t->name = strdup(name);
@@ -80,8 +76,9 @@ ag_status ag_grammar_add_terminal(ag_grammar *g, const char *name, const double 
 ag_status ag_grammar_add_rule(ag_grammar *g, const char *name, const double size[3],
                               size_t *index)
 {
-    if (grow((void **)&g->rules, &g->cap_rules, g->nrules + 1, sizeof *g->rules))
-        return AG_ERR_NOMEM;
+    ag_status st = AG_ARRAY_RESERVE(g->rules, g->cap_rules, g->nrules + 1);
+    if (st)
+        return st;
     ag_grule *r = &g->rules[g->nrules];
     memset(r, 0, sizeof *r);
     r->name = strdup(name);
@@ -96,7 +93,7 @@ ag_status ag_grammar_add_rule(ag_grammar *g, const char *name, const double size
 
 static ag_gstmt *new_stmt(ag_grule *r)
 {
-    if (grow((void **)&r->stmts, &r->cap, r->nstmts + 1, sizeof *r->stmts))
+    if (AG_ARRAY_RESERVE(r->stmts, r->cap, r->nstmts + 1))
         return NULL;
     ag_gstmt *s = &r->stmts[r->nstmts++];
     memset(s, 0, sizeof *s);
@@ -238,22 +235,29 @@ static int find_callee(const ag_grammar *g, const nametab *rt, const nametab *tt
     return k;
 }
 
+static int tab_init(nametab *t, size_t n)
+{
+    t->n = 0;
+    if (ag_array_hash_size(n + 1, &t->cap))
+        return -1;
+    t->names = malloc((n + 1) * sizeof *t->names);
+    t->slot = malloc(t->cap * sizeof *t->slot);
+    if (!t->names || !t->slot)
+        return -1;
+    for (size_t i = 0; i < t->cap; i++)
+        t->slot[i] = -1;
+    return 0;
+}
+
 static ag_status resolve_rule(ag_grammar *g, ag_grule *r, size_t nrules_before, const nametab *rt,
                               const nametab *tt, ag_error *err, long *col)
 {
     nametab nt = {0};
-    nt.cap = 16;
-    while (nt.cap < 2 * (r->nstmts + 1))
-        nt.cap <<= 1;
-    nt.names = malloc((r->nstmts + 1) * sizeof *nt.names);
-    nt.slot = malloc(nt.cap * sizeof *nt.slot);
-    if (!nt.names || !nt.slot) {
+    if (tab_init(&nt, r->nstmts)) {
         free(nt.names);
         free(nt.slot);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
-    for (size_t i = 0; i < nt.cap; i++)
-        nt.slot[i] = -1;
     add_node(&nt, "p");
     ag_status st = AG_OK;
     for (size_t i = 0; i < r->nstmts && !st; i++) {
@@ -318,7 +322,7 @@ static ag_status resolve_rule(ag_grammar *g, ag_grule *r, size_t nrules_before, 
                     }
                     cells *= s->counts[a];
                 }
-                if (!st && cells > 1e7)
+                if (!st && cells > GRAMMAR_MAX_CELLS)
                     st = rerr(err, col, s->line, s->col, "subdivide has too many cells%s", "");
             }
         }
@@ -327,21 +331,6 @@ static ag_status resolve_rule(ag_grammar *g, ag_grule *r, size_t nrules_before, 
     free(nt.names);
     free(nt.slot);
     return st;
-}
-
-static int tab_init(nametab *t, size_t n)
-{
-    t->n = 0;
-    t->cap = 16;
-    while (t->cap < 2 * (n + 1))
-        t->cap <<= 1;
-    t->names = malloc((n + 1) * sizeof *t->names);
-    t->slot = malloc(t->cap * sizeof *t->slot);
-    if (!t->names || !t->slot)
-        return -1;
-    for (size_t i = 0; i < t->cap; i++)
-        t->slot[i] = -1;
-    return 0;
 }
 
 ag_status ag_grammar_resolve(ag_grammar *g, ag_error *err, long *col)
@@ -443,8 +432,7 @@ static int32_t terminal_for(exctx *x, int32_t variant)
     uint32_t c = L->variant_exemplar[variant];
     const ag_box *nb = &x->t->nodes[x->t->comp_node[c]].box;
     double size[3];
-    for (int a = 0; a < 3; a++)
-        size[a] = nb->max[a] - nb->min[a];
+    ag_box_extents(nb, size);
     char name[32];
     snprintf(name, sizeof name, "T%zu", x->g->nterminals + 1);
     size_t ti;
@@ -509,10 +497,8 @@ static int32_t use_rule(exctx *x, int32_t cls, int32_t node, int weight)
     unsigned counter = 0;
     int32_t ex = x->exemplar[cls];
     emit_content(x, &body, ex, "p", &counter);
-    const ag_box *b = &x->t->nodes[ex].box;
     double size[3];
-    for (int a = 0; a < 3; a++)
-        size[a] = b->max[a] - b->min[a];
+    ag_box_extents(&x->t->nodes[ex].box, size);
     char name[32];
     snprintf(name, sizeof name, "R%zu", x->g->nrules + 1);
     size_t ri;
@@ -685,6 +671,9 @@ static void apply_one(dctx *d, const ag_gstmt *s, const ag_box *B, const ag_gfra
 {
     if (d->st)
         return;
+    /* derivation takes a resolved grammar: every callee is an index */
+    assert(s->callee_ix >= 0 &&
+           (size_t)s->callee_ix < (s->callee_is_rule ? d->g->nrules : d->g->nterminals));
     if (s->callee_is_rule) {
         const ag_grule *r = &d->g->rules[s->callee_ix];
         ag_gframe G = ag_gframe_place(F, r->size, s->rot, B);
@@ -731,9 +720,9 @@ static void derive_body(dctx *d, const ag_grule *r, const ag_box *p, const ag_gf
 {
     if (d->st)
         return;
-    if (depth > 512) {
+    if (depth > DERIVE_MAX_DEPTH) {
         d->st = ag_error_set(d->err, AG_ERR_TOO_LARGE, r->line,
-                             "rules are nested more than 512 deep");
+                             "rules are nested more than %d deep", DERIVE_MAX_DEPTH);
         return;
     }
     ag_box stackb[64];
@@ -774,7 +763,7 @@ ag_status ag_grammar_derive(const ag_grammar *g, const ag_grammar_derive_options
     if (!g->has_axiom)
         return ag_error_set(err, AG_ERR_INVALID, 0, "the grammar has no axiom");
     dctx d = {.g = g, .err = err};
-    d.max_tris = opt && opt->max_triangles ? opt->max_triangles : 50000000;
+    d.max_tris = opt && opt->max_triangles ? opt->max_triangles : DERIVE_MAX_TRIANGLES;
     d.out = ag_mesh_create();
     if (!d.out)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
@@ -830,7 +819,7 @@ ag_status ag_grammar_fidelity(const ag_mesh *input, const ag_mesh *derived, doub
     if (!(diag > 0))
         diag = 1;
     if (tol <= 0)
-        tol = 1e-5 * diag;
+        tol = AG_PROC_FIDELITY * diag;
     double *a = soup_of(derived), *s = soup_of(input);
     if (!a || !s) {
         free(a);

@@ -4,6 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
+#include "../base/search.h"
+#include "../base/tolerance.h"
 #include "weld.h"
 
 void ag_label_rotate(int k, double *x, double *y)
@@ -55,8 +58,8 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
     size_t miss = 0;
     double worst = 0;
     if (tol <= 0)
-        tol = 1e-300;
-    double cell = 2 * tol;
+        tol = AG_PROC_TINY;
+    double cell = 2 * tol; /* a match within tol lies in a neighbouring cell */
     hidx *ha = malloc((na + 1) * sizeof *ha);
     uint8_t *used = calloc(na + 1, 1);
     if (!ha || !used) {
@@ -84,14 +87,7 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
             for (int dy = -1; dy <= 1; dy++)
                 for (int dz = -1; dz <= 1; dz++) {
                     uint64_t h = ag__cell_hash(k0 + dx, k1 + dy, k2 + dz);
-                    size_t lo = 0, hi = na;
-                    while (lo < hi) {
-                        size_t mid = (lo + hi) / 2;
-                        if (ha[mid].h < h)
-                            lo = mid + 1;
-                        else
-                            hi = mid;
-                    }
+                    size_t lo = ag_search_lower_u64(&ha[0].h, na, sizeof *ha, h);
                     for (size_t s = lo; s < na && ha[s].h == h; s++) {
                         uint32_t i = ha[s].i;
                         if (used[i])
@@ -143,10 +139,8 @@ void ag_labels_free(ag_labels *l)
 /* Triangle soup of component c, centred on its box centre, rotated by k. */
 static void soup(const ag_mesh *m, const ag_labels *L, uint32_t c, int k, double *out)
 {
-    const ag_box *b = &L->box[c];
     double ctr[3];
-    for (int a = 0; a < 3; a++)
-        ctr[a] = 0.5 * (b->min[a] + b->max[a]);
+    ag_box_centre(&L->box[c], ctr);
     size_t o = 0;
     for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++) {
         uint32_t t = L->tris[s];
@@ -164,10 +158,8 @@ static void soup(const ag_mesh *m, const ag_labels *L, uint32_t c, int k, double
 static int dims_match(const ag_box *e, const ag_box *c, int k, double tol)
 {
     double de[3], dc[3];
-    for (int a = 0; a < 3; a++) {
-        de[a] = e->max[a] - e->min[a];
-        dc[a] = c->max[a] - c->min[a];
-    }
+    ag_box_extents(e, de);
+    ag_box_extents(c, dc);
     if (k & 1) {
         double s = de[0];
         de[0] = de[1];
@@ -191,9 +183,9 @@ static long classify(const ag_mesh *m, const ag_labels *L, const uint32_t *comps
                      double tol, int no_rotation, int32_t *cls, uint8_t *rot, uint32_t *exemplar,
                      uint32_t *count, double *sa, double *sb)
 {
-    size_t cap = 16;
-    while (cap < 2 * n + 16)
-        cap <<= 1;
+    size_t cap;
+    if (ag_array_hash_size(n, &cap))
+        return -1;
     bucket *bk = calloc(cap, sizeof *bk);
     int32_t *next_in_bucket = malloc((n + 1) * sizeof *next_in_bucket);
     if (!bk || !next_in_bucket) {
@@ -206,11 +198,11 @@ static long classify(const ag_mesh *m, const ag_labels *L, const uint32_t *comps
     long ncls = 0;
     /* buckets: triangle count and the box's height and sorted plan sizes in cells of 4 tol,
      * so a match within tol is always in a neighbouring cell */
-    double q = 4 * tol > 0 ? 4 * tol : 1e-300;
+    double q = 4 * tol > 0 ? 4 * tol : AG_PROC_TINY;
     for (size_t i = 0; i < n; i++) {
         uint32_t c = comps[i];
-        double dx = L->box[c].max[0] - L->box[c].min[0], dy = L->box[c].max[1] - L->box[c].min[1];
-        double dz = L->box[c].max[2] - L->box[c].min[2];
+        double dx = ag_box_extent(&L->box[c], 0), dy = ag_box_extent(&L->box[c], 1);
+        double dz = ag_box_extent(&L->box[c], 2);
         int64_t kb[3] = {(int64_t)floor(dz / q), (int64_t)floor(fmin(dx, dy) / q),
                          (int64_t)floor(fmax(dx, dy) / q)};
         int found = -1, fk = 0;
@@ -278,9 +270,9 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
 {
     ag_label_options o = opt ? *opt : (ag_label_options){0};
     if (o.tolerance <= 0)
-        o.tolerance = 1e-4;
+        o.tolerance = AG_PROC_LABEL_TOLERANCE;
     if (o.exact <= 0)
-        o.exact = 1e-7;
+        o.exact = AG_PROC_LABEL_EXACT;
     if (o.exact > o.tolerance)
         o.exact = o.tolerance;
     *out = NULL;
@@ -318,22 +310,12 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
     L->exact = o.exact * (L->diagonal > 0 ? L->diagonal : 1.0);
 
     for (size_t c = 0; c < nc; c++)
-        for (int a = 0; a < 3; a++) {
-            L->box[c].min[a] = INFINITY;
-            L->box[c].max[a] = -INFINITY;
-        }
+        L->box[c] = ag_box_empty();
     for (size_t t = 0; t < m->ntris; t++) {
         uint32_t c = m->tri_component[t];
         L->ntris[c]++;
-        for (int v = 0; v < 3; v++) {
-            const double *p = m->pos + 3 * m->tri[3 * t + v];
-            for (int a = 0; a < 3; a++) {
-                if (p[a] < L->box[c].min[a])
-                    L->box[c].min[a] = p[a];
-                if (p[a] > L->box[c].max[a])
-                    L->box[c].max[a] = p[a];
-            }
-        }
+        for (int v = 0; v < 3; v++)
+            ag_box_extend_point(&L->box[c], m->pos + 3 * m->tri[3 * t + v]);
     }
     for (size_t c = 0; c < nc; c++) {
         L->tri_start[c + 1] = L->tri_start[c] + L->ntris[c];

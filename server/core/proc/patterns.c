@@ -4,6 +4,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
+#include "../base/tolerance.h"
+
+/* Work limits of the fits: a grid of more steps per axis, a lattice over more instances or
+ * with larger indices is not looked for (the instances stay as they are). */
+#define GRID_MAX_STEPS 1e6
+#define LATTICE_MAX_INSTANCES 4096
+#define LATTICE_MAX_INDEX 1000000
+
 typedef struct {
     int32_t rule;
     uint8_t rot;
@@ -53,7 +62,7 @@ static int grid_fit(const ag_splittree *t, const inst *g, size_t n, double tol, 
         /* refine the step over the whole span so errors do not accumulate */
         double span = tmp[n - 1] - lo;
         double m = floor(span / d + 0.5);
-        if (m < 1 || m > 1e6)
+        if (m < 1 || m > GRID_MAX_STEPS)
             return 0;
         d = span / m;
         counts[a] = (uint32_t)m + 1;
@@ -98,24 +107,9 @@ typedef struct {
 static int add_found(foundset *f, const inst *m, size_t n, const uint32_t counts[3],
                      const double step[3], int nvec, const double vec[][3])
 {
-    if (f->nmembers + n > f->capm) {
-        size_t nc = f->capm ? f->capm : 256;
-        while (nc < f->nmembers + n)
-            nc *= 2;
-        inst *nm = realloc(f->members, nc * sizeof *nm);
-        if (!nm)
-            return -1;
-        f->members = nm;
-        f->capm = nc;
-    }
-    if (f->n == f->cap) {
-        size_t nc = f->cap ? 2 * f->cap : 16;
-        found *nl = realloc(f->list, nc * sizeof *nl);
-        if (!nl)
-            return -1;
-        f->list = nl;
-        f->cap = nc;
-    }
+    if (AG_ARRAY_RESERVE_MORE(f->members, f->capm, f->nmembers, n) ||
+        AG_ARRAY_RESERVE(f->list, f->cap, f->n + 1))
+        return -1;
     memcpy(f->members + f->nmembers, m, n * sizeof *m);
     found *x = &f->list[f->n++];
     x->first = f->nmembers;
@@ -162,17 +156,10 @@ static ag_status apply_found(ag_splittree *t, int32_t parent, foundset *f, uint8
         const inst *g = f->members + x->first;
         ag_box b = t->nodes[g[0].node].box;
         for (size_t i = 1; i < x->n; i++)
-            for (int a = 0; a < 3; a++) {
-                const ag_box *c = &t->nodes[g[i].node].box;
-                if (c->min[a] < b.min[a])
-                    b.min[a] = c->min[a];
-                if (c->max[a] > b.max[a])
-                    b.max[a] = c->max[a];
-            }
-        ag_pattern *np = realloc(t->patterns, (t->npatterns + 1) * sizeof *np);
-        if (!np)
-            return AG_ERR_NOMEM;
-        t->patterns = np;
+            ag_box_extend_box(&b, &t->nodes[g[i].node].box);
+        ag_status st = AG_ARRAY_RESERVE(t->patterns, t->cap_patterns, t->npatterns + 1);
+        if (st)
+            return st;
         int32_t pn = ag_splittree_insert(t, parent, &b, AG_NODE_PATTERN);
         if (pn < 0)
             return AG_ERR_NOMEM;
@@ -235,7 +222,7 @@ static int cmp_by_x(const void *a, const void *b)
 static int lattice_fit(const ag_splittree *t, const inst *g, size_t n, double tol, int *nvec,
                        double vec[2][3], uint32_t counts[2], int64_t *ij, int *complete)
 {
-    if (n < 2 || n > 4096)
+    if (n < 2 || n > LATTICE_MAX_INSTANCES)
         return 0;
     by_x *ord = malloc(n * sizeof *ord);
     if (!ord)
@@ -275,7 +262,7 @@ static int lattice_fit(const ag_splittree *t, const inst *g, size_t n, double to
             double r[3] = {d[0] - s * a[0], d[1] - s * a[1], d[2] - s * a[2]};
             double off = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
             double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            if (off > 4 * tol && l < bestb - tol) {
+            if (off > AG_PROC_LATTICE_OFF_LINE * tol && l < bestb - tol) {
                 bestb = l;
                 memcpy(b, d, sizeof b);
             }
@@ -303,7 +290,7 @@ static int lattice_fit(const ag_splittree *t, const inst *g, size_t n, double to
             c[1] = (aa * db - ab * da) / det;
         }
         int64_t r0 = (int64_t)floor(c[0] + 0.5), r1 = (int64_t)floor(c[1] + 0.5);
-        int off = llabs(r0) > 1000000 || llabs(r1) > 1000000;
+        int off = llabs(r0) > LATTICE_MAX_INDEX || llabs(r1) > LATTICE_MAX_INDEX;
         for (int q = 0; q < 3 && !off; q++)
             off = fabs(d[q] - r0 * a[q] - r1 * b[q]) > tol;
         if (off) { /* not on the lattice: left out of its runs */
@@ -414,18 +401,22 @@ static int cmp_runkey(const void *p, const void *q)
     return x->i < y->i ? -1 : x->i > y->i;
 }
 
-/* Sorting instances by their min corner on two axes (rows along the third). */
-static const ag_splittree *sort_tree;
-static int sort_b1, sort_b2, sort_a;
+/* Sorting instances by their min corner on two axes (rows along the third). The order goes
+ * to the comparison as an argument (qsort_r), not through globals: proceduralizations run on
+ * several worker threads at once. */
+typedef struct {
+    const ag_splittree *t;
+    int ax[3]; /* the two other axes, then the row's axis */
+} row_order;
 
-static int cmp_row(const void *p, const void *q)
+static int cmp_row(const void *p, const void *q, void *arg)
 {
-    const ag_box *x = &sort_tree->nodes[((const inst *)p)->node].box;
-    const ag_box *y = &sort_tree->nodes[((const inst *)q)->node].box;
-    int ax[3] = {sort_b1, sort_b2, sort_a};
+    const row_order *o = arg;
+    const ag_box *x = &o->t->nodes[((const inst *)p)->node].box;
+    const ag_box *y = &o->t->nodes[((const inst *)q)->node].box;
     for (int k = 0; k < 3; k++)
-        if (x->min[ax[k]] != y->min[ax[k]])
-            return x->min[ax[k]] < y->min[ax[k]] ? -1 : 1;
+        if (x->min[o->ax[k]] != y->min[o->ax[k]])
+            return x->min[o->ax[k]] < y->min[o->ax[k]] ? -1 : 1;
     return 0;
 }
 
@@ -434,18 +425,15 @@ static int cmp_row(const void *p, const void *q)
 static size_t rows(const ag_splittree *t, inst *g, size_t n, int a, size_t minn, double tol,
                    int (*cb)(void *, inst *, size_t), void *user, int *fail)
 {
-    sort_tree = t;
-    sort_a = a;
-    sort_b1 = (a + 1) % 3;
-    sort_b2 = (a + 2) % 3;
-    qsort(g, n, sizeof *g, cmp_row);
+    int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+    row_order order = {t, {b1, b2, a}};
+    qsort_r(g, n, sizeof *g, cmp_row, &order);
     size_t cover = 0;
     for (size_t i = 0, j; i < n; i = j) {
         const ag_box *x = &t->nodes[g[i].node].box;
         for (j = i + 1; j < n; j++) {
             const ag_box *y = &t->nodes[g[j].node].box;
-            if (fabs(x->min[sort_b1] - y->min[sort_b1]) > tol ||
-                fabs(x->min[sort_b2] - y->min[sort_b2]) > tol)
+            if (fabs(x->min[b1] - y->min[b1]) > tol || fabs(x->min[b2] - y->min[b2]) > tol)
                 break;
         }
         if (j - i >= minn) {

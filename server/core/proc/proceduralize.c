@@ -1,14 +1,9 @@
 #include "proceduralize.h"
 
 #include <stdlib.h>
-#include <time.h>
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
+#include "../base/clock.h"
+#include "../base/tolerance.h"
 
 const char *ag_proceduralize_stage_name(ag_stage s)
 {
@@ -46,9 +41,9 @@ ag_status ag_proceduralize_run(const ag_mesh *in, const ag_proceduralize_options
                               ag_proceduralize_stage_name(s));                         \
             goto fail;                                                                 \
         }                                                                              \
-        t0 = now();                                                                    \
+        t0 = ag_clock_seconds();                                                       \
         st = (call);                                                                   \
-        r->seconds[s] = now() - t0;                                                    \
+        r->seconds[s] = ag_clock_seconds() - t0;                                       \
         if (st)                                                                        \
             goto fail;                                                                 \
     } while (0)
@@ -66,12 +61,13 @@ ag_status ag_proceduralize_run(const ag_mesh *in, const ag_proceduralize_options
             st = ag_error_set(err, AG_ERR_CANCELLED, 0, "cancelled before verify");
             goto fail;
         }
-        t0 = now();
+        t0 = ag_clock_seconds();
         st = ag_grammar_derive(r->grammar, NULL, &d, err);
         if (!st)
-            st = ag_grammar_fidelity(r->mesh, d, 10 * r->labels->tol, &r->fidelity, err);
+            st = ag_grammar_fidelity(r->mesh, d, AG_PROC_VERIFY_FACTOR * r->labels->tol,
+                                     &r->fidelity, err);
         ag_mesh_free(d);
-        r->seconds[AG_STAGE_VERIFY] = now() - t0;
+        r->seconds[AG_STAGE_VERIFY] = ag_clock_seconds() - t0;
         if (st)
             goto fail;
     }

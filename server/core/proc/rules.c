@@ -1,5 +1,6 @@
 #include "rules.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,10 +8,9 @@
 /* Box of child e relative to the centre of node v, rotated by k quarter turns. */
 static void rel_box(const ag_splittree *t, int32_t v, int32_t e, int k, double lo[3], double hi[3])
 {
-    const ag_box *pb = &t->nodes[v].box, *cb = &t->nodes[e].box;
+    const ag_box *cb = &t->nodes[e].box;
     double c[3];
-    for (int a = 0; a < 3; a++)
-        c[a] = 0.5 * (pb->min[a] + pb->max[a]);
+    ag_box_centre(&t->nodes[v].box, c);
     double x0 = cb->min[0] - c[0], y0 = cb->min[1] - c[1];
     double x1 = cb->max[0] - c[0], y1 = cb->max[1] - c[1];
     ag_label_rotate(k, &x0, &y0);
@@ -41,8 +41,10 @@ static size_t children(const ag_splittree *t, int32_t v, int32_t *buf, size_t ca
 static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca, int32_t *cb,
                 uint8_t *used, size_t n)
 {
-    children(t, a, ca, n);
-    children(t, b, cb, n);
+    size_t na = children(t, a, ca, n), nb = children(t, b, cb, n);
+    assert(na == n && nb == n); /* the caller compared the counts */
+    (void)na;
+    (void)nb;
     memset(used, 0, n);
     double tol = t->tol;
     for (size_t j = 0; j < n; j++) {

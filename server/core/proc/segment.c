@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/tolerance.h"
+#include "../base/uf.h"
 #include "weld.h"
 
 ag_status ag_segment_validate(const ag_mesh *m, ag_error *err)
@@ -32,25 +34,6 @@ ag_status ag_segment_validate(const ag_mesh *m, ag_error *err)
                                 "component %zu names group %d of %zu", c + 1,
                                 m->component_group[c], m->ngroups);
     return AG_OK;
-}
-
-static uint32_t uf_find(uint32_t *p, uint32_t x)
-{
-    while (p[x] != x) {
-        p[x] = p[p[x]];
-        x = p[x];
-    }
-    return x;
-}
-
-static void uf_union(uint32_t *p, uint32_t a, uint32_t b)
-{
-    a = uf_find(p, a);
-    b = uf_find(p, b);
-    if (a < b)
-        p[b] = a;
-    else if (b < a)
-        p[a] = b;
 }
 
 typedef struct {
@@ -185,11 +168,11 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
 {
     ag_segment_options o = opt ? *opt : (ag_segment_options){0};
     if (o.weld <= 0)
-        o.weld = 1e-9;
+        o.weld = AG_PROC_WELD;
     if (o.planar_degrees <= 0)
-        o.planar_degrees = 1.0;
+        o.planar_degrees = AG_PROC_PLANAR_DEGREES;
     if (o.split_min_pieces == 0)
-        o.split_min_pieces = 4;
+        o.split_min_pieces = AG_PROC_SPLIT_MIN_PIECES;
     ag_segment_info inf = {0};
     *out = NULL;
     ag_status st = ag_segment_validate(in, err);
@@ -204,7 +187,8 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
     double cell = o.weld * (diag > 0 ? diag : 1.0);
 
     uint32_t *wid = malloc((in->nverts + 1) * sizeof *wid);
-    uint32_t *uf = malloc(n * sizeof *uf);
+    ag_uf uf = {0};
+    uint32_t *newc = NULL; /* per triangle: its new component */
     uint32_t *piece = malloc(n * sizeof *piece);
     keyed *kv = malloc(3 * n * sizeof *kv);
     size_t *ctris = calloc(nc + 1, sizeof *ctris);
@@ -212,14 +196,13 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
     ag_mesh *m = ag_mesh_create();
     size_t nw = 0;
     st = AG_ERR_NOMEM;
-    if (!wid || !uf || !piece || !kv || !ctris || !split || !m)
+    if (ag_uf_init(&uf, n, 0) || !wid || !piece || !kv || !ctris || !split || !m)
         goto done;
     if ((st = ag__weld(in->pos, in->nverts, cell, wid, &nw)))
         goto done;
+    st = AG_ERR_NOMEM; /* what every failure up to the new mesh is */
 
     /* connected pieces inside each component */
-    for (size_t t = 0; t < n; t++)
-        uf[t] = (uint32_t)t;
     for (size_t t = 0; t < n; t++)
         for (int k = 0; k < 3; k++) {
             kv[3 * t + k].key = (uint64_t)in->tri_component[t] << 32 | wid[in->tri[3 * t + k]];
@@ -228,9 +211,12 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
     qsort(kv, 3 * n, sizeof *kv, cmp_keyed);
     for (size_t i = 1; i < 3 * n; i++)
         if (kv[i].key == kv[i - 1].key)
-            uf_union(uf, kv[i].tri, kv[i - 1].tri);
+            ag_uf_union(&uf, kv[i].tri, kv[i - 1].tri);
     for (size_t t = 0; t < n; t++)
-        piece[t] = uf_find(uf, (uint32_t)t); /* root = first triangle of the piece */
+        piece[t] = ag_uf_find(&uf, (uint32_t)t); /* root: a triangle of the piece */
+    ag_uf_free(&uf);
+    if (!(newc = malloc((n + 1) * sizeof *newc)))
+        goto done;
 
     /* per piece: triangle count and box, to find twins */
     size_t ngroups_used = 0;
@@ -251,7 +237,7 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
     {
         /* roots are triangles: compute per root stats in arrays indexed by triangle */
         uint32_t *pcount = calloc(n, sizeof *pcount);
-        double *pbox = malloc(6 * n * sizeof *pbox);
+        ag_box *pbox = malloc(n * sizeof *pbox);
         size_t *npieces = calloc(nc, sizeof *npieces);
         if (!pcount || !pbox || !npieces) {
             free(pcount);
@@ -263,30 +249,20 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
             uint32_t r = piece[t];
             if (pcount[r]++ == 0) {
                 npieces[in->tri_component[t]]++;
-                for (int a = 0; a < 3; a++) {
-                    pbox[6 * r + a] = INFINITY;
-                    pbox[6 * r + 3 + a] = -INFINITY;
-                }
+                pbox[r] = ag_box_empty();
             }
-            for (int k = 0; k < 3; k++) {
-                const double *p = in->pos + 3 * in->tri[3 * t + k];
-                for (int a = 0; a < 3; a++) {
-                    if (p[a] < pbox[6 * r + a])
-                        pbox[6 * r + a] = p[a];
-                    if (p[a] > pbox[6 * r + 3 + a])
-                        pbox[6 * r + 3 + a] = p[a];
-                }
-            }
+            for (int k = 0; k < 3; k++)
+                ag_box_extend_point(&pbox[r], in->pos + 3 * in->tri[3 * t + k]);
         }
         /* twin keys: component, triangle count, quantized box size */
         size_t nk = 0;
-        double q = 1e-6 * (diag > 0 ? diag : 1.0);
+        double q = AG_PROC_TWIN_STEP * (diag > 0 ? diag : 1.0);
         for (size_t t = 0; t < n; t++)
             if (piece[t] == t) {
                 uint64_t h = ag__mix64(in->tri_component[t] * 31ULL + pcount[t]);
                 for (int a = 0; a < 3; a++)
-                    h = ag__mix64(h ^ (uint64_t)(int64_t)floor(
-                                          (pbox[6 * t + 3 + a] - pbox[6 * t + a]) / q + 0.5));
+                    h = ag__mix64(h ^ (uint64_t)(int64_t)floor(ag_box_extent(&pbox[t], a) / q +
+                                                                0.5));
                 kv[nk].key = h;
                 kv[nk++].tri = (uint32_t)t;
             }
@@ -323,7 +299,6 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
 
     /* new component of every triangle: (old component, piece when split) in first-use order */
     {
-        uint32_t *newc = uf; /* reuse: uf no longer needed */
         uint32_t *first = malloc(n * sizeof *first); /* root/old comp → new comp */
         uint32_t *cfirst = malloc(nc * sizeof *cfirst);
         if (!first || !cfirst) {
@@ -361,7 +336,8 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
         if (next == 1 && n > 1 && one_piece) {
             size_t nr = 0;
             double cosmax = cos(o.planar_degrees * M_PI / 180.0);
-            st = planar_regions(in, wid, cosmax, 1e-4 * (diag > 0 ? diag : 1.0), newc, &nr);
+            st = planar_regions(in, wid, cosmax, AG_PROC_PLANE_DISTANCE * (diag > 0 ? diag : 1.0),
+                                newc, &nr);
             if (st) {
                 free(cg);
                 goto done;
@@ -405,7 +381,8 @@ done:
         ag_error_set(err, st, 0, "out of memory while segmenting");
     ag_mesh_free(m);
     free(wid);
-    free(uf);
+    ag_uf_free(&uf);
+    free(newc);
     free(piece);
     free(kv);
     free(ctris);

@@ -1,8 +1,12 @@
 #include "splittree.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "../base/array.h"
+#include "../base/tolerance.h"
 
 void ag_splittree_free(ag_splittree *t)
 {
@@ -36,6 +40,7 @@ ag_box ag_splittree_child_box(const ag_box *p, const double pivot[3], int octant
 
 int32_t ag_splittree_chain_end(const ag_splittree *t, int32_t n)
 {
+    assert(n < 0 || (size_t)n < t->nnodes);
     while (n >= 0 && t->nodes[n].kind == AG_NODE_SPLIT)
         n = t->nodes[n].first_child;
     return n;
@@ -43,14 +48,8 @@ int32_t ag_splittree_chain_end(const ag_splittree *t, int32_t n)
 
 static int32_t new_node(ag_splittree *t, int kind)
 {
-    if (t->nnodes == t->cap) {
-        size_t nc = t->cap ? 2 * t->cap : 64;
-        ag_tnode *nn = realloc(t->nodes, nc * sizeof *nn);
-        if (!nn)
-            return -1;
-        t->nodes = nn;
-        t->cap = nc;
-    }
+    if (t->nnodes >= INT32_MAX || AG_ARRAY_RESERVE(t->nodes, t->cap, t->nnodes + 1))
+        return -1;
     int32_t i = (int32_t)t->nnodes++;
     ag_tnode *n = &t->nodes[i];
     memset(n, 0, sizeof *n);
@@ -62,6 +61,8 @@ static int32_t new_node(ag_splittree *t, int kind)
 
 void ag_splittree_attach(ag_splittree *t, int32_t parent, int32_t child)
 {
+    assert(parent >= 0 && (size_t)parent < t->nnodes && child > 0 && (size_t)child < t->nnodes);
+    assert(parent != child);
     ag_tnode *p = &t->nodes[parent];
     t->nodes[child].parent = parent;
     t->nodes[child].next_sibling = -1;
@@ -72,8 +73,32 @@ void ag_splittree_attach(ag_splittree *t, int32_t parent, int32_t child)
     p->last_child = child;
 }
 
+/* A pivot (relative to the parent's min corner) kept within the parent's extent. */
+static double pivot_within(double pivot, double size)
+{
+    if (pivot < 0)
+        pivot = 0;
+    if (pivot > size)
+        pivot = size;
+    return pivot;
+}
+
+/* A child of parent cut by (pivot, octant q + 1), of the given kind; -1 when out of memory. */
+static int32_t add_split(ag_splittree *t, int32_t parent, const double piv[3], int q, int kind)
+{
+    int32_t n = new_node(t, kind);
+    if (n < 0)
+        return -1;
+    memcpy(t->nodes[n].pivot, piv, sizeof t->nodes[n].pivot);
+    t->nodes[n].octant = (uint8_t)(q + 1);
+    t->nodes[n].box = ag_splittree_child_box(&t->nodes[parent].box, piv, q + 1);
+    ag_splittree_attach(t, parent, n);
+    return n;
+}
+
 int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *c, int kind)
 {
+    assert(parent >= 0 && (size_t)parent < t->nnodes);
     const ag_box P = t->nodes[parent].box;
     double eps = t->eps;
     int done[3], single = 1;
@@ -93,20 +118,10 @@ int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *c, in
             done[a] = 0;
             single = 0;
         }
-        double size = P.max[a] - P.min[a];
-        if (piv[a] < 0)
-            piv[a] = 0;
-        if (piv[a] > size)
-            piv[a] = size;
+        piv[a] = pivot_within(piv[a], ag_box_extent(&P, a));
     }
-    int32_t n = new_node(t, single ? kind : AG_NODE_SPLIT);
-    if (n < 0)
-        return -1;
-    memcpy(t->nodes[n].pivot, piv, sizeof piv);
-    t->nodes[n].octant = (uint8_t)(q + 1);
-    t->nodes[n].box = ag_splittree_child_box(&t->nodes[parent].box, piv, q + 1);
-    ag_splittree_attach(t, parent, n);
-    if (single)
+    int32_t n = add_split(t, parent, piv, q, single ? kind : AG_NODE_SPLIT);
+    if (n < 0 || single)
         return n;
     const ag_box I = t->nodes[n].box;
     q = 0;
@@ -115,22 +130,10 @@ int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *c, in
             piv[a] = 0;
             q |= 1 << a;
         } else {
-            piv[a] = c->max[a] - I.min[a];
-            double size = I.max[a] - I.min[a];
-            if (piv[a] < 0)
-                piv[a] = 0;
-            if (piv[a] > size)
-                piv[a] = size;
+            piv[a] = pivot_within(c->max[a] - I.min[a], ag_box_extent(&I, a));
         }
     }
-    int32_t m = new_node(t, kind);
-    if (m < 0)
-        return -1;
-    memcpy(t->nodes[m].pivot, piv, sizeof piv);
-    t->nodes[m].octant = (uint8_t)(q + 1);
-    t->nodes[m].box = ag_splittree_child_box(&t->nodes[n].box, piv, q + 1);
-    ag_splittree_attach(t, n, m);
-    return m;
+    return add_split(t, n, piv, q, kind);
 }
 
 typedef struct {
@@ -144,24 +147,6 @@ static int cmp_volc(const void *a, const void *b)
     if (x->vol != y->vol)
         return x->vol > y->vol ? -1 : 1;
     return x->c < y->c ? -1 : x->c > y->c;
-}
-
-static double fvol(const ag_box *b, double floor_)
-{
-    double v = 1;
-    for (int a = 0; a < 3; a++) {
-        double d = b->max[a] - b->min[a];
-        v *= d > floor_ ? d : floor_;
-    }
-    return v;
-}
-
-static int encloses(const ag_box *o, const ag_box *i, double eps)
-{
-    for (int a = 0; a < 3; a++)
-        if (i->min[a] < o->min[a] - eps || i->max[a] > o->max[a] + eps)
-            return 0;
-    return 1;
 }
 
 typedef struct {
@@ -198,18 +183,13 @@ static ag_status adjacency(ag_splittree *t)
         const ag_box *a = &t->nodes[s[i].n].box;
         for (size_t j = i + 1; j < nv && s[j].x <= a->max[0] + tol; j++) {
             const ag_box *b = &t->nodes[s[j].n].box;
-            if (b->min[1] > a->max[1] + tol || a->min[1] > b->max[1] + tol ||
-                b->min[2] > a->max[2] + tol || a->min[2] > b->max[2] + tol)
+            /* x is ensured by the sweep */
+            if (!ag_box_meets_axis(a, b, 1, tol) || !ag_box_meets_axis(a, b, 2, tol))
                 continue;
-            if (t->nadj == cap) {
-                size_t nc = cap ? 2 * cap : 256;
-                uint32_t *na = realloc(t->adj, 2 * nc * sizeof *na);
-                if (!na) {
-                    free(s);
-                    return AG_ERR_NOMEM;
-                }
-                t->adj = na;
-                cap = nc;
+            /* pairs: two indices per element */
+            if (ag_array_reserve((void **)&t->adj, &cap, t->nadj + 1, 2 * sizeof *t->adj)) {
+                free(s);
+                return AG_ERR_NOMEM;
             }
             uint32_t x = s[i].n, y = s[j].n;
             t->adj[2 * t->nadj] = x < y ? x : y;
@@ -224,8 +204,13 @@ static ag_status adjacency(ag_splittree *t)
 /* Spatial index of visible nodes for the parent search: a box is registered in the cells it
  * covers on the finest of three grid levels where it covers at most 64 cells (boxes larger
  * than that are kept in a short list). A query looks at the cell holding the centre of the
- * new box on each level: every node enclosing the box is found without scanning siblings. */
+ * new box on each level: every node enclosing the box is found without scanning siblings.
+ * The coarsest cell is an eighth of the diagonal, each level four times finer per axis. */
 #define GI_LEVELS 3
+#define GI_COARSEST 8.0   /* cells per diagonal on the coarsest level */
+#define GI_REFINE 4       /* finer per axis from one level to the next */
+#define GI_MAX_CELLS 64   /* most cells one box is registered in */
+#define GI_MIN_CELLS 1024 /* first size of the hash table (a power of two) */
 typedef struct {
     uint64_t key;
     int32_t head; /* -1 = empty slot */
@@ -266,7 +251,10 @@ static gcell *gi_slot(gindex *g, uint64_t key)
 
 static int gi_grow(gindex *g)
 {
-    size_t nc = g->cap ? 2 * g->cap : 1024;
+    /* a power of two from GI_MIN_CELLS on, for the probe mask */
+    size_t nc;
+    if (ag_array_capacity(g->cap, g->cap ? g->cap + 1 : GI_MIN_CELLS, sizeof *g->cells, &nc))
+        return -1;
     gcell *old = g->cells;
     size_t oc = g->cap;
     g->cells = malloc(nc * sizeof *g->cells);
@@ -294,23 +282,17 @@ static int gi_add(gindex *g, const ag_box *b, int32_t node)
             hi[a] = (int64_t)floor((b->max[a] - g->o[a]) / g->h[l]);
             cells *= (double)(hi[a] - lo[a] + 1);
         }
-        if (cells > 64 && l > 0)
+        if (cells > GI_MAX_CELLS && l > 0)
             continue;
-        if (cells > 64)
+        if (cells > GI_MAX_CELLS)
             break;
         for (int64_t x = lo[0]; x <= hi[0]; x++)
             for (int64_t y = lo[1]; y <= hi[1]; y++)
                 for (int64_t z = lo[2]; z <= hi[2]; z++) {
                     if (2 * (g->used + 1) > g->cap && gi_grow(g))
                         return -1;
-                    if (g->nent == g->capent) {
-                        size_t nc = g->capent ? 2 * g->capent : 1024;
-                        gentry *ne = realloc(g->ent, nc * sizeof *ne);
-                        if (!ne)
-                            return -1;
-                        g->ent = ne;
-                        g->capent = nc;
-                    }
+                    if (AG_ARRAY_RESERVE(g->ent, g->capent, g->nent + 1))
+                        return -1;
                     uint64_t key = gkey(l, x, y, z);
                     gcell *c = gi_slot(g, key);
                     if (c->head < 0) {
@@ -323,14 +305,8 @@ static int gi_add(gindex *g, const ag_box *b, int32_t node)
                 }
         return 0;
     }
-    if (g->nlarge == g->caplarge) {
-        size_t nc = g->caplarge ? 2 * g->caplarge : 64;
-        int32_t *nl = realloc(g->large, nc * sizeof *nl);
-        if (!nl)
-            return -1;
-        g->large = nl;
-        g->caplarge = nc;
-    }
+    if (AG_ARRAY_RESERVE(g->large, g->caplarge, g->nlarge + 1))
+        return -1;
     g->large[g->nlarge++] = node;
     return 0;
 }
@@ -360,23 +336,19 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
         goto nomem;
     double diag = L->diagonal > 0 ? L->diagonal : 1.0;
     t->tol = L->exact;
-    t->eps = 1e-9 * diag;
+    t->eps = AG_PROC_COINCIDENT * diag;
+    double min_extent = AG_PROC_ORDER_MIN_EXTENT * diag;
     int32_t root = new_node(t, AG_NODE_ROOT);
     if (root < 0)
         goto nomem;
-    ag_box all = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    ag_box all = ag_box_empty();
     size_t n = 0;
     for (size_t c = 0; c < nc; c++) {
         t->comp_node[c] = -1;
         if (!L->ntris[c])
             continue;
-        for (int a = 0; a < 3; a++) {
-            if (L->box[c].min[a] < all.min[a])
-                all.min[a] = L->box[c].min[a];
-            if (L->box[c].max[a] > all.max[a])
-                all.max[a] = L->box[c].max[a];
-        }
-        order[n].vol = fvol(&L->box[c], 1e-3 * diag);
+        ag_box_extend_box(&all, &L->box[c]);
+        order[n].vol = ag_box_volume_floor(&L->box[c], min_extent);
         order[n++].c = (uint32_t)c;
     }
     if (n == 0) {
@@ -391,8 +363,9 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
     depth = calloc(3 * n + 8, sizeof *depth); /* at most two splits per component */
     if (!depth)
         goto nomem;
-    for (int l = 0; l < GI_LEVELS; l++)
-        gi.h[l] = diag / (8.0 * (1 << (2 * l)));
+    double per_diag = GI_COARSEST;
+    for (int l = 0; l < GI_LEVELS; l++, per_diag *= GI_REFINE)
+        gi.h[l] = diag / per_diag;
     for (int a = 0; a < 3; a++)
         gi.o[a] = all.min[a];
     for (size_t i = 0; i < n; i++) {
@@ -401,8 +374,7 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
         /* the tightest enclosing visible node; on equal volume the later (deeper) one */
         int32_t P = root;
         double bv = INFINITY, ctr[3];
-        for (int a = 0; a < 3; a++)
-            ctr[a] = 0.5 * (cb->min[a] + cb->max[a]);
+        ag_box_centre(cb, ctr);
         for (int l = 0; l <= GI_LEVELS; l++) {
             if (l < GI_LEVELS) {
                 if (!gi.cap)
@@ -413,9 +385,9 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
                 gcell *cell = gi_slot(&gi, key);
                 for (int32_t en = cell->head; en >= 0; en = gi.ent[en].next) {
                     int32_t e = gi.ent[en].node;
-                    if (!encloses(&t->nodes[e].box, cb, t->eps))
+                    if (!ag_box_contains(&t->nodes[e].box, cb, t->eps))
                         continue;
-                    double v = fvol(&t->nodes[e].box, 1e-3 * diag);
+                    double v = ag_box_volume_floor(&t->nodes[e].box, min_extent);
                     if (v < bv || (v == bv && e > P)) {
                         bv = v;
                         P = e;
@@ -425,9 +397,9 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
             }
             for (size_t q = 0; q < gi.nlarge; q++) {
                 int32_t e = gi.large[q];
-                if (!encloses(&t->nodes[e].box, cb, t->eps))
+                if (!ag_box_contains(&t->nodes[e].box, cb, t->eps))
                     continue;
-                double v = fvol(&t->nodes[e].box, 1e-3 * diag);
+                double v = ag_box_volume_floor(&t->nodes[e].box, min_extent);
                 if (v < bv || (v == bv && e > P)) {
                     bv = v;
                     P = e;

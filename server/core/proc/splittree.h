@@ -61,7 +61,7 @@ typedef struct {
     size_t nrules;
     uint32_t *rule_count; /* per rule: visible nodes in the class */
     int32_t *rule_rep;    /* per rule: its representative node */
-    size_t npatterns;
+    size_t npatterns, cap_patterns;
     ag_pattern *patterns;
     double tol; /* absolute matching tolerance (the labels' exact tolerance) */
     double eps; /* absolute coincidence tolerance for faces */

@@ -3,11 +3,13 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "../base/array.h"
+
 ag_status ag__weld(const double *pos, size_t n, double cell, uint32_t *ids, size_t *count)
 {
-    size_t cap = 16;
-    while (cap < 2 * n + 16)
-        cap <<= 1;
+    size_t cap;
+    if (ag_array_hash_size(n, &cap))
+        return AG_ERR_TOO_LARGE;
     uint32_t *slot = malloc(cap * sizeof *slot); /* first vertex of the id + 1, 0 = empty */
     int64_t *key = malloc(3 * n * sizeof *key);
     if (!slot || !key) {

@@ -1,0 +1,130 @@
+#include "usecase_compose.h"
+
+#include <string.h>
+#include <time.h>
+
+#include "model_tree.h"
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* The composed grammar (resolved, terminals with geometry) and the budget of what it may
+ * derive. */
+static ag_status compose_grammar(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                 ag_grammar **g, size_t *budget, ag_usecase_compose_result *out,
+                                 ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    *g = NULL;
+    if (p->op.mode < AG_COMPOSE_REPLACE || p->op.mode > AG_COMPOSE_FILL)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "mode: replace, insert or fill");
+    if (p->op.scope != AG_COMPOSE_NODE && p->op.scope != AG_COMPOSE_RULE)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "scope: node or rule");
+    double t0 = now_ms();
+    ag_edit_model *em = NULL;
+    const ag_edit_model *source = NULL;
+    int64_t source_version = 0;
+    ag_status s = ag_workspace_open_models(ws, NULL, &em, &source, &source_version, err);
+    if (s == AG_OK)
+        s = ag_model_tree_check_node(em, p->op.target, "target", err);
+    const ag_part *part = NULL;
+    if (s == AG_OK)
+        s = ag_workspace_open_part(ws, p->part, &part, err);
+    if (s != AG_OK)
+        return s;
+    out->load_ms = now_ms() - t0;
+    out->part = part;
+    size_t own = 2 * em->proc->mesh->ntris;
+    *budget = p->max_triangles                       ? p->max_triangles
+              : own > AG_USECASE_COMPOSE_MAX_TRIANGLES ? own
+                                                       : AG_USECASE_COMPOSE_MAX_TRIANGLES;
+    t0 = now_ms();
+    s = ag_compose(em->proc, part, &p->op, g, &out->report, err);
+    out->compose_ms = now_ms() - t0;
+    return s;
+}
+
+/* A result past the budget, said as the composition's. */
+static ag_status over_budget(ag_status s, size_t budget, ag_error *err)
+{
+    if (s == AG_ERR_TOO_LARGE)
+        ag_error_set(err, s, 0,
+                     "the composition makes more than %zu triangles (at most that in one op): "
+                     "compose a larger part, or into a smaller target",
+                     budget);
+    return s;
+}
+
+ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                  ag_model_state *st, ag_usecase_compose_result *out,
+                                  ag_error *err)
+{
+    memset(st, 0, sizeof *st);
+    ag_grammar *g = NULL;
+    size_t budget = 0;
+    ag_status s = compose_grammar(ws, p, &g, &budget, out, err);
+    if (s != AG_OK)
+        return s;
+    double t0 = now_ms();
+    s = over_budget(ag_model_state_from_grammar(g, budget, st, err), budget, err);
+    ag_grammar_free(g);
+    out->state_ms = now_ms() - t0;
+    return s;
+}
+
+ag_status ag_usecase_compose_preview(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                     ag_mesh **mesh, ag_usecase_compose_result *out,
+                                     ag_error *err)
+{
+    *mesh = NULL;
+    ag_grammar *g = NULL;
+    size_t budget = 0;
+    ag_status s = compose_grammar(ws, p, &g, &budget, out, err);
+    if (s != AG_OK)
+        return s;
+    double t0 = now_ms();
+    ag_grammar_derive_options o = {.max_triangles = budget};
+    s = over_budget(ag_grammar_derive(g, &o, mesh, err), budget, err);
+    ag_grammar_free(g);
+    out->state_ms = now_ms() - t0;
+    return s;
+}
+
+ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_params *p,
+                                 ag_usecase_compose_result *out, ag_error *err)
+{
+    ag_model_state st;
+    ag_status s = ag_usecase_compose_make(ws, p, &st, out, err);
+    if (s != AG_OK)
+        return s;
+    ag_compose_outcome o = {.op = &p->op,
+                            .part = out->part,
+                            .report = out->report,
+                            .load_ms = out->load_ms,
+                            .compose_ms = out->compose_ms,
+                            .state_ms = out->state_ms};
+    return ag_workspace_save_composed(ws, &st, &o, err);
+}
+
+json_t *ag_usecase_compose_report_json(const ag_compose_outcome *o)
+{
+    const ag_compose_report *r = &o->report;
+    return json_pack(
+        "{s:{s:s,s:I,s:s},s:s,s:s,s:I,s:[I,I,I],s:i,s:[f,f,f],"
+        "s:{s:I,s:I,s:I,s:I,s:I,s:I,s:I},s:{s:I,s:I,s:I,s:I},s:s}",
+        "part", "name", o->part->name, "version", (json_int_t)o->part->version, "root",
+        o->part->root, "root_rule", r->root, "target_rule", r->target_rule, "instances",
+        (json_int_t)r->instances, "counts", (json_int_t)r->counts[0], (json_int_t)r->counts[1],
+        (json_int_t)r->counts[2], "turn", 90 * r->turn, "fitted", r->fitted[0], r->fitted[1],
+        r->fitted[2], "grammar", "rules_added", (json_int_t)r->rules_added, "rules_shared",
+        (json_int_t)r->rules_shared, "terminals_added", (json_int_t)r->terminals_added,
+        "terminals_shared", (json_int_t)r->terminals_shared, "renamed", (json_int_t)r->renamed,
+        "cloned", (json_int_t)r->cloned, "expanded_cells", (json_int_t)r->expanded_cells, "fit",
+        "elements", (json_int_t)r->fit.elements, "equations", (json_int_t)r->fit.equations,
+        "rigid", (json_int_t)r->fit.rigid, "rigid_relaxed", (json_int_t)r->fit.rigid_relaxed,
+        "message", r->message);
+}

@@ -1,0 +1,282 @@
+#include "verify.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "keysort.h"
+#include "weld_points.h"
+#include "tolerance.h"
+
+/* How far outwards profile p leads (m, >= 0) and, when its last segment leans inwards,
+ * the height it rises per metre it moves in (0: it does not). */
+static void profile_reach(const ag_profile *p, double cap, double *out, double *rise)
+{
+    double o = 0;
+    for (size_t i = 0; i < p->npoints; i++)
+        o = fmax(o, -p->points[i].w);
+    const ag_profile_point *a = &p->points[p->npoints - 2], *b = &p->points[p->npoints - 1];
+    double slope = (b->w - a->w) / (b->z - a->z);
+    if (slope < 0 && cap > b->z)
+        o = fmax(o, -(b->w + slope * (cap - b->z)));
+    *out = o;
+    *rise = slope > 0 ? 1 / slope : 0;
+}
+
+void ag_verify_reach(const ag_plan *plan, double *outwards, double *height)
+{
+    double prof_out = 0, rise = 0, top = 0;
+    for (size_t i = 0; i < plan->nprofiles; i++) {
+        double o, r;
+        const ag_profile *p = &plan->profiles[i];
+        profile_reach(p, plan->cap_height, &o, &r);
+        prof_out = fmax(prof_out, o);
+        rise = fmax(rise, r);
+        top = fmax(top, p->points[p->npoints - 1].z);
+    }
+    /* profiles of steps and offsets count from their heights, and add to each other */
+    double out = prof_out, base = 0;
+    for (size_t k = 0; k < plan->noffsets; k++) {
+        const ag_plan_offset *o = &plan->offsets[k];
+        double w = fmax(o->outside, 0);
+        for (size_t e = 0; e < o->nedges; e++)
+            if (o->edges[e].has_outside)
+                w = fmax(w, o->edges[e].outside);
+        out += w + prof_out;
+        base = fmax(base, o->z);
+    }
+    for (size_t k = 0; k < plan->nsteps; k++) {
+        const ag_plan_step *s = &plan->steps[k];
+        double w = s->depth > 0 ? s->depth : 0;
+        if (s->npoints && !s->plan_frame)
+            for (size_t i = 0; i < s->npoints; i++)
+                w = fmax(w, hypot(s->points[2 * i], s->points[2 * i + 1]));
+        out += w + prof_out;
+        base = fmax(base, s->at.z);
+    }
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (size_t L = 0; L < plan->nloops; L++)
+        for (size_t i = 0; i < plan->loops[L].n; i++)
+            for (int k = 0; k < 2; k++) {
+                lo[k] = fmin(lo[k], plan->loops[L].xy[2 * i + k]);
+                hi[k] = fmax(hi[k], plan->loops[L].xy[2 * i + k]);
+            }
+    double extent = plan->nloops ? hypot(hi[0] - lo[0], hi[1] - lo[1]) : 0;
+    *outwards = out;
+    *height = plan->cap_height > 0 ? plan->cap_height
+                                   : base + top + (extent + 2 * out) * rise;
+}
+
+/* --- closed 2-manifold -------------------------------------------------------------------- */
+
+/* Welded ids of the vertices the triangles use. */
+static int weld(const ag_mesh *m, size_t t0, size_t t1, double tol, uint32_t *id,
+                ag_keyed *vs)
+{
+    size_t nv = 0;
+    for (size_t t = t0; t < t1; t++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t v = m->tri[3 * t + k];
+            id[v] = v;
+            vs[nv++] = (ag_keyed){ag_keysort_double(m->pos[3 * v]), v};
+        }
+    return ag_weld_points(m->pos, vs, nv, tol, id) == AG_OK;
+}
+
+/* Index of key in sorted e[0..n), or n. */
+static size_t find_key(const ag_keyed *e, size_t n, uint64_t key)
+{
+    size_t lo = ag_keysort_lower_bound(e, n, key);
+    return lo < n && e[lo].key == key ? lo : n;
+}
+
+static int closed_manifold(const ag_mesh *m, size_t t0, size_t t1, double tol, char *why,
+                           size_t nwhy)
+{
+    size_t nt = t1 - t0;
+    uint32_t *id = malloc((m->nverts ? m->nverts : 1) * sizeof *id);
+    ag_keyed *e = malloc((3 * nt + 1) * sizeof *e);
+    ag_keyed *tv = malloc((nt + 1) * sizeof *tv);
+    int ok = id && e && tv && weld(m, t0, t1, tol, id, e);
+    if (!ok)
+        snprintf(why, nwhy, "out of memory checking the building");
+    size_t ne = 0, ntv = 0;
+    for (size_t t = t0; ok && t < t1; t++) {
+        uint32_t v[3] = {id[m->tri[3 * t]], id[m->tri[3 * t + 1]], id[m->tri[3 * t + 2]]};
+        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
+            continue; /* shorter than the weld tolerance: no edges of its own */
+        for (int k = 0; k < 3; k++)
+            e[ne++] = (ag_keyed){(uint64_t)v[k] << 32 | v[(k + 1) % 3], (uint32_t)t};
+        for (int a = 0; a < 2; a++)
+            for (int b = 0; b < 2 - a; b++)
+                if (v[b] > v[b + 1]) {
+                    uint32_t x = v[b];
+                    v[b] = v[b + 1];
+                    v[b + 1] = x;
+                }
+        /* the triple sorted: the two smallest as the key, the largest as the value */
+        tv[ntv++] = (ag_keyed){(uint64_t)v[0] << 32 | v[1], v[2]};
+    }
+    if (ok && !ne) {
+        ok = 0;
+        snprintf(why, nwhy, "the building has no triangles");
+    }
+    if (ok && ag_keysort(e, ne, NULL) != AG_OK) {
+        ok = 0;
+        snprintf(why, nwhy, "out of memory checking the building");
+    }
+    for (size_t i = 0; ok && i < ne; i++) {
+        if (i + 1 < ne && e[i].key == e[i + 1].key) {
+            ok = 0;
+            const double *p = &m->pos[3 * (e[i].key >> 32)];
+            snprintf(why, nwhy, "an edge at (%.3f, %.3f, %.3f) is shared by more than two faces "
+                     "(not a closed 2-manifold)", p[0], p[1], p[2]);
+            break;
+        }
+        uint64_t rev = (e[i].key << 32) | (e[i].key >> 32);
+        if (find_key(e, ne, rev) == ne) {
+            ok = 0;
+            const double *p = &m->pos[3 * (e[i].key >> 32)];
+            snprintf(why, nwhy, "the building is open at an edge from (%.3f, %.3f, %.3f)", p[0],
+                     p[1], p[2]);
+        }
+    }
+    if (ok) {
+        /* by the two smallest vertices; a run of equal keys holds the largest ones */
+        ok = ag_keysort(tv, ntv, NULL) == AG_OK;
+        if (!ok)
+            snprintf(why, nwhy, "out of memory checking the building");
+        for (size_t i = 0; ok && i < ntv; i++)
+            for (size_t j = i + 1; ok && j < ntv && tv[j].key == tv[i].key; j++)
+                if (tv[j].val == tv[i].val) {
+                    ok = 0;
+                    const double *p = &m->pos[3 * (tv[i].key >> 32)];
+                    snprintf(why, nwhy, "two faces lie on each other near (%.3f, %.3f, %.3f) "
+                             "(a double-sided sliver)", p[0], p[1], p[2]);
+                }
+    }
+    free(id);
+    free(e);
+    free(tv);
+    return ok;
+}
+
+/* --- within reach of the footprint ------------------------------------------------------- */
+
+static double seg_dist2(double x, double y, const double *a, const double *b)
+{
+    double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+    double t = l2 > 0 ? ((x - a[0]) * dx + (y - a[1]) * dy) / l2 : 0;
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    double ex = a[0] + t * dx - x, ey = a[1] + t * dy - y;
+    return ex * ex + ey * ey;
+}
+
+static int inside_ring(const double *xy, size_t n, double x, double y)
+{
+    int in = 0;
+    for (size_t i = 0, j = n - 1; i < n; j = i++) {
+        const double *a = &xy[2 * j], *b = &xy[2 * i];
+        if ((b[1] > y) != (a[1] > y) && x < a[0] + (y - a[1]) * (b[0] - a[0]) / (b[1] - a[1]))
+            in = !in;
+    }
+    return in;
+}
+
+/* Is (x, y) within `allowed` of the union of the loops (even-odd) and the plan-frame
+ * forced polygons (each alone)? *dist gets the distance when it is not. */
+static int within(const ag_plan *plan, double x, double y, double allowed, double *dist)
+{
+    int in = 0;
+    double d2 = INFINITY, a2 = allowed * allowed;
+    for (size_t L = 0; L < plan->nloops; L++) {
+        const ag_plan_loop *l = &plan->loops[L];
+        in ^= inside_ring(l->xy, l->n, x, y);
+    }
+    if (in)
+        return 1;
+    for (size_t L = 0; L < plan->nloops; L++) {
+        const ag_plan_loop *l = &plan->loops[L];
+        for (size_t i = 0, j = l->n - 1; i < l->n; j = i++) {
+            d2 = fmin(d2, seg_dist2(x, y, &l->xy[2 * j], &l->xy[2 * i]));
+            if (d2 <= a2)
+                return 1;
+        }
+    }
+    for (size_t k = 0; k < plan->nsteps; k++) {
+        const ag_plan_step *s = &plan->steps[k];
+        if (!s->npoints || !s->plan_frame)
+            continue;
+        if (inside_ring(s->points, s->npoints, x, y))
+            return 1;
+        for (size_t i = 0, j = s->npoints - 1; i < s->npoints; j = i++)
+            d2 = fmin(d2, seg_dist2(x, y, &s->points[2 * j], &s->points[2 * i]));
+        if (d2 <= a2)
+            return 1;
+    }
+    *dist = sqrt(d2);
+    return 0;
+}
+
+int ag_verify_building(const ag_mesh *m, size_t t0, size_t t1, const ag_plan *plan, char *why,
+                       size_t nwhy)
+{
+    char local[160];
+    if (!why || !nwhy) {
+        why = local;
+        nwhy = sizeof local;
+    }
+    why[0] = 0;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY}, mag = 0;
+    for (size_t L = 0; L < plan->nloops; L++)
+        for (size_t i = 0; i < plan->loops[L].n; i++)
+            for (int k = 0; k < 2; k++) {
+                double v = plan->loops[L].xy[2 * i + k];
+                lo[k] = fmin(lo[k], v);
+                hi[k] = fmax(hi[k], v);
+                mag = fmax(mag, fabs(v));
+            }
+    double extent = hypot(hi[0] - lo[0], hi[1] - lo[1]);
+    ag_extrude_tol tol = ag_extrude_tolerances(extent, mag);
+    if (!closed_manifold(m, t0, t1, tol.point, why, nwhy))
+        return 0;
+    double out, top;
+    ag_verify_reach(plan, &out, &top);
+    double slack = AG_VERIFY_REACH_REL * tol.size + tol.point;
+    double allowed = AG_VERIFY_MITRE * out + slack;
+    double worst = 0, wx = 0, wy = 0, zmin = INFINITY, zmax = -INFINITY;
+    uint8_t *seen = calloc(m->nverts ? m->nverts : 1, 1);
+    if (!seen) {
+        snprintf(why, nwhy, "out of memory checking the building");
+        return 0;
+    }
+    for (size_t t = t0; t < t1; t++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t v = m->tri[3 * t + k];
+            if (seen[v])
+                continue;
+            seen[v] = 1;
+            const double *p = &m->pos[3 * v];
+            zmin = fmin(zmin, p[2]);
+            zmax = fmax(zmax, p[2]);
+            double d = 0;
+            if (!within(plan, p[0], p[1], allowed, &d) && d > worst) {
+                worst = d;
+                wx = p[0];
+                wy = p[1];
+            }
+        }
+    free(seen);
+    if (worst > allowed) {
+        snprintf(why, nwhy, "it reaches %.3g m outside its footprint at (%.3f, %.3f) (its "
+                 "profiles lead %.3g m out)", worst, wx, wy, out);
+        return 0;
+    }
+    if (zmin < -slack || zmax > top + slack + AG_VERIFY_REACH_REL * top) {
+        snprintf(why, nwhy, "its height runs from %.4g to %.4g m (the plan allows 0 to %.4g m)",
+                 zmin, zmax, top);
+        return 0;
+    }
+    return 1;
+}
