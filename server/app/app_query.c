@@ -369,8 +369,9 @@ static ag_status as_plan_problem(ag_status s, ag_error *err)
     return AG_ERR_PARSE;
 }
 
-ag_status ag_app_query_extrusion_preview(const char *plan_json, size_t len, ag_app_bytes *out,
-                                         size_t *failing_faces, ag_error *err)
+/* One building extruded under opt (NULL: the defaults), as GLB. */
+static ag_status preview(const char *plan_json, size_t len, const ag_extrude_options *opt,
+                         ag_app_bytes *out, size_t *failing_faces, ag_error *err)
 {
     memset(out, 0, sizeof *out);
     *failing_faces = 0;
@@ -384,17 +385,23 @@ ag_status ag_app_query_extrusion_preview(const char *plan_json, size_t len, ag_a
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
     ag_extrude_result res;
-    s = ag_extrude_plan(plan, m, -1, &res, NULL, err);
+    s = ag_extrude_plan_with(plan, opt, m, -1, &res, NULL, err);
     ag_plan_free(plan);
     if (s != AG_OK) {
         ag_mesh_free(m);
-        return as_plan_problem(s, err);
+        return s == AG_ERR_CANCELLED ? s : as_plan_problem(s, err);
     }
     s = ag_glb_write(m, &out->data, &out->len, err);
     ag_mesh_free(m);
     /* A shell that is not watertight is still shown; the caller tells the editor so. */
     *failing_faces = res.failing_faces;
     return s;
+}
+
+ag_status ag_app_query_extrusion_preview(const char *plan_json, size_t len, ag_app_bytes *out,
+                                         size_t *failing_faces, ag_error *err)
+{
+    return preview(plan_json, len, NULL, out, failing_faces, err);
 }
 
 ag_status ag_app_query_extrusion_preview_budgeted(const char *plan_json, size_t len,
@@ -405,17 +412,12 @@ ag_status ag_app_query_extrusion_preview_budgeted(const char *plan_json, size_t 
     *failing_faces = 0;
     if (ag_task_budget_exhausted(budget))
         return ag_task_budget_explain(budget, AG_ERR_CANCELLED, "the extrusion preview", err);
-    /* The sweep itself takes the budget once the extrusion options have one (their
-     * cancel callback is ag_task_budget_exhausted with this budget, their time what
-     * ag_task_budget_left says); until then it runs to its end, and an answer nobody waits
-     * for any more is dropped (a late one is still worth sending). */
-    ag_status s = ag_app_query_extrusion_preview(plan_json, len, out, failing_faces, err);
-    if (s == AG_OK && ag_task_budget_exhausted(budget) && budget->why != AG_ERR_DEADLINE) {
-        free(out->data);
-        memset(out, 0, sizeof *out);
-        s = ag_task_budget_explain(budget, AG_ERR_CANCELLED, "the extrusion preview", err);
-    }
-    return s;
+    /* the sweep polls the task's budget (its deadline, the asker still there, the service
+     * still running) and stops within milliseconds of any; the events and memory it may
+     * spend stay the extrusion's own defaults */
+    ag_extrude_options o = {.budget = {.cancelled = ag_task_budget_exhausted, .user = budget}};
+    ag_status s = preview(plan_json, len, &o, out, failing_faces, err);
+    return ag_task_budget_explain(budget, s, "the extrusion preview", err);
 }
 
 json_t *ag_app_query_health(ag_app *app, int ws_port, ag_error *err)

@@ -30,8 +30,6 @@ static void task_run(void *user, ag_task_budget *budget)
     budget->gone = client_gone;
     budget->gone_user = r;
     if (ag_task_budget_exhausted(budget)) {
-        if (budget->gone_seen && r->cfg->abandoned)
-            atomic_fetch_add(r->cfg->abandoned, 1);
         ag_error err;
         ag_error_clear(&err);
         ag_status s = ag_task_budget_explain(budget, AG_ERR_CANCELLED, "the request", &err);
@@ -39,6 +37,9 @@ static void task_run(void *user, ag_task_budget *budget)
     } else {
         r->work(r, budget);
     }
+    /* the client left before its answer: the work was skipped or stopped */
+    if (budget->gone_seen && r->cfg->abandoned)
+        atomic_fetch_add(r->cfg->abandoned, 1);
     resume(r);
 }
 

@@ -31,7 +31,8 @@ typedef struct {
     struct ag_ratelimit *rest_limit, *job_limit; /* NULL: none */
     ag_rate_key_fn rate_key;                     /* NULL: ag_request_address_key */
     struct ag_connguard *guard;
-    atomic_size_t *abandoned; /* deferred requests dropped: their client went away first */
+    atomic_size_t *abandoned; /* deferred requests whose client went away first: their work
+                                 was skipped or stopped */
     int no_auth;         /* everyone is the local admin (loopback only) */
     const char *const *cors; /* origins allowed to call the API from a browser ("*": any) */
     int ncors;

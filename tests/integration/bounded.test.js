@@ -119,7 +119,7 @@ describe('bounded work', () => {
     assert.ok(worst < 500, `health took ${worst.toFixed(1)} ms`);
   });
 
-  it('previews whose client went away are not run', async () => {
+  it('previews whose client went away are not run, or stop', async () => {
     const body = JSON.stringify(plan838());
     const before = (await http(d, 'GET', '/api/v1/health')).json.http.abandoned;
     // previews run on all but one task worker; the rest wait their turn, then their clients leave
@@ -136,9 +136,8 @@ describe('bounded work', () => {
     assert.ok(waiting >= 6, `${waiting} previews waiting`);
     for (const c of ctls) c.abort();
     await Promise.all(sent);
-    // the waiting ones are dropped when their turn comes (a worker may have taken one or
-    // two between the count and the aborts: previews run on up to three at once)
-    const expected = Math.max(3, waiting - 3);
+    // the waiting ones are dropped when their turn comes, the running ones stop in their sweep
+    const expected = waiting;
     let abandoned = before;
     for (let i = 0; i < 400 && abandoned - before < expected; i++) {
       await sleep(25);
@@ -151,14 +150,20 @@ describe('bounded work', () => {
     assert.equal(r.status, 200);
   });
 
-  it('an op past its time budget stops and stores nothing; SIGTERM while work runs stops within a second', async () => {
+  it('an op or a preview past its time budget stops and stores nothing; SIGTERM while work runs stops within a second', async () => {
     await d.stop();
-    d = await startDaemon({ dir, args: ['--no-web', '--op-seconds', '0.05'] });
+    d = await startDaemon({ dir, args: ['--no-web', '--op-seconds', '0.05', '--preview-seconds', '0.02'] });
     const tower = (await http(d, 'GET', '/api/v1/models/2')).json;
     const r = await resize(d, tower.id, [2, 2, 1]);
     assertProblem(r, 503, 'deadline', 'resize past its budget');
     assert.match(r.json.detail, /budget of 0.05 s/);
     assert.equal((await http(d, 'GET', `/api/v1/models/${tower.id}`)).json.version, tower.version);
+    // an extrusion preview stops in its sweep
+    const p = await http(d, 'POST', '/api/v1/extrusions/preview', {
+      body: JSON.stringify(plan838()), headers: { 'Content-Type': 'application/json' },
+    });
+    assertProblem(p, 503, 'deadline', 'a preview past its budget');
+    assert.match(p.json.detail, /extrusion preview ran longer than its budget of 0.02 s/);
     await d.stop();
 
     d = await startDaemon({ dir, args: ['--no-web'] });
