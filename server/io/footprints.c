@@ -652,25 +652,78 @@ static int add_issue(ag_footprint_issue **list, size_t *n, const char *id, const
     return 1;
 }
 
-ag_status ag_footprints_report_add(ag_footprints_report *r, const ag_footprint *fp,
-                                   const ag_building_result *b)
+ag_status ag_footprints_report_add_id(ag_footprints_report *r, const char *id,
+                                      const char *read_fixes, const ag_building_result *b)
 {
     int ok = 1;
+    if (!read_fixes)
+        read_fixes = "";
     if (b->built == AG_BUILT_STYLED)
         r->succeeded++;
     else if (b->built == AG_BUILT_NONE)
-        ok = add_issue(&r->failed, &r->nfailed, fp->id, b->reason, b->built, 0);
+        ok = add_issue(&r->failed, &r->nfailed, id, b->reason, b->built, 0);
     else
-        ok = add_issue(&r->fallbacks, &r->nfallbacks, fp->id, b->reason, b->built, b->moved);
-    if (ok && (b->nfixes || fp->fixes[0])) {
+        ok = add_issue(&r->fallbacks, &r->nfallbacks, id, b->reason, b->built, b->moved);
+    if (ok && (b->nfixes || read_fixes[0])) {
         char text[sizeof r->fixed[0].reason];
-        snprintf(text, sizeof text, "%.100s%s%.150s", fp->fixes,
-                 fp->fixes[0] && b->nfixes ? "; " : "", b->nfixes ? b->fixes : "");
-        ok = add_issue(&r->fixed, &r->nfixed, fp->id, text, b->built, 0);
+        snprintf(text, sizeof text, "%.100s%s%.150s", read_fixes,
+                 read_fixes[0] && b->nfixes ? "; " : "", b->nfixes ? b->fixes : "");
+        ok = add_issue(&r->fixed, &r->nfixed, id, text, b->built, 0);
     }
     r->triangles += b->triangles;
     r->events += b->events;
     return ok ? AG_OK : AG_ERR_NOMEM;
+}
+
+ag_status ag_footprints_report_add(ag_footprints_report *r, const ag_footprint *fp,
+                                   const ag_building_result *b)
+{
+    return ag_footprints_report_add_id(r, fp->id, fp->fixes, b);
+}
+
+static json_t *issues_json(const ag_footprint_issue *v, size_t n, int with_fallback)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && i < n; i++) {
+        json_t *o = json_pack("{s:s,s:s}", "id", v[i].id, "reason", v[i].reason);
+        if (o && with_fallback) {
+            json_object_set_new(o, "fallback", json_string(ag_built_name(v[i].built)));
+            if (v[i].built == AG_BUILT_SIMPLIFIED)
+                json_object_set_new(o, "moved", json_real(v[i].moved));
+        }
+        if (!o || json_array_append_new(a, o) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+static json_t *fixes_json(const ag_footprint_issue *v, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && i < n; i++) {
+        json_t *o = json_pack("{s:s,s:s}", "id", v[i].id, "fixes", v[i].reason);
+        if (!o || json_array_append_new(a, o) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+json_t *ag_footprints_report_json(const ag_footprints_report *r)
+{
+    return json_pack("{s:I,s:I,s:o*,s:o*,s:I,s:o*,s:o*,s:I,s:I}",
+                     "footprints", (json_int_t)r->footprints,
+                     "succeeded", (json_int_t)r->succeeded,
+                     "fallbacks", issues_json(r->fallbacks, r->nfallbacks, 1),
+                     "failed", issues_json(r->failed, r->nfailed, 0),
+                     "not_watertight", (json_int_t)r->nnot_watertight,
+                     "not_watertight_items", issues_json(r->not_watertight, r->nnot_watertight, 0),
+                     "fixed", fixes_json(r->fixed, r->nfixed),
+                     "triangles", (json_int_t)r->triangles,
+                     "events", (json_int_t)r->events);
 }
 
 ag_status ag_footprints_extrude_with(const ag_footprints *f, const ag_style *style,
