@@ -11,14 +11,14 @@ typedef struct {
     uint8_t type, is_int;
     uint32_t key;   /* offset of the member's key in text, or NONE */
     uint32_t first; /* first child */
-    uint32_t last;  /* last child (while building) */
     uint32_t next;  /* next sibling */
     uint32_t count;
     union {
-        double num;
-        uint32_t str; /* offset in text */
+        double num;   /* a number (is_int: ival) */
+        int64_t ival; /* a number written as an integer */
+        uint32_t str; /* a string's offset in text */
+        uint32_t last; /* a container's last child, while it is open */
     } u;
-    int64_t ival;
 } node;
 
 struct ag_jsondoc {
@@ -61,18 +61,19 @@ static node *add_node(ag_jsondoc *d, ag_json_type type)
     memset(x, 0, sizeof *x);
     x->type = (uint8_t)type;
     x->key = NONE;
-    x->first = x->last = x->next = NONE;
+    x->first = x->next = NONE;
+    x->u.last = NONE;
     if (d->depth) {
         node *p = &d->nodes[d->stack[d->depth - 1]];
         if (p->type == AG_JSON_OBJECT) {
             x->key = d->pending_key;
             d->pending_key = NONE;
         }
-        if (p->last == NONE)
+        if (p->u.last == NONE)
             p->first = id;
         else
-            d->nodes[p->last].next = id;
-        p->last = id;
+            d->nodes[p->u.last].next = id;
+        p->u.last = id;
         p->count++;
     } else if (d->root == NONE) {
         d->root = id;
@@ -119,7 +120,7 @@ static int on_number(void *ctx, const char *s, size_t len)
             long long v = strtoll(tmp, NULL, 10);
             if (errno == 0) {
                 x->is_int = 1;
-                x->ival = v;
+                x->u.ival = v;
             }
         }
     }
@@ -153,7 +154,7 @@ static int on_key(void *ctx, const unsigned char *s, size_t len)
 static int on_end(void *ctx)
 {
     ag_jsondoc *d = ctx;
-    d->depth--;
+    d->nodes[d->stack[--d->depth]].u.last = 0; /* closed: the union holds nothing */
     return 1;
 }
 
@@ -293,7 +294,9 @@ uint32_t ag_jsondoc_at(const ag_jsondoc *d, uint32_t arr, size_t i)
 
 double ag_jsondoc_number(const ag_jsondoc *d, uint32_t n)
 {
-    return n != NONE && d->nodes[n].type == AG_JSON_NUMBER ? d->nodes[n].u.num : 0;
+    if (n == NONE || d->nodes[n].type != AG_JSON_NUMBER)
+        return 0;
+    return d->nodes[n].is_int ? (double)d->nodes[n].u.ival : d->nodes[n].u.num;
 }
 
 const char *ag_jsondoc_string(const ag_jsondoc *d, uint32_t n)
@@ -305,6 +308,6 @@ int ag_jsondoc_integer(const ag_jsondoc *d, uint32_t n, int64_t *value)
 {
     if (n == NONE || d->nodes[n].type != AG_JSON_NUMBER || !d->nodes[n].is_int)
         return 0;
-    *value = d->nodes[n].ival;
+    *value = d->nodes[n].u.ival;
     return 1;
 }

@@ -27,19 +27,38 @@ static const uint64_t pow10_u64[20] = {1ull,
                                        1000000000000000000ull,
                                        10000000000000000000ull};
 
+/* "00" .. "99" */
+static const char digit_pairs[201] = "00010203040506070809101112131415161718192021222324"
+                                     "25262728293031323334353637383940414243444546474849"
+                                     "50515253545556575859606162636465666768697071727374"
+                                     "75767778798081828384858687888990919293949596979899";
+
 size_t ag_numtext_u64(char *out, uint64_t v)
 {
     char tmp[24];
-    size_t n = 0;
-    do {
-        tmp[n++] = (char)('0' + v % 10);
-        v /= 10;
-    } while (v);
-    for (size_t i = 0; i < n; i++)
-        out[i] = tmp[n - 1 - i];
-    out[n] = '\0';
-    return n;
+    size_t n = sizeof tmp;
+    while (v >= 100) {
+        unsigned r = (unsigned)(v % 100);
+        v /= 100;
+        n -= 2;
+        memcpy(tmp + n, digit_pairs + 2 * r, 2);
+    }
+    if (v >= 10) {
+        n -= 2;
+        memcpy(tmp + n, digit_pairs + 2 * v, 2);
+    } else {
+        tmp[--n] = (char)('0' + v);
+    }
+    size_t len = sizeof tmp - n;
+    memcpy(out, tmp + n, len);
+    out[len] = '\0';
+    return len;
 }
+
+/* Powers of ten from 1e-6 to 1e16, as doubles (exact from 1e0 up). */
+static const double pow10_double[23] = {1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1e-1, 1e0,  1e1,
+                                        1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,
+                                        1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16};
 
 static size_t fallback(char *out, double v)
 {
@@ -59,10 +78,14 @@ size_t ag_numtext_double(char *out, double v)
     int be = (int)(bits >> 52); /* a >= 1e-5: normal */
     uint64_t m = (bits & ((1ull << 52) - 1)) | (1ull << 52);
     int sh = 1075 - be; /* a = m / 2^sh, sh >= 1 here */
-    /* a * 10^s in [1e16, 1e17). log10 may be one off next to a power of ten; that costs
-     * nothing: one more digit is searched away below, one fewer finds no candidate and
-     * falls back. */
-    int k = (int)floor(log10(a));
+    /* k = floor(log10(a)), so that a * 10^s lies in [1e16, 1e17): estimated from the binary
+     * exponent (log10(2) slightly low, so never above), then raised against the powers of
+     * ten. Below 1 those are not exact and k may be one off next to a power of ten; that
+     * costs nothing: one more digit is searched away below, one fewer finds no candidate
+     * and falls back. */
+    int k = (int)floor((be - 1023) * 0.30102999566398114);
+    while (k < 16 && k >= -6 && a >= pow10_double[k + 1 + 6])
+        k++;
     int s = 16 - k;
     if (s < 0 || s > 21)
         return fallback(out, v);
