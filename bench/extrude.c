@@ -16,6 +16,7 @@
 #include "core/extrude/predicates.h"
 #include "core/extrude/style.h"
 #include "io/footprints.h"
+#include "io/plan_write.h"
 
 static double now(void)
 {
@@ -577,9 +578,14 @@ static void grid_profiles(ag_plan *p, double h)
     ag_plan_add_profile(p, "terrace", terrace, 5, NULL, NULL, NULL);
 }
 
+/* --grid-dump N: the description of stress plan N (before validation) goes to this file */
+static long dump_index = -1;
+static const char *dump_path = NULL;
+
 static void grid_stress(size_t count)
 {
-    size_t failed = 0, leaky = 0, rejected = 0;
+    size_t failed = 0, leaky = 0, rejected = 0, leaky_nested = 0, good_nested = 0;
+    size_t kinds[2] = {0, 0}, leaky_kind[2] = {0, 0};
     static double xy[2 * 1200];
     size_t starts[300];
     static int32_t prof[1200];
@@ -601,6 +607,12 @@ static void grid_stress(size_t count)
             prof[k] = mode == 0 ? 6 : mode == 1 ? base : (int)(srnd() * 8);
         for (size_t l = 0; l < nl; l++)
             ag_plan_add_loop(p, xy + 2 * starts[l], starts[l + 1] - starts[l], prof + starts[l], NULL);
+        if ((long)i == dump_index) {
+            json_t *doc = NULL;
+            if (ag_plan_write_json(p, &doc, NULL) == AG_OK)
+                json_dump_file(doc, dump_path, JSON_INDENT(1));
+            json_decref(doc);
+        }
         ag_mesh *m = ag_mesh_create();
         ag_extrude_result r;
         ag_error err = {0};
@@ -612,8 +624,14 @@ static void grid_stress(size_t count)
             printf("    failed grid%zu: %s\n", i, err.text);
         } else if (not_good(&r)) {
             leaky++;
-            printf("    not good grid%zu: %s\n", i, not_good(&r));
+            leaky_nested += r.stats.irregular > 0;
+            leaky_kind[kind]++;
+            printf("    not good grid%zu (%s, %zu nested intersections): %s\n", i,
+                   kind ? "star" : "grid", r.stats.irregular, not_good(&r));
+        } else {
+            good_nested += r.stats.irregular > 0;
         }
+        kinds[kind] += st == AG_OK;
         ag_mesh_free(m);
         ag_plan_free(p);
     }
@@ -623,12 +641,24 @@ static void grid_stress(size_t count)
            "(%.3f%% of %zu valid)\n",
            "integer-grid stress", count, dt, rejected, failed, leaky,
            100.0 * (failed + leaky) / (valid ? valid : 1), valid);
+    printf("    not good: %zu of %zu grid shapes, %zu of %zu stars; %zu of them with nested "
+           "intersections (as are %zu good ones)\n", leaky_kind[0], kinds[0], leaky_kind[1],
+           kinds[1], leaky_nested, good_nested);
 }
 
 int main(int argc, char **argv)
 {
     /* --cgal: only the comparison with CGAL on Den Haag */
     int only_cgal = argc > 1 && strcmp(argv[1], "--cgal") == 0;
+    /* --grid: only the integer-grid stress plans */
+    if (argc > 3 && strcmp(argv[1], "--grid-dump") == 0) {
+        dump_index = atol(argv[2]);
+        dump_path = argv[3];
+    }
+    if (argc > 1 && (strcmp(argv[1], "--grid") == 0 || dump_path)) {
+        grid_stress(20000);
+        return 0;
+    }
     const char *path = AG_REPO_DIR "/../shared/data/footprints_denhaag_lod2/denhaag_tile01_footprints.geojson";
     printf("extrude benchmark\n");
     ag_footprints *f = NULL;

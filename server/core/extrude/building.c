@@ -242,6 +242,23 @@ static ag_status block(const double *const *loops, const size_t *sizes, size_t n
     return st;
 }
 
+/* The last resort: the block, recorded in out (nothing added when none can be made). */
+static ag_status block_fallback(const double *const *loops, const size_t *sizes, size_t nloops,
+                                double height, ag_mesh *m, int32_t group, ag_building_result *out,
+                                ag_error *err)
+{
+    int made = 0;
+    mark k = mark_of(m);
+    ag_status st = block(loops, sizes, nloops, height, m, group, &out->triangles, &made);
+    if (st != AG_OK)
+        ag_error_set(err, st, 0, "out of memory");
+    if (st == AG_OK && made)
+        out->built = AG_BUILT_BLOCK;
+    if (st != AG_OK || !made)
+        roll_back(m, k);
+    return st;
+}
+
 ag_status ag_building_extrude(const ag_style *style, const double *const *loops,
                               const size_t *sizes, size_t nloops, double height, size_t index,
                               const ag_extrude_options *opt, ag_mesh *m, int32_t group,
@@ -298,17 +315,8 @@ ag_status ag_building_extrude(const ag_style *style, const double *const *loops,
     free_loops(cp, nloops);
     free(sz);
     /* 3. a block */
-    if ((r == NOT_GOOD || r == REFUSED) && st == AG_OK) {
-        int made = 0;
-        mark k = mark_of(m);
-        st = block(loops, sizes, nloops, h, m, group, &out->triangles, &made);
-        if (st != AG_OK)
-            ag_error_set(err, st, 0, "out of memory");
-        if (st == AG_OK && made)
-            out->built = AG_BUILT_BLOCK;
-        if (st != AG_OK || !made)
-            roll_back(m, k);
-    }
+    if ((r == NOT_GOOD || r == REFUSED) && st == AG_OK)
+        st = block_fallback(loops, sizes, nloops, h, m, group, out, err);
 done:
     if (r == -2 && st != AG_OK)
         ag_error_set(err, st, 0, "%s", out->reason[0] ? out->reason : why);
@@ -367,18 +375,9 @@ ag_status ag_building_extrude_plan(ag_plan *plan, const ag_extrude_options *opt,
                         group, out, 0, why, sizeof why, &st);
             if (r == GOOD)
                 out->built = AG_BUILT_FLAT;
-            if ((r == NOT_GOOD || r == REFUSED) && st == AG_OK) {
-                int made = 0;
-                mark k = mark_of(m);
-                st = block((const double *const *)loops, sizes, plan->nloops, h, m, group,
-                           &out->triangles, &made);
-                if (st != AG_OK)
-                    ag_error_set(err, st, 0, "out of memory");
-                if (st == AG_OK && made)
-                    out->built = AG_BUILT_BLOCK;
-                if (st != AG_OK || !made)
-                    roll_back(m, k);
-            }
+            if ((r == NOT_GOOD || r == REFUSED) && st == AG_OK)
+                st = block_fallback((const double *const *)loops, sizes, plan->nloops, h, m,
+                                    group, out, err);
         }
         free(loops);
         free(sizes);
