@@ -15,6 +15,7 @@
 
 #include "app/accounts.h"
 #include "app/app.h"
+#include "app/extrusion.h"
 #include "net/http.h"
 #include "net/live.h"
 #include "store/db.h"
@@ -84,6 +85,15 @@ static void usage(FILE *to)
             "On a first start with no account, archgramd makes the admin account \"admin\" and\n"
             "prints a sign-in link with its token, once.\n"
             "\n"
+            "  --extrude-timeout SECONDS\n"
+            "                   time budget of one building (and of a preview; default 10;\n"
+            "                   0: none): one that takes longer falls back to a flat roof\n"
+            "  --extrude-max-events N\n"
+            "                   event budget of one building (default 100000 + 4000 per corner)\n"
+            "  --extrude-max-memory MB\n"
+            "                   memory budget of one building (default 64 + 0.125 per corner)\n"
+            "  --extrude-threads N\n"
+            "                   threads of one extrusion batch (default: the number of cores)\n"
             "  --help           this text\n"
             "  --version        print the version\n");
 }
@@ -252,7 +262,8 @@ int main(int argc, char **argv)
            O_CREATE_TOKEN, O_MAX_TRIANGLES, O_MAX_NODES, O_OP_SECONDS, O_JOB_SECONDS,
            O_PREVIEW_SECONDS, O_IMPORT_SECONDS, O_TASK_WORKERS, O_DB_MAX_BYTES, O_STOP_GRACE,
            O_RATE_REST, O_RATE_JOBS, O_RATE_WS, O_MAX_CONNECTIONS, O_MAX_PER_ADDRESS,
-           O_HEADER_TIMEOUT, O_IDLE_TIMEOUT };
+           O_HEADER_TIMEOUT, O_IDLE_TIMEOUT, O_EXTRUDE_TIMEOUT, O_EXTRUDE_EVENTS,
+           O_EXTRUDE_MEMORY, O_EXTRUDE_THREADS };
     static const struct option options[] = {
         {"port", required_argument, NULL, O_PORT},
         {"ws-port", required_argument, NULL, O_WS_PORT},
@@ -269,6 +280,10 @@ int main(int argc, char **argv)
         {"create-user", required_argument, NULL, O_CREATE_USER},
         {"role", required_argument, NULL, O_ROLE},
         {"create-token", required_argument, NULL, O_CREATE_TOKEN},
+        {"extrude-timeout", required_argument, NULL, O_EXTRUDE_TIMEOUT},
+        {"extrude-max-events", required_argument, NULL, O_EXTRUDE_EVENTS},
+        {"extrude-max-memory", required_argument, NULL, O_EXTRUDE_MEMORY},
+        {"extrude-threads", required_argument, NULL, O_EXTRUDE_THREADS},
         {"help", no_argument, NULL, O_HELP},
         {"version", no_argument, NULL, O_VERSION},
         {"max-triangles", required_argument, NULL, O_MAX_TRIANGLES},
@@ -300,6 +315,8 @@ int main(int argc, char **argv)
     int no_web = 0, demo = 0, no_auth = 0, ncors = 0, opt;
     const char *cors[MAX_CORS];
     const char *token_file = NULL, *create_user = NULL, *create_token = NULL, *role = NULL;
+    ag_extrusion_limits extrude = ag_extrusion_limits_get();
+    long long extrude_n = 0;
     while ((opt = getopt_long(argc, argv, "", options, NULL)) != -1) {
         switch (opt) {
         case O_PORT: if (parse_int("--port", optarg, 1, 65535, &port)) return 2; break;
@@ -375,6 +392,29 @@ int main(int argc, char **argv)
         case O_CREATE_USER: create_user = optarg; break;
         case O_ROLE: role = optarg; break;
         case O_CREATE_TOKEN: create_token = optarg; break;
+        case O_EXTRUDE_TIMEOUT: {
+            char *end = NULL;
+            double v = strtod(optarg, &end);
+            if (end == optarg || *end || !(v >= 0 && v <= 1e6)) {
+                fprintf(stderr, "archgramd: --extrude-timeout needs seconds (0: none), not "
+                                "\"%s\"\n", optarg);
+                return 2;
+            }
+            extrude.seconds = v > 0 ? v : -1;
+            break;
+        }
+        case O_EXTRUDE_EVENTS:
+            if (parse_int("--extrude-max-events", optarg, 1, 1LL << 40, &extrude_n)) return 2;
+            extrude.max_events = (size_t)extrude_n;
+            break;
+        case O_EXTRUDE_MEMORY:
+            if (parse_int("--extrude-max-memory", optarg, 1, 1LL << 20, &extrude_n)) return 2;
+            extrude.max_bytes = (size_t)extrude_n << 20;
+            break;
+        case O_EXTRUDE_THREADS:
+            if (parse_int("--extrude-threads", optarg, 1, 256, &extrude_n)) return 2;
+            extrude.threads = (size_t)extrude_n;
+            break;
         case O_HELP: usage(stdout); return 0;
         case O_VERSION: printf("archgramd %s\n", AG_VERSION); return 0;
         default: usage(stderr); return 2;
@@ -428,6 +468,7 @@ int main(int argc, char **argv)
     pthread_sigmask(SIG_BLOCK, &sigs, NULL);
     signal(SIGPIPE, SIG_IGN);
 
+    ag_extrusion_configure(&extrude);
     ag_error err;
     ag_error_clear(&err);
     ag_app *app = NULL;
@@ -528,6 +569,7 @@ int main(int argc, char **argv)
      * interrupted is not waited for past the grace period: it is recorded as cancelled and the
      * process ends (every write is one transaction, so the store stays consistent). */
     ag_http_quiesce(http);
+    ag_extrusion_stop_all(); /* extrusions in requests, ops and jobs stop within milliseconds */
     if (!ag_app_shutdown(app, stop_grace)) {
         ag_app_abandon(app);
         fprintf(stderr, "archgramd: work still running after %g s was recorded as cancelled; "

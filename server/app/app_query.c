@@ -226,6 +226,11 @@ static ag_status add_view(void *user, ag_extrusion_building *b)
         return ag_error_set(v->err, AG_ERR_NOMEM, 0, "out of memory");
     if (b->reason)
         json_object_set_new(o, "reason", json_string(b->reason));
+    if (b->fallback) {
+        json_object_set_new(o, "fallback", json_string(b->fallback));
+        if (strcmp(b->fallback, "simplified") == 0)
+            json_object_set_new(o, "moved", json_real(b->moved));
+    }
     v->component += has_mesh;
     json_array_append_new(v->list, o);
     return AG_OK;

@@ -477,7 +477,7 @@ static ag_status add_model(ag_workspace *ws, const char *name, const ag_mesh *me
     return s == AG_OK ? ag_db_commit(db, err) : (ag_db_rollback(db), s);
 }
 
-static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extrude_batch *b,
+static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extrusion_batch *b,
                                const ag_mesh *mesh, const char *source, size_t source_len,
                                const json_t *report, int64_t *model_out, ag_error *err)
 {
@@ -523,7 +523,9 @@ static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extr
                                      .mesh_len = it->built.blob_len,
                                      .triangles = (int64_t)it->built.triangles,
                                      .reason = it->built.reason[0] ? (char *)it->built.reason
-                                                                   : NULL};
+                                                                   : NULL,
+                                     .fallback = ag_extrusion_built_fallback(&it->built),
+                                     .moved = it->built.moved};
         snprintf(row.status, sizeof row.status, "%s", it->built.status);
         s = ag_extrusions_put_building(db, &row, err);
     }
