@@ -477,7 +477,7 @@ static ag_status add_model(ag_workspace *ws, const char *name, const ag_mesh *me
     return s == AG_OK ? ag_db_commit(db, err) : (ag_db_rollback(db), s);
 }
 
-static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extrude_batch *b,
+static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extrusion_batch *b,
                                const ag_mesh *mesh, const char *source, size_t source_len,
                                const json_t *report, int64_t *model_out, ag_error *err)
 {
@@ -523,7 +523,9 @@ static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extr
                                      .mesh_len = it->built.blob_len,
                                      .triangles = (int64_t)it->built.triangles,
                                      .reason = it->built.reason[0] ? (char *)it->built.reason
-                                                                   : NULL};
+                                                                   : NULL,
+                                     .fallback = ag_extrusion_built_fallback(&it->built),
+                                     .moved = it->built.moved};
         snprintf(row.status, sizeof row.status, "%s", it->built.status);
         s = ag_extrusions_put_building(db, &row, err);
     }
@@ -600,7 +602,8 @@ void ag_store_ws_end(ag_store_ws *w, ag_status outcome)
     if (w->target && outcome != AG_OK && outcome != AG_ERR_STALE && outcome != AG_ERR_INVALID &&
         outcome != AG_ERR_NOT_FOUND && outcome != AG_ERR_CONFLICT && outcome != AG_ERR_PARSE &&
         outcome != AG_ERR_NOT_PROCEDURALIZED && outcome != AG_ERR_TOO_LARGE &&
-        outcome != AG_ERR_EMPTY)
+        outcome != AG_ERR_EMPTY && outcome != AG_ERR_RESULT_TOO_LARGE &&
+        outcome != AG_ERR_DEADLINE && outcome != AG_ERR_CANCELLED)
         ag_edit_session_reset(w->target); /* an unexpected failure: load afresh next time */
     ag_edit_session_release(w->o.env.sessions, w->source);
     ag_edit_session_release(w->o.env.sessions, w->target);

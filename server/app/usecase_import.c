@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "../io/import.h"
+#include "import_sandbox.h"
 
 void ag_usecase_import_release(ag_mesh_file *f)
 {
@@ -69,7 +70,10 @@ ag_status ag_usecase_import_read(const ag_mesh_source *src, int (*progress)(void
                                   .user = user,
                                   .allow_external_files = src->own_file,
                                   .source_path = src->own_file ? src->path : NULL};
-        s = ag_import_buffer(data, len, format, &iopt, mesh, err);
+        s = src->sandbox_seconds > 0 && !src->own_file && format != AG_FORMAT_OBJ
+                ? ag_import_sandbox_read(data, len, format, &iopt, src->sandbox_seconds, mesh,
+                                         err)
+                : ag_import_buffer(data, len, format, &iopt, mesh, err);
     }
     file->data = data;
     file->len = len;

@@ -26,6 +26,10 @@ typedef struct {
     /* Non-zero for a person's own file (the CLI): the files it refers to (an OBJ's mtllib, a
      * glTF's buffers) are read from next to it. Zero (uploads): no other file is ever read. */
     int own_file;
+    /* > 0: a format read by assimp (anything but OBJ) is read in a child process that is
+     * killed after this many seconds (app/import_sandbox.h): what the service does with
+     * uploads. 0: in this process (the CLI). */
+    double sandbox_seconds;
 } ag_mesh_source;
 
 /* The file, mapped, while its mesh is used. */

@@ -347,6 +347,41 @@ ag_status ag_edit_resize_solver_solve(ag_edit_resize_solver *s, const ag_edit_op
     return st;
 }
 
+/* What the edited tree would place, against the op's budget: refused before it is made. */
+static ag_status check_budget(const ag_proceduralize_result *in, const ag_splittree *t,
+                              const int32_t *source, const ag_edit_budget *b, ag_error *err)
+{
+    size_t max_tris = AG_EDIT_MAX_TRIANGLES, max_comps = SIZE_MAX;
+    if (b && b->max_triangles && b->max_triangles < max_tris)
+        max_tris = b->max_triangles;
+    if (b && b->max_components)
+        max_comps = b->max_components;
+    const ag_labels *L = in->labels;
+    size_t ncomps = 0, ntris = 0;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        if (t->nodes[n].kind != AG_NODE_COMPONENT)
+            continue;
+        int32_t oc = in->tree->nodes[source[n]].component;
+        if (oc < 0 || (size_t)oc >= L->ncomponents)
+            continue;
+        ncomps++;
+        ntris += L->tri_start[oc + 1] - L->tri_start[oc];
+    }
+    if (ncomps > max_comps)
+        return ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, 0,
+                            "resize: the result would place more than %zu terminals, the most "
+                            "this server takes",
+                            max_comps);
+    if (ntris > max_tris)
+        return ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, 0,
+                            "resize: the result would have more than %zu triangles, the most "
+                            "this server takes",
+                            max_tris);
+    if (ag_edit_budget_cancelled(b))
+        return ag_error_set(err, AG_ERR_CANCELLED, 0, "resize: stopped");
+    return AG_OK;
+}
+
 ag_status ag_edit_resize_tree(const ag_proceduralize_result *in, const ag_edit_op *op,
                               ag_splittree **tree, int32_t **source, ag_edit_report *rep,
                               ag_error *err)
@@ -366,8 +401,15 @@ ag_status ag_edit_resize_tree(const ag_proceduralize_result *in, const ag_edit_o
     st = ag__resize_solve_level(s, op, ub, &frame, rep, err);
     if (rep)
         rep->solve_ms = ag_clock_ms() - t0; /* equations, factorization and solve */
+    s->budget = op->budget;
     if (!st)
         st = ag__resize_layout(s, ub, &frame, 1, NULL, tree, source, rep, err);
+    if (!st && (st = check_budget(in, *tree, *source, op->budget, err))) {
+        ag_splittree_free(*tree);
+        free(*source);
+        *tree = NULL;
+        *source = NULL;
+    }
     free(ub);
     ag_edit_resize_solver_free(s);
     return st;

@@ -35,7 +35,8 @@
 /* Squeezed plain siblings join only under nodes with at most this many children. */
 #define AG_EDIT_JOIN_SIBLINGS_MAX 20000
 
-/* Largest result of an emission (a huge stretch splits exponentially): AG_ERR_TOO_LARGE. */
+/* Largest result of an emission (a huge stretch splits exponentially) when the op's budget
+ * sets no lower limit: AG_ERR_RESULT_TOO_LARGE. */
 #define AG_EDIT_MAX_TRIANGLES 20000000
 
 typedef struct ag_edit_resize_solver ag_edit_resize_solver;
@@ -52,7 +53,9 @@ ag_status ag_edit_resize_solver_solve(ag_edit_resize_solver *s, const ag_edit_op
 
 /* The edited tree of a resize: *tree (nodes that stay keep their index, copies appended,
  * removed nodes dead) and *source (per node, malloc'd: the node of in's tree it copies), the
- * input for ag_rebuild (rebuild.h). */
+ * input for ag_rebuild (rebuild.h). What the tree would place is counted before anything is
+ * made of it and refused past the op's budget (AG_ERR_RESULT_TOO_LARGE); the budget's
+ * callback is polled while the tree is laid out. */
 ag_status ag_edit_resize_tree(const ag_proceduralize_result *in, const ag_edit_op *op,
                               ag_splittree **tree, int32_t **source, ag_edit_report *rep,
                               ag_error *err);

@@ -161,6 +161,7 @@ struct ag_edit_resize_solver {
     int32_t *level;           /* the level's units, the edited first */
     ag_box *old;              /* their boxes */
     ag__resize_system sys;
+    const ag_edit_budget *budget; /* a commit's limits and stop flag (not owned), NULL */
 };
 
 /* The nearest visible ancestor of node n, 0 (the root) when there is none. */

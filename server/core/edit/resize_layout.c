@@ -47,9 +47,14 @@ typedef struct {
     int structural;
     double eps;
     size_t splits, joins;
+    size_t max_nodes;         /* the new tree's bound (the budget's, when it sets a lower one) */
+    unsigned since_poll;      /* copies since the budget's callback was last asked */
     ag_status st;
     ag_error *err;
 } lay;
+
+/* Copies made between two polls of the budget's callback. */
+#define LAYOUT_POLL 1024
 
 static void layout_node(lay *L, int32_t x, int depth);
 static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth);
@@ -80,11 +85,19 @@ static int32_t copy_node(lay *L, int32_t y)
 {
     if (L->st)
         return -1;
-    if (L->nt->nnodes >= LAYOUT_MAX_NODES(L->ot->nnodes)) {
-        L->st = ag_error_set(L->err, AG_ERR_TOO_LARGE, 0,
-                             "resize: the result would have more than %zu nodes",
-                             LAYOUT_MAX_NODES(L->ot->nnodes));
+    if (L->nt->nnodes >= L->max_nodes) {
+        L->st = ag_error_set(L->err, AG_ERR_RESULT_TOO_LARGE, 0,
+                             "resize: the result would have more than %zu nodes, the most this "
+                             "server takes",
+                             L->max_nodes);
         return -1;
+    }
+    if (++L->since_poll >= LAYOUT_POLL) {
+        L->since_poll = 0;
+        if (ag_edit_budget_cancelled(L->s->budget)) {
+            L->st = ag_error_set(L->err, AG_ERR_CANCELLED, 0, "resize: stopped");
+            return -1;
+        }
     }
     int32_t c = ag_splittree_add_node(L->nt, AG_NODE_DEAD);
     if (c < 0 || AG_ARRAY_RESERVE(L->src, L->cap_src, (size_t)c + 1)) {
@@ -892,6 +905,12 @@ ag_status ag__resize_layout(const ag_edit_resize_solver *s, const ag_box *unit_b
     const ag_splittree *ot = s->in->tree;
     lay L = {.s = s, .ot = ot, .structural = structural, .err = err};
     L.eps = ot->eps > 0 ? ot->eps : AG_EDIT_COINCIDENT * (s->diag > 0 ? s->diag : 1);
+    /* a tree within the budget has at most three nodes per terminal (its split chain and a
+     * pattern) besides the input's nodes, so a larger one is refused before it is made */
+    L.max_nodes = LAYOUT_MAX_NODES(ot->nnodes);
+    if (s->budget && s->budget->max_components &&
+        ot->nnodes + 3 * s->budget->max_components + 16 < L.max_nodes)
+        L.max_nodes = ot->nnodes + 3 * s->budget->max_components + 16;
     L.nt = ag_splittree_copy(ot);
     if (!L.nt || AG_ARRAY_RESERVE(L.src, L.cap_src, ot->nnodes + 1)) {
         ag_splittree_free(L.nt);
