@@ -203,7 +203,8 @@ fail:
 char *ag_model_tree_served_text(const ag_edit_model *em)
 {
     json_t *j = ag_model_tree_served(em);
-    char *text = j ? json_dumps(j, JSON_COMPACT | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(12))
+    /* 15 digits: a box at UTM coordinates to the nanometre */
+    char *text = j ? json_dumps(j, JSON_COMPACT | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(15))
                    : NULL;
     json_decref(j);
     return text;

@@ -36,6 +36,7 @@ typedef struct {
     double wall_thick_err;      /* largest relative error of a wall's thickness */
     double min_gap;             /* smallest gap between two windows of one facade (< 0: overlap) */
     double period;              /* the front windows' column period (mean) */
+    double ext[3];              /* the whole building's extents (building frame) */
     size_t open_edges;
 } bb_measure;
 
@@ -117,6 +118,14 @@ static bb_measure measure(const ag_mesh *m, const bb_options *o, const bb_groups
         if (p[i].group == g->wall_fb || p[i].group == g->wall_lr)
             xmax = fmax(xmax, p[i].max[0]);
     r.min_gap = INFINITY;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], p[i].min[a]);
+            hi[a] = fmax(hi[a], p[i].max[a]);
+        }
+    for (int a = 0; a < 3; a++)
+        r.ext[a] = hi[a] - lo[a];
     for (size_t i = 0; i < n; i++) {
         const bb_part *x = &p[i];
         if (x->group == g->window) {
@@ -318,11 +327,20 @@ static void run_variant(const bb_options *o)
     bb_measure mw = measure(wide->proc->mesh, o, &g);
     print_measure("root stretched 2x", o, &mw);
     expect_stretched(&mw, o, "root stretched 2x");
+    /* the building is what was asked: twice as long, nothing past its new ends */
+    for (int a = 0; a < 3; a++)
+        if (fabs(mw.ext[a] - (a ? 1 : 2) * before.ext[a]) > 1e-6 * before.ext[0])
+            fail_msg("%s root stretched 2x: extent %d is %.9f, want %.9f", o->name, a, mw.ext[a],
+                     (a ? 1 : 2) * before.ext[a]);
     assert_grammar_derives_mesh(wide, "root stretched 2x");
     ag_edit_model *back = scale_node(wide, AG_EDIT_ROOT, 0.5, 0, "root x0.5", o);
     bb_measure mb = measure(back->proc->mesh, o, &g);
     print_measure("and squeezed back", o, &mb);
     expect_original(&mb, o, "root squeezed back");
+    for (int a = 0; a < 3; a++)
+        if (fabs(mb.ext[a] - before.ext[a]) > 1e-6 * before.ext[0])
+            fail_msg("%s root squeezed back: extent %d is %.9f, want %.9f", o->name, a, mb.ext[a],
+                     before.ext[a]);
     assert_grammar_derives_mesh(back, "root squeezed back");
     ag_edit_model_free(back);
     ag_edit_model_free(wide);

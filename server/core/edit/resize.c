@@ -123,7 +123,7 @@ static ag_status edited_level(ag_edit_resize_solver *s, const ag_edit_op *op, ag
     const ag_splittree *t = s->in->tree;
     const ag__resize_units *u = &s->units;
     size_t nn = t->nnodes;
-    double eps = t->eps > 0 ? t->eps : AG_EDIT_COINCIDENT * (s->diag > 0 ? s->diag : 1);
+    double eps = ag__resize_touch(t, s->diag);
     ag_box region = op->region;
     if (op->mode == AG_EDIT_LOCAL && !op->has_region) {
         ag_box tb;
@@ -178,6 +178,12 @@ static ag_status edited_level(ag_edit_resize_solver *s, const ag_edit_op *op, ag
     free(slot);
     free(peer);
     return AG_OK;
+}
+
+double ag__resize_touch(const ag_splittree *t, double diag)
+{
+    double eps = t->eps > 0 ? t->eps : AG_EDIT_COINCIDENT * (diag > 0 ? diag : 1);
+    return fmax(eps, t->tol);
 }
 
 ag_status ag_edit_resize_solver_create(const ag_proceduralize_result *in, const ag_edit_op *op,

@@ -164,6 +164,11 @@ struct ag_edit_resize_solver {
     const ag_edit_budget *budget; /* a commit's limits and stop flag (not owned), NULL */
 };
 
+/* How far apart faces may be and still touch (attach): the tree's coincidence, or its exact
+ * tolerance when larger, so a vertex jitter below what derivation reproduces does not undo an
+ * attachment (a wall whose end lies a fraction of a micrometre inside the building's face). */
+double ag__resize_touch(const ag_splittree *t, double diag);
+
 /* The nearest visible ancestor of node n, 0 (the root) when there is none. */
 int32_t ag__resize_visible_ancestor(const ag_splittree *t, int32_t n);
 /* The op's target box for its node (op->box, or op->scale about the node's min corner). */

@@ -565,8 +565,8 @@ typedef struct {
 
 /* Along axis a, the pattern's new count and period from its stretch f, unless a reference
  * pattern ref (interleaved with it, same count, period and stretch) fixes them. */
-static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, int a, int thin,
-                        const axis_layout *ref)
+static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const ag_box *cont,
+                        int a, int thin, const axis_layout *ref)
 {
     uint32_t k = x->n;
     if (ref) {
@@ -596,7 +596,19 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, int a, i
         /* the pattern's length in periods: cells keep their share of a period */
         x->pn = x->f * x->n * x->p / k;
         x->wn = x->w * x->pn / x->p;
-        x->on = ag_box_centre_axis(nb, a) - 0.5 * ((k - 1) * x->pn + x->wn);
+        /* k periods span one spacing more than the stretched cells did: the cells stay inside
+         * what holds the pattern, one fewer when they would not fit (a facade of 6 windows
+         * stretched twice as long with less than half a spacing at its ends holds 11) */
+        double room = ag_box_extent(cont, a) + L->eps;
+        while (k > 1 && (k - 1) * x->pn + x->wn > room)
+            k--;
+        x->k = k;
+        double span = (k - 1) * x->pn + x->wn;
+        x->on = ag_box_centre_axis(nb, a) - 0.5 * span;
+        if (x->on + span > cont->max[a])
+            x->on = cont->max[a] - span;
+        if (x->on < cont->min[a])
+            x->on = cont->min[a];
     }
 }
 
@@ -828,6 +840,15 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
                   ncells == (size_t)pp->counts[0] * pp->counts[1] * pp->counts[2];
         if (!x->grid)
             continue;
+        /* what holds the pattern: its nearest visible ancestor (or the root), already laid out */
+        int32_t holder = pn->parent;
+        while (holder > 0 && t->nodes[holder].kind != AG_NODE_COMPONENT)
+            holder = t->nodes[holder].parent;
+        ag_box cont = holder >= 0 ? t->nodes[holder].box : nb;
+        for (int a = 0; a < 3; a++) { /* a pattern already past its holder keeps its own box */
+            cont.min[a] = fmin(cont.min[a], nb.min[a]);
+            cont.max[a] = fmax(cont.max[a], nb.max[a]);
+        }
         ag_box cb = oldb(L, first);
         double e[3], emax = 0;
         ag_box_extents(&cb, e);
@@ -853,7 +874,7 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
             for (size_t j = 0; j < i && !ref; j++)
                 if (pl[j].grid && interleaved(&pl[j].ax[a], ax, tol))
                     ref = &pl[j].ax[a];
-            layout_axis(L, ax, &nb, a, e[a] < AG_EDIT_THIN_RATIO * emax, ref);
+            layout_axis(L, ax, &nb, &cont, a, e[a] < AG_EDIT_THIN_RATIO * emax, ref);
         }
     }
     for (size_t i = 0; i < n && !L->st; i++)
@@ -904,7 +925,7 @@ ag_status ag__resize_layout(const ag_edit_resize_solver *s, const ag_box *unit_b
 {
     const ag_splittree *ot = s->in->tree;
     lay L = {.s = s, .ot = ot, .structural = structural, .err = err};
-    L.eps = ot->eps > 0 ? ot->eps : AG_EDIT_COINCIDENT * (s->diag > 0 ? s->diag : 1);
+    L.eps = ag__resize_touch(ot, s->diag);
     /* a tree within the budget has at most three nodes per terminal (its split chain and a
      * pattern) besides the input's nodes, so a larger one is refused before it is made */
     L.max_nodes = LAYOUT_MAX_NODES(ot->nnodes);

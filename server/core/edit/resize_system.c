@@ -706,7 +706,7 @@ ag_status ag__resize_system_build(ag__resize_system *s, const ag_proceduralize_r
         return ag_error_set(err, AG_ERR_TOO_LARGE, 0, "resize: too many nodes move");
     build b = {.t = t,
                .spec = spec,
-               .eps = t->eps > 0 ? t->eps : AG_EDIT_COINCIDENT * (s->diag > 0 ? s->diag : 1)};
+               .eps = ag__resize_touch(t, s->diag)};
     s->slot_node = malloc((s->nslots + 1) * sizeof *s->slot_node);
     s->old = malloc((s->nslots + 1) * sizeof *s->old);
     b.slot = malloc((t->nnodes + 1) * sizeof *b.slot);

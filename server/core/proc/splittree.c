@@ -530,6 +530,10 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
         gi.h[l] = diag / per_diag;
     for (int a = 0; a < 3; a++)
         gi.o[a] = all.min[a];
+    /* a component nests in a box that holds it within the exact tolerance: a vertex jitter
+     * below what derivation reproduces (a flush window a fraction of a micrometre out of its
+     * wall's face) does not change where it hangs */
+    double nest = fmax(t->eps, t->tol);
     for (size_t i = 0; i < n; i++) {
         uint32_t c = order[i].c;
         const ag_box *cb = &L->box[c];
@@ -547,7 +551,7 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
                 gcell *cell = gi_slot(&gi, key);
                 for (int32_t en = cell->head; en >= 0; en = gi.ent[en].next) {
                     int32_t e = gi.ent[en].node;
-                    if (!ag_box_contains(&t->nodes[e].box, cb, t->eps))
+                    if (!ag_box_contains(&t->nodes[e].box, cb, nest))
                         continue;
                     double v = ag_box_volume_floor(&t->nodes[e].box, min_extent);
                     if (v < bv || (v == bv && e > P)) {
@@ -559,7 +563,7 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
             }
             for (size_t q = 0; q < gi.nlarge; q++) {
                 int32_t e = gi.large[q];
-                if (!ag_box_contains(&t->nodes[e].box, cb, t->eps))
+                if (!ag_box_contains(&t->nodes[e].box, cb, nest))
                     continue;
                 double v = ag_box_volume_floor(&t->nodes[e].box, min_extent);
                 if (v < bv || (v == bv && e > P)) {
