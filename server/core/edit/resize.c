@@ -114,10 +114,20 @@ static void gather_edited(ag_edit_resize_solver *s, const ag_edit_op *op)
     }
 }
 
+/* Does b hold the region on two axes or more (a wall or slab the edited element stands on or
+ * in)? A local edit happens on such a unit, which stays where it is. */
+static int holds_region(const ag_box *b, const ag_box *region, double eps)
+{
+    int axes = 0;
+    for (int a = 0; a < 3; a++)
+        axes += b->min[a] <= region->min[a] + eps && b->max[a] >= region->max[a] - eps;
+    return axes >= 2;
+}
+
 /* The units of the edited level, breadth-first from the edited units over the adjacency of
  * units with the same nearest visible ancestor (the edited root: every unit right below it);
  * local mode keeps only units meeting the region (given, or the edited node's old and new
- * boxes). */
+ * boxes) but not those holding it, which stay as they are. */
 static ag_status edited_level(ag_edit_resize_solver *s, const ag_edit_op *op, ag_error *err)
 {
     const ag_splittree *t = s->in->tree;
@@ -166,7 +176,8 @@ static ag_status edited_level(ag_edit_resize_solver *s, const ag_edit_op *op, ag
                 int32_t v = (int32_t)u->adj_list[k];
                 if (slot[v] >= 0 || !peer[u->va[v]])
                     continue;
-                if (op->mode == AG_EDIT_LOCAL && !ag_box_meets(&t->nodes[v].box, &region, eps))
+                if (op->mode == AG_EDIT_LOCAL && (!ag_box_meets(&t->nodes[v].box, &region, eps) ||
+                                                  holds_region(&t->nodes[v].box, &region, eps)))
                     continue;
                 slot[v] = (int32_t)s->nunits;
                 s->level[s->nunits++] = v;
@@ -388,12 +399,55 @@ static ag_status check_budget(const ag_proceduralize_result *in, const ag_splitt
     return AG_OK;
 }
 
+static void shift_box(ag_box *b, const double d[3])
+{
+    for (int a = 0; a < 3; a++) {
+        b->min[a] += d[a];
+        b->max[a] += d[a];
+    }
+}
+
+static ag_status resize_tree_at_origin(const ag_proceduralize_result *in, const ag_edit_op *op,
+                                       ag_splittree **tree, int32_t **source,
+                                       ag_edit_report *rep, ag_error *err);
+
+/* Far from the origin (UTM coordinates) the least squares would lose the digits a window's
+ * size lives in: the resize runs on the tree moved so that its root's min corner is the
+ * origin (every equation is one of differences, sizes or positions, so it moves with it), and
+ * the result moves back. */
 ag_status ag_edit_resize_tree(const ag_proceduralize_result *in, const ag_edit_op *op,
                               ag_splittree **tree, int32_t **source, ag_edit_report *rep,
                               ag_error *err)
 {
     *tree = NULL;
     *source = NULL;
+    double back[3], to[3];
+    for (int a = 0; a < 3; a++) {
+        back[a] = in->tree->nodes[0].box.min[a];
+        to[a] = -back[a];
+    }
+    ag_splittree *moved = ag_splittree_copy(in->tree);
+    if (!moved)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    for (size_t n = 0; n < moved->nnodes; n++)
+        shift_box(&moved->nodes[n].box, to);
+    ag_proceduralize_result at = *in;
+    at.tree = moved;
+    ag_edit_op mop = *op;
+    shift_box(&mop.box, to);
+    shift_box(&mop.region, to);
+    ag_status st = resize_tree_at_origin(&at, &mop, tree, source, rep, err);
+    if (!st)
+        for (size_t n = 0; n < (*tree)->nnodes; n++)
+            shift_box(&(*tree)->nodes[n].box, back);
+    ag_splittree_free(moved);
+    return st;
+}
+
+static ag_status resize_tree_at_origin(const ag_proceduralize_result *in, const ag_edit_op *op,
+                                       ag_splittree **tree, int32_t **source,
+                                       ag_edit_report *rep, ag_error *err)
+{
     ag_edit_resize_solver *s;
     double t0 = ag_clock_ms();
     ag_status st = ag_edit_resize_solver_create(in, op, &s, err);

@@ -11,9 +11,11 @@
  *   layout_patterns  a pattern's cells are its lattice periods: the pattern's new length in
  *                    periods of the original size, doubled or halved while a period would pass
  *                    the split ratio or fall under the join ratio (a facade stretched 2x holds
- *                    twice the windows at the original size and spacing); each cell keeps its
- *                    share of its period, except along an axis that is thin for it (it keeps
- *                    its size and is spaced out); patterns of one parent whose lattices
+ *                    twice the windows at the original size and spacing, held inside what
+ *                    holds the pattern, one fewer when they would not fit); cells of a new
+ *                    count keep their size, cells of the same count their share of the new
+ *                    box, except along an axis that is thin for them (they keep their size
+ *                    and are spaced out); patterns of one parent whose lattices
  *                    interleave (the pieces of composite windows) share one lattice; new cells
  *                    copy the cell at their place in the old grid, cells no new cell copies go
  *
@@ -583,7 +585,11 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const ag
         }
     }
     x->k = k;
-    if (ref) {
+    if (ref && ref->k != ref->n) { /* cells of a new count keep their size and offset */
+        x->pn = ref->pn;
+        x->wn = x->w;
+        x->on = ref->on + (x->o - ref->o);
+    } else if (ref) {
         x->pn = ref->pn;
         x->wn = thin ? x->w : x->w * x->pn / x->p;
         x->on = ref->on + (x->o - ref->o) * x->pn / x->p;
@@ -593,9 +599,10 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const ag
         x->pn = (ag_box_extent(nb, a) - x->wn) / (k - 1);
         x->on = nb->min[a];
     } else {
-        /* the pattern's length in periods: cells keep their share of a period */
+        /* the pattern's length in periods; the cells keep their size (a facade stretched 2x
+         * holds twice the windows at the original size and spacing, 1.9x slightly closer) */
         x->pn = x->f * x->n * x->p / k;
-        x->wn = x->w * x->pn / x->p;
+        x->wn = x->w;
         /* k periods span one spacing more than the stretched cells did: the cells stay inside
          * what holds the pattern, one fewer when they would not fit (a facade of 6 windows
          * stretched twice as long with less than half a spacing at its ends holds 11) */
