@@ -5,148 +5,141 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <sodium.h>
+
 #include "../core/edit/rebuild.h"
 #include "model_tree.h"
 
-#define KEPT_FORMAT 1
+#define KEPT_FORMAT 2
 #define NODE_INTS 13
-#define NODE_FIELDS (NODE_INTS + 9)
-#define PATTERN_FIELDS 19
+#define NODE_BYTES (4 * NODE_INTS + 8 * 9)
+#define PATTERN_BYTES (4 * 7 + 8 * 12)
+#define RULE_BYTES 8
+#define COMPONENT_BYTES 16
+#define VARIANT_BYTES 4
 
 /* ---- writing ----------------------------------------------------------------------------- */
 
-static int push(json_t *a, json_t *v)
-{
-    return json_array_append_new(a, v);
-}
+/* The kept data: little-endian int32 and IEEE doubles, packed, then base64 (libsodium). */
+typedef struct {
+    uint8_t *p;
+    size_t n, cap;
+    int fail;
+} packer;
 
-static json_t *int_array(const int32_t *v, size_t n)
+static void put_bytes(packer *k, const void *v, size_t n)
 {
-    json_t *a = json_array();
-    for (size_t i = 0; a && i < n; i++)
-        if (push(a, json_integer(v[i]))) {
-            json_decref(a);
-            return NULL;
+    if (k->fail)
+        return;
+    if (k->n + n > k->cap) {
+        size_t cap = k->cap ? 2 * k->cap : 4096;
+        while (cap < k->n + n)
+            cap *= 2;
+        uint8_t *q = realloc(k->p, cap);
+        if (!q) {
+            k->fail = 1;
+            return;
         }
-    return a;
-}
-
-static json_t *byte_array(const uint8_t *v, size_t n)
-{
-    json_t *a = json_array();
-    for (size_t i = 0; a && i < n; i++)
-        if (push(a, json_integer(v[i]))) {
-            json_decref(a);
-            return NULL;
-        }
-    return a;
-}
-
-static json_t *node_json(const ag_tnode *x)
-{
-    json_t *a = json_array();
-    if (!a)
-        return NULL;
-    const json_int_t ints[NODE_INTS] = {x->kind,      x->parent,  x->first_child, x->last_child,
-                                        x->next_sibling, x->component, x->label,  x->variant,
-                                        x->rot,       x->octant,  x->rule_rot,    x->rule,
-                                        x->pattern};
-    int fail = 0;
-    for (int k = 0; k < NODE_INTS; k++)
-        fail |= push(a, json_integer(ints[k]));
-    for (int k = 0; k < 3; k++)
-        fail |= push(a, json_real(x->box.min[k]));
-    for (int k = 0; k < 3; k++)
-        fail |= push(a, json_real(x->box.max[k]));
-    for (int k = 0; k < 3; k++)
-        fail |= push(a, json_real(x->pivot[k]));
-    if (fail) {
-        json_decref(a);
-        return NULL;
+        k->p = q;
+        k->cap = cap;
     }
-    return a;
+    memcpy(k->p + k->n, v, n);
+    k->n += n;
 }
 
-static json_t *pattern_json(const ag_pattern *p)
+static void put_u32(packer *k, uint32_t v)
 {
-    json_t *a = json_array();
-    if (!a)
-        return NULL;
-    int fail = push(a, json_integer(p->rule)) | push(a, json_integer(p->rot)) |
-               push(a, json_integer(p->nvec));
-    for (int k = 0; k < 3; k++)
-        fail |= push(a, json_integer(p->counts[k]));
-    for (int k = 0; k < 3; k++)
-        fail |= push(a, json_real(p->step[k]));
-    for (int v = 0; v < 3; v++)
-        for (int k = 0; k < 3; k++)
-            fail |= push(a, json_real(p->vec[v][k]));
-    fail |= push(a, json_integer(p->node));
-    if (fail) {
-        json_decref(a);
-        return NULL;
-    }
-    return a;
+    uint8_t b[4] = {(uint8_t)v, (uint8_t)(v >> 8), (uint8_t)(v >> 16), (uint8_t)(v >> 24)};
+    put_bytes(k, b, 4);
 }
 
-static json_t *kept_json(const ag_edit_model *em)
+static void put_i32(packer *k, int32_t v)
+{
+    put_u32(k, (uint32_t)v);
+}
+
+static void put_f64(packer *k, double v)
+{
+    uint64_t u;
+    memcpy(&u, &v, 8);
+    put_u32(k, (uint32_t)u);
+    put_u32(k, (uint32_t)(u >> 32));
+}
+
+static char *kept_text(const ag_edit_model *em)
 {
     const ag_splittree *t = em->proc->tree;
     const ag_labels *L = em->proc->labels;
-    json_t *nodes = json_array(), *patterns = json_array(), *rules = json_array();
-    json_t *classes = json_object(), *o = json_object();
-    int fail = !nodes || !patterns || !rules || !classes || !o;
-    for (size_t n = 0; !fail && n < t->nnodes; n++)
-        fail = push(nodes, node_json(&t->nodes[n]));
-    for (size_t p = 0; !fail && p < t->npatterns; p++)
-        fail = push(patterns, pattern_json(&t->patterns[p]));
-    for (size_t r = 0; !fail && r < t->nrules; r++)
-        fail = push(rules, json_pack("[I,I]", (json_int_t)t->rule_count[r],
-                                     (json_int_t)t->rule_rep[r]));
-    if (!fail) {
-        fail |= json_object_set_new(classes, "nlabels", json_integer((json_int_t)L->nlabels));
-        fail |= json_object_set_new(classes, "nvariants",
-                                    json_integer((json_int_t)L->nvariants));
-        fail |= json_object_set_new(classes, "diagonal", json_real(L->diagonal));
-        fail |= json_object_set_new(classes, "tol", json_real(L->tol));
-        fail |= json_object_set_new(classes, "exact", json_real(L->exact));
-        fail |= json_object_set_new(classes, "label", int_array(L->label, L->ncomponents));
-        fail |= json_object_set_new(classes, "variant", int_array(L->variant, L->ncomponents));
-        fail |= json_object_set_new(classes, "rot", byte_array(L->rot, L->ncomponents));
-        fail |= json_object_set_new(classes, "vrot", byte_array(L->vrot, L->ncomponents));
-        fail |= json_object_set_new(classes, "variant_label",
-                                    int_array(L->variant_label, L->nvariants));
+    packer k = {0};
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        const int32_t ints[NODE_INTS] = {x->kind,      x->parent,    x->first_child, x->last_child,
+                                         x->next_sibling, x->component, x->label,    x->variant,
+                                         x->rot,       x->octant,    x->rule_rot,    x->rule,
+                                         x->pattern};
+        for (int q = 0; q < NODE_INTS; q++)
+            put_i32(&k, ints[q]);
+        for (int a = 0; a < 3; a++)
+            put_f64(&k, x->box.min[a]);
+        for (int a = 0; a < 3; a++)
+            put_f64(&k, x->box.max[a]);
+        for (int a = 0; a < 3; a++)
+            put_f64(&k, x->pivot[a]);
     }
-    if (!fail) {
-        fail |= json_object_set_new(o, "format", json_integer(KEPT_FORMAT));
-        fail |= json_object_set_new(o, "tol", json_real(t->tol));
-        fail |= json_object_set_new(o, "eps", json_real(t->eps));
-        fail |= json_object_set_new(o, "ncomponents", json_integer((json_int_t)t->ncomponents));
-        fail |= json_object_set_new(o, "nodes", nodes);
-        fail |= json_object_set_new(o, "patterns", patterns);
-        fail |= json_object_set_new(o, "rules", rules);
-        fail |= json_object_set_new(o, "classes", classes);
-        nodes = patterns = rules = classes = NULL; /* taken (or freed) by o */
+    for (size_t i = 0; i < t->npatterns; i++) {
+        const ag_pattern *p = &t->patterns[i];
+        put_i32(&k, p->rule);
+        put_i32(&k, p->rot);
+        put_i32(&k, p->nvec);
+        for (int a = 0; a < 3; a++)
+            put_u32(&k, p->counts[a]);
+        for (int a = 0; a < 3; a++)
+            put_f64(&k, p->step[a]);
+        for (int v = 0; v < 3; v++)
+            for (int a = 0; a < 3; a++)
+                put_f64(&k, p->vec[v][a]);
+        put_i32(&k, p->node);
     }
-    json_decref(nodes);
-    json_decref(patterns);
-    json_decref(rules);
-    json_decref(classes);
-    if (fail) {
-        json_decref(o);
-        return NULL;
+    for (size_t r = 0; r < t->nrules; r++) {
+        put_u32(&k, t->rule_count[r]);
+        put_i32(&k, t->rule_rep[r]);
     }
-    return o;
+    for (size_t c = 0; c < L->ncomponents; c++) {
+        put_i32(&k, L->label[c]);
+        put_i32(&k, L->variant[c]);
+        put_i32(&k, L->rot[c]);
+        put_i32(&k, L->vrot[c]);
+    }
+    for (size_t v = 0; v < L->nvariants; v++)
+        put_i32(&k, L->variant_label[v]);
+    /* printed directly: jansson would copy and scan the data string character by character */
+    char *out = NULL;
+    if (!k.fail) {
+        size_t blen = sodium_base64_ENCODED_LEN(k.n, sodium_base64_VARIANT_ORIGINAL);
+        char head[640];
+        int hn = snprintf(head, sizeof head,
+                          "{\"format\":%d,\"tol\":%.17g,\"eps\":%.17g,\"ncomponents\":%zu,"
+                          "\"nnodes\":%zu,\"npatterns\":%zu,\"nrules\":%zu,\"nlabels\":%zu,"
+                          "\"nvariants\":%zu,\"diagonal\":%.17g,\"label_tol\":%.17g,"
+                          "\"exact\":%.17g,\"data\":\"",
+                          KEPT_FORMAT, t->tol, t->eps, L->ncomponents, t->nnodes, t->npatterns,
+                          t->nrules, L->nlabels, L->nvariants, L->diagonal, L->tol, L->exact);
+        if (hn > 0 && (size_t)hn < sizeof head && (out = malloc((size_t)hn + blen + 4))) {
+            memcpy(out, head, (size_t)hn);
+            sodium_bin2base64(out + hn, blen, k.p ? k.p : (const uint8_t *)"", k.n,
+                              sodium_base64_VARIANT_ORIGINAL);
+            strcat(out + hn, "\"}");
+        }
+    }
+    free(k.p);
+    return out;
 }
 
 char *ag_model_kept_tree_text(const ag_edit_model *em)
 {
     /* the served part keeps its own (shorter) printing; the kept member is exact */
     char *served = ag_model_tree_served_text(em);
-    json_t *k = served ? kept_json(em) : NULL;
-    char *kept = k ? json_dumps(k, JSON_COMPACT | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17))
-                   : NULL;
-    json_decref(k);
+    char *kept = served ? kept_text(em) : NULL;
     char *out = NULL;
     size_t n = served ? strlen(served) : 0;
     if (kept && n >= 2 && served[n - 1] == '}') {
@@ -192,6 +185,8 @@ char *ag_model_kept_served_text(const char *tree_text)
 typedef struct {
     ag_error *err;
     ag_status st;
+    const uint8_t *p; /* the decoded data */
+    size_t n, at;
 } reader;
 
 static int bad(reader *R, const char *what)
@@ -201,124 +196,112 @@ static int bad(reader *R, const char *what)
     return 0;
 }
 
-/* An integer in [lo, hi]. */
-static int get_int(reader *R, const json_t *v, json_int_t lo, json_int_t hi, json_int_t *out,
-                   const char *what)
+static uint32_t get_u32(reader *R)
 {
-    if (!json_is_integer(v) || json_integer_value(v) < lo || json_integer_value(v) > hi)
-        return bad(R, what);
-    *out = json_integer_value(v);
+    const uint8_t *b = R->p + R->at;
+    R->at += 4;
+    return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+}
+
+static int32_t get_i32(reader *R)
+{
+    return (int32_t)get_u32(R);
+}
+
+static double get_f64(reader *R)
+{
+    uint64_t lo = get_u32(R), hi = get_u32(R);
+    uint64_t u = lo | hi << 32;
+    double v;
+    memcpy(&v, &u, 8);
+    return v;
+}
+
+/* An int32 in [lo, hi]. */
+static int in_range(reader *R, int32_t v, int64_t lo, int64_t hi, const char *what)
+{
+    return v >= lo && v <= hi ? 1 : bad(R, what);
+}
+
+static int finite3(reader *R, const double *v, const char *what)
+{
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(v[a]))
+            return bad(R, what);
     return 1;
 }
 
-static int get_real(reader *R, const json_t *v, double *out, const char *what)
+static int read_node(reader *R, const ag_splittree *t, size_t nlabels, size_t nvariants,
+                     ag_tnode *x)
 {
-    if (!json_is_number(v) || !isfinite(json_number_value(v)))
-        return bad(R, what);
-    *out = json_number_value(v);
-    return 1;
-}
-
-static const json_t *get_array(reader *R, const json_t *o, const char *key, size_t n,
-                               const char *what)
-{
-    const json_t *a = json_object_get(o, key);
-    if (!json_is_array(a) || (n != SIZE_MAX && json_array_size(a) != n)) {
-        bad(R, what);
-        return NULL;
-    }
-    return a;
-}
-
-static int read_node(reader *R, const json_t *a, const ag_splittree *t, size_t nlabels,
-                     size_t nvariants, ag_tnode *x)
-{
-    if (!json_is_array(a) || json_array_size(a) != NODE_FIELDS)
-        return bad(R, "a node is not an array of 22 numbers");
-    json_int_t n = (json_int_t)t->nnodes, v[NODE_INTS];
-    const json_int_t lo[NODE_INTS] = {AG_NODE_ROOT, -1, -1, -1, -1, -1, -1, -1, 0, 0, 0, -1, -1};
-    const json_int_t hi[NODE_INTS] = {AG_NODE_DEAD,
-                                      n - 1,
-                                      n - 1,
-                                      n - 1,
-                                      n - 1,
-                                      (json_int_t)t->ncomponents - 1,
-                                      (json_int_t)nlabels - 1,
-                                      (json_int_t)nvariants - 1,
-                                      3,
-                                      8,
-                                      3,
-                                      (json_int_t)t->nrules - 1,
-                                      (json_int_t)t->npatterns - 1};
+    int64_t n = (int64_t)t->nnodes;
+    const int64_t lo[NODE_INTS] = {AG_NODE_ROOT, -1, -1, -1, -1, -1, -1, -1, 0, 0, 0, -1, -1};
+    const int64_t hi[NODE_INTS] = {AG_NODE_DEAD,          n - 1, n - 1, n - 1, n - 1,
+                                   (int64_t)t->ncomponents - 1, (int64_t)nlabels - 1,
+                                   (int64_t)nvariants - 1, 3,     8,     3,
+                                   (int64_t)t->nrules - 1,      (int64_t)t->npatterns - 1};
+    int32_t v[NODE_INTS];
     for (int k = 0; k < NODE_INTS; k++)
-        if (!get_int(R, json_array_get(a, k), lo[k], hi[k], &v[k],
-                     "a node's field is out of range"))
+        if (!in_range(R, v[k] = get_i32(R), lo[k], hi[k], "a node's field is out of range"))
             return 0;
     memset(x, 0, sizeof *x);
     x->kind = (uint8_t)v[0];
-    x->parent = (int32_t)v[1];
-    x->first_child = (int32_t)v[2];
-    x->last_child = (int32_t)v[3];
-    x->next_sibling = (int32_t)v[4];
-    x->component = (int32_t)v[5];
-    x->label = (int32_t)v[6];
-    x->variant = (int32_t)v[7];
+    x->parent = v[1];
+    x->first_child = v[2];
+    x->last_child = v[3];
+    x->next_sibling = v[4];
+    x->component = v[5];
+    x->label = v[6];
+    x->variant = v[7];
     x->rot = (uint8_t)v[8];
     x->octant = (uint8_t)v[9];
     x->rule_rot = (uint8_t)v[10];
-    x->rule = (int32_t)v[11];
-    x->pattern = (int32_t)v[12];
-    double d[9];
-    for (int k = 0; k < 9; k++)
-        if (!get_real(R, json_array_get(a, NODE_INTS + k), &d[k], "a node's box or pivot"))
-            return 0;
-    for (int k = 0; k < 3; k++) {
-        x->box.min[k] = d[k];
-        x->box.max[k] = d[3 + k];
-        x->pivot[k] = d[6 + k];
-        if (x->box.max[k] < x->box.min[k])
+    x->rule = v[11];
+    x->pattern = v[12];
+    for (int a = 0; a < 3; a++)
+        x->box.min[a] = get_f64(R);
+    for (int a = 0; a < 3; a++)
+        x->box.max[a] = get_f64(R);
+    for (int a = 0; a < 3; a++)
+        x->pivot[a] = get_f64(R);
+    if (!finite3(R, x->box.min, "a node's box") || !finite3(R, x->box.max, "a node's box") ||
+        !finite3(R, x->pivot, "a node's pivot"))
+        return 0;
+    for (int a = 0; a < 3; a++)
+        if (x->box.max[a] < x->box.min[a])
             return bad(R, "a node's box is inverted");
-    }
     return 1;
 }
 
-static int read_pattern(reader *R, const json_t *a, const ag_splittree *t, ag_pattern *p)
+static int read_pattern(reader *R, const ag_splittree *t, ag_pattern *p)
 {
-    if (!json_is_array(a) || json_array_size(a) != PATTERN_FIELDS)
-        return bad(R, "a pattern is not an array of 19 numbers");
-    json_int_t v;
     memset(p, 0, sizeof *p);
-    if (!get_int(R, json_array_get(a, 0), -1, (json_int_t)t->nrules - 1, &v, "a pattern's rule"))
+    int32_t rule = get_i32(R), rot = get_i32(R), nvec = get_i32(R);
+    if (!in_range(R, rule, -1, (int64_t)t->nrules - 1, "a pattern's rule") ||
+        !in_range(R, rot, 0, 3, "a pattern's turn") ||
+        !in_range(R, nvec, 0, 3, "a pattern's lattice"))
         return 0;
-    p->rule = (int32_t)v;
-    if (!get_int(R, json_array_get(a, 1), 0, 3, &v, "a pattern's turn"))
+    p->rule = rule;
+    p->rot = (uint8_t)rot;
+    p->nvec = (uint8_t)nvec;
+    for (int a = 0; a < 3; a++)
+        p->counts[a] = get_u32(R);
+    for (int a = 0; a < 3; a++)
+        p->step[a] = get_f64(R);
+    for (int v = 0; v < 3; v++)
+        for (int a = 0; a < 3; a++)
+            p->vec[v][a] = get_f64(R);
+    if (!finite3(R, p->step, "a pattern's step") || !finite3(R, p->vec[0], "a pattern's vectors") ||
+        !finite3(R, p->vec[1], "a pattern's vectors") ||
+        !finite3(R, p->vec[2], "a pattern's vectors"))
         return 0;
-    p->rot = (uint8_t)v;
-    if (!get_int(R, json_array_get(a, 2), 0, 3, &v, "a pattern's lattice"))
+    int32_t node = get_i32(R); /* -1: a pattern dissolved */
+    if (!in_range(R, node, -1, (int64_t)t->nnodes - 1, "a pattern's node"))
         return 0;
-    p->nvec = (uint8_t)v;
-    for (int k = 0; k < 3; k++) {
-        if (!get_int(R, json_array_get(a, 3 + k), 0, UINT32_MAX, &v, "a pattern's counts"))
-            return 0;
-        p->counts[k] = (uint32_t)v;
-    }
-    for (int k = 0; k < 3; k++)
-        if (!get_real(R, json_array_get(a, 6 + k), &p->step[k], "a pattern's step"))
-            return 0;
-    for (int q = 0; q < 3; q++)
-        for (int k = 0; k < 3; k++)
-            if (!get_real(R, json_array_get(a, 9 + 3 * q + k), &p->vec[q][k],
-                          "a pattern's vectors"))
-                return 0;
-    if (!get_int(R, json_array_get(a, 18), -1, (json_int_t)t->nnodes - 1, &v,
-                 "a pattern's node")) /* -1: a pattern dissolved */
-        return 0;
-    p->node = (int32_t)v;
+    p->node = node;
     return 1;
 }
 
-/* The links make one tree from node 0: every node reached once, by its parent's list, each
- * list ending at its last child; every component named by at most one visible node. */
 static int check_links(reader *R, const ag_splittree *t)
 {
     if (!t->nnodes || t->nodes[0].kind != AG_NODE_ROOT || t->nodes[0].parent != -1)
@@ -369,132 +352,25 @@ static int check_links(reader *R, const ag_splittree *t)
     return ok;
 }
 
-static int read_classes(reader *R, const json_t *c, size_t ncomp, ag_rebuild_classes *k,
-                        int32_t **label, int32_t **variant, uint8_t **rot, uint8_t **vrot,
-                        int32_t **vlabel)
+
+/* A count of the kept member, at most `most`. */
+static int get_count(reader *R, const json_t *k, const char *key, size_t most, size_t *out)
 {
-    json_int_t nl, nv;
-    if (!json_is_object(c) ||
-        !get_int(R, json_object_get(c, "nlabels"), 0, INT32_MAX, &nl, "the number of labels") ||
-        !get_int(R, json_object_get(c, "nvariants"), 0, INT32_MAX, &nv,
-                 "the number of variants") ||
-        !get_real(R, json_object_get(c, "diagonal"), &k->diagonal, "the labels' diagonal") ||
-        !get_real(R, json_object_get(c, "tol"), &k->tol, "the labels' tolerance") ||
-        !get_real(R, json_object_get(c, "exact"), &k->exact, "the variants' tolerance"))
-        return 0;
-    k->ncomponents = ncomp;
-    k->nlabels = (size_t)nl;
-    k->nvariants = (size_t)nv;
-    const json_t *la = get_array(R, c, "label", ncomp, "the components' labels");
-    const json_t *va = get_array(R, c, "variant", ncomp, "the components' variants");
-    const json_t *ra = get_array(R, c, "rot", ncomp, "the components' turns");
-    const json_t *wa = get_array(R, c, "vrot", ncomp, "the components' variant turns");
-    const json_t *vl = get_array(R, c, "variant_label", (size_t)nv, "the variants' labels");
-    if (!la || !va || !ra || !wa || !vl)
-        return 0;
-    *label = malloc((ncomp + 1) * sizeof **label);
-    *variant = malloc((ncomp + 1) * sizeof **variant);
-    *rot = malloc(ncomp + 1);
-    *vrot = malloc(ncomp + 1);
-    *vlabel = malloc(((size_t)nv + 1) * sizeof **vlabel);
-    if (!*label || !*variant || !*rot || !*vrot || !*vlabel) {
-        R->st = ag_error_set(R->err, AG_ERR_NOMEM, 0, "out of memory");
-        return 0;
-    }
-    json_int_t v;
-    for (size_t i = 0; i < ncomp; i++) {
-        if (!get_int(R, json_array_get(la, i), -1, nl - 1, &v, "a component's label"))
-            return 0;
-        (*label)[i] = (int32_t)v;
-        if (!get_int(R, json_array_get(va, i), -1, nv - 1, &v, "a component's variant"))
-            return 0;
-        (*variant)[i] = (int32_t)v;
-        if (!get_int(R, json_array_get(ra, i), 0, 3, &v, "a component's turn"))
-            return 0;
-        (*rot)[i] = (uint8_t)v;
-        if (!get_int(R, json_array_get(wa, i), 0, 3, &v, "a component's variant turn"))
-            return 0;
-        (*vrot)[i] = (uint8_t)v;
-    }
-    for (size_t i = 0; i < (size_t)nv; i++) {
-        if (!get_int(R, json_array_get(vl, i), -1, nl - 1, &v, "a variant's label"))
-            return 0;
-        (*vlabel)[i] = (int32_t)v;
-    }
-    k->label = *label;
-    k->variant = *variant;
-    k->rot = *rot;
-    k->vrot = *vrot;
-    k->variant_label = *vlabel;
+    const json_t *v = json_object_get(k, key);
+    if (!json_is_integer(v) || json_integer_value(v) < 0 ||
+        (uint64_t)json_integer_value(v) > most)
+        return bad(R, key);
+    *out = (size_t)json_integer_value(v);
     return 1;
 }
 
-static ag_splittree *read_tree(reader *R, const json_t *k, const ag_mesh *mesh, size_t nlabels,
-                               size_t nvariants)
+static int get_real(reader *R, const json_t *k, const char *key, double *out)
 {
-    json_int_t format, ncomp;
-    if (!get_int(R, json_object_get(k, "format"), KEPT_FORMAT, KEPT_FORMAT, &format,
-                 "an unknown format") ||
-        !get_int(R, json_object_get(k, "ncomponents"), 0, INT32_MAX, &ncomp,
-                 "the number of components"))
-        return NULL;
-    if ((size_t)ncomp != mesh->ncomponents) {
-        bad(R, "it names another number of components than the mesh has");
-        return NULL;
-    }
-    const json_t *nodes = get_array(R, k, "nodes", SIZE_MAX, "no nodes");
-    const json_t *pats = get_array(R, k, "patterns", SIZE_MAX, "no patterns");
-    const json_t *rules = get_array(R, k, "rules", SIZE_MAX, "no rules");
-    if (!nodes || !pats || !rules)
-        return NULL;
-    if (json_array_size(nodes) > INT32_MAX || json_array_size(pats) > INT32_MAX ||
-        json_array_size(rules) > INT32_MAX) {
-        bad(R, "too many nodes");
-        return NULL;
-    }
-    ag_splittree *t = calloc(1, sizeof *t);
-    if (!t) {
-        R->st = ag_error_set(R->err, AG_ERR_NOMEM, 0, "out of memory");
-        return NULL;
-    }
-    t->nnodes = t->cap = json_array_size(nodes);
-    t->npatterns = t->cap_patterns = json_array_size(pats);
-    t->nrules = json_array_size(rules);
-    t->ncomponents = (size_t)ncomp;
-    t->nodes = malloc((t->nnodes + 1) * sizeof *t->nodes);
-    t->patterns = malloc((t->npatterns + 1) * sizeof *t->patterns);
-    t->rule_count = malloc((t->nrules + 1) * sizeof *t->rule_count);
-    t->rule_rep = malloc((t->nrules + 1) * sizeof *t->rule_rep);
-    if (!t->nodes || !t->patterns || !t->rule_count || !t->rule_rep) {
-        R->st = ag_error_set(R->err, AG_ERR_NOMEM, 0, "out of memory");
-        ag_splittree_free(t);
-        return NULL;
-    }
-    int ok = get_real(R, json_object_get(k, "tol"), &t->tol, "the tree's tolerance") &&
-             get_real(R, json_object_get(k, "eps"), &t->eps, "the tree's coincidence");
-    for (size_t r = 0; ok && r < t->nrules; r++) {
-        const json_t *a = json_array_get(rules, r);
-        json_int_t c, rep;
-        ok = json_is_array(a) && json_array_size(a) == 2 ? 1 : bad(R, "a rule is not a pair");
-        ok = ok && get_int(R, json_array_get(a, 0), 0, UINT32_MAX, &c, "a rule's count") &&
-             get_int(R, json_array_get(a, 1), -1, (json_int_t)t->nnodes - 1, &rep,
-                     "a rule's representative");
-        if (ok) {
-            t->rule_count[r] = (uint32_t)c;
-            t->rule_rep[r] = (int32_t)rep;
-        }
-    }
-    for (size_t p = 0; ok && p < t->npatterns; p++)
-        ok = read_pattern(R, json_array_get(pats, p), t, &t->patterns[p]);
-    for (size_t n = 0; ok && n < t->nnodes; n++)
-        ok = read_node(R, json_array_get(nodes, n), t, nlabels, nvariants, &t->nodes[n]);
-    if (ok)
-        ok = check_links(R, t);
-    if (!ok) {
-        ag_splittree_free(t);
-        return NULL;
-    }
-    return t;
+    const json_t *v = json_object_get(k, key);
+    if (!json_is_number(v) || !isfinite(json_number_value(v)))
+        return bad(R, key);
+    *out = json_number_value(v);
+    return 1;
 }
 
 ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_edit_model **em,
@@ -513,13 +389,96 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
     reader R = {.err = err};
     ag_rebuild_classes classes = {0};
     int32_t *label = NULL, *variant = NULL, *vlabel = NULL;
-    uint8_t *rot = NULL, *vrot = NULL;
+    uint8_t *rot = NULL, *vrot = NULL, *data = NULL;
     ag_splittree *t = NULL;
-    if (read_classes(&R, json_object_get(k, "classes"), mesh->ncomponents, &classes, &label,
-                     &variant, &rot, &vrot, &vlabel))
-        t = read_tree(&R, k, mesh, classes.nlabels, classes.nvariants);
+    size_t format = 0, ncomp = 0, nnodes = 0, npat = 0, nrules = 0, nl = 0, nv = 0;
+    double tol = 0, eps = 0;
+    const json_t *d = json_object_get(k, "data");
+    const char *b64 = json_string_value(d);
+    size_t blen = b64 ? strlen(b64) : 0;
+    /* every count is bounded by the data's length, so nothing larger than it is allocated */
+    int ok = get_count(&R, k, "format", KEPT_FORMAT, &format) &&
+             (format == KEPT_FORMAT || bad(&R, "an unknown format")) &&
+             (b64 || bad(&R, "no data")) && get_count(&R, k, "ncomponents", blen, &ncomp) &&
+             get_count(&R, k, "nnodes", blen, &nnodes) &&
+             get_count(&R, k, "npatterns", blen, &npat) &&
+             get_count(&R, k, "nrules", blen, &nrules) && get_count(&R, k, "nlabels", INT32_MAX, &nl) &&
+             get_count(&R, k, "nvariants", blen, &nv) && get_real(&R, k, "tol", &tol) &&
+             get_real(&R, k, "eps", &eps) && get_real(&R, k, "diagonal", &classes.diagonal) &&
+             get_real(&R, k, "label_tol", &classes.tol) && get_real(&R, k, "exact", &classes.exact);
+    if (ok && ncomp != mesh->ncomponents)
+        ok = bad(&R, "it names another number of components than the mesh has");
+    if (ok && !(data = malloc(blen + 1)))
+        R.st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory"), ok = 0;
+    size_t dlen = 0;
+    if (ok && sodium_base642bin(data, blen + 1, b64, blen, NULL, &dlen, NULL,
+                                sodium_base64_VARIANT_ORIGINAL))
+        ok = bad(&R, "the data is not base64");
+    if (ok && dlen != nnodes * NODE_BYTES + npat * PATTERN_BYTES + nrules * RULE_BYTES +
+                          ncomp * COMPONENT_BYTES + nv * VARIANT_BYTES)
+        ok = bad(&R, "the data's length does not match its counts");
+    if (ok && !nnodes)
+        ok = bad(&R, "no nodes");
+    R.p = data;
+    R.n = dlen;
+    if (ok) {
+        t = calloc(1, sizeof *t);
+        label = malloc((ncomp + 1) * sizeof *label);
+        variant = malloc((ncomp + 1) * sizeof *variant);
+        rot = malloc(ncomp + 1);
+        vrot = malloc(ncomp + 1);
+        vlabel = malloc((nv + 1) * sizeof *vlabel);
+        if (t) {
+            t->nnodes = t->cap = nnodes;
+            t->npatterns = t->cap_patterns = npat;
+            t->nrules = nrules;
+            t->ncomponents = ncomp;
+            t->tol = tol;
+            t->eps = eps;
+            t->nodes = malloc((nnodes + 1) * sizeof *t->nodes);
+            t->patterns = malloc((npat + 1) * sizeof *t->patterns);
+            t->rule_count = malloc((nrules + 1) * sizeof *t->rule_count);
+            t->rule_rep = malloc((nrules + 1) * sizeof *t->rule_rep);
+        }
+        if (!t || !label || !variant || !rot || !vrot || !vlabel || !t->nodes || !t->patterns ||
+            !t->rule_count || !t->rule_rep)
+            R.st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory"), ok = 0;
+    }
+    for (size_t n = 0; ok && n < nnodes; n++)
+        ok = read_node(&R, t, nl, nv, &t->nodes[n]);
+    for (size_t i = 0; ok && i < npat; i++)
+        ok = read_pattern(&R, t, &t->patterns[i]);
+    for (size_t r = 0; ok && r < nrules; r++) {
+        t->rule_count[r] = get_u32(&R);
+        t->rule_rep[r] = get_i32(&R);
+        ok = in_range(&R, t->rule_rep[r], -1, (int64_t)nnodes - 1, "a rule's representative");
+    }
+    for (size_t c = 0; ok && c < ncomp; c++) {
+        int32_t l = get_i32(&R), v = get_i32(&R), r = get_i32(&R), w = get_i32(&R);
+        ok = in_range(&R, l, -1, (int64_t)nl - 1, "a component's label") &&
+             in_range(&R, v, -1, (int64_t)nv - 1, "a component's variant") &&
+             in_range(&R, r, 0, 3, "a component's turn") &&
+             in_range(&R, w, 0, 3, "a component's variant turn");
+        label[c] = l;
+        variant[c] = v;
+        rot[c] = (uint8_t)r;
+        vrot[c] = (uint8_t)w;
+    }
+    for (size_t v = 0; ok && v < nv; v++)
+        ok = in_range(&R, vlabel[v] = get_i32(&R), -1, (int64_t)nl - 1, "a variant's label");
+    if (ok)
+        ok = check_links(&R, t);
     json_decref(doc);
+    free(data);
     ag_status st = R.st;
+    classes.ncomponents = ncomp;
+    classes.nlabels = nl;
+    classes.nvariants = nv;
+    classes.label = label;
+    classes.variant = variant;
+    classes.rot = rot;
+    classes.vrot = vrot;
+    classes.variant_label = vlabel;
     ag_mesh *m = NULL;
     if (!st && !(m = ag_mesh_clone(mesh)))
         st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");

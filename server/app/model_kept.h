@@ -8,14 +8,16 @@
  * the rules survive the store round trip, undo, redo and restore.
  *
  * The stored tree text (app/model_tree.h, numbering AG_MODEL_TREE_NUMBERING) is the served
- * tree with one more member, "kept": {"format":1,"tol","eps","ncomponents","nodes":[[kind,
- * parent, first child, last child, next sibling, component, label, variant, rot, octant,
- * rule rot, rule, pattern, min x, y, z, max x, y, z, pivot x, y, z], ...],"patterns":[[rule,
- * rot, nvec, counts 3, step 3, vectors 9, node], ...],"rules":[[count, representative], ...],
- * "classes":{"nlabels","nvariants","diagonal","tol","exact","label":[...],"variant":[...],
- * "rot":[...],"vrot":[...],"variant_label":[...]}}, numbers printed exactly (17 digits). A
- * kept member that does not describe a tree over the mesh is refused (AG_ERR_PARSE naming what
- * is wrong), never trusted. */
+ * tree with one more member, "kept": {"format":2,"tol","eps","ncomponents","nnodes",
+ * "npatterns","nrules","nlabels","nvariants","diagonal","label_tol","exact","data"}, data the
+ * base64 of little-endian int32s and doubles: per node its kind, parent, first child, last
+ * child, next sibling, component, label, variant, rot, octant, rule rot, rule and pattern,
+ * then its box (min, max) and pivot; per pattern its rule, rot, lattice size, counts, step,
+ * vectors and node; per rule its count and representative; per component its label,
+ * variant, rot and variant rot; per variant its label. Binary, because the tree is written
+ * with every edit: numbers exactly, a 200k-triangle building's in milliseconds. A kept member
+ * that does not describe a tree over the mesh is refused (AG_ERR_PARSE naming what is wrong),
+ * never trusted. */
 #ifndef AG_MODEL_KEPT_H
 #define AG_MODEL_KEPT_H
 
