@@ -260,8 +260,39 @@ static void run_file(const char *path, ag_up_axis up)
     ag_mesh_free(m);
 }
 
-int main(void)
+/* The generated buildings (20k, 200k and 2M triangles). */
+static const struct {
+    const char *name, *key;
+    ag_gen_facade_options go;
+} gens[] = {
+    {"generated ~20k triangles", "20k", {.cols = 12, .rows = 6, .side_cols = 8, .back = 1, .left = 1}},
+    {"generated ~200k triangles", "200k",
+     {.cols = 40, .rows = 20, .side_cols = 30, .back = 1, .left = 1, .annex = 1}},
+    {"generated ~2M triangles", "2M",
+     {.cols = 40, .rows = 20, .side_cols = 30, .back = 1, .left = 1, .annex = 1, .bars = 56}},
+};
+
+int main(int argc, char **argv)
 {
+    /* edit --write-obj 20k|200k|2M PATH: one generated building as a z-up OBJ (bench/edit_ws.js
+     * sends it to the service) */
+    if (argc == 4 && !strcmp(argv[1], "--write-obj")) {
+        for (size_t i = 0; i < sizeof gens / sizeof *gens; i++) {
+            if (strcmp(argv[2], gens[i].key))
+                continue;
+            ag_mesh *m = NULL;
+            ag_error err = {0};
+            ag_status s = ag_gen_facade(&gens[i].go, &m, &err);
+            if (!s)
+                s = ag_obj_write_file(m, AG_UP_Z, argv[3], &err);
+            ag_mesh_free(m);
+            if (s)
+                fprintf(stderr, "edit: %s\n", err.text);
+            return s ? 1 : 0;
+        }
+        fprintf(stderr, "edit: --write-obj takes 20k, 200k or 2M\n");
+        return 2;
+    }
     printf("%-28s %8s %8s %8s | %9s %9s %9s %10s %10s %9s | %8s %5s\n", "model", "tris",
            "equations", "unknowns", "proc ms", "first ms", "drag ms", "commit ms", "service ms",
            "solve ms", "residual", "MiB");
@@ -285,16 +316,6 @@ int main(void)
     printf("%-28s %8s %8s %-14s | %8s | %7s %7s %7s %7s %7s | %7s | %6s %6s %5s\n", "building",
            "tris", "after", "edit", "proc ms", "solve", "edit", "state", "tree", "blob", "total",
            "treeKB", "blobKB", "MiB");
-    static const struct {
-        const char *name;
-        ag_gen_facade_options go;
-    } gens[] = {
-        {"generated ~20k triangles", {.cols = 12, .rows = 6, .side_cols = 8, .back = 1, .left = 1}},
-        {"generated ~200k triangles",
-         {.cols = 40, .rows = 20, .side_cols = 30, .back = 1, .left = 1, .annex = 1}},
-        {"generated ~2M triangles",
-         {.cols = 40, .rows = 20, .side_cols = 30, .back = 1, .left = 1, .annex = 1, .bars = 24}},
-    };
     for (size_t i = 0; i < sizeof gens / sizeof *gens; i++)
         run_generated(gens[i].name, &gens[i].go);
     return 0;
