@@ -2,6 +2,7 @@
 
 #include <string.h>
 
+#include "cloud_ops.h"
 #include "compose_ops.h"
 #include "edit_ops.h"
 #include "modelops.h"
@@ -19,6 +20,9 @@ const ag_op_kind ag_optable[] = {
     {"paste",       ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL},
     {"remove",      ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL},
     {"compose",     ag_compose_ops_validate,       NULL,                       ag_compose_ops_run,      EDIT,                         AG_OP_STRUCTURAL, NULL},
+    /* point clouds */
+    {"segment_roi", ag_cloud_ops_validate_roi,     NULL,                       ag_cloud_ops_run,        EDIT,                         AG_OP_STRUCTURAL, NULL},
+    {"mark_template", ag_cloud_ops_validate_template, NULL,                    ag_cloud_ops_run,        EDIT,                         AG_OP_STRUCTURAL, NULL},
     /* undo and redo are logged as the restore they become */
     {"undo",        ag_edit_ops_validate_history,  NULL,                       ag_edit_ops_run_restore, AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL},
     {"redo",        ag_edit_ops_validate_history,  NULL,                       ag_edit_ops_run_restore, AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL},
@@ -28,6 +32,7 @@ const ag_op_kind ag_optable[] = {
     {"profile",     ag_plan_edit_validate,         ag_plan_edit_apply,         NULL,                    AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL},
     {"proceduralize", NULL,                        NULL,                       NULL,                    AG_OP_GEOMETRY,               AG_OP_STRUCTURAL, "POST /api/v1/models/{id}/proceduralize"},
     {"grammar",     NULL,                          NULL,                       NULL,                    AG_OP_UNDOABLE | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, "PUT /api/v1/models/{id}/grammar"},
+    {"segment",     NULL,                          NULL,                       NULL,                    AG_OP_GEOMETRY,               AG_OP_STRUCTURAL, "POST /api/v1/models/{id}/segment"},
 };
 const size_t ag_optable_count = sizeof ag_optable / sizeof ag_optable[0];
 

@@ -31,6 +31,7 @@
     X(AG_ERR_NOT_PROCEDURALIZED,     -18, 409, "not-proceduralized",    "the model is not proceduralized") \
     X(AG_ERR_UNDO_CONFLICT,          -19, 409, "undo-conflict",         "nothing can be undone or redone here") \
     X(AG_ERR_EXTERNAL_REF,           -20, 422, "external-reference",    "the file refers to another file") \
+    X(AG_ERR_NOT_AVAILABLE,          -30, 422, "not-available",         "this step is not available for the model") \
     X(AG_ERR_UNAUTHORIZED,           -40, 401, "unauthorized",          "sign in first")             \
     X(AG_ERR_FORBIDDEN,              -41, 403, "forbidden",             "not allowed for this account")
 
