@@ -9,6 +9,8 @@
 #define EXTENT_SHARE 0.05    /* and extents within 5 % */
 #define OVERLAP_SHARE 0.1    /* copies may overlap by a tenth of the template per axis */
 #define MAX_POSITIONS 400000 /* the budget of window positions: coarser steps beyond it */
+#define PLACE_WEIGHT 4.0     /* how much the points' centre counts in placing a copy */
+#define REFINE 2             /* a copy is placed to a quarter step: 2 sub-steps either side */
 
 void ag_template_mark_report_clear(ag_template_mark_report *rep)
 {
@@ -21,8 +23,9 @@ void ag_template_mark_report_clear(ag_template_mark_report *rep)
 typedef struct {
     double off[3];
     size_t count;
-    double score;
-    size_t order; /* position index: ties are broken by it */
+    double score;  /* how close it is in everything: copies are taken best first */
+    double place;  /* how close its points' centre and spread are: copies are placed by it */
+    size_t order;  /* position index: ties are broken by it */
 } candidate;
 
 static int by_score(const void *a, const void *b)
@@ -145,6 +148,97 @@ static int overlaps(const double a[3], const double b[3], const double size[3], 
     return 1;
 }
 
+/* The template as the windows are compared with it. */
+typedef struct {
+    const grid *g;
+    const double *u;
+    const double *tlo, *thi, *tsize, *tdims, *tmid, *tspread;
+    size_t tc;
+    double slack;
+} tmpl;
+
+/* Whether the window at offset off is a copy of the template: c->count, c->score and
+ * c->place (lower is closer) filled. */
+static int evaluate(const tmpl *T, const double off[3], candidate *c)
+{
+    const double *u = T->u, slack = T->slack;
+    double lo[3], hi[3], elo[3], ehi[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = T->tlo[k] + off[k];
+        hi[k] = T->thi[k] + off[k];
+        elo[k] = INFINITY;
+        ehi[k] = -INFINITY;
+    }
+    size_t count = 0;
+    EACH_IN_WINDOW(T->g, lo, hi, j, {
+        count++;
+        for (int k = 0; k < 3; k++) {
+            elo[k] = fmin(elo[k], u[3 * j + k]);
+            ehi[k] = fmax(ehi[k], u[3 * j + k]);
+        }
+    });
+    size_t tc = T->tc;
+    double big = (double)(count > tc ? count : tc);
+    if (!count || fabs((double)count - (double)tc) > COUNT_SHARE * big)
+        return 0;
+    double dims[3] = {ehi[0] - elo[0], ehi[1] - elo[1], ehi[2] - elo[2]};
+    qsort(dims, 3, sizeof dims[0], cmp_desc);
+    double score = fabs((double)count - (double)tc) / big;
+    for (int k = 0; k < 3; k++) {
+        double e = fmax(dims[k], T->tdims[k]);
+        if (fabs(dims[k] - T->tdims[k]) > EXTENT_SHARE * e + slack)
+            return 0;
+        score += fabs(dims[k] - T->tdims[k]) / fmax(e, slack > 0 ? slack : 1e-9);
+    }
+    double mid[3] = {0, 0, 0}, spread[3] = {0, 0, 0};
+    EACH_IN_WINDOW(T->g, lo, hi, j, {
+        for (int k = 0; k < 3; k++) {
+            double d = u[3 * j + k] - lo[k];
+            mid[k] += d / (double)count;
+            spread[k] += d * d / (double)count;
+        }
+    });
+    /* and its points placed in it as the template's are in its own: their centre and their
+     * spread about it */
+    double place = 0;
+    for (int k = 0; k < 3; k++) {
+        if (T->tsize[k] <= slack)
+            continue;
+        spread[k] = sqrt(fmax(0, spread[k] - mid[k] * mid[k]));
+        double dm = fabs(mid[k] - T->tmid[k]), ds = fabs(spread[k] - T->tspread[k]);
+        double tol = EXTENT_SHARE * T->tsize[k] + slack;
+        if (dm > tol || ds > tol)
+            return 0;
+        place += (dm + ds) / T->tsize[k];
+    }
+    memcpy(c->off, off, sizeof c->off);
+    c->count = count;
+    c->score = score + PLACE_WEIGHT * place;
+    c->place = place;
+    return 1;
+}
+
+/* The best place for a copy found at c->off, within half a step of it on each axis: where
+ * its points lie most as the template's do (the count, noisy by its square root, would pull
+ * the place about). */
+static void refine_place(const tmpl *T, const double step[3], const size_t steps[3],
+                         candidate *c)
+{
+    candidate best = *c;
+    for (int i = -REFINE; i <= REFINE; i++)
+        for (int j = -REFINE; j <= REFINE; j++) {
+            double off[3] = {c->off[0], c->off[1], c->off[2]};
+            if (steps[0] > 1)
+                off[0] += step[0] * i / (2.0 * REFINE);
+            if (steps[1] > 1)
+                off[1] += step[1] * j / (2.0 * REFINE);
+            candidate t = *c;
+            if ((i || j) && evaluate(T, off, &t) && t.place < best.place)
+                best = t;
+        }
+    *c = best;
+}
+
 ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **rp, int32_t segment,
                            const double min[3], const double max[3],
                            ag_template_mark_report *rep, ag_error *err)
@@ -224,38 +318,28 @@ ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **rp, int3
     }
     if (st == AG_OK && !(cand = malloc((npos ? npos : 1) * sizeof *cand)))
         st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    /* Copies are accepted by the label rule alone, but placed by where their points lie: a
+     * window shifted while the template's features stay inside it holds as many points, and
+     * the centre of its points relative to the window tells the shift */
+    double tmid[3] = {0, 0, 0}, tspread[3] = {0, 0, 0};
+    for (size_t j = 0; st == AG_OK && j < m; j++)
+        if (group[j] == 0)
+            for (int k = 0; k < 3; k++) {
+                double d = u[3 * j + k] - tlo[k];
+                tmid[k] += d / (double)tc;
+                tspread[k] += d * d / (double)tc;
+            }
+    for (int k = 0; k < 3; k++)
+        tspread[k] = sqrt(fmax(0, tspread[k] - tmid[k] * tmid[k]));
+    tmpl T = {&g, u, tlo, thi, tsize, tdims, tmid, tspread, tc, slack};
     for (size_t pos = 0; st == AG_OK && pos < npos; pos++) {
         size_t ix[3] = {pos % steps[0], (pos / steps[0]) % steps[1], pos / (steps[0] * steps[1])};
-        double off[3], lo[3], hi[3], elo[3], ehi[3];
-        for (int k = 0; k < 3; k++) {
+        double off[3];
+        for (int k = 0; k < 3; k++)
             off[k] = steps[k] > 1 ? first[k] + (double)ix[k] * step[k] : 0;
-            lo[k] = tlo[k] + off[k];
-            hi[k] = thi[k] + off[k];
-            elo[k] = INFINITY;
-            ehi[k] = -INFINITY;
-        }
-        size_t count = 0;
-        EACH_IN_WINDOW(&g, lo, hi, j, {
-            count++;
-            for (int k = 0; k < 3; k++) {
-                elo[k] = fmin(elo[k], u[3 * j + k]);
-                ehi[k] = fmax(ehi[k], u[3 * j + k]);
-            }
-        });
-        double big = (double)(count > tc ? count : tc);
-        if (!count || fabs((double)count - (double)tc) > COUNT_SHARE * big)
-            continue;
-        double dims[3] = {ehi[0] - elo[0], ehi[1] - elo[1], ehi[2] - elo[2]};
-        qsort(dims, 3, sizeof dims[0], cmp_desc);
-        double score = fabs((double)count - (double)tc) / big;
-        int ok = 1;
-        for (int k = 0; k < 3 && ok; k++) {
-            double e = fmax(dims[k], tdims[k]);
-            ok = fabs(dims[k] - tdims[k]) <= EXTENT_SHARE * e + slack;
-            score += fabs(dims[k] - tdims[k]) / fmax(e, slack > 0 ? slack : 1e-9);
-        }
-        if (ok)
-            cand[ncand++] = (candidate){{off[0], off[1], off[2]}, count, score, pos};
+        cand[ncand].order = pos;
+        if (evaluate(&T, off, &cand[ncand]))
+            ncand++;
     }
     rep->positions = npos;
     rep->template_points = tc;
@@ -272,6 +356,11 @@ ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **rp, int3
     }
     for (size_t i = 0; st == AG_OK && i < ncand; i++) {
         int free_place = 1;
+        for (size_t t = 0; t < ntaken && free_place; t++)
+            free_place = !overlaps(cand[i].off, taken[t], tsize, slack);
+        if (!free_place)
+            continue;
+        refine_place(&T, step, steps, &cand[i]);
         for (size_t t = 0; t < ntaken && free_place; t++)
             free_place = !overlaps(cand[i].off, taken[t], tsize, slack);
         if (!free_place)

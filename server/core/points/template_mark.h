@@ -1,5 +1,5 @@
-/* Template marking (§3.2 of "Procedural editing of building point clouds"), by the label
- * rule alone: a person marks a template — the points of one segment inside a box — and the
+/* Template marking (§3.2 of "Procedural editing of building point clouds") by the label
+ * rule: a person marks a template — the points of one segment inside a box — and the
  * copies of it along the segment are found and given one label with it.
  *
  * The template is slid along the axes of the segment's frame (the frame ag_segment_cloud
@@ -7,12 +7,15 @@
  * room, in steps of a tenth of the template's size on each axis (at least one point
  * spacing). A window of the segment at a position is a copy when it passes the label rule
  * of the segmentation: its point count within 10 % of the template's and its extents,
- * sorted, within 5 % (plus two point spacings of slack). Copies are taken best first
- * (closest count and extents) where they do not overlap the template or a copy taken
- * before. The template and every copy become segments of their own (of the segment's
- * kind), all with one new label; what is left of the segment stays a segment. Shape is not
- * compared beyond the rule (no registration): that is the template matching of the
- * consensus stage. Deterministic. Core: no I/O. */
+ * sorted, within 5 % (plus two point spacings of slack) — and its points placed in it as
+ * the template's are in the template's box: their centre and their spread about it within
+ * 5 % of the template's size on each axis (a window shifted while the template's features
+ * stay inside it holds as many points, and one straddling two features may too: the centre
+ * and the spread tell them apart). Copies are taken best first (closest in all of it) where
+ * they do not overlap the template or a copy taken before. The template and every copy
+ * become segments of their own (of the segment's kind), all with one new label; what is
+ * left of the segment stays a segment. Shape is not compared beyond this (no registration):
+ * that is the template matching of the consensus stage. Deterministic. Core: no I/O. */
 #ifndef AG_POINTS_TEMPLATE_MARK_H
 #define AG_POINTS_TEMPLATE_MARK_H
 
