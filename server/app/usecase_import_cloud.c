@@ -58,6 +58,9 @@ ag_status ag_usecase_import_cloud_run(ag_workspace *ws, const ag_mesh_source *sr
                          (unsigned long long)count, AG_CLOUD_MAX_POINTS);
     if (s == AG_OK)
         s = ag_cloud_import_buffer(file.data, file.len, fmt, &c, err);
+    if (s == AG_OK && c->n == 0)
+        s = ag_error_set(err, AG_ERR_EMPTY, 0, "%s holds no points",
+                         src->what ? src->what : "the cloud");
     if (s == AG_OK && ag_workspace_progress(ws, 0.6, "order"))
         s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
     if (s == AG_OK && !(lod = malloc((c->n ? c->n : 1) * sizeof *lod)))

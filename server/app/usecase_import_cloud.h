@@ -6,7 +6,7 @@
  *
  * Progress (to the workspace): "parse" 0.05, "order" 0.6, "store" 0.8. A cloud of more than
  * AG_CLOUD_MAX_POINTS points (app/cloud_state.h), counted from its header, is refused before
- * it is read. */
+ * it is read (AG_ERR_TOO_LARGE); one without points is AG_ERR_EMPTY. */
 #ifndef AG_USECASE_IMPORT_CLOUD_H
 #define AG_USECASE_IMPORT_CLOUD_H
 
