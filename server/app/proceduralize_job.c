@@ -2,6 +2,7 @@
 
 #include <stdio.h>
 
+#include "cloud_pipeline.h"
 #include "store_ws.h"
 #include "usecase_proceduralize.h"
 
@@ -25,10 +26,17 @@ static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_p
                                                 .cid = cid,
                                                 .job = ctx,
                                                 .job_id = job});
+    int cloud = 0;
+    s = ag_cloud_pipeline_is_cloud(env.db, pj->model, &cloud, err);
     ag_usecase_proceduralize_result r;
     ag_usecase_proceduralize_params up = {
         .max_triangles = ag_work_limits_resolved(env.limits).max_triangles};
-    s = ag_usecase_proceduralize_run(&w.ws, &up, &r, err);
+    if (s == AG_OK && cloud)
+        s = ag_cloud_pipeline_proceduralize ? ag_cloud_pipeline_proceduralize(&w.ws, err)
+                                            : ag_cloud_pipeline_missing(pj->model, "proceduralize",
+                                                                        err);
+    else if (s == AG_OK)
+        s = ag_usecase_proceduralize_run(&w.ws, &up, &r, err);
     ag_store_ws_end(&w, s);
     return s;
 }

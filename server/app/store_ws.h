@@ -62,6 +62,17 @@ ag_status ag_store_ws_insert_model(ag_db *db, const char *name, const ag_mesh *m
 ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
                                  const ag_model_state *st, const char *summary_json,
                                  ag_error *err);
+/* The point cloud operations of the store workspace (app/store_ws_cloud.c): a cloud upload
+ * is a new model of kind "pointcloud" (its points in the point cloud tables, its file kept
+ * as the source up to 256 MiB); a segmentation is saved as a server op ("segment", a job) or
+ * the client's op (segment_roi, mark_template) with its report, with the states before and
+ * after kept for undo. */
+ag_status ag__store_ws_add_cloud(ag_workspace *ws, const char *name, const ag_cloud_new *c,
+                                 int64_t *model, ag_error *err);
+ag_status ag__store_ws_input_cloud(ag_workspace *ws, int with_properties, int need_segmentation,
+                                   ag_cloud_state *st, ag_error *err);
+ag_status ag__store_ws_save_segmentation(ag_workspace *ws, const ag_cloud_state *st,
+                                         const ag_segment_outcome *o, ag_error *err);
 /* Keeps st's edit model (taken) as the model's edit session at version. */
 void ag__store_ws_keep_model(ag_edit_sessions *reg, int64_t model, int64_t version,
                              ag_model_state *st);
