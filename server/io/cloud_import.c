@@ -91,8 +91,11 @@ ag_cloud_format ag_cloud_format_sniff(const uint8_t *data, size_t len, const cha
 int ag_cloud_import_is_cloud(const uint8_t *data, size_t len, const char *filename)
 {
     ag_cloud_format f = ag_cloud_format_sniff(data, len, filename);
+    /* a PLY whose header this reader does not take goes to the mesh importer, which judges
+     * it (as it did every PLY before clouds were read) */
+    uint64_t vertices = 0;
     if (f == AG_CLOUD_FORMAT_PLY)
-        return !ag_ply_has_faces(data, len);
+        return ag_ply_vertex_count(data, len, &vertices) == 0 && !ag_ply_has_faces(data, len);
     return f != AG_CLOUD_FORMAT_UNKNOWN;
 }
 
