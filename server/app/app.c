@@ -17,6 +17,7 @@
 #include "import_job.h"
 #include "jobqueue.h"
 #include "proceduralize_job.h"
+#include "segment_job.h"
 #include "store_env.h"
 
 struct ag_app {
@@ -159,6 +160,7 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
     ag_jobqueue_register(app->jobs, &ag_extrude_job_kind, &app->services);
     ag_jobqueue_register(app->jobs, &ag_proceduralize_job_kind, &app->services);
     ag_jobqueue_register(app->jobs, &ag_demo_parts_job_kind, &app->services);
+    ag_jobqueue_register(app->jobs, &ag_segment_job_kind, &app->services);
     /* after the job kinds: the demo content is proceduralized and extruded by jobs */
     if (opt->demo && (s = ag_demo_load_if_empty(db, app->jobs, err)) != AG_OK) {
         ag_app_free(app);

@@ -13,6 +13,7 @@
 #include "../store/jobs.h"
 #include "../store/models.h"
 #include "../store/ops.h"
+#include "app_points.h"
 #include "edit_session.h"
 #include "jobqueue.h"
 #include "model_kept.h"
@@ -330,6 +331,17 @@ ag_status ag_app_query_glb(ag_app *app, int64_t id, int (*fresh)(void *user, con
 {
     memset(out, 0, sizeof *out);
     DB_OR_RETURN(db, app, err);
+    {
+        /* a point cloud's mesh is empty until a surface is made of it: its points instead */
+        ag_model_row row;
+        ag_status ks = ag_models_get(db, id, &row, err);
+        if (ks != AG_OK)
+            return ks;
+        int cloud = strcmp(row.kind, "pointcloud") == 0;
+        ag_models_row_clear(&row);
+        if (cloud)
+            return ag_app_points_glb(app, id, 0, fresh, user, out, err);
+    }
     ag_grammar_row g;
     ag_error e;
     ag_error_clear(&e);

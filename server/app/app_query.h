@@ -38,7 +38,7 @@ ag_status ag_app_query_plan(ag_app *app, int64_t id, json_t **doc, int64_t *vers
                             ag_error *err);
 
 /* mesh.glb: binary glTF of the model's mesh (a proceduralized model's components carry their
- * label and tree node). etag is a strong validator of the geometry; when fresh(user, etag)
+ * label and tree node; a point cloud model's points, as app/app_points.h serves them). etag is a strong validator of the geometry; when fresh(user, etag)
  * says the client has it, nothing is built and data stays NULL. */
 typedef struct {
     uint8_t *data; /* malloc'd */

@@ -2,6 +2,7 @@
 
 #include <string.h>
 
+#include "cloud_ops.h"
 #include "compose_ops.h"
 #include "edit_ops.h"
 #include "modelops.h"
@@ -19,6 +20,9 @@ const ag_op_kind ag_optable[] = {
     {"paste",       ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL, AG_REBASE_NODES},
     {"remove",      ag_edit_ops_validate,          NULL,                       ag_edit_ops_run_edit,    EDIT,                         AG_OP_STRUCTURAL, NULL, AG_REBASE_NODES},
     {"compose",     ag_compose_ops_validate,       NULL,                       ag_compose_ops_run,      EDIT,                         AG_OP_STRUCTURAL, NULL, AG_REBASE_NODES},
+    /* point clouds: they name boxes of the cloud, so any geometry op since conflicts */
+    {"segment_roi", ag_cloud_ops_validate_roi,     NULL,                       ag_cloud_ops_run,        EDIT,                         AG_OP_STRUCTURAL, NULL, AG_REBASE_OVER_CONTENT},
+    {"mark_template", ag_cloud_ops_validate_template, NULL,                    ag_cloud_ops_run,        EDIT,                         AG_OP_STRUCTURAL, NULL, AG_REBASE_OVER_CONTENT},
     /* undo and redo are logged as the restore they become; they name no version's content */
     {"undo",        ag_edit_ops_validate_history,  NULL,                       ag_edit_ops_run_restore, AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL, AG_REBASE_ALWAYS},
     {"redo",        ag_edit_ops_validate_history,  NULL,                       ag_edit_ops_run_restore, AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL, AG_REBASE_ALWAYS},

@@ -575,6 +575,9 @@ static const ag_workspace_ops store_ops = {
     .open_part = open_part,
     .save_part = save_part,
     .save_composed = save_composed,
+    .add_cloud = ag__store_ws_add_cloud,
+    .input_cloud = ag__store_ws_input_cloud,
+    .save_segmentation = ag__store_ws_save_segmentation,
     .cancelled = cancelled,
     .progress = progress,
     .state_flags = 0, /* the mesh is kept: a reload gives the saved model itself */
@@ -596,6 +599,21 @@ void ag_store_ws_init_op(ag_store_ws *w, const ag_store_env *env, const ag_op_re
                                                .cid = rq->cid,
                                                .origin = rq->origin,
                                                .op = rq->op});
+}
+
+void ag_store_ws_init_job(ag_store_ws *w, const ag_store_env *env, ag_jobctx *ctx, int64_t job,
+                          int64_t model, int64_t base, const char *author)
+{
+    char cid[sizeof w->job_cid];
+    snprintf(cid, sizeof cid, "job-%lld", (long long)job);
+    ag_store_ws_init(w, &(ag_store_ws_options){.env = *env,
+                                               .model = model,
+                                               .base = base,
+                                               .author = author,
+                                               .job = ctx,
+                                               .job_id = job});
+    memcpy(w->job_cid, cid, sizeof cid);
+    w->o.cid = w->job_cid;
 }
 
 void ag_store_ws_end(ag_store_ws *w, ag_status outcome)

@@ -39,6 +39,10 @@ typedef struct {
     const char *format; /* the format read */
 } ag_mesh_file;
 
+/* Maps src's file (the checks and messages of ag_usecase_import_read: AG_ERR_IO, AG_ERR_EMPTY);
+ * file->format stays NULL. Shared with the point cloud import (app/usecase_import_cloud.h). */
+ag_status ag_usecase_import_map(const ag_mesh_source *src, ag_mesh_file *file, ag_error *err);
+
 /* Reads src into *mesh; progress (may be NULL) gets the parsed fraction and may cancel.
  * AG_ERR_IO for a file that cannot be read (strerror), AG_ERR_EMPTY for an empty one,
  * AG_ERR_UNSUPPORTED for an unknown format, the reader's errors (with the line) otherwise.

@@ -39,6 +39,7 @@
     X(AG_ERR_STORE_UNAVAILABLE,      -25, 503, "store-unavailable",     "the database cannot be read or written") \
     X(AG_ERR_URI_TOO_LONG,           -26, 414, "uri-too-long",          "the URL is too long")       \
     X(AG_ERR_HEADERS_TOO_LARGE,      -27, 431, "headers-too-large",     "the request headers are too large") \
+    X(AG_ERR_NOT_AVAILABLE,          -30, 422, "not-available",         "this step is not available for the model") \
     X(AG_ERR_UNAUTHORIZED,           -40, 401, "unauthorized",          "sign in first")             \
     X(AG_ERR_FORBIDDEN,              -41, 403, "forbidden",             "not allowed for this account")
 

@@ -26,6 +26,12 @@ const ag_route ag_routes[] = {
     {"POST", "/api/v1/models/{id}/proceduralize", ag_api_model_proceduralize, JSON,
      AG_NEED_MODEL_EDITOR, JOB},
     {"GET", "/api/v1/models/{id}/tree", ag_api_model_tree, NONE, AG_NEED_MODEL_VIEWER, 0},
+    /* point cloud models (api_points.c): their points, a budget of them to view, segmenting */
+    {"GET", "/api/v1/models/{id}/points.ply", ag_api_model_points_ply, NONE, AG_NEED_MODEL_VIEWER,
+     0},
+    {"GET", "/api/v1/models/{id}/points.glb", ag_api_model_points_glb, NONE, AG_NEED_MODEL_VIEWER,
+     0},
+    {"POST", "/api/v1/models/{id}/segment", ag_api_model_segment, JSON, AG_NEED_MODEL_EDITOR, JOB},
     {"GET", "/api/v1/models/{id}/grammar", ag_api_model_grammar_get, NONE, AG_NEED_MODEL_VIEWER, 0},
     /* spooled like an upload; api_grammar.c takes at most 8 MiB of it */
     {"PUT", "/api/v1/models/{id}/grammar", ag_api_model_grammar_put, UPLOAD,
