@@ -7,6 +7,7 @@
 
 #include <sodium.h>
 
+#include "../core/base/array.h"
 #include "../core/edit/rebuild.h"
 #include "model_tree.h"
 
@@ -29,20 +30,8 @@ typedef struct {
 
 static void put_bytes(packer *k, const void *v, size_t n)
 {
-    if (k->fail)
+    if (k->fail || (k->fail = AG_ARRAY_RESERVE_MORE(k->p, k->cap, k->n, n) != AG_OK))
         return;
-    if (k->n + n > k->cap) {
-        size_t cap = k->cap ? 2 * k->cap : 4096;
-        while (cap < k->n + n)
-            cap *= 2;
-        uint8_t *q = realloc(k->p, cap);
-        if (!q) {
-            k->fail = 1;
-            return;
-        }
-        k->p = q;
-        k->cap = cap;
-    }
     memcpy(k->p + k->n, v, n);
     k->n += n;
 }

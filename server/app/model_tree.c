@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/base/array.h"
+
 
 static const char *kind_name(int k)
 {
@@ -228,18 +230,8 @@ typedef struct {
 
 static void out_reserve(text_out *o, size_t more)
 {
-    if (o->fail || o->n + more + 1 <= o->cap)
-        return;
-    size_t cap = o->cap ? o->cap : 1 << 16;
-    while (cap < o->n + more + 1)
-        cap *= 2;
-    char *q = realloc(o->p, cap);
-    if (!q) {
-        o->fail = 1;
-        return;
-    }
-    o->p = q;
-    o->cap = cap;
+    if (!o->fail)
+        o->fail = AG_ARRAY_RESERVE_MORE(o->p, o->cap, o->n, more + 1) != AG_OK;
 }
 
 static void out_str(text_out *o, const char *s, size_t n)

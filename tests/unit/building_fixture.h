@@ -18,7 +18,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/edit/edit.h"
 #include "core/mesh.h"
+#include "core/proc/proceduralize.h"
 
 typedef enum { BB_RECESSED = 0, BB_FLUSH = 1, BB_PROUD = 2 } bb_mount;
 
@@ -341,6 +343,19 @@ static inline size_t bb_open_edges(const ag_mesh *m, double eps)
     }
     free(e);
     return bad;
+}
+
+/* The building proceduralized and read back through its grammar, as the service keeps a
+ * proceduralized model (NULL when anything fails; *mesh gets the generated mesh). */
+static inline ag_edit_model *bb_service_model(const bb_options *o, ag_mesh **mesh, ag_error *err)
+{
+    *mesh = bb_generate(o);
+    ag_proceduralize_result *r = NULL;
+    ag_edit_model *em = NULL;
+    if (*mesh && !ag_proceduralize_run(*mesh, NULL, &r, err))
+        ag_edit_model_from_grammar(r->grammar, NULL, &em, err);
+    ag_proceduralize_result_free(r);
+    return em;
 }
 
 #endif

@@ -127,15 +127,11 @@ static const bb_options variants[] = {
 
 static void run_variant(const bb_options *o)
 {
-    ag_mesh *m = bb_generate(o);
-    assert_non_null(m);
-    ag_proceduralize_result *r = NULL;
+    ag_mesh *m = NULL;
     ag_error err = {0};
-    if (ag_proceduralize_run(m, NULL, &r, &err))
+    ag_edit_model *em = bb_service_model(o, &m, &err);
+    if (!em)
         fail_msg("%s: proceduralize: %s", o->name, err.text);
-    ag_edit_model *em = NULL;
-    assert_int_equal(ag_edit_model_from_grammar(r->grammar, NULL, &em, &err), AG_OK);
-    ag_proceduralize_result_free(r);
 
     /* the window a person selects: the first of the bottom front row; and the front wall */
     double fr[2], gl[2], si[2];

@@ -307,16 +307,12 @@ static const bb_options variants[] = {
  * and, for the root, the command line's (read back through the grammar). */
 static void run_variant(const bb_options *o)
 {
-    ag_mesh *m = bb_generate(o);
-    assert_non_null(m);
-    ag_proceduralize_result *r = NULL;
-    ag_error err = {0};
-    if (ag_proceduralize_run(m, NULL, &r, &err))
-        fail_msg("%s: proceduralize: %s", o->name, err.text);
     /* as the service keeps it: read back through its grammar, the mesh grouped by label */
-    ag_edit_model *em = NULL;
-    assert_int_equal(ag_edit_model_from_grammar(r->grammar, NULL, &em, &err), AG_OK);
-    ag_proceduralize_result_free(r);
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    ag_edit_model *em = bb_service_model(o, &m, &err);
+    if (!em)
+        fail_msg("%s: proceduralize: %s", o->name, err.text);
     bb_groups g = find_groups(em->proc->mesh, o);
     bb_measure before = measure(em->proc->mesh, o, &g);
     print_measure("as proceduralized", o, &before);
