@@ -5,6 +5,7 @@
 
 #include "../core/points/lod.h"
 #include "../io/cloud_import.h"
+#include "../io/ply.h"
 
 int ag_usecase_import_cloud_accepts(const ag_mesh_source *src)
 {
@@ -22,6 +23,13 @@ int ag_usecase_import_cloud_accepts(const ag_mesh_source *src)
     /* named ply: a PLY without faces; sniffed: a LAS, a faceless PLY or lines of numbers */
     if (cloud && named == AG_CLOUD_FORMAT_PLY &&
         ag_cloud_format_sniff(file.data, file.len, NULL) != AG_CLOUD_FORMAT_PLY)
+        cloud = 0;
+    /* a PLY whose header does not parse says nothing of faces: it stays with the mesh
+     * readers, as every PLY did before clouds were read (they answer it, or its import
+     * runs out of --import-seconds in the sandbox) */
+    uint64_t vertices = 0;
+    if (cloud && ag_cloud_format_sniff(file.data, file.len, NULL) == AG_CLOUD_FORMAT_PLY &&
+        ag_ply_vertex_count(file.data, file.len, &vertices) != 0)
         cloud = 0;
     ag_usecase_import_release(&file);
     return cloud;
