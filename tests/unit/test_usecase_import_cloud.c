@@ -17,7 +17,8 @@
 /* A temporary file holding text; its path in path. */
 static void write_temp(char *path, size_t len, const char *text, size_t n)
 {
-    snprintf(path, len, "/tmp/ag_test_import_cloud_XXXXXX");
+    const char *tmp = getenv("TMPDIR");
+    snprintf(path, len, "%s/ag_test_import_cloud_XXXXXX", tmp && tmp[0] ? tmp : P_tmpdir);
     int fd = mkstemp(path);
     assert_true(fd >= 0);
     assert_int_equal(write(fd, text, n), (ssize_t)n);
@@ -26,7 +27,7 @@ static void write_temp(char *path, size_t len, const char *text, size_t n)
 
 static int accepts(const char *text, size_t n, const char *format, const char *filename)
 {
-    char path[64];
+    char path[1024];
     write_temp(path, sizeof path, text, n);
     ag_mesh_source src = {.path = path, .format = format, .filename = filename};
     int yes = ag_usecase_import_cloud_accepts(&src);
