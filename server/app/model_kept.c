@@ -65,7 +65,9 @@ static char *kept_text(const ag_edit_model *em)
         const int32_t ints[NODE_INTS] = {x->kind,      x->parent,    x->first_child, x->last_child,
                                          x->next_sibling, x->component, x->label,    x->variant,
                                          x->rot,       x->octant,    x->rule_rot,    x->rule,
-                                         x->pattern};
+                                         /* only a pattern node's names a pattern (dead
+                                          * ones may keep an index of a dropped one) */
+                                         x->kind == AG_NODE_PATTERN ? x->pattern : -1};
         for (int q = 0; q < NODE_INTS; q++)
             put_i32(&k, ints[q]);
         for (int a = 0; a < 3; a++)
@@ -229,10 +231,18 @@ static int read_node(reader *R, const ag_splittree *t, size_t nlabels, size_t nv
                                    (int64_t)t->ncomponents - 1, (int64_t)nlabels - 1,
                                    (int64_t)nvariants - 1, 3,     8,     3,
                                    (int64_t)t->nrules - 1,      (int64_t)t->npatterns - 1};
+    static const char *const field[NODE_INTS] = {
+        "kind", "parent", "first child", "last child", "next sibling", "component", "label",
+        "variant", "rot", "octant", "rule rot", "rule", "pattern"};
     int32_t v[NODE_INTS];
     for (int k = 0; k < NODE_INTS; k++)
-        if (!in_range(R, v[k] = get_i32(R), lo[k], hi[k], "a node's field is out of range"))
+        if ((v[k] = get_i32(R)) < lo[k] || v[k] > hi[k]) {
+            if (!R->st)
+                R->st = ag_error_set(R->err, AG_ERR_PARSE, 0,
+                                     "the kept model: a node's %s (%d) is out of range",
+                                     field[k], (int)v[k]);
             return 0;
+        }
     memset(x, 0, sizeof *x);
     x->kind = (uint8_t)v[0];
     x->parent = v[1];

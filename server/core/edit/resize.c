@@ -80,6 +80,7 @@ void ag_edit_resize_solver_free(ag_edit_resize_solver *s)
     free(s->edit);
     free(s->edit_turn);
     free(s->level);
+    free(s->held);
     free(s->old);
     free(s);
 }
@@ -115,7 +116,7 @@ static void gather_edited(ag_edit_resize_solver *s, const ag_edit_op *op)
 }
 
 /* Does b hold the region on two axes or more (a wall or slab the edited element stands on or
- * in)? A local edit happens on such a unit, which stays where it is. */
+ * in)? A local edit happens on such a unit, which the edited element does not pull along. */
 static int holds_region(const ag_box *b, const ag_box *region, double eps)
 {
     int axes = 0;
@@ -127,7 +128,8 @@ static int holds_region(const ag_box *b, const ag_box *region, double eps)
 /* The units of the edited level, breadth-first from the edited units over the adjacency of
  * units with the same nearest visible ancestor (the edited root: every unit right below it);
  * local mode keeps only units meeting the region (given, or the edited node's old and new
- * boxes) but not those holding it, which stay as they are. */
+ * boxes); those holding it (the wall behind a window) are held: no ratio to an edited unit
+ * moves them. */
 static ag_status edited_level(ag_edit_resize_solver *s, const ag_edit_op *op, ag_error *err)
 {
     const ag_splittree *t = s->in->tree;
@@ -146,8 +148,9 @@ static ag_status edited_level(ag_edit_resize_solver *s, const ag_edit_op *op, ag
     int32_t *slot = malloc((nn + 1) * sizeof *slot);
     uint8_t *peer = calloc(nn + 1, 1);
     s->level = malloc((nn + 1) * sizeof *s->level);
+    s->held = calloc(nn + 1, 1);
     s->old = malloc((nn + 1) * sizeof *s->old);
-    if (!slot || !peer || !s->level || !s->old) {
+    if (!slot || !peer || !s->level || !s->held || !s->old) {
         free(slot);
         free(peer);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
@@ -176,9 +179,10 @@ static ag_status edited_level(ag_edit_resize_solver *s, const ag_edit_op *op, ag
                 int32_t v = (int32_t)u->adj_list[k];
                 if (slot[v] >= 0 || !peer[u->va[v]])
                     continue;
-                if (op->mode == AG_EDIT_LOCAL && (!ag_box_meets(&t->nodes[v].box, &region, eps) ||
-                                                  holds_region(&t->nodes[v].box, &region, eps)))
+                if (op->mode == AG_EDIT_LOCAL && !ag_box_meets(&t->nodes[v].box, &region, eps))
                     continue;
+                if (op->mode == AG_EDIT_LOCAL && holds_region(&t->nodes[v].box, &region, eps))
+                    s->held[s->nunits] = 1;
                 slot[v] = (int32_t)s->nunits;
                 s->level[s->nunits++] = v;
             }
@@ -234,7 +238,8 @@ ag_status ag_edit_resize_solver_create(const ag_proceduralize_result *in, const 
                             .nedit = s->nedit,
                             .frame_node = -1,
                             .outside = 1,
-                            .old = s->old};
+                            .old = s->old,
+                            .held = s->held};
     if (s->root) {
         spec.frame = AG__FRAME_TARGETED;
         spec.frame_old = spec.frame_new = t->nodes[0].box;

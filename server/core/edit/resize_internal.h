@@ -91,6 +91,8 @@ typedef struct {
                                  edited level: they stay where they are) */
     const ag_box *old;        /* per unit: the box attachments are measured on */
     const ag_box *expect;     /* per unit: where the weak position terms hold it; NULL: old */
+    const uint8_t *held;      /* per unit (NULL: none): a unit a local edit happens on (it
+                                 holds the region): no ratio to an edited unit moves it */
 } ag__resize_spec;
 
 typedef struct {
@@ -159,6 +161,7 @@ struct ag_edit_resize_solver {
                                  root), -1 when the level has none */
     size_t nunits;
     int32_t *level;           /* the level's units, the edited first */
+    uint8_t *held;            /* per level unit: it holds a local edit's region */
     ag_box *old;              /* their boxes */
     ag__resize_system sys;
     const ag_edit_budget *budget; /* a commit's limits and stop flag (not owned), NULL */

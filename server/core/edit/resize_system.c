@@ -389,8 +389,14 @@ static ag_status add_ratios(ag__resize_system *s, build *b, ag_error *err)
     for (size_t i = 0; i < b->nratios; i++)
         if (b->ratios[i].lu >= 0)
             b->holds[b->ratios[i].lu] |= (uint8_t)(1u << b->ratios[i].at.ci);
+    const ag__resize_spec *sp = b->spec;
     for (size_t i = 0; i < b->nratios; i++) {
         const ratio *r = &b->ratios[i];
+        if (sp->held && r->su >= 0 && r->lu >= 0 && (size_t)r->su < sp->nunits &&
+            (size_t)r->lu < sp->nunits &&
+            ((sp->held[r->su] && (size_t)r->lu < sp->nedit) ||
+             (sp->held[r->lu] && (size_t)r->su < sp->nedit)))
+            continue; /* the edited element does not pull what the edit happens on */
         int a = r->at.ci;
         double w = ag_attach_weight(r->at.type);
         int sa = settled(s, b, r->su, a), sb = settled(s, b, r->su, a + 3);
