@@ -620,10 +620,13 @@ ag_status ag_grammar_export(const ag_mesh *m, const ag_labels *L, const ag_split
         goto done;
     {
         long col;
-        st = ag_grammar_resolve(x.g, err, &col);
+        ag_error why;
+        ag_error_clear(&why);
+        st = ag_grammar_resolve(x.g, &why, &col);
         if (st) {
+            /* the reason is copied first: err may not be both the source and the target */
             st = ag_error_set(err, AG_ERR_INTERNAL, 0, "exported grammar does not resolve: %s",
-                              err ? err->text : "");
+                              why.text);
             goto done;
         }
     }
