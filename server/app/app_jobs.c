@@ -26,8 +26,10 @@ ag_status ag_app_jobs_check_import(const ag_import_job *p, ag_error *err)
                          "unknown format \"%s\"; archgram reads obj, ply, stl, gltf, glb, fbx and "
                          "dae",
                          p->format);
-    if (s == AG_OK && p->up && strcmp(p->up, "y") != 0 && strcmp(p->up, "z") != 0)
-        s = ag_error_set(err, AG_ERR_INVALID, 0, "up must be \"y\" or \"z\", not \"%s\"", p->up);
+    if (s == AG_OK && p->up && strcmp(p->up, "y") != 0 && strcmp(p->up, "z") != 0 &&
+        strcmp(p->up, "auto") != 0)
+        s = ag_error_set(err, AG_ERR_INVALID, 0, "up must be \"auto\", \"y\" or \"z\", not \"%s\"",
+                         p->up);
     return s;
 }
 

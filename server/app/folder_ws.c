@@ -76,6 +76,7 @@ static ag_status input_mesh(ag_workspace *ws, ag_mesh **mesh, ag_error *err)
     blame(w, w->o.mesh_path);
     ag_status s = ag_usecase_import_read(&src, NULL, NULL, mesh, &file, err);
     w->input_bytes = file.len;
+    w->up = file.up;
     ag_usecase_import_release(&file);
     w->import_s = now() - t0;
     return s;
@@ -204,15 +205,14 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
     json_object_set_new(ji, "bytes", json_integer((json_int_t)w->input_bytes));
     /* what import did to reach z-up metres (see io/import.h and io/assimp_import.h) */
     ag_format fmt = ag_format_sniff(NULL, 0, in);
-    int zup = w->o.up == AG_UP_Z ||
-              (w->o.up == AG_UP_DEFAULT && (fmt == AG_FORMAT_PLY || fmt == AG_FORMAT_STL));
+    int zup = w->up.axis == AG_UP_Z;
     char norm[160];
     snprintf(norm, sizeof norm, "%s; %s",
              zup ? "input taken as z-up, kept" : "y-up input turned to z-up: (x, y, z) -> (x, -z, y)",
              fmt == AG_FORMAT_FBX ? "FBX units (UnitScaleFactor) converted to metres"
                                   : "units taken as metres");
     json_object_set_new(ji, "format", json_string(ag_format_name(fmt)));
-    json_object_set_new(ji, "up", json_string(zup ? "z" : "y"));
+    json_object_set_new(ji, "up", ag_import_up_json(&w->up));
     json_object_set_new(ji, "normalization", json_string(norm));
     json_object_set_new(ji, "groups_split", json_integer((json_int_t)r->segment.groups_split));
     json_object_set_new(ji, "planar_fallback", json_boolean(r->segment.planar_fallback));
