@@ -77,6 +77,7 @@ ag_status ag_usecase_proceduralize_run(ag_workspace *ws, const ag_usecase_proced
     out->grammar_bytes = st.text_len;
     out->terminal_bytes = st.terms.bytes;
     out->fidelity = o.fidelity;
+    out->label_tolerance = r->labels->tol;
     o.total_s = now() - t_all - o.seconds[AG_STAGE_VERIFY];
     s = ag_workspace_save(ws, &st, &o, NULL, err);
     out->total_s = now() - t_all - o.seconds[AG_STAGE_VERIFY];
