@@ -34,6 +34,11 @@
  * moves a surface by more than that on large sites (fidelity reports what it did move). */
 #define AG_PROC_LABEL_TOLERANCE 2e-4
 #define AG_PROC_LABEL_TOLERANCE_MAX 0.005
+/* Label: copies whose orientations about the up axis differ (beyond quarter turns) share a
+ * label when that turn moves their plan corners by at most this (metres): a facade a degree
+ * or two off square holds the same windows; a window on a facade turned further is set
+ * otherwise and labelled apart (no terminal could serve both anyway). */
+#define AG_PROC_LABEL_TURN_MOVE 0.02
 /* Label, exact copies (--exact): components equal within this (relative) share a terminal;
  * it is the precision derivation then reproduces, 1e-7 of the diagonal (3 µm on a 30 m
  * building). */

@@ -407,6 +407,16 @@ static int compare(lctx *x, size_t na, size_t nb, double tol, int fast, double *
     return r > 0;
 }
 
+/* Whether c's orientation is close enough to e's, beyond quarter turns, for one label: the
+ * turn between them moves c's plan corners by at most AG_PROC_LABEL_TURN_MOVE. */
+static int turn_close(const frame *e, const frame *c)
+{
+    double d = fmod(fabs(c->phi - e->phi), M_PI / 2);
+    if (d > M_PI / 4)
+        d = M_PI / 2 - d;
+    return 0.5 * hypot(c->ext[0], c->ext[1]) * d <= AG_PROC_LABEL_TURN_MOVE;
+}
+
 /* Labels: every component against the exemplars of the labels in its bucket and the
  * neighbouring ones, in its own frame. */
 static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
@@ -449,6 +459,8 @@ static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
                      l = next_in_bucket[l]) {
                     uint32_t e = L->exemplar[l];
                     if (fast ? L->ntris[e] != L->ntris[c] : !areas_close(x, e, c))
+                        continue;
+                    if (!turn_close(&F[e], &F[c]))
                         continue;
                     for (int k = 0; k < nk && found < 0; k++) {
                         if (!extents_match(F[e].ext, dc, k, tol))

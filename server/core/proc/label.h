@@ -3,9 +3,10 @@
  *
  * Each component is seen in its own frame: turned about z by its orientation (the dominant
  * direction of its vertical faces, modulo 90 degrees: a window on a facade at 23 degrees is
- * seen square), centred on its box in that frame. Candidates are bucketed by the extents of
- * that box and compared under the 4 quarter turns, then the 4 quarter turns of the mirror
- * image: first by their triangle lists (every triangle of one lands on a triangle of the
+ * seen square), centred on its box in that frame. Two whose orientations differ by a turn
+ * that moves their plan corners by more than AG_PROC_LABEL_TURN_MOVE are set differently and
+ * labelled apart. Candidates are bucketed by the extents of that box and compared under the
+ * 4 quarter turns, then the 4 quarter turns of the mirror image: first by their triangle lists (every triangle of one lands on a triangle of the
  * other within the tolerance: copies), then, when the lists differ (another triangulation,
  * another vertex order, a copy re-triangulated after a turn), by their surfaces: every point
  * of each within the tolerance of the other, certified (surface.h). The oriented extents must
