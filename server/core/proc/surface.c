@@ -305,6 +305,142 @@ static void gather(query *q, const ag_box *b, double pad)
             }
 }
 
+
+/* ---- covering a piece by several triangles (another triangulation of its surface) ----
+ *
+ * The distance to one triangle t is convex, so over any convex polygon Q it is largest at
+ * Q's corners. A piece of A is clipped to the prism over each triangle of B (widened by
+ * CLIP_WIDEN of the tolerance so that neighbouring prisms overlap): where those corners are
+ * within tol of t, that part is proven and cut away; what is left goes on as pieces of its
+ * own. A surface triangulated otherwise is so proven in a few clips instead of being cut
+ * down to the tolerance's size along every edge of B. */
+#define CLIP_MAXV 32  /* corners of a clipped polygon at most */
+#define CLIP_MAXP 48  /* polygons left at most */
+#define CLIP_WIDEN (1.0 / 64)
+#define CLIP_MAX_LEFT 0 /* polygons left for which a clip still counts (else the piece is cut) */
+
+typedef struct {
+    double v[CLIP_MAXV][3];
+    int n;
+} cpoly;
+
+/* in ∩ {m·x >= off} into out; -1 when it has too many corners. */
+static int clip_keep(const cpoly *in, const double m[3], double off, cpoly *out)
+{
+    out->n = 0;
+    for (int i = 0; i < in->n; i++) {
+        const double *a = in->v[i], *b = in->v[(i + 1) % in->n];
+        double sa = dot3(m, a) - off, sb = dot3(m, b) - off;
+        if (sa >= 0) {
+            if (out->n >= CLIP_MAXV)
+                return -1;
+            memcpy(out->v[out->n++], a, 3 * sizeof(double));
+        }
+        if ((sa >= 0) != (sb >= 0)) {
+            if (out->n >= CLIP_MAXV)
+                return -1;
+            double t = sa / (sa - sb);
+            for (int k = 0; k < 3; k++)
+                out->v[out->n][k] = a[k] + t * (b[k] - a[k]);
+            out->n++;
+        }
+    }
+    return 0;
+}
+
+/* Proves what it can of triangle P on the triangles cand of B: *bound gets the largest
+ * distance over the proven parts, left[] the convex polygons not proven. Returns the number
+ * of polygons left, or -1 when nothing was proven (or the polygons outgrew their limits).
+ * work: room for 2 CLIP_MAXP polygons. */
+static int clip_cover(const ag_surface *b, const uint32_t *cand, size_t ncand, const double *P,
+                      double tol, double *bound, cpoly *work, cpoly *left)
+{
+    cpoly *cur = work, *nxt = work + CLIP_MAXP;
+    int ncur = 1, proven = 0;
+    double eps = tol * CLIP_WIDEN;
+    cur[0].n = 3;
+    memcpy(cur[0].v, P, 9 * sizeof(double));
+    *bound = 0;
+    for (size_t k = 0; k < ncand && ncur > 0; k++) {
+        const double *t = b->tri + 9 * (size_t)cand[k];
+        double e1[3], e2[3], n[3];
+        for (int a = 0; a < 3; a++) {
+            e1[a] = t[3 + a] - t[a];
+            e2[a] = t[6 + a] - t[a];
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double nn = sqrt(dot3(n, n));
+        if (!(nn > 0))
+            continue;
+        /* inward side normals: n × edge, for the edges in order */
+        double m[3][3], off[3];
+        int ok = 1;
+        for (int i = 0; i < 3 && ok; i++) {
+            const double *p = t + 3 * i, *q = t + 3 * ((i + 1) % 3);
+            double e[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+            m[i][0] = n[1] * e[2] - n[2] * e[1];
+            m[i][1] = n[2] * e[0] - n[0] * e[2];
+            m[i][2] = n[0] * e[1] - n[1] * e[0];
+            double l = sqrt(dot3(m[i], m[i]));
+            ok = l > 0;
+            for (int a = 0; a < 3 && ok; a++)
+                m[i][a] /= l;
+            off[i] = dot3(m[i], p) - eps;
+        }
+        if (!ok)
+            continue;
+        int nnxt = 0;
+        for (int j = 0; j < ncur; j++) {
+            cpoly q, r;
+            q = cur[j];
+            int inside = 1;
+            for (int i = 0; i < 3 && inside; i++) {
+                if (clip_keep(&q, m[i], off[i], &r) < 0)
+                    return -1;
+                q = r;
+                inside = q.n >= 3;
+            }
+            double d = 0;
+            for (int v = 0; inside && v < q.n && d <= tol; v++)
+                d = fmax(d, ag_surface_point_triangle(q.v[v], t, t + 3, t + 6));
+            if (!inside || d > tol) {
+                if (nnxt >= CLIP_MAXP)
+                    return -1;
+                nxt[nnxt++] = cur[j];
+                continue;
+            }
+            proven = 1;
+            *bound = fmax(*bound, d);
+            /* what lies outside the prism: outside side 0; inside 0, outside 1; ... */
+            cpoly rest = cur[j];
+            for (int i = 0; i < 3 && rest.n >= 3; i++) {
+                double mi[3] = {-m[i][0], -m[i][1], -m[i][2]};
+                if (clip_keep(&rest, mi, -off[i], &r) < 0)
+                    return -1;
+                if (r.n >= 3) {
+                    if (nnxt >= CLIP_MAXP)
+                        return -1;
+                    nxt[nnxt++] = r;
+                }
+                if (clip_keep(&rest, m[i], off[i], &r) < 0)
+                    return -1;
+                rest = r;
+            }
+        }
+        cpoly *sw = cur;
+        cur = nxt;
+        nxt = sw;
+        ncur = nnxt;
+    }
+    if (!proven)
+        return -1;
+    for (int j = 0; j < ncur; j++)
+        left[j] = cur[j];
+    return ncur;
+}
+
 typedef struct {
     double p[9];
     int depth;
@@ -320,6 +456,7 @@ void ag_surface_cover(ag_surface *b, const double *a, size_t na, double tol, siz
         budget = BUDGET_PER_TRIANGLE * na + BUDGET_FLOOR;
     query q = {.s = b};
     piece *stack = NULL;
+    cpoly *clipbuf = NULL; /* clip_cover's polygons, made when first needed */
     size_t cap = 0;
     size_t used = 0;
     for (size_t i = 0; i < na; i++) {
@@ -390,7 +527,39 @@ void ag_surface_cover(ag_surface *b, const double *a, size_t na, double tol, siz
                     out->upper = best;
                 continue;
             }
-            /* no single triangle covers the piece: the bound from its centre, else cut it */
+            /* no single triangle covers the piece: several may (another triangulation) */
+            if (!clipbuf && !(clipbuf = malloc(3 * CLIP_MAXP * sizeof *clipbuf))) {
+                failed = 1;
+                break;
+            }
+            {
+                cpoly *left = clipbuf + 2 * CLIP_MAXP;
+                double bound;
+                int nleft = clip_cover(b, q.cand, q.ncand, P.p, tol, &bound, clipbuf, left);
+                /* wholly proven, or proven but for a few slivers: those go on as pieces;
+                 * otherwise the piece is cut as before (its quarters are clipped again) */
+                if (nleft >= 0 && nleft <= CLIP_MAX_LEFT) {
+                    if (bound > out->upper)
+                        out->upper = bound;
+                    size_t more = 0;
+                    for (int j = 0; j < nleft; j++)
+                        more += (size_t)(left[j].n - 2);
+                    if (AG_ARRAY_RESERVE(stack, cap, top + more)) {
+                        failed = 1;
+                        break;
+                    }
+                    for (int j = 0; j < nleft; j++)
+                        for (int v = 1; v + 1 < left[j].n; v++) {
+                            piece *Q = &stack[top++];
+                            memcpy(Q->p, left[j].v[0], 3 * sizeof(double));
+                            memcpy(Q->p + 3, left[j].v[v], 3 * sizeof(double));
+                            memcpy(Q->p + 6, left[j].v[v + 1], 3 * sizeof(double));
+                            Q->depth = P.depth + 1;
+                        }
+                    continue;
+                }
+            }
+            /* nor several: the bound from its centre, else cut it */
             double c[3], r = 0, L = 0;
             for (int k = 0; k < 3; k++)
                 c[k] = (P.p[k] + P.p[3 + k] + P.p[6 + k]) / 3;
@@ -450,5 +619,6 @@ void ag_surface_cover(ag_surface *b, const double *a, size_t na, double tol, siz
         }
     }
     free(stack);
+    free(clipbuf);
     free(q.cand);
 }

@@ -4,8 +4,10 @@
  * ag_surface_cover checks that every point of surface A lies within tol of surface B. The
  * distance to one triangle is convex, so a piece of A whose three corners lie within d of one
  * triangle of B lies within d of B everywhere: that is the certificate. A piece that no single
- * triangle of B covers (B is triangulated differently there, or A leaves B) is cut into four
- * and tried again, down to pieces of the tolerance's size; a corner farther than tol from
+ * triangle of B covers (B is triangulated differently there, or A leaves B) is clipped to
+ * the prisms over B's triangles (the same convexity proves each clipped part on its
+ * triangle); when that does not prove it whole it is cut into four and tried again, down to
+ * pieces of the tolerance's size; a corner farther than tol from
  * every triangle of B is a witness that A leaves B. So "covered" is a proof (no sampling gaps),
  * `upper` a bound on the distance over the covered part and `lower` a distance some point of A
  * has. The work is bounded: past the budget the pieces left are counted as not covered, which
