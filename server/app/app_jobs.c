@@ -47,7 +47,8 @@ ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_impor
 }
 
 ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
-                                    const int64_t *if_match, int64_t *job, ag_error *err)
+                                    const int64_t *if_match, int exact, int64_t *job,
+                                    ag_error *err)
 {
     int64_t current;
     ag_status s = ag_app_query_version(app, model, &current, err);
@@ -60,7 +61,7 @@ ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t
     ag_job_params jp = {.type = AG_JOB_PROCEDURALIZE,
                         .user = who->user,
                         .u.proceduralize = {.model = model, .base = current,
-                                            .author = (char *)who->name}};
+                                            .author = (char *)who->name, .exact = exact != 0}};
     return submit(app, &jp, NULL, job, err);
 }
 

@@ -20,9 +20,11 @@ ag_status ag_app_jobs_check_extrude(const ag_extrude_job *p, ag_error *err);
 ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_import_job *p,
                              int64_t *job, ag_error *err);
 /* Proceduralizing a model at its current version, the op authored by who; if_match (NULL:
- * none; -1: any) must be the current version (AG_ERR_STALE otherwise). */
+ * none; -1: any) must be the current version (AG_ERR_STALE otherwise); exact: terminals
+ * shared by exact copies only. */
 ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
-                                    const int64_t *if_match, int64_t *job, ag_error *err);
+                                    const int64_t *if_match, int exact, int64_t *job,
+                                    ag_error *err);
 /* An extrusion of an uploaded description or GeoJSON: the name, format and style are checked.
  * The upload is removed when the job cannot be queued. */
 ag_status ag_app_jobs_extrude(ag_app *app, const ag_identity *who, const ag_extrude_job *p,

@@ -26,7 +26,9 @@ static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_p
                                                 .job = ctx,
                                                 .job_id = job});
     ag_usecase_proceduralize_result r;
-    s = ag_usecase_proceduralize_run(&w.ws, NULL, &r, err);
+    ag_usecase_proceduralize_params up = {0};
+    up.label.exact_copies = pj->exact;
+    s = ag_usecase_proceduralize_run(&w.ws, &up, &r, err);
     ag_store_ws_end(&w, s);
     return s;
 }

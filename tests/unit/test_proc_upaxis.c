@@ -89,6 +89,58 @@ static char *obj_text(const ag_mesh *m, size_t *len)
 
 /* The import applies the decision (a y-up file comes out z up), reports why, and a request
  * overrides the content. */
+/* An axis-aligned box as 12 triangles, corners lo..hi, into m as one component. */
+static void add_box(ag_mesh *m, const double lo[3], const double hi[3])
+{
+    static const int F[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    size_t c;
+    assert_int_equal(ag_mesh_add_component(m, -1, &c), AG_OK);
+    uint32_t v0 = (uint32_t)m->nverts;
+    for (int k = 0; k < 8; k++)
+        assert_int_equal(ag_mesh_add_vertex(m, k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1],
+                                            k & 4 ? hi[2] : lo[2]),
+                         AG_OK);
+    for (int t = 0; t < 12; t++)
+        assert_int_equal(ag_mesh_add_triangle(m, v0 + F[t][0], v0 + F[t][1], v0 + F[t][2],
+                                              (uint32_t)c),
+                         AG_OK);
+}
+
+/* A lone facade (a 15 x 13 m wall slab with 6 x 4 windows standing out of it) lies on no base:
+ * its thin axis is never up, whichever of y or z holds its height. */
+static void test_lone_facade(void **state)
+{
+    (void)state;
+    for (int yup = 0; yup < 2; yup++)
+        for (int proud = 0; proud < 2; proud++) {
+            ag_mesh *m = ag_mesh_create();
+            /* (along the facade, up, depth) to the axes as written */
+            int up = yup ? 1 : 2, depth = yup ? 2 : 1;
+            double lo[3] = {0, 0, 0}, hi[3] = {15, 0, 0};
+            hi[up] = 13;
+            hi[depth] = 0.3;
+            add_box(m, lo, hi);
+            for (int i = 0; i < 6; i++)
+                for (int j = 0; j < 4; j++) {
+                    double a[3] = {0.8 + 2.5 * i, 0, 0}, b[3] = {2.1 + 2.5 * i, 0, 0};
+                    a[up] = 0.9 + 3.2 * j;
+                    b[up] = a[up] + 1.86;
+                    a[depth] = proud ? 0.3 : 0.1;
+                    b[depth] = proud ? 0.5 : 0.3;
+                    add_box(m, a, b);
+                }
+            ag_upaxis_evidence ev;
+            assert_int_equal(ag_upaxis_decide(m, &ev, NULL), AG_OK);
+            if (ev.axis != (yup ? 1 : 2))
+                fail_msg("facade %s, windows %s: decided %d (score %.3f)", yup ? "y up" : "z up",
+                         proud ? "proud" : "set in", ev.axis, ev.score);
+            assert_true(ev.storey);
+            assert_true(fabs(ev.cue[yup ? 0 : 1].extent - 13) < 1e-9);
+            ag_mesh_free(m);
+        }
+}
+
 static void test_import_applies_and_reports(void **state)
 {
     (void)state;
@@ -207,6 +259,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_generated_buildings),
+        cmocka_unit_test(test_lone_facade),
         cmocka_unit_test(test_import_applies_and_reports),
         cmocka_unit_test(test_real_buildings),
     };

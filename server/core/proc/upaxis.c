@@ -196,8 +196,16 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
     free(lo);
     free(hi);
     free(h);
+    ev->cue[0].extent = ext[1];
+    ev->cue[1].extent = ext[2];
     if (ev->georeferenced)
         return AG_OK;
+    if ((ext[1] < AG_UPAXIS_MIN_HEIGHT) != (ext[2] < AG_UPAXIS_MIN_HEIGHT)) {
+        ev->storey = 1;
+        ev->axis = ext[2] < AG_UPAXIS_MIN_HEIGHT ? 1 : 2;
+        ev->score = ev->axis == 2 ? 1 : -1;
+        return AG_OK;
+    }
 
     const ag_upaxis_cues *y = &ev->cue[0], *z = &ev->cue[1];
     double dv = z->vertical - y->vertical;

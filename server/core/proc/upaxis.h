@@ -17,6 +17,10 @@
  *                  that are not aligned with the coordinate axes (most geo-referenced data)
  *                  make this large for the up axis only; aligned plans make it similar for all
  *                  axes, so differences below VERTICAL_DEAD_ZONE count for nothing.
+ *   storey         a building is at least a storey tall: an axis along which the model is
+ *                  lower than AG_UPAXIS_MIN_HEIGHT is not up when the other is at least that
+ *                  tall (a lone facade slab lies down on no base). Decides alone, after the
+ *                  map coordinates.
  *   origin         models kept in their own frame (game and CAD assets) have the origin on the
  *                  ground at the centre of the plan: the two horizontal axes are centred on 0
  *                  and the up axis is not.
@@ -32,11 +36,14 @@
 
 /* Scores closer to 0 than this decide nothing. */
 #define AG_UPAXIS_UNDECIDED 0.1
+/* Metres: the storey cue's least height of a building. */
+#define AG_UPAXIS_MIN_HEIGHT 2.0
 
 typedef struct {
     double base;     /* support at the low end less support at the high end, -1..1 */
     double top;      /* the high end's support, 0..1 (base = bottom - top) */
     double vertical; /* share of the area perpendicular or parallel to the axis, 0..1 */
+    double extent;   /* the model's extent along the axis, metres */
     double origin;   /* how far the axis's centre is above the origin, in half extents,
                         when the two other axes are centred on the origin (else 0), 0..1 */
 } ag_upaxis_cues;
@@ -44,6 +51,7 @@ typedef struct {
 typedef struct {
     int axis;             /* 1 = y, 2 = z; 0 when the content decides nothing */
     int georeferenced;    /* the map-coordinate cue decided */
+    int storey;           /* the storey cue decided */
     double score;         /* > 0 for z, < 0 for y */
     double centre[3];     /* of the bounding box, as read */
     ag_upaxis_cues cue[2]; /* [0] for y, [1] for z */
