@@ -27,7 +27,7 @@ DB      ?= var/archgram.db
 
 # Debian packages: to build and run; in addition to test (and to run the sanitizer build);
 # to benchmark.
-DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libwebsockets-dev \
+DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libyajl-dev libwebsockets-dev \
              libsqlite3-dev libsuitesparse-dev libassimp-dev libssl-dev libsodium-dev libpng-dev
 DEB_TEST  := libcmocka-dev chromium curl sqlite3 python3 binutils libasan8 libubsan1 libcgal-dev g++
 DEB_BENCH := wrk
@@ -48,7 +48,7 @@ ARCHIVES  := $(foreach l,$(LAYERS),$(LIBDIR)/libag_$(l).a)
 # Link order: the highest layer first, each followed by what it may use.
 LINK_ARCHIVES := $(foreach l,net app store io core,$(LIBDIR)/libag_$(l).a)
 # The system libraries, in the same order: net's, app's, store's, io's, core's.
-LDLIBS    := -lwebsockets -lmicrohttpd -lpthread -lsodium -lsqlite3 -lpng -ljansson -lassimp -lcrypto \
+LDLIBS    := -lwebsockets -lmicrohttpd -lpthread -lsodium -lsqlite3 -lpng -ljansson -lyajl -lassimp -lcrypto \
              -lcholmod -lspqr -lsuitesparseconfig -lm
 LIB_OBJ   := $(foreach l,$(LAYERS),$(call layer_obj,$(l)))
 
@@ -177,6 +177,7 @@ test: deps-test
 	@$(MAKE) --no-print-directory test-unit
 	@$(MAKE) --no-print-directory test-integration
 	@$(MAKE) --no-print-directory test-browser
+	@$(MAKE) --no-print-directory test-fuzz
 
 check-layers: $(ARCHIVES) | deps-test
 	python3 tools/check_layers.py --lib $(LIBDIR)
@@ -224,6 +225,8 @@ bench: deps-bench all $(BENCH_BIN) $(ORACLE)
 	@for b in bench/*.sh; do [ -f "$$b" ] && sh "$$b"; done; true
 	@for b in bench/*.js; do [ -f "$$b" ] && node "$$b"; done; true
 	@for b in $(BENCH_BIN); do $$b; done
+
+include tests/fuzz/fuzz.mk
 
 clean:
 	rm -rf $(BUILD)

@@ -11,8 +11,11 @@
  * Parts (app/usecase_save_part.h, app/usecase_compose.h) go through it too: a folder reads and
  * writes part bundle files, the store its parts library (app/part_library.h).
  *
- * A workspace that cannot do something answers AG_ERR_UNSUPPORTED. Segmenting point clouds
- * will be a use case over the same interface. */
+ * Point clouds too (app/cloud_state.h): an upload becomes a cloud model
+ * (app/usecase_import_cloud.h), segmentations are read and saved through it
+ * (app/usecase_segment.h, app/usecase_mark_template.h); only the store keeps cloud models.
+ *
+ * A workspace that cannot do something answers AG_ERR_UNSUPPORTED. */
 #ifndef AG_WORKSPACE_H
 #define AG_WORKSPACE_H
 
@@ -26,6 +29,7 @@
 #include "../core/status.h"
 #include "../io/edit_op_json.h"
 #include "../io/import.h"
+#include "cloud_state.h"
 #include "model_state.h"
 
 typedef struct ag_workspace ag_workspace;
@@ -106,6 +110,18 @@ typedef struct {
     /* Saves a composed model (st is taken and cleared, as for save). */
     ag_status (*save_composed)(ag_workspace *ws, ag_model_state *st, const ag_compose_outcome *o,
                                ag_error *err);
+    /* Stores a point cloud as a new model of kind "pointcloud" (an import). */
+    ag_status (*add_cloud)(ag_workspace *ws, const char *name, const ag_cloud_new *c,
+                           int64_t *model, ag_error *err);
+    /* The point cloud model to work on: its positions and normals (with_properties: every
+     * property too) and its current segmentation; st is the caller's (ag_cloud_state_clear).
+     * need_segmentation: a model that is not segmented is refused (AG_ERR_CONFLICT). */
+    ag_status (*input_cloud)(ag_workspace *ws, int with_properties, int need_segmentation,
+                             ag_cloud_state *st, ag_error *err);
+    /* Saves st's segmentation (and the normals it computed for a cloud without) as the
+     * model's, logged as o describes; st stays the caller's. */
+    ag_status (*save_segmentation)(ag_workspace *ws, const ag_cloud_state *st,
+                                   const ag_segment_outcome *o, ag_error *err);
     /* Non-zero when the work should stop (a cancelled job). May be NULL. */
     int (*cancelled)(ag_workspace *ws);
     /* Progress of long work (0..1, stage name); may be NULL. */
@@ -139,6 +155,12 @@ ag_status ag_workspace_save_part(ag_workspace *ws, ag_part *part, const ag_part_
                                  ag_error *err);
 ag_status ag_workspace_save_composed(ag_workspace *ws, ag_model_state *st,
                                      const ag_compose_outcome *o, ag_error *err);
+ag_status ag_workspace_add_cloud(ag_workspace *ws, const char *name, const ag_cloud_new *c,
+                                 int64_t *model, ag_error *err);
+ag_status ag_workspace_input_cloud(ag_workspace *ws, int with_properties, int need_segmentation,
+                                   ag_cloud_state *st, ag_error *err);
+ag_status ag_workspace_save_segmentation(ag_workspace *ws, const ag_cloud_state *st,
+                                         const ag_segment_outcome *o, ag_error *err);
 int ag_workspace_cancelled(ag_workspace *ws);
 /* Reports progress; returns ag_workspace_cancelled. */
 int ag_workspace_progress(ag_workspace *ws, double fraction, const char *stage);

@@ -33,6 +33,13 @@ ag_cloud_format ag_cloud_format_sniff(const uint8_t *data, size_t len, const cha
  * declares no faces. */
 int ag_cloud_import_is_cloud(const uint8_t *data, size_t len, const char *filename);
 
+/* How many points reading the data would make, from the header alone (LAS, LAZ, PLY) or an
+ * upper bound (XYZ: its lines), so a caller with a budget can refuse a cloud before anything
+ * is allocated. The reader's own error when the header does not parse; AG_ERR_UNSUPPORTED
+ * when the format cannot be told. */
+ag_status ag_cloud_import_count(const uint8_t *data, size_t len, ag_cloud_format fmt,
+                                uint64_t *count, ag_error *err);
+
 /* Reads a cloud; AG_CLOUD_FORMAT_UNKNOWN is sniffed. AG_ERR_UNSUPPORTED when the format
  * cannot be told, AG_ERR_EMPTY for no bytes. */
 ag_status ag_cloud_import_buffer(const uint8_t *data, size_t len, ag_cloud_format fmt,
