@@ -240,6 +240,11 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
         json_array_append_new(jl, lo);
     }
     json_object_set_new(j, "labels", jl);
+    /* how labels and shared terminals were decided (README, "Labels and shared terminals") */
+    json_object_set_new(j, "labeling",
+                        json_pack("{s:f, s:f, s:b, s:I}", "tolerance", L->tol, "share",
+                                  L->share, "exact_copies", L->exact_copies,
+                                  "surface_checks", (json_int_t)L->surface_checks));
 
     json_t *jc = json_array();
     for (size_t c = 0; c < r->mesh->ncomponents; c++) {
@@ -251,6 +256,7 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
         json_object_set_new(co, "variant",
                             L->variant[c] >= 0 ? json_integer(L->variant[c]) : json_null());
         json_object_set_new(co, "rot", json_integer(90 * L->rot[c]));
+        json_object_set_new(co, "mirror", json_boolean(L->mirror[c]));
         json_object_set_new(co, "node", r->tree->comp_node[c] >= 0
                                             ? json_integer(r->tree->comp_node[c])
                                             : json_null());
@@ -299,6 +305,7 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
     json_object_set_new(jf, "max_error", json_real(o->fidelity.max_error));
     json_object_set_new(jf, "relative", json_real(o->fidelity.relative));
     json_object_set_new(jf, "unmatched", json_integer((json_int_t)o->fidelity.unmatched));
+    json_object_set_new(jf, "spurious", json_integer((json_int_t)o->fidelity.spurious));
     json_object_set_new(jf, "derived_triangles",
                         json_integer((json_int_t)o->fidelity.derived_triangles));
     json_object_set_new(j, "fidelity", jf);
