@@ -368,6 +368,9 @@ typedef struct {
     const frame *F;
     double *sa, *sb;
     double *area; /* per component: its surface area */
+    double *ldev; /* per component: the label match's bound when it matched its exemplar's
+                     triangle list in the box frames, unmirrored (else -1): variant_pass's
+                     shortcut */
     int no_rotation;
     int nomem;
 } lctx;
@@ -445,7 +448,7 @@ static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
         const double *dc = F[c].ext;
         int64_t kb[3] = {(int64_t)floor(dc[2] / q), (int64_t)floor(fmin(dc[0], dc[1]) / q),
                          (int64_t)floor(fmax(dc[0], dc[1]) / q)};
-        int found = -1, fk = 0, have_cb = 0;
+        int found = -1, fk = 0, have_cb = 0, ffast = 0;
         double fdev = 0;
         for (int fast = 1; fast >= 0 && found < 0 && !x->nomem; fast--)
             for (int nb = 0; nb < 27 && found < 0 && !x->nomem; nb++) {
@@ -475,13 +478,16 @@ static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
                             found = l;
                             fk = k;
                             fdev = dev;
+                            ffast = fast;
                         }
                     }
                 }
             }
-        (void)fdev;
+        x->ldev[c] = -1;
         if (found >= 0) {
             uint32_t e = L->exemplar[found];
+            if (ffast && !(fk >> 2) && F[c].phi == 0 && F[e].phi == 0)
+                x->ldev[c] = fdev;
             L->label[c] = found;
             L->rot[c] = (uint8_t)(fk & 3);
             L->mirror[c] = (uint8_t)(fk >> 2);
@@ -533,6 +539,25 @@ static long variant_pass(lctx *x, const uint32_t *comps, size_t n, double tol, i
         ag_box_extents(&L->box[c], dc);
         int found = -1, fk = 0, have_cb = 0;
         double fdev = 0;
+        if (x->ldev[c] >= 0) {
+            /* matched its label's exemplar by triangle lists in the box frames: placing the
+             * exemplar's terminal on c's box differs from that match by the scaling to c's
+             * extents, at most half the extents' difference per axis */
+            uint32_t e = L->exemplar[l];
+            int32_t v0 = L->variant[e];
+            int k = L->rot[c];
+            double de[3];
+            ag_box_extents(&L->box[e], de);
+            double ex = (k & 1) ? de[1] : de[0], ey = (k & 1) ? de[0] : de[1];
+            double bound = x->ldev[c] + 0.5 * sqrt((dc[0] - ex) * (dc[0] - ex) +
+                                                   (dc[1] - ey) * (dc[1] - ey) +
+                                                   (dc[2] - de[2]) * (dc[2] - de[2]));
+            if (v0 >= 0 && L->variant_exemplar[v0] == e && bound <= tol) {
+                found = v0;
+                fk = k;
+                fdev = bound;
+            }
+        }
         for (int fast = 1; fast >= (surfaces ? 0 : 1) && found < 0 && !x->nomem; fast--)
             for (int32_t v = head[l]; v >= 0 && found < 0 && !x->nomem; v = next[v]) {
                 uint32_t e = L->variant_exemplar[v];
@@ -659,7 +684,8 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
     x.sa = malloc((9 * maxt + 1) * sizeof *x.sa);
     x.sb = malloc((9 * maxt + 1) * sizeof *x.sb);
     x.area = calloc(nc + 1, sizeof *x.area);
-    if (!x.sa || !x.sb || !x.area)
+    x.ldev = malloc((nc + 1) * sizeof *x.ldev);
+    if (!x.sa || !x.sb || !x.area || !x.ldev)
         goto fail;
     for (size_t t = 0; t < m->ntris; t++) {
         const double *p = m->pos + 3 * (size_t)m->tri[3 * t], *q = m->pos + 3 * (size_t)m->tri[3 * t + 1],
@@ -690,6 +716,7 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
     free(x.sa);
     free(x.sb);
     free(x.area);
+    free(x.ldev);
     free(F);
     free(list);
     *out = L;
@@ -698,6 +725,7 @@ fail:
     free(x.sa);
     free(x.sb);
     free(x.area);
+    free(x.ldev);
     free(F);
     free(list);
     ag_labels_free(L);
