@@ -488,11 +488,50 @@ static void test_same_surface(void **state)
     assert_int_equal(ag_label_same_surface(a, 2, w, 2, 5e-3, &dev), 0);
 }
 
+/* Hundreds of different pyramids on one square base (the apex moved by 1.2 cm steps, on one
+ * side of the diagonal so that no turn or mirror image maps one onto another): each is a label
+ * of its own, and the surface comparisons stay within their budget per component, not one per
+ * pair. */
+static void test_many_shapes_on_one_box(void **state)
+{
+    (void)state;
+    ag_mesh *m = ag_mesh_create();
+    size_t n = 0;
+    for (int i = 0; i < 34; i++)
+        for (int j = i + 1; j < 34; j++) {
+            double ax = 0.05 + 0.012 * i, ay = 0.05 + 0.012 * j, x0 = 2.0 * (double)(n % 30),
+                   y0 = 2.0 * (double)(n / 30);
+            size_t c;
+            assert_int_equal(ag_mesh_add_component(m, -1, &c), AG_OK);
+            uint32_t b = (uint32_t)m->nverts;
+            ag_mesh_add_vertex(m, x0, y0, 0);
+            ag_mesh_add_vertex(m, x0 + 1, y0, 0);
+            ag_mesh_add_vertex(m, x0 + 1, y0 + 1, 0);
+            ag_mesh_add_vertex(m, x0, y0 + 1, 0);
+            ag_mesh_add_vertex(m, x0 + ax, y0 + ay, 1);
+            /* the base cut along the diagonal the apex's side does not show */
+            ag_mesh_add_triangle(m, b, b + 2, b + 1, (uint32_t)c);
+            ag_mesh_add_triangle(m, b, b + 3, b + 2, (uint32_t)c);
+            for (uint32_t k = 0; k < 4; k++)
+                ag_mesh_add_triangle(m, b + k, b + (k + 1) % 4, b + 4, (uint32_t)c);
+            n++;
+        }
+    ag_labels *L;
+    assert_int_equal(ag_label_components(m, NULL, &L, NULL), AG_OK);
+    assert_int_equal(L->nlabels, n);
+    /* 64 comparisons per component and pass at most */
+    if (L->surface_checks > 2 * 64 * n)
+        fail_msg("%zu surface checks for %zu components", L->surface_checks, n);
+    ag_labels_free(L);
+    ag_mesh_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_surface),
         cmocka_unit_test(test_triangulations_share_a_label),
+        cmocka_unit_test(test_many_shapes_on_one_box),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

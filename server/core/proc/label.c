@@ -21,6 +21,10 @@
 #define ORIENT_SNAP 1e-9
 /* Surfaces are compared only when their areas agree this closely (relative; areas_close). */
 #define AREA_SLACK 0.02
+/* Surface comparisons one component may make (against exemplars and under turns) before it
+ * is taken as new: many different shapes with equal boxes and areas cost linear time, and
+ * such a component only shares less. */
+#define MAX_SURFACE_CHECKS 64
 
 void ag_label_rotate(int k, double *x, double *y)
 {
@@ -373,6 +377,7 @@ typedef struct {
                      shortcut */
     int no_rotation;
     int nomem;
+    unsigned checks_left; /* surface comparisons the current component may still make */
 } lctx;
 
 /* A necessary-looking condition before surfaces are compared: the areas agree within
@@ -403,6 +408,9 @@ static int compare(lctx *x, size_t na, size_t nb, double tol, int fast, double *
         *dev = w;
         return 1;
     }
+    if (!x->checks_left)
+        return 0; /* past the budget: no match, never a wrong one */
+    x->checks_left--;
     x->L->surface_checks++;
     int r = surfaces_match(x->sa, na, x->sb, nb, tol, dev);
     if (r < 0)
@@ -445,6 +453,7 @@ static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
     int nk = x->no_rotation ? 1 : 8;
     for (size_t i = 0; i < n && !x->nomem; i++) {
         uint32_t c = comps[i];
+        x->checks_left = MAX_SURFACE_CHECKS;
         const double *dc = F[c].ext;
         int64_t kb[3] = {(int64_t)floor(dc[2] / q), (int64_t)floor(fmin(dc[0], dc[1]) / q),
                          (int64_t)floor(fmax(dc[0], dc[1]) / q)};
@@ -534,6 +543,7 @@ static long variant_pass(lctx *x, const uint32_t *comps, size_t n, double tol, i
     int nk = x->no_rotation ? 1 : 4;
     for (size_t i = 0; i < n && !x->nomem; i++) {
         uint32_t c = comps[i];
+        x->checks_left = MAX_SURFACE_CHECKS;
         int32_t l = L->label[c];
         double dc[3];
         ag_box_extents(&L->box[c], dc);
