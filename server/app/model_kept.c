@@ -11,13 +11,13 @@
 #include "../core/edit/rebuild.h"
 #include "model_tree.h"
 
-#define KEPT_FORMAT 2
+#define KEPT_FORMAT 3
 #define NODE_INTS 13
 #define NODE_BYTES (4 * NODE_INTS + 8 * 9)
 #define PATTERN_BYTES (4 * 7 + 8 * 12)
 #define RULE_BYTES 8
-#define COMPONENT_BYTES 16
-#define VARIANT_BYTES 4
+#define COMPONENT_BYTES (4 * 5 + 8)
+#define VARIANT_BYTES (4 + 8)
 
 /* ---- writing ----------------------------------------------------------------------------- */
 
@@ -100,9 +100,13 @@ static char *kept_text(const ag_edit_model *em)
         put_i32(&k, L->variant[c]);
         put_i32(&k, L->rot[c]);
         put_i32(&k, L->vrot[c]);
+        put_i32(&k, L->mirror ? L->mirror[c] : 0);
+        put_f64(&k, L->turn ? L->turn[c] : L->rot[c] * 1.5707963267948966);
     }
-    for (size_t v = 0; v < L->nvariants; v++)
+    for (size_t v = 0; v < L->nvariants; v++) {
         put_i32(&k, L->variant_label[v]);
+        put_f64(&k, L->variant_deviation ? L->variant_deviation[v] : 0);
+    }
     /* printed directly: jansson would copy and scan the data string character by character */
     char *out = NULL;
     if (!k.fail) {
@@ -112,9 +116,10 @@ static char *kept_text(const ag_edit_model *em)
                           "{\"format\":%d,\"tol\":%.17g,\"eps\":%.17g,\"ncomponents\":%zu,"
                           "\"nnodes\":%zu,\"npatterns\":%zu,\"nrules\":%zu,\"nlabels\":%zu,"
                           "\"nvariants\":%zu,\"diagonal\":%.17g,\"label_tol\":%.17g,"
-                          "\"exact\":%.17g,\"data\":\"",
+                          "\"exact\":%.17g,\"share\":%.17g,\"exact_copies\":%d,\"data\":\"",
                           KEPT_FORMAT, t->tol, t->eps, L->ncomponents, t->nnodes, t->npatterns,
-                          t->nrules, L->nlabels, L->nvariants, L->diagonal, L->tol, L->exact);
+                          t->nrules, L->nlabels, L->nvariants, L->diagonal, L->tol, L->exact,
+                          L->share, L->exact_copies ? 1 : 0);
         if (hn > 0 && (size_t)hn < sizeof head && (out = malloc((size_t)hn + blen + 4))) {
             memcpy(out, head, (size_t)hn);
             sodium_bin2base64(out + hn, blen, k.p ? k.p : (const uint8_t *)"", k.n,
@@ -391,6 +396,9 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
     uint8_t *rot = NULL, *vrot = NULL, *data = NULL;
     ag_splittree *t = NULL;
     size_t format = 0, ncomp = 0, nnodes = 0, npat = 0, nrules = 0, nl = 0, nv = 0;
+    size_t exact_copies = 0;
+    uint8_t *mirror = NULL;
+    double *turn = NULL, *deviation = NULL;
     double tol = 0, eps = 0;
     const json_t *d = json_object_get(k, "data");
     const char *b64 = json_string_value(d);
@@ -404,7 +412,9 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
              get_count(&R, k, "nrules", blen, &nrules) && get_count(&R, k, "nlabels", INT32_MAX, &nl) &&
              get_count(&R, k, "nvariants", blen, &nv) && get_real(&R, k, "tol", &tol) &&
              get_real(&R, k, "eps", &eps) && get_real(&R, k, "diagonal", &classes.diagonal) &&
-             get_real(&R, k, "label_tol", &classes.tol) && get_real(&R, k, "exact", &classes.exact);
+             get_real(&R, k, "label_tol", &classes.tol) && get_real(&R, k, "exact", &classes.exact) &&
+             get_real(&R, k, "share", &classes.share) &&
+             get_count(&R, k, "exact_copies", 1, &exact_copies);
     if (ok && ncomp != mesh->ncomponents)
         ok = bad(&R, "it names another number of components than the mesh has");
     if (ok && !(data = malloc(blen + 1)))
@@ -427,6 +437,9 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
         rot = malloc(ncomp + 1);
         vrot = malloc(ncomp + 1);
         vlabel = malloc((nv + 1) * sizeof *vlabel);
+        mirror = malloc(ncomp + 1);
+        turn = malloc((ncomp + 1) * sizeof *turn);
+        deviation = malloc((nv + 1) * sizeof *deviation);
         if (t) {
             t->nnodes = t->cap = nnodes;
             t->npatterns = t->cap_patterns = npat;
@@ -439,7 +452,8 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
             t->rule_count = malloc((nrules + 1) * sizeof *t->rule_count);
             t->rule_rep = malloc((nrules + 1) * sizeof *t->rule_rep);
         }
-        if (!t || !label || !variant || !rot || !vrot || !vlabel || !t->nodes || !t->patterns ||
+        if (!t || !label || !variant || !rot || !vrot || !vlabel || !mirror || !turn ||
+            !deviation || !t->nodes || !t->patterns ||
             !t->rule_count || !t->rule_rep)
             R.st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory"), ok = 0;
     }
@@ -454,17 +468,25 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
     }
     for (size_t c = 0; ok && c < ncomp; c++) {
         int32_t l = get_i32(&R), v = get_i32(&R), r = get_i32(&R), w = get_i32(&R);
+        int32_t mi = get_i32(&R);
+        turn[c] = get_f64(&R);
         ok = in_range(&R, l, -1, (int64_t)nl - 1, "a component's label") &&
              in_range(&R, v, -1, (int64_t)nv - 1, "a component's variant") &&
              in_range(&R, r, 0, 3, "a component's turn") &&
-             in_range(&R, w, 0, 3, "a component's variant turn");
+             in_range(&R, w, 0, 3, "a component's variant turn") &&
+             in_range(&R, mi, 0, 1, "a component's mirror flag") &&
+             (isfinite(turn[c]) || bad(&R, "a component's turn angle"));
+        mirror[c] = (uint8_t)mi;
         label[c] = l;
         variant[c] = v;
         rot[c] = (uint8_t)r;
         vrot[c] = (uint8_t)w;
     }
-    for (size_t v = 0; ok && v < nv; v++)
+    for (size_t v = 0; ok && v < nv; v++) {
         ok = in_range(&R, vlabel[v] = get_i32(&R), -1, (int64_t)nl - 1, "a variant's label");
+        deviation[v] = get_f64(&R);
+        ok = ok && (isfinite(deviation[v]) || bad(&R, "a variant's deviation"));
+    }
     if (ok)
         ok = check_links(&R, t);
     json_decref(doc);
@@ -478,6 +500,10 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
     classes.rot = rot;
     classes.vrot = vrot;
     classes.variant_label = vlabel;
+    classes.mirror = mirror;
+    classes.turn = turn;
+    classes.variant_deviation = deviation;
+    classes.exact_copies = (int)exact_copies;
     ag_mesh *m = NULL;
     if (!st && !(m = ag_mesh_clone(mesh)))
         st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
@@ -497,5 +523,8 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
     free(rot);
     free(vrot);
     free(vlabel);
+    free(mirror);
+    free(turn);
+    free(deviation);
     return st;
 }

@@ -8,13 +8,15 @@
  * the rules survive the store round trip, undo, redo and restore.
  *
  * The stored tree text (app/model_tree.h, numbering AG_MODEL_TREE_NUMBERING) is the served
- * tree with one more member, "kept": {"format":2,"tol","eps","ncomponents","nnodes",
- * "npatterns","nrules","nlabels","nvariants","diagonal","label_tol","exact","data"}, data the
+ * tree with one more member, "kept": {"format":3,"tol","eps","ncomponents","nnodes",
+ * "npatterns","nrules","nlabels","nvariants","diagonal","label_tol","exact","share",
+ * "exact_copies","data"}, data the
  * base64 of little-endian int32s and doubles: per node its kind, parent, first child, last
  * child, next sibling, component, label, variant, rot, octant, rule rot, rule and pattern,
  * then its box (min, max) and pivot; per pattern its rule, rot, lattice size, counts, step,
  * vectors and node; per rule its count and representative; per component its label,
- * variant, rot and variant rot; per variant its label. Binary, because the tree is written
+ * variant, rot, variant rot, mirror flag and turn (radians); per variant its label and
+ * deviation. Binary, because the tree is written
  * with every edit: numbers exactly, a 200k-triangle building's in milliseconds. A kept member
  * that does not describe a tree over the mesh is refused (AG_ERR_PARSE naming what is wrong),
  * never trusted. */

@@ -1,4 +1,4 @@
-/* Node ids survive edits: on generated box buildings (building_fixture.h; windows recessed,
+/* Node ids survive edits: on generated box buildings (edit_building_fixture.h; windows recessed,
  * flush and proud, turned, at UTM coordinates, jittered) a window picked by its place before
  * the front wall is stretched 2x is named by the same id after it (same label, same size,
  * still the first window of its row); no visible node of the input loses its id or changes
@@ -20,7 +20,7 @@
 #include "app/model_kept.h"
 #include "app/model_state.h"
 #include "app/model_tree.h"
-#include "building_fixture.h"
+#include "edit_building_fixture.h"
 #include "core/edit/edit.h"
 #include "core/proc/proceduralize.h"
 #include "io/meshblob.h"
@@ -234,7 +234,7 @@ static void a_broken_kept_model_is_refused(void **state)
     static const struct {
         const char *from, *to;
     } breaks[] = {
-        {"\"format\":2", "\"format\":7"},
+        {"\"format\":3", "\"format\":7"},
         {"\"ncomponents\":", "\"ncomponents\":1"},
         {"\"nnodes\":", "\"nnodes\":9"},
         {"\"data\":\"", "\"data\":\"AAAA"},

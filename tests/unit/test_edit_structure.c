@@ -3,7 +3,7 @@
  * resized by the attachment equations like any node; thin elements keep their thickness; a
  * node attached at one end only keeps its size).
  *
- * Box buildings (building_fixture.h) with a grid on the front and on one or both side facades
+ * Box buildings (edit_building_fixture.h) with a grid on the front and on one or both side facades
  * and a door, the windows recessed, flush and proud, with and without a roof overhang, turned a
  * quarter, at UTM coordinates and jittered, are proceduralized and then stretched 2x along the
  * front (the root and the front wall) and squeezed back. Every result is checked on its mesh
@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "building_fixture.h"
+#include "edit_building_fixture.h"
 #include "core/edit/edit.h"
 #include "core/proc/proceduralize.h"
 

@@ -161,9 +161,13 @@ static ag_labels *labels_new(size_t nc, size_t nlabels, size_t nvariants)
     L->variant_exemplar = calloc(nvariants + 1, sizeof *L->variant_exemplar);
     L->variant_count = calloc(nvariants + 1, sizeof *L->variant_count);
     L->variant_label = calloc(nvariants + 1, sizeof *L->variant_label);
+    L->mirror = calloc(nc + 1, 1);
+    L->turn = calloc(nc + 1, sizeof *L->turn);
+    L->variant_deviation = calloc(nvariants + 1, sizeof *L->variant_deviation);
     if (!L->box || !L->ntris || !L->label || !L->rot || !L->variant || !L->vrot ||
         !L->tri_start || !L->exemplar || !L->count || !L->variant_exemplar ||
-        !L->variant_count || !L->variant_label) {
+        !L->variant_count || !L->variant_label || !L->mirror || !L->turn ||
+        !L->variant_deviation) {
         ag_labels_free(L);
         return NULL;
     }
@@ -433,14 +437,21 @@ ag_status ag_rebuild(const ag_proceduralize_result *in, ag_splittree *t, int32_t
         L->rot[i] = ok ? OL->rot[oc] : 0;
         L->variant[i] = ok ? OL->variant[oc] : -1;
         L->vrot[i] = ok ? OL->vrot[oc] : 0;
+        L->mirror[i] = ok && OL->mirror ? OL->mirror[oc] : 0;
+        L->turn[i] = ok && OL->turn ? OL->turn[oc] : 0;
     }
     memcpy(L->variant_label, OL->variant_label, OL->nvariants * sizeof *L->variant_label);
+    if (OL->variant_deviation)
+        memcpy(L->variant_deviation, OL->variant_deviation,
+               OL->nvariants * sizeof *L->variant_deviation);
+    L->exact_copies = OL->exact_copies;
     /* tolerances follow the model's size */
     double od = ag_box_diagonal(&ot->nodes[0].box), nd = ag_box_diagonal(&t->nodes[0].box);
     double scale = od > 0 && nd > 0 ? nd / od : 1;
     L->diagonal = OL->diagonal * scale;
     L->tol = OL->tol * scale;
     L->exact = OL->exact * scale;
+    L->share = OL->share * scale;
     t->tol = L->exact;
     t->eps = ot->eps * scale;
     free(order);
@@ -478,9 +489,21 @@ ag_status ag_rebuild_finish(ag_mesh *mesh, ag_splittree *tree, const ag_rebuild_
     memcpy(L->rot, c->rot, c->ncomponents);
     memcpy(L->vrot, c->vrot, c->ncomponents);
     memcpy(L->variant_label, c->variant_label, c->nvariants * sizeof *L->variant_label);
+    if (c->mirror)
+        memcpy(L->mirror, c->mirror, c->ncomponents);
+    if (c->turn)
+        memcpy(L->turn, c->turn, c->ncomponents * sizeof *L->turn);
+    else
+        for (size_t i = 0; i < c->ncomponents; i++)
+            L->turn[i] = c->rot[i] * 1.5707963267948966;
+    if (c->variant_deviation)
+        memcpy(L->variant_deviation, c->variant_deviation,
+               c->nvariants * sizeof *L->variant_deviation);
     L->diagonal = c->diagonal;
     L->tol = c->tol;
     L->exact = c->exact;
+    L->share = c->share;
+    L->exact_copies = c->exact_copies;
     return finish(mesh, L, tree, 0, NULL, out, err);
 }
 

@@ -39,8 +39,12 @@ typedef struct {
     size_t ncomponents, nlabels, nvariants;
     const int32_t *label, *variant; /* per component; -1 for a component without triangles */
     const uint8_t *rot, *vrot;      /* per component */
+    const uint8_t *mirror;          /* per component (NULL: none mirrored) */
+    const double *turn;             /* per component (NULL: 90 degrees times rot) */
     const int32_t *variant_label;   /* per variant */
-    double diagonal, tol, exact;    /* the labels' (absolute) tolerances */
+    const double *variant_deviation; /* per variant (NULL: 0) */
+    double diagonal, tol, exact, share; /* the labels' (absolute) tolerances */
+    int exact_copies;
 } ag_rebuild_classes;
 
 /* A result from a kept model: mesh (taken) whose components the tree's visible nodes name
