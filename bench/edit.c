@@ -4,7 +4,12 @@
  * solve (equations, factorization, solve), a drag re-solve with a new target and the
  * factorization kept, the whole committed edit (solve, emission, re-proceduralization) as the
  * CLI makes it (read back through the grammar) and as the service makes it (no read-back),
- * and the peak resident memory. Not a test. */
+ * and the peak resident memory. Then generated buildings of about 20k, 200k and 2M triangles
+ * (windows on four facades) through a committed resize as the service makes it, phase by
+ * phase: the edited tree (solve and layout), the new model (rebuild.h: no
+ * re-proceduralization), the model state (grammar printed and read back), the stored tree
+ * (served tree and kept model) and the mesh blob; the database writes and the broadcast are
+ * measured through the service by bench/edit_ws.js. Not a test. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,7 +17,11 @@
 #include <sys/resource.h>
 #include <time.h>
 
+#include "app/model_kept.h"
+#include "app/model_state.h"
 #include "core/edit/edit.h"
+#include "core/gen_facade.h"
+#include "io/meshblob.h"
 #include "io/obj.h"
 
 #define SHARED AG_REPO_DIR "/../shared/data"
@@ -150,6 +159,93 @@ static void run(const char *name, const ag_mesh *m)
     ag_edit_model_free(model);
 }
 
+/* A committed resize on a generated building, phase by phase, as the service makes it: one
+ * window 0.2 m taller in global mode (every window of its rule follows), then the front wall
+ * 1.5x wider in global mode. */
+static void run_generated(const char *name, const ag_gen_facade_options *go)
+{
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    if (ag_gen_facade(go, &m, &err)) {
+        printf("%-28s generation failed: %s\n", name, err.text);
+        return;
+    }
+    double t0 = now_ms();
+    ag_edit_model *made = NULL;
+    ag_model_state st;
+    if (ag_edit_model_create(m, NULL, &made, &err) || ag_model_state_make(&made, 0, &st, &err)) {
+        printf("%-28s proceduralize failed: %s\n", name, err.text);
+        ag_edit_model_free(made);
+        ag_mesh_free(m);
+        return;
+    }
+    double t_proc = now_ms() - t0;
+    const ag_splittree *t = st.em->proc->tree;
+    int32_t win = -1, wall = -1;
+    double wall_area = 0;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_box *b = &t->nodes[n].box;
+        if (t->nodes[n].kind != AG_NODE_COMPONENT)
+            continue;
+        double dx = b->max[0] - b->min[0], dz = b->max[2] - b->min[2];
+        if (win < 0 && dx < 2 && dz < 3 && dx > 0.5)
+            win = (int32_t)n;
+        if (dx * dz > wall_area && b->max[1] - b->min[1] < 1) {
+            wall_area = dx * dz;
+            wall = (int32_t)n;
+        }
+    }
+    for (int k = 0; k < 2 && win > 0 && wall > 0; k++) {
+        ag_edit_op op = {.kind = AG_EDIT_RESIZE, .mode = AG_EDIT_GLOBAL};
+        if (k == 0) {
+            op.node = win;
+            op.has_box = 1;
+            op.box = t->nodes[win].box;
+            op.box.max[2] += 0.2;
+        } else {
+            op.node = wall;
+            op.has_scale = 1;
+            op.scale[0] = 1.5, op.scale[1] = op.scale[2] = 1;
+        }
+        ag_edit_report rep = {0};
+        ag_edit_model *out = NULL;
+        double a = now_ms();
+        ag_status s = ag_edit_apply_ex(st.em, &op, 0, &out, &rep, &err);
+        double t_edit = now_ms() - a;
+        ag_model_state next;
+        a = now_ms();
+        if (!s)
+            s = ag_model_state_make(&out, 0, &next, &err);
+        double t_state = now_ms() - a;
+        if (s) {
+            printf("%-28s %s failed: %s\n", name, k ? "wall x1.5" : "window taller", err.text);
+            ag_edit_model_free(out);
+            ag_edit_report_clear(&rep);
+            break;
+        }
+        a = now_ms();
+        char *tree = ag_model_kept_tree_text(next.em);
+        double t_tree = now_ms() - a;
+        a = now_ms();
+        uint8_t *blob = NULL;
+        size_t len = 0;
+        ag_meshblob_encode(next.em->proc->mesh, &blob, &len);
+        double t_blob = now_ms() - a;
+        printf("%-28s %8zu %8zu %-14s | %8.0f | %7.1f %7.1f %7.1f %7.1f %7.1f | %7.1f | %6zu "
+               "%6zu %5ld\n",
+               name, m->ntris, next.em->proc->mesh->ntris, k ? "wall x1.5" : "window +0.2 m",
+               t_proc, rep.solve_ms, t_edit, t_state, t_tree, t_blob,
+               t_edit + t_state + t_tree + t_blob, tree ? strlen(tree) >> 10 : 0, len >> 10,
+               peak_mib());
+        free(tree);
+        free(blob);
+        ag_model_state_clear(&next);
+        ag_edit_report_clear(&rep);
+    }
+    ag_model_state_clear(&st);
+    ag_mesh_free(m);
+}
+
 static void run_file(const char *path, ag_up_axis up)
 {
     ag_obj_read_options ro = {.up = up};
@@ -164,8 +260,39 @@ static void run_file(const char *path, ag_up_axis up)
     ag_mesh_free(m);
 }
 
-int main(void)
+/* The generated buildings (20k, 200k and 2M triangles). */
+static const struct {
+    const char *name, *key;
+    ag_gen_facade_options go;
+} gens[] = {
+    {"generated ~20k triangles", "20k", {.cols = 12, .rows = 6, .side_cols = 8, .back = 1, .left = 1}},
+    {"generated ~200k triangles", "200k",
+     {.cols = 40, .rows = 20, .side_cols = 30, .back = 1, .left = 1, .annex = 1}},
+    {"generated ~2M triangles", "2M",
+     {.cols = 40, .rows = 20, .side_cols = 30, .back = 1, .left = 1, .annex = 1, .bars = 56}},
+};
+
+int main(int argc, char **argv)
 {
+    /* edit --write-obj 20k|200k|2M PATH: one generated building as a z-up OBJ (bench/edit_ws.js
+     * sends it to the service) */
+    if (argc == 4 && !strcmp(argv[1], "--write-obj")) {
+        for (size_t i = 0; i < sizeof gens / sizeof *gens; i++) {
+            if (strcmp(argv[2], gens[i].key))
+                continue;
+            ag_mesh *m = NULL;
+            ag_error err = {0};
+            ag_status s = ag_gen_facade(&gens[i].go, &m, &err);
+            if (!s)
+                s = ag_obj_write_file(m, AG_UP_Z, argv[3], &err);
+            ag_mesh_free(m);
+            if (s)
+                fprintf(stderr, "edit: %s\n", err.text);
+            return s ? 1 : 0;
+        }
+        fprintf(stderr, "edit: --write-obj takes 20k, 200k or 2M\n");
+        return 2;
+    }
     printf("%-28s %8s %8s %8s | %9s %9s %9s %10s %10s %9s | %8s %5s\n", "model", "tris",
            "equations", "unknowns", "proc ms", "first ms", "drag ms", "commit ms", "service ms",
            "solve ms", "residual", "MiB");
@@ -181,5 +308,15 @@ int main(void)
     }
     run_file(SHARED "/lod3_ingolstadt/obj/4018267.obj", AG_UP_Z);
     run_file(SHARED "/meshes_0ad/ptol_edfu_struct.obj", AG_UP_Y);
+
+    printf("\ncommitted resize as the service makes it (ms): solve; edit = edited tree + new "
+           "model; state = grammar printed and read back; tree = stored tree text; blob = mesh "
+           "blob; total = edit + state + tree + blob (database writes and broadcast: "
+           "bench/edit_ws.js)\n");
+    printf("%-28s %8s %8s %-14s | %8s | %7s %7s %7s %7s %7s | %7s | %6s %6s %5s\n", "building",
+           "tris", "after", "edit", "proc ms", "solve", "edit", "state", "tree", "blob", "total",
+           "treeKB", "blobKB", "MiB");
+    for (size_t i = 0; i < sizeof gens / sizeof *gens; i++)
+        run_generated(gens[i].name, &gens[i].go);
     return 0;
 }

@@ -1,11 +1,15 @@
 // archgram live editing latency: two clients in the room of a proceduralized demo building;
-// A commits resize ops (each re-solved, re-proceduralized and stored) and sends drag previews
-// (solved with the kept factorization, never stored); prints op→ack, op→broadcast (to B) and
-// preview→room (to B) times. Target: an op reaches the other clients ≤ 50 ms after it is sent.
+// A commits resize ops (each solved, rebuilt without re-proceduralizing and stored) and sends
+// drag previews (solved with the kept factorization, never stored); prints op→ack,
+// op→broadcast (to B) and preview→room (to B) times. Then the same committed ops on the
+// generated 20k- and 200k-triangle buildings of bench/edit (written by `build/bench/edit
+// --write-obj`). Target: an op reaches the other clients ≤ 50 ms after it is sent at 200k.
 // Prints figures; not a test.
 import fs from 'node:fs';
 import { performance } from 'node:perf_hooks';
-import { DAEMON, http, removeDir, sleep, startDaemon, WsClient } from '../tests/integration/harness.js';
+import { execFileSync } from 'node:child_process';
+import path from 'node:path';
+import { DAEMON, http, importModel, removeDir, sleep, startDaemon, waitJob, WsClient } from '../tests/integration/harness.js';
 
 const OPS = 60;
 const PREVIEWS = 200;
@@ -19,6 +23,42 @@ function summary(ms) {
 if (!fs.existsSync(DAEMON)) {
   console.log(`bench/edit_ws.js: ${DAEMON} is missing (make build/archgramd); skipped`);
   process.exit(0);
+}
+
+// Committed resize ops on a model: the root alternately 1.25x wider and back (global), then a
+// window alternately 0.2 m taller and back (global: every window of its rule follows).
+async function committedOps(model, A, B, version, what) {
+  const toAck = [];
+  const toPeer = [];
+  for (let i = 0; i < OPS; i++) {
+    const cid = `edit-${model.id}-${i}`;
+    const t = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`, { timeout: 60000 })).json;
+    let node = 'root';
+    let box = [...t.nodes.find((n) => n.id === t.root).box];
+    if (i < OPS / 2) {
+      box[3] = box[0] + (box[3] - box[0]) * (i % 2 ? 1 / 1.25 : 1.25);
+    } else {
+      const w = t.nodes.find((n) => n.visible && n.box[3] - n.box[0] < 2 && n.box[5] - n.box[2] < 3 && n.box[3] - n.box[0] > 0.3) ??
+        t.nodes.find((n) => n.visible);
+      node = w.id;
+      box = [...w.box];
+      box[5] += i % 2 ? -0.2 : 0.2;
+    }
+    const ack = A.next((m) => (m.type === 'ack' || m.type === 'nack') && m.cid === cid, 60000);
+    const seen = B.next((m) => m.type === 'op' && m.cid === cid, 60000);
+    const ts = performance.now();
+    A.send({ type: 'op', base: version, cid, op: { kind: 'resize', node, box, mode: 'global' } });
+    const [a] = await Promise.all([
+      ack.then((m) => { toAck.push(performance.now() - ts); return m; }),
+      seen.then(() => { toPeer.push(performance.now() - ts); }),
+    ]);
+    if (a.type !== 'ack') throw new Error(`op ${i} on ${what} refused: ${JSON.stringify(a)}`);
+    version = a.version;
+    A.all.length = 0;
+    B.all.length = 0;
+  }
+  console.log(`edit ws ${what}: op→ack ${summary(toAck)}`);
+  console.log(`edit ws ${what}: op→broadcast ${summary(toPeer)}   (target ≤ 50 ms at 200k)`);
 }
 
 const d = await startDaemon({ args: ['--demo'] });
@@ -58,30 +98,34 @@ try {
   }
   A.send({ type: 'preview.end' });
 
-  // committed resize ops, alternately wider and back
-  const toAck = [];
-  const toPeer = [];
-  for (let i = 0; i < OPS; i++) {
-    const cid = `edit-${i}`;
-    const t = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`)).json;
-    const box = [...t.nodes.find((n) => n.id === t.root).box];
-    box[3] = box[0] + (box[3] - box[0]) * (i % 2 ? 1 / 1.25 : 1.25);
-    const ack = A.next((m) => (m.type === 'ack' || m.type === 'nack') && m.cid === cid, 30000);
-    const seen = B.next((m) => m.type === 'op' && m.cid === cid, 30000);
-    const ts = performance.now();
-    A.send({ type: 'op', base: version, cid, op: { kind: 'resize', node: 'root', box, mode: 'global' } });
-    const [a] = await Promise.all([
-      ack.then((m) => { toAck.push(performance.now() - ts); return m; }),
-      seen.then(() => { toPeer.push(performance.now() - ts); }),
-    ]);
-    if (a.type !== 'ack') throw new Error(`op ${i} refused: ${JSON.stringify(a)}`);
-    version = a.version;
-    A.all.length = 0;
-    B.all.length = 0;
-  }
   console.log(`edit ws preview→room:   ${summary(toRoom)}`);
-  console.log(`edit ws op→ack:         ${summary(toAck)}`);
-  console.log(`edit ws op→broadcast:   ${summary(toPeer)}   (target ≤ 50 ms)`);
+  await committedOps(model, A, B, version, 'demo building');
+
+  // the generated buildings, uploaded z-up and proceduralized
+  const bench = path.join(path.dirname(DAEMON), 'bench', 'edit');
+  for (const size of ['20k', '200k']) {
+    if (!fs.existsSync(bench)) {
+      console.log(`edit ws: ${bench} is missing (make build/bench/edit); generated buildings skipped`);
+      break;
+    }
+    const file = path.join(d.dir, `gen${size}.obj`);
+    execFileSync(bench, ['--write-obj', size, file]);
+    const m = await importModel(d, fs.readFileSync(file), { name: `generated ${size}`, up: 'z' });
+    const r = await http(d, 'POST', `/api/v1/models/${m.id}/proceduralize`, {});
+    const job = await waitJob(d, r.json.id, { timeout: 300000, interval: 200 });
+    if (job.status !== 'succeeded') throw new Error(`proceduralize ${size}: ${JSON.stringify(job)}`);
+    const g = (await http(d, 'GET', `/api/v1/models/${m.id}`)).json;
+    const GA = await WsClient.open(d.wsUrl);
+    const GB = await WsClient.open(d.wsUrl);
+    try {
+      const v = (await GA.request({ type: 'hello', model: g.id, user: 'a' }, 'welcome')).version;
+      await GB.request({ type: 'hello', model: g.id, user: 'b' }, 'welcome');
+      await committedOps(g, GA, GB, v, `generated ${size} (${g.stats.triangles} triangles)`);
+    } finally {
+      await GA.close();
+      await GB.close();
+    }
+  }
 } finally {
   if (A) await A.close();
   if (B) await B.close();

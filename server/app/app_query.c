@@ -16,6 +16,7 @@
 #include "app_points.h"
 #include "edit_session.h"
 #include "jobqueue.h"
+#include "model_kept.h"
 #include "model_tree.h"
 #include "store_env.h"
 #include "views.h"
@@ -169,8 +170,14 @@ ag_status ag_app_query_tree(ag_app *app, int64_t id, char **json, size_t *len,
     ag_status s = current_tree(app, db, id, &g, err);
     if (s != AG_OK)
         return s;
-    /* The stored tree is an object; the model, its version and the summary go in front. */
-    const char *tree = g.tree_json;
+    /* The stored tree is an object; the model, its version and the summary go in front, and
+     * what it keeps to reload the model (app/model_kept.h) is not served. */
+    char *served = ag_model_kept_served_text(g.tree_json);
+    if (!served) {
+        ag_grammars_row_clear(&g);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    const char *tree = served;
     while (*tree == ' ')
         tree++;
     char *out = NULL;
@@ -181,8 +188,10 @@ ag_status ag_app_query_tree(ag_app *app, int64_t id, char **json, size_t *len,
                      tree + 1);
     *version = g.model_version;
     ag_grammars_row_clear(&g);
+    int is_object = *tree == '{';
+    free(served);
     if (n < 0)
-        return ag_error_set(err, *tree == '{' ? AG_ERR_NOMEM : AG_ERR_INTERNAL, 0,
+        return ag_error_set(err, is_object ? AG_ERR_NOMEM : AG_ERR_INTERNAL, 0,
                             "the stored split tree cannot be served");
     *json = out;
     *len = (size_t)n;

@@ -8,6 +8,7 @@
 #include "../io/meshblob.h"
 #include "../store/grammars.h"
 #include "../store/models.h"
+#include "model_kept.h"
 #include "model_state.h"
 #include "model_tree.h"
 
@@ -78,7 +79,7 @@ static double now_ms(void)
 static void renumber_stored_tree(ag_db *db, int64_t model, int64_t mesh_blob,
                                  const ag_edit_model *em)
 {
-    char *tree = ag_model_tree_served_text(em);
+    char *tree = ag_model_kept_tree_text(em);
     if (tree && ag_db_begin(db, NULL) == AG_OK) {
         if (ag_grammars_set_tree(db, model, mesh_blob, tree, AG_MODEL_TREE_NUMBERING, NULL) ==
             AG_OK)
@@ -95,7 +96,7 @@ static ag_status load(ag_db *db, ag_edit_state *st, int64_t version, ag_error *e
     ag_grammar_row g;
     ag_error e;
     ag_error_clear(&e);
-    ag_status s = ag_grammars_current(db, st->model, 0, &g, &e);
+    ag_status s = ag_grammars_current(db, st->model, 1, &g, &e);
     if (s == AG_ERR_NOT_FOUND && strstr(e.text, "proceduralized"))
         return ag_error_set(err, AG_ERR_NOT_PROCEDURALIZED, 0,
                             "model %lld is not proceduralized: structural edits need a grammar "
@@ -112,7 +113,10 @@ static ag_status load(ag_db *db, ag_edit_state *st, int64_t version, ag_error *e
     ag_edit_model *em = NULL;
     if ((s = ag_blobs_get(db, g.mesh_blob, &blob, &len, err)) == AG_OK &&
         (s = ag_meshblob_decode(blob, len, &mesh, err)) == AG_OK &&
-        (s = ag_model_state_reload(mesh, &em, err)) == AG_OK) {
+        (s = ag_model_state_reload_kept(mesh, g.tree_numbering == AG_MODEL_TREE_NUMBERING
+                                                  ? g.tree_json
+                                                  : NULL,
+                                        &em, err)) == AG_OK) {
         if (g.tree_numbering != AG_MODEL_TREE_NUMBERING)
             renumber_stored_tree(db, st->model, g.mesh_blob, em);
         ag_edit_session_replace(st, version, em);

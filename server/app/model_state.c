@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "../io/grammar_text.h"
+#include "model_kept.h"
 
 void ag_model_state_clear(ag_model_state *s)
 {
@@ -265,4 +266,15 @@ ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_loo
 ag_status ag_model_state_reload(const ag_mesh *mesh, ag_edit_model **em, ag_error *err)
 {
     return ag_edit_model_create(mesh, NULL, em, err);
+}
+
+ag_status ag_model_state_reload_kept(const ag_mesh *mesh, const char *tree_text,
+                                     ag_edit_model **em, ag_error *err)
+{
+    if (!tree_text)
+        return ag_model_state_reload(mesh, em, err);
+    ag_status s = ag_model_kept_reload(mesh, tree_text, em, err);
+    if (s == AG_ERR_NOT_FOUND) /* a tree stored before models were kept with it */
+        s = ag_model_state_reload(mesh, em, err);
+    return s;
 }

@@ -4,8 +4,10 @@
  *
  * The edit model's mesh (em->proc->mesh) is the model's mesh: the components in the order the
  * tree's components name them, in groups named as the grammar names its labels. An edit model
- * is rebuilt from that mesh alone (ag_model_state_reload gives the same tree, node for node),
- * so a workspace that keeps the mesh (the store) reloads exactly the model it saved; one that
+ * is rebuilt from that mesh and the tree stored with it (ag_model_state_reload_kept gives the
+ * same tree, node for node: an edit keeps the ids of the nodes it did not remove, which
+ * proceduralizing its mesh again would not), so a workspace that keeps the mesh and its tree
+ * (the store) reloads exactly the model it saved; one that
  * keeps only the grammar (a folder) reads it back: the grammar derived and proceduralized
  * anew, which is the edit model AG_MODEL_READ_BACK makes before saving. */
 #ifndef AG_MODEL_STATE_H
@@ -66,7 +68,14 @@ ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_loo
                                    void *user, const ag_edit_budget *budget,
                                    ag_model_state *out, ag_error *err, long *col);
 
-/* The edit model of a kept model mesh (the store's reload). */
+/* The edit model of a model mesh proceduralized (a mesh kept without its tree). */
 ag_status ag_model_state_reload(const ag_mesh *mesh, ag_edit_model **em, ag_error *err);
+
+/* The edit model of a kept model mesh and its stored tree text (the store's reload): made
+ * from what the tree keeps (app/model_kept.h), so an edited model comes back node for node;
+ * a tree that keeps nothing (NULL, or stored before) proceduralizes the mesh. AG_ERR_PARSE
+ * for a kept model that does not fit the mesh. */
+ag_status ag_model_state_reload_kept(const ag_mesh *mesh, const char *tree_text,
+                                     ag_edit_model **em, ag_error *err);
 
 #endif

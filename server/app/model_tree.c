@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/base/array.h"
+
 
 static const char *kind_name(int k)
 {
@@ -111,7 +113,9 @@ static json_t *children_json(const ag_splittree *t, const ag_tnode *x)
     return ch;
 }
 
-json_t *ag_model_tree_served(const ag_edit_model *em)
+/* The served tree; with_nodes = 0 leaves out "root" and "nodes" (the text form prints them
+ * itself). */
+static json_t *served(const ag_edit_model *em, int with_nodes)
 {
     const ag_proceduralize_result *r = em->proc;
     const ag_splittree *t = r->tree;
@@ -123,19 +127,21 @@ json_t *ag_model_tree_served(const ag_edit_model *em)
     size_t visible = 0, live = 0;
     for (size_t n = 0; n < t->nnodes; n++) {
         const ag_tnode *x = &t->nodes[n];
-        json_t *o = json_object();
-        if (!o)
+        json_t *o = with_nodes ? json_object() : NULL;
+        if (with_nodes && !o)
             goto fail;
         json_array_append_new(nodes, o);
         int dead = x->kind == AG_NODE_DEAD;
         live += !dead;
-        json_object_set_new(o, "id", json_integer((json_int_t)n));
-        json_object_set_new(o, "parent",
-                            !dead && x->parent >= 0 ? json_integer(x->parent) : json_null());
-        json_object_set_new(o, "children", dead ? json_array() : children_json(t, x));
-        json_object_set_new(o, "kind", json_string(kind_name(x->kind)));
-        json_object_set_new(o, "box", box_json(&x->box));
-        json_object_set_new(o, "visible", json_boolean(x->kind == AG_NODE_COMPONENT));
+        if (o) {
+            json_object_set_new(o, "id", json_integer((json_int_t)n));
+            json_object_set_new(o, "parent",
+                                !dead && x->parent >= 0 ? json_integer(x->parent) : json_null());
+            json_object_set_new(o, "children", dead ? json_array() : children_json(t, x));
+            json_object_set_new(o, "kind", json_string(kind_name(x->kind)));
+            json_object_set_new(o, "box", box_json(&x->box));
+            json_object_set_new(o, "visible", json_boolean(x->kind == AG_NODE_COMPONENT));
+        }
         const ag_pattern *p = dead ? NULL : pattern_of(t, x);
         char fallback[32];
         const char *label = x->kind == AG_NODE_COMPONENT ? label_of(r, x, fallback) : NULL;
@@ -143,14 +149,16 @@ json_t *ag_model_tree_served(const ag_edit_model *em)
         const char *rule = rule_name(r, cls);
         if (rule && !p && cls >= 0)
             apps[cls]++;
-        json_object_set_new(o, "label", label ? json_string(label) : json_null());
-        json_object_set_new(o, "rule", rule ? json_string(rule) : json_null());
-        const char *term = x->kind == AG_NODE_COMPONENT ? terminal_name(r, x) : NULL;
-        json_object_set_new(o, "terminal", term ? json_string(term) : json_null());
-        json_object_set_new(o, "component", x->kind == AG_NODE_COMPONENT && x->component >= 0
-                                                ? json_integer(x->component)
-                                                : json_null());
-        json_object_set_new(o, "pattern", p ? pattern_json(p) : json_null());
+        if (o) {
+            json_object_set_new(o, "label", label ? json_string(label) : json_null());
+            json_object_set_new(o, "rule", rule ? json_string(rule) : json_null());
+            const char *term = x->kind == AG_NODE_COMPONENT ? terminal_name(r, x) : NULL;
+            json_object_set_new(o, "terminal", term ? json_string(term) : json_null());
+            json_object_set_new(o, "component", x->kind == AG_NODE_COMPONENT && x->component >= 0
+                                                    ? json_integer(x->component)
+                                                    : json_null());
+            json_object_set_new(o, "pattern", p ? pattern_json(p) : json_null());
+        }
         if (x->kind == AG_NODE_COMPONENT && x->component >= 0)
             visible++;
         if (x->kind != AG_NODE_COMPONENT || !label)
@@ -178,8 +186,12 @@ json_t *ag_model_tree_served(const ag_edit_model *em)
                                                "instances", (json_int_t)n));
     }
     ag_splittree_stats st = ag_splittree_stats_of(t);
-    json_object_set_new(root, "root", json_integer(0));
-    json_object_set_new(root, "nodes", nodes);
+    if (with_nodes) {
+        json_object_set_new(root, "root", json_integer(0));
+        json_object_set_new(root, "nodes", nodes);
+    } else {
+        json_decref(nodes);
+    }
     json_object_set_new(root, "labels", labels);
     json_object_set_new(root, "rules", rules);
     json_object_set_new(root, "stats",
@@ -200,13 +212,229 @@ fail:
     return NULL;
 }
 
+json_t *ag_model_tree_served(const ag_edit_model *em)
+{
+    return served(em, 1);
+}
+
+/* ---- the served tree as text: the nodes printed directly -------------------------------- */
+
+/* The tree is stored with every edit; printing its nodes through jansson objects took most
+ * of an edit's time on large buildings, so they are printed here, as jansson would print
+ * them (REAL_PRECISION(15), compact), and the small rest (labels, rules, stats) through it. */
+typedef struct {
+    char *p;
+    size_t n, cap;
+    int fail;
+} text_out;
+
+static void out_reserve(text_out *o, size_t more)
+{
+    if (!o->fail)
+        o->fail = AG_ARRAY_RESERVE_MORE(o->p, o->cap, o->n, more + 1) != AG_OK;
+}
+
+static void out_str(text_out *o, const char *s, size_t n)
+{
+    out_reserve(o, n);
+    if (o->fail)
+        return;
+    memcpy(o->p + o->n, s, n);
+    o->n += n;
+    o->p[o->n] = '\0';
+}
+
+#define OUT_LIT(o, lit) out_str(o, lit, sizeof lit - 1)
+
+static void out_int(text_out *o, long long v)
+{
+    char b[32];
+    int n = snprintf(b, sizeof b, "%lld", v);
+    out_str(o, b, (size_t)n);
+}
+
+/* A real as jansson prints it with REAL_PRECISION(15): %.15g, ".0" added to integral forms
+ * (15 digits: a box at UTM coordinates to the nanometre). */
+static void out_real(text_out *o, double v)
+{
+    char b[40];
+    if (v == 0)
+        v = 0; /* no "-0.0" */
+    int n = snprintf(b, sizeof b, "%.15g", v);
+    char *e = strchr(b, 'e');
+    if (e) { /* jansson drops the exponent's '+' and leading zeros: 1e-07 is 1e-7, 1e+20 1e20 */
+        char *d = e + 1;
+        if (*d == '-')
+            d++;
+        char *z = *d == '+' ? d + 1 : d;
+        while (*z == '0' && z[1])
+            z++;
+        if (z != d) {
+            memmove(d, z, strlen(z) + 1);
+            n = (int)strlen(b);
+        }
+    }
+    if (!strpbrk(b, ".eE") && n + 2 < (int)sizeof b) {
+        b[n++] = '.';
+        b[n++] = '0';
+        b[n] = '\0';
+    }
+    out_str(o, b, (size_t)n);
+}
+
+/* A JSON string (or null for a name that is not valid UTF-8, which jansson would not take). */
+static void out_name(text_out *o, const char *s)
+{
+    if (!s) {
+        OUT_LIT(o, "null");
+        return;
+    }
+    size_t len = 0;
+    while (s[len] && s[len] >= 0x20 && s[len] < 0x7f && s[len] != '"' && s[len] != '\\')
+        len++;
+    if (!s[len]) { /* plain ASCII (label, rule and terminal names): as it is */
+        out_reserve(o, len + 2);
+        OUT_LIT(o, "\"");
+        out_str(o, s, len);
+        OUT_LIT(o, "\"");
+        return;
+    }
+    json_t *j = json_string(s);
+    if (!j) {
+        OUT_LIT(o, "null");
+        return;
+    }
+    /* anything else: jansson escapes it as it would */
+    char *e = json_dumps(j, JSON_ENCODE_ANY);
+    json_decref(j);
+    if (!e) {
+        o->fail = 1;
+        return;
+    }
+    out_str(o, e, strlen(e));
+    free(e);
+}
+
+static void out_vec(text_out *o, const double *v)
+{
+    OUT_LIT(o, "[");
+    for (int k = 0; k < 3; k++) {
+        if (k)
+            OUT_LIT(o, ",");
+        out_real(o, v[k]);
+    }
+    OUT_LIT(o, "]");
+}
+
+static void out_pattern(text_out *o, const ag_pattern *p)
+{
+    OUT_LIT(o, "{\"counts\":[");
+    for (int k = 0; k < 3; k++) {
+        if (k)
+            OUT_LIT(o, ",");
+        out_int(o, p->nvec && k >= p->nvec ? 1 : p->counts[k]);
+    }
+    OUT_LIT(o, "],\"step\":");
+    if (p->nvec) {
+        OUT_LIT(o, "null,\"vectors\":[");
+        for (int k = 0; k < p->nvec; k++) {
+            if (k)
+                OUT_LIT(o, ",");
+            out_vec(o, p->vec[k]);
+        }
+        OUT_LIT(o, "]");
+    } else {
+        out_vec(o, p->step);
+    }
+    if (p->rot) {
+        OUT_LIT(o, ",\"rot\":");
+        out_int(o, 90 * p->rot);
+    }
+    OUT_LIT(o, "}");
+}
+
+static void out_node(text_out *o, const ag_proceduralize_result *r, size_t n)
+{
+    const ag_splittree *t = r->tree;
+    const ag_tnode *x = &t->nodes[n];
+    int dead = x->kind == AG_NODE_DEAD;
+    OUT_LIT(o, "{\"id\":");
+    out_int(o, (long long)n);
+    OUT_LIT(o, ",\"parent\":");
+    if (!dead && x->parent >= 0)
+        out_int(o, x->parent);
+    else
+        OUT_LIT(o, "null");
+    OUT_LIT(o, ",\"children\":[");
+    if (!dead)
+        for (int32_t c = x->first_child; c >= 0; c = t->nodes[c].next_sibling) {
+            if (c != x->first_child)
+                OUT_LIT(o, ",");
+            out_int(o, c);
+        }
+    OUT_LIT(o, "],\"kind\":\"");
+    const char *k = kind_name(x->kind);
+    out_str(o, k, strlen(k));
+    OUT_LIT(o, "\",\"box\":[");
+    for (int a = 0; a < 6; a++) {
+        if (a)
+            OUT_LIT(o, ",");
+        out_real(o, a < 3 ? x->box.min[a] : x->box.max[a - 3]);
+    }
+    OUT_LIT(o, "],\"visible\":");
+    if (x->kind == AG_NODE_COMPONENT)
+        OUT_LIT(o, "true");
+    else
+        OUT_LIT(o, "false");
+    const ag_pattern *p = dead ? NULL : pattern_of(t, x);
+    char fallback[32];
+    OUT_LIT(o, ",\"label\":");
+    out_name(o, x->kind == AG_NODE_COMPONENT ? label_of(r, x, fallback) : NULL);
+    OUT_LIT(o, ",\"rule\":");
+    out_name(o, rule_name(r, dead ? -1 : p ? p->rule : x->rule));
+    OUT_LIT(o, ",\"terminal\":");
+    out_name(o, x->kind == AG_NODE_COMPONENT ? terminal_name(r, x) : NULL);
+    OUT_LIT(o, ",\"component\":");
+    if (x->kind == AG_NODE_COMPONENT && x->component >= 0)
+        out_int(o, x->component);
+    else
+        OUT_LIT(o, "null");
+    OUT_LIT(o, ",\"pattern\":");
+    if (p)
+        out_pattern(o, p);
+    else
+        OUT_LIT(o, "null");
+    OUT_LIT(o, "}");
+}
+
 char *ag_model_tree_served_text(const ag_edit_model *em)
 {
-    json_t *j = ag_model_tree_served(em);
-    char *text = j ? json_dumps(j, JSON_COMPACT | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(12))
-                   : NULL;
-    json_decref(j);
-    return text;
+    json_t *rest = served(em, 0);
+    char *tail = rest ? json_dumps(rest, JSON_COMPACT | JSON_PRESERVE_ORDER) : NULL;
+    json_decref(rest);
+    if (!tail || tail[0] != '{') {
+        free(tail);
+        return NULL;
+    }
+    const ag_splittree *t = em->proc->tree;
+    text_out o = {0};
+    out_reserve(&o, 256 * t->nnodes + strlen(tail) + 64);
+    OUT_LIT(&o, "{\"root\":0,\"nodes\":[");
+    for (size_t n = 0; n < t->nnodes && !o.fail; n++) {
+        if (n)
+            OUT_LIT(&o, ",");
+        out_node(&o, em->proc, n);
+    }
+    OUT_LIT(&o, "]");
+    if (tail[1] != '}')
+        OUT_LIT(&o, ",");
+    out_str(&o, tail + 1, strlen(tail + 1));
+    free(tail);
+    if (o.fail) {
+        free(o.p);
+        return NULL;
+    }
+    return o.p;
 }
 
 json_t *ag_model_tree_folder_stats(const ag_edit_model *em)

@@ -14,6 +14,7 @@
 #include "../store/models.h"
 #include "../store/states.h"
 #include "extrusion.h"
+#include "model_kept.h"
 #include "model_tree.h"
 #include "part_library.h"
 #include "usecase_compose.h"
@@ -117,7 +118,7 @@ ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
     ag_status s = encode_mesh(st->em->proc->mesh, &blob, &blob_len, &stats, err);
     if (s != AG_OK)
         return s;
-    char *tree = ag_model_tree_served_text(st->em);
+    char *tree = ag_model_kept_tree_text(st->em); /* a reload gives this model back */
     int64_t mesh_blob = 0;
     if (!tree)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory describing the model");

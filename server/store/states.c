@@ -29,7 +29,8 @@ ag_status ag_states_keep(ag_db *db, int64_t model, int64_t version, ag_error *er
         "SELECT m.id, ?, m.mesh_blob, m.stats, g.text, g.tree, g.summary, "
         "coalesce(g.tree_numbering, 1) FROM models m "
         "LEFT JOIN grammars g ON g.model_id = m.id AND g.mesh_blob = m.mesh_blob "
-        "WHERE m.id = ?",
+        "WHERE m.id = ? AND NOT EXISTS (SELECT 1 FROM model_states k " /* kept: not read again */
+        "WHERE k.model_id = m.id AND k.version = ?1)",
         err);
     if (s != AG_OK)
         return s;

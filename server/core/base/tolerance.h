@@ -82,6 +82,13 @@
  * returns to its count, and a cell squeezed to half its size joins with its neighbour. */
 #define AG_EDIT_JOIN_RATIO (1.0 / 1.8)
 
+/* Resize: an axis along which an element is thinner than this share of its longest extent is
+ * a thin axis (a wall's thickness, a slab's depth, a window's depth): the element keeps its
+ * size there, never splits across it, and a pattern of such elements along it keeps the
+ * elements and spaces them out. A quarter keeps a window 1.2 m wide and 0.3 m deep thin in its
+ * depth but neither a square pier nor a door. */
+#define AG_EDIT_THIN_RATIO 0.25
+
 /* Coincidence (relative) where a tree gives none (a tree without eps, the sibling join's
  * span test): the split tree's own AG_PROC_COINCIDENT, so edits and proceduralization agree
  * on what touches. */

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "../base/clock.h"
+#include "rebuild.h"
 #include "resize.h"
 
 struct ag_edit_cache {
@@ -200,6 +201,8 @@ ag_status ag_edit_model_create(const ag_mesh *mesh, const ag_proceduralize_optio
     o.segment.keep_groups = 1;
     ag_proceduralize_result *r;
     ag_status st = ag_proceduralize_run(mesh, &o, &r, err);
+    if (!st && (st = ag_rebuild_name_labels(r, err)))
+        ag_proceduralize_result_free(r);
     if (st)
         return st;
     if ((st = ag_edit_model_wrap(r, &o, out, err)))
@@ -237,6 +240,40 @@ ag_status ag_edit_apply(ag_edit_model *m, const ag_edit_op *op, ag_edit_model **
     return ag_edit_apply_ex(m, op, AG_EDIT_READ_BACK, out, rep, err);
 }
 
+/* A resize knows its result: the edited tree rebuilt into the new model (rebuild.h), node ids
+ * kept; read back through its grammar when asked. */
+static ag_status apply_resize(ag_edit_model *m, const ag_edit_op *op, unsigned flags,
+                              ag_edit_model **out, ag_edit_report *rep, ag_error *err)
+{
+    ag_splittree *tree = NULL;
+    int32_t *source = NULL;
+    ag_proceduralize_result *r = NULL;
+    ag_status st = ag_edit_resize_tree(m->proc, op, &tree, &source, rep, err);
+    if (!st)
+        st = ag_rebuild(m->proc, tree, source, &m->opt.patterns, &r, err);
+    if (st)
+        return st;
+    if (ag_edit_budget_cancelled(op->budget)) {
+        ag_proceduralize_result_free(r);
+        return ag_error_set(err, AG_ERR_CANCELLED, 0, "the edit was stopped");
+    }
+    if (!r->mesh->ntris) {
+        ag_proceduralize_result_free(r);
+        return ag_error_set(err, AG_ERR_EMPTY, 0, "the edit leaves no geometry");
+    }
+    if (flags & AG_EDIT_READ_BACK) {
+        st = ag_edit_model_from_grammar(r->grammar, &m->opt, out, err);
+        ag_proceduralize_result_free(r);
+    } else if ((st = ag_edit_model_wrap(r, &m->opt, out, err))) {
+        ag_proceduralize_result_free(r);
+    }
+    if (!st && (st = count_tree_labels(rep, (*out)->proc, err))) {
+        ag_edit_model_free(*out);
+        *out = NULL;
+    }
+    return st;
+}
+
 ag_status ag_edit_apply_ex(ag_edit_model *m, const ag_edit_op *op, unsigned flags,
                            ag_edit_model **out, ag_edit_report *rep, ag_error *err)
 {
@@ -249,10 +286,9 @@ ag_status ag_edit_apply_ex(ag_edit_model *m, const ag_edit_op *op, unsigned flag
         ag_edit_report_clear(rep);
     ag_mesh *mesh = NULL;
     ag_status st;
+    if (op->kind == AG_EDIT_RESIZE)
+        return apply_resize(m, op, flags, out, rep, err);
     switch (op->kind) {
-    case AG_EDIT_RESIZE:
-        st = ag_edit_resize(m->proc, op, &mesh, rep, err);
-        break;
     case AG_EDIT_SPLIT:
         st = ag_edit_split(m->proc, op, &mesh, rep, err);
         break;

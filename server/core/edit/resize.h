@@ -1,25 +1,30 @@
 /* Structure-preserving resize (see edit.h for the op and attach.h for the equations).
  *
- * 1. The edited nodes: the op's node, and in global mode every visible node of its rule
- *    (turned by their quarter turns). Each gets a target box, kept inside the box of its
- *    nearest visible ancestor (a window never leaves its wall).
- * 2. The area of effect: breadth-first from the edited nodes over the adjacency of visible
- *    nodes with the same nearest visible ancestor (the same level of nesting); local mode
- *    keeps only nodes meeting the region. Their descendants are not unknowns: they are
- *    re-derived from their ancestors afterwards.
- * 3. Hard attachments (targets, ground, shared coordinates) are eliminated by merging
- *    coordinates into classes; the soft ones (ratios, size, position) over the free classes
- *    form a sparse least-squares system (lsq.h) whose factorization depends only on the
- *    structure, so a drag re-solves with new targets without refactorizing.
- * 4. Emission: every visible node's component is mapped affinely from its old box to its new
- *    one; a node stretched past AG_EDIT_SPLIT_RATIO splits into two copies of its subtree,
- *    and a pattern whose cells pass AG_EDIT_SPLIT_RATIO or fall under AG_EDIT_JOIN_RATIO
- *    doubles or halves its count on that axis, recursively, keeping each cell's share of its
- *    period; plain siblings of one rule (not cells of a grid pattern) squeezed under
- *    AG_EDIT_JOIN_RATIO join with their nearest same-rule sibling along that axis, recursively.
- *    Editing the root or an invisible node maps its subtree affinely (no solve).
- * The steps live in resize_system.c (1-3, in named phases), resize_solve.c and resize_emit.c
- * (4); resize_internal.h holds what they share. */
+ * 1. Units: the boxes the equations move are the visible nodes and the patterns (a pattern is
+ *    one box whose cells are its lattice periods; an edited cell opens its pattern).
+ * 2. The edited level: the op's node, and in global mode every visible node of its rule
+ *    (turned by their quarter turns), each with a target box kept inside its nearest visible
+ *    ancestor (a window never leaves its wall); around them, breadth-first over the units'
+ *    adjacency, the units with the same nearest visible ancestor (local mode: only those
+ *    meeting the region). The root is resized like any node: its target is the frame of every
+ *    unit right below it.
+ * 3. The system: hard attachments (targets, the frame's faces, the ground, shared
+ *    coordinates) merge coordinates into classes; the soft ones (overlap ratios, size,
+ *    position) over the free classes form a sparse least-squares system (lsq.h) whose
+ *    factorization depends only on the structure, so a drag re-solves with new targets
+ *    without refactorizing. A unique element keeps its size where one end is attached (the
+ *    paper's size equations) and its centre's place where it floats; a pattern, and one of
+ *    several elements of one rule, follows what it lies in (not along a thin axis).
+ * 4. Down the tree: every changed node's children are solved the same way in its new box
+ *    (moved as a whole when it only moved); a pattern's count doubles or halves while a
+ *    period would pass AG_EDIT_SPLIT_RATIO or fall under AG_EDIT_JOIN_RATIO, its cells keeping
+ *    the original size and spacing at twice or half the length; a leaf stretched past the split
+ *    ratio on an axis that is not thin splits into two copies; plain siblings of one rule
+ *    squeezed under the join ratio join with their nearest same-rule sibling, recursively.
+ * The steps live in resize_units.c (1), resize.c (2), resize_system.c (3, in named phases) and
+ * resize_layout.c (4); resize_internal.h holds what they share. A commit gives the new tree
+ * (nodes keep their indices, copies are appended, removed nodes are dead), which
+ * core/edit/rebuild.h turns into the new model. */
 #ifndef AG_EDIT_RESIZE_H
 #define AG_EDIT_RESIZE_H
 
@@ -46,10 +51,13 @@ int ag_edit_resize_solver_matches(const ag_edit_resize_solver *s, const ag_edit_
 ag_status ag_edit_resize_solver_solve(ag_edit_resize_solver *s, const ag_edit_op *op,
                                       ag_box *boxes, ag_edit_report *rep, ag_error *err);
 
-/* The mesh of the model with the nodes moved to boxes, with pattern split/join. What it would
- * place is counted first and refused past the budget's limits (budget may be NULL). */
-ag_status ag_edit_resize_emit(const ag_proceduralize_result *in, const ag_box *boxes,
-                              const ag_edit_budget *budget, ag_mesh **out, ag_edit_report *rep,
+/* The edited tree of a resize: *tree (nodes that stay keep their index, copies appended,
+ * removed nodes dead) and *source (per node, malloc'd: the node of in's tree it copies), the
+ * input for ag_rebuild (rebuild.h). What the tree would place is counted before anything is
+ * made of it and refused past the op's budget (AG_ERR_RESULT_TOO_LARGE); the budget's
+ * callback is polled while the tree is laid out. */
+ag_status ag_edit_resize_tree(const ag_proceduralize_result *in, const ag_edit_op *op,
+                              ag_splittree **tree, int32_t **source, ag_edit_report *rep,
                               ag_error *err);
 
 #endif

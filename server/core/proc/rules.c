@@ -37,7 +37,35 @@ static size_t children(const ag_splittree *t, int32_t v, int32_t *buf, size_t ca
     return n;
 }
 
-/* Does b match rep a with b = rotate(a, k)? */
+/* Do pattern nodes x (of a) and y (of b) repeat the same cells the same way, y being x turned
+ * by k quarter turns? */
+static int same_pattern(const ag_splittree *t, const ag_tnode *x, const ag_tnode *y, int k)
+{
+    if (x->pattern < 0 || y->pattern < 0 || (size_t)x->pattern >= t->npatterns ||
+        (size_t)y->pattern >= t->npatterns)
+        return 0;
+    const ag_pattern *p = &t->patterns[x->pattern], *q = &t->patterns[y->pattern];
+    if (p->rule != q->rule || ((p->rot + k) & 3) != q->rot || p->nvec != q->nvec)
+        return 0;
+    if (!p->nvec) {
+        int odd = k & 1;
+        return p->counts[odd ? 1 : 0] == q->counts[0] && p->counts[odd ? 0 : 1] == q->counts[1] &&
+               p->counts[2] == q->counts[2];
+    }
+    for (int v = 0; v < p->nvec; v++) {
+        double vx = p->vec[v][0], vy = p->vec[v][1];
+        ag_label_rotate(k, &vx, &vy);
+        if (p->counts[v] != q->counts[v] || fabs(vx - q->vec[v][0]) > t->tol ||
+            fabs(vy - q->vec[v][1]) > t->tol || fabs(p->vec[v][2] - q->vec[v][2]) > t->tol)
+            return 0;
+    }
+    return 1;
+}
+
+/* Does b match rep a with b = rotate(a, k)? b must also have a's size: a rule is placed scaled
+ * to the box it is applied to (its children would move with it) and a pattern's cells are of
+ * one size (nodes of one variant have it anyway; an edited model's stretched copies of a
+ * variant do not). Pattern children repeat the same rule the same way. */
 static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca, int32_t *cb,
                 uint8_t *used, size_t n)
 {
@@ -47,6 +75,15 @@ static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca,
     (void)nb;
     memset(used, 0, n);
     double tol = t->tol;
+    {
+        double ea[3], eb[3];
+        ag_box_extents(&t->nodes[a].box, ea);
+        ag_box_extents(&t->nodes[b].box, eb);
+        int odd = k & 1;
+        if (fabs(ea[odd ? 1 : 0] - eb[0]) > tol || fabs(ea[odd ? 0 : 1] - eb[1]) > tol ||
+            fabs(ea[2] - eb[2]) > tol)
+            return 0;
+    }
     for (size_t j = 0; j < n; j++) {
         const ag_tnode *y = &t->nodes[cb[j]];
         double blo[3], bhi[3];
@@ -56,7 +93,11 @@ static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca,
             if (used[i])
                 continue;
             const ag_tnode *x = &t->nodes[ca[i]];
-            if (x->rule != y->rule || x->kind != y->kind || ((x->rule_rot + k) & 3) != y->rule_rot)
+            if (x->kind != y->kind)
+                continue;
+            if (x->kind == AG_NODE_PATTERN ? !same_pattern(t, x, y, k)
+                                           : x->rule != y->rule ||
+                                                 ((x->rule_rot + k) & 3) != y->rule_rot)
                 continue;
             double alo[3], ahi[3];
             rel_box(t, a, ca[i], k, alo, ahi);
@@ -81,6 +122,61 @@ size_t ag_rules_max_count(const ag_splittree *t)
         if (t->rule_count[r] > m)
             m = t->rule_count[r];
     return m;
+}
+
+/* The visible nodes in an order where every visible node comes after the visible nodes below
+ * it: reverse index order when every visible node's nearest visible ancestor has a smaller
+ * index (a tree as built, or edited keeping that), else a post-order walk. */
+static int32_t *children_first(const ag_splittree *t, size_t *n_out)
+{
+    size_t N = t->nnodes, n = 0;
+    int32_t *order = malloc((N + 1) * sizeof *order);
+    if (!order)
+        return NULL;
+    int indexed = 1;
+    for (size_t i = 0; i < N && indexed; i++) {
+        if (t->nodes[i].kind != AG_NODE_COMPONENT)
+            continue;
+        int32_t p = t->nodes[i].parent;
+        while (p >= 0 && t->nodes[p].kind != AG_NODE_COMPONENT && t->nodes[p].kind != AG_NODE_ROOT)
+            p = t->nodes[p].parent;
+        indexed = p < (int32_t)i;
+    }
+    if (indexed) {
+        for (size_t i = N; i-- > 0;)
+            if (t->nodes[i].kind == AG_NODE_COMPONENT)
+                order[n++] = (int32_t)i;
+        *n_out = n;
+        return order;
+    }
+    /* iterative post-order: a node is emitted once its children are */
+    int32_t *stack = malloc((N + 1) * sizeof *stack), *next = malloc((N + 1) * sizeof *next);
+    if (!stack || !next) {
+        free(stack);
+        free(next);
+        free(order);
+        return NULL;
+    }
+    size_t sp = 0;
+    stack[sp++] = 0;
+    next[0] = t->nodes[0].first_child;
+    while (sp) {
+        int32_t v = stack[sp - 1];
+        int32_t c = next[v];
+        if (c >= 0 && sp < N + 1) {
+            next[v] = t->nodes[c].next_sibling;
+            stack[sp++] = c;
+            next[c] = t->nodes[c].first_child;
+            continue;
+        }
+        sp--;
+        if (t->nodes[v].kind == AG_NODE_COMPONENT)
+            order[n++] = v;
+    }
+    free(stack);
+    free(next);
+    *n_out = n;
+    return order;
 }
 
 ag_status ag_rules_label(ag_splittree *t, ag_error *err)
@@ -110,11 +206,20 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     }
     for (int32_t l = 0; l <= maxlabel; l++)
         lhead[l] = -1;
-    /* parents are created before their children: reverse order visits children first */
-    for (size_t ii = N; ii-- > 0;) {
+    /* children first, so each comparison is one level deep */
+    size_t norder = 0;
+    int32_t *order = children_first(t, &norder);
+    if (!order) {
+        free(lhead);
+        free(rnext);
+        free(ca);
+        free(cb);
+        free(used);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
+    }
+    for (size_t oi = 0; oi < norder; oi++) {
+        size_t ii = (size_t)order[oi];
         ag_tnode *b = &t->nodes[ii];
-        if (b->kind != AG_NODE_COMPONENT)
-            continue;
         size_t nb = children(t, (int32_t)ii, NULL, 0);
         int32_t found = -1;
         int fk = 0;
@@ -139,6 +244,16 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
         b->rule = found;
         b->rule_rot = (uint8_t)fk;
         t->rule_count[found]++;
+    }
+    free(order);
+    /* a pattern repeats its cells' rule */
+    for (size_t p = 0; p < t->npatterns; p++) {
+        int32_t pn = t->patterns[p].node;
+        int32_t c = pn >= 0 && (size_t)pn < N ? t->nodes[pn].first_child : -1;
+        if (c >= 0 && t->nodes[pn].kind == AG_NODE_PATTERN) {
+            t->patterns[p].rule = t->nodes[c].rule;
+            t->patterns[p].rot = t->nodes[c].rule_rot;
+        }
     }
     free(lhead);
     free(rnext);

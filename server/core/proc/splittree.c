@@ -21,6 +21,41 @@ void ag_splittree_free(ag_splittree *t)
     free(t);
 }
 
+/* A malloc'd copy of n elements of size sz (NULL for none). */
+static void *dup_array(const void *p, size_t n, size_t sz, int *fail)
+{
+    if (!p || !n)
+        return NULL;
+    void *q = malloc(n * sz);
+    if (!q)
+        *fail = 1;
+    else
+        memcpy(q, p, n * sz);
+    return q;
+}
+
+ag_splittree *ag_splittree_copy(const ag_splittree *t)
+{
+    ag_splittree *c = calloc(1, sizeof *c);
+    if (!c)
+        return NULL;
+    *c = *t;
+    int fail = 0;
+    c->nodes = dup_array(t->nodes, t->nnodes, sizeof *t->nodes, &fail);
+    c->cap = c->nodes ? t->nnodes : 0;
+    c->comp_node = dup_array(t->comp_node, t->ncomponents, sizeof *t->comp_node, &fail);
+    c->adj = dup_array(t->adj, 2 * t->nadj, sizeof *t->adj, &fail);
+    c->rule_count = dup_array(t->rule_count, t->nrules, sizeof *t->rule_count, &fail);
+    c->rule_rep = dup_array(t->rule_rep, t->nrules, sizeof *t->rule_rep, &fail);
+    c->patterns = dup_array(t->patterns, t->npatterns, sizeof *t->patterns, &fail);
+    c->cap_patterns = c->patterns ? t->npatterns : 0;
+    if (fail) {
+        ag_splittree_free(c);
+        return NULL;
+    }
+    return c;
+}
+
 ag_box ag_splittree_child_box(const ag_box *p, const double pivot[3], int octant)
 {
     ag_box b;
@@ -98,44 +133,168 @@ static int32_t add_split(ag_splittree *t, int32_t parent, const double piv[3], i
     return n;
 }
 
-int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *c, int kind)
+/* The one or two point splits that cut box c out of parent box P (insertion's rule): the first
+ * keeps, per axis, the part from P's face that c shares (or from c's min when it shares none);
+ * the second, needed when c shares no face of P on some axis, then cuts c's max there. Returns
+ * the number of splits (1 or 2). */
+static int chain_splits(const ag_box *P, const ag_box *c, double eps, double piv[2][3],
+                        int oct[2])
 {
-    assert(parent >= 0 && (size_t)parent < t->nnodes);
-    const ag_box P = t->nodes[parent].box;
-    double eps = t->eps;
-    int done[3], single = 1;
-    double piv[3];
-    int q = 0;
+    int done[3], single = 1, q = 0;
     for (int a = 0; a < 3; a++) {
-        int lo = fabs(c->min[a] - P.min[a]) <= eps, hi = fabs(c->max[a] - P.max[a]) <= eps;
+        int lo = fabs(c->min[a] - P->min[a]) <= eps, hi = fabs(c->max[a] - P->max[a]) <= eps;
         done[a] = 1;
         if (lo) {
-            piv[a] = c->max[a] - P.min[a];
+            piv[0][a] = c->max[a] - P->min[a];
         } else if (hi) {
-            piv[a] = c->min[a] - P.min[a];
+            piv[0][a] = c->min[a] - P->min[a];
             q |= 1 << a;
         } else {
-            piv[a] = c->min[a] - P.min[a];
+            piv[0][a] = c->min[a] - P->min[a];
             q |= 1 << a;
             done[a] = 0;
             single = 0;
         }
-        piv[a] = pivot_within(piv[a], ag_box_extent(&P, a));
+        piv[0][a] = pivot_within(piv[0][a], ag_box_extent(P, a));
     }
-    int32_t n = add_split(t, parent, piv, q, single ? kind : AG_NODE_SPLIT);
-    if (n < 0 || single)
-        return n;
-    const ag_box I = t->nodes[n].box;
+    oct[0] = q + 1;
+    if (single)
+        return 1;
+    const ag_box I = ag_splittree_child_box(P, piv[0], oct[0]);
     q = 0;
     for (int a = 0; a < 3; a++) {
         if (done[a]) {
-            piv[a] = 0;
+            piv[1][a] = 0;
             q |= 1 << a;
         } else {
-            piv[a] = pivot_within(c->max[a] - I.min[a], ag_box_extent(&I, a));
+            piv[1][a] = pivot_within(c->max[a] - I.min[a], ag_box_extent(&I, a));
         }
     }
-    return add_split(t, n, piv, q, kind);
+    oct[1] = q + 1;
+    return 2;
+}
+
+int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *c, int kind)
+{
+    assert(parent >= 0 && (size_t)parent < t->nnodes);
+    const ag_box P = t->nodes[parent].box;
+    double piv[2][3];
+    int oct[2];
+    int n = chain_splits(&P, c, t->eps, piv, oct);
+    int32_t k = add_split(t, parent, piv[0], oct[0] - 1, n == 1 ? kind : AG_NODE_SPLIT);
+    if (k < 0 || n == 1)
+        return k;
+    return add_split(t, k, piv[1], oct[1] - 1, kind);
+}
+
+int32_t ag_splittree_add_node(ag_splittree *t, int kind)
+{
+    return new_node(t, kind);
+}
+
+void ag_splittree_detach(ag_splittree *t, int32_t child)
+{
+    int32_t p = t->nodes[child].parent;
+    if (p < 0)
+        return;
+    ag_tnode *P = &t->nodes[p];
+    int32_t prev = -1;
+    for (int32_t s = P->first_child; s >= 0; prev = s, s = t->nodes[s].next_sibling) {
+        if (s != child)
+            continue;
+        if (prev >= 0)
+            t->nodes[prev].next_sibling = t->nodes[s].next_sibling;
+        else
+            P->first_child = t->nodes[s].next_sibling;
+        if (P->last_child == s)
+            P->last_child = prev;
+        break;
+    }
+    t->nodes[child].parent = -1;
+    t->nodes[child].next_sibling = -1;
+}
+
+void ag_splittree_attach_after(ag_splittree *t, int32_t parent, int32_t after, int32_t child)
+{
+    if (after < 0) {
+        ag_splittree_attach(t, parent, child);
+        return;
+    }
+    assert(t->nodes[after].parent == parent);
+    t->nodes[child].parent = parent;
+    t->nodes[child].next_sibling = t->nodes[after].next_sibling;
+    t->nodes[after].next_sibling = child;
+    if (t->nodes[parent].last_child == after)
+        t->nodes[parent].last_child = child;
+}
+
+ag_status ag_splittree_hang(ag_splittree *t, int32_t parent, int32_t node)
+{
+    double piv[2][3];
+    int oct[2];
+    int n = chain_splits(&t->nodes[parent].box, &t->nodes[node].box, t->eps, piv, oct);
+    int32_t at = parent;
+    if (n == 2) {
+        at = add_split(t, parent, piv[0], oct[0] - 1, AG_NODE_SPLIT);
+        if (at < 0)
+            return AG_ERR_NOMEM;
+    }
+    ag_tnode *x = &t->nodes[node];
+    memcpy(x->pivot, piv[n - 1], sizeof x->pivot);
+    x->octant = (uint8_t)oct[n - 1];
+    ag_splittree_attach(t, at, node);
+    return AG_OK;
+}
+
+ag_status ag_splittree_rechain(ag_splittree *t, int32_t end)
+{
+    int32_t first = end, parent = t->nodes[end].parent;
+    if (parent < 0)
+        return AG_OK;
+    if (t->nodes[parent].kind == AG_NODE_SPLIT) {
+        first = parent;
+        parent = t->nodes[parent].parent;
+    }
+    if (parent < 0 || t->nodes[parent].kind == AG_NODE_PATTERN)
+        return AG_OK; /* a pattern's cells are placed by the pattern, not by splits */
+    double piv[2][3];
+    int oct[2];
+    int n = chain_splits(&t->nodes[parent].box, &t->nodes[end].box, t->eps, piv, oct);
+    if (first == end && n == 2) {
+        /* a second split is needed: an intermediate node in the end's slot */
+        int32_t s = new_node(t, AG_NODE_SPLIT);
+        if (s < 0)
+            return AG_ERR_NOMEM;
+        ag_tnode *S = &t->nodes[s], *E = &t->nodes[end], *P = &t->nodes[parent];
+        S->parent = parent;
+        S->next_sibling = E->next_sibling;
+        S->first_child = S->last_child = end;
+        if (P->first_child == end)
+            P->first_child = s;
+        if (P->last_child == end)
+            P->last_child = s;
+        for (int32_t c = P->first_child; c >= 0; c = t->nodes[c].next_sibling)
+            if (t->nodes[c].next_sibling == end)
+                t->nodes[c].next_sibling = s;
+        E->parent = s;
+        E->next_sibling = -1;
+        first = s;
+    }
+    ag_tnode *F = &t->nodes[first];
+    memcpy(F->pivot, piv[0], sizeof F->pivot);
+    F->octant = (uint8_t)oct[0];
+    F->box = ag_splittree_child_box(&t->nodes[parent].box, piv[0], oct[0]);
+    if (first != end) {
+        ag_tnode *E = &t->nodes[end];
+        if (n == 2) {
+            memcpy(E->pivot, piv[1], sizeof E->pivot);
+            E->octant = (uint8_t)oct[1];
+        } else { /* one split suffices: the second keeps the whole intermediate box */
+            memset(E->pivot, 0, sizeof E->pivot);
+            E->octant = 8;
+        }
+    }
+    return AG_OK;
 }
 
 typedef struct {
@@ -164,8 +323,11 @@ static int cmp_xn(const void *a, const void *b)
     return p->n < q->n ? -1 : p->n > q->n;
 }
 
-static ag_status adjacency(ag_splittree *t)
+ag_status ag_splittree_adjacency(ag_splittree *t)
 {
+    free(t->adj);
+    t->adj = NULL;
+    t->nadj = 0;
     size_t nv = 0;
     for (size_t i = 0; i < t->nnodes; i++)
         nv += t->nodes[i].kind == AG_NODE_COMPONENT;
@@ -370,6 +532,10 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
         gi.h[l] = diag / per_diag;
     for (int a = 0; a < 3; a++)
         gi.o[a] = all.min[a];
+    /* a component nests in a box that holds it within the exact tolerance: a vertex jitter
+     * below what derivation reproduces (a flush window a fraction of a micrometre out of its
+     * wall's face) does not change where it hangs */
+    double nest = fmax(t->eps, t->tol);
     for (size_t i = 0; i < n; i++) {
         uint32_t c = order[i].c;
         const ag_box *cb = &L->box[c];
@@ -387,7 +553,7 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
                 gcell *cell = gi_slot(&gi, key);
                 for (int32_t en = cell->head; en >= 0; en = gi.ent[en].next) {
                     int32_t e = gi.ent[en].node;
-                    if (!ag_box_contains(&t->nodes[e].box, cb, t->eps))
+                    if (!ag_box_contains(&t->nodes[e].box, cb, nest))
                         continue;
                     double v = ag_box_volume_floor(&t->nodes[e].box, min_extent);
                     if (v < bv || (v == bv && e > P)) {
@@ -399,7 +565,7 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
             }
             for (size_t q = 0; q < gi.nlarge; q++) {
                 int32_t e = gi.large[q];
-                if (!ag_box_contains(&t->nodes[e].box, cb, t->eps))
+                if (!ag_box_contains(&t->nodes[e].box, cb, nest))
                     continue;
                 double v = ag_box_volume_floor(&t->nodes[e].box, min_extent);
                 if (v < bv || (v == bv && e > P)) {
@@ -427,7 +593,7 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
     gi = (gindex){0};
     free(depth);
     depth = NULL;
-    if (adjacency(t))
+    if (ag_splittree_adjacency(t))
         goto nomem;
     *out = t;
     return AG_OK;

@@ -88,6 +88,26 @@ int32_t ag_splittree_chain_end(const ag_splittree *t, int32_t n);
 int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *box, int kind);
 /* Appends child to parent's list. */
 void ag_splittree_attach(ag_splittree *t, int32_t parent, int32_t child);
+/* Inserts child into parent's list right after sibling `after` (-1: at the end). */
+void ag_splittree_attach_after(ag_splittree *t, int32_t parent, int32_t after, int32_t child);
+/* Takes child out of its parent's list (parent = -1 afterwards). */
+void ag_splittree_detach(ag_splittree *t, int32_t child);
+/* A new node of the given kind, linked to nothing (-1 when out of memory). */
+int32_t ag_splittree_add_node(ag_splittree *t, int kind);
+/* Hangs an existing node (its box set, linked to nothing) under parent by the split chain
+ * insertion would give it: its pivot and octant, and an intermediate split node when it needs
+ * two splits. */
+ag_status ag_splittree_hang(ag_splittree *t, int32_t parent, int32_t node);
+/* Recomputes the split chain from a chain end's parent (through its intermediate node, if any)
+ * to the end from their current boxes: pivots, octants and the intermediate box, adding an
+ * intermediate node when one split no longer cuts the end's box (a chain of two whose first
+ * split suffices keeps its second as a split that keeps everything). Pattern cells have no
+ * chain. */
+ag_status ag_splittree_rechain(ag_splittree *t, int32_t end);
+/* Recomputes the adjacency of visible nodes (pairs whose boxes touch or overlap). */
+ag_status ag_splittree_adjacency(ag_splittree *t);
+/* A deep copy (NULL when out of memory). */
+ag_splittree *ag_splittree_copy(const ag_splittree *t);
 ag_splittree_stats ag_splittree_stats_of(const ag_splittree *t);
 
 #endif

@@ -1,0 +1,44 @@
+/* What rebuilds a model's edit model exactly, kept beside its mesh in the stored tree.
+ *
+ * An edit keeps the ids of the nodes it did not remove (core/edit/rebuild.h): its tree is not
+ * the one proceduralizing its mesh again would give. So the store keeps, with the mesh, the
+ * edit model's split tree (every node with its links, box, pivot and classes; patterns;
+ * rules) and the classes labeling gave each component, and a reload makes the edit model from
+ * those (ag_rebuild_finish) instead of proceduralizing the mesh: the numbering, the labels and
+ * the rules survive the store round trip, undo, redo and restore.
+ *
+ * The stored tree text (app/model_tree.h, numbering AG_MODEL_TREE_NUMBERING) is the served
+ * tree with one more member, "kept": {"format":3,"tol","eps","ncomponents","nnodes",
+ * "npatterns","nrules","nlabels","nvariants","diagonal","label_tol","exact","share",
+ * "exact_copies","data"}, data the
+ * base64 of little-endian int32s and doubles: per node its kind, parent, first child, last
+ * child, next sibling, component, label, variant, rot, octant, rule rot, rule and pattern,
+ * then its box (min, max) and pivot; per pattern its rule, rot, lattice size, counts, step,
+ * vectors and node; per rule its count and representative; per component its label,
+ * variant, rot, variant rot, mirror flag and turn (radians); per variant its label and
+ * deviation. Binary, because the tree is written
+ * with every edit: numbers exactly, a 200k-triangle building's in milliseconds. A kept member
+ * that does not describe a tree over the mesh is refused (AG_ERR_PARSE naming what is wrong),
+ * never trusted. */
+#ifndef AG_MODEL_KEPT_H
+#define AG_MODEL_KEPT_H
+
+#include <jansson.h>
+
+#include "../core/edit/edit.h"
+
+/* The stored tree text of em (malloc'd): the served tree with the kept member; NULL when out
+ * of memory. */
+char *ag_model_kept_tree_text(const ag_edit_model *em);
+
+/* The served tree of a stored tree text (malloc'd): the text without its kept member (all of
+ * it when it keeps none); NULL when out of memory. */
+char *ag_model_kept_served_text(const char *tree_text);
+
+/* The edit model of a kept mesh from the kept member of its stored tree (tree_text):
+ * AG_ERR_NOT_FOUND when the text has no kept member (a tree stored before it), AG_ERR_PARSE
+ * when it is not one over this mesh. */
+ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_edit_model **em,
+                               ag_error *err);
+
+#endif
