@@ -243,18 +243,17 @@ ag_status ag_cloud_subset(const ag_cloud *c, const uint32_t *idx, size_t k, ag_c
 
 void ag_cloud_bounds(const ag_cloud *c, double min[3], double max[3])
 {
-    for (int a = 0; a < 3; a++) {
-        min[a] = INFINITY;
-        max[a] = -INFINITY;
-    }
+    ag_box b = ag_cloud_box(c);
+    memcpy(min, b.min, sizeof b.min);
+    memcpy(max, b.max, sizeof b.max);
+}
+
+ag_box ag_cloud_box(const ag_cloud *c)
+{
+    ag_box b = ag_box_empty();
     for (size_t i = 0; i < c->n; i++)
-        for (int a = 0; a < 3; a++) {
-            double v = c->xyz[3 * i + a];
-            if (v < min[a])
-                min[a] = v;
-            if (v > max[a])
-                max[a] = v;
-        }
+        ag_box_extend_point(&b, c->xyz + 3 * i);
+    return b;
 }
 
 double ag_cloud_diagonal(const ag_cloud *c)

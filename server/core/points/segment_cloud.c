@@ -3,10 +3,11 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "../base/clock.h"
 #include "../base/kdtree.h"
 #include "cluster.h"
+#include "group.h"
 #include "normals.h"
 
 #define DEFAULT_SEED 0x61726368677261ull /* "archgra" */
@@ -19,20 +20,6 @@ static const char *const stage_names[AG_SEGMENT_CLOUD_STAGES] = {
 const char *ag_segment_cloud_stage_name(ag_segment_cloud_stage s)
 {
     return (unsigned)s < AG_SEGMENT_CLOUD_STAGES ? stage_names[s] : "?";
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
 void ag_segment_cloud_free(ag_segment_cloud_result *r)
@@ -64,26 +51,14 @@ static ag_status build_members(ag_segment_cloud_result *r, ag_error *err)
 {
     free(r->member_start);
     free(r->members);
-    r->member_start = calloc(r->nsegments + 1, sizeof *r->member_start);
-    size_t total = 0;
-    for (size_t i = 0; i < r->n; i++)
-        total += r->segment[i] >= 0;
-    r->members = malloc((total ? total : 1) * sizeof *r->members);
-    if (!r->member_start || !r->members)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    for (size_t i = 0; i < r->n; i++)
-        if (r->segment[i] >= 0)
-            r->member_start[r->segment[i] + 1]++;
-    for (size_t s = 0; s < r->nsegments; s++)
-        r->member_start[s + 1] += r->member_start[s];
-    uint32_t *fill = malloc((r->nsegments + 1) * sizeof *fill);
-    if (!fill)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    memcpy(fill, r->member_start, (r->nsegments + 1) * sizeof *fill);
-    for (size_t i = 0; i < r->n; i++)
-        if (r->segment[i] >= 0)
-            r->members[fill[r->segment[i]]++] = (uint32_t)i;
-    free(fill);
+    r->member_start = NULL;
+    r->members = NULL;
+    ag_group g;
+    ag_status st = ag_group_build(&g, r->segment, r->n, r->nsegments, err);
+    if (st != AG_OK)
+        return st;
+    r->member_start = g.start;
+    r->members = g.members;
     return AG_OK;
 }
 
@@ -290,7 +265,7 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
     r->coarse_threshold = coarse > 0 ? coarse * r->diagonal : 0;
     progress_ctx pc = {&o, AG_SEGMENT_CLOUD_INDEX};
 
-    double t = now(), tc = cpu_now();
+    double t = ag_clock_seconds(), tc = ag_clock_thread_cpu_seconds();
     ag_kdtree *tree = NULL;
     float *variation = malloc(n * sizeof *variation);
     uint32_t *graph = malloc(n * (size_t)k * sizeof *graph);
@@ -306,12 +281,12 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
     st = ag_kdtree_build(c->xyz, NULL, n, &tree, err);
     if (st != AG_OK)
         goto done;
-    r->seconds[AG_SEGMENT_CLOUD_INDEX] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_INDEX] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_INDEX] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_INDEX] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     pc.stage = AG_SEGMENT_CLOUD_NORMALS;
     ag_normals_options no = {k, o.progress ? stage_progress : NULL, &pc};
     ag_normals_info info;
@@ -326,15 +301,15 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         view.normals = c->normals;
     }
     ag_ransac_graph g = {graph, k};
-    r->seconds[AG_SEGMENT_CLOUD_NORMALS] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_NORMALS] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_NORMALS] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_NORMALS] = ag_clock_thread_cpu_seconds() - tc;
 
     for (size_t i = 0; i < n; i++) {
         plane_of[i] = -1;
         idx[i] = (uint32_t)i;
     }
-    t = now();
-    tc = cpu_now();
+    t = ag_clock_seconds();
+    tc = ag_clock_thread_cpu_seconds();
     if (coarse > 0) {
         pc.stage = AG_SEGMENT_CLOUD_COARSE;
         ag_ransac_options ro = {.threshold = r->coarse_threshold,
@@ -351,12 +326,12 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         for (size_t i = 0; i < n; i++)
             plane_of[i] = -1;
     }
-    r->seconds[AG_SEGMENT_CLOUD_COARSE] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_COARSE] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_COARSE] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_COARSE] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     pc.stage = AG_SEGMENT_CLOUD_REFINE;
     double radius = 4 * r->spacing;
     ag_ransac_options lo = {.threshold = r->fine_threshold,
@@ -387,12 +362,12 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         if (st != AG_OK)
             goto done;
     }
-    r->seconds[AG_SEGMENT_CLOUD_REFINE] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_REFINE] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_REFINE] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_REFINE] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     size_t ncomp = 0;
     {
         /* pieces of each plane; stray pieces leave their plane (for the clustering) */
@@ -455,12 +430,12 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         free(main_id);
         free(pseg);
     }
-    r->seconds[AG_SEGMENT_CLOUD_COMPONENTS] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_COMPONENTS] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_COMPONENTS] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_COMPONENTS] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     {
         size_t m = 0;
         for (size_t i = 0; i < n; i++) {
@@ -483,15 +458,15 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
                 r->piece[idx[j]] = (int32_t)r->npieces + (r->segment[idx[j]] - (int32_t)ncomp);
         r->npieces += ncl;
     }
-    r->seconds[AG_SEGMENT_CLOUD_CLUSTER] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_CLUSTER] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_CLUSTER] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_CLUSTER] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     st = finish(c, r, ncomp, err);
-    r->seconds[AG_SEGMENT_CLOUD_LABEL] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_LABEL] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_LABEL] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_LABEL] = ag_clock_thread_cpu_seconds() - tc;
 
 done:
     if (view.normals && view.normals != c->normals)
