@@ -88,6 +88,17 @@
 #define AG_EDIT_WEIGHT_SIZE 3.0
 #define AG_EDIT_WEIGHT_POSITION 1e-3
 
+/* ---- point clouds (core/points) ---------------------------------------------------------- */
+
+/* Resize of a point model: a node stretched past this splits in two, a pattern's cells double
+ * (the paper's 1.5 for point clouds: a stretched point set thins out sooner than a mesh). */
+#define AG_POINTS_SPLIT_RATIO 1.5
+/* Repetition (§3.2): template steps are this share of the template's size on each axis. */
+#define AG_POINTS_TEMPLATE_STEP 0.1
+/* The label rule (§3.2): box dimensions within this share, point counts within this share. */
+#define AG_POINTS_LABEL_DIMS 0.05
+#define AG_POINTS_LABEL_COUNT 0.10
+
 /* ---- extrusion (core/extrude) ------------------------------------------------------------
  * The sweep's tolerances (delta1..delta3, parallel, same slope, and their scaling with the
  * plan's extent) live in core/extrude/tolerance.h for now and move here. */

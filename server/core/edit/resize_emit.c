@@ -11,7 +11,8 @@
  *   emit_component   the triangles of one node under one map, grouped by label
  *
  * A subtree below a node with a map of its own (a copy, a cell, a joined group) follows that
- * map; otherwise every node takes its solved box. */
+ * map; otherwise every node takes its solved box. The op may set another split ratio (point
+ * clouds split past 1.5, see ag_edit_op.split_ratio); the join ratio is its inverse. */
 #include <assert.h>
 #include <math.h>
 #include <stdio.h>
@@ -38,6 +39,7 @@ typedef struct {
     uint32_t emission;
     size_t splits, joins;
     size_t max_components;
+    double split, join; /* the split ratio and its inverse */
     ag_status st;
     ag_error *err;
 } emitter;
@@ -123,10 +125,11 @@ typedef struct {
 } sibling;
 
 /* The most squeezed group that may still join (index, axis), or m when none is squeezed. */
-static size_t most_squeezed(const ag_splittree *t, const sibling *s, size_t m, int *axis)
+static size_t most_squeezed(const ag_splittree *t, const sibling *s, size_t m, double join,
+                            int *axis)
 {
     size_t best = m;
-    double worst = AG_EDIT_JOIN_RATIO;
+    double worst = join;
     for (size_t i = 0; i < m; i++) {
         if (s[i].leader != (int32_t)i || s[i].stuck)
             continue;
@@ -239,7 +242,7 @@ static int join_siblings(emitter *E, int32_t n, const ag__resize_map *g, int dep
     /* every round joins two groups or gives up on one (until a join frees it again) */
     for (size_t round = 0; round < 4 * m; round++) {
         int axis = -1;
-        size_t best = most_squeezed(t, s, m, &axis);
+        size_t best = most_squeezed(t, s, m, E->join, &axis);
         if (best == m)
             break;
         size_t other = nearest_peer(t, s, m, best, axis, eps);
@@ -335,9 +338,9 @@ static void layout_pattern(emitter *E, const ag_pattern *P, int32_t first,
         for (int it = 0; it < PATTERN_MAX_STEPS; it++) {
             double p = Lnew / (k - 1 + rho);
             double cw = rho * p;
-            if (cw / l->w[a] > AG_EDIT_SPLIT_RATIO && k < PATTERN_MAX_COUNT)
+            if (cw / l->w[a] > E->split && k < PATTERN_MAX_COUNT)
                 k *= 2;
-            else if (cw / l->w[a] < AG_EDIT_JOIN_RATIO && k > 1)
+            else if (cw / l->w[a] < E->join && k > 1)
                 k = k / 2;
             else
                 break;
@@ -432,10 +435,10 @@ static void emit_pattern(emitter *E, int32_t n, const ag__resize_map *g, int dep
 /* ---- nodes ------------------------------------------------------------------------------- */
 
 /* The axis on which node x stretched most past the split ratio from its old box to nb, or -1. */
-static int split_axis(const ag_tnode *x, const ag_box *nb)
+static int split_axis(const ag_tnode *x, const ag_box *nb, double split)
 {
     int axis = -1;
-    double best = AG_EDIT_SPLIT_RATIO;
+    double best = split;
     for (int a = 0; a < 3; a++) {
         double w = ag_box_extent(&x->box, a);
         if (w <= AG_EDIT_FLAT)
@@ -467,7 +470,7 @@ static void emit_node(emitter *E, int32_t n, const ag__resize_map *g, int depth)
     ag_box nb = new_box(E, n, g);
     ag__resize_map m = ag__resize_map_between(&x->box, &nb);
     /* stretched past the split ratio on an axis: two copies of the subtree, each half */
-    int axis = split_axis(x, &nb);
+    int axis = split_axis(x, &nb, E->split);
     if (axis >= 0) {
         E->splits++;
         double mid = ag_box_centre_axis(&nb, axis);
@@ -492,8 +495,17 @@ static void emit_node(emitter *E, int32_t n, const ag__resize_map *g, int depth)
 ag_status ag_edit_resize_emit(const ag_proceduralize_result *in, const ag_box *boxes,
                               ag_mesh **out, ag_edit_report *rep, ag_error *err)
 {
+    return ag_edit_resize_emit_ratio(in, boxes, 0, out, rep, err);
+}
+
+ag_status ag_edit_resize_emit_ratio(const ag_proceduralize_result *in, const ag_box *boxes,
+                                    double split_ratio, ag_mesh **out, ag_edit_report *rep,
+                                    ag_error *err)
+{
     *out = NULL;
     emitter E = {.in = in, .boxes = boxes, .err = err};
+    E.split = split_ratio > 1 ? split_ratio : AG_EDIT_SPLIT_RATIO;
+    E.join = 1 / E.split;
     const ag_labels *L = in->labels;
     E.out = ag_mesh_create();
     E.group_of_label = malloc((L->nlabels + 1) * sizeof *E.group_of_label);

@@ -6,6 +6,7 @@
 
 #include "../base/array.h"
 #include "../base/box.h"
+#include "voxel.h"
 
 ag_status ag_cluster_components(const ag_cloud *c, const ag_ransac_graph *g, double radius,
                                 int32_t *labels, size_t min_size, size_t *ncomponents,
@@ -121,14 +122,6 @@ static uint64_t cell_key(uint64_t label, uint64_t x, uint64_t y, uint64_t z)
     return label << (3 * CELL_BITS) | x << (2 * CELL_BITS) | y << CELL_BITS | z;
 }
 
-static uint64_t mix(uint64_t k)
-{
-    k ^= k >> 33;
-    k *= 0xff51afd7ed558ccdull;
-    k ^= k >> 33;
-    k *= 0xc4ceb9fe1a85ec53ull;
-    return k ^ (k >> 33);
-}
 
 typedef struct {
     uint64_t *keys; /* UINT64_MAX = empty */
@@ -138,7 +131,7 @@ typedef struct {
 
 static uint32_t table_find(const cell_table *t, uint64_t key)
 {
-    for (size_t h = mix(key) & t->mask;; h = (h + 1) & t->mask) {
+    for (size_t h = ag__voxel_mix(key) & t->mask;; h = (h + 1) & t->mask) {
         if (t->keys[h] == key)
             return t->cell[h];
         if (t->keys[h] == UINT64_MAX)
@@ -196,7 +189,7 @@ ag_status ag_cluster_pieces(const ag_cloud *c, int32_t *labels, double cell, siz
         for (int a = 0; a < 3; a++)
             q[a] = (uint64_t)((c->xyz[3 * i + a] - mn[a]) / h) + 1; /* +1: room for -1 */
         uint64_t key = cell_key((uint64_t)labels[i], q[0], q[1], q[2]);
-        size_t slot = mix(key) & t.mask;
+        size_t slot = ag__voxel_mix(key) & t.mask;
         while (t.keys[slot] != UINT64_MAX && t.keys[slot] != key)
             slot = (slot + 1) & t.mask;
         if (t.keys[slot] == UINT64_MAX) {
