@@ -241,6 +241,32 @@ ag_status ag_cloud_subset(const ag_cloud *c, const uint32_t *idx, size_t k, ag_c
     return AG_OK;
 }
 
+ag_status ag_cloud_clone(const ag_cloud *c, ag_cloud **out, ag_error *err)
+{
+    *out = NULL;
+    ag_cloud *s = ag_cloud_create();
+    if (!s)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    memcpy(s->offset, c->offset, sizeof s->offset);
+    memcpy(s->scale, c->scale, sizeof s->scale);
+    ag_status st = ag_cloud_resize(s, c->n, err);
+    if (st == AG_OK && c->normals)
+        st = ag_cloud_add_normals(s, err);
+    for (size_t p = 0; st == AG_OK && p < c->nprops; p++)
+        st = ag_cloud_add_property(s, c->props[p].name, c->props[p].type, NULL, err);
+    if (st != AG_OK) {
+        ag_cloud_free(s);
+        return st;
+    }
+    memcpy(s->xyz, c->xyz, 3 * c->n * sizeof *s->xyz);
+    if (c->normals)
+        memcpy(s->normals, c->normals, 3 * c->n * sizeof *s->normals);
+    for (size_t p = 0; p < c->nprops; p++)
+        memcpy(s->props[p].values, c->props[p].values, c->n * ag_scalar_size(c->props[p].type));
+    *out = s;
+    return AG_OK;
+}
+
 void ag_cloud_bounds(const ag_cloud *c, double min[3], double max[3])
 {
     ag_box b = ag_cloud_box(c);

@@ -187,6 +187,54 @@ static ag_segment_cloud_spec *current_spec(const ag_segment_cloud_result *r, siz
     return spec;
 }
 
+/* Segments left over around the elements (the ring of wall points at an opening's edge that
+ * was no part of the wall's plane, bits of reveals): a segment that is not a host, holds no
+ * more points than an element and whose remaining points lie within that element's box grown
+ * by a share of its size joins the element. spec[first .. first + nel) are the elements. */
+#define ADOPT_GROW 0.15
+static void adopt_fragments(const ag_cloud *c, ag_segment_cloud_result *r,
+                            ag_segment_cloud_spec *spec, size_t first, size_t nel,
+                            const int32_t *is_host)
+{
+    size_t *el_count = calloc(nel + 1, sizeof *el_count);
+    if (!el_count)
+        return; /* nothing adopted: still a valid decomposition */
+    for (size_t i = 0; i < c->n; i++)
+        if (r->segment[i] >= (int32_t)first && (size_t)r->segment[i] < first + nel)
+            el_count[r->segment[i] - first]++;
+    for (size_t s = 0; s < r->nsegments; s++) {
+        if (is_host[s] || r->segments[s].kind == AG_SEGMENT_CLOUD_ELEMENT)
+            continue;
+        const uint32_t *m = r->members + r->member_start[s];
+        size_t cnt = r->member_start[s + 1] - r->member_start[s], left = 0;
+        ag_box b = ag_box_empty();
+        for (size_t j = 0; j < cnt; j++)
+            if (r->segment[m[j]] == (int32_t)s) {
+                ag_box_extend_point(&b, c->xyz + 3 * (size_t)m[j]);
+                left++;
+            }
+        if (!left)
+            continue;
+        for (size_t e = 0; e < nel; e++) {
+            const ag_box *eb = &spec[first + e].box;
+            if (left > el_count[e])
+                continue;
+            double g = 0;
+            for (int a = 0; a < 3; a++)
+                g = fmax(g, ADOPT_GROW * ag_box_extent(eb, a));
+            if (!ag_box_contains(eb, &b, g))
+                continue;
+            for (size_t j = 0; j < cnt; j++)
+                if (r->segment[m[j]] == (int32_t)s)
+                    r->segment[m[j]] = (int32_t)(first + e);
+            ag_box_extend_box(&spec[first + e].box, &b);
+            el_count[e] += left;
+            break;
+        }
+    }
+    free(el_count);
+}
+
 /* ---- template matching -------------------------------------------------------------------- */
 
 typedef struct {
@@ -660,6 +708,16 @@ ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, cons
         }
     }
     size_t before = r->nsegments;
+    {
+        int32_t *is_host = calloc(before + 1, sizeof *is_host);
+        if (!is_host) {
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            goto done;
+        }
+        is_host[M.host] = 1;
+        adopt_fragments(c, r, spec, before, nacc, is_host);
+        free(is_host);
+    }
     if ((st = ag_segment_cloud_rebuild(c, r, spec, before + nacc, err)) != AG_OK)
         goto done;
     if (rep) {
@@ -891,8 +949,18 @@ ag_status ag_repeat_auto(const ag_cloud *c, ag_segment_cloud_result *r,
             taken[cand[j]] = 1;
         }
     }
-    if (nel)
+    if (nel) {
+        int32_t *is_host = calloc(ns + 1, sizeof *is_host);
+        if (!is_host) {
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            goto done;
+        }
+        for (size_t h = 0; h < nhosts; h++)
+            is_host[hosts[h]] = 1;
+        adopt_fragments(c, r, spec, r->nsegments, nel, is_host);
+        free(is_host);
         st = ag_segment_cloud_rebuild(c, r, spec, r->nsegments + nel, err);
+    }
     if (rep)
         rep->elements = nel;
 done:
