@@ -153,6 +153,11 @@ static int safe_path(const char *p)
     return 1;
 }
 
+int ag_terminals_path_is_safe(const char *path)
+{
+    return path && safe_path(path);
+}
+
 ag_status ag_terminals_load_buffer(ag_gterminal *t, const char *data, size_t len, ag_error *err)
 {
     ag_obj_read_options o = {.up = AG_UP_Z};

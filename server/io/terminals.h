@@ -38,6 +38,10 @@ ag_status ag_terminals_set_lookup(void *user, const char *path, char **obj, size
 /* Sets one terminal's geometry from OBJ text in memory (e.g. a terminal kept in a database). */
 ag_status ag_terminals_load_buffer(ag_gterminal *t, const char *data, size_t len, ag_error *err);
 
+/* Whether a terminal path may be opened below the grammar's folder: relative, no "..", no
+ * empty part, no backslash. */
+int ag_terminals_path_is_safe(const char *path);
+
 /* Loads every terminal's geometry from dir/<path>. Paths must be relative and must not
  * leave dir ("..", absolute paths and backslashes are refused). */
 ag_status ag_terminals_load(ag_grammar *g, const char *dir, ag_error *err);

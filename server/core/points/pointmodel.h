@@ -51,7 +51,7 @@ typedef struct {
     uint8_t rot;    /* the quarter turns of A about z */
 } ag_pointmodel_placement;
 
-typedef struct {
+typedef struct ag_pointmodel {
     double offset[3];  /* the cloud's local origin (positions are relative to it) */
     double scale[3];   /* coordinate resolution of the source, 0 = unknown */
     double spacing;    /* typical point spacing, metres */

@@ -57,7 +57,7 @@ typedef struct {
     double cell;            /* thinning cell, metres */
 } ag_pcloud_completion;
 
-typedef struct {
+typedef struct ag_proceduralize_cloud_result {
     ag_pointmodel *model;              /* built */
     ag_segment_cloud_result *seg;      /* per point: segment, label (elements included) */
     size_t ntemplates;
