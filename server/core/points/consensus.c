@@ -107,7 +107,9 @@ ag_status ag_consensus_build(const ag_cloud *c, const uint32_t *idx, const uint3
         goto done;
     }
     size_t at = 0;
-    for (size_t j = 0; j < k; j++) {
+    for (size_t jj = 0; jj < k; jj++) {
+        /* the base first: the thinning keeps its points where it has them */
+        size_t j = jj == 0 ? base : jj <= base ? jj - 1 : jj;
         if (!out->members[j].merged)
             continue;
         out->merged++;
@@ -128,10 +130,22 @@ ag_status ag_consensus_build(const ag_cloud *c, const uint32_t *idx, const uint3
         double h = AREA_CELL * o->spacing;
         size_t occ_base, occ_pool;
         const double *origin = boxes[base].min;
-        if ((st = ag_resample_occupied(bxyz, NULL, nb, h, origin, &occ_base, err)) != AG_OK ||
-            (st = ag_resample_occupied(pool, NULL, pooled, h, origin, &occ_pool, err)) != AG_OK)
+        if ((st = ag_resample_occupied(bxyz, NULL, nb, h, origin, &occ_base, err)) != AG_OK)
             goto done;
-        target = (size_t)llround((double)nb * (double)occ_pool / (double)(occ_base ? occ_base : 1));
+        /* the pool's area measured at one member's density (every merged-th point, a few
+         * phases averaged): the whole pool, merged times denser, would also fill the cells a
+         * slanted surface only grazes, which one member mostly misses */
+        size_t stride = out->merged, phases = stride < 4 ? stride : 4, occ_sum = 0;
+        for (size_t ph = 0; ph < phases; ph++) {
+            size_t ns = 0;
+            for (size_t i = ph; i < pooled; i += stride)
+                keep[ns++] = (uint32_t)i;
+            if ((st = ag_resample_occupied(pool, keep, ns, h, origin, &occ_pool, err)) != AG_OK)
+                goto done;
+            occ_sum += occ_pool;
+        }
+        double occ_mean = (double)occ_sum / (double)phases;
+        target = (size_t)llround((double)nb * occ_mean / (double)(occ_base ? occ_base : 1));
         if (target < nb)
             target = nb;
     }

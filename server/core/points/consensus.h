@@ -44,7 +44,7 @@ typedef struct {
     double mean_before;          /* points per member, on average */
     size_t pooled;               /* points of the merged members before thinning */
     size_t points_after;         /* the consensus's points */
-    double cell;                 /* thinning cell size (0: nothing thinned) */
+    double cell;                 /* thinning radius (0: nothing thinned) */
 } ag_consensus_model;
 
 /* The members: k point sets of c (member j: idx[start[j] .. start[j + 1])), their boxes and,

@@ -54,7 +54,7 @@ typedef struct {
     size_t points_before;   /* the base member's */
     double mean_before;     /* per member */
     size_t points_after;    /* the consensus's */
-    double cell;            /* thinning cell, metres */
+    double cell;            /* thinning radius, metres */
 } ag_pcloud_completion;
 
 typedef struct ag_proceduralize_cloud_result {

@@ -41,6 +41,63 @@ ag_status ag_resample_occupied(const double *xyz, const uint32_t *idx, size_t n,
     return AG_OK;
 }
 
+/* The grid of the disk thinning: cells of the radius, each with its kept points (a list
+ * through next[]). */
+typedef struct {
+    ag__voxel_set cells;
+    uint32_t *head, *next;
+    double o[3], r;
+} thin_grid;
+
+static void cell_of_point(const thin_grid *g, const double p[3], int64_t c[3])
+{
+    for (int a = 0; a < 3; a++)
+        c[a] = (int64_t)floor((p[a] - g->o[a]) / g->r) + 1; /* >= 1: neighbours stay >= 0 */
+}
+
+/* Keeps, in index order, every point farther than r from the points kept before it; the
+ * count (keep: the kept indices when not NULL). */
+static size_t disk_thin(thin_grid *g, const double *xyz, size_t n, double r, uint32_t *keep)
+{
+    g->r = r;
+    ag__voxel_set_clear(&g->cells);
+    size_t kept = 0;
+    double r2 = r * r;
+    for (size_t i = 0; i < n; i++) {
+        const double *p = xyz + 3 * i;
+        int64_t c[3];
+        cell_of_point(g, p, c);
+        int near = 0;
+        for (int dx = -1; dx <= 1 && !near; dx++)
+            for (int dy = -1; dy <= 1 && !near; dy++)
+                for (int dz = -1; dz <= 1 && !near; dz++) {
+                    uint32_t k = ag__voxel_set_find(
+                        &g->cells, ag__voxel_key((uint64_t)(c[0] + dx), (uint64_t)(c[1] + dy),
+                                                 (uint64_t)(c[2] + dz)));
+                    if (k == UINT32_MAX)
+                        continue;
+                    for (uint32_t q = g->head[k]; q != UINT32_MAX && !near; q = g->next[q]) {
+                        const double *x = xyz + 3 * (size_t)q;
+                        double d0 = x[0] - p[0], d1 = x[1] - p[1], d2 = x[2] - p[2];
+                        near = d0 * d0 + d1 * d1 + d2 * d2 < r2;
+                    }
+                }
+        if (near)
+            continue;
+        size_t before = g->cells.used;
+        uint32_t k = ag__voxel_set_add(
+            &g->cells, ag__voxel_key((uint64_t)c[0], (uint64_t)c[1], (uint64_t)c[2]));
+        if (g->cells.used > before)
+            g->head[k] = UINT32_MAX;
+        g->next[i] = g->head[k];
+        g->head[k] = (uint32_t)i;
+        if (keep)
+            keep[kept] = (uint32_t)i;
+        kept++;
+    }
+    return kept;
+}
+
 ag_status ag_resample_thin(const double *xyz, size_t n, size_t target, uint32_t *keep,
                            size_t *nkeep, double *cell, ag_error *err)
 {
@@ -64,87 +121,40 @@ ag_status ag_resample_thin(const double *xyz, size_t n, size_t target, uint32_t 
         *nkeep = 1;
         return AG_OK;
     }
-    ag__voxel_set s;
-    double *sum = NULL;
-    double *best = NULL;
-    if (ag__voxel_set_init(&s, n)) {
-        ag__voxel_set_free(&s);
+    thin_grid g = {.head = malloc(n * sizeof *g.head), .next = malloc(n * sizeof *g.next)};
+    memcpy(g.o, b.min, sizeof g.o);
+    if (!g.head || !g.next || ag__voxel_set_init(&g.cells, n)) {
+        free(g.head);
+        free(g.next);
+        ag__voxel_set_free(&g.cells);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
-    /* count(h) falls as h grows: bisection in log h between a cell far below the spacing and
-     * the whole extent */
-    double lo = diag / (double)AG__VOXEL_AXIS_MAX, hi = diag, h = hi;
-    size_t got = 0;
-    double best_h = hi;
+    /* count(r) falls as r grows: bisection in log r between a radius far below the spacing
+     * (cells stay within the keys' range) and the whole extent */
+    double lo = 4 * diag / (double)AG__VOXEL_AXIS_MAX, hi = diag, r = hi;
+    double best_r = hi;
     size_t best_got = 1;
     for (int it = 0; it < THIN_STEPS; it++) {
-        h = sqrt(lo * hi);
-        got = occupied(&s, xyz, NULL, n, h, b.min);
+        r = sqrt(lo * hi);
+        size_t got = disk_thin(&g, xyz, n, r, NULL);
         double off = fabs((double)got - (double)target);
         if (off < fabs((double)best_got - (double)target)) {
             best_got = got;
-            best_h = h;
+            best_r = r;
         }
         if (off <= THIN_CLOSE * (double)target)
             break;
         if (got > target)
-            lo = h;
+            lo = r;
         else
-            hi = h;
+            hi = r;
     }
-    h = best_h;
-    got = occupied(&s, xyz, NULL, n, h, b.min);
-    sum = calloc(4 * got, sizeof *sum);
-    best = malloc(got * sizeof *best);
-    uint32_t *cell_of = malloc(n * sizeof *cell_of);
-    uint32_t *pick = malloc(got * sizeof *pick);
-    if (!sum || !best || !cell_of || !pick) {
-        free(sum);
-        free(best);
-        free(cell_of);
-        free(pick);
-        ag__voxel_set_free(&s);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
-    ag__voxel_set_clear(&s);
-    for (size_t i = 0; i < n; i++) {
-        uint32_t k = ag__voxel_set_add(&s, ag__voxel_key_of(xyz + 3 * i, b.min, h));
-        cell_of[i] = k;
-        for (int a = 0; a < 3; a++)
-            sum[4 * k + a] += xyz[3 * i + a];
-        sum[4 * k + 3] += 1;
-    }
-    for (size_t k = 0; k < got; k++)
-        best[k] = INFINITY;
-    for (size_t i = 0; i < n; i++) {
-        uint32_t k = cell_of[i];
-        double d = 0;
-        for (int a = 0; a < 3; a++) {
-            double e = xyz[3 * i + a] - sum[4 * k + a] / sum[4 * k + 3];
-            d += e * e;
-        }
-        if (d < best[k]) {
-            best[k] = d;
-            pick[k] = (uint32_t)i;
-        }
-    }
-    /* ascending indices: mark, then collect */
-    uint8_t *mark = (uint8_t *)cell_of; /* n bytes fit in n uint32 */
-    memset(mark, 0, n);
-    for (size_t k = 0; k < got; k++)
-        mark[pick[k]] = 1;
-    size_t m = 0;
-    for (size_t i = 0; i < n; i++)
-        if (mark[i])
-            keep[m++] = (uint32_t)i;
-    *nkeep = m;
+    *nkeep = disk_thin(&g, xyz, n, best_r, keep); /* index order: ascending */
     if (cell)
-        *cell = h;
-    free(sum);
-    free(best);
-    free(cell_of);
-    free(pick);
-    ag__voxel_set_free(&s);
+        *cell = best_r;
+    free(g.head);
+    free(g.next);
+    ag__voxel_set_free(&g.cells);
     return AG_OK;
 }
 

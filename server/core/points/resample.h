@@ -6,12 +6,15 @@
  * metre:
  *
  * - Thinning (consensus models): the merged members are k times denser than one member. They
- *   are thinned to one point per cell of a uniform grid, the point nearest the cell's mean
- *   (an input point, so edges and corners are not rounded off), with the cell size found by
- *   bisection so that the count matches the target: the base's count times the merged
- *   surface's area over the base's (areas measured as occupied cells of four point
- *   spacings). Where the base was sampled the density is the base's; what the other members
- *   add (an occluded part) comes at that density too.
+ *   are thinned by a disk rule: in a fixed order (the base's points first), a point is kept
+ *   when no point kept before it lies within a radius r (input points are kept, so edges and
+ *   corners are not rounded off), r found by bisection so that the count matches the target:
+ *   the base's count times the merged surface's area over the base's (areas measured as
+ *   occupied cells of four point spacings, the pool's at one member's density). A disk rule
+ *   gives the same density wherever the pool is dense enough, whether three members or thirty
+ *   sampled a part and however thick their registration left the surface (a grid of cells,
+ *   tried first, gives thick parts more cells). Where the base was sampled its points stay;
+ *   what the other members add (an occluded part) comes at that density too.
  * - Stretch compensation (a placement scaled by an edit): a point of a surface with normal n
  *   under the linear map A covers |cof(A) n| times its former area (cof(A) = det(A) A^-T), so
  *   it is emitted that many times on average (the whole part, and one more with the fraction as
@@ -38,8 +41,8 @@ ag_status ag_resample_occupied(const double *xyz, const uint32_t *idx, size_t n,
                                const double origin[3], size_t *count, ag_error *err);
 
 /* Thins the first n points of xyz to about target (within 2 %, or the closest the bisection
- * reaches) as above; keep (n entries) receives the kept points' indices, ascending, *nkeep
- * their count and *cell (optional) the cell size used. n <= target keeps every point. */
+ * reaches) as above, preferring earlier points; keep (n entries) receives the kept points'
+ * indices, ascending, *nkeep their count and *cell (optional) the disk radius used. n <= target keeps every point. */
 ag_status ag_resample_thin(const double *xyz, size_t n, size_t target, uint32_t *keep,
                            size_t *nkeep, double *cell, ag_error *err);
 
