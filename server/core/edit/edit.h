@@ -53,6 +53,10 @@ typedef struct {
      * under which they join); 0 = AG_EDIT_SPLIT_RATIO (meshes). Point clouds use
      * AG_POINTS_SPLIT_RATIO, the paper's 1.5. */
     double split_ratio;
+    /* resize: a node is not split on an axis where it is thinner than this share of its
+     * largest extent (a wall's thickness, which a point cloud's boxes have); 0: only flat
+     * axes are never split (meshes) */
+    double thin_share;
 
     /* split: axis 0..2 and the plane's world coordinate on it */
     int axis;

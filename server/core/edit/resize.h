@@ -48,9 +48,10 @@ ag_status ag_edit_resize_solver_solve(ag_edit_resize_solver *s, const ag_edit_op
 /* The mesh of the model with the nodes moved to boxes, with pattern split/join. */
 ag_status ag_edit_resize_emit(const ag_proceduralize_result *in, const ag_box *boxes,
                               ag_mesh **out, ag_edit_report *rep, ag_error *err);
-/* The same with another split ratio (see ag_edit_op.split_ratio; 0 = AG_EDIT_SPLIT_RATIO). */
+/* The same with another split ratio (see ag_edit_op.split_ratio; 0 = AG_EDIT_SPLIT_RATIO) and
+ * thin share (ag_edit_op.thin_share). */
 ag_status ag_edit_resize_emit_ratio(const ag_proceduralize_result *in, const ag_box *boxes,
-                                    double split_ratio, ag_mesh **out, ag_edit_report *rep,
+                                    double split_ratio, double thin_share, ag_mesh **out, ag_edit_report *rep,
                                     ag_error *err);
 
 #endif

@@ -40,6 +40,7 @@ typedef struct {
     size_t splits, joins;
     size_t max_components;
     double split, join; /* the split ratio and its inverse */
+    double thin_share;  /* axes thinner than this share of a node's largest are not split */
     ag_status st;
     ag_error *err;
 } emitter;
@@ -435,13 +436,15 @@ static void emit_pattern(emitter *E, int32_t n, const ag__resize_map *g, int dep
 /* ---- nodes ------------------------------------------------------------------------------- */
 
 /* The axis on which node x stretched most past the split ratio from its old box to nb, or -1. */
-static int split_axis(const ag_tnode *x, const ag_box *nb, double split)
+static int split_axis(const ag_tnode *x, const ag_box *nb, double split, double thin_share)
 {
     int axis = -1;
     double best = split;
+    double largest = fmax(ag_box_extent(&x->box, 0),
+                          fmax(ag_box_extent(&x->box, 1), ag_box_extent(&x->box, 2)));
     for (int a = 0; a < 3; a++) {
         double w = ag_box_extent(&x->box, a);
-        if (w <= AG_EDIT_FLAT)
+        if (w <= AG_EDIT_FLAT || w < thin_share * largest)
             continue;
         double r = ag_box_extent(nb, a) / w;
         if (r > best) {
@@ -470,7 +473,7 @@ static void emit_node(emitter *E, int32_t n, const ag__resize_map *g, int depth)
     ag_box nb = new_box(E, n, g);
     ag__resize_map m = ag__resize_map_between(&x->box, &nb);
     /* stretched past the split ratio on an axis: two copies of the subtree, each half */
-    int axis = split_axis(x, &nb, E->split);
+    int axis = split_axis(x, &nb, E->split, E->thin_share);
     if (axis >= 0) {
         E->splits++;
         double mid = ag_box_centre_axis(&nb, axis);
@@ -495,17 +498,18 @@ static void emit_node(emitter *E, int32_t n, const ag__resize_map *g, int depth)
 ag_status ag_edit_resize_emit(const ag_proceduralize_result *in, const ag_box *boxes,
                               ag_mesh **out, ag_edit_report *rep, ag_error *err)
 {
-    return ag_edit_resize_emit_ratio(in, boxes, 0, out, rep, err);
+    return ag_edit_resize_emit_ratio(in, boxes, 0, 0, out, rep, err);
 }
 
 ag_status ag_edit_resize_emit_ratio(const ag_proceduralize_result *in, const ag_box *boxes,
-                                    double split_ratio, ag_mesh **out, ag_edit_report *rep,
+                                    double split_ratio, double thin_share, ag_mesh **out, ag_edit_report *rep,
                                     ag_error *err)
 {
     *out = NULL;
     emitter E = {.in = in, .boxes = boxes, .err = err};
     E.split = split_ratio > 1 ? split_ratio : AG_EDIT_SPLIT_RATIO;
     E.join = 1 / E.split;
+    E.thin_share = thin_share;
     const ag_labels *L = in->labels;
     E.out = ag_mesh_create();
     E.group_of_label = malloc((L->nlabels + 1) * sizeof *E.group_of_label);

@@ -131,6 +131,8 @@ ag_status ag_pointedit_apply(const ag_pointmodel *pm, const ag_edit_op *op,
     ag_edit_op o = *op;
     if (!o.split_ratio)
         o.split_ratio = AG_POINTS_SPLIT_RATIO;
+    if (!o.thin_share)
+        o.thin_share = AG_POINTS_THIN_SHARE;
     o.source = source && source != pm ? source->em->proc : NULL;
     const ag_proceduralize_result *in = pm->em->proc;
     ag_mesh *mesh = NULL;

@@ -794,7 +794,7 @@ ag_status ag_repeat_auto(const ag_cloud *c, ag_segment_cloud_result *r,
     ag_group pieces = {0};
     unit *units = NULL;
     size_t nunits = 0, capunits = 0;
-    uint8_t *taken = calloc(c->n, 1);
+    uint8_t *taken = calloc(c->n, 1), *is_host_seg = NULL;
     uint32_t *cand = NULL;
     size_t ncand = 0, capcand = 0;
     ag_segment_cloud_spec *spec = NULL;
@@ -819,6 +819,12 @@ ag_status ag_repeat_auto(const ag_cloud *c, ag_segment_cloud_result *r,
     }
     if (!nhosts)
         goto done;
+    if (!(is_host_seg = calloc(ns + 1, 1))) {
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        goto done;
+    }
+    for (size_t h = 0; h < nhosts; h++)
+        is_host_seg[hosts[h]] = 1;
     if ((st = ag_group_build(&pieces, r->piece, c->n, r->npieces, err)) != AG_OK)
         goto done;
     /* units: the pieces of planes in several pieces, and the clusters */
@@ -901,6 +907,12 @@ ag_status ag_repeat_auto(const ag_cloud *c, ag_segment_cloud_result *r,
             double depth = fabs(dot3(dm, H->plane.n));
             if (depth < 2 * spacing || depth > max_depth || depth >= best_depth)
                 continue;
+            /* the whole unit within reach of the host (a corner's leftovers running down two
+             * walls are no element of the roof) */
+            double ulo, uhi;
+            box_range(&ub, H->centroid, H->plane.n, &ulo, &uhi);
+            if (uhi - ulo > max_depth + 2 * spacing)
+                continue;
             int inside = 1;
             for (int a = 0; a < 2 && inside; a++) {
                 double lo, hi;
@@ -935,10 +947,18 @@ ag_status ag_repeat_auto(const ag_cloud *c, ag_segment_cloud_result *r,
             st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
             goto done;
         }
+        /* not the host's points, nor those of another host across it (the walls at a
+         * roof's edge); a parallel one (the panes' plane of a row of windows) gives its own */
         size_t kept = 0;
-        for (size_t j = 0; j < ncand; j++)
-            if (r->segment[cand[j]] != best)
-                cand[kept++] = cand[j];
+        for (size_t j = 0; j < ncand; j++) {
+            int32_t cs = r->segment[cand[j]];
+            if (cs == best)
+                continue;
+            if (cs >= 0 && is_host_seg[cs] &&
+                fabs(dot3(r->segments[cs].plane.n, H->plane.n)) < cos_max)
+                continue;
+            cand[kept++] = cand[j];
+        }
         ncand = kept;
         if (ncand < min_points)
             continue;
@@ -969,6 +989,7 @@ done:
     ag_group_free(&pieces);
     free(units);
     free(taken);
+    free(is_host_seg);
     free(cand);
     free(spec);
     grid_free(&grid);
