@@ -208,6 +208,21 @@ static json_t *box_json(const ag_box *b, const double offset[3])
     return a;
 }
 
+/* The tree's boxes in the input's coordinates (the model keeps them local to its offset), as
+ * edit ops give them. */
+static void shift_tree_boxes(json_t *tree, const double offset[3])
+{
+    json_t *nodes = json_object_get(tree, "nodes"), *node;
+    size_t i;
+    json_array_foreach(nodes, i, node) {
+        json_t *box = json_object_get(node, "box");
+        for (size_t c = 0; c < json_array_size(box) && c < 6; c++) {
+            json_t *v = json_array_get(box, c);
+            json_real_set(v, json_number_value(v) + offset[c % 3]);
+        }
+    }
+}
+
 /* The tree and grammar of the saved model, shared by both summaries. */
 static void model_summary(json_t *j, const ag_points_state *st)
 {
@@ -387,6 +402,8 @@ static ag_status save_points(ag_workspace *ws, ag_points_state *st, const ag_poi
         s = write_file(w, path, st->text, st->text_len, err);
     if (s == AG_OK) {
         json_t *tree = ag_model_tree_folder(st->pm->em);
+        if (tree)
+            shift_tree_boxes(tree, st->pm->offset);
         snprintf(path, sizeof path, "%s/tree.json", dir);
         if (!tree || json_dump_file(tree, path, JSON_INDENT(1) | JSON_REAL_PRECISION(12))) {
             blame(w, NULL);

@@ -131,7 +131,18 @@ ag_status ag_usecase_points_edit_run(ag_workspace *ws, const ag_usecase_points_e
     t0 = ag_clock_ms();
     if ((s = check_nodes(p->op, pm, source, err)) != AG_OK)
         return s;
-    if ((s = ag_pointedit_apply(pm, p->op, source, &made, &out->report, err)) != AG_OK ||
+    /* boxes and split planes come in the input's coordinates (tree.json's), the model works
+     * in its local frame */
+    ag_edit_op op = *p->op;
+    for (int a = 0; a < 3; a++) {
+        op.box.min[a] -= pm->offset[a];
+        op.box.max[a] -= pm->offset[a];
+        op.region.min[a] -= pm->offset[a];
+        op.region.max[a] -= pm->offset[a];
+    }
+    if (op.kind == AG_EDIT_SPLIT && op.axis >= 0 && op.axis < 3)
+        op.at -= pm->offset[op.axis];
+    if ((s = ag_pointedit_apply(pm, &op, source, &made, &out->report, err)) != AG_OK ||
         (s = ag_points_state_make(made, &st, err)) != AG_OK)
         goto done;
     out->placements = st.pm->nplacements;
