@@ -46,7 +46,10 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* Median distance from a point to its nearest other point (0 for fewer than two). */
+/* Neighbours asked for the spacing: more than a point's copies in a scan that repeats them. */
+#define SPACING_K 16
+
+/* Median distance from a point to its nearest point elsewhere (0 for fewer than two places). */
 static ag_status median_spacing(const ag_cloud *c, double *out, ag_error *err)
 {
     *out = 0;
@@ -63,11 +66,17 @@ static ag_status median_spacing(const ag_cloud *c, double *out, ag_error *err)
         ag_kdtree_free(t);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
+    /* the nearest point at another place: copies of a point (a scan that repeats points)
+     * are no spacing */
     for (size_t i = 0; i < c->n; i += step) {
-        uint32_t id[2];
-        double d2[2];
-        if (ag_kdtree_knn(t, c->xyz + 3 * i, 2, id, d2) == 2 && d2[1] > 0)
-            d[m++] = sqrt(d2[1]);
+        uint32_t id[SPACING_K];
+        double d2[SPACING_K];
+        size_t got = ag_kdtree_knn(t, c->xyz + 3 * i, SPACING_K, id, d2);
+        for (size_t q = 1; q < got; q++)
+            if (d2[q] > 0) {
+                d[m++] = sqrt(d2[q]);
+                break;
+            }
     }
     ag_kdtree_free(t);
     if (m) {
