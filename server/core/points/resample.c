@@ -153,8 +153,8 @@ ag_status ag_resample_thin(const double *xyz, size_t n, size_t target, uint32_t 
         size_t pn = pass == 0 ? ns : n;
         size_t best_got = 1;
         if (pass == 1 && stride > 1) {
-            lo = fmax(lo, best_r / 1.5);
-            hi = fmin(hi, best_r * 1.5);
+            lo = best_r / 1.5; /* the sample's bracket has closed around its radius */
+            hi = best_r * 1.5;
             best_got = disk_thin(&g, xyz, n, best_r, NULL);
         }
         for (int it = 0; it < THIN_STEPS; it++) {
