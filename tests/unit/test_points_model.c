@@ -2,7 +2,8 @@
  * consensus, split tree, rules, patterns, grammar), its grammar text and PLY terminals read
  * back and derived into the cloud again, and edits: a resize that doubles the front facade
  * doubles its windows at the input's density (windows counted and densities measured on the
- * derived points alone, by a geometric slab test), a paste turned to its destination, bad ops
+ * derived points alone, by a geometric slab test), a paste turned to its destination (the
+ * derived points' spread in the destination), bad ops
  * refused, hard clouds refused precisely. */
 #include <stdarg.h>
 #include <stddef.h>
@@ -247,6 +248,82 @@ static void test_resize_doubles_the_windows_at_the_density(void **state)
     ag_cloud_free(c);
 }
 
+/* The front window's node whose box is about w x h on the facade: thin in `thin` (0: x, 1: y),
+ * its lowest-z one with the smallest coordinate along the facade. */
+static int32_t window_node(const ag_pointmodel *pm, int thin, double w, double h)
+{
+    const ag_splittree *t = pm->em->proc->tree;
+    int32_t best = -1;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_box *b = &t->nodes[n].box;
+        double e[3] = {b->max[0] - b->min[0], b->max[1] - b->min[1], b->max[2] - b->min[2]};
+        int along = 1 - thin;
+        if (t->nodes[n].component < 0 || e[thin] > 0.6 || fabs(e[along] - w) > 0.3 ||
+            fabs(e[2] - h) > 0.3)
+            continue;
+        if (best < 0 || b->min[2] < t->nodes[best].box.min[2] - 0.5 ||
+            (fabs(b->min[2] - t->nodes[best].box.min[2]) < 0.5 &&
+             b->min[along] < t->nodes[best].box.min[along]))
+            best = (int32_t)n;
+    }
+    return best;
+}
+
+/* A paste of a front window onto a side window: turned to face the side (its glass spread
+ * along y, one plane in x), measured on the derived points inside the side window's box
+ * (less a margin that leaves the reveals out). */
+static void test_paste_turns_to_the_target(void **state)
+{
+    (void)state;
+    ag_gen_building_options o = {.points = 120000, .width = 16, .depth = 10, .height = 7,
+                                 .ridge = -1, .cols = 4, .rows = 2, .side_cols = 2, .seed = 71};
+    ag_cloud *c = building(&o);
+    ag_proceduralize_cloud_result *r = proceduralize(c);
+    ag_pointmodel *pm = r->model;
+    int32_t src = window_node(pm, 1, 1.2 + 0.2, 1.5 + 0.2);
+    int32_t dst = window_node(pm, 0, 1.2 + 0.2, 1.5 + 0.2);
+    print_message("front window node %d, side window node %d\n", src, dst);
+    assert_true(src >= 0 && dst >= 0);
+    ag_box db = pm->em->proc->tree->nodes[dst].box;
+    int32_t nodes[1] = {src};
+    ag_edit_op op = {.kind = AG_EDIT_PASTE, .node = dst, .nnodes = 1, .nodes = nodes,
+                     .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_FILL};
+    ag_pointmodel *out;
+    ag_edit_report rep = {0};
+    ag_error e;
+    if (ag_pointedit_apply(pm, &op, NULL, &out, &rep, &e) != AG_OK)
+        fail_msg("paste: %s", e.text);
+    print_message("paste: %s\n", rep.message);
+    ag_cloud *d = derive(out);
+    /* the derived points in the side window's box (less a margin): spread along y, the glass
+     * and reveals' depth in x */
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    size_t in = 0;
+    for (size_t i = 0; i < d->n; i++) {
+        const double *p = d->xyz + 3 * i;
+        if (p[0] < db.min[0] || p[0] > db.max[0] || p[1] < db.min[1] + 0.15 ||
+            p[1] > db.max[1] - 0.15 || p[2] < db.min[2] + 0.15 || p[2] > db.max[2] - 0.15)
+            continue;
+        in++;
+        for (int a = 0; a < 3; a++) {
+            lo[a] = fmin(lo[a], p[a]);
+            hi[a] = fmax(hi[a], p[a]);
+        }
+    }
+    print_message("%zu points in the side window's box: x %.2f, y %.2f, z %.2f m\n", in,
+                  hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    assert_true(in > 100);
+    /* the glass is one plane across x (unturned, the front window's glass squeezed into the
+     * side's box would spread over its depth) */
+    assert_true(hi[0] - lo[0] < 0.1);
+    assert_true(hi[1] - lo[1] > 0.8);
+    ag_cloud_free(d);
+    ag_pointmodel_free(out);
+    ag_edit_report_clear(&rep);
+    ag_proceduralize_cloud_free(r);
+    ag_cloud_free(c);
+}
+
 static void test_bad_ops(void **state)
 {
     (void)state;
@@ -318,6 +395,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_proceduralize_and_read_back),
         cmocka_unit_test(test_resize_doubles_the_windows_at_the_density),
+        cmocka_unit_test(test_paste_turns_to_the_target),
         cmocka_unit_test(test_bad_ops),
         cmocka_unit_test(test_hard_clouds),
     };
