@@ -52,56 +52,17 @@ ag_status ag_point_terminals_format(const ag_cloud *t, char **out, size_t *len, 
     return AG_OK;
 }
 
-static uint64_t fnv1a(const char *s, size_t n)
-{
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (size_t i = 0; i < n; i++) {
-        h ^= (unsigned char)s[i];
-        h *= 0x100000001b3ULL;
-    }
-    return h;
-}
-
 ag_status ag_point_terminals_collect(ag_grammar *g, ag_cloud *const *clouds, ag_terminal_set *s,
                                      ag_error *err)
 {
-    size_t cap = g->nterminals + 1;
-    s->path = calloc(cap, sizeof *s->path);
-    s->obj = calloc(cap, sizeof *s->obj);
-    s->len = calloc(cap, sizeof *s->len);
-    if (!s->path || !s->obj || !s->len)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    for (size_t i = 0; i < g->nterminals; i++) {
+    ag_status st = ag_terminals_set_init(s, g->nterminals, err);
+    for (size_t i = 0; st == AG_OK && i < g->nterminals; i++) {
         char *bytes;
         size_t len;
-        ag_status st = ag_point_terminals_format(clouds[i], &bytes, &len, err);
-        if (st != AG_OK)
-            return st;
-        char path[64];
-        snprintf(path, sizeof path, "terminals/%016llx.ply", (unsigned long long)fnv1a(bytes, len));
-        ag_gterminal *t = &g->terminals[i];
-        free(t->path);
-        if (!(t->path = strdup(path))) {
-            free(bytes);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
-        size_t k = 0;
-        while (k < s->n && strcmp(s->path[k], path) != 0)
-            k++;
-        if (k < s->n) {
-            free(bytes);
-            continue;
-        }
-        if (!(s->path[s->n] = strdup(path))) {
-            free(bytes);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
-        s->obj[s->n] = bytes;
-        s->len[s->n] = len;
-        s->bytes += len;
-        s->n++;
+        if ((st = ag_point_terminals_format(clouds[i], &bytes, &len, err)) == AG_OK)
+            st = ag_terminals_set_add(s, &g->terminals[i], bytes, len, "ply", err);
     }
-    return AG_OK;
+    return st;
 }
 
 ag_status ag_point_terminals_decode(const ag_gterminal *t, const uint8_t *data, size_t len,

@@ -206,6 +206,19 @@ void ag_cloud_set(ag_cloud_property *p, size_t i, double v)
     }
 }
 
+/* s (new) gets c's frame, n points, and c's normals and properties, uninitialized. */
+static ag_status shape_like(const ag_cloud *c, size_t n, ag_cloud *s, ag_error *err)
+{
+    memcpy(s->offset, c->offset, sizeof s->offset);
+    memcpy(s->scale, c->scale, sizeof s->scale);
+    ag_status st = ag_cloud_resize(s, n, err);
+    if (st == AG_OK && c->normals)
+        st = ag_cloud_add_normals(s, err);
+    for (size_t p = 0; st == AG_OK && p < c->nprops; p++)
+        st = ag_cloud_add_property(s, c->props[p].name, c->props[p].type, NULL, err);
+    return st;
+}
+
 ag_status ag_cloud_subset(const ag_cloud *c, const uint32_t *idx, size_t k, ag_cloud **out,
                           ag_error *err)
 {
@@ -213,13 +226,7 @@ ag_status ag_cloud_subset(const ag_cloud *c, const uint32_t *idx, size_t k, ag_c
     ag_cloud *s = ag_cloud_create();
     if (!s)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    memcpy(s->offset, c->offset, sizeof s->offset);
-    memcpy(s->scale, c->scale, sizeof s->scale);
-    ag_status st = ag_cloud_resize(s, k, err);
-    if (st == AG_OK && c->normals)
-        st = ag_cloud_add_normals(s, err);
-    for (size_t p = 0; st == AG_OK && p < c->nprops; p++)
-        st = ag_cloud_add_property(s, c->props[p].name, c->props[p].type, NULL, err);
+    ag_status st = shape_like(c, k, s, err);
     if (st != AG_OK) {
         ag_cloud_free(s);
         return st;
@@ -247,13 +254,7 @@ ag_status ag_cloud_clone(const ag_cloud *c, ag_cloud **out, ag_error *err)
     ag_cloud *s = ag_cloud_create();
     if (!s)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    memcpy(s->offset, c->offset, sizeof s->offset);
-    memcpy(s->scale, c->scale, sizeof s->scale);
-    ag_status st = ag_cloud_resize(s, c->n, err);
-    if (st == AG_OK && c->normals)
-        st = ag_cloud_add_normals(s, err);
-    for (size_t p = 0; st == AG_OK && p < c->nprops; p++)
-        st = ag_cloud_add_property(s, c->props[p].name, c->props[p].type, NULL, err);
+    ag_status st = shape_like(c, c->n, s, err);
     if (st != AG_OK) {
         ag_cloud_free(s);
         return st;

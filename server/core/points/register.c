@@ -61,6 +61,26 @@ typedef struct {
 } icp;
 
 /* ICP from translation t; fills rms, inliers. */
+/* Sample s moved by t and its nearest base point within dmax: the residual r (base point less
+ * sample) and the base normal n; 0 when none is that near. */
+static int pair_of(const icp *I, size_t s, const double t[3], double dmax, double r[3],
+                   double n[3])
+{
+    double y[3] = {I->sample[3 * s] + t[0], I->sample[3 * s + 1] + t[1],
+                   I->sample[3 * s + 2] + t[2]};
+    uint32_t q;
+    double d2;
+    if (!ag_kdtree_knn(I->base->tree, y, 1, &q, &d2) || d2 > dmax * dmax)
+        return 0;
+    const double *p = I->base->xyz + 3 * (size_t)q;
+    const float *nf = I->base->normals + 3 * (size_t)q;
+    for (int a = 0; a < 3; a++) {
+        r[a] = p[a] - y[a];
+        n[a] = nf[a];
+    }
+    return 1;
+}
+
 static void run_icp(const icp *I, double t[3], double *rms, double *inliers)
 {
     double final = FINAL_PAIRING * I->spacing;
@@ -72,16 +92,9 @@ static void run_icp(const icp *I, double t[3], double *rms, double *inliers)
         pairs = 0;
         sq = 0;
         for (size_t s = 0; s < I->ns; s++) {
-            double y[3] = {I->sample[3 * s] + t[0], I->sample[3 * s + 1] + t[1],
-                           I->sample[3 * s + 2] + t[2]};
-            uint32_t q;
-            double d2;
-            if (!ag_kdtree_knn(I->base->tree, y, 1, &q, &d2) || d2 > dmax * dmax)
+            double r[3], n[3];
+            if (!pair_of(I, s, t, dmax, r, n))
                 continue;
-            const double *p = I->base->xyz + 3 * (size_t)q;
-            const float *nf = I->base->normals + 3 * (size_t)q;
-            double n[3] = {nf[0], nf[1], nf[2]};
-            double r[3] = {p[0] - y[0], p[1] - y[1], p[2] - y[2]};
             double rn = r[0] * n[0] + r[1] * n[1] + r[2] * n[2];
             /* point-to-plane: n n^T dt = n (r . n); point-to-point: w dt = w r */
             A[0] += n[0] * n[0] + POINT_WEIGHT;
@@ -111,15 +124,10 @@ static void run_icp(const icp *I, double t[3], double *rms, double *inliers)
     pairs = 0;
     sq = 0;
     for (size_t s = 0; s < I->ns; s++) {
-        double y[3] = {I->sample[3 * s] + t[0], I->sample[3 * s + 1] + t[1],
-                       I->sample[3 * s + 2] + t[2]};
-        uint32_t q;
-        double d2;
-        if (!ag_kdtree_knn(I->base->tree, y, 1, &q, &d2) || d2 > final * final)
+        double r[3], n[3];
+        if (!pair_of(I, s, t, final, r, n))
             continue;
-        const double *p = I->base->xyz + 3 * (size_t)q;
-        const float *nf = I->base->normals + 3 * (size_t)q;
-        double rn = (p[0] - y[0]) * nf[0] + (p[1] - y[1]) * nf[1] + (p[2] - y[2]) * nf[2];
+        double rn = r[0] * n[0] + r[1] * n[1] + r[2] * n[2];
         sq += rn * rn;
         pairs++;
     }
