@@ -27,7 +27,7 @@ DB      ?= var/archgram.db
 
 # Debian packages: to build and run; in addition to test (and to run the sanitizer build);
 # to benchmark.
-DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libwebsockets-dev \
+DEB_BUILD := gcc make pkg-config libc6-dev libmicrohttpd-dev libjansson-dev libyajl-dev libwebsockets-dev \
              libsqlite3-dev libsuitesparse-dev libassimp-dev libssl-dev libsodium-dev libpng-dev
 DEB_TEST  := libcmocka-dev chromium curl sqlite3 python3 binutils libasan8 libubsan1 libcgal-dev g++
 DEB_BENCH := wrk
@@ -48,7 +48,7 @@ ARCHIVES  := $(foreach l,$(LAYERS),$(LIBDIR)/libag_$(l).a)
 # Link order: the highest layer first, each followed by what it may use.
 LINK_ARCHIVES := $(foreach l,net app store io core,$(LIBDIR)/libag_$(l).a)
 # The system libraries, in the same order: net's, app's, store's, io's, core's.
-LDLIBS    := -lwebsockets -lmicrohttpd -lpthread -lsodium -lsqlite3 -lpng -ljansson -lassimp -lcrypto \
+LDLIBS    := -lwebsockets -lmicrohttpd -lpthread -lsodium -lsqlite3 -lpng -ljansson -lyajl -lassimp -lcrypto \
              -lcholmod -lspqr -lsuitesparseconfig -lm
 LIB_OBJ   := $(foreach l,$(LAYERS),$(call layer_obj,$(l)))
 
@@ -62,7 +62,7 @@ BENCH_BIN := $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%)
 WEB_SRC   := $(shell find web -type f 2>/dev/null | sort)
 NPM_STAMP := node_modules/.archgram-stamp
 
-.PHONY: all deps deps-test deps-bench npm run test test-unit test-integration test-browser \
+.PHONY: all deps deps-test deps-bench npm run test bench-programs test-unit test-integration test-browser \
         test-asan check-layers bench clean web programs unit-tests
 
 # Running needs the two programs and the web client, nothing built for tests.
@@ -152,7 +152,7 @@ $(BUILD)/tests/%: tests/unit/%.c $(ARCHIVES) | deps-test
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $(TEST_CFLAGS) $(ALL_LDFLAGS) -o $@ $< $(LINK_ARCHIVES) $(LDLIBS) -lcmocka
 
-$(BUILD)/bench/%: bench/%.c $(ARCHIVES) | deps-bench
+$(BUILD)/bench/%: bench/%.c $(ARCHIVES) | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $(TEST_CFLAGS) $(ALL_LDFLAGS) -o $@ $< $(LINK_ARCHIVES) $(LDLIBS)
 
@@ -173,10 +173,11 @@ run: all
 # --- tests --------------------------------------------------------------------------------
 # The tiers run one after the other (they share two cores); each is also a target of its own.
 test: deps-test
-	@$(MAKE) --no-print-directory check-layers
+	@$(MAKE) --no-print-directory check-layers bench-programs
 	@$(MAKE) --no-print-directory test-unit
 	@$(MAKE) --no-print-directory test-integration
 	@$(MAKE) --no-print-directory test-browser
+	@$(MAKE) --no-print-directory test-fuzz
 
 check-layers: $(ARCHIVES) | deps-test
 	python3 tools/check_layers.py --lib $(LIBDIR)
@@ -220,10 +221,15 @@ test-asan: deps-test $(NPM_STAMP)
 	  test-integration
 
 # --- benchmarks ---------------------------------------------------------------------------
+# make test builds them (bench-programs) so that they keep compiling; make bench runs them.
+bench-programs: $(BENCH_BIN)
+
 bench: deps-bench all $(BENCH_BIN) $(ORACLE)
 	@for b in bench/*.sh; do [ -f "$$b" ] && sh "$$b"; done; true
 	@for b in bench/*.js; do [ -f "$$b" ] && node "$$b"; done; true
 	@for b in $(BENCH_BIN); do $$b; done
+
+include tests/fuzz/fuzz.mk
 
 clean:
 	rm -rf $(BUILD)

@@ -26,13 +26,13 @@ import sys
 SUITESPARSE = ["m", "cholmod", "spqr", "suitesparseconfig"]
 LAYERS = {
     "core": {"uses": [], "headers": [], "libs": SUITESPARSE},
-    "io": {"uses": ["core"], "headers": [], "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "png"]},
+    "io": {"uses": ["core"], "headers": [], "libs": SUITESPARSE + ["jansson", "yajl", "assimp", "crypto", "png"]},
     "store": {"uses": ["core", "io"], "headers": [],
-              "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "png", "sqlite3", "sodium"]},
+              "libs": SUITESPARSE + ["jansson", "yajl", "assimp", "crypto", "png", "sqlite3", "sodium"]},
     "app": {"uses": ["core", "io", "store"], "headers": [],
-            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "png", "sqlite3", "sodium", "pthread"]},
+            "libs": SUITESPARSE + ["jansson", "yajl", "assimp", "crypto", "png", "sqlite3", "sodium", "pthread"]},
     "net": {"uses": ["app"], "headers": ["core/status.h"],
-            "libs": SUITESPARSE + ["jansson", "assimp", "crypto", "png", "sqlite3", "sodium", "pthread", "microhttpd",
+            "libs": SUITESPARSE + ["jansson", "yajl", "assimp", "crypto", "png", "sqlite3", "sodium", "pthread", "microhttpd",
                                    "websockets"]},
 }
 ORDER = ["core", "io", "store", "app", "net"]
@@ -45,6 +45,7 @@ SHARED_HEADERS = {"embedded.h": ["store", "net"]}
 # libc's; core additionally does no threads, sockets or I/O libraries (FORBIDDEN_CORE).
 SYSTEM_HEADERS = [
     (re.compile(r"^jansson\.h$"), "jansson"),
+    (re.compile(r"^yajl/"), "yajl"),
     (re.compile(r"^assimp/"), "assimp"),
     (re.compile(r"^openssl/"), "crypto"),
     (re.compile(r"^png\.h$|^libpng"), "png"),

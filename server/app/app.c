@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "../core/utf8.h"
 #include "../store/jobs.h"
 #include "../store/models.h"
 #include "auth.h"
@@ -16,11 +17,13 @@
 #include "import_job.h"
 #include "jobqueue.h"
 #include "proceduralize_job.h"
+#include "segment_job.h"
 #include "store_env.h"
 
 struct ag_app {
     char *upload_dir;
     int workers;
+    ag_work_limits limits;
     ag_events *events;
     ag_store_services services; /* the pool, the sequencer, the kept edit models */
     ag_jobqueue *jobs;
@@ -44,10 +47,25 @@ ag_status ag_app_check_name(const char *name, ag_error *err)
     return ag_models_check_name(name, err);
 }
 
-ag_status ag_app_run_fast(ag_app *app, void (*run)(void *user), void (*drop)(void *user),
-                          void *user, ag_error *err)
+ag_status ag_app_check_utf8(const char *what, const char *s, size_t len, ag_error *err)
 {
-    return ag_jobqueue_run_fast(app->jobs, run, drop, user, err);
+    size_t valid = ag_utf8_valid_prefix(s, len);
+    if (valid == len)
+        return AG_OK;
+    return ag_error_set(err, AG_ERR_INVALID, (long)valid + 1, "%s is not valid UTF-8 (byte %zu)",
+                        what, valid + 1);
+}
+
+const ag_work_limits *ag_app_limits(const ag_app *app) { return &app->limits; }
+
+ag_status ag_app_run_task(ag_app *app, ag_task_kind kind, int64_t model,
+                          void (*run)(void *user, ag_task_budget *budget),
+                          void (*drop)(void *user), void *user, ag_error *err)
+{
+    double seconds = kind == AG_TASK_PREVIEW ? app->limits.preview_seconds
+                                             : app->limits.op_seconds;
+    return ag_jobqueue_run_task(app->jobs, kind == AG_TASK_PREVIEW ? 0 : model, seconds, run,
+                                drop, user, err);
 }
 
 static void purge_uploads(const char *dir)
@@ -91,6 +109,8 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
         app->upload_dir = strdup(opt->upload_dir);
     else if (asprintf(&app->upload_dir, "%s.uploads", opt->db_path) < 0)
         app->upload_dir = NULL;
+    app->limits = ag_work_limits_resolved(&opt->limits);
+    app->services.limits = &app->limits;
     app->events = ag_events_create();
     app->services.seq = app->events ? ag_sequencer_create(app->events) : NULL;
     app->services.sessions = ag_edit_sessions_create();
@@ -106,7 +126,7 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
         return AG_ERR_IO;
     }
     purge_uploads(app->upload_dir);
-    ag_status s = ag_dbpool_create(opt->db_path, &app->services.pool, err);
+    ag_status s = ag_dbpool_create_ex(opt->db_path, opt->db_max_bytes, &app->services.pool, err);
     ag_db *db = s == AG_OK ? ag_dbpool_get(app->services.pool, err) : NULL;
     if (s == AG_OK && !db)
         s = err ? err->code : AG_ERR_DB;
@@ -119,10 +139,19 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
     app->workers = opt->workers > 0 ? opt->workers : (int)sysconf(_SC_NPROCESSORS_ONLN);
     if (app->workers < 1)
         app->workers = 1;
+    int task_workers = opt->task_workers;
+    if (task_workers <= 0) {
+        long cores = sysconf(_SC_NPROCESSORS_ONLN);
+        task_workers = cores > 0 ? 2 * (int)cores : 4;
+        if (task_workers < 4)
+            task_workers = 4;
+    }
     ag_jobqueue_options qo = {.db = app->services.pool,
                               .seq = app->services.seq,
                               .workers = app->workers,
-                              .capacity = opt->queue_capacity};
+                              .capacity = opt->queue_capacity,
+                              .job_seconds = app->limits.job_seconds,
+                              .task_workers = task_workers};
     if (!(app->jobs = ag_jobqueue_create(&qo))) {
         ag_app_free(app);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "cannot start the worker threads");
@@ -131,6 +160,7 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
     ag_jobqueue_register(app->jobs, &ag_extrude_job_kind, &app->services);
     ag_jobqueue_register(app->jobs, &ag_proceduralize_job_kind, &app->services);
     ag_jobqueue_register(app->jobs, &ag_demo_parts_job_kind, &app->services);
+    ag_jobqueue_register(app->jobs, &ag_segment_job_kind, &app->services);
     /* after the job kinds: the demo content is proceduralized and extruded by jobs */
     if (opt->demo && (s = ag_demo_load_if_empty(db, app->jobs, err)) != AG_OK) {
         ag_app_free(app);
@@ -140,10 +170,23 @@ ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
     return AG_OK;
 }
 
-void ag_app_shutdown(ag_app *app)
+int ag_app_shutdown(ag_app *app, double grace)
 {
-    if (app && app->jobs)
-        ag_jobqueue_stop(app->jobs);
+    return app && app->jobs ? ag_jobqueue_stop(app->jobs, grace) : 1;
+}
+
+void ag_app_abandon(ag_app *app)
+{
+    if (!app || !app->services.pool)
+        return;
+    /* a connection of its own with a short wait: a worker may hold the write lock, and then
+     * the next start records the rows instead (cancel_leftovers) */
+    ag_db *db = NULL;
+    if (ag_db_open(ag_dbpool_path(app->services.pool),
+                   &(ag_db_options){.busy_timeout_ms = 200, .no_migrate = 1}, &db,
+                   NULL) == AG_OK)
+        cancel_leftovers(db, NULL);
+    ag_db_close(db);
 }
 
 void ag_app_free(ag_app *app)

@@ -27,13 +27,14 @@ ag_status ag_app_change_delete(ag_app *app, int64_t model, int64_t version, ag_e
 
 ag_status ag_app_change_grammar(ag_app *app, int64_t model, int64_t base, const char *author,
                                 const char *cid, const char *text, size_t len,
-                                int64_t *version, ag_error *err, long *col)
+                                ag_task_budget *budget, int64_t *version, ag_error *err,
+                                long *col)
 {
     ag_store_env env;
     ag_status s = ag__app_env(app, &env, err);
     return s != AG_OK ? s
-                      : ag_grammar_edit_apply(&env, model, base, author, cid, text, len, version,
-                                              err, col);
+                      : ag_grammar_edit_apply(&env, model, base, author, cid, text, len, budget,
+                                              version, err, col);
 }
 
 size_t ag_app_change_grammar_max(void)

@@ -16,10 +16,11 @@ ag_status ag_app_change_op(ag_app *app, const ag_op_request *rq, int64_t *versio
                            int *duplicate, ag_error *err);
 /* Deletes the model at version (AG_ERR_STALE otherwise) and announces its end. */
 ag_status ag_app_change_delete(ag_app *app, int64_t model, int64_t version, ag_error *err);
-/* PUT …/grammar (app/grammar_edit.h). */
+/* PUT …/grammar (app/grammar_edit.h), under budget (may be NULL). */
 ag_status ag_app_change_grammar(ag_app *app, int64_t model, int64_t base, const char *author,
                                 const char *cid, const char *text, size_t len,
-                                int64_t *version, ag_error *err, long *col);
+                                ag_task_budget *budget, int64_t *version, ag_error *err,
+                                long *col);
 /* Largest grammar text a PUT takes. */
 size_t ag_app_change_grammar_max(void);
 /* A live drag (app/edit_ops.h): the moved boxes, nothing stored. */

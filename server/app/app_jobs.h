@@ -3,6 +3,7 @@
 #ifndef AG_APP_JOBS_H
 #define AG_APP_JOBS_H
 
+#include <jansson.h>
 #include <stdint.h>
 
 #include "app.h"
@@ -23,6 +24,14 @@ ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_impor
  * none; -1: any) must be the current version (AG_ERR_STALE otherwise). */
 ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
                                     const int64_t *if_match, int64_t *job, ag_error *err);
+/* Segmenting a point cloud model at its current version (app/usecase_segment.h), the op
+ * authored by who; body: {"threshold", "coarse_threshold", "cluster_tolerance": fractions of
+ * the diagonal, "recompute_normals": bool}, each optional (AG_ERR_INVALID naming a bad or
+ * unknown member). if_match as for proceduralize. AG_ERR_CONFLICT for a model that is not a
+ * point cloud, AG_ERR_TOO_LARGE past AG_CLOUD_MAX_SEGMENT_POINTS. */
+ag_status ag_app_jobs_segment(ag_app *app, const ag_identity *who, int64_t model,
+                              const int64_t *if_match, const json_t *body, int64_t *job,
+                              ag_error *err);
 /* An extrusion of an uploaded description or GeoJSON: the name, format and style are checked.
  * The upload is removed when the job cannot be queued. */
 ag_status ag_app_jobs_extrude(ag_app *app, const ag_identity *who, const ag_extrude_job *p,

@@ -13,7 +13,9 @@
 #include "../store/jobs.h"
 #include "../store/models.h"
 #include "../store/ops.h"
+#include "app_points.h"
 #include "edit_session.h"
+#include "jobqueue.h"
 #include "model_tree.h"
 #include "store_env.h"
 #include "views.h"
@@ -225,6 +227,11 @@ static ag_status add_view(void *user, ag_extrusion_building *b)
         return ag_error_set(v->err, AG_ERR_NOMEM, 0, "out of memory");
     if (b->reason)
         json_object_set_new(o, "reason", json_string(b->reason));
+    if (b->fallback) {
+        json_object_set_new(o, "fallback", json_string(b->fallback));
+        if (strcmp(b->fallback, "simplified") == 0)
+            json_object_set_new(o, "moved", json_real(b->moved));
+    }
     v->component += has_mesh;
     json_array_append_new(v->list, o);
     return AG_OK;
@@ -315,6 +322,17 @@ ag_status ag_app_query_glb(ag_app *app, int64_t id, int (*fresh)(void *user, con
 {
     memset(out, 0, sizeof *out);
     DB_OR_RETURN(db, app, err);
+    {
+        /* a point cloud's mesh is empty until a surface is made of it: its points instead */
+        ag_model_row row;
+        ag_status ks = ag_models_get(db, id, &row, err);
+        if (ks != AG_OK)
+            return ks;
+        int cloud = strcmp(row.kind, "pointcloud") == 0;
+        ag_models_row_clear(&row);
+        if (cloud)
+            return ag_app_points_glb(app, id, 0, fresh, user, out, err);
+    }
     ag_grammar_row g;
     ag_error e;
     ag_error_clear(&e);
@@ -368,8 +386,9 @@ static ag_status as_plan_problem(ag_status s, ag_error *err)
     return AG_ERR_PARSE;
 }
 
-ag_status ag_app_query_extrusion_preview(const char *plan_json, size_t len, ag_app_bytes *out,
-                                         size_t *failing_faces, ag_error *err)
+/* One building extruded under opt (NULL: the defaults), as GLB. */
+static ag_status preview(const char *plan_json, size_t len, const ag_extrude_options *opt,
+                         ag_app_bytes *out, size_t *failing_faces, ag_error *err)
 {
     memset(out, 0, sizeof *out);
     *failing_faces = 0;
@@ -383,11 +402,11 @@ ag_status ag_app_query_extrusion_preview(const char *plan_json, size_t len, ag_a
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
     ag_extrude_result res;
-    s = ag_extrude_plan(plan, m, -1, &res, NULL, err);
+    s = ag_extrude_plan_with(plan, opt, m, -1, &res, NULL, err);
     ag_plan_free(plan);
     if (s != AG_OK) {
         ag_mesh_free(m);
-        return as_plan_problem(s, err);
+        return s == AG_ERR_CANCELLED ? s : as_plan_problem(s, err);
     }
     s = ag_glb_write(m, &out->data, &out->len, err);
     ag_mesh_free(m);
@@ -396,13 +415,44 @@ ag_status ag_app_query_extrusion_preview(const char *plan_json, size_t len, ag_a
     return s;
 }
 
+ag_status ag_app_query_extrusion_preview(const char *plan_json, size_t len, ag_app_bytes *out,
+                                         size_t *failing_faces, ag_error *err)
+{
+    return preview(plan_json, len, NULL, out, failing_faces, err);
+}
+
+ag_status ag_app_query_extrusion_preview_budgeted(const char *plan_json, size_t len,
+                                                  ag_task_budget *budget, ag_app_bytes *out,
+                                                  size_t *failing_faces, ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    *failing_faces = 0;
+    if (ag_task_budget_exhausted(budget))
+        return ag_task_budget_explain(budget, AG_ERR_CANCELLED, "the extrusion preview", err);
+    /* the sweep polls the task's budget (its deadline, the asker still there, the service
+     * still running) and stops within milliseconds of any; the events and memory it may
+     * spend stay the extrusion's own defaults */
+    ag_extrude_options o = {.budget = {.cancelled = ag_task_budget_exhausted, .user = budget}};
+    ag_status s = preview(plan_json, len, &o, out, failing_faces, err);
+    return ag_task_budget_explain(budget, s, "the extrusion preview", err);
+}
+
 json_t *ag_app_query_health(ag_app *app, int ws_port, ag_error *err)
 {
     ag_db *db = db_of(app, err);
     if (!db)
         return NULL;
-    return json_pack("{s:s, s:s, s:{s:s, s:i}, s:i, s:i}", "status", "ok", "version",
-                     AG_VERSION, "db", "path", ag_db_path(db), "schema_version",
-                     ag_db_schema_version(db), "ws_port", ws_port, "workers",
-                     ag_app_workers(app));
+    const ag_work_limits *l = ag_app_limits(app);
+    ag_jobqueue_stats q = ag_jobqueue_stats_now(ag__app_jobqueue(app));
+    return json_pack("{s:s, s:s, s:{s:s, s:i}, s:i, s:i, s:{s:I, s:I, s:f, s:f, s:f}, "
+                     "s:{s:I, s:I, s:I, s:I}}",
+                     "status", "ok", "version", AG_VERSION, "db", "path", ag_db_path(db),
+                     "schema_version", ag_db_schema_version(db), "ws_port", ws_port, "workers",
+                     ag_app_workers(app), "limits", "max_triangles",
+                     (json_int_t)l->max_triangles, "max_nodes", (json_int_t)l->max_nodes,
+                     "op_seconds", l->op_seconds, "job_seconds", l->job_seconds,
+                     "preview_seconds", l->preview_seconds, "work", "jobs_waiting",
+                     (json_int_t)q.jobs_waiting, "jobs_running", (json_int_t)q.jobs_running,
+                     "tasks_waiting", (json_int_t)q.tasks_waiting, "tasks_running",
+                     (json_int_t)q.tasks_running);
 }

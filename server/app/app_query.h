@@ -38,7 +38,7 @@ ag_status ag_app_query_plan(ag_app *app, int64_t id, json_t **doc, int64_t *vers
                             ag_error *err);
 
 /* mesh.glb: binary glTF of the model's mesh (a proceduralized model's components carry their
- * label and tree node). etag is a strong validator of the geometry; when fresh(user, etag)
+ * label and tree node; a point cloud model's points, as app/app_points.h serves them). etag is a strong validator of the geometry; when fresh(user, etag)
  * says the client has it, nothing is built and data stays NULL. */
 typedef struct {
     uint8_t *data; /* malloc'd */
@@ -53,6 +53,12 @@ ag_status ag_app_query_glb(ag_app *app, int64_t id, int (*fresh)(void *user, con
  * *failing_faces counts faces of a shell that is not watertight. */
 ag_status ag_app_query_extrusion_preview(const char *plan_json, size_t len, ag_app_bytes *out,
                                          size_t *failing_faces, ag_error *err);
+/* The same under a task budget (run it as an AG_TASK_PREVIEW, app.h): the sweep stops when
+ * the budget runs out (AG_ERR_DEADLINE), the asker goes away or the service stops
+ * (AG_ERR_CANCELLED), and does not start when it is already spent. */
+ag_status ag_app_query_extrusion_preview_budgeted(const char *plan_json, size_t len,
+                                                  ag_task_budget *budget, ag_app_bytes *out,
+                                                  size_t *failing_faces, ag_error *err);
 
 /* GET /api/v1/health. */
 json_t *ag_app_query_health(ag_app *app, int ws_port, ag_error *err);

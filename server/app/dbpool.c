@@ -6,6 +6,7 @@
 
 struct ag_dbpool {
     char *path;
+    size_t max_bytes;
     pthread_key_t key;
     pthread_mutex_t lock;
     ag_db **conns; /* every connection opened, closed at free */
@@ -19,15 +20,22 @@ static void forget_thread_db(void *db)
 
 ag_status ag_dbpool_create(const char *path, ag_dbpool **out, ag_error *err)
 {
+    return ag_dbpool_create_ex(path, 0, out, err);
+}
+
+ag_status ag_dbpool_create_ex(const char *path, size_t max_bytes, ag_dbpool **out,
+                              ag_error *err)
+{
     *out = NULL;
     ag_dbpool *p = calloc(1, sizeof *p);
     if (!p || !(p->path = strdup(path))) {
         free(p);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
+    p->max_bytes = max_bytes;
     /* The first connection creates and migrates the schema; the others only open it. */
     ag_db *db = NULL;
-    ag_status s = ag_db_open(path, NULL, &db, err);
+    ag_status s = ag_db_open(path, &(ag_db_options){.max_bytes = max_bytes}, &db, err);
     if (s != AG_OK) {
         free(p->path);
         free(p);
@@ -45,7 +53,8 @@ ag_db *ag_dbpool_get(ag_dbpool *p, ag_error *err)
     ag_db *db = pthread_getspecific(p->key);
     if (db)
         return db;
-    if (ag_db_open(p->path, &(ag_db_options){.no_migrate = 1}, &db, err) != AG_OK)
+    if (ag_db_open(p->path, &(ag_db_options){.no_migrate = 1, .max_bytes = p->max_bytes}, &db,
+                   err) != AG_OK)
         return NULL;
     pthread_mutex_lock(&p->lock);
     if (p->n == p->cap) {

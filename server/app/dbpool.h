@@ -12,6 +12,9 @@ typedef struct ag_dbpool ag_dbpool;
 
 /* Creates and migrates the database at path (the first connection, closed again). */
 ag_status ag_dbpool_create(const char *path, ag_dbpool **out, ag_error *err);
+/* The same, every connection limited to max_bytes of database (0: none; store/db.h). */
+ag_status ag_dbpool_create_ex(const char *path, size_t max_bytes, ag_dbpool **out,
+                              ag_error *err);
 void ag_dbpool_free(ag_dbpool *p);
 
 /* This thread's connection; NULL with err filled when it cannot be opened. */

@@ -47,6 +47,16 @@ ag_status ag_edit_ops_validate_restore(const json_t *op, ag_error *err)
 
 /* --- structural edits -------------------------------------------------------------------- */
 
+/* What core may spend on one edit: the service's limits, the op's time and stop flag. */
+static ag_edit_budget edit_budget(const ag_store_env *env, ag_task_budget *tb)
+{
+    ag_work_limits l = ag_work_limits_resolved(env->limits);
+    return (ag_edit_budget){.max_triangles = l.max_triangles,
+                            .max_components = l.max_nodes,
+                            .cancelled = tb ? ag_task_budget_exhausted : NULL,
+                            .user = tb};
+}
+
 ag_status ag_edit_ops_run_edit(const ag_store_env *env, const ag_op_request *rq,
                                int64_t *version, int *duplicate, ag_error *err)
 {
@@ -68,10 +78,13 @@ ag_status ag_edit_ops_run_edit(const ag_store_env *env, const ag_op_request *rq,
         ag_edit_op_origin_clear(&from);
         return s;
     }
+    ag_edit_budget budget = edit_budget(env, rq->budget);
+    e.budget = &budget;
     ag_store_ws w;
     ag_store_ws_init_op(&w, env, rq);
     ag_usecase_edit_result r;
     s = ag_usecase_edit_run(&w.ws, &(ag_usecase_edit_params){&e, &from}, &r, err);
+    s = ag_task_budget_explain(rq->budget, s, "the edit", err);
     ag_store_ws_end(&w, s);
     if (s == AG_OK) {
         *version = w.version;

@@ -28,6 +28,90 @@ static double now(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+/* Set once at start-up, before any worker runs; read-only afterwards. */
+static ag_extrusion_limits limits = {.seconds = AG_EXTRUSION_SECONDS};
+static atomic_int stopping;
+
+void ag_extrusion_configure(const ag_extrusion_limits *l)
+{
+    limits = *l;
+    if (!limits.seconds)
+        limits.seconds = AG_EXTRUSION_SECONDS;
+}
+
+ag_extrusion_limits ag_extrusion_limits_get(void)
+{
+    return limits;
+}
+
+void ag_extrusion_stop_all(void)
+{
+    atomic_store(&stopping, 1);
+}
+
+int ag_extrusion_stopping(void)
+{
+    return atomic_load(&stopping) != 0;
+}
+
+static int hook_cancelled(void *user)
+{
+    const ag_extrusion_cancel *h = user;
+    return atomic_load(&stopping) || (h->cancel && atomic_load(h->cancel)) ||
+           (h->cancelled && h->cancelled(h->user));
+}
+
+void ag_extrusion_options(ag_extrude_options *o, ag_extrusion_cancel *hook, double deadline,
+                          const atomic_int *cancel, int (*cancelled)(void *user), void *user)
+{
+    memset(o, 0, sizeof *o);
+    hook->cancel = cancel;
+    hook->cancelled = cancelled;
+    hook->user = user;
+    double seconds = limits.seconds;
+    if (deadline > 0) {
+        seconds = deadline - now();
+        if (seconds <= 0)
+            seconds = 1e-9; /* already past: stops at its first poll */
+    }
+    o->budget.max_seconds = seconds;
+    o->budget.max_events = limits.max_events;
+    o->budget.max_bytes = limits.max_bytes;
+    o->budget.cancelled = hook_cancelled;
+    o->budget.user = hook;
+}
+
+const char *ag_extrusion_built_fallback(const ag_extrusion_built *b)
+{
+    return b->built == AG_BUILT_SIMPLIFIED || b->built == AG_BUILT_FLAT ||
+                   b->built == AG_BUILT_BLOCK
+               ? ag_built_name(b->built)
+               : NULL;
+}
+
+ag_status ag_extrusion_built_set(ag_extrusion_built *out, const ag_building_result *r,
+                                 const ag_mesh *m, ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->built = r->built;
+    out->moved = r->moved;
+    out->triangles = r->triangles;
+    out->events = r->events;
+    out->seconds = r->seconds;
+    snprintf(out->reason, sizeof out->reason, "%s", r->reason);
+    snprintf(out->fixes, sizeof out->fixes, "%s", r->fixes);
+    if (r->built == AG_BUILT_NONE) {
+        snprintf(out->status, sizeof out->status, "failed");
+        out->failure = AG_ERR_INVALID;
+        if (!out->reason[0])
+            snprintf(out->reason, sizeof out->reason, "nothing could be built");
+        return AG_OK;
+    }
+    snprintf(out->status, sizeof out->status, "ok");
+    ag_status st = ag_meshblob_encode(m, &out->blob, &out->blob_len);
+    return st == AG_OK ? AG_OK : ag_error_set(err, st, 0, "cannot keep the mesh of a building");
+}
+
 ag_status ag_extrusion_append(ag_mesh *dst, const ag_mesh *src)
 {
     size_t v0 = dst->nverts, g0 = dst->ngroups, c0 = dst->ncomponents;
@@ -50,44 +134,35 @@ ag_status ag_extrusion_append(ag_mesh *dst, const ag_mesh *src)
     return s;
 }
 
-ag_status ag_extrusion_build(ag_plan *plan, const char *footprint, ag_mesh *into,
-                             ag_extrusion_built *out, ag_error *err)
+ag_status ag_extrusion_build(ag_plan *plan, const char *footprint, const ag_extrude_options *opt,
+                             ag_mesh *into, ag_extrusion_built *out, ag_error *err)
 {
     memset(out, 0, sizeof *out);
-    double t0 = now();
+    ag_extrude_options own;
+    ag_extrusion_cancel hook;
+    if (!opt) {
+        ag_extrusion_options(&own, &hook, 0, NULL, NULL, NULL);
+        opt = &own;
+    }
     ag_mesh *m = ag_mesh_create();
     size_t group = 0;
     if (!m || ag_mesh_add_group(m, footprint, &group) != AG_OK) {
         ag_mesh_free(m);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
+    ag_building_result r;
     ag_error e = {0};
-    ag_extrude_result res;
-    ag_status st = ag_extrude_plan(plan, m, (int32_t)group, &res, NULL, &e);
-    out->seconds = now() - t0;
-    if (st == AG_ERR_NOMEM) {
-        ag_mesh_free(m);
-        return ag_error_set(err, st, 0, "out of memory extruding %s", footprint);
-    }
-    if (st != AG_OK) {
-        ag_mesh_free(m);
-        snprintf(out->status, sizeof out->status, "failed");
-        snprintf(out->reason, sizeof out->reason, "%s", e.text[0] ? e.text : ag_status_message(st));
-        out->failure = st;
-        return AG_OK;
-    }
-    snprintf(out->status, sizeof out->status, "%s", res.failing_faces ? "not_watertight" : "ok");
-    if (res.failing_faces)
-        snprintf(out->reason, sizeof out->reason, "%zu face(s) fail; face %d: %s",
-                 res.failing_faces, (int)res.problems[0].face, res.problems[0].reason);
-    out->triangles = res.triangles;
-    st = ag_meshblob_encode(m, &out->blob, &out->blob_len);
-    if (st == AG_OK && into)
+    ag_status st = ag_building_extrude_plan(plan, opt, m, (int32_t)group, &r, &e);
+    if (st == AG_OK)
+        st = ag_extrusion_built_set(out, &r, m, &e);
+    if (st == AG_OK && into && out->blob)
         st = ag_extrusion_append(into, m);
     ag_mesh_free(m);
     if (st != AG_OK) {
         ag_extrusion_built_clear(out);
-        return ag_error_set(err, st, 0, "cannot keep the mesh of %s", footprint);
+        if (st == AG_ERR_CANCELLED)
+            return ag_error_set(err, st, 0, "extruding %s was stopped: %s", footprint, e.text);
+        return ag_error_set(err, st, 0, "out of memory extruding %s", footprint);
     }
     return AG_OK;
 }

@@ -21,7 +21,8 @@ static ag_status lookup_stored(void *user, const char *path, char **obj, size_t 
 
 ag_status ag_grammar_edit_apply(const ag_store_env *env, int64_t model, int64_t base,
                                 const char *author, const char *cid, const char *text,
-                                size_t len, int64_t *version, ag_error *err, long *col)
+                                size_t len, ag_task_budget *budget, int64_t *version,
+                                ag_error *err, long *col)
 {
     *version = 0;
     if (col)
@@ -37,8 +38,14 @@ ag_status ag_grammar_edit_apply(const ag_store_env *env, int64_t model, int64_t 
 
     stored_terminals ctx = {env->db, model};
     ag_model_state st;
-    if ((s = ag_model_state_from_text(text, len, lookup_stored, &ctx, &st, err, col)) != AG_OK)
-        return s;
+    ag_work_limits limits = ag_work_limits_resolved(env->limits);
+    ag_edit_budget eb = {.max_triangles = limits.max_triangles,
+                         .max_components = limits.max_nodes,
+                         .cancelled = budget ? ag_task_budget_exhausted : NULL,
+                         .user = budget};
+    if ((s = ag_model_state_from_text(text, len, lookup_stored, &ctx, &eb, &st, err, col)) !=
+        AG_OK)
+        return ag_task_budget_explain(budget, s, "the grammar edit", err);
     const ag_grammar *g = st.em->proc->grammar;
     json_t *summary = json_pack(
         "{s:s, s:I, s:I, s:I, s:I, s:I, s:I}", "source", "edit", "rules", (json_int_t)g->nrules,

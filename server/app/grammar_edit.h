@@ -14,13 +14,17 @@
 
 #include "model_state.h"
 #include "store_env.h"
+#include "task_budget.h"
 
 /* AG_ERR_NOT_FOUND when the model does not exist or was never proceduralized, parse errors as
  * ag_model_state_from_text (line in err->element, column in *col), AG_ERR_STALE when base is
  * not the current version, AG_ERR_TOO_LARGE beyond AG_GRAMMAR_TEXT_MAX. *version gets the new
  * version. */
+/* budget (may be NULL): the edit stops when it runs out (AG_ERR_DEADLINE, AG_ERR_CANCELLED);
+ * a derivation past env's limits is AG_ERR_RESULT_TOO_LARGE. */
 ag_status ag_grammar_edit_apply(const ag_store_env *env, int64_t model, int64_t base,
                                 const char *author, const char *cid, const char *text,
-                                size_t len, int64_t *version, ag_error *err, long *col);
+                                size_t len, ag_task_budget *budget, int64_t *version,
+                                ag_error *err, long *col);
 
 #endif

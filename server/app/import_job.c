@@ -4,6 +4,7 @@
 
 #include "store_ws.h"
 #include "usecase_import.h"
+#include "usecase_import_cloud.h"
 
 static ag_up_axis up_from(const char *s)
 {
@@ -31,9 +32,13 @@ static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_p
                           .filename = ij->filename,
                           .up = up_from(ij->up),
                           .what = "the uploaded file",
-                          .format_hint = "name it with ?format="};
+                          .format_hint = "name it with ?format=",
+                          /* assimp apart: its loops, crashes and leaks end with the child */
+                          .sandbox_seconds = ag_work_limits_resolved(env.limits).import_seconds};
     int64_t model = 0;
-    s = ag_usecase_import_run(&w.ws, &src, ij->name, &model, err);
+    s = ag_usecase_import_cloud_accepts(&src)
+            ? ag_usecase_import_cloud_run(&w.ws, &src, ij->name, &model, err)
+            : ag_usecase_import_run(&w.ws, &src, ij->name, &model, err);
     ag_store_ws_end(&w, s);
     return s;
 }

@@ -15,6 +15,8 @@ const char *ag_job_params_kind(ag_job_type type)
         return "extrude";
     case AG_JOB_DEMO_PARTS:
         return "demo-parts";
+    case AG_JOB_SEGMENT:
+        return "segment";
     default:
         return NULL;
     }
@@ -43,6 +45,15 @@ char *ag_job_params_encode(const ag_job_params *p)
                       e->height_property, "seed",
                       e->seed >= 0 ? json_integer((json_int_t)e->seed) : json_null(), "lonlat",
                       e->lonlat > 0 ? json_true() : e->lonlat < 0 ? json_false() : json_null());
+        break;
+    }
+    case AG_JOB_SEGMENT: {
+        const ag_segment_job *q = &p->u.segment;
+        j = json_pack("{s:I, s:I, s:s, s:f, s:f, s:f, s:b}", "model", (json_int_t)q->model,
+                      "base", (json_int_t)q->base, "author", q->author, "threshold",
+                      q->threshold, "coarse_threshold", q->coarse_threshold,
+                      "cluster_tolerance", q->cluster_tolerance, "recompute_normals",
+                      q->recompute_normals);
         break;
     }
     case AG_JOB_DEMO_PARTS: {
@@ -102,6 +113,18 @@ ag_status ag_job_params_decode(const char *kind, const char *json, ag_job_params
         q->base = json_integer_value(b);
         bad = !json_is_integer(m) || !json_is_integer(b) || q->model <= 0 || q->base <= 0 ||
               take(o, "author", 1, &q->author);
+    } else if (strcmp(kind, "segment") == 0) {
+        out->type = AG_JOB_SEGMENT;
+        ag_segment_job *q = &out->u.segment;
+        json_t *m = json_object_get(o, "model"), *b = json_object_get(o, "base");
+        q->model = json_integer_value(m);
+        q->base = json_integer_value(b);
+        q->threshold = json_number_value(json_object_get(o, "threshold"));
+        q->coarse_threshold = json_number_value(json_object_get(o, "coarse_threshold"));
+        q->cluster_tolerance = json_number_value(json_object_get(o, "cluster_tolerance"));
+        q->recompute_normals = json_is_true(json_object_get(o, "recompute_normals"));
+        bad = !json_is_integer(m) || !json_is_integer(b) || q->model <= 0 || q->base <= 0 ||
+              take(o, "author", 1, &q->author);
     } else if (strcmp(kind, "extrude") == 0) {
         out->type = AG_JOB_EXTRUDE;
         ag_extrude_job *e = &out->u.extrude;
@@ -147,6 +170,9 @@ ag_status ag_job_params_copy(ag_job_params *dst, const ag_job_params *src, ag_er
     case AG_JOB_PROCEDURALIZE:
         DUP(u.proceduralize.author);
         break;
+    case AG_JOB_SEGMENT:
+        DUP(u.segment.author);
+        break;
     case AG_JOB_EXTRUDE:
         DUP(u.extrude.upload), DUP(u.extrude.name), DUP(u.extrude.format),
             DUP(u.extrude.style), DUP(u.extrude.height_property);
@@ -173,6 +199,9 @@ void ag_job_params_clear(ag_job_params *p)
         break;
     case AG_JOB_PROCEDURALIZE:
         free(p->u.proceduralize.author);
+        break;
+    case AG_JOB_SEGMENT:
+        free(p->u.segment.author);
         break;
     case AG_JOB_EXTRUDE:
         free(p->u.extrude.upload), free(p->u.extrude.name), free(p->u.extrude.format),

@@ -14,6 +14,7 @@ typedef enum {
     AG_JOB_PROCEDURALIZE,
     AG_JOB_EXTRUDE,
     AG_JOB_DEMO_PARTS,
+    AG_JOB_SEGMENT,
     AG_JOB_TEST, /* job kinds of tests: no parameters */
 } ag_job_type;
 
@@ -32,6 +33,18 @@ typedef struct {
     int64_t base;
     char *author;
 } ag_proceduralize_job;
+
+/* A point cloud model at version base → segmented (§3.1), by author. Thresholds are
+ * fractions of the cloud's diagonal, 0 = the defaults (core/points/segment_cloud.h). */
+typedef struct {
+    int64_t model;
+    int64_t base;
+    char *author;
+    double threshold;         /* the refinement pass's plane threshold */
+    double coarse_threshold;  /* the first pass's */
+    double cluster_tolerance; /* T_C */
+    int recompute_normals;
+} ag_segment_job;
 
 /* An uploaded building description, list of them or GeoJSON → a new extrusion model. */
 typedef struct {
@@ -61,11 +74,12 @@ typedef struct {
         ag_proceduralize_job proceduralize;
         ag_extrude_job extrude;
         ag_demo_parts_job demo_parts;
+        ag_segment_job segment;
     } u;
 } ag_job_params;
 
 /* The kind name a job of this type is stored under ("import", "proceduralize", "extrude",
- * "demo-parts");
+ * "demo-parts", "segment");
  * test jobs name their own kind. */
 const char *ag_job_params_kind(ag_job_type type);
 

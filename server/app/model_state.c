@@ -176,6 +176,12 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
     return s;
 }
 
+static int budget_stage(void *budget, ag_stage stage)
+{
+    (void)stage;
+    return ag_edit_budget_cancelled(budget);
+}
+
 ag_status ag_model_state_from_grammar(ag_grammar *g, size_t max_triangles, ag_model_state *out,
                                       ag_error *err)
 {
@@ -210,12 +216,31 @@ ag_status ag_model_state_from_grammar(ag_grammar *g, size_t max_triangles, ag_mo
 }
 
 ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_lookup lookup,
-                                   void *user, ag_model_state *out, ag_error *err, long *col)
+                                   void *user, const ag_edit_budget *budget,
+                                   ag_model_state *out, ag_error *err, long *col)
 {
     memset(out, 0, sizeof *out);
     ag_grammar *g = NULL;
-    ag_status s = derive_text(text, len, lookup, user, AG_GRAMMAR_MAX_TRIANGLES, &g,
-                              &out->derived, err, col);
+    size_t max_tris = budget && budget->max_triangles && budget->max_triangles <
+                                                             AG_GRAMMAR_MAX_TRIANGLES
+                          ? budget->max_triangles
+                          : AG_GRAMMAR_MAX_TRIANGLES;
+    ag_status s = derive_text(text, len, lookup, user, max_tris, &g, &out->derived, err, col);
+    if (s == AG_ERR_TOO_LARGE && max_tris < AG_GRAMMAR_MAX_TRIANGLES)
+        s = ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, err ? err->element : 0,
+                         "the grammar derives more than %zu triangles, the most this server "
+                         "takes",
+                         max_tris);
+    if (s == AG_OK && budget && budget->max_components &&
+        out->derived->ncomponents > budget->max_components)
+        s = ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, 0,
+                         "the grammar places %zu terminals; this server takes at most %zu",
+                         out->derived->ncomponents, budget->max_components);
+    if (s != AG_OK) {
+        ag_grammar_free(g);
+        ag_model_state_clear(out);
+        return s;
+    }
     if (s != AG_OK)
         return s;
     if (!(out->text = malloc(len + 1)))
@@ -226,8 +251,12 @@ ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_loo
         out->text_len = len;
     }
     ag_grammar_free(g);
-    if (s == AG_OK)
+    if (s == AG_OK && budget && budget->cancelled) {
+        ag_proceduralize_options po = {.progress = budget_stage, .user = (void *)budget};
+        s = ag_edit_model_create(out->derived, &po, &out->em, err);
+    } else if (s == AG_OK) {
         s = ag_model_state_reload(out->derived, &out->em, err);
+    }
     if (s != AG_OK)
         ag_model_state_clear(out);
     return s;

@@ -60,8 +60,11 @@ typedef ag_status (*ag_terminal_lookup)(void *user, const char *path, char **obj
  * with the line in err->element and the column in *col; a terminal path lookup does not know:
  * AG_ERR_PARSE at the terminal's declaration, naming it; a grammar that derives nothing:
  * AG_ERR_EMPTY; a derivation larger than AG_GRAMMAR_MAX_TRIANGLES: AG_ERR_TOO_LARGE. */
+/* budget (may be NULL) bounds the derivation (AG_ERR_RESULT_TOO_LARGE past its limits) and
+ * is asked between the stages of proceduralizing it. */
 ag_status ag_model_state_from_text(const char *text, size_t len, ag_terminal_lookup lookup,
-                                   void *user, ag_model_state *out, ag_error *err, long *col);
+                                   void *user, const ag_edit_budget *budget,
+                                   ag_model_state *out, ag_error *err, long *col);
 
 /* The edit model of a kept model mesh (the store's reload). */
 ag_status ag_model_state_reload(const ag_mesh *mesh, ag_edit_model **em, ag_error *err);

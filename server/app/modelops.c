@@ -4,6 +4,8 @@
 #include <string.h>
 
 #include "../store/models.h"
+#include "../store/ops.h"
+#include "rebase.h"
 
 #define AG_NOTE_MAX 4000
 
@@ -83,22 +85,17 @@ ag_status ag_modelops_check_token(const char *what, const char *value, ag_error 
     return AG_OK;
 }
 
-ag_status ag_modelops_apply(const ag_store_env *env, const ag_op_request *rq, int64_t *version,
-                            int *duplicate, ag_error *err)
+/* The op at rq->base, once. */
+static ag_status apply_once(const ag_store_env *env, const ag_op_request *rq,
+                            const ag_op_kind *row, int64_t *version, int *duplicate,
+                            ag_error *err)
 {
-    *duplicate = 0;
-    *version = 0;
-    ag_status s;
-    if ((s = ag_modelops_check_token("the client id (cid)", rq->cid, err)) != AG_OK ||
-        (s = ag_models_check_name(rq->author, err)) != AG_OK ||
-        (s = ag_modelops_validate(rq->op, err)) != AG_OK)
-        return s;
-    const ag_op_kind *row = ag_optable_find(json_string_value(json_object_get(rq->op, "kind")));
     /* structural kinds compute off the commit lock, then commit as one change */
     if (row->run)
         return row->run(env, rq, version, duplicate, err);
     ag_seq_txn t;
     int64_t seen = 0;
+    ag_status s;
     if ((s = ag_sequencer_begin(env->seq, env->db, rq->model, rq->base, rq->author, rq->cid, &t,
                                 &seen, err)) != AG_OK)
         return s;
@@ -116,4 +113,50 @@ ag_status ag_modelops_apply(const ag_store_env *env, const ag_op_request *rq, in
     if ((s = ag_sequencer_commit(&t, rq->author, rq->cid, rq->op, err)) == AG_OK)
         *version = v;
     return s;
+}
+
+/* A live op may meet ops committed between its rebase and its own commit: rebased again, a
+ * few times. */
+#define AG_REBASE_ATTEMPTS 8
+
+ag_status ag_modelops_apply(const ag_store_env *env, const ag_op_request *rq, int64_t *version,
+                            int *duplicate, ag_error *err)
+{
+    *duplicate = 0;
+    *version = 0;
+    ag_status s;
+    if ((s = ag_modelops_check_token("the client id (cid)", rq->cid, err)) != AG_OK ||
+        (s = ag_models_check_name(rq->author, err)) != AG_OK ||
+        (s = ag_modelops_validate(rq->op, err)) != AG_OK)
+        return s;
+    const ag_op_kind *row = ag_optable_find(json_string_value(json_object_get(rq->op, "kind")));
+    if (!rq->rebase)
+        return apply_once(env, rq, row, version, duplicate, err);
+    for (int attempt = 0;; attempt++) {
+        /* a retry of an op applied before is answered as such, never rebased again */
+        int64_t seen = 0, current = 0;
+        if ((s = ag_ops_find_cid(env->db, rq->model, rq->author, rq->cid, &seen, err)) != AG_OK)
+            return s;
+        if (seen) {
+            *duplicate = 1;
+            *version = seen;
+            return AG_OK;
+        }
+        ag_model_row m;
+        if ((s = ag_models_get(env->db, rq->model, &m, err)) != AG_OK)
+            return s;
+        current = m.version;
+        ag_models_row_clear(&m);
+        ag_op_request at = *rq;
+        json_t *rewritten = NULL;
+        if ((s = ag_rebase_op(env, rq, row, current, &at.base, &rewritten, err)) != AG_OK)
+            return s;
+        if (rewritten)
+            at.op = rewritten;
+        s = apply_once(env, &at, row, version, duplicate, err);
+        json_decref(rewritten);
+        if (s != AG_ERR_STALE || attempt + 1 >= AG_REBASE_ATTEMPTS)
+            return s;
+        /* an op came in between: rebase again onto the newer version */
+    }
 }

@@ -15,10 +15,12 @@
  * makes them. */
 ag_status ag_modelops_validate(const json_t *op, ag_error *err);
 
-/* Applies a client's op if rq->base is the model's version: *version gets the new version.
- * A (author, cid) pair seen before on this model is not applied again: *duplicate = 1 and
- * *version is the version it got then. AG_ERR_STALE carries the current version in
- * err->element. */
+/* Applies a client's op if rq->base is the model's version — or, for a live op
+ * (rq->rebase), onto the current version when nothing since its base conflicts with it
+ * (app/rebase.h): *version gets the new version. A (author, cid) pair seen before on this
+ * model is not applied again: *duplicate = 1 and *version is the version it got then.
+ * AG_ERR_STALE carries the current version in err->element (and names the conflicting op
+ * when a live op could not be rebased). */
 ag_status ag_modelops_apply(const ag_store_env *env, const ag_op_request *rq, int64_t *version,
                             int *duplicate, ag_error *err);
 

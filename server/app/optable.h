@@ -13,7 +13,9 @@
  *   lane       AG_OP_FAST: applied at once on the thread that received it;
  *              AG_OP_STRUCTURAL: may take long (a model is loaded and proceduralized, a
  *              batch re-extruded): the live layer runs it on the job queue's fast lane
- *   made_by    server-made kinds: the REST call that makes them (named in the refusal) */
+ *   made_by    server-made kinds: the REST call that makes them (named in the refusal)
+ *   rebase     how a live op of the kind made on an older version is applied to the current
+ *              one when nothing since conflicts with it (app/rebase.h) */
 #ifndef AG_OPTABLE_H
 #define AG_OPTABLE_H
 
@@ -22,6 +24,7 @@
 #include <stdint.h>
 
 #include "../core/status.h"
+#include "task_budget.h"
 
 /* declared, not included: the live layer reads the table without seeing the store */
 struct ag_db;
@@ -35,6 +38,15 @@ enum {
 
 typedef enum { AG_OP_FAST = 0, AG_OP_STRUCTURAL = 1 } ag_op_lane;
 
+/* How a live op made on an older version is brought onto the current one (app/rebase.h). */
+typedef enum {
+    AG_REBASE_NEVER = 0,
+    AG_REBASE_ALWAYS,
+    AG_REBASE_UNLESS_SAME,
+    AG_REBASE_OVER_CONTENT,
+    AG_REBASE_NODES,
+} ag_op_rebase;
+
 /* One op as a client (or the server) asks for it. */
 typedef struct {
     int64_t model;
@@ -43,6 +55,10 @@ typedef struct {
     const char *cid;    /* the client's id of the op: one use per author and model */
     const json_t *op;
     uint64_t origin;    /* the live session it came from, 0 = none */
+    ag_task_budget *budget; /* the time it may take and whether to stop; NULL = no limit */
+    /* base is what the client had seen (a live op): rebase it onto the current version when
+     * nothing since conflicts (app/rebase.h). 0: base is a precondition (REST If-Match). */
+    int rebase;
 } ag_op_request;
 
 typedef struct {
@@ -54,6 +70,7 @@ typedef struct {
     unsigned flags;
     ag_op_lane lane;
     const char *made_by;
+    ag_op_rebase rebase;
 } ag_op_kind;
 
 extern const ag_op_kind ag_optable[];

@@ -115,7 +115,7 @@ static ag_status rebuild(const json_t *doc, int64_t b, const char *footprint, in
     ag_plan *plan = NULL;
     ag_status s = parse(doc, what, &plan, &u->plan_json, err);
     if (s == AG_OK)
-        s = ag_extrusion_build(plan, footprint, NULL, &u->built, err);
+        s = ag_extrusion_build(plan, footprint, NULL, NULL, &u->built, err);
     ag_plan_free(plan);
     if (s == AG_OK && strcmp(u->built.status, "failed") == 0 && !may_fail)
         s = ag_error_set(err, AG_ERR_PARSE, 0, "%sthe plan cannot be extruded: %s", what,
@@ -134,7 +134,9 @@ static ag_status store(ag_db *db, int64_t model, update *u, size_t n, ag_error *
                                      .mesh = u[i].built.blob,
                                      .mesh_len = u[i].built.blob_len,
                                      .triangles = (int64_t)u[i].built.triangles,
-                                     .reason = u[i].built.reason[0] ? u[i].built.reason : NULL};
+                                     .reason = u[i].built.reason[0] ? u[i].built.reason : NULL,
+                                     .fallback = ag_extrusion_built_fallback(&u[i].built),
+                                     .moved = u[i].built.moved};
         snprintf(row.status, sizeof row.status, "%s", u[i].built.status);
         s = ag_extrusions_put_building(db, &row, err);
     }

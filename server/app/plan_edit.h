@@ -7,11 +7,14 @@
  *                                                    replaces that profile in every building
  *                                                    whose description has it
  *
- * Only the buildings an op touches are extruded again; the model's mesh is re-assembled from
- * the stored buildings. A description that does not parse or validate, or a building that
- * fails to extrude, refuses the whole op (AG_ERR_PARSE, 422, naming the building and the
- * reason) and nothing is stored; only a building that had already failed before a profile op
- * (a batch's bad footprint) may stay failed. */
+ * Only the buildings an op touches are extruded again (app/extrusion.h: under the service's
+ * budget, stopped on shutdown); the model's mesh is re-assembled from the stored buildings.
+ * A description that does not parse or validate refuses the whole op (AG_ERR_PARSE, 422,
+ * naming the building and the reason) and nothing is stored; only a building that had
+ * already failed before a profile op (a batch's bad footprint) may stay failed. A building
+ * whose new description does not give a good building (not a closed 2-manifold, reaching
+ * outside its footprint, over its budget) falls back to a flat roof or a block, stored with
+ * the reason and the fallback, as the extrude job does. */
 #ifndef AG_PLAN_EDIT_H
 #define AG_PLAN_EDIT_H
 

@@ -111,15 +111,22 @@ int ag_points_folder_is_point_model(const char *dir)
     return ag_points_grammar_file_is_points(path);
 }
 
-static ag_status input_cloud(ag_workspace *ws, ag_cloud **cloud, ag_error *err)
+/* The cloud file, with every property (a folder keeps no segmentation of it). */
+static ag_status input_cloud(ag_workspace *ws, int with_properties, int need_segmentation,
+                             ag_cloud_state *cs, ag_error *err)
 {
+    (void)with_properties;
     ag_points_folder_ws *w = (ag_points_folder_ws *)ws;
-    double t0 = ag_clock_seconds();
     blame(w, w->o.cloud_path);
+    if (need_segmentation)
+        return ag_error_set(err, AG_ERR_CONFLICT, 0, "a cloud file has no segmentation to use");
+    double t0 = ag_clock_seconds();
     struct stat sb;
     w->input_bytes = stat(w->o.cloud_path, &sb) ? 0 : (size_t)sb.st_size;
-    ag_status st = ag_cloud_import_file(w->o.cloud_path, cloud, err);
+    ag_status st = ag_cloud_import_file(w->o.cloud_path, &cs->cloud, err);
     w->read_s = ag_clock_seconds() - t0;
+    if (st == AG_OK)
+        cs->had_normals = cs->cloud->normals != NULL;
     return st;
 }
 

@@ -9,17 +9,20 @@
 #include "dbpool.h"
 #include "edit_session.h"
 #include "sequencer.h"
+#include "work_limits.h"
 
 typedef struct ag_store_env {
     ag_db *db;
     ag_sequencer *seq;
     ag_edit_sessions *sessions; /* NULL: an edit loads its model afresh and keeps nothing */
+    const ag_work_limits *limits; /* NULL: the defaults */
 } ag_store_env;
 
 typedef struct ag_store_services {
     ag_dbpool *pool;
     ag_sequencer *seq;
     ag_edit_sessions *sessions;
+    const ag_work_limits *limits;
 } ag_store_services;
 
 /* The calling thread's environment. */
@@ -28,6 +31,7 @@ static inline ag_status ag_store_services_env(const ag_store_services *s, ag_sto
 {
     env->seq = s->seq;
     env->sessions = s->sessions;
+    env->limits = s->limits;
     env->db = ag_dbpool_get(s->pool, err);
     return env->db ? AG_OK : err ? err->code : AG_ERR_DB;
 }

@@ -477,7 +477,7 @@ static ag_status add_model(ag_workspace *ws, const char *name, const ag_mesh *me
     return s == AG_OK ? ag_db_commit(db, err) : (ag_db_rollback(db), s);
 }
 
-static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extrude_batch *b,
+static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extrusion_batch *b,
                                const ag_mesh *mesh, const char *source, size_t source_len,
                                const json_t *report, int64_t *model_out, ag_error *err)
 {
@@ -523,7 +523,9 @@ static ag_status add_extrusion(ag_workspace *ws, const char *name, const ag_extr
                                      .mesh_len = it->built.blob_len,
                                      .triangles = (int64_t)it->built.triangles,
                                      .reason = it->built.reason[0] ? (char *)it->built.reason
-                                                                   : NULL};
+                                                                   : NULL,
+                                     .fallback = ag_extrusion_built_fallback(&it->built),
+                                     .moved = it->built.moved};
         snprintf(row.status, sizeof row.status, "%s", it->built.status);
         s = ag_extrusions_put_building(db, &row, err);
     }
@@ -572,6 +574,9 @@ static const ag_workspace_ops store_ops = {
     .open_part = open_part,
     .save_part = save_part,
     .save_composed = save_composed,
+    .add_cloud = ag__store_ws_add_cloud,
+    .input_cloud = ag__store_ws_input_cloud,
+    .save_segmentation = ag__store_ws_save_segmentation,
     .cancelled = cancelled,
     .progress = progress,
     .state_flags = 0, /* the mesh is kept: a reload gives the saved model itself */
@@ -595,12 +600,28 @@ void ag_store_ws_init_op(ag_store_ws *w, const ag_store_env *env, const ag_op_re
                                                .op = rq->op});
 }
 
+void ag_store_ws_init_job(ag_store_ws *w, const ag_store_env *env, ag_jobctx *ctx, int64_t job,
+                          int64_t model, int64_t base, const char *author)
+{
+    char cid[sizeof w->job_cid];
+    snprintf(cid, sizeof cid, "job-%lld", (long long)job);
+    ag_store_ws_init(w, &(ag_store_ws_options){.env = *env,
+                                               .model = model,
+                                               .base = base,
+                                               .author = author,
+                                               .job = ctx,
+                                               .job_id = job});
+    memcpy(w->job_cid, cid, sizeof cid);
+    w->o.cid = w->job_cid;
+}
+
 void ag_store_ws_end(ag_store_ws *w, ag_status outcome)
 {
     if (w->target && outcome != AG_OK && outcome != AG_ERR_STALE && outcome != AG_ERR_INVALID &&
         outcome != AG_ERR_NOT_FOUND && outcome != AG_ERR_CONFLICT && outcome != AG_ERR_PARSE &&
         outcome != AG_ERR_NOT_PROCEDURALIZED && outcome != AG_ERR_TOO_LARGE &&
-        outcome != AG_ERR_EMPTY)
+        outcome != AG_ERR_EMPTY && outcome != AG_ERR_RESULT_TOO_LARGE &&
+        outcome != AG_ERR_DEADLINE && outcome != AG_ERR_CANCELLED)
         ag_edit_session_reset(w->target); /* an unexpected failure: load afresh next time */
     ag_edit_session_release(w->o.env.sessions, w->source);
     ag_edit_session_release(w->o.env.sessions, w->target);

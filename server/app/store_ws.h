@@ -40,12 +40,17 @@ typedef struct {
     int duplicate;                  /* the cid was used before: nothing was applied */
     ag_part *part;                  /* the part a composition read */
     int64_t part_id, part_version;  /* where a part save went */
+    char job_cid[32];               /* a job's cid, "job-<id>" */
 } ag_store_ws;
 
 void ag_store_ws_init(ag_store_ws *w, const ag_store_ws_options *o);
 /* The workspace of a client's op (a structural kind's run): its model, base, author, cid,
  * origin and the op as logged. */
 void ag_store_ws_init_op(ag_store_ws *w, const ag_store_env *env, const ag_op_request *rq);
+/* The workspace of a job's run on a model: its cid is "job-<id>", the job reports progress
+ * and is asked whether to stop. */
+void ag_store_ws_init_job(ag_store_ws *w, const ag_store_env *env, ag_jobctx *ctx, int64_t job,
+                          int64_t model, int64_t base, const char *author);
 /* Gives the sessions back; after a failure that is not the op's or the model's fault the
  * target's kept model is dropped (it is loaded afresh next time). */
 void ag_store_ws_end(ag_store_ws *w, ag_status outcome);
@@ -62,6 +67,17 @@ ag_status ag_store_ws_insert_model(ag_db *db, const char *name, const ag_mesh *m
 ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
                                  const ag_model_state *st, const char *summary_json,
                                  ag_error *err);
+/* The point cloud operations of the store workspace (app/store_ws_cloud.c): a cloud upload
+ * is a new model of kind "pointcloud" (its points in the point cloud tables, its file kept
+ * as the source up to 256 MiB); a segmentation is saved as a server op ("segment", a job) or
+ * the client's op (segment_roi, mark_template) with its report, with the states before and
+ * after kept for undo. */
+ag_status ag__store_ws_add_cloud(ag_workspace *ws, const char *name, const ag_cloud_new *c,
+                                 int64_t *model, ag_error *err);
+ag_status ag__store_ws_input_cloud(ag_workspace *ws, int with_properties, int need_segmentation,
+                                   ag_cloud_state *st, ag_error *err);
+ag_status ag__store_ws_save_segmentation(ag_workspace *ws, const ag_cloud_state *st,
+                                         const ag_segment_outcome *o, ag_error *err);
 /* Keeps st's edit model (taken) as the model's edit session at version. */
 void ag__store_ws_keep_model(ag_edit_sessions *reg, int64_t model, int64_t version,
                              ag_model_state *st);

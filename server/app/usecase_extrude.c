@@ -10,8 +10,9 @@
 #include "../io/footprints.h"
 #include "../io/plan_json.h"
 #include "../io/plan_write.h"
+#include "extrude_batch.h"
 
-void ag_usecase_extrude_batch_clear(ag_extrude_batch *b)
+void ag_usecase_extrude_batch_clear(ag_extrusion_batch *b)
 {
     for (size_t i = 0; i < b->n; i++) {
         free(b->items[i].id);
@@ -45,7 +46,7 @@ static const char *sniff(const json_t *root)
     return NULL;
 }
 
-static ag_status add_building(ag_extrude_batch *b, size_t cap, const char *id, char *plan_json,
+static ag_status add_building(ag_extrusion_batch *b, size_t cap, const char *id, char *plan_json,
                               ag_plan *plan, ag_error *err)
 {
     if (!b->items && !(b->items = calloc(cap ? cap : 1, sizeof *b->items))) {
@@ -80,7 +81,7 @@ static ag_status parse_description(json_t *doc, const char *what, char **text, a
     return AG_OK;
 }
 
-static ag_status read_plan(json_t *root, const char *name, ag_extrude_batch *b, ag_error *err)
+static ag_status read_plan(json_t *root, const char *name, ag_extrusion_batch *b, ag_error *err)
 {
     char *text;
     ag_plan *plan;
@@ -88,7 +89,7 @@ static ag_status read_plan(json_t *root, const char *name, ag_extrude_batch *b, 
     return s != AG_OK ? s : add_building(b, 1, name, text, plan, err);
 }
 
-static ag_status read_buildings(json_t *root, ag_extrude_batch *b, ag_error *err)
+static ag_status read_buildings(json_t *root, ag_extrusion_batch *b, ag_error *err)
 {
     json_t *list = json_object_get(root, "buildings");
     size_t n = json_array_size(list);
@@ -123,15 +124,18 @@ static ag_status read_buildings(json_t *root, ag_extrude_batch *b, ag_error *err
     return AG_OK;
 }
 
+/* A GeoJSON batch: its footprints (*out, for the batch to extrude) and, per footprint, the
+ * plan its style makes, stored as the building's description. */
 static ag_status read_geojson(const char *data, size_t len, const ag_extrude_input *params,
-                              ag_extrude_batch *b, ag_error *err)
+                              ag_style *style, ag_footprints **out, ag_extrusion_batch *b,
+                              ag_error *err)
 {
-    ag_style style;
-    ag_status s = ag_style_builtin(params->style ? params->style : "hip", &style, err);
+    *out = NULL;
+    ag_status s = ag_style_builtin(params->style ? params->style : "hip", style, err);
     if (s != AG_OK)
         return s;
     if (params->seed >= 0)
-        style.seed = (uint64_t)params->seed;
+        style->seed = (uint64_t)params->seed;
     ag_footprints_options fo = {
         .height_property = params->height_property,
         .lonlat = params->lonlat,
@@ -147,7 +151,7 @@ static ag_status read_geojson(const char *data, size_t len, const ag_extrude_inp
     }
     b->skipped = f->skipped;
     b->meta = json_pack("{s:s, s:s, s:b, s:[f,f], s:I}", "format", "geojson", "style",
-                        style.name, "lonlat", f->lonlat, "origin", f->origin[0], f->origin[1],
+                        style->name, "lonlat", f->lonlat, "origin", f->origin[0], f->origin[1],
                         "skipped_features", (json_int_t)f->skipped);
     for (size_t i = 0; i < f->n && s == AG_OK; i++) {
         const ag_footprint *fp = &f->items[i];
@@ -155,43 +159,113 @@ static ag_status read_geojson(const char *data, size_t len, const ag_extrude_inp
         json_t *doc = NULL;
         char *text = NULL;
         ag_error e = {0};
-        ag_status made = ag_style_apply(&style, (const double *const *)fp->loops, fp->sizes,
+        /* the plan the batch's first attempt extrudes (same style, footprint and index) */
+        ag_status made = ag_style_apply(style, (const double *const *)fp->loops, fp->sizes,
                                         fp->nloops, fp->height, i, &plan, &e);
         if (made == AG_OK && (made = ag_plan_write_json(plan, &doc, &e)) == AG_OK &&
             !(text = json_dumps(doc, JSON_COMPACT)))
             made = ag_error_set(&e, AG_ERR_NOMEM, 0, "out of memory");
         json_decref(doc);
+        ag_plan_free(plan);
         if (made == AG_ERR_NOMEM) {
-            ag_plan_free(plan);
+            free(text);
             s = ag_error_set(err, made, 0, "out of memory");
             break;
         }
         if (made != AG_OK) {
-            ag_plan_free(plan);
             free(text);
-            plan = NULL;
-            text = NULL;
+            text = NULL; /* the batch reports why */
         }
-        s = add_building(b, f->n, fp->id, text, plan, err);
-        if (s == AG_OK && made != AG_OK) {
-            ag_extrude_building *it = &b->items[b->n - 1];
-            snprintf(it->built.status, sizeof it->built.status, "failed");
-            snprintf(it->built.reason, sizeof it->built.reason, "%s", e.text);
-            it->built.failure = made;
-        }
+        s = add_building(b, f->n, fp->id, text, NULL, err);
     }
-    ag_footprints_free(f);
+    if (s == AG_OK)
+        *out = f;
+    else
+        ag_footprints_free(f);
     return s;
 }
 
-static json_t *issues(const ag_extrude_batch *b, const char *status)
+/* --- the batch: every building on every core -------------------------------------------- */
+
+typedef struct {
+    ag_extrusion_batch *b;
+    const ag_footprints *f; /* GeoJSON: footprints with a style; else the items' plans */
+    const ag_style *style;
+} batch_input;
+
+static ag_status build_one(void *user, size_t i, const ag_extrude_options *opt, ag_mesh *m,
+                           ag_building_result *out, ag_error *err)
 {
-    json_t *a = json_array();
+    const batch_input *in = user;
+    ag_extrude_building *it = &in->b->items[i];
+    size_t group = 0;
+    if (ag_mesh_add_group(m, it->id, &group) != AG_OK)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    if (in->f) {
+        const ag_footprint *fp = &in->f->items[i];
+        return ag_building_extrude(in->style, (const double *const *)fp->loops, fp->sizes,
+                                   fp->nloops, fp->height, i, opt, m, (int32_t)group, out, err);
+    }
+    return ag_building_extrude_plan(it->plan, opt, m, (int32_t)group, out, err);
+}
+
+static void batch_progress(void *user, size_t done, size_t total)
+{
+    ag_workspace_progress(user, 0.05 + 0.85 * (double)done / (double)(total ? total : 1),
+                          "extrude");
+}
+
+static int ws_cancelled(void *user)
+{
+    return ag_workspace_cancelled(user);
+}
+
+/* Extrudes every building of b on every core into its built record (and `mesh`, in order)
+ * and fills the report. */
+static ag_status extrude_all(ag_workspace *ws, ag_extrusion_batch *b, const ag_footprints *f,
+                             const ag_style *style, ag_mesh *mesh, ag_footprints_report *report,
+                             ag_error *err)
+{
+    memset(report, 0, sizeof *report);
+    report->footprints = b->n;
+    ag_mesh **meshes = calloc(b->n ? b->n : 1, sizeof *meshes);
+    ag_building_result *results = calloc(b->n ? b->n : 1, sizeof *results);
+    if (!meshes || !results) {
+        free(meshes);
+        free(results);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    ag_extrude_batch_options bo;
+    memset(&bo, 0, sizeof bo);
+    ag_extrusion_cancel hook;
+    ag_extrusion_options(&bo.extrude, &hook, 0, NULL, ws_cancelled, ws);
+    bo.threads = ag_extrusion_limits_get().threads;
+    bo.progress = batch_progress;
+    bo.progress_user = ws;
+    batch_input in = {b, f, style};
+    ag_error e = {0};
+    ag_status s = ag_extrude_batch_each(b->n, build_one, &in, &bo, meshes, results, &e);
+    if (s == AG_ERR_CANCELLED)
+        ag_error_set(err, s, 0, "the job was cancelled (%s)", e.text);
+    else if (s != AG_OK)
+        ag_error_set(err, s, 0, "%s", e.text[0] ? e.text : ag_status_message(s));
+    for (size_t i = 0; s == AG_OK && i < b->n; i++) {
+        ag_extrude_building *it = &b->items[i];
+        ag_extrusion_built_clear(&it->built);
+        s = ag_extrusion_built_set(&it->built, &results[i], meshes[i], err);
+        if (s == AG_OK && it->built.blob)
+            s = ag_extrusion_append(mesh, meshes[i]);
+        if (s == AG_OK)
+            s = ag_footprints_report_add_id(report, it->id, f ? f->items[i].fixes : NULL,
+                                            &results[i]);
+        if (s == AG_ERR_NOMEM)
+            ag_error_set(err, s, 0, "out of memory");
+    }
     for (size_t i = 0; i < b->n; i++)
-        if (strcmp(b->items[i].built.status, status) == 0)
-            json_array_append_new(a, json_pack("{s:s, s:s}", "id", b->items[i].id, "reason",
-                                               b->items[i].built.reason));
-    return a;
+        ag_mesh_free(meshes[i]);
+    free(meshes);
+    free(results);
+    return s;
 }
 
 ag_status ag_usecase_extrude_run(ag_workspace *ws, const ag_extrude_input *params,
@@ -204,7 +278,11 @@ ag_status ag_usecase_extrude_run(ag_workspace *ws, const ag_extrude_input *param
     size_t len = params->len;
     json_t *root = NULL;
     ag_mesh *mesh = NULL;
-    ag_extrude_batch b = {0};
+    ag_extrusion_batch b = {0};
+    ag_footprints *footprints = NULL;
+    ag_style style;
+    ag_footprints_report report;
+    memset(&report, 0, sizeof report);
     ag_status s;
     if (!data || !name) {
         s = ag_error_set(err, AG_ERR_INTERNAL, 0, "an extrusion without an input or a name");
@@ -231,7 +309,7 @@ ag_status ag_usecase_extrude_run(ag_workspace *ws, const ag_extrude_input *param
         goto done;
     }
     if (strcmp(format, "geojson") == 0) {
-        s = read_geojson(data, len, params, &b, err);
+        s = read_geojson(data, len, params, &style, &footprints, &b, err);
     } else if (strcmp(format, "buildings") == 0) {
         b.meta = json_pack("{s:s}", "format", "buildings");
         s = read_buildings(root, &b, err);
@@ -250,30 +328,18 @@ ag_status ag_usecase_extrude_run(ag_workspace *ws, const ag_extrude_input *param
         goto done;
     }
 
-    /* Extrude each building on its own: progress per building, failures reported. */
     if (!(mesh = ag_mesh_create())) {
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         goto done;
     }
+    ag_workspace_progress(ws, 0.05, "extrude");
     double t0 = now();
-    size_t succeeded = 0, not_watertight = 0, triangles = 0;
-    for (size_t i = 0; i < b.n; i++) {
-        ag_extrude_building *it = &b.items[i];
-        if (ag_workspace_progress(ws, 0.05 + 0.85 * (double)i / (double)b.n, "extrude")) {
-            s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
-            goto done;
-        }
-        if (it->plan && (s = ag_extrusion_build(it->plan, it->id, mesh, &it->built, err)) != AG_OK)
-            goto done;
-        if (strcmp(it->built.status, "failed") != 0) {
-            succeeded++;
-            triangles += it->built.triangles;
-            not_watertight += strcmp(it->built.status, "not_watertight") == 0;
-        }
-    }
+    s = extrude_all(ws, &b, footprints, &style, mesh, &report, err);
     double seconds = now() - t0;
+    if (s != AG_OK)
+        goto done;
     int single = strcmp(format, "plan") == 0;
-    if (succeeded == 0) {
+    if (report.nfailed == b.n) {
         const ag_extrude_building *first = &b.items[0];
         s = single ? ag_error_set(err, first->built.failure ? first->built.failure : AG_ERR_INVALID,
                                   0, "the plan cannot be extruded: %s", first->built.reason)
@@ -283,26 +349,29 @@ ag_status ag_usecase_extrude_run(ag_workspace *ws, const ag_extrude_input *param
                                   b.n, first->id, first->built.reason);
         goto done;
     }
-    json_t *report = json_pack(
-        "{s:I, s:I, s:o, s:I, s:o, s:I, s:f, s:I}", "footprints", (json_int_t)b.n, "succeeded",
-        (json_int_t)succeeded, "failed", issues(&b, "failed"), "not_watertight",
-        (json_int_t)not_watertight, "not_watertight_items", issues(&b, "not_watertight"),
-        "triangles", (json_int_t)triangles, "seconds", seconds, "skipped_features",
-        (json_int_t)b.skipped);
-    if (!report) {
+    json_t *rep = ag_footprints_report_json(&report);
+    if (rep && json_object_update_new(rep, json_pack("{s:f, s:I}", "seconds", seconds,
+                                                     "skipped_features",
+                                                     (json_int_t)b.skipped)) != 0) {
+        json_decref(rep);
+        rep = NULL;
+    }
+    if (!rep) {
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         goto done;
     }
     if (ag_workspace_progress(ws, 0.92, "store")) {
-        json_decref(report);
+        json_decref(rep);
         s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
         goto done;
     }
-    s = ag_workspace_add_extrusion(ws, name, &b, mesh, data, len, report, model, err);
-    json_decref(report);
+    s = ag_workspace_add_extrusion(ws, name, &b, mesh, data, len, rep, model, err);
+    json_decref(rep);
 done:
     json_decref(root);
     ag_mesh_free(mesh);
+    ag_footprints_report_free(&report);
+    ag_footprints_free(footprints);
     ag_usecase_extrude_batch_clear(&b);
     return s;
 }

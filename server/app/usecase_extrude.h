@@ -1,12 +1,18 @@
 /* The extrude use case, over a workspace (app/workspace.h): a building description (plan JSON,
  * schema/plan.md), a list of them ({"buildings": [{"id", "plan"}]}, as GET …/plan gives for a
- * batch) or a GeoJSON FeatureCollection of footprints turned into plans by a style → each
- * building extruded on its own (progress per building, stage "extrude"; a building that fails
- * is reported with its id and the reason and the batch goes on) → saved as a new extrusion
- * model with the report {"footprints", "succeeded", "failed": [{"id", "reason"}],
- * "not_watertight", "not_watertight_items", "triangles", "seconds", "skipped_features"}.
- * Input that cannot be read, a single plan that fails, or a batch where every building fails
- * fails the use case with the reason and saves nothing. The extrude job runs it on the store. */
+ * batch) or a GeoJSON FeatureCollection of footprints turned into plans by a style → every
+ * building extruded on every core (app/extrude_batch.h; progress per building, stage
+ * "extrude"), each under the service's budget (app/extrusion.h) and cancelled with the job:
+ * a building whose result is not good (not a closed 2-manifold within reach of its
+ * footprint) is retried on a simplified footprint (GeoJSON), then falls back to a flat roof,
+ * then to a block; one that validation refuses is reported failed and the batch goes on →
+ * saved as a new extrusion model with the report of `archgram extrude --report`
+ * (ag_footprints_report_json: "footprints", "succeeded", "fallbacks": [{"id", "reason",
+ * "fallback", "moved"}], "failed": [{"id", "reason"}], "not_watertight" (0),
+ * "not_watertight_items", "fixed", "triangles", "events"; plus "seconds" and
+ * "skipped_features"). Input that cannot be read, or a batch where nothing could be built,
+ * fails the use case with the reason and saves nothing. The extrude job runs it on the
+ * store. */
 #ifndef AG_USECASE_EXTRUDE_H
 #define AG_USECASE_EXTRUDE_H
 
@@ -37,15 +43,17 @@ typedef struct {
     ag_extrusion_built built;
 } ag_extrude_building;
 
+/* (struct ag_extrude_batch, the name workspaces know it by; ag_extrude_batch() is the
+ * batch runner of app/extrude_batch.h) */
 typedef struct ag_extrude_batch {
     ag_extrude_building *items;
     size_t n;
     const char *format; /* "plan" | "buildings" | "geojson" */
     json_t *meta;       /* format, and for GeoJSON style, origin, lonlat, skipped features */
     size_t skipped;
-} ag_extrude_batch;
+} ag_extrusion_batch;
 
-void ag_usecase_extrude_batch_clear(ag_extrude_batch *b);
+void ag_usecase_extrude_batch_clear(ag_extrusion_batch *b);
 
 /* *model gets the new model's id. */
 ag_status ag_usecase_extrude_run(ag_workspace *ws, const ag_extrude_input *in, int64_t *model,

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "../io/import.h"
+#include "import_sandbox.h"
 
 void ag_usecase_import_release(ag_mesh_file *f)
 {
@@ -23,10 +24,8 @@ static ag_status io_problem(const ag_mesh_source *src, int e, ag_error *err)
                      : ag_error_set(err, AG_ERR_IO, 0, "%s", strerror(e));
 }
 
-ag_status ag_usecase_import_read(const ag_mesh_source *src, int (*progress)(void *, double),
-                                 void *user, ag_mesh **mesh, ag_mesh_file *file, ag_error *err)
+ag_status ag_usecase_import_map(const ag_mesh_source *src, ag_mesh_file *file, ag_error *err)
 {
-    *mesh = NULL;
     memset(file, 0, sizeof *file);
     int fd = open(src->path, O_RDONLY | O_CLOEXEC);
     struct stat sb;
@@ -54,10 +53,23 @@ ag_status ag_usecase_import_read(const ag_mesh_source *src, int (*progress)(void
         return src->what ? ag_error_set(err, AG_ERR_IO, 0, "cannot map %s: %s", src->what,
                                         strerror(e))
                          : io_problem(src, e, err);
+    file->data = data;
+    file->len = len;
+    return AG_OK;
+}
+
+ag_status ag_usecase_import_read(const ag_mesh_source *src, int (*progress)(void *, double),
+                                 void *user, ag_mesh **mesh, ag_mesh_file *file, ag_error *err)
+{
+    *mesh = NULL;
+    ag_status s = ag_usecase_import_map(src, file, err);
+    if (s != AG_OK)
+        return s;
+    void *data = file->data;
+    size_t len = file->len;
     ag_format format = src->format ? ag_format_from_name(src->format)
                                    : ag_format_sniff(data, len,
                                                      src->filename ? src->filename : src->path);
-    ag_status s = AG_OK;
     if (format == AG_FORMAT_UNKNOWN && src->format)
         s = ag_error_set(err, AG_ERR_UNSUPPORTED, 0, "unknown format \"%s\"", src->format);
     else if (format == AG_FORMAT_UNKNOWN && src->format_hint)
@@ -69,10 +81,11 @@ ag_status ag_usecase_import_read(const ag_mesh_source *src, int (*progress)(void
                                   .user = user,
                                   .allow_external_files = src->own_file,
                                   .source_path = src->own_file ? src->path : NULL};
-        s = ag_import_buffer(data, len, format, &iopt, mesh, err);
+        s = src->sandbox_seconds > 0 && !src->own_file && format != AG_FORMAT_OBJ
+                ? ag_import_sandbox_read(data, len, format, &iopt, src->sandbox_seconds, mesh,
+                                         err)
+                : ag_import_buffer(data, len, format, &iopt, mesh, err);
     }
-    file->data = data;
-    file->len = len;
     file->format = ag_format_name(format);
     if (s != AG_OK)
         ag_usecase_import_release(file);

@@ -26,6 +26,10 @@ typedef struct {
     /* Non-zero for a person's own file (the CLI): the files it refers to (an OBJ's mtllib, a
      * glTF's buffers) are read from next to it. Zero (uploads): no other file is ever read. */
     int own_file;
+    /* > 0: a format read by assimp (anything but OBJ) is read in a child process that is
+     * killed after this many seconds (app/import_sandbox.h): what the service does with
+     * uploads. 0: in this process (the CLI). */
+    double sandbox_seconds;
 } ag_mesh_source;
 
 /* The file, mapped, while its mesh is used. */
@@ -34,6 +38,10 @@ typedef struct {
     size_t len;
     const char *format; /* the format read */
 } ag_mesh_file;
+
+/* Maps src's file (the checks and messages of ag_usecase_import_read: AG_ERR_IO, AG_ERR_EMPTY);
+ * file->format stays NULL. Shared with the point cloud import (app/usecase_import_cloud.h). */
+ag_status ag_usecase_import_map(const ag_mesh_source *src, ag_mesh_file *file, ag_error *err);
 
 /* Reads src into *mesh; progress (may be NULL) gets the parsed fraction and may cancel.
  * AG_ERR_IO for a file that cannot be read (strerror), AG_ERR_EMPTY for an empty one,

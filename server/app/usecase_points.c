@@ -29,9 +29,17 @@ ag_status ag_usecase_points_proceduralize_run(ag_workspace *ws,
     ag_cloud *cloud = NULL, *derived = NULL;
     ag_proceduralize_cloud_result *r = NULL;
     ag_points_state st = {0};
-    ag_status s = ag_workspace_input_cloud(ws, &cloud, err);
-    if (s != AG_OK)
+    /* the cloud with every property (the terminals keep them); a segmentation the workspace
+     * has is not used: the pipeline segments with its repetition stages together */
+    ag_cloud_state cs;
+    ag_status s = ag_workspace_input_cloud(ws, 1, 0, &cs, err);
+    cloud = cs.cloud;
+    cs.cloud = NULL;
+    ag_cloud_state_clear(&cs);
+    if (s != AG_OK) {
+        ag_cloud_free(cloud);
         return s;
+    }
     ag_proceduralize_cloud_options o = p ? p->options : (ag_proceduralize_cloud_options){0};
     o.progress = on_stage;
     o.user = ws;

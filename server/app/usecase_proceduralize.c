@@ -30,6 +30,13 @@ ag_status ag_usecase_proceduralize_run(ag_workspace *ws, const ag_usecase_proced
     ag_status s = ag_workspace_input_mesh(ws, &mesh, err);
     if (s != AG_OK)
         return s;
+    if (p && p->max_triangles && mesh->ntris > p->max_triangles) {
+        s = ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, 0,
+                         "the mesh has %zu triangles; this server proceduralizes at most %zu",
+                         mesh->ntris, p->max_triangles);
+        ag_mesh_free(mesh);
+        return s;
+    }
     ag_proceduralize_options po = {.progress = on_stage, .user = ws};
     if (p) {
         po.segment = p->segment;

@@ -19,6 +19,9 @@ typedef struct {
      * wrong; the result says how many are missing). Otherwise nothing is saved and the use case
      * fails with AG_ERR_INTERNAL. */
     int save_unfaithful;
+    /* A mesh with more triangles is refused before any work (AG_ERR_RESULT_TOO_LARGE);
+     * 0: no limit. */
+    size_t max_triangles;
 } ag_usecase_proceduralize_params;
 
 typedef struct {

@@ -56,6 +56,32 @@ ag_status ag_workspace_save(ag_workspace *ws, ag_model_state *st, const ag_proc_
     return ws->ops->save(ws, st, proc, edit, err);
 }
 
+ag_status ag_workspace_add_cloud(ag_workspace *ws, const char *name, const ag_cloud_new *c,
+                                 int64_t *model, ag_error *err)
+{
+    *model = 0;
+    return ws->ops->add_cloud ? ws->ops->add_cloud(ws, name, c, model, err)
+                              : unsupported("store a point cloud", err);
+}
+
+ag_status ag_workspace_input_cloud(ag_workspace *ws, int with_properties, int need_segmentation,
+                                   ag_cloud_state *st, ag_error *err)
+{
+    st->cloud = NULL;
+    st->seg = NULL;
+    st->had_normals = 0;
+    return ws->ops->input_cloud
+               ? ws->ops->input_cloud(ws, with_properties, need_segmentation, st, err)
+               : unsupported("give a point cloud", err);
+}
+
+ag_status ag_workspace_save_segmentation(ag_workspace *ws, const ag_cloud_state *st,
+                                         const ag_segment_outcome *o, ag_error *err)
+{
+    return ws->ops->save_segmentation ? ws->ops->save_segmentation(ws, st, o, err)
+                                      : unsupported("save a segmentation", err);
+}
+
 ag_status ag_workspace_open_part(ag_workspace *ws, const ag_part_ref *ref, const ag_part **part,
                                  ag_error *err)
 {
@@ -82,13 +108,6 @@ ag_status ag_workspace_save_composed(ag_workspace *ws, ag_model_state *st,
         return unsupported("save a composed model", err);
     }
     return ws->ops->save_composed(ws, st, o, err);
-}
-
-ag_status ag_workspace_input_cloud(ag_workspace *ws, ag_cloud **cloud, ag_error *err)
-{
-    *cloud = NULL;
-    return ws->ops->input_cloud ? ws->ops->input_cloud(ws, cloud, err)
-                                : unsupported("give a point cloud to proceduralize", err);
 }
 
 ag_status ag_workspace_open_point_models(ag_workspace *ws, const ag_edit_op_origin *from,

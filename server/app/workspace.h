@@ -11,8 +11,11 @@
  * Parts (app/usecase_save_part.h, app/usecase_compose.h) go through it too: a folder reads and
  * writes part bundle files, the store its parts library (app/part_library.h).
  *
- * Point clouds go through it too (app/usecase_points.h): a cloud to proceduralize, point
- * models to edit, their grammar and PLY terminals saved (app/points_folder_ws.h for folders).
+ * Point clouds too (app/cloud_state.h): an upload becomes a cloud model
+ * (app/usecase_import_cloud.h), segmentations are read and saved through it
+ * (app/usecase_segment.h, app/usecase_mark_template.h); only the store keeps cloud models.
+ * A cloud is also proceduralized into a point model, point models are edited and their
+ * grammar and PLY terminals saved (app/usecase_points.h; app/points_folder_ws.h for folders).
  *
  * A workspace that cannot do something answers AG_ERR_UNSUPPORTED. */
 #ifndef AG_WORKSPACE_H
@@ -29,6 +32,7 @@
 #include "../core/points/pointmodel.h"
 #include "../core/status.h"
 #include "../io/edit_op_json.h"
+#include "cloud_state.h"
 #include "model_state.h"
 
 typedef struct ag_workspace ag_workspace;
@@ -121,9 +125,20 @@ typedef struct {
     /* Saves a composed model (st is taken and cleared, as for save). */
     ag_status (*save_composed)(ag_workspace *ws, ag_model_state *st, const ag_compose_outcome *o,
                                ag_error *err);
-    /* Point clouds (app/usecase_points.h), each may be NULL. The cloud to proceduralize; */
-    ag_status (*input_cloud)(ag_workspace *ws, ag_cloud **cloud, ag_error *err);
-    /* the point model to edit and, for a paste from elsewhere, its source (both the
+    /* Stores a point cloud as a new model of kind "pointcloud" (an import). */
+    ag_status (*add_cloud)(ag_workspace *ws, const char *name, const ag_cloud_new *c,
+                           int64_t *model, ag_error *err);
+    /* The point cloud model to work on: its positions and normals (with_properties: every
+     * property too) and its current segmentation; st is the caller's (ag_cloud_state_clear).
+     * need_segmentation: a model that is not segmented is refused (AG_ERR_CONFLICT). */
+    ag_status (*input_cloud)(ag_workspace *ws, int with_properties, int need_segmentation,
+                             ag_cloud_state *st, ag_error *err);
+    /* Saves st's segmentation (and the normals it computed for a cloud without) as the
+     * model's, logged as o describes; st stays the caller's. */
+    ag_status (*save_segmentation)(ag_workspace *ws, const ag_cloud_state *st,
+                                   const ag_segment_outcome *o, ag_error *err);
+    /* Point models (app/usecase_points.h), each may be NULL (the cloud to proceduralize is
+     * input_cloud's). The point model to edit and, for a paste from elsewhere, its source (both the
      * workspace's until close); */
     ag_status (*open_point_models)(ag_workspace *ws, const ag_edit_op_origin *from,
                                    struct ag_pointmodel **pm,
@@ -166,7 +181,12 @@ ag_status ag_workspace_save_part(ag_workspace *ws, ag_part *part, const ag_part_
                                  ag_error *err);
 ag_status ag_workspace_save_composed(ag_workspace *ws, ag_model_state *st,
                                      const ag_compose_outcome *o, ag_error *err);
-ag_status ag_workspace_input_cloud(ag_workspace *ws, ag_cloud **cloud, ag_error *err);
+ag_status ag_workspace_add_cloud(ag_workspace *ws, const char *name, const ag_cloud_new *c,
+                                 int64_t *model, ag_error *err);
+ag_status ag_workspace_input_cloud(ag_workspace *ws, int with_properties, int need_segmentation,
+                                   ag_cloud_state *st, ag_error *err);
+ag_status ag_workspace_save_segmentation(ag_workspace *ws, const ag_cloud_state *st,
+                                         const ag_segment_outcome *o, ag_error *err);
 ag_status ag_workspace_open_point_models(ag_workspace *ws, const ag_edit_op_origin *from,
                                          struct ag_pointmodel **pm,
                                          const struct ag_pointmodel **source, ag_error *err);

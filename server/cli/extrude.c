@@ -145,29 +145,6 @@ static int run_plan(const char *plan_path, const char *out, const ag_extrude_opt
     return ok ? 0 : 1;
 }
 
-static json_t *issues_json(const ag_footprint_issue *v, size_t n, int with_fallback)
-{
-    json_t *a = json_array();
-    for (size_t i = 0; i < n; i++) {
-        json_t *o = json_pack("{s:s,s:s}", "id", v[i].id, "reason", v[i].reason);
-        if (o && with_fallback) {
-            json_object_set_new(o, "fallback", json_string(ag_built_name(v[i].built)));
-            if (v[i].built == AG_BUILT_SIMPLIFIED)
-                json_object_set_new(o, "moved", json_real(v[i].moved));
-        }
-        json_array_append_new(a, o);
-    }
-    return a;
-}
-
-static json_t *fixes_json(const ag_footprint_issue *v, size_t n)
-{
-    json_t *a = json_array();
-    for (size_t i = 0; i < n; i++)
-        json_array_append_new(a, json_pack("{s:s,s:s}", "id", v[i].id, "fixes", v[i].reason));
-    return a;
-}
-
 static int run_batch(const char *in, const char *style_arg, const char *out, const char *report,
                      const char *height_prop, long seed, int lonlat,
                      const ag_extrude_batch_options *bo)
@@ -207,21 +184,15 @@ static int run_batch(const char *in, const char *style_arg, const char *out, con
     if (st != AG_OK)
         fprintf(stderr, "archgram extrude: %s: %s\n", out, err.text);
     if (report) {
-        json_t *j = json_pack("{s:I,s:I,s:o,s:o,s:I,s:o,s:o,s:I,s:I,s:f,s:s,s:b,s:[f,f],s:I}",
-                              "footprints", (json_int_t)r.footprints,
-                              "succeeded", (json_int_t)r.succeeded,
-                              "fallbacks", issues_json(r.fallbacks, r.nfallbacks, 1),
-                              "failed", issues_json(r.failed, r.nfailed, 0),
-                              "not_watertight", (json_int_t)r.nnot_watertight,
-                              "not_watertight_items", issues_json(r.not_watertight, r.nnot_watertight, 0),
-                              "fixed", fixes_json(r.fixed, r.nfixed),
-                              "triangles", (json_int_t)r.triangles,
-                              "events", (json_int_t)r.events,
-                              "seconds", dt,
-                              "style", style.name,
-                              "lonlat", f->lonlat,
-                              "origin", f->origin[0], f->origin[1],
-                              "skipped_features", (json_int_t)f->skipped);
+        json_t *j = ag_footprints_report_json(&r);
+        if (j && json_object_update_new(j, json_pack("{s:f,s:s,s:b,s:[f,f],s:I}", "seconds", dt,
+                                                     "style", style.name, "lonlat", f->lonlat,
+                                                     "origin", f->origin[0], f->origin[1],
+                                                     "skipped_features",
+                                                     (json_int_t)f->skipped)) != 0) {
+            json_decref(j);
+            j = NULL;
+        }
         if (!j || json_dump_file(j, report, JSON_INDENT(2)) != 0) {
             fprintf(stderr, "archgram extrude: cannot write %s\n", report);
             rc = 1;

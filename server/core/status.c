@@ -1,5 +1,7 @@
 #include "status.h"
 
+#include "utf8.h"
+
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -51,8 +53,12 @@ ag_status ag_error_set(ag_error *err, ag_status code, long element, const char *
         err->element = element;
         va_list ap;
         va_start(ap, fmt);
-        vsnprintf(err->text, sizeof err->text, fmt, ap);
+        int n = vsnprintf(err->text, sizeof err->text, fmt, ap);
         va_end(ap);
+        if (n < 0)
+            err->text[0] = '\0';
+        else if ((size_t)n >= sizeof err->text)
+            ag_utf8_trim_partial(err->text); /* cut mid-character, it would not be UTF-8 */
     }
     return code;
 }

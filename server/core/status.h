@@ -31,6 +31,15 @@
     X(AG_ERR_NOT_PROCEDURALIZED,     -18, 409, "not-proceduralized",    "the model is not proceduralized") \
     X(AG_ERR_UNDO_CONFLICT,          -19, 409, "undo-conflict",         "nothing can be undone or redone here") \
     X(AG_ERR_EXTERNAL_REF,           -20, 422, "external-reference",    "the file refers to another file") \
+    /* the work an op or job would do is past the server's limits (its input may be small) */ \
+    X(AG_ERR_RESULT_TOO_LARGE,       -21, 422, "too-large",             "the result would be too large") \
+    X(AG_ERR_DEADLINE,               -22, 503, "deadline",              "the work took longer than its time budget") \
+    X(AG_ERR_RATE_LIMITED,           -23, 429, "rate-limited",          "too many requests")         \
+    X(AG_ERR_STORAGE_FULL,           -24, 507, "storage-full",          "the database is full")      \
+    X(AG_ERR_STORE_UNAVAILABLE,      -25, 503, "store-unavailable",     "the database cannot be read or written") \
+    X(AG_ERR_URI_TOO_LONG,           -26, 414, "uri-too-long",          "the URL is too long")       \
+    X(AG_ERR_HEADERS_TOO_LARGE,      -27, 431, "headers-too-large",     "the request headers are too large") \
+    X(AG_ERR_NOT_AVAILABLE,          -30, 422, "not-available",         "this step is not available for the model") \
     X(AG_ERR_UNAUTHORIZED,           -40, 401, "unauthorized",          "sign in first")             \
     X(AG_ERR_FORBIDDEN,              -41, 403, "forbidden",             "not allowed for this account")
 
@@ -41,7 +50,8 @@ typedef enum {
 } ag_status;
 
 /* Filled by a failing function when the caller passes one; never allocates.
- * `element` is a 1-based line, element or byte index where that makes sense, else 0. */
+ * `element` is a 1-based line, element or byte index where that makes sense, else 0. A text
+ * longer than the buffer is cut between UTF-8 characters, never inside one. */
 #define AG_ERROR_TEXT 256
 typedef struct {
     ag_status code;

@@ -91,9 +91,50 @@ ag_cloud_format ag_cloud_format_sniff(const uint8_t *data, size_t len, const cha
 int ag_cloud_import_is_cloud(const uint8_t *data, size_t len, const char *filename)
 {
     ag_cloud_format f = ag_cloud_format_sniff(data, len, filename);
+    /* a PLY whose header this reader does not take goes to the mesh importer, which judges
+     * it (as it did every PLY before clouds were read) */
+    uint64_t vertices = 0;
     if (f == AG_CLOUD_FORMAT_PLY)
-        return !ag_ply_has_faces(data, len);
+        return ag_ply_vertex_count(data, len, &vertices) == 0 && !ag_ply_has_faces(data, len);
     return f != AG_CLOUD_FORMAT_UNKNOWN;
+}
+
+ag_status ag_cloud_import_count(const uint8_t *data, size_t len, ag_cloud_format fmt,
+                                uint64_t *count, ag_error *err)
+{
+    *count = 0;
+    if (fmt == AG_CLOUD_FORMAT_UNKNOWN)
+        fmt = ag_cloud_format_sniff(data, len, NULL);
+    switch (fmt) {
+    case AG_CLOUD_FORMAT_LAS:
+    case AG_CLOUD_FORMAT_LAZ: {
+        ag_las_header h;
+        ag_status st = ag_las_read_header(data, len, &h, err);
+        if (st == AG_OK)
+            *count = h.count;
+        return st;
+    }
+    case AG_CLOUD_FORMAT_PLY: {
+        if (ag_ply_vertex_count(data, len, count) == 0)
+            return AG_OK;
+        ag_cloud *c = NULL; /* the reader names what is wrong with the header */
+        ag_status st = ag_ply_read_buffer(data, len, &c, err);
+        ag_cloud_free(c);
+        return st != AG_OK ? st : ag_error_set(err, AG_ERR_PARSE, 0, "the PLY has no vertex element");
+    }
+    case AG_CLOUD_FORMAT_XYZ: {
+        uint64_t lines = 0;
+        for (const uint8_t *p = data, *end = data + len; p < end; lines++) {
+            const uint8_t *nl = memchr(p, '\n', (size_t)(end - p));
+            p = nl ? nl + 1 : end;
+        }
+        *count = lines;
+        return AG_OK;
+    }
+    default:
+        return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
+                            "not a point cloud format archgram reads (PLY, LAS, LAZ, XYZ)");
+    }
 }
 
 ag_status ag_cloud_import_buffer(const uint8_t *data, size_t len, ag_cloud_format fmt,

@@ -12,6 +12,7 @@
 #include "../core/extrude/building.h"
 #include "../core/extrude/extrude.h"
 #include "../core/extrude/predicates.h"
+#include "jsondoc.h"
 
 #define EARTH_RADIUS 6371008.8
 
@@ -38,37 +39,42 @@ static void skip(ag_footprints *f, size_t index, const char *why)
     f->skipped++;
 }
 
-/* Visits every coordinate pair of a Polygon/MultiPolygon's rings. */
-static int ring_ok(json_t *ring)
+/* An [x, y, ...] position: its x and y when both are finite numbers. */
+static int position(const ag_jsondoc *d, uint32_t pt, double *x, double *y)
 {
-    if (!json_is_array(ring) || json_array_size(ring) < 3)
+    if (ag_jsondoc_type(d, pt) != AG_JSON_ARRAY || ag_jsondoc_size(d, pt) < 2)
         return 0;
-    size_t i;
-    json_t *pt;
-    json_array_foreach(ring, i, pt)
-    {
-        if (!json_is_array(pt) || json_array_size(pt) < 2 ||
-            !json_is_number(json_array_get(pt, 0)) || !json_is_number(json_array_get(pt, 1)))
+    uint32_t a = ag_jsondoc_first(d, pt), b = ag_jsondoc_next(d, a);
+    if (ag_jsondoc_type(d, a) != AG_JSON_NUMBER || ag_jsondoc_type(d, b) != AG_JSON_NUMBER)
+        return 0;
+    *x = ag_jsondoc_number(d, a);
+    *y = ag_jsondoc_number(d, b);
+    return isfinite(*x) && isfinite(*y);
+}
+
+/* Visits every coordinate pair of a Polygon/MultiPolygon's rings. */
+static int ring_ok(const ag_jsondoc *d, uint32_t ring)
+{
+    if (ag_jsondoc_type(d, ring) != AG_JSON_ARRAY || ag_jsondoc_size(d, ring) < 3)
+        return 0;
+    double x, y;
+    for (uint32_t pt = ag_jsondoc_first(d, ring); pt != AG_JSONDOC_NONE;
+         pt = ag_jsondoc_next(d, pt))
+        if (!position(d, pt, &x, &y))
             return 0;
-        double x = json_number_value(json_array_get(pt, 0));
-        double y = json_number_value(json_array_get(pt, 1));
-        if (!isfinite(x) || !isfinite(y))
-            return 0;
-    }
     return 1;
 }
 
-static ag_status add_ring(ag_footprint *fp, json_t *ring, int hole)
+static ag_status add_ring(ag_footprint *fp, const ag_jsondoc *d, uint32_t ring, int hole)
 {
-    size_t n = json_array_size(ring);
+    size_t n = ag_jsondoc_size(d, ring);
     double *xy = malloc(2 * n * sizeof *xy);
     if (!xy)
         return AG_ERR_NOMEM;
     size_t k = 0;
-    for (size_t i = 0; i < n; i++) {
-        json_t *pt = json_array_get(ring, i);
-        xy[2 * k] = json_number_value(json_array_get(pt, 0));
-        xy[2 * k + 1] = json_number_value(json_array_get(pt, 1));
+    for (uint32_t pt = ag_jsondoc_first(d, ring); pt != AG_JSONDOC_NONE && k < n;
+         pt = ag_jsondoc_next(d, pt)) {
+        position(d, pt, &xy[2 * k], &xy[2 * k + 1]);
         k++;
     }
     if (k > 1 && xy[0] == xy[2 * (k - 1)] && xy[1] == xy[2 * (k - 1) + 1])
@@ -129,22 +135,21 @@ static void note(ag_footprint *fp, const char *fmt, ...)
 
 /* One polygon (part `part` of the feature, or -1 for a Polygon): rings oriented outer
  * counter-clockwise, holes clockwise, each reversal noted. */
-static ag_status add_polygon(ag_footprint *fp, json_t *rings, size_t fi, long part,
-                             ag_error *err)
+static ag_status add_polygon(ag_footprint *fp, const ag_jsondoc *d, uint32_t rings, size_t fi,
+                             long part, ag_error *err)
 {
-    if (!json_is_array(rings) || json_array_size(rings) == 0)
+    if (ag_jsondoc_type(d, rings) != AG_JSON_ARRAY || ag_jsondoc_size(d, rings) == 0)
         return ag_error_set(err, AG_ERR_PARSE, (long)fi + 1,
                             "feature %zu: a polygon needs an array of rings", fi);
-    size_t i;
-    json_t *ring;
-    json_array_foreach(rings, i, ring)
-    {
-        if (!ring_ok(ring))
+    size_t i = 0;
+    for (uint32_t ring = ag_jsondoc_first(d, rings); ring != AG_JSONDOC_NONE;
+         ring = ag_jsondoc_next(d, ring), i++) {
+        if (!ring_ok(d, ring))
             return ag_error_set(err, AG_ERR_PARSE, (long)fi + 1,
                                 "feature %zu: ring %zu is not an array of at least 3 finite "
                                 "[x, y] positions", fi, i);
         size_t first = fp->nloops;
-        if (add_ring(fp, ring, i > 0) != AG_OK)
+        if (add_ring(fp, d, ring, i > 0) != AG_OK)
             return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         double a = ring_area(fp->loops[first], fp->sizes[first]);
         if ((i == 0 && a < 0) || (i > 0 && a > 0)) {
@@ -401,59 +406,75 @@ static char *dupstr(const char *s)
     return d;
 }
 
-static char *id_text(json_t *v)
+static char *id_text(const ag_jsondoc *d, uint32_t v)
 {
     char buf[64];
-    if (json_is_string(v))
-        return dupstr(json_string_value(v));
-    if (json_is_integer(v)) {
-        snprintf(buf, sizeof buf, "%lld", (long long)json_integer_value(v));
+    int64_t i;
+    if (ag_jsondoc_type(d, v) == AG_JSON_STRING)
+        return dupstr(ag_jsondoc_string(d, v));
+    if (ag_jsondoc_integer(d, v, &i)) {
+        snprintf(buf, sizeof buf, "%lld", (long long)i);
         return dupstr(buf);
     }
-    if (json_is_real(v)) {
-        snprintf(buf, sizeof buf, "%.17g", json_real_value(v));
+    if (ag_jsondoc_type(d, v) == AG_JSON_NUMBER) {
+        snprintf(buf, sizeof buf, "%.17g", ag_jsondoc_number(d, v));
         return dupstr(buf);
     }
     return NULL;
 }
 
-static int crs_is_lonlat(json_t *root)
+static int crs_is_lonlat(const ag_jsondoc *d, uint32_t root)
 {
-    json_t *name = json_object_get(json_object_get(json_object_get(root, "crs"), "properties"), "name");
-    if (!json_is_string(name))
+    uint32_t name = ag_jsondoc_get(
+        d, ag_jsondoc_get(d, ag_jsondoc_get(d, root, "crs"), "properties"), "name");
+    const char *s = ag_jsondoc_string(d, name);
+    if (!s)
         return -1; /* no crs member */
-    const char *s = json_string_value(name);
     return strstr(s, "CRS84") || strstr(s, "4326") ? 1 : 0;
+}
+
+/* A number member of props as the height, when it is one. */
+static int height_of(const ag_jsondoc *d, uint32_t props, const char *key, double *h)
+{
+    uint32_t v = ag_jsondoc_get(d, props, key);
+    if (ag_jsondoc_type(d, v) != AG_JSON_NUMBER)
+        return 0;
+    *h = ag_jsondoc_number(d, v);
+    return 1;
 }
 
 ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footprints_options *opt,
                                     ag_footprints **out, ag_error *err)
 {
     *out = NULL;
-    json_error_t je;
-    json_t *root = json_loadb(data, len, 0, &je);
-    if (!root)
-        return ag_error_set(err, AG_ERR_PARSE, je.line, "GeoJSON: %s (line %d, column %d)",
-                            je.text, je.line, je.column);
-    json_t *features = NULL, *single = NULL;
-    const char *type = json_string_value(json_object_get(root, "type"));
+    ag_jsondoc *doc = NULL;
+    ag_error pe = {0};
+    ag_status ps = ag_jsondoc_parse(data, len, &doc, &pe);
+    if (ps == AG_ERR_NOMEM)
+        return ag_error_set(err, ps, 0, "out of memory");
+    if (ps != AG_OK)
+        return ag_error_set(err, AG_ERR_PARSE, pe.element, "GeoJSON: %s", pe.text);
+    uint32_t root = ag_jsondoc_root(doc);
+    uint32_t features = AG_JSONDOC_NONE, first = AG_JSONDOC_NONE;
+    size_t nf = 0;
+    const char *type = ag_jsondoc_string(doc, ag_jsondoc_get(doc, root, "type"));
     if (type && strcmp(type, "FeatureCollection") == 0) {
-        features = json_object_get(root, "features");
-        if (!json_is_array(features)) {
-            json_decref(root);
+        features = ag_jsondoc_get(doc, root, "features");
+        if (ag_jsondoc_type(doc, features) != AG_JSON_ARRAY) {
+            ag_jsondoc_free(doc);
             return ag_error_set(err, AG_ERR_PARSE, 0, "GeoJSON: \"features\" must be an array");
         }
+        first = ag_jsondoc_first(doc, features);
+        nf = ag_jsondoc_size(doc, features);
     } else if (type && strcmp(type, "Feature") == 0) {
-        single = json_array();
-        json_array_append(single, root);
-        features = single;
+        first = root; /* a lone Feature: the root is the only one (it has no sibling) */
+        nf = 1;
     } else {
-        json_decref(root);
+        ag_jsondoc_free(doc);
         return ag_error_set(err, AG_ERR_PARSE, 0,
                             "GeoJSON: expected a FeatureCollection or a Feature");
     }
     ag_footprints *f = calloc(1, sizeof *f);
-    size_t nf = json_array_size(features);
     if (f)
         f->items = calloc(nf ? nf : 1, sizeof *f->items);
     ag_status st = AG_OK;
@@ -462,60 +483,52 @@ ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footp
         goto done;
     }
     const char *hp[] = {"height", "building:height", "measuredHeight", NULL};
-    size_t fi;
-    json_t *feat;
-    json_array_foreach(features, fi, feat)
-    {
-        json_t *geom = json_object_get(feat, "geometry");
-        const char *gt = json_string_value(json_object_get(geom, "type"));
-        json_t *coords = json_object_get(geom, "coordinates");
+    size_t fi = 0;
+    for (uint32_t feat = first; feat != AG_JSONDOC_NONE && fi < nf;
+         feat = ag_jsondoc_next(doc, feat), fi++) {
+        uint32_t geom = ag_jsondoc_get(doc, feat, "geometry");
+        const char *gt = ag_jsondoc_string(doc, ag_jsondoc_get(doc, geom, "type"));
+        uint32_t coords = ag_jsondoc_get(doc, geom, "coordinates");
         if (!gt || (strcmp(gt, "Polygon") != 0 && strcmp(gt, "MultiPolygon") != 0)) {
             skip(f, fi, "geometry is not a Polygon or MultiPolygon");
             continue;
         }
         ag_footprint *fp = &f->items[f->n];
         memset(fp, 0, sizeof *fp);
-        json_t *props = json_object_get(feat, "properties");
-        fp->id = id_text(json_object_get(feat, "id"));
+        uint32_t props = ag_jsondoc_get(doc, feat, "properties");
+        fp->id = id_text(doc, ag_jsondoc_get(doc, feat, "id"));
         if (!fp->id)
-            fp->id = id_text(json_object_get(props, "id"));
+            fp->id = id_text(doc, ag_jsondoc_get(doc, props, "id"));
         if (!fp->id) {
             char buf[32];
             snprintf(buf, sizeof buf, "%zu", fi);
             fp->id = dupstr(buf);
         }
         if (opt && opt->height_property) {
-            json_t *h = json_object_get(props, opt->height_property);
-            if (json_is_number(h))
-                fp->height = json_number_value(h);
+            height_of(doc, props, opt->height_property, &fp->height);
         } else {
-            for (int k = 0; hp[k]; k++) {
-                json_t *h = json_object_get(props, hp[k]);
-                if (json_is_number(h)) {
-                    fp->height = json_number_value(h);
+            for (int k = 0; hp[k]; k++)
+                if (height_of(doc, props, hp[k], &fp->height))
                     break;
-                }
-            }
         }
         if (!isfinite(fp->height) || fp->height < 0)
             fp->height = 0;
         if (strcmp(gt, "Polygon") == 0) {
-            st = add_polygon(fp, coords, fi, -1, err);
-        } else if (!json_is_array(coords)) {
+            st = add_polygon(fp, doc, coords, fi, -1, err);
+        } else if (ag_jsondoc_type(doc, coords) != AG_JSON_ARRAY) {
             st = ag_error_set(err, AG_ERR_PARSE, (long)fi + 1,
                               "feature %zu: MultiPolygon coordinates must be an array", fi);
         } else {
-            size_t pi;
-            json_t *poly;
-            json_array_foreach(coords, pi, poly)
-            {
-                st = add_polygon(fp, poly, fi, (long)pi, err);
+            long pi = 0;
+            for (uint32_t poly = ag_jsondoc_first(doc, coords); poly != AG_JSONDOC_NONE;
+                 poly = ag_jsondoc_next(doc, poly), pi++) {
+                st = add_polygon(fp, doc, poly, fi, pi, err);
                 if (st != AG_OK)
                     break;
             }
             int dissolved = 0;
-            if (st == AG_OK && json_array_size(coords) > 1 &&
-                dissolve(fp, json_array_size(coords), &dissolved) != AG_OK)
+            size_t nparts = ag_jsondoc_size(doc, coords);
+            if (st == AG_OK && nparts > 1 && dissolve(fp, nparts, &dissolved) != AG_OK)
                 st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         }
         f->n++; /* counted even on error so that free() releases it */
@@ -547,7 +560,7 @@ ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footp
     }
     int ll = opt && opt->lonlat ? opt->lonlat > 0 : 0;
     if (!opt || !opt->lonlat) {
-        int c = crs_is_lonlat(root);
+        int c = crs_is_lonlat(doc, root);
         ll = c == 1 || (c == -1 && lo[0] >= -180 && hi[0] <= 180 && lo[1] >= -90 && hi[1] <= 90);
     }
     f->lonlat = ll;
@@ -575,9 +588,7 @@ ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footp
                 }
     }
 done:
-    if (single)
-        json_decref(single);
-    json_decref(root);
+    ag_jsondoc_free(doc);
     if (st != AG_OK) {
         ag_footprints_free(f);
         return st;
@@ -652,25 +663,78 @@ static int add_issue(ag_footprint_issue **list, size_t *n, const char *id, const
     return 1;
 }
 
-ag_status ag_footprints_report_add(ag_footprints_report *r, const ag_footprint *fp,
-                                   const ag_building_result *b)
+ag_status ag_footprints_report_add_id(ag_footprints_report *r, const char *id,
+                                      const char *read_fixes, const ag_building_result *b)
 {
     int ok = 1;
+    if (!read_fixes)
+        read_fixes = "";
     if (b->built == AG_BUILT_STYLED)
         r->succeeded++;
     else if (b->built == AG_BUILT_NONE)
-        ok = add_issue(&r->failed, &r->nfailed, fp->id, b->reason, b->built, 0);
+        ok = add_issue(&r->failed, &r->nfailed, id, b->reason, b->built, 0);
     else
-        ok = add_issue(&r->fallbacks, &r->nfallbacks, fp->id, b->reason, b->built, b->moved);
-    if (ok && (b->nfixes || fp->fixes[0])) {
+        ok = add_issue(&r->fallbacks, &r->nfallbacks, id, b->reason, b->built, b->moved);
+    if (ok && (b->nfixes || read_fixes[0])) {
         char text[sizeof r->fixed[0].reason];
-        snprintf(text, sizeof text, "%.100s%s%.150s", fp->fixes,
-                 fp->fixes[0] && b->nfixes ? "; " : "", b->nfixes ? b->fixes : "");
-        ok = add_issue(&r->fixed, &r->nfixed, fp->id, text, b->built, 0);
+        snprintf(text, sizeof text, "%.100s%s%.150s", read_fixes,
+                 read_fixes[0] && b->nfixes ? "; " : "", b->nfixes ? b->fixes : "");
+        ok = add_issue(&r->fixed, &r->nfixed, id, text, b->built, 0);
     }
     r->triangles += b->triangles;
     r->events += b->events;
     return ok ? AG_OK : AG_ERR_NOMEM;
+}
+
+ag_status ag_footprints_report_add(ag_footprints_report *r, const ag_footprint *fp,
+                                   const ag_building_result *b)
+{
+    return ag_footprints_report_add_id(r, fp->id, fp->fixes, b);
+}
+
+static json_t *issues_json(const ag_footprint_issue *v, size_t n, int with_fallback)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && i < n; i++) {
+        json_t *o = json_pack("{s:s,s:s}", "id", v[i].id, "reason", v[i].reason);
+        if (o && with_fallback) {
+            json_object_set_new(o, "fallback", json_string(ag_built_name(v[i].built)));
+            if (v[i].built == AG_BUILT_SIMPLIFIED)
+                json_object_set_new(o, "moved", json_real(v[i].moved));
+        }
+        if (!o || json_array_append_new(a, o) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+static json_t *fixes_json(const ag_footprint_issue *v, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && i < n; i++) {
+        json_t *o = json_pack("{s:s,s:s}", "id", v[i].id, "fixes", v[i].reason);
+        if (!o || json_array_append_new(a, o) != 0) {
+            json_decref(a);
+            return NULL;
+        }
+    }
+    return a;
+}
+
+json_t *ag_footprints_report_json(const ag_footprints_report *r)
+{
+    return json_pack("{s:I,s:I,s:o*,s:o*,s:I,s:o*,s:o*,s:I,s:I}",
+                     "footprints", (json_int_t)r->footprints,
+                     "succeeded", (json_int_t)r->succeeded,
+                     "fallbacks", issues_json(r->fallbacks, r->nfallbacks, 1),
+                     "failed", issues_json(r->failed, r->nfailed, 0),
+                     "not_watertight", (json_int_t)r->nnot_watertight,
+                     "not_watertight_items", issues_json(r->not_watertight, r->nnot_watertight, 0),
+                     "fixed", fixes_json(r->fixed, r->nfixed),
+                     "triangles", (json_int_t)r->triangles,
+                     "events", (json_int_t)r->events);
 }
 
 ag_status ag_footprints_extrude_with(const ag_footprints *f, const ag_style *style,

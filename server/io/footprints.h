@@ -11,6 +11,7 @@
 #ifndef AG_FOOTPRINTS_H
 #define AG_FOOTPRINTS_H
 
+#include <jansson.h>
 #include <stddef.h>
 
 #include "../core/extrude/building.h"
@@ -78,6 +79,18 @@ void ag_footprints_report_free(ag_footprints_report *r);
  * by the serial and the threaded batches). Returns AG_ERR_NOMEM or AG_OK. */
 ag_status ag_footprints_report_add(ag_footprints_report *r, const ag_footprint *fp,
                                    const ag_building_result *b);
+/* The same for a building named id whose reading made the fixes read_fixes (may be NULL or
+ * ""): a building description of the service. */
+ag_status ag_footprints_report_add_id(ag_footprints_report *r, const char *id,
+                                      const char *read_fixes, const ag_building_result *b);
+
+/* The report as JSON, one shape for `archgram extrude --report` and the service's job
+ * result: {"footprints", "succeeded" (built as styled or described, and good),
+ * "fallbacks": [{"id", "reason", "fallback": "simplified"|"flat"|"block", "moved" (m,
+ * simplified only)}], "failed": [{"id", "reason"}], "not_watertight" (always 0: nothing
+ * that is not good is kept), "not_watertight_items": [], "fixed": [{"id", "fixes"}],
+ * "triangles", "events"}. NULL on out-of-memory. */
+json_t *ag_footprints_report_json(const ag_footprints_report *r);
 
 /* Extrudes every footprint with the style into m, one after another: one group (named
  * by the footprint id) and one component per footprint, each made good or reported

@@ -30,12 +30,9 @@ static void put_f32(uint8_t *p, float f)
     put_u32(p, u);
 }
 
-/* z-up archgram → y-up glTF, a proper rotation: winding and handedness are kept. */
 static void to_yup(const double *p, const double *centre, double *o)
 {
-    o[0] = p[0] - centre[0];
-    o[1] = p[2] - centre[1];
-    o[2] = -p[1] - centre[2];
+    ag_glb_yup(p, centre, o);
 }
 
 static json_t *vec3(const double *v)
@@ -76,8 +73,7 @@ ag_status ag_glb_write_meta(const ag_mesh *m, const ag_glb_component_meta *meta,
     size_t *start = calloc(nc + 1, sizeof *start);
     uint32_t *order = malloc((m->ntris ? m->ntris : 1) * sizeof *order);
     json_t *root = NULL;
-    uint8_t *bin = NULL, *glb = NULL;
-    char *text = NULL;
+    uint8_t *bin = NULL;
     ag_status st = AG_ERR_NOMEM;
     if (!count || !start || !order)
         goto out;
@@ -227,20 +223,41 @@ ag_status ag_glb_write_meta(const ag_mesh *m, const ag_glb_component_meta *meta,
         json_object_del(root, "nodes");
     }
 
-    text = json_dumps(root, JSON_COMPACT);
+    st = ag_glb_frame(root, bin, binlen, out, len, err);
+    goto done;
+out:
+    if (st == AG_ERR_NOMEM)
+        ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while writing GLB");
+done:
+    free(count);
+    free(start);
+    free(order);
+    free(bin);
+    json_decref(root);
+    return st;
+}
+
+ag_status ag_glb_frame(const json_t *root, const uint8_t *bin, size_t binlen, uint8_t **out,
+                       size_t *len, ag_error *err)
+{
+    *out = NULL;
+    *len = 0;
+    char *text = json_dumps(root, JSON_COMPACT);
     if (!text)
-        goto out;
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while writing GLB");
     size_t tlen = strlen(text);
     size_t jpad = (tlen + 3) & ~(size_t)3;
-    size_t bpad = (binlen + 3) & ~(size_t)3; /* 72 per triangle: already aligned */
+    size_t bpad = (binlen + 3) & ~(size_t)3;
     size_t total = 12 + 8 + jpad + (binlen ? 8 + bpad : 0);
-    if (total > UINT32_MAX) {
-        st = ag_error_set(err, AG_ERR_TOO_LARGE, 0, "the GLB would exceed 4 GiB");
-        goto out;
+    if (binlen > UINT32_MAX || total > UINT32_MAX) {
+        free(text);
+        return ag_error_set(err, AG_ERR_TOO_LARGE, 0, "the GLB would exceed 4 GiB");
     }
-    glb = malloc(total);
-    if (!glb)
-        goto out;
+    uint8_t *glb = malloc(total);
+    if (!glb) {
+        free(text);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while writing GLB");
+    }
     put_u32(glb, GLB_MAGIC);
     put_u32(glb + 4, GLB_VERSION);
     put_u32(glb + 8, (uint32_t)total);
@@ -255,21 +272,10 @@ ag_status ag_glb_write_meta(const ag_mesh *m, const ag_glb_component_meta *meta,
         memcpy(c + 8, bin, binlen);
         memset(c + 8 + binlen, 0, bpad - binlen);
     }
+    free(text);
     *out = glb;
     *len = total;
-    glb = NULL;
-    st = AG_OK;
-out:
-    if (st == AG_ERR_NOMEM)
-        ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while writing GLB");
-    free(count);
-    free(start);
-    free(order);
-    free(bin);
-    free(glb);
-    free(text);
-    json_decref(root);
-    return st;
+    return AG_OK;
 }
 
 ag_status ag_glb_write_file(const ag_mesh *m, const char *path, ag_error *err)

@@ -15,6 +15,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <jansson.h>
+
 #include "../core/mesh.h"
 #include "../core/status.h"
 
@@ -32,5 +34,19 @@ typedef struct {
 ag_status ag_glb_write_meta(const ag_mesh *m, const ag_glb_component_meta *meta, size_t nmeta,
                             uint8_t **out, size_t *len, ag_error *err);
 ag_status ag_glb_write_file(const ag_mesh *m, const char *path, ag_error *err);
+
+/* The GLB container around a glTF document and its binary buffer (binlen may be 0: no BIN
+ * chunk); *out is malloc'd. Shared by every GLB archgram writes (io/points_glb.h). */
+ag_status ag_glb_frame(const json_t *root, const uint8_t *bin, size_t binlen, uint8_t **out,
+                       size_t *len, ag_error *err);
+
+/* z-up archgram → y-up glTF, a proper rotation (winding and handedness are kept): p as
+ * (x, z, -y) minus centre (already in glTF axes). */
+static inline void ag_glb_yup(const double *p, const double *centre, double *o)
+{
+    o[0] = p[0] - centre[0];
+    o[1] = p[2] - centre[1];
+    o[2] = -p[1] - centre[2];
+}
 
 #endif

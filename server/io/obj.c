@@ -1,18 +1,16 @@
 #include "obj.h"
 
 #include "external_ref.h"
+#include "filemap.h"
+#include "numtext.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #define DEFAULT_MAX_VERTICES 100000000u
 #define DEFAULT_MAX_TRIANGLES 200000000u
@@ -678,58 +676,88 @@ ag_status ag_obj_read_file(const char *path, const ag_obj_read_options *opt, ag_
         local = *opt;
     local.allow_external_files = 1;
     opt = &local;
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return ag_error_set(err, AG_ERR_IO, 0, "cannot open %s: %s", path, strerror(errno));
-    struct stat sb;
-    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
-        close(fd);
-        return ag_error_set(err, AG_ERR_IO, 0, "%s: not a regular file", path);
-    }
-    size_t len = (size_t)sb.st_size;
-    if (len == 0) {
-        close(fd);
-        return ag_error_set(err, AG_ERR_EMPTY, 0, "%s: empty file", path);
-    }
-    void *map = mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0);
-    if (map != MAP_FAILED) {
-        close(fd);
-        madvise(map, len, MADV_SEQUENTIAL);
-        ag_status st = ag_obj_read_buffer(map, len, opt, out, err);
-        munmap(map, len);
+    ag_filemap fm;
+    ag_status st = ag_filemap_open(path, &fm, err);
+    if (st != AG_OK)
         return st;
-    }
-    /* Some file systems cannot map: read it all. */
-    char *buf = malloc(len);
-    if (!buf) {
-        close(fd);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "%s: out of memory", path);
-    }
-    size_t got = 0;
-    while (got < len) {
-        ssize_t k = read(fd, buf + got, len - got);
-        if (k < 0 && errno == EINTR)
-            continue;
-        if (k <= 0) {
-            int e = k < 0 ? errno : EIO;
-            free(buf);
-            close(fd);
-            return ag_error_set(err, AG_ERR_IO, 0, "cannot read %s: %s", path, strerror(e));
-        }
-        got += (size_t)k;
-    }
-    close(fd);
-    ag_status st = ag_obj_read_buffer(buf, len, opt, out, err);
-    free(buf);
+    if (fm.len == 0)
+        st = ag_error_set(err, AG_ERR_EMPTY, 0, "%s: empty file", path);
+    else
+        st = ag_obj_read_buffer((const char *)fm.data, fm.len, opt, out, err);
+    ag_filemap_close(&fm);
     return st;
 }
 
 /* ---- writer ----------------------------------------------------------------------------- */
 
-static void put_name(FILE *f, const char *name)
+/* The writer's output: lines are built in a buffer and written in large blocks (printf
+ * per number was most of the time of writing a city). */
+typedef struct {
+    FILE *f;
+    size_t n;
+    char buf[1 << 16];
+} out_buf;
+
+static void flush(out_buf *o)
 {
-    for (const char *c = name; *c; c++)
-        fputc(*c == '\n' || *c == '\r' || *c == '\\' ? '_' : *c, f);
+    if (o->n)
+        fwrite(o->buf, 1, o->n, o->f);
+    o->n = 0;
+}
+
+/* Room for at least `need` more bytes (need <= sizeof buf). */
+static char *room(out_buf *o, size_t need)
+{
+    if (o->n + need > sizeof o->buf)
+        flush(o);
+    return o->buf + o->n;
+}
+
+static void put_text(out_buf *o, const char *s)
+{
+    for (; *s; s++) {
+        room(o, 1);
+        o->buf[o->n++] = *s;
+    }
+}
+
+static void put_name(out_buf *o, const char *name)
+{
+    for (const char *c = name; *c; c++) {
+        room(o, 1);
+        o->buf[o->n++] = *c == '\n' || *c == '\r' || *c == '\\' ? '_' : *c;
+    }
+}
+
+/* "v x y z\n" with every coordinate exact (io/numtext.h). */
+static void put_vertex(out_buf *o, double x, double y, double z)
+{
+    char *p = room(o, 3 * AG_NUMTEXT_MAX + 4);
+    size_t k = 0;
+    p[k++] = 'v';
+    p[k++] = ' ';
+    k += ag_numtext_double(p + k, x);
+    p[k++] = ' ';
+    k += ag_numtext_double(p + k, y);
+    p[k++] = ' ';
+    k += ag_numtext_double(p + k, z);
+    p[k++] = '\n';
+    o->n += k;
+}
+
+static void put_face(out_buf *o, uint32_t a, uint32_t b, uint32_t c)
+{
+    char *p = room(o, 3 * AG_NUMTEXT_MAX + 4);
+    size_t k = 0;
+    p[k++] = 'f';
+    p[k++] = ' ';
+    k += ag_numtext_u64(p + k, (uint64_t)a + 1);
+    p[k++] = ' ';
+    k += ag_numtext_u64(p + k, (uint64_t)b + 1);
+    p[k++] = ' ';
+    k += ag_numtext_u64(p + k, (uint64_t)c + 1);
+    p[k++] = '\n';
+    o->n += k;
 }
 
 ag_status ag_obj_write_file(const ag_mesh *m, ag_up_axis up, const char *path, ag_error *err)
@@ -737,16 +765,24 @@ ag_status ag_obj_write_file(const ag_mesh *m, ag_up_axis up, const char *path, a
     FILE *f = fopen(path, "w");
     if (!f)
         return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", path, strerror(errno));
-    setvbuf(f, NULL, _IOFBF, 1 << 16);
+    out_buf *o = malloc(sizeof *o);
+    if (!o) {
+        fclose(f);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    o->f = f;
+    o->n = 0;
     int yup = up != AG_UP_Z;
-    fprintf(f, "# archgram: %zu vertices, %zu triangles, %zu components; %s up\n", m->nverts,
-            m->ntris, m->ncomponents, yup ? "y" : "z");
+    char head[160];
+    snprintf(head, sizeof head, "# archgram: %zu vertices, %zu triangles, %zu components; %s up\n",
+             m->nverts, m->ntris, m->ncomponents, yup ? "y" : "z");
+    put_text(o, head);
     for (size_t i = 0; i < m->nverts; i++) {
         const double *p = m->pos + 3 * i;
         if (yup) /* inverse of the reader's (x, y, z) → (x, -z, y) */
-            fprintf(f, "v %.17g %.17g %.17g\n", p[0], p[2], -p[1]);
+            put_vertex(o, p[0], p[2], -p[1]);
         else
-            fprintf(f, "v %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+            put_vertex(o, p[0], p[1], p[2]);
     }
     /* Triangles grouped by component, in file order within each. */
     size_t nc = m->ncomponents;
@@ -755,6 +791,7 @@ ag_status ag_obj_write_file(const ag_mesh *m, ag_up_axis up, const char *path, a
     if (!start || !order) {
         free(start);
         free(order);
+        free(o);
         fclose(f);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
@@ -777,18 +814,23 @@ ag_status ag_obj_write_file(const ag_mesh *m, ag_up_axis up, const char *path, a
         /* A group-less first component is written before any g line, where the reader
          * puts group-less faces. */
         if (named && !(c == 0 && g < 0)) {
-            fputs("g ", f);
-            if (g >= 0 && (size_t)g < m->ngroups && m->group_names[g][0])
-                put_name(f, m->group_names[g]);
-            else
-                fprintf(f, "component_%zu", c);
-            fputc('\n', f);
+            put_text(o, "g ");
+            if (g >= 0 && (size_t)g < m->ngroups && m->group_names[g][0]) {
+                put_name(o, m->group_names[g]);
+            } else {
+                char name[48];
+                snprintf(name, sizeof name, "component_%zu", c);
+                put_text(o, name);
+            }
+            put_text(o, "\n");
         }
         for (size_t i = start[c]; i < start[c + 1]; i++) {
             const uint32_t *t = m->tri + 3 * (size_t)order[i];
-            fprintf(f, "f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
+            put_face(o, t[0], t[1], t[2]);
         }
     }
+    flush(o);
+    free(o);
     free(start);
     free(order);
     int bad = ferror(f);

@@ -62,8 +62,9 @@ ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_opt
 ag_status ag_obj_read_file(const char *path, const ag_obj_read_options *opt, ag_mesh **out,
                            ag_error *err);
 
-/* Writes z-up geometry back in the given up axis (AG_UP_DEFAULT = y): every vertex
- * (%.17g, so reading it back is exact), then per component a `g` line named after its
+/* Writes z-up geometry back in the given up axis (AG_UP_DEFAULT = y): every vertex (the
+ * shortest decimal that reads back to the same double, io/numtext.h: reading it back is
+ * exact), then per component a `g` line named after its
  * group (or `component_<i>`) and its triangles, 1-based. A mesh without groups is written
  * without g lines, and a group-less component 0 before the first g line, so that reading
  * the file back reproduces the components; components sharing one group merge. */

@@ -255,6 +255,21 @@ int ag_ply_has_faces(const uint8_t *data, size_t len)
     return faces;
 }
 
+int ag_ply_vertex_count(const uint8_t *data, size_t len, uint64_t *count)
+{
+    ply_header h;
+    if (parse_header(data, len, &h, NULL) != AG_OK)
+        return -1;
+    int found = -1;
+    for (size_t i = 0; i < h.nelements; i++)
+        if (!strcmp(h.elements[i].name, "vertex")) {
+            *count = (uint64_t)h.elements[i].count;
+            found = 0;
+        }
+    header_free(&h);
+    return found;
+}
+
 /* ---- reading values ------------------------------------------------------------------ */
 
 static double value_to_double(const void *v, ag_scalar_type t)

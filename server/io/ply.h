@@ -26,6 +26,10 @@ ag_status ag_ply_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag
  * mesh rather than a point cloud). */
 int ag_ply_has_faces(const uint8_t *data, size_t len);
 
+/* The point count a PLY's header declares (its vertex element): 0 with *count, -1 when the
+ * header does not parse or has no vertex element. */
+int ag_ply_vertex_count(const uint8_t *data, size_t len, uint64_t *count);
+
 typedef enum {
     AG_PLY_BINARY_LE = 0, /* the default */
     AG_PLY_BINARY_BE,

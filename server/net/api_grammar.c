@@ -11,6 +11,7 @@
 #include "../app/app_jobs.h"
 #include "../app/app_query.h"
 #include "../app/problem.h"
+#include "defer.h"
 #include "routes.h"
 #include "upload.h"
 
@@ -22,16 +23,10 @@ static ag_status if_match(ag_request *r, int required, int64_t current, int64_t 
     *version = 0;
     if (!required && !ag_request_header(r, MHD_HTTP_HEADER_IF_MATCH))
         return AG_OK;
-    ag_status s = ag_request_if_match(r, version, err);
-    if (s != AG_OK)
-        return s;
-    if (*version == -1)
-        *version = current;
-    if (*version != current)
-        return ag_error_set(err, AG_ERR_STALE, (long)current,
-                            "model %lld is at version %lld, not %lld", (long long)r->ids[0],
-                            (long long)current, (long long)*version);
-    return AG_OK;
+    ag_if_match m;
+    ag_status s = ag_request_if_match(r, &m, err);
+    return s != AG_OK ? s
+                      : ag_request_if_match_check(&m, "model", r->ids[0], current, version, err);
 }
 
 enum MHD_Result ag_api_model_proceduralize(ag_request *r)
@@ -94,7 +89,7 @@ enum MHD_Result ag_api_model_grammar_get(ag_request *r)
 }
 
 /* A parse problem with "line" and "column" as members, and in the detail. */
-static enum MHD_Result reply_parse_problem(ag_request *r, ag_error *err, long col)
+static void answer_parse_problem(ag_request *r, ag_error *err, long col)
 {
     long line = err->element > 0 ? err->element : 1;
     if (col < 1)
@@ -110,8 +105,41 @@ static enum MHD_Result reply_parse_problem(ag_request *r, ag_error *err, long co
     char *body = p ? json_dumps(p, JSON_COMPACT) : NULL;
     json_decref(p);
     if (!body)
-        return ag_reply_problem(r, AG_ERR_PARSE, err);
-    return ag_reply_bytes(r, 422, "application/problem+json", body, strlen(body), NULL);
+        return ag_defer_answer_problem(r, AG_ERR_PARSE, err);
+    ag_defer_answer_bytes(r, 422, "application/problem+json", body, strlen(body), NULL);
+}
+
+/* What PUT …/grammar checked before its work. */
+typedef struct {
+    char *text;
+    size_t len;
+    int64_t base;
+} grammar_put;
+
+static void grammar_put_free(void *p)
+{
+    grammar_put *g = p;
+    if (g)
+        free(g->text);
+    free(g);
+}
+
+static void put_grammar(ag_request *r, ag_task_budget *budget)
+{
+    grammar_put *g = r->work_input;
+    ag_error err;
+    ag_error_clear(&err);
+    char cid[64];
+    ag_request_fresh_cid("grammar", cid, sizeof cid);
+    int64_t version;
+    long col = 0;
+    ag_status s = ag_app_change_grammar(r->cfg->app, r->ids[0], g->base, ag_request_author(r),
+                                        cid, g->text, g->len, budget, &version, &err, &col);
+    if (s == AG_ERR_PARSE)
+        return answer_parse_problem(r, &err, col);
+    if (s != AG_OK)
+        return ag_defer_answer_problem(r, s, &err);
+    ag_api_answer_model(r, r->ids[0], 200);
 }
 
 enum MHD_Result ag_api_model_grammar_put(ag_request *r)
@@ -122,23 +150,19 @@ enum MHD_Result ag_api_model_grammar_put(ag_request *r)
     ag_status s = ag_app_query_version(r->cfg->app, r->ids[0], &current, &err);
     if (s == AG_OK)
         s = if_match(r, 1, current, &base, &err);
-    char *text = NULL;
-    size_t len = 0;
+    grammar_put *g = NULL;
+    if (s == AG_OK && !(g = calloc(1, sizeof *g)))
+        s = ag_error_set(&err, AG_ERR_NOMEM, 0, "out of memory");
     if (s == AG_OK)
-        s = ag_upload_read_all(r, ag_app_change_grammar_max(), "grammar text", &text, &len,
-                               &err);
-    if (s != AG_OK)
+        s = ag_upload_read_all(r, ag_app_change_grammar_max(), "grammar text", &g->text,
+                               &g->len, &err);
+    if (s != AG_OK) {
+        grammar_put_free(g);
         return ag_reply_problem(r, s, &err);
-    char cid[64];
-    ag_request_fresh_cid("grammar", cid, sizeof cid);
-    int64_t version;
-    long col = 0;
-    s = ag_app_change_grammar(r->cfg->app, r->ids[0], base, ag_request_author(r), cid, text, len,
-                              &version, &err, &col);
-    free(text);
-    if (s == AG_ERR_PARSE)
-        return reply_parse_problem(r, &err, col);
-    if (s != AG_OK)
-        return ag_reply_problem(r, s, &err);
-    return ag_api_reply_model(r, r->ids[0], 200);
+    }
+    g->base = base;
+    r->work_input = g;
+    r->work_input_free = grammar_put_free;
+    /* parsing, deriving and proceduralizing the text may take long: the model's task lane */
+    return ag_defer_run(r, AG_TASK_OP, r->ids[0], put_grammar);
 }

@@ -6,6 +6,7 @@
 #include "../app/app_change.h"
 #include "../app/app_jobs.h"
 #include "../app/app_query.h"
+#include "defer.h"
 #include "routes.h"
 #include "upload.h"
 
@@ -93,6 +94,19 @@ enum MHD_Result ag_api_reply_model(ag_request *r, int64_t id, unsigned status)
     return ag_reply_json(r, status, body, etag);
 }
 
+void ag_api_answer_model(ag_request *r, int64_t id, unsigned status)
+{
+    ag_error err;
+    json_t *body;
+    int64_t version;
+    ag_status s = ag_app_query_model(r->cfg->app, id, &body, &version, &err);
+    if (s != AG_OK)
+        return ag_defer_answer_problem(r, s, &err);
+    char etag[32];
+    version_etag(etag, sizeof etag, version);
+    ag_defer_answer_json(r, status, body, etag);
+}
+
 enum MHD_Result ag_api_model_get(ag_request *r)
 {
     return ag_api_reply_model(r, r->ids[0], 200);
@@ -103,10 +117,19 @@ ag_status ag_api_precondition(ag_request *r, int required, int64_t *version, ag_
     *version = 0;
     if (!required && !ag_request_header(r, MHD_HTTP_HEADER_IF_MATCH))
         return AG_OK;
-    ag_status s = ag_request_if_match(r, version, err);
-    if (s != AG_OK || *version != -1)
+    ag_if_match m;
+    ag_status s = ag_request_if_match(r, &m, err);
+    if (s != AG_OK)
         return s;
-    return ag_app_query_version(r->cfg->app, r->ids[0], version, err);
+    /* one version named: the change itself checks it, atomically */
+    if (!m.any && m.n == 1 && m.tags == 1) {
+        *version = m.versions[0];
+        return AG_OK;
+    }
+    int64_t current;
+    if ((s = ag_app_query_version(r->cfg->app, r->ids[0], &current, err)) != AG_OK)
+        return s;
+    return ag_request_if_match_check(&m, "model", r->ids[0], current, version, err);
 }
 
 /* What every change needs: the JSON body and the If-Match version. Returns 0 after answering
@@ -210,14 +233,20 @@ enum MHD_Result ag_api_model_ops_list(ag_request *r)
     return ag_reply_json(r, 200, json_pack("{s:o}", "items", items), etag);
 }
 
-enum MHD_Result ag_api_model_ops_create(ag_request *r)
+/* POST …/ops: the op applied (on a task worker for structural kinds). */
+static void apply_op(ag_request *r, ag_task_budget *budget)
 {
     ag_error err;
-    enum MHD_Result rc;
-    json_t *body;
+    ag_error_clear(&err);
+    json_t *body = NULL;
     int64_t base;
-    if (!change_request(r, &body, &base, &rc))
-        return rc;
+    ag_status s = ag_request_json(r, &body, &err);
+    if (s == AG_OK)
+        s = ag_api_precondition(r, 1, &base, &err);
+    if (s != AG_OK) {
+        json_decref(body);
+        return ag_defer_answer_problem(r, s, &err);
+    }
     char generated[64];
     const char *cid = json_string_value(json_object_get(body, "cid"));
     if (!cid) {
@@ -227,14 +256,30 @@ enum MHD_Result ag_api_model_ops_create(ag_request *r)
     int64_t version;
     int dup;
     ag_op_request rq = {.model = r->ids[0], .base = base, .author = ag_request_author(r),
-                        .cid = cid, .op = json_object_get(body, "op")};
-    ag_status s = ag_app_change_op(r->cfg->app, &rq, &version, &dup, &err);
+                        .cid = cid, .op = json_object_get(body, "op"), .budget = budget};
+    s = ag_app_change_op(r->cfg->app, &rq, &version, &dup, &err);
     json_decref(body);
     if (s != AG_OK)
-        return ag_reply_problem(r, s, &err);
+        return ag_defer_answer_problem(r, s, &err);
     char etag[32];
     version_etag(etag, sizeof etag, version);
-    return ag_reply_json(r, 200, json_pack("{s:I, s:b}", "version", (json_int_t)version,
+    ag_defer_answer_json(r, 200, json_pack("{s:I, s:b}", "version", (json_int_t)version,
                                            "duplicate", dup),
                          etag);
+}
+
+enum MHD_Result ag_api_model_ops_create(ag_request *r)
+{
+    enum MHD_Result rc;
+    json_t *body;
+    int64_t base;
+    if (!change_request(r, &body, &base, &rc))
+        return rc;
+    /* what may take long runs on the model's task lane, the rest here */
+    const ag_op_kind *row = ag_optable_find(
+        json_string_value(json_object_get(json_object_get(body, "op"), "kind")));
+    int structural = row && row->lane == AG_OP_STRUCTURAL && (row->flags & AG_OP_CLIENT);
+    json_decref(body);
+    return structural ? ag_defer_run(r, AG_TASK_OP, r->ids[0], apply_op)
+                      : ag_defer_inline(r, apply_op);
 }

@@ -7,6 +7,7 @@
 
 #include "../app/app_parts.h"
 #include "../app/problem.h"
+#include "defer.h"
 #include "routes.h"
 #include "upload.h"
 
@@ -168,12 +169,21 @@ enum MHD_Result ag_api_parts_create(ag_request *r)
 /* The If-Match version of a change to a part; "*" is its newest. */
 static ag_status part_precondition(ag_request *r, int64_t *version, ag_error *err)
 {
-    ag_status s = ag_request_if_match(r, version, err);
+    ag_if_match m;
+    ag_status s = ag_request_if_match(r, &m, err);
     if (s == AG_ERR_PRECONDITION_REQUIRED)
         return ag_error_set(err, s, 0, "send If-Match with the part's ETag (its version)");
-    if (s == AG_OK && *version == -1)
-        s = ag_app_parts_version(r->cfg->app, r->ids[0], version, err);
-    return s;
+    if (s != AG_OK)
+        return s;
+    /* one version named: the save checks it, atomically */
+    if (!m.any && m.n == 1 && m.tags == 1) {
+        *version = m.versions[0];
+        return AG_OK;
+    }
+    int64_t current;
+    if ((s = ag_app_parts_version(r->cfg->app, r->ids[0], &current, err)) != AG_OK)
+        return s;
+    return ag_request_if_match_check(&m, "part", r->ids[0], current, version, err);
 }
 
 enum MHD_Result ag_api_part_versions_create(ag_request *r)
@@ -436,8 +446,10 @@ enum MHD_Result ag_api_model_selection(ag_request *r)
     return ag_reply_json(r, 200, out, etag);
 }
 
-enum MHD_Result ag_api_model_compose_preview(ag_request *r)
+/* The composition is derived and encoded: on the model's task lane, off the HTTP threads. */
+static void compose_preview(ag_request *r, ag_task_budget *budget)
 {
+    (void)budget;
     ag_error err;
     ag_error_clear(&err);
     json_t *b = NULL;
@@ -452,11 +464,16 @@ enum MHD_Result ag_api_model_compose_preview(ag_request *r)
                                          &glb, &report, &err);
     json_decref(b);
     if (s != AG_OK)
-        return ag_reply_problem(r, s, &err);
+        return ag_defer_answer_problem(r, s, &err);
     char n[32];
     snprintf(n, sizeof n, "%lld",
              (long long)json_integer_value(json_object_get(report, "instances")));
     ag_reply_header(r, "X-Archgram-Instances", n);
     json_decref(report);
-    return ag_reply_bytes(r, 200, "model/gltf-binary", glb.data, glb.len, NULL);
+    ag_defer_answer_bytes(r, 200, "model/gltf-binary", glb.data, glb.len, NULL);
+}
+
+enum MHD_Result ag_api_model_compose_preview(ag_request *r)
+{
+    return ag_defer_run(r, AG_TASK_OP, r->ids[0], compose_preview);
 }

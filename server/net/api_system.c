@@ -4,6 +4,7 @@
 
 #include "../app/app_query.h"
 #include "../embedded.h"
+#include "connguard.h"
 #include "routes.h"
 
 enum MHD_Result ag_api_health(ag_request *r)
@@ -12,6 +13,12 @@ enum MHD_Result ag_api_health(ag_request *r)
     json_t *body = ag_app_query_health(r->cfg->app, r->cfg->ws_port, &err);
     if (!body)
         return ag_reply_problem(r, err.code, &err);
+    /* the HTTP side: open connections, slow ones cut, requests whose client left first */
+    json_object_set_new(body, "http",
+                        json_pack("{s:I, s:I, s:I}", "connections",
+                                  (json_int_t)ag_connguard_open(r->cfg->guard), "slow_cut",
+                                  (json_int_t)ag_connguard_cut(r->cfg->guard), "abandoned",
+                                  (json_int_t)atomic_load(r->cfg->abandoned)));
     /* the web client asks for a token only when there are accounts */
     json_object_set_new(body, "auth", json_boolean(!r->cfg->no_auth));
     return ag_reply_json(r, 200, body, NULL);

@@ -9,12 +9,23 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "connguard.h"
+#include "defer.h"
+#include "ratelimit.h"
 #include "request.h"
 #include "routes.h"
 #include "static_files.h"
 #include "upload.h"
 
 #define AG_MAX_JSON_BODY (1u << 20)
+/* A request line and headers libmicrohttpd keeps in a connection's memory (its own 414/431
+ * answers, which are HTML, come only past this); below it archgram answers with problems
+ * from the limits that follow. */
+#define AG_MHD_MEMORY ((size_t)64 << 10)
+#define AG_MAX_URL 8192
+#define AG_MAX_HEADERS 16384
+/* Distinct clients the rate limiters keep buckets for. */
+#define AG_RATE_KEYS 8192
 /* How much of a rejected body is read and dropped before the connection is cut. */
 #define AG_DISCARD_LIMIT ((size_t)64 << 20)
 
@@ -22,11 +33,17 @@ struct ag_http {
     struct MHD_Daemon *daemon;
     ag_http_config cfg;
     char *web_dir;
+    int listen_fd; /* after ag_http_quiesce: the listening socket, closed at the stop */
+    ag_ratelimit *rest_limit, *job_limit;
+    atomic_size_t abandoned;
     char **cors; /* owned copies of the allowed origins */
 };
 
 static void http_free(ag_http *http)
 {
+    ag_connguard_stop(http->cfg.guard);
+    ag_ratelimit_free(http->rest_limit);
+    ag_ratelimit_free(http->job_limit);
     for (int i = 0; i < http->cfg.ncors; i++)
         free(http->cors[i]);
     free(http->cors);
@@ -130,6 +147,7 @@ static ag_request *request_new(ag_http *http, struct MHD_Connection *conn, const
         return NULL;
     r->cfg = &http->cfg;
     r->conn = conn;
+    r->fd = -1;
     r->url = url;
     r->method = method;
     return r;
@@ -140,6 +158,9 @@ static void request_free(ag_request *r)
     if (!r)
         return;
     free(r->body);
+    free(r->answer.body);
+    if (r->work_input_free)
+        r->work_input_free(r->work_input);
     ag_upload_free(r->upload);
     free(r);
 }
@@ -147,9 +168,44 @@ static void request_free(ag_request *r)
 static void on_completed(void *cls, struct MHD_Connection *conn, void **con_cls,
                          enum MHD_RequestTerminationCode toe)
 {
-    (void)cls, (void)conn, (void)toe;
+    ag_http *http = cls;
+    (void)toe;
     request_free(*con_cls);
     *con_cls = NULL;
+    ag_connguard_request_done(http->cfg.guard, conn); /* the next request's headers are timed */
+}
+
+static enum MHD_Result count_header(void *cls, enum MHD_ValueKind kind, const char *key,
+                                    const char *value)
+{
+    (void)kind;
+    size_t *n = cls;
+    *n += strlen(key) + (value ? strlen(value) : 0) + 4;
+    return MHD_YES;
+}
+
+/* Takes a token of limit for r: 0 after answering 429 with Retry-After. */
+static int within_rate(ag_request *r, ag_ratelimit *limit, const char *what,
+                       enum MHD_Result *rc)
+{
+    char key[96];
+    double wait = 0;
+    if (!limit)
+        return 1;
+    ag_request_rate_key(r, key, sizeof key);
+    if (ag_ratelimit_take(limit, key, &wait))
+        return 1;
+    long seconds = (long)wait + ((double)(long)wait < wait);
+    if (seconds < 1)
+        seconds = 1;
+    char retry[24];
+    snprintf(retry, sizeof retry, "%ld", seconds);
+    ag_reply_header(r, MHD_HTTP_HEADER_RETRY_AFTER, retry);
+    ag_error err;
+    ag_error_set(&err, AG_ERR_RATE_LIMITED, 0, "too many %s from this client; try again in %ld s",
+                 what, seconds);
+    *rc = ag_reply_problem(r, AG_ERR_RATE_LIMITED, &err);
+    return 0;
 }
 
 static ag_status append_body(ag_request *r, const char *data, size_t len, ag_error *err)
@@ -181,16 +237,40 @@ static enum MHD_Result begin(ag_http *http, struct MHD_Connection *conn, const c
     if (!r)
         return MHD_NO;
     *con_cls = r;
+    ag_connguard_headers_in(http->cfg.guard, conn);
+    ag_error err;
+    ag_error_clear(&err);
+    enum MHD_Result rc;
+    if (strncmp(url, "/api/", 5) == 0)
+        cors_origin(http, r); /* a 429 to an allowed page is readable by it */
+    if (!within_rate(r, http->cfg.rest_limit, "requests", &rc))
+        return rc;
+    size_t url_len = strlen(url), headers = 0;
+    /* the query's arguments count too (libmicrohttpd hands the path alone) */
+    MHD_get_connection_values(conn, MHD_GET_ARGUMENT_KIND, count_header, &url_len);
+    if (url_len > AG_MAX_URL) {
+        ag_error_set(&err, AG_ERR_URI_TOO_LONG, 0, "the URL has %zu bytes; at most %d are taken",
+                     url_len, AG_MAX_URL);
+        return ag_reply_problem(r, AG_ERR_URI_TOO_LONG, &err);
+    }
+    MHD_get_connection_values(conn, MHD_HEADER_KIND, count_header, &headers);
+    if (headers > AG_MAX_HEADERS) {
+        ag_error_set(&err, AG_ERR_HEADERS_TOO_LARGE, 0,
+                     "the request headers have %zu bytes; at most %d are taken", headers,
+                     AG_MAX_HEADERS);
+        return ag_reply_problem(r, AG_ERR_HEADERS_TOO_LARGE, &err);
+    }
+    /* libmicrohttpd has decoded %-escapes: a path that is not UTF-8 names nothing here */
+    if (ag_app_check_utf8("the URL path (after decoding %-escapes)", url, strlen(url), &err) !=
+        AG_OK)
+        return ag_reply_problem(r, AG_ERR_INVALID, &err);
     if (strncmp(url, "/api/", 5) != 0)
         return MHD_YES; /* static files: answered once the (empty) body is in */
 
-    cors_origin(http, r);
     if (strcmp(method, "OPTIONS") == 0)
         return preflight(r);
     char allow[64];
     ag_match m = ag_routes_find(method, url, &r->route, r->ids, r->name, allow, sizeof allow);
-    ag_error err;
-    ag_error_clear(&err);
     if (m == AG_MATCH_NONE) {
         ag_error_set(&err, AG_ERR_NOT_FOUND, 0, "no resource at %s", url);
         return ag_reply_problem(r, AG_ERR_NOT_FOUND, &err);
@@ -206,6 +286,9 @@ static enum MHD_Result begin(ag_http *http, struct MHD_Connection *conn, const c
         r->route = NULL; /* a body that still comes is dropped */
         return ag_reply_problem(r, checked, &err);
     }
+    if ((r->route->flags & AG_ROUTE_SUBMITS_JOB) &&
+        !within_rate(r, http->cfg.job_limit, "job submissions", &rc))
+        return rc;
     const char *length = ag_request_header(r, MHD_HTTP_HEADER_CONTENT_LENGTH);
     size_t limit = r->route->body == AG_BODY_UPLOAD ? http->cfg.max_body : http->cfg.max_json;
     if (length && strtoull(length, NULL, 10) > limit) {
@@ -259,7 +342,12 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *conn, const 
         return MHD_YES;
     }
 
-    /* The whole body is in. */
+    /* The whole body is in, or a deferred request's work is done. */
+    enum MHD_Result rc;
+    if (ag_defer_reply(r, &rc))
+        return rc;
+    if (r->deferred)
+        return MHD_YES; /* still working: the task resumes the connection */
     if (strncmp(url, "/api/", 5) != 0)
         return ag_static_serve(r, http->cfg.web_dir);
     if (r->body_status != AG_OK)
@@ -286,6 +374,7 @@ ag_status ag_http_start(ag_app *app, const ag_http_options *opt, ag_http **out, 
     if (!http)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     http->cfg.app = app;
+    http->listen_fd = -1;
     http->cfg.max_body = opt->max_body ? opt->max_body : (size_t)512 << 20;
     http->cfg.max_json = AG_MAX_JSON_BODY;
     http->cfg.ws_port = opt->ws_port;
@@ -324,13 +413,31 @@ ag_status ag_http_start(ag_app *app, const ag_http_options *opt, ag_http **out, 
         if (threads < 4)
             threads = 4;
     }
+    http->rest_limit = ag_ratelimit_create(opt->rest_rate, AG_RATE_KEYS);
+    http->job_limit = ag_ratelimit_create(opt->job_rate, AG_RATE_KEYS);
+    http->cfg.guard = ag_connguard_start(opt->header_timeout > 0 ? opt->header_timeout : 10);
+    if (!http->rest_limit || !http->job_limit || !http->cfg.guard) {
+        http_free(http);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory starting the HTTP server");
+    }
+    http->cfg.rest_limit = http->rest_limit;
+    http->cfg.job_limit = http->job_limit;
+    http->cfg.rate_key = opt->rate_key;
+    http->cfg.abandoned = &http->abandoned;
+    unsigned max_conns = opt->max_connections ? opt->max_connections : 4096;
+    unsigned per_address = opt->max_per_address ? opt->max_per_address : 64;
+    unsigned idle = opt->idle_timeout ? opt->idle_timeout : 60;
     http->daemon = MHD_start_daemon(
-        MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL | MHD_USE_ERROR_LOG, (uint16_t)opt->port,
+        MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_EPOLL | MHD_USE_ERROR_LOG |
+            MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ITC,
+        (uint16_t)opt->port,
         NULL, NULL, on_request, http, MHD_OPTION_EXTERNAL_LOGGER, log_mhd, NULL,
         MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
         MHD_OPTION_THREAD_POOL_SIZE, (unsigned)threads, MHD_OPTION_NOTIFY_COMPLETED, on_completed,
-        http, MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)120, MHD_OPTION_LISTENING_ADDRESS_REUSE,
-        (unsigned)1, MHD_OPTION_END);
+        http, MHD_OPTION_NOTIFY_CONNECTION, ag_connguard_notify, http->cfg.guard,
+        MHD_OPTION_CONNECTION_TIMEOUT, idle, MHD_OPTION_CONNECTION_LIMIT, max_conns,
+        MHD_OPTION_PER_IP_CONNECTION_LIMIT, per_address, MHD_OPTION_CONNECTION_MEMORY_LIMIT,
+        AG_MHD_MEMORY, MHD_OPTION_LISTENING_ADDRESS_REUSE, (unsigned)1, MHD_OPTION_END);
     if (!http->daemon) {
         int e = errno;
         http_free(http);
@@ -342,10 +449,20 @@ ag_status ag_http_start(ag_app *app, const ag_http_options *opt, ag_http **out, 
     return AG_OK;
 }
 
+void ag_http_quiesce(ag_http *http)
+{
+    if (!http || http->listen_fd >= 0)
+        return;
+    MHD_socket fd = MHD_quiesce_daemon(http->daemon);
+    http->listen_fd = fd == MHD_INVALID_SOCKET ? -2 : (int)fd;
+}
+
 void ag_http_stop(ag_http *http)
 {
     if (!http)
         return;
     MHD_stop_daemon(http->daemon);
+    if (http->listen_fd >= 0)
+        close(http->listen_fd);
     http_free(http);
 }

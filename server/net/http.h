@@ -9,6 +9,8 @@
 #include <stddef.h>
 
 #include "../app/app.h"
+#include "ratelimit.h"
+#include "request.h"
 
 typedef struct ag_http ag_http;
 
@@ -19,6 +21,15 @@ typedef struct {
     const char *web_dir; /* NULL: no web client */
     size_t max_body;     /* 0 = 512 MiB */
     int threads;         /* 0 = 2 × cores, at least 4 */
+    /* rate limits per client (net/ratelimit.h; rate 0: none) */
+    ag_rate rest_rate;   /* every request */
+    ag_rate job_rate;    /* requests that submit a job (uploads, proceduralize, extrusions) */
+    ag_rate_key_fn rate_key; /* NULL: by client address */
+    /* slow and many clients */
+    unsigned max_connections;  /* 0 = 4096 */
+    unsigned max_per_address;  /* open connections of one client address; 0 = 64 */
+    double header_timeout;     /* seconds to send a request's headers; 0 = 10 */
+    unsigned idle_timeout;     /* seconds a connection may stay silent; 0 = 60 */
     int no_auth;         /* no accounts: everyone is the local admin; refused unless bind is a
                             loopback address */
     const char *const *cors; /* origins a browser may call the API from ("*": any); copied */
@@ -29,7 +40,11 @@ typedef struct {
 int ag_http_is_loopback(const char *addr);
 
 ag_status ag_http_start(ag_app *app, const ag_http_options *opt, ag_http **out, ag_error *err);
-/* Stops accepting and waits for the request threads. */
+/* Stops accepting connections; the open ones are still served (a shutdown answers what
+ * waits on the task lanes before the request threads go). */
+void ag_http_quiesce(ag_http *http);
+/* Stops accepting and waits for the request threads. Call it once no task works for a
+ * request (ag_app_shutdown returned 1). */
 void ag_http_stop(ag_http *http);
 
 #endif

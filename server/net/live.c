@@ -43,9 +43,11 @@ struct ag_live {
     pthread_mutex_t lock; /* guards the pending list */
     pending *head, *tail;
     ag_live_rooms rooms;  /* service thread only */
+    ag_ratelimit *messages;
 };
 
 ag_app *ag__live_app(ag_live *live) { return live->app; }
+ag_ratelimit *ag__live_message_limit(ag_live *live) { return live->messages; }
 ag_live_rooms *ag__live_rooms(ag_live *live) { return &live->rooms; }
 
 static void pending_free(pending *p)
@@ -329,9 +331,17 @@ static int on_lws(struct lws *wsi, enum lws_callback_reasons reason, void *user,
     switch (reason) {
     case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
         return live && s ? admit(live, s, wsi) : -1;
-    case LWS_CALLBACK_ESTABLISHED:
+    case LWS_CALLBACK_ESTABLISHED: {
         ag_live_rooms_add(&live->rooms, s, wsi);
+        char peer[48] = "?";
+        lws_get_peer_simple(wsi, peer, sizeof peer);
+        /* an account's messages count together, wherever it connects from */
+        if (s->who.user)
+            snprintf(s->rate_key, sizeof s->rate_key, "user:%lld", (long long)s->who.user);
+        else
+            snprintf(s->rate_key, sizeof s->rate_key, "addr:%s", peer);
         break;
+    }
     case LWS_CALLBACK_RECEIVE:
         return receive(live, s, wsi, in, len);
     case LWS_CALLBACK_SERVER_WRITEABLE:
@@ -386,15 +396,21 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
     if (!live)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     live->app = app;
+    if (!(live->messages = ag_ratelimit_create(opt->message_rate, 8192))) {
+        free(live);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
     live->http_port = opt->http_port;
     live->no_auth = opt->no_auth;
     if (opt->norigins > 0 && !(live->origins = calloc((size_t)opt->norigins, sizeof *live->origins))) {
+        ag_ratelimit_free(live->messages);
         free(live);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
     for (int i = 0; i < opt->norigins; i++, live->norigins++)
         if (!(live->origins[i] = strdup(opt->origins[i]))) {
             free_origins(live);
+            ag_ratelimit_free(live->messages);
             free(live);
             return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         }
@@ -412,6 +428,7 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
     live->context = lws_create_context(&info);
     if (!live->context) {
         pthread_mutex_destroy(&live->lock);
+        ag_ratelimit_free(live->messages);
         free_origins(live);
         free(live);
         return ag_error_set(err, AG_ERR_IO, 0,
@@ -423,6 +440,7 @@ ag_status ag_live_start(ag_app *app, const ag_live_options *opt, ag_live **out, 
         ag_events_unsubscribe(ag_app_events(app), on_event, live);
         lws_context_destroy(live->context);
         pthread_mutex_destroy(&live->lock);
+        ag_ratelimit_free(live->messages);
         free_origins(live);
         free(live);
         return ag_error_set(err, AG_ERR_INTERNAL, 0, "cannot start the websocket thread");
@@ -445,6 +463,7 @@ void ag_live_stop(ag_live *live)
         pending_free(p);
     }
     pthread_mutex_destroy(&live->lock);
+    ag_ratelimit_free(live->messages);
     free_origins(live);
     free(live);
 }

@@ -4,18 +4,20 @@
  * session's identity for good, and an Origin that must be the web client's (the HTTP port on
  * the host the socket was opened on) or one allowed by --cors; other handshakes are refused. The protocol is documented in schema/websocket.md; its handlers are in
  * live_protocol.c, rooms and presence in live_rooms.c, structural ops and previews run on the
- * app's fast lane. Stop the app (ag_app_shutdown, which drops the fast lane's waiting work)
+ * models' task lanes. Stop the app (ag_app_shutdown, which answers the lanes' waiting work)
  * before the live layer. */
 #ifndef AG_LIVE_H
 #define AG_LIVE_H
 
 #include "../app/app.h"
+#include "ratelimit.h"
 
 typedef struct ag_live ag_live;
 
 typedef struct {
     const char *bind; /* NULL = 127.0.0.1 */
     int port;
+    ag_rate message_rate; /* messages per client address (net/ratelimit.h); rate 0: none */
     int http_port;    /* the web client's origin is this port on the host the client named */
     int no_auth;      /* everyone is the local admin (loopback only, see net/http.h) */
     const char *const *origins; /* other origins allowed to connect ("*": any); copied */

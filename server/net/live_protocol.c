@@ -11,6 +11,7 @@
 #include "../app/auth.h"
 #include "../app/optable.h"
 #include "../app/problem.h"
+#include "ratelimit.h"
 
 #define AG_LIVE_MAX_PRESENCE (16u << 10)
 #define AG_LIVE_WELCOME_OPS 5000
@@ -130,7 +131,7 @@ static void on_watch(ag_live *live, ag_live_session *s, json_t *msg)
 
 /* The ack or nack of an op (any thread). */
 static json_t *op_reply(ag_app *app, int64_t model, const char *user, uint64_t origin,
-                        json_t *msg)
+                        json_t *msg, ag_task_budget *budget)
 {
     json_t *jcid = json_object_get(msg, "cid");
     const char *cid = json_string_value(jcid);
@@ -151,7 +152,9 @@ static json_t *op_reply(ag_app *app, int64_t model, const char *user, uint64_t o
                             .author = user,
                             .cid = cid,
                             .op = json_object_get(msg, "op"),
-                            .origin = origin};
+                            .origin = origin,
+                            .budget = budget,
+                            .rebase = 1};
         st = ag_app_change_op(app, &rq, &version, &dup, &err);
     }
     if (st == AG_OK)
@@ -167,6 +170,41 @@ static json_t *op_reply(ag_app *app, int64_t model, const char *user, uint64_t o
     return json_pack("{s:s, s:o, s:I, s:o}", "type", "nack", "cid",
                      cid ? json_string(cid) : json_null(), "version", (json_int_t)current,
                      "problem", ag_problem_json(st, &err));
+}
+
+/* The nack of an op whose answer could not be built (out of memory), written without
+ * allocating: the cid is kept when it can go into JSON as it is. */
+static void nack_fallback(const json_t *msg, char *buf, size_t cap)
+{
+    const char *cid = json_string_value(json_object_get(msg, "cid"));
+    int plain = cid && strlen(cid) <= 100;
+    for (const char *c = cid; plain && *c; c++)
+        plain = *c >= 0x20 && *c < 0x7f && *c != '"' && *c != '\\';
+    char problem[AG_PROBLEM_FALLBACK_MAX];
+    ag_problem_fallback(AG_ERR_NOMEM, problem, sizeof problem);
+    snprintf(buf, cap, "{\"type\":\"nack\",\"cid\":%s%s%s,\"version\":0,\"problem\":%s}",
+             plain ? "\"" : "", plain ? cid : "null", plain ? "\"" : "", problem);
+}
+#define NACK_FALLBACK_MAX (AG_PROBLEM_FALLBACK_MAX + 160)
+
+/* The text of an op's answer (reply stolen): its JSON, or, when that could not be built, the
+ * fallback nack written into buf. *heap is what to free afterwards (NULL when buf is used). */
+static const char *answer_text(json_t *reply, const json_t *msg, char *buf, size_t cap,
+                               char **heap)
+{
+    *heap = reply ? json_dumps(reply, JSON_COMPACT) : NULL;
+    json_decref(reply);
+    if (*heap)
+        return *heap;
+    nack_fallback(msg, buf, cap);
+    return buf;
+}
+
+/* A nack refused before any model was read. */
+static json_t *nack_json(const json_t *msg, ag_status st, const ag_error *err)
+{
+    return json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid", json_object_get(msg, "cid"),
+                     "version", (json_int_t)0, "problem", ag_problem_json(st, err));
 }
 
 /* Solves a drag preview (any thread): the message for the whole room (the author too: the
@@ -199,7 +237,7 @@ static json_t *preview_message(ag_app *app, int64_t model, const char *user, con
                      user, "base", jbase, "boxes", boxes, "solve_ms", solve_ms);
 }
 
-/* A structural op or a preview, computed on the job queue's fast lane. */
+/* A structural op or a preview, computed on the model's task lane (app.h). */
 typedef struct {
     ag_live *live;
     uint64_t session;
@@ -218,24 +256,53 @@ static void task_free(void *user)
     free(t);
 }
 
-static void task_run(void *user)
+static void task_run(void *user, ag_task_budget *budget)
 {
     task *t = user;
     ag_app *app = ag__live_app(t->live);
     int to_room = 0;
     json_t *reply = t->preview ? preview_message(app, t->model, t->user, t->peer, t->msg, &to_room)
-                               : op_reply(app, t->model, t->user, t->session, t->msg);
-    char *text = reply ? json_dumps(reply, JSON_COMPACT) : NULL;
-    json_decref(reply);
-    if (text && to_room)
+                               : op_reply(app, t->model, t->user, t->session, t->msg, budget);
+    char fallback[NACK_FALLBACK_MAX], *heap;
+    if (!reply && t->preview) {
+        task_free(t); /* a preview is only worth its newest position */
+        return;
+    }
+    const char *text = answer_text(reply, t->msg, fallback, sizeof fallback, &heap);
+    if (to_room)
         ag__live_post_to_room(t->live, t->model, text);
-    else if (text)
-        ag__live_post_to_session(t->live, t->session, text);
-    free(text);
+    else
+        ag__live_post_to_session(t->live, t->session, text); /* an op is always answered */
+    free(heap);
     task_free(t);
 }
 
-static void run_on_fast_lane(ag_live *live, ag_live_session *s, json_t *msg, int preview)
+/* Sends the answer to an op from the service thread. */
+static void send_answer(ag_live_session *s, const json_t *msg, json_t *reply /* stolen */)
+{
+    char fallback[NACK_FALLBACK_MAX], *heap;
+    ag_live_rooms_send(s, answer_text(reply, msg, fallback, sizeof fallback, &heap));
+    free(heap);
+}
+
+/* A task the queue dropped at a stop: an op is still answered. */
+static void task_drop(void *user)
+{
+    task *t = user;
+    if (!t->preview) {
+        ag_error err;
+        ag_error_set(&err, AG_ERR_CANCELLED, 0,
+                     "archgramd is shutting down; the op was not applied");
+        char fallback[NACK_FALLBACK_MAX], *heap;
+        ag__live_post_to_session(t->live, t->session,
+                                 answer_text(nack_json(t->msg, AG_ERR_CANCELLED, &err), t->msg,
+                                             fallback, sizeof fallback, &heap));
+        free(heap);
+    }
+    task_free(t);
+}
+
+static void run_on_task_lane(ag_live *live, ag_live_session *s, json_t *msg, int preview)
 {
     task *t = calloc(1, sizeof *t);
     char peer[32];
@@ -253,7 +320,8 @@ static void run_on_fast_lane(ag_live *live, ag_live_session *s, json_t *msg, int
     t->msg = json_incref(msg);
     t->preview = preview;
     ag_error err;
-    ag_status st = ag_app_run_fast(ag__live_app(live), task_run, task_free, t, &err);
+    ag_status st = ag_app_run_task(ag__live_app(live), AG_TASK_OP, s->model, task_run,
+                                   task_drop, t, &err);
     if (st == AG_OK)
         return;
     task_free(t);
@@ -261,9 +329,7 @@ static void run_on_fast_lane(ag_live *live, ag_live_session *s, json_t *msg, int
         return; /* a preview is only worth its newest position: drop it */
     if (st == AG_ERR_BUSY)
         ag_error_set(&err, AG_ERR_BUSY, 0, "too many edits are waiting; send it again later");
-    ag_live_rooms_send_json(s, json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid",
-                                         json_object_get(msg, "cid"), "version", (json_int_t)0,
-                                         "problem", ag_problem_json(st, &err)));
+    send_answer(s, msg, nack_json(msg, st, &err));
 }
 
 /* May s change its room's model now? Checked on every op and preview, so a role taken away
@@ -284,19 +350,19 @@ static void on_op(ag_live *live, ag_live_session *s, json_t *msg)
         int64_t current = 0;
         if (ag_app_query_version(ag__live_app(live), s->model, &current, NULL) != AG_OK)
             current = 0;
-        return ag_live_rooms_send_json(
-            s, json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid",
-                         json_object_get(msg, "cid"), "version", (json_int_t)current, "problem",
-                         ag_problem_json(st, &err)));
+        return send_answer(s, msg,
+                           json_pack("{s:s, s:O?, s:I, s:o}", "type", "nack", "cid",
+                                     json_object_get(msg, "cid"), "version",
+                                     (json_int_t)current, "problem", ag_problem_json(st, &err)));
     }
     const ag_op_kind *row =
         ag_optable_find(json_string_value(json_object_get(json_object_get(msg, "op"), "kind")));
-    /* structural kinds a client may send go to the fast lane; the rest (and every refusal
-     * that needs no model) is answered here */
+    /* structural kinds a client may send go to the model's task lane; the rest (and every
+     * refusal that needs no model) is answered here */
     if (row && row->lane == AG_OP_STRUCTURAL && (row->flags & AG_OP_CLIENT) &&
         json_is_string(json_object_get(msg, "cid")))
-        return run_on_fast_lane(live, s, msg, 0);
-    ag_live_rooms_send_json(s, op_reply(ag__live_app(live), s->model, s->user, s->id, msg));
+        return run_on_task_lane(live, s, msg, 0);
+    send_answer(s, msg, op_reply(ag__live_app(live), s->model, s->user, s->id, msg, NULL));
 }
 
 /* --- previews ------------------------------------------------------------------------------ */
@@ -304,7 +370,7 @@ static void on_op(ag_live *live, ag_live_session *s, json_t *msg)
 static void send_preview(ag_live *live, ag_live_session *s, json_t *msg)
 {
     s->preview_at = mono_ms();
-    run_on_fast_lane(live, s, msg, 1);
+    run_on_task_lane(live, s, msg, 1);
 }
 
 static void on_preview(ag_live *live, ag_live_session *s, json_t *msg)
@@ -376,9 +442,44 @@ const char *ag_live_protocol_type(size_t i)
     return i < sizeof handlers / sizeof handlers[0] ? handlers[i].type : NULL;
 }
 
+/* Past the client's message rate: an op is nacked (its sender waits for an answer), a drag
+ * preview dropped (a newer one follows), anything else answered with an error. */
+static void refuse_rate(ag_live_session *s, const char *data, size_t len, double wait)
+{
+    long seconds = (long)wait + ((double)(long)wait < wait);
+    if (seconds < 1)
+        seconds = 1;
+    json_t *msg = data && len ? json_loadb(data, len, 0, NULL) : NULL;
+    const char *type = json_string_value(json_object_get(msg, "type"));
+    if (type && strcmp(type, "preview") == 0) {
+        json_decref(msg);
+        return;
+    }
+    ag_error err;
+    ag_error_set(&err, AG_ERR_RATE_LIMITED, 0,
+                 "too many messages from this client; try again in %ld s", seconds);
+    json_t *reply =
+        type && strcmp(type, "op") == 0
+            ? json_pack("{s:s, s:O?, s:I, s:o, s:I}", "type", "nack", "cid",
+                        json_object_get(msg, "cid"), "version", (json_int_t)0, "problem",
+                        ag_problem_json(AG_ERR_RATE_LIMITED, &err), "retry_after",
+                        (json_int_t)seconds)
+            : json_pack("{s:s, s:o, s:I}", "type", "error", "problem",
+                        ag_problem_json(AG_ERR_RATE_LIMITED, &err), "retry_after",
+                        (json_int_t)seconds);
+    if (reply)
+        ag_live_rooms_send_json(s, reply);
+    else
+        ag_live_rooms_send_problem(s, AG_ERR_RATE_LIMITED, &err);
+    json_decref(msg);
+}
+
 void ag_live_protocol_message(ag_live *live, ag_live_session *s, const char *data, size_t len,
                               int binary, int overflow)
 {
+    double wait = 0;
+    if (!ag_ratelimit_take(ag__live_message_limit(live), s->rate_key, &wait))
+        return refuse_rate(s, overflow || binary ? NULL : data, len, wait);
     if (overflow) {
         char limit[32];
         snprintf(limit, sizeof limit, "%u", AG_LIVE_MAX_MESSAGE);

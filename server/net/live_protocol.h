@@ -1,7 +1,8 @@
 /* The live protocol (schema/websocket.md): one table from message type to handler, and the
  * handlers. Fast things (hello, presence, watch, rename and note ops) are answered on the
  * websocket service thread; structural ops and drag previews (rows of the op table with lane
- * AG_OP_STRUCTURAL, app/optable.h) run on the job queue's fast lane, in arrival order, and
+ * AG_OP_STRUCTURAL, app/optable.h) run on the model's task lane (one model's in arrival
+ * order, other models' beside them) under the op budget, and
  * their answers come back through the live layer's pending list. */
 #ifndef AG_LIVE_PROTOCOL_H
 #define AG_LIVE_PROTOCOL_H
@@ -29,6 +30,7 @@ const char *ag_live_protocol_type(size_t i);
 /* Provided by live.c: the app, the rooms, and posting an answer computed on another thread
  * (to one session, or to everyone in a room) to the service thread. */
 ag_app *ag__live_app(ag_live *live);
+struct ag_ratelimit *ag__live_message_limit(ag_live *live);
 ag_live_rooms *ag__live_rooms(ag_live *live);
 void ag__live_post_to_session(ag_live *live, uint64_t session, const char *text);
 void ag__live_post_to_room(ag_live *live, int64_t model, const char *text);

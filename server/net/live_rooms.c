@@ -61,8 +61,19 @@ void ag_live_rooms_send_json(ag_live_session *s, json_t *msg)
 
 void ag_live_rooms_send_problem(ag_live_session *s, ag_status st, const ag_error *err)
 {
-    ag_live_rooms_send_json(
-        s, json_pack("{s:s, s:o}", "type", "error", "problem", ag_problem_json(st, err)));
+    json_t *msg = json_pack("{s:s, s:o}", "type", "error", "problem", ag_problem_json(st, err));
+    char *text = msg ? json_dumps(msg, JSON_COMPACT) : NULL;
+    json_decref(msg);
+    if (text) {
+        ag_live_rooms_send(s, text);
+        free(text);
+        return;
+    }
+    /* out of memory: the error still goes out, without its detail */
+    char problem[AG_PROBLEM_FALLBACK_MAX], fallback[AG_PROBLEM_FALLBACK_MAX + 32];
+    ag_problem_fallback(st, problem, sizeof problem);
+    snprintf(fallback, sizeof fallback, "{\"type\":\"error\",\"problem\":%s}", problem);
+    ag_live_rooms_send(s, fallback);
 }
 
 void ag_live_rooms_send_error(ag_live_session *s, ag_status st, const char *fmt, const char *arg)

@@ -30,6 +30,7 @@ typedef struct ag_live_session {
     ag_identity who;    /* from the handshake's token, for the session's life */
     ag_model_role role; /* who's role on the room's model, as last checked */
     char user[801];     /* the name the room sees: the account's */
+    char rate_key[64];  /* what its message rate counts under: "user:<id>" or "addr:<peer>" */
     char *presence; /* last state, JSON text */
     char *rx;
     size_t rx_len;

@@ -1,3 +1,5 @@
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -72,12 +74,17 @@ enum MHD_Result ag_reply_json(ag_request *r, unsigned status, json_t *body, cons
 enum MHD_Result ag_reply_problem(ag_request *r, ag_status s, const ag_error *err)
 {
     char *text = ag_problem_text(s, err);
-    if (!text)
-        return MHD_NO;
     if (s == AG_ERR_UNAUTHORIZED)
         ag_reply_header(r, MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"archgram\"");
-    return ag_reply_bytes(r, (unsigned)ag_status_http(s), "application/problem+json", text,
-                          strlen(text), NULL);
+    if (text)
+        return ag_reply_bytes(r, (unsigned)ag_status_http(s), "application/problem+json", text,
+                              strlen(text), NULL);
+    /* out of memory: still an answer, built without allocating */
+    char fallback[AG_PROBLEM_FALLBACK_MAX];
+    size_t n = ag_problem_fallback(s, fallback, sizeof fallback);
+    return queue(r, (unsigned)ag_status_http(s),
+                 MHD_create_response_from_buffer(n, fallback, MHD_RESPMEM_MUST_COPY),
+                 "application/problem+json", NULL);
 }
 
 enum MHD_Result ag_reply_empty(ag_request *r, unsigned status, const char *etag)
@@ -146,6 +153,29 @@ int ag_request_none_match(ag_request *r, const char *etag)
     return 0;
 }
 
+void ag_request_address_key(ag_request *r, char *buf, size_t len)
+{
+    const union MHD_ConnectionInfo *ci =
+        MHD_get_connection_info(r->conn, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+    char addr[INET6_ADDRSTRLEN] = "?";
+    const struct sockaddr *sa = ci ? ci->client_addr : NULL;
+    if (sa && sa->sa_family == AF_INET)
+        inet_ntop(AF_INET, &((const struct sockaddr_in *)sa)->sin_addr, addr, sizeof addr);
+    else if (sa && sa->sa_family == AF_INET6)
+        inet_ntop(AF_INET6, &((const struct sockaddr_in6 *)sa)->sin6_addr, addr, sizeof addr);
+    snprintf(buf, len, "addr:%s", addr);
+}
+
+void ag_request_rate_key(ag_request *r, char *buf, size_t len)
+{
+    if (r->cfg->rate_key)
+        r->cfg->rate_key(r, buf, len);
+    else if (r->who.user) /* signed in: the account's budget, wherever it calls from */
+        snprintf(buf, len, "user:%lld", (long long)r->who.user);
+    else
+        ag_request_address_key(r, buf, len);
+}
+
 const char *ag_request_query(ag_request *r, const char *name)
 {
     return MHD_lookup_connection_value(r->conn, MHD_GET_ARGUMENT_KIND, name);
@@ -191,31 +221,98 @@ ag_status ag_request_json(ag_request *r, json_t **out, ag_error *err)
     return AG_OK;
 }
 
-ag_status ag_request_if_match(ag_request *r, int64_t *version, ag_error *err)
+/* One entity-tag of an If-Match list at *p (RFC 9110: [W/]"etagc*"), or bare digits (an
+ * older client's form): 0 when malformed. Sets *strong and the opaque part. */
+static int read_etag(const char **p, int *strong, const char **opaque, size_t *len)
 {
+    const char *c = *p;
+    *strong = 1;
+    if (c[0] == 'W' && c[1] == '/') {
+        *strong = 0;
+        c += 2;
+    }
+    if (*c == '"') {
+        const char *start = ++c;
+        while ((unsigned char)*c == 0x21 || ((unsigned char)*c >= 0x23 && (unsigned char)*c != 0x7f))
+            c++;
+        if (*c != '"')
+            return 0;
+        *opaque = start;
+        *len = (size_t)(c - start);
+        *p = c + 1;
+        return 1;
+    }
+    if (!*strong || *c < '0' || *c > '9')
+        return 0;
+    *opaque = c;
+    while (*c >= '0' && *c <= '9')
+        c++;
+    *len = (size_t)(c - *opaque);
+    *p = c;
+    return 1;
+}
+
+ag_status ag_request_if_match(ag_request *r, ag_if_match *m, ag_error *err)
+{
+    memset(m, 0, sizeof *m);
     const char *h = ag_request_header(r, MHD_HTTP_HEADER_IF_MATCH);
     if (!h)
         return ag_error_set(err, AG_ERR_PRECONDITION_REQUIRED, 0,
                             "send If-Match with the model's ETag (its version) to change it");
-    while (*h == ' ')
-        h++;
-    if (h[0] == '*' && (h[1] == '\0' || h[1] == ' ')) {
-        *version = -1;
-        return AG_OK;
-    }
     const char *p = h;
-    int quoted = *p == '"';
-    if (quoted)
+    while (*p == ' ' || *p == '\t')
         p++;
-    char *end;
-    long long v = strtoll(p, &end, 10);
-    if (end == p || v < 1 || (quoted && *end++ != '"'))
-        return ag_error_set(err, AG_ERR_INVALID, 0, "If-Match must be an ETag such as \"3\"");
-    while (*end == ' ')
-        end++;
-    if (*end != '\0')
-        return ag_error_set(err, AG_ERR_INVALID, 0,
-                            "If-Match must hold one ETag, the model's current version");
-    *version = v;
-    return AG_OK;
+    if (p[0] == '*') {
+        const char *q = p + 1;
+        while (*q == ' ' || *q == '\t')
+            q++;
+        if (*q == '\0') {
+            m->any = 1;
+            return AG_OK;
+        }
+    }
+    for (;;) {
+        int strong;
+        const char *opaque;
+        size_t len;
+        if (!read_etag(&p, &strong, &opaque, &len))
+            return ag_error_set(err, AG_ERR_INVALID, 0,
+                                "If-Match must be \"*\" or entity tags such as \"3\" (the model's "
+                                "ETag)");
+        m->tags++;
+        /* only a strong tag of digits can be a version (a weak tag never matches If-Match) */
+        int digits = strong && len > 0 && len <= 18 && opaque[0] != '0';
+        for (size_t i = 0; digits && i < len; i++)
+            digits = opaque[i] >= '0' && opaque[i] <= '9';
+        if (digits && m->n < sizeof m->versions / sizeof m->versions[0])
+            m->versions[m->n++] = strtoll(opaque, NULL, 10);
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (*p == '\0')
+            return AG_OK;
+        if (*p++ != ',')
+            return ag_error_set(err, AG_ERR_INVALID, 0,
+                                "If-Match holds entity tags separated by commas");
+        while (*p == ' ' || *p == '\t' || *p == ',')
+            p++;
+    }
+}
+
+ag_status ag_request_if_match_check(const ag_if_match *m, const char *what, int64_t id,
+                                    int64_t current, int64_t *version, ag_error *err)
+{
+    *version = current;
+    if (m->any)
+        return AG_OK;
+    for (size_t i = 0; i < m->n; i++)
+        if (m->versions[i] == current)
+            return AG_OK;
+    *version = 0;
+    if (m->n == 1 && m->tags == 1)
+        return ag_error_set(err, AG_ERR_STALE, (long)current,
+                            "%s %lld is at version %lld, not %lld", what, (long long)id,
+                            (long long)current, (long long)m->versions[0]);
+    return ag_error_set(err, AG_ERR_STALE, (long)current,
+                        "%s %lld is at version %lld, which If-Match does not name", what,
+                        (long long)id, (long long)current);
 }

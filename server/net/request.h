@@ -4,6 +4,7 @@
 
 #include <jansson.h>
 #include <microhttpd.h>
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -14,16 +15,41 @@
 struct ag_route;
 struct ag_upload;
 
+struct ag_ratelimit;
+struct ag_connguard;
+struct ag_request;
+
+/* Writes the key a request's rate limits are counted under into buf (len bytes). */
+typedef void (*ag_rate_key_fn)(struct ag_request *r, char *buf, size_t len);
+
 typedef struct {
     ag_app *app;
     size_t max_body;     /* uploads */
     size_t max_json;     /* JSON request bodies */
     int ws_port;
     const char *web_dir; /* NULL: no client served */
+    struct ag_ratelimit *rest_limit, *job_limit; /* NULL: none */
+    ag_rate_key_fn rate_key;                     /* NULL: ag_request_address_key */
+    struct ag_connguard *guard;
+    atomic_size_t *abandoned; /* deferred requests whose client went away first: their work
+                                 was skipped or stopped */
     int no_auth;         /* everyone is the local admin (loopback only) */
     const char *const *cors; /* origins allowed to call the API from a browser ("*": any) */
     int ncors;
 } ag_http_config;
+
+/* The answer a deferred request's work made on a task worker (net/defer.h), sent by the
+ * HTTP thread when the connection resumes. */
+typedef struct {
+    int ready;
+    ag_status problem;        /* != AG_OK: answer this problem */
+    ag_error err;
+    unsigned status;
+    const char *content_type; /* a string constant */
+    void *body;               /* malloc'd */
+    size_t len;
+    char etag[48];
+} ag_defer_answer;
 
 typedef struct ag_request {
     const ag_http_config *cfg;
@@ -46,6 +72,13 @@ typedef struct ag_request {
     ag_status body_status;   /* set when receiving the body failed */
     ag_error body_err;
     size_t discarded;        /* bytes of a rejected body dropped so far */
+    /* work deferred to a task lane (net/defer.h) */
+    int deferred;            /* the connection is suspended while a task works for it */
+    int fd;                  /* its socket, to see whether the client is still there */
+    void (*work)(struct ag_request *r, ag_task_budget *budget);
+    void *work_input;                  /* what the handler parsed for its work, */
+    void (*work_input_free)(void *);   /* freed with the request */
+    ag_defer_answer answer;
     /* headers for the reply, added by handlers */
     struct {
         char name[32];
@@ -81,6 +114,13 @@ void ag_request_fresh_cid(const char *prefix, char *buf, size_t len);
 /* Does If-None-Match name etag (or "*")? Weak tags ("W/") match by their opaque part. */
 int ag_request_none_match(ag_request *r, const char *etag);
 
+/* "addr:<the client's IP address>" into buf: the default rate-limit key. */
+void ag_request_address_key(ag_request *r, char *buf, size_t len);
+/* The key r's rate limits count under: cfg->rate_key when set, else "user:<id>" once the
+ * request is signed in (job submissions are counted after that), else the address (REST
+ * requests are counted before it, so a flood of bad tokens is limited too). */
+void ag_request_rate_key(ag_request *r, char *buf, size_t len);
+
 /* Query parameter or NULL. */
 const char *ag_request_query(ag_request *r, const char *name);
 /* A decimal query parameter within [lo, hi]; absent gives def; AG_ERR_INVALID naming it. */
@@ -90,8 +130,21 @@ const char *ag_request_header(ag_request *r, const char *name);
 /* The body parsed as a JSON object; AG_ERR_INVALID with the parse position otherwise. */
 ag_status ag_request_json(ag_request *r, json_t **out, ag_error *err);
 
-/* Preconditions: parses If-Match into *version (quoted or bare digits; "*" gives -1).
- * AG_ERR_PRECONDITION_REQUIRED when the header is absent, AG_ERR_INVALID when malformed. */
-ag_status ag_request_if_match(ag_request *r, int64_t *version, ag_error *err);
+/* Preconditions (RFC 9110 If-Match): "*", or a list of entity tags of which the strong ones
+ * made of digits name versions ("3"; bare digits are taken too). */
+typedef struct {
+    int any;             /* "*" */
+    size_t n;            /* versions named */
+    int64_t versions[16];
+    size_t tags;         /* entity tags in the list, versions or not */
+} ag_if_match;
+/* AG_ERR_PRECONDITION_REQUIRED when the header is absent, AG_ERR_INVALID when it is not
+ * "*" or a list of entity tags. */
+ag_status ag_request_if_match(ag_request *r, ag_if_match *m, ag_error *err);
+/* *version = current when m matches the resource (`what` id: "model 7", "part 3") at
+ * `current`, else AG_ERR_STALE (the current version in err->element), whatever the tags'
+ * text ("stale-0" is well-formed and stale). */
+ag_status ag_request_if_match_check(const ag_if_match *m, const char *what, int64_t id,
+                                    int64_t current, int64_t *version, ag_error *err);
 
 #endif

@@ -7,66 +7,74 @@
 #define NONE AG_BODY_NONE
 #define JSON AG_BODY_JSON
 #define UPLOAD AG_BODY_UPLOAD
+#define JOB AG_ROUTE_SUBMITS_JOB
 
 const ag_route ag_routes[] = {
-    /* method  pattern                                handler                      body    need */
-    {"GET", "/api/v1/health", ag_api_health, NONE, AG_NEED_NOTHING},
-    {"GET", "/api/v1/openapi.json", ag_api_openapi, NONE, AG_NEED_NOTHING},
+    /* method  pattern  handler  body  need  flags */
+    {"GET", "/api/v1/health", ag_api_health, NONE, AG_NEED_NOTHING, 0},
+    {"GET", "/api/v1/openapi.json", ag_api_openapi, NONE, AG_NEED_NOTHING, 0},
     /* the models the caller may see */
-    {"GET", "/api/v1/models", ag_api_models_list, NONE, AG_NEED_ACCOUNT},
-    {"POST", "/api/v1/models", ag_api_models_create, UPLOAD, AG_NEED_EDITOR},
-    {"GET", "/api/v1/models/{id}", ag_api_model_get, NONE, AG_NEED_MODEL_VIEWER},
-    {"PATCH", "/api/v1/models/{id}", ag_api_model_patch, JSON, AG_NEED_MODEL_EDITOR},
-    {"DELETE", "/api/v1/models/{id}", ag_api_model_delete, NONE, AG_NEED_MODEL_OWNER},
+    {"GET", "/api/v1/models", ag_api_models_list, NONE, AG_NEED_ACCOUNT, 0},
+    {"POST", "/api/v1/models", ag_api_models_create, UPLOAD, AG_NEED_EDITOR, JOB},
+    {"GET", "/api/v1/models/{id}", ag_api_model_get, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"PATCH", "/api/v1/models/{id}", ag_api_model_patch, JSON, AG_NEED_MODEL_EDITOR, 0},
+    {"DELETE", "/api/v1/models/{id}", ag_api_model_delete, NONE, AG_NEED_MODEL_OWNER, 0},
     /* label and split-tree node per component once the model is proceduralized */
-    {"GET", "/api/v1/models/{id}/mesh.glb", ag_api_model_mesh_glb, NONE, AG_NEED_MODEL_VIEWER},
-    {"GET", "/api/v1/models/{id}/ops", ag_api_model_ops_list, NONE, AG_NEED_MODEL_VIEWER},
-    {"POST", "/api/v1/models/{id}/ops", ag_api_model_ops_create, JSON, AG_NEED_MODEL_EDITOR},
+    {"GET", "/api/v1/models/{id}/mesh.glb", ag_api_model_mesh_glb, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"GET", "/api/v1/models/{id}/ops", ag_api_model_ops_list, NONE, AG_NEED_MODEL_VIEWER, 0},
+    {"POST", "/api/v1/models/{id}/ops", ag_api_model_ops_create, JSON, AG_NEED_MODEL_EDITOR, 0},
     {"POST", "/api/v1/models/{id}/proceduralize", ag_api_model_proceduralize, JSON,
-     AG_NEED_MODEL_EDITOR},
-    {"GET", "/api/v1/models/{id}/tree", ag_api_model_tree, NONE, AG_NEED_MODEL_VIEWER},
-    {"GET", "/api/v1/models/{id}/grammar", ag_api_model_grammar_get, NONE, AG_NEED_MODEL_VIEWER},
+     AG_NEED_MODEL_EDITOR, JOB},
+    {"GET", "/api/v1/models/{id}/tree", ag_api_model_tree, NONE, AG_NEED_MODEL_VIEWER, 0},
+    /* point cloud models (api_points.c): their points, a budget of them to view, segmenting */
+    {"GET", "/api/v1/models/{id}/points.ply", ag_api_model_points_ply, NONE, AG_NEED_MODEL_VIEWER,
+     0},
+    {"GET", "/api/v1/models/{id}/points.glb", ag_api_model_points_glb, NONE, AG_NEED_MODEL_VIEWER,
+     0},
+    {"POST", "/api/v1/models/{id}/segment", ag_api_model_segment, JSON, AG_NEED_MODEL_EDITOR, JOB},
+    {"GET", "/api/v1/models/{id}/grammar", ag_api_model_grammar_get, NONE, AG_NEED_MODEL_VIEWER, 0},
     /* spooled like an upload; api_grammar.c takes at most 8 MiB of it */
-    {"PUT", "/api/v1/models/{id}/grammar", ag_api_model_grammar_put, UPLOAD, AG_NEED_MODEL_EDITOR},
+    {"PUT", "/api/v1/models/{id}/grammar", ag_api_model_grammar_put, UPLOAD,
+     AG_NEED_MODEL_EDITOR, 0},
     /* who may use the model */
-    {"GET", "/api/v1/models/{id}/members", ag_api_model_members, NONE, AG_NEED_MODEL_VIEWER},
+    {"GET", "/api/v1/models/{id}/members", ag_api_model_members, NONE, AG_NEED_MODEL_VIEWER, 0},
     {"PUT", "/api/v1/models/{id}/members/{name}", ag_api_model_member_put, JSON,
-     AG_NEED_MODEL_OWNER},
+     AG_NEED_MODEL_OWNER, 0},
     {"DELETE", "/api/v1/models/{id}/members/{name}", ag_api_model_member_delete, NONE,
-     AG_NEED_MODEL_OWNER},
-    {"PUT", "/api/v1/models/{id}/public", ag_api_model_public_put, JSON, AG_NEED_MODEL_OWNER},
+     AG_NEED_MODEL_OWNER, 0},
+    {"PUT", "/api/v1/models/{id}/public", ag_api_model_public_put, JSON, AG_NEED_MODEL_OWNER, 0},
     /* a building description or GeoJSON footprints, spooled like model uploads */
-    {"POST", "/api/v1/extrusions", ag_api_extrusions_create, UPLOAD, AG_NEED_EDITOR},
+    {"POST", "/api/v1/extrusions", ag_api_extrusions_create, UPLOAD, AG_NEED_EDITOR, JOB},
     /* stores nothing: editors of a shared extrusion model preview their plan edits */
-    {"POST", "/api/v1/extrusions/preview", ag_api_extrusions_preview, JSON, AG_NEED_ACCOUNT},
-    {"GET", "/api/v1/models/{id}/plan", ag_api_model_plan, NONE, AG_NEED_MODEL_VIEWER},
+    {"POST", "/api/v1/extrusions/preview", ag_api_extrusions_preview, JSON, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/models/{id}/plan", ag_api_model_plan, NONE, AG_NEED_MODEL_VIEWER, 0},
     /* what the client needs to select and compose (api_parts.c); composing is an op */
-    {"GET", "/api/v1/models/{id}/selection", ag_api_model_selection, NONE, AG_NEED_MODEL_VIEWER},
+    {"GET", "/api/v1/models/{id}/selection", ag_api_model_selection, NONE, AG_NEED_MODEL_VIEWER, 0},
     {"POST", "/api/v1/models/{id}/compose-preview", ag_api_model_compose_preview, JSON,
-     AG_NEED_MODEL_EDITOR},
+     AG_NEED_MODEL_EDITOR, 0},
     /* the shared parts library: every account reads it, editors write it; bundles are spooled
      * like uploads */
-    {"GET", "/api/v1/parts", ag_api_parts_list, NONE, AG_NEED_ACCOUNT},
-    {"POST", "/api/v1/parts", ag_api_parts_create, JSON, AG_NEED_EDITOR},
-    {"POST", "/api/v1/parts:import", ag_api_parts_import, UPLOAD, AG_NEED_EDITOR},
-    {"GET", "/api/v1/parts:export", ag_api_parts_export, NONE, AG_NEED_ACCOUNT},
-    {"GET", "/api/v1/parts/{id}", ag_api_part_get, NONE, AG_NEED_ACCOUNT},
-    {"DELETE", "/api/v1/parts/{id}", ag_api_part_delete, NONE, AG_NEED_EDITOR},
-    {"POST", "/api/v1/parts/{id}/versions", ag_api_part_versions_create, JSON, AG_NEED_EDITOR},
-    {"GET", "/api/v1/parts/{id}/thumbnail.png", ag_api_part_thumbnail, NONE, AG_NEED_ACCOUNT},
-    {"GET", "/api/v1/parts/{id}/mesh.glb", ag_api_part_mesh_glb, NONE, AG_NEED_ACCOUNT},
-    {"GET", "/api/v1/parts/{id}/bundle", ag_api_part_bundle, NONE, AG_NEED_ACCOUNT},
-    {"GET", "/api/v1/jobs/{id}", ag_api_job_get, NONE, AG_NEED_JOB},
-    {"DELETE", "/api/v1/jobs/{id}", ag_api_job_cancel, NONE, AG_NEED_JOB},
+    {"GET", "/api/v1/parts", ag_api_parts_list, NONE, AG_NEED_ACCOUNT, 0},
+    {"POST", "/api/v1/parts", ag_api_parts_create, JSON, AG_NEED_EDITOR, 0},
+    {"POST", "/api/v1/parts:import", ag_api_parts_import, UPLOAD, AG_NEED_EDITOR, 0},
+    {"GET", "/api/v1/parts:export", ag_api_parts_export, NONE, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/parts/{id}", ag_api_part_get, NONE, AG_NEED_ACCOUNT, 0},
+    {"DELETE", "/api/v1/parts/{id}", ag_api_part_delete, NONE, AG_NEED_EDITOR, 0},
+    {"POST", "/api/v1/parts/{id}/versions", ag_api_part_versions_create, JSON, AG_NEED_EDITOR, 0},
+    {"GET", "/api/v1/parts/{id}/thumbnail.png", ag_api_part_thumbnail, NONE, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/parts/{id}/mesh.glb", ag_api_part_mesh_glb, NONE, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/parts/{id}/bundle", ag_api_part_bundle, NONE, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/jobs/{id}", ag_api_job_get, NONE, AG_NEED_JOB, 0},
+    {"DELETE", "/api/v1/jobs/{id}", ag_api_job_cancel, NONE, AG_NEED_JOB, 0},
     /* the caller's own account and tokens */
-    {"GET", "/api/v1/me", ag_api_me, NONE, AG_NEED_ACCOUNT},
-    {"GET", "/api/v1/me/tokens", ag_api_me_tokens_list, NONE, AG_NEED_ACCOUNT},
-    {"POST", "/api/v1/me/tokens", ag_api_me_tokens_create, JSON, AG_NEED_ACCOUNT},
-    {"DELETE", "/api/v1/me/tokens/{id}", ag_api_me_token_delete, NONE, AG_NEED_ACCOUNT},
+    {"GET", "/api/v1/me", ag_api_me, NONE, AG_NEED_ACCOUNT, 0},
+    {"GET", "/api/v1/me/tokens", ag_api_me_tokens_list, NONE, AG_NEED_ACCOUNT, 0},
+    {"POST", "/api/v1/me/tokens", ag_api_me_tokens_create, JSON, AG_NEED_ACCOUNT, 0},
+    {"DELETE", "/api/v1/me/tokens/{id}", ag_api_me_token_delete, NONE, AG_NEED_ACCOUNT, 0},
     /* accounts, for admins */
-    {"GET", "/api/v1/users", ag_api_users_list, NONE, AG_NEED_ADMIN},
-    {"POST", "/api/v1/users", ag_api_users_create, JSON, AG_NEED_ADMIN},
-    {"POST", "/api/v1/users/{name}/tokens", ag_api_user_tokens_create, JSON, AG_NEED_ADMIN},
+    {"GET", "/api/v1/users", ag_api_users_list, NONE, AG_NEED_ADMIN, 0},
+    {"POST", "/api/v1/users", ag_api_users_create, JSON, AG_NEED_ADMIN, 0},
+    {"POST", "/api/v1/users/{name}/tokens", ag_api_user_tokens_create, JSON, AG_NEED_ADMIN, 0},
 };
 const size_t ag_routes_count = sizeof ag_routes / sizeof ag_routes[0];
 

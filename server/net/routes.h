@@ -16,12 +16,17 @@ typedef enum {
     AG_BODY_UPLOAD, /* spooled to a file up to cfg->max_body */
 } ag_body_kind;
 
+enum {
+    AG_ROUTE_SUBMITS_JOB = 1u << 0, /* counted against the job-submission rate limit */
+};
+
 typedef struct ag_route {
     const char *method;
     const char *pattern;
     ag_handler handler;
     ag_body_kind body;
     ag_need need; /* of the caller: a token, an account role, a role on the model of {id} */
+    unsigned flags;
 } ag_route;
 
 extern const ag_route ag_routes[];
@@ -51,6 +56,9 @@ enum MHD_Result ag_api_model_ops_create(ag_request *r);
 enum MHD_Result ag_api_model_mesh_glb(ag_request *r);
 enum MHD_Result ag_api_model_proceduralize(ag_request *r);
 enum MHD_Result ag_api_model_tree(ag_request *r);
+enum MHD_Result ag_api_model_points_ply(ag_request *r);
+enum MHD_Result ag_api_model_points_glb(ag_request *r);
+enum MHD_Result ag_api_model_segment(ag_request *r);
 enum MHD_Result ag_api_model_grammar_get(ag_request *r);
 enum MHD_Result ag_api_model_grammar_put(ag_request *r);
 enum MHD_Result ag_api_extrusions_create(ag_request *r);
@@ -86,6 +94,8 @@ enum MHD_Result ag_api_model_public_put(ag_request *r);
 /* Shared by the handlers (api_models.c): a model's view with its ETag; the If-Match version
  * of a change ("*" = the current one; not required: 0 when absent). */
 enum MHD_Result ag_api_reply_model(ag_request *r, int64_t id, unsigned status);
+/* The same as the answer of deferred work (net/defer.h). */
+void ag_api_answer_model(ag_request *r, int64_t id, unsigned status);
 ag_status ag_api_precondition(ag_request *r, int required, int64_t *version, ag_error *err);
 
 #endif

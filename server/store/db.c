@@ -1,5 +1,6 @@
 #include "db.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -52,6 +53,18 @@ ag_status ag_db_open(const char *path, const ag_db_options *opt, ag_db **out, ag
         s = exec(db, "PRAGMA foreign_keys = ON", err);
     if (s == AG_OK)
         s = exec(db, "PRAGMA synchronous = NORMAL", err);
+    if (s == AG_OK && opt && opt->max_bytes) {
+        sqlite3_stmt *st = NULL;
+        long long page = 4096;
+        if (sqlite3_prepare_v2(db->handle, "PRAGMA page_size", -1, &st, NULL) == SQLITE_OK &&
+            sqlite3_step(st) == SQLITE_ROW)
+            page = sqlite3_column_int64(st, 0);
+        sqlite3_finalize(st);
+        char sql[64];
+        snprintf(sql, sizeof sql, "PRAGMA max_page_count = %lld",
+                 (long long)(opt->max_bytes / (size_t)(page > 0 ? page : 4096)) + 1);
+        s = exec(db, sql, err);
+    }
     if (s == AG_OK) {
         if (opt && opt->no_migrate) {
             int v = ag_migrate_user_version(db->handle);
@@ -89,9 +102,15 @@ int ag_db_schema_version(ag_db *db) { return ag_migrate_user_version(db->handle)
 
 ag_status ag_db_fail(ag_db *db, ag_error *err, const char *doing)
 {
-    int code = sqlite3_extended_errcode(db->handle);
-    ag_status s = (code & 0xff) == SQLITE_BUSY || (code & 0xff) == SQLITE_LOCKED ? AG_ERR_BUSY
-                                                                                  : AG_ERR_DB;
+    int code = sqlite3_extended_errcode(db->handle) & 0xff;
+    ag_status s = AG_ERR_DB;
+    if (code == SQLITE_BUSY || code == SQLITE_LOCKED)
+        s = AG_ERR_BUSY;
+    else if (code == SQLITE_FULL)
+        s = AG_ERR_STORAGE_FULL;
+    else if (code == SQLITE_IOERR || code == SQLITE_CANTOPEN || code == SQLITE_READONLY ||
+             code == SQLITE_CORRUPT || code == SQLITE_NOTADB || code == SQLITE_PROTOCOL)
+        s = AG_ERR_STORE_UNAVAILABLE;
     return ag_error_set(err, s, 0, "%s: %s", doing, sqlite3_errmsg(db->handle));
 }
 

@@ -16,6 +16,8 @@ typedef struct ag_db ag_db;
 typedef struct {
     int busy_timeout_ms; /* 0 = 10000 */
     int no_migrate;      /* 1: open an existing schema as it is (still refuses a newer one) */
+    size_t max_bytes;    /* the file may grow to about this size (PRAGMA max_page_count);
+                            0: no limit. Writes past it fail with AG_ERR_STORAGE_FULL */
 } ag_db_options;
 
 ag_status ag_db_open(const char *path, const ag_db_options *opt, ag_db **out, ag_error *err);
@@ -29,8 +31,10 @@ ag_status ag_db_begin(ag_db *db, ag_error *err);
 ag_status ag_db_commit(ag_db *db, ag_error *err);
 void ag_db_rollback(ag_db *db);
 
-/* Turns the connection's last SQLite error into AG_ERR_DB (or AG_ERR_BUSY for a lock
- * timeout) with the message and what was being done. */
+/* Turns the connection's last SQLite error into a status with the message and what was
+ * being done: AG_ERR_BUSY for a lock timeout, AG_ERR_STORAGE_FULL when the disk or the
+ * configured size is full, AG_ERR_STORE_UNAVAILABLE for I/O errors and a file that cannot be
+ * read or written, AG_ERR_DB otherwise. */
 ag_status ag_db_fail(ag_db *db, ag_error *err, const char *doing);
 
 /* Prepares (and caches per connection) a statement; NULL with err filled on failure.

@@ -83,11 +83,12 @@ ag_status ag_extrusions_put_building(ag_db *db, const ag_extrusion_building *b, 
     ag_status s = ag_db_prepared(
         db, &st,
         "INSERT INTO extrusion_buildings "
-        "(model_id, building, footprint, plan, mesh, triangles, status, reason) "
-        "VALUES (?, ?, ?, ?, ?, ?, ?, ?) "
+        "(model_id, building, footprint, plan, mesh, triangles, status, reason, fallback, moved) "
+        "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?) "
         "ON CONFLICT (model_id, building) DO UPDATE SET footprint = excluded.footprint, "
         "plan = excluded.plan, mesh = excluded.mesh, triangles = excluded.triangles, "
-        "status = excluded.status, reason = excluded.reason",
+        "status = excluded.status, reason = excluded.reason, fallback = excluded.fallback, "
+        "moved = excluded.moved",
         err);
     if (s != AG_OK)
         return s;
@@ -105,10 +106,30 @@ ag_status ag_extrusions_put_building(ag_db *db, const ag_extrusion_building *b, 
         sqlite3_bind_text(st, 8, b->reason, -1, SQLITE_STATIC);
     else
         sqlite3_bind_null(st, 8);
+    if (b->fallback)
+        sqlite3_bind_text(st, 9, b->fallback, -1, SQLITE_STATIC);
+    else
+        sqlite3_bind_null(st, 9);
+    if (b->fallback)
+        sqlite3_bind_double(st, 10, b->moved);
+    else
+        sqlite3_bind_null(st, 10);
     return ag_db_step_done(db, st, "storing a building of an extrusion", err);
 }
 
-/* Fills b from a row of SELECT building, footprint, triangles, status, reason, plan, mesh. */
+/* The stored fallback name as static text (the table's CHECK allows these only). */
+static const char *fallback_name(sqlite3_stmt *st, int col)
+{
+    static const char *const names[] = {"simplified", "flat", "block"};
+    const char *v = (const char *)sqlite3_column_text(st, col);
+    for (size_t i = 0; v && i < sizeof names / sizeof *names; i++)
+        if (strcmp(v, names[i]) == 0)
+            return names[i];
+    return NULL;
+}
+
+/* Fills b from a row of SELECT building, footprint, triangles, status, reason, plan, mesh,
+ * fallback, moved. */
 static int read_building(sqlite3_stmt *st, int64_t model, unsigned what, ag_extrusion_building *b)
 {
     memset(b, 0, sizeof *b);
@@ -131,6 +152,8 @@ static int read_building(sqlite3_stmt *st, int64_t model, unsigned what, ag_extr
             bad = 1;
         }
     }
+    b->fallback = fallback_name(st, 7);
+    b->moved = sqlite3_column_double(st, 8);
     if (!b->footprint)
         bad = 1;
     if (bad)
@@ -140,7 +163,7 @@ static int read_building(sqlite3_stmt *st, int64_t model, unsigned what, ag_extr
 
 #define BUILDING_COLUMNS                                                                        \
     "SELECT building, footprint, triangles, status, reason, CASE WHEN ? THEN plan END, "        \
-    "CASE WHEN ? THEN mesh END FROM extrusion_buildings WHERE model_id = ? "
+    "CASE WHEN ? THEN mesh END, fallback, moved FROM extrusion_buildings WHERE model_id = ? "
 
 ag_status ag_extrusions_get_building(ag_db *db, int64_t model, int64_t building, unsigned what,
                                      ag_extrusion_building *b, ag_error *err)

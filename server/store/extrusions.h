@@ -29,8 +29,13 @@ typedef struct {
     void *mesh;        /* meshblob of this building; NULL when it failed */
     size_t mesh_len;
     int64_t triangles;
-    char status[16];   /* ok | not_watertight | failed */
-    char *reason;      /* NULL when ok */
+    char status[16];   /* ok | failed (| not_watertight in rows of older versions) */
+    char *reason;      /* NULL when built as described */
+    /* what was built instead of the description's building: "simplified" | "flat" |
+     * "block", or NULL (as described, or failed); borrowed when writing, static text when
+     * read */
+    const char *fallback;
+    double moved;      /* a simplified footprint's boundary moved up to this far (m) */
 } ag_extrusion_building;
 
 /* Frees what ag_extrusions_get_building / _each_building filled in. */

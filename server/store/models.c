@@ -258,6 +258,23 @@ ag_status ag_models_set_name(ag_db *db, int64_t id, const char *name, ag_error *
     return ag_db_step_done(db, st, "renaming a model", err);
 }
 
+ag_status ag_models_set_stats(ag_db *db, int64_t id, const char *stats_json, ag_error *err)
+{
+    sqlite3_stmt *st = ag_db_prepare(
+        db,
+        "UPDATE models SET stats = ?, updated_at = strftime('%Y-%m-%dT%H:%M:%fZ', 'now') "
+        "WHERE id = ?",
+        err);
+    if (!st)
+        return err ? err->code : AG_ERR_DB;
+    sqlite3_bind_text(st, 1, stats_json ? stats_json : "{}", -1, SQLITE_STATIC);
+    sqlite3_bind_int64(st, 2, id);
+    ag_status s = ag_db_step_done(db, st, "describing a model", err);
+    if (s == AG_OK && sqlite3_changes(ag_db_handle(db)) == 0)
+        s = ag_error_set(err, AG_ERR_NOT_FOUND, 0, "there is no model %lld", (long long)id);
+    return s;
+}
+
 ag_status ag_models_set_public_read(ag_db *db, int64_t id, int on, ag_error *err)
 {
     sqlite3_stmt *st = ag_db_prepare(db, "UPDATE models SET public_read = ? WHERE id = ?", err);

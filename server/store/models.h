@@ -59,6 +59,10 @@ ag_status ag_models_set_public_read(ag_db *db, int64_t id, int on, ag_error *err
  * AG_ERR_NOT_FOUND when there is no such model. Inside the caller's transaction. */
 ag_status ag_models_set_mesh(ag_db *db, int64_t id, const void *mesh, size_t mesh_len,
                              const char *stats_json, int64_t *blob, ag_error *err);
+/* Replaces the model's stats JSON (NULL = "{}"), e.g. a point cloud's figures after a
+ * segmentation. AG_ERR_NOT_FOUND when there is no such model. Inside the caller's
+ * transaction. */
+ag_status ag_models_set_stats(ag_db *db, int64_t id, const char *stats_json, ag_error *err);
 /* Deletes when the version is `version` (AG_ERR_STALE otherwise); its blobs and ops go too. */
 ag_status ag_models_delete(ag_db *db, int64_t id, int64_t version, ag_error *err);
 

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "grammars.h"
+#include "pointclouds.h"
 
 void ag_states_row_clear(ag_state_row *row)
 {
@@ -34,7 +35,9 @@ ag_status ag_states_keep(ag_db *db, int64_t model, int64_t version, ag_error *er
         return s;
     sqlite3_bind_int64(st, 1, version);
     sqlite3_bind_int64(st, 2, model);
-    return ag_db_step_done(db, st, "keeping a model version's state", err);
+    s = ag_db_step_done(db, st, "keeping a model version's state", err);
+    /* a point cloud's segmentation is part of its state */
+    return s == AG_OK ? ag_pointclouds_states_keep(db, model, version, err) : s;
 }
 
 /* The first op after `from` up to `to` that changes geometry: its version, or 0. */
@@ -139,6 +142,8 @@ ag_status ag_states_restore(ag_db *db, int64_t model, int64_t version, const ag_
         return s;
     if (sqlite3_changes(ag_db_handle(db)) == 0)
         return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "there is no model %lld", (long long)model);
+    if ((s = ag_pointclouds_states_restore(db, model, row->version, err)) != AG_OK)
+        return s;
     if (!row->grammar)
         return AG_OK; /* the grammar no longer describes the mesh: not proceduralized then */
     ag_grammar_new g = {.model = model,

@@ -1,6 +1,7 @@
 /* The model_states table (migration 0004): the mesh file, stats, grammar, split tree and
- * summary of model versions, written around structural edits and restores so undo, redo and
- * restoring an old version bring back exactly that version's state.
+ * summary of model versions (and a point cloud's segmentation, store/pointclouds.h), written
+ * around structural edits and restores so undo, redo and restoring an old version bring back
+ * exactly that version's state.
  *
  * Every call runs inside the caller's transaction (ag_db_begin). */
 #ifndef AG_STATES_H

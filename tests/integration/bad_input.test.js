@@ -63,8 +63,9 @@ describe('bad input', () => {
   });
 
   it('an unknown format → 415 problem+json', async () => {
-    const r = await http(d, 'POST', '/api/v1/models?name=u&format=xyz', { body: fixture('two_boxes.obj') });
-    assertProblem(r, 415, 'unsupported', 'format=xyz');
+    // (xyz, once unknown here, is a point cloud format now)
+    const r = await http(d, 'POST', '/api/v1/models?name=u&format=dwg', { body: fixture('two_boxes.obj') });
+    assertProblem(r, 415, 'unsupported', 'format=dwg');
   });
 
   it('after shutdown the database holds no model and is intact', async () => {

@@ -6,112 +6,12 @@ import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { REPO, tempDir, removeDir } from './harness.js';
+import { boxCloud, planesFound, readPly, rng, writePly } from './clouds.js';
 
 const CLI = process.env.ARCHGRAM ? path.resolve(process.env.ARCHGRAM) : path.join(REPO, 'build', 'archgram');
 const POINTS = path.join(REPO, 'tests', 'data', 'points');
 const SHARED = path.join(REPO, '..', 'shared', 'data');
 const run = (...args) => spawnSync(CLI, args, { encoding: 'utf8', timeout: 60000 });
-
-const TYPES = {
-  char: ['getInt8', 1], uchar: ['getUint8', 1], short: ['getInt16', 2], ushort: ['getUint16', 2],
-  int: ['getInt32', 4], uint: ['getUint32', 4], float: ['getFloat32', 4], double: ['getFloat64', 8],
-  int8: ['getInt8', 1], uint8: ['getUint8', 1], int16: ['getInt16', 2], uint16: ['getUint16', 2],
-  int32: ['getInt32', 4], uint32: ['getUint32', 4], float32: ['getFloat32', 4], float64: ['getFloat64', 8],
-};
-
-// The vertex element of a binary little-endian PLY without lists: { comments, props: {name: [values]} }.
-function readPly(file) {
-  const buf = fs.readFileSync(file);
-  const end = buf.indexOf('end_header\n');
-  const header = buf.toString('latin1', 0, end).split('\n');
-  assert.equal(header[0], 'ply');
-  assert.match(header[1], /binary_little_endian/);
-  let n = 0;
-  const props = [];
-  const comments = [];
-  for (const line of header) {
-    const t = line.trim().split(/\s+/);
-    if (t[0] === 'element' && t[1] === 'vertex') n = Number(t[2]);
-    if (t[0] === 'property') props.push([t[2], t[1]]);
-    if (t[0] === 'comment') comments.push(t.slice(1).join(' '));
-  }
-  const view = new DataView(buf.buffer, buf.byteOffset + end + 11);
-  const out = Object.fromEntries(props.map(([name]) => [name, new Array(n)]));
-  let at = 0;
-  for (let i = 0; i < n; i++) {
-    for (const [name, type] of props) {
-      const [get, size] = TYPES[type];
-      out[name][i] = view[get](at, true);
-      at += size;
-    }
-  }
-  return { n, comments, props: out, types: Object.fromEntries(props) };
-}
-
-// A binary PLY from columns: [[name, type, values], ...].
-function writePly(file, columns, comments = []) {
-  const n = columns[0][2].length;
-  let header = 'ply\nformat binary_little_endian 1.0\n';
-  for (const c of comments) header += `comment ${c}\n`;
-  header += `element vertex ${n}\n`;
-  for (const [name, type] of columns) header += `property ${type} ${name}\n`;
-  header += 'end_header\n';
-  const row = columns.reduce((s, [, type]) => s + TYPES[type][1], 0);
-  const body = new DataView(new ArrayBuffer(row * n));
-  let at = 0;
-  for (let i = 0; i < n; i++) {
-    for (const [, type, values] of columns) {
-      const [get, size] = TYPES[type];
-      body['set' + get.slice(3)](at, values[i], true);
-      at += size;
-    }
-  }
-  fs.writeFileSync(file, Buffer.concat([Buffer.from(header, 'latin1'), Buffer.from(body.buffer)]));
-}
-
-// A deterministic pseudo-random generator (tests must not depend on Math.random).
-function rng(seed) {
-  let s = seed >>> 0;
-  return () => ((s = (Math.imul(s, 1664525) + 1013904223) >>> 0) / 4294967296);
-}
-
-// A 12 x 8 x 6 m box without floor sampled on its 5 faces; `plane` is the face.
-function boxCloud(n, origin = [0, 0, 0]) {
-  const r = rng(7);
-  const x = [], y = [], z = [], plane = [], cls = [];
-  const faces = [
-    (u, v) => [u * 12, 0, v * 6], (u, v) => [12, u * 8, v * 6], (u, v) => [u * 12, 8, v * 6],
-    (u, v) => [0, u * 8, v * 6], (u, v) => [u * 12, v * 8, 6],
-  ];
-  for (let i = 0; i < n; i++) {
-    const f = i % 5;
-    const p = faces[f](r(), r());
-    x.push(p[0] + origin[0]); y.push(p[1] + origin[1]); z.push(p[2] + origin[2] + (r() - 0.5) * 0.01);
-    plane.push(f); cls.push(6);
-  }
-  return { x, y, z, plane, cls };
-}
-
-function planesFound(truth, seg) {
-  const tsize = new Map(), ssize = new Map(), pair = new Map();
-  for (let i = 0; i < truth.length; i++) {
-    if (truth[i] >= 0) tsize.set(truth[i], (tsize.get(truth[i]) || 0) + 1);
-    if (seg[i] < 0) continue;
-    ssize.set(seg[i], (ssize.get(seg[i]) || 0) + 1);
-    const k = `${truth[i]}/${seg[i]}`;
-    pair.set(k, (pair.get(k) || 0) + 1);
-  }
-  let found = 0;
-  for (const [t, size] of tsize) {
-    let best = 0, bs = -1;
-    for (const [k, c] of pair) {
-      const [tt, s] = k.split('/').map(Number);
-      if (tt === t && c > best) { best = c; bs = s; }
-    }
-    if (bs >= 0 && best >= 0.5 * size && best >= 0.8 * ssize.get(bs)) found++;
-  }
-  return found;
-}
 
 test('segment writes every input point in order with segment, label and the input properties', () => {
   const dir = tempDir();

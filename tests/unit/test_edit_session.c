@@ -217,7 +217,7 @@ static void one_numbering_survives_every_reload(void **state)
         long col = 0;
         assert_int_equal(ag_model_state_from_text(folder.text, folder.text_len,
                                                   ag_terminals_set_lookup, &folder.terms,
-                                                  &reread, &err, &col),
+                                                  NULL, &reread, &err, &col),
                          AG_OK);
         tree = ag_model_tree_served_text(folder.em);
         again = ag_model_tree_served_text(reread.em);

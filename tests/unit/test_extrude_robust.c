@@ -573,6 +573,60 @@ static void test_batch_budget_falls_back(void **state)
     ag_footprints_free(f);
 }
 
+/* A building description through ag_building_extrude_plan: a good plan is built as
+ * described; one over its budget falls back to a flat roof at its wall height (checked on
+ * its triangles: closed 2-manifold, inside the footprint, as high as the eaves); one that
+ * validation refuses builds nothing and says why. */
+static void test_plan_falls_back(void **state)
+{
+    (void)state;
+    static const double comb[] = {0, 0, 40, 0, 40, 3, 37, 3, 37, 9, 34, 9, 34, 3, 31, 3, 31, 9,
+                                  28, 9, 28, 3, 25, 3, 25, 9, 22, 9, 22, 3, 19, 3, 19, 9, 16, 9,
+                                  16, 3, 13, 3, 13, 9, 10, 9, 10, 3, 7, 3, 7, 9, 4, 9, 4, 3, 0, 3};
+    const size_t n = sizeof comb / sizeof *comb / 2;
+    const ag_profile_point hip[] = {{0, 0}, {0, 4.5}, {1, 5.5}};
+    for (int budget = 0; budget < 2; budget++) {
+        ag_plan *p = ag_plan_create();
+        assert_int_equal(ag_plan_add_profile(p, "hip", hip, 3, "roof", NULL, NULL), AG_OK);
+        assert_int_equal(ag_plan_add_loop(p, comb, n, NULL, NULL), AG_OK);
+        ag_extrude_options o = {.budget = {.max_events = budget ? 100 : 0}};
+        ag_mesh *m = ag_mesh_create();
+        ag_building_result r;
+        ag_error err = {0};
+        assert_int_equal(ag_building_extrude_plan(p, &o, m, -1, &r, &err), AG_OK);
+        char why[200];
+        if (!xc_closed_manifold(m, -1, 1e-6, why, sizeof why))
+            fail_msg("budget %d: %s", budget, why);
+        const double *loops[] = {comb};
+        assert_true(xc_outside(m, -1, loops, &n, 1, 0) < 1e-6);
+        if (budget) {
+            assert_int_equal(r.built, AG_BUILT_FLAT);
+            assert_non_null(strstr(r.reason, "event budget"));
+            assert_true(fabs(xc_top(m, -1) - 4.5) < 1e-9); /* the eaves */
+        } else {
+            assert_int_equal(r.built, AG_BUILT_STYLED);
+            assert_string_equal(r.reason, "");
+            assert_true(xc_top(m, -1) > 5);
+        }
+        assert_int_equal(r.triangles, m->ntris);
+        ag_mesh_free(m);
+        ag_plan_free(p);
+    }
+    /* a bow tie: refused, nothing built */
+    static const double bow[] = {0, 0, 10, 10, 10, 0, 0, 10};
+    ag_plan *p = ag_plan_create();
+    assert_int_equal(ag_plan_add_profile(p, "hip", hip, 3, NULL, NULL, NULL), AG_OK);
+    assert_int_equal(ag_plan_add_loop(p, bow, 4, NULL, NULL), AG_OK);
+    ag_mesh *m = ag_mesh_create();
+    ag_building_result r;
+    assert_int_equal(ag_building_extrude_plan(p, NULL, m, -1, &r, NULL), AG_OK);
+    assert_int_equal(r.built, AG_BUILT_NONE);
+    assert_non_null(strstr(r.reason, "cross"));
+    assert_int_equal(m->ntris, 0);
+    ag_mesh_free(m);
+    ag_plan_free(p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -583,6 +637,7 @@ int main(void)
         cmocka_unit_test(test_large_footprints),
         cmocka_unit_test(test_budgets),
         cmocka_unit_test(test_batch_budget_falls_back),
+        cmocka_unit_test(test_plan_falls_back),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

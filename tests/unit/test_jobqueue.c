@@ -1,6 +1,9 @@
 /* The job queue: success recorded by the job, failures and cancellations by the queue,
- * a full queue refuses, and shutdown cancels what runs; the fast lane runs tasks while a long
- * job holds every normal worker, refuses beyond its capacity and drops what waits at a stop;
+ * a full queue refuses, and shutdown cancels what runs; a job past its time budget fails as
+ * such; the task lanes run tasks while a long job holds every normal worker, refuse beyond
+ * their capacity and drop what waits at a stop; one model's tasks run in order while another
+ * model's run beside them; a task's budget runs out at its deadline and at a stop; a stop with
+ * a grace period comes back in time even when a task ignores its budget;
  * typed params are stored as the one encoding and read back the same, and an upload they name
  * is removed after the job. The queue is built from its parts, without an app. */
 #include <setjmp.h>
@@ -73,7 +76,8 @@ static const ag_job_kind bad = {.kind = "bad", .run = run_and_fail};
 /* an import that reads nothing: it only checks its params arrived typed */
 static const ag_job_kind import_probe = {.kind = "import", .run = run_and_fail};
 
-static fixture *make_queue(int workers, size_t capacity, size_t fast_capacity)
+static fixture *make_queue_ex(int workers, size_t capacity, size_t task_capacity,
+                             int task_workers, double job_seconds)
 {
     snprintf(dir, sizeof dir, "/tmp/archgram-jobs-XXXXXX");
     assert_non_null(mkdtemp(dir));
@@ -84,7 +88,8 @@ static fixture *make_queue(int workers, size_t capacity, size_t fast_capacity)
     f->events = ag_events_create();
     f->seq = ag_sequencer_create(f->events);
     ag_jobqueue_options o = {.db = f->pool, .seq = f->seq, .workers = workers,
-                             .capacity = capacity, .fast_capacity = fast_capacity};
+                             .capacity = capacity, .task_capacity = task_capacity,
+                             .task_workers = task_workers, .job_seconds = job_seconds};
     assert_non_null(f->q = ag_jobqueue_create(&o));
     ag_jobqueue_register(f->q, &slow, f->pool);
     ag_jobqueue_register(f->q, &good, f->pool);
@@ -92,6 +97,11 @@ static fixture *make_queue(int workers, size_t capacity, size_t fast_capacity)
     ag_jobqueue_register(f->q, &import_probe, f->pool);
     atomic_store(&stop_slow, 0);
     return f;
+}
+
+static fixture *make_queue(int workers, size_t capacity, size_t task_capacity)
+{
+    return make_queue_ex(workers, capacity, task_capacity, 1, 0);
 }
 
 static void drop_queue(fixture *f)
@@ -192,7 +202,7 @@ static void shutdown_cancels_running_jobs(void **state)
     assert_int_equal(ag_jobqueue_submit(f->q, "slow", NULL, &job, &err), AG_OK);
     while (!atomic_load(&started))
         usleep(1000);
-    ag_jobqueue_stop(f->q);
+    assert_int_equal(ag_jobqueue_stop(f->q, -1), 1);
     ag_job_row row;
     assert_int_equal(ag_jobs_get(ag_dbpool_get(f->pool, NULL), job, &row, NULL), AG_OK);
     assert_string_equal(row.status, "cancelled");
@@ -202,20 +212,35 @@ static void shutdown_cancels_running_jobs(void **state)
     drop_queue(f);
 }
 
-/* --- the fast lane ------------------------------------------------------------------------- */
+static void a_job_past_its_budget_fails_as_such(void **state)
+{
+    (void)state;
+    fixture *f = make_queue_ex(1, 0, 0, 1, 0.2);
+    int64_t job;
+    ag_error err;
+    assert_int_equal(ag_jobqueue_submit(f->q, "slow", NULL, &job, &err), AG_OK);
+    ag_job_row row;
+    wait_status(f, job, "failed", &row); /* 4 s if left alone */
+    assert_non_null(strstr(row.error_json, "urn:archgram:problem:deadline"));
+    assert_non_null(strstr(row.error_json, "budget of 0.2 s"));
+    ag_jobs_row_clear(&row);
+    drop_queue(f);
+}
+
+/* --- the task lanes ------------------------------------------------------------------------ */
 
 static atomic_int ran, dropped;
 static atomic_int gate; /* a blocking task waits until it is set */
 
-static void count_run(void *user)
+static void count_run(void *user, ag_task_budget *b)
 {
-    (void)user;
+    (void)user, (void)b;
     atomic_fetch_add(&ran, 1);
 }
 
-static void block_run(void *user)
+static void block_run(void *user, ag_task_budget *b)
 {
-    (void)user;
+    (void)user, (void)b;
     while (!atomic_load(&gate))
         usleep(1000);
     atomic_fetch_add(&ran, 1);
@@ -234,7 +259,7 @@ static double now_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-static void a_long_job_does_not_delay_the_fast_lane(void **state)
+static void a_long_job_does_not_delay_the_task_lanes(void **state)
 {
     (void)state;
     fixture *f = make_queue(1, 0, 0);
@@ -248,7 +273,7 @@ static void a_long_job_does_not_delay_the_fast_lane(void **state)
     /* the only normal worker runs the slow job (4 s if left alone); tasks still run */
     double t0 = now_s();
     for (int i = 0; i < 10; i++)
-        assert_int_equal(ag_jobqueue_run_fast(f->q, count_run, count_drop, NULL, &err), AG_OK);
+        assert_int_equal(ag_jobqueue_run_task(f->q, 0, 0, count_run, count_drop, NULL, &err), AG_OK);
     while (atomic_load(&ran) < 10 && now_s() - t0 < 2.0)
         usleep(1000);
     assert_int_equal(atomic_load(&ran), 10);
@@ -259,7 +284,7 @@ static void a_long_job_does_not_delay_the_fast_lane(void **state)
     drop_queue(f);
 }
 
-static void the_fast_lane_is_bounded_and_drops_at_a_stop(void **state)
+static void the_task_lanes_are_bounded_and_drop_at_a_stop(void **state)
 {
     (void)state;
     fixture *f = make_queue(1, 0, 3);
@@ -267,23 +292,165 @@ static void the_fast_lane_is_bounded_and_drops_at_a_stop(void **state)
     atomic_store(&ran, 0);
     atomic_store(&dropped, 0);
     atomic_store(&gate, 0);
-    assert_int_equal(ag_jobqueue_run_fast(f->q, block_run, count_drop, NULL, &err), AG_OK);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 0, 0, block_run, count_drop, NULL, &err), AG_OK);
     /* the blocking task is taken by the worker; three more wait, the fourth is refused */
     double t0 = now_s();
     int queued = 0;
     while (queued < 3 && now_s() - t0 < 2.0)
-        if (ag_jobqueue_run_fast(f->q, count_run, count_drop, NULL, &err) == AG_OK)
+        if (ag_jobqueue_run_task(f->q, 0, 0, count_run, count_drop, NULL, &err) == AG_OK)
             queued++;
     assert_int_equal(queued, 3);
     usleep(20000);
-    assert_int_equal(ag_jobqueue_run_fast(f->q, count_run, count_drop, NULL, &err), AG_ERR_BUSY);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 0, 0, count_run, count_drop, NULL, &err), AG_ERR_BUSY);
     assert_int_equal(err.code, AG_ERR_BUSY);
     atomic_store(&gate, 1);
-    ag_jobqueue_stop(f->q);
+    assert_int_equal(ag_jobqueue_stop(f->q, -1), 1);
     /* the running task finished; the waiting ones either ran before the stop or were dropped */
     assert_int_equal(atomic_load(&ran) + atomic_load(&dropped), 4);
-    assert_int_equal(ag_jobqueue_run_fast(f->q, count_run, count_drop, NULL, &err),
+    assert_int_equal(ag_jobqueue_run_task(f->q, 0, 0, count_run, count_drop, NULL, &err),
                      AG_ERR_CANCELLED);
+    drop_queue(f);
+}
+
+/* One model's tasks run one at a time in order; another model's run beside them. */
+typedef struct {
+    int id;
+    atomic_int *open; /* the task waits until *open (NULL: does not wait) */
+} ordered_task;
+
+static atomic_int order_log[8], order_n, gate2;
+
+static void ordered_run(void *user, ag_task_budget *b)
+{
+    (void)b;
+    ordered_task *t = user;
+    while (t->open && !atomic_load(t->open))
+        usleep(1000);
+    order_log[atomic_fetch_add(&order_n, 1)] = t->id;
+}
+
+static void wait_count(atomic_int *n, int want)
+{
+    double t0 = now_s();
+    while (atomic_load(n) < want && now_s() - t0 < 5.0)
+        usleep(1000);
+    assert_true(atomic_load(n) >= want);
+}
+
+static void one_models_tasks_run_in_order_beside_another_models(void **state)
+{
+    (void)state;
+    fixture *f = make_queue_ex(1, 0, 0, 3, 0);
+    ag_error err;
+    atomic_store(&order_n, 0);
+    atomic_store(&gate, 0);
+    atomic_store(&gate2, 0);
+    ordered_task a = {1, &gate}, b = {2, NULL}, c = {3, NULL}, d = {4, &gate2}, e = {5, NULL};
+    /* model 7: a (held), then b; model 8: c; model 9: d (held), then e */
+    assert_int_equal(ag_jobqueue_run_task(f->q, 7, 0, ordered_run, NULL, &a, &err), AG_OK);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 7, 0, ordered_run, NULL, &b, &err), AG_OK);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 9, 0, ordered_run, NULL, &d, &err), AG_OK);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 9, 0, ordered_run, NULL, &e, &err), AG_OK);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 8, 0, ordered_run, NULL, &c, &err), AG_OK);
+    /* models 7 and 9 hold two workers: model 8's task runs on the third meanwhile */
+    wait_count(&order_n, 1);
+    usleep(50000);
+    assert_int_equal(atomic_load(&order_n), 1);
+    assert_int_equal(order_log[0], 3);
+    /* releasing model 9 runs d then e, while model 7 still waits on a */
+    atomic_store(&gate2, 1);
+    wait_count(&order_n, 3);
+    usleep(20000);
+    assert_int_equal(atomic_load(&order_n), 3);
+    assert_int_equal(order_log[1], 4);
+    assert_int_equal(order_log[2], 5);
+    atomic_store(&gate, 1);
+    wait_count(&order_n, 5);
+    assert_int_equal(order_log[3], 1);
+    assert_int_equal(order_log[4], 2);
+    drop_queue(f);
+}
+
+/* Tasks without a key leave a worker for the models' tasks. */
+static void unkeyed_tasks_leave_a_worker_for_models(void **state)
+{
+    (void)state;
+    fixture *f = make_queue_ex(1, 0, 0, 2, 0);
+    ag_error err;
+    atomic_store(&order_n, 0);
+    atomic_store(&gate, 0);
+    ordered_task p1 = {1, &gate}, p2 = {2, &gate}, m = {3, NULL};
+    assert_int_equal(ag_jobqueue_run_task(f->q, 0, 0, ordered_run, NULL, &p1, &err), AG_OK);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 0, 0, ordered_run, NULL, &p2, &err), AG_OK);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 5, 0, ordered_run, NULL, &m, &err), AG_OK);
+    wait_count(&order_n, 1);
+    assert_int_equal(order_log[0], 3);
+    atomic_store(&gate, 1);
+    wait_count(&order_n, 3);
+    drop_queue(f);
+}
+
+/* A task's budget: its deadline, and the queue's stop. */
+static atomic_int why_seen;
+static double budget_elapsed;
+
+static void until_exhausted(void *user, ag_task_budget *b)
+{
+    (void)user;
+    double t0 = now_s();
+    while (!ag_task_budget_exhausted(b) && now_s() - t0 < 5.0)
+        usleep(1000);
+    budget_elapsed = now_s() - t0;
+    atomic_store(&why_seen, b->why);
+    ag_error err;
+    ag_error_clear(&err);
+    ag_status s = ag_task_budget_explain(b, AG_ERR_CANCELLED, "the test task", &err);
+    atomic_fetch_add(&ran, s == b->why && strstr(err.text, "the test task") ? 1 : 0);
+}
+
+static void a_task_budget_runs_out_at_its_deadline_and_at_a_stop(void **state)
+{
+    (void)state;
+    fixture *f = make_queue_ex(1, 0, 0, 2, 0);
+    ag_error err;
+    atomic_store(&ran, 0);
+    atomic_store(&why_seen, 0);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 3, 0.15, until_exhausted, NULL, NULL, &err), AG_OK);
+    double t0 = now_s();
+    while (!atomic_load(&why_seen) && now_s() - t0 < 5.0)
+        usleep(1000);
+    assert_int_equal(atomic_load(&why_seen), AG_ERR_DEADLINE);
+    assert_true(budget_elapsed >= 0.14 && budget_elapsed < 1.0);
+    assert_int_equal(atomic_load(&ran), 1);
+    /* without a deadline, the stop ends it */
+    atomic_store(&why_seen, 0);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 3, 0, until_exhausted, NULL, NULL, &err), AG_OK);
+    usleep(50000);
+    t0 = now_s();
+    assert_int_equal(ag_jobqueue_stop(f->q, 2.0), 1);
+    assert_true(now_s() - t0 < 0.5);
+    assert_int_equal(atomic_load(&why_seen), AG_ERR_CANCELLED);
+    assert_int_equal(atomic_load(&ran), 2);
+    drop_queue(f);
+}
+
+/* A task that never looks at its budget cannot hold a stop past its grace period. */
+static void a_stop_with_grace_comes_back_in_time(void **state)
+{
+    (void)state;
+    fixture *f = make_queue_ex(1, 0, 0, 1, 0);
+    ag_error err;
+    atomic_store(&ran, 0);
+    atomic_store(&gate, 0);
+    assert_int_equal(ag_jobqueue_run_task(f->q, 4, 0, block_run, NULL, NULL, &err), AG_OK);
+    usleep(30000);
+    double t0 = now_s();
+    assert_int_equal(ag_jobqueue_stop(f->q, 0.2), 0);
+    double took = now_s() - t0;
+    assert_true(took >= 0.19 && took < 0.6);
+    atomic_store(&gate, 1);
+    assert_int_equal(ag_jobqueue_stop(f->q, -1), 1); /* now everything has stopped */
+    assert_int_equal(atomic_load(&ran), 1);
     drop_queue(f);
 }
 
@@ -356,8 +523,13 @@ int main(void)
         cmocka_unit_test(running_and_queued_jobs_cancel),
         cmocka_unit_test(full_queue_refuses),
         cmocka_unit_test(shutdown_cancels_running_jobs),
-        cmocka_unit_test(a_long_job_does_not_delay_the_fast_lane),
-        cmocka_unit_test(the_fast_lane_is_bounded_and_drops_at_a_stop),
+        cmocka_unit_test(a_job_past_its_budget_fails_as_such),
+        cmocka_unit_test(a_long_job_does_not_delay_the_task_lanes),
+        cmocka_unit_test(the_task_lanes_are_bounded_and_drop_at_a_stop),
+        cmocka_unit_test(one_models_tasks_run_in_order_beside_another_models),
+        cmocka_unit_test(unkeyed_tasks_leave_a_worker_for_models),
+        cmocka_unit_test(a_task_budget_runs_out_at_its_deadline_and_at_a_stop),
+        cmocka_unit_test(a_stop_with_grace_comes_back_in_time),
         cmocka_unit_test(typed_params_are_stored_once_and_uploads_removed),
     };
     return cmocka_run_group_tests_name("jobqueue", tests, NULL, NULL);

@@ -183,6 +183,11 @@ static void test_ascii_details(void **state)
     const ag_cloud_property *s = ag_cloud_find(c, "segment_index");
     assert_true(ag_cloud_get(s, 0) == -1 && ag_cloud_get(s, 1) == 7 && ag_cloud_get(s, 2) == 18);
     assert_false(ag_ply_has_faces((const uint8_t *)text, strlen(text)));
+    assert_true(ag_cloud_import_is_cloud((const uint8_t *)text, strlen(text), NULL));
+    /* a header that does not end is no cloud of this reader's: the mesh importer judges it */
+    const char *cut = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                      "property float y\nproperty float z\nelement face 1\nend_hea";
+    assert_false(ag_cloud_import_is_cloud((const uint8_t *)cut, strlen(cut), NULL));
     ag_cloud_free(c);
 }
 

@@ -81,10 +81,11 @@ export class CityView {
     const bs = ext.buildings;
     const failed = bs.filter((b) => b.status === 'failed');
     const leaky = bs.filter((b) => b.status === 'not_watertight');
+    const fellBack = bs.filter((b) => b.fallback);
     const tris = bs.reduce((n, b) => n + (b.triangles || 0), 0);
     const style = ext.doc.style ? ` · style ${ext.doc.style}` : '';
     this.summary.textContent = ext.batch
-      ? `${bs.length} footprint${bs.length === 1 ? '' : 's'} · ${bs.length - failed.length} built · ${failed.length} failed · ${leaky.length} not watertight${style}${tris ? ` · ${tris.toLocaleString()} triangles` : ''}`
+      ? `${bs.length} footprint${bs.length === 1 ? '' : 's'} · ${bs.length - failed.length} built · ${failed.length} failed${fellBack.length ? ` · ${fellBack.length} fell back` : ''}${leaky.length ? ` · ${leaky.length} not watertight` : ''}${style}${tris ? ` · ${tris.toLocaleString()} triangles` : ''}`
       : 'one building';
     this.colourBy.hidden = !ext.batch;
     this.fitBtn.hidden = !ext.batch;
@@ -100,12 +101,12 @@ export class CityView {
         onkeydown: (e) => e.key === 'Enter' && ext.focus(i),
       },
       el('span.failed-id', {}, String(b.id)),
-      el('span.failed-status', {}, b.status === 'failed' ? 'failed' : 'not watertight'),
+      el('span.failed-status', {}, b.status === 'failed' ? 'failed' : b.fallback ? `fell back: ${b.fallback}` : 'not watertight'),
       el('div.failed-reason', {}, b.reason || ''),
     );
     const items = [];
     bs.forEach((b, i) => {
-      if (b.status !== 'ok') items.push(row(b, i));
+      if (b.status !== 'ok' || b.fallback) items.push(row(b, i));
     });
     this.failed.replaceChildren(...(items.length ? items : [el('li.empty', {}, ext.batch ? 'Every footprint was built.' : '')]));
     this.renderSelected();

@@ -8,6 +8,9 @@
 #ifndef AG_TOLERANCE_H
 #define AG_TOLERANCE_H
 
+#include <float.h>
+#include <math.h>
+
 /* ---- proceduralization (core/proc) ------------------------------------------------------ */
 
 /* Segment: vertices within this (relative) are one point when finding connected pieces, so
@@ -103,8 +106,140 @@
 #define AG_POINTS_LABEL_DIMS 0.05
 #define AG_POINTS_LABEL_COUNT 0.10
 
-/* ---- extrusion (core/extrude) ------------------------------------------------------------
- * The sweep's tolerances (delta1..delta3, parallel, same slope, and their scaling with the
- * plan's extent) live in core/extrude/tolerance.h for now and move here. */
+/* ---- extrusion (core/extrude) ------------------------------------------------------------ */
+
+/* The sweep computes every event from the planes of the edges involved, in a local frame
+ * (each plan is moved to its first corner), so its error grows with the plan's size and
+ * with the magnitude of the coordinates it computes with, not with where the plan lies
+ * on Earth. Its tolerances are therefore relative: ag_extrude_tolerances() multiplies the
+ * relative values below by the plan's size (its bounding-box diagonal, at least
+ * AG_EXTRUDE_SIZE_MIN) and adds a few units in the last place of the largest coordinate.
+ *
+ * The paper tuned delta1 = 1e-4 (height) and delta2 = 1e-6 (plan) for its floor plans;
+ * those absolute values are far larger than what double precision needs and are exactly
+ * what digitising noise (1 µm .. 0.3 mm jitter) breaks: events of different corners
+ * within 0.1 mm of height were merged into one. The values here are a few orders of
+ * magnitude above the rounding error of a plane intersection, so genuinely coincident
+ * events (symmetric plans, integer grids) still cluster, and noise above them is swept
+ * as what it is. */
+
+/* Plans smaller than this get the tolerances of a plan this size (m). */
+#define AG_EXTRUDE_SIZE_MIN 10.0
+/* delta1: height window of one cluster of intersection events, relative to the size. */
+#define AG_EXTRUDE_REL_HEIGHT 1e-8
+/* delta2: plan radius within which intersection points are one point, relative. */
+#define AG_EXTRUDE_REL_POINT 1e-10
+/* delta3: margin by which an edge is lengthened when testing whether a corner hits it. */
+#define AG_EXTRUDE_REL_ALONG 1e-9
+/* Units in the last place of the largest coordinate added to every tolerance: the
+ * rounding of the coordinates themselves. */
+#define AG_EXTRUDE_COORD_ULPS 64.0
+/* |sin| of the angle between two edges below which they count as parallel (collinear or
+ * antiparallel) for a corner's velocity: a corner between them would move faster than
+ * 1e9 m per metre of height. Faster corners than a double height can place are still
+ * swept right because their events are computed from the planes that meet there
+ * (ag__skel_meet3), not from where the corner is said to be. */
+#define AG_EXTRUDE_PARALLEL 1e-9
+/* An event's height from its three planes replaces the one from its corners' motion
+ * when they agree to this fraction of the size (else the corners' motion is kept: the
+ * planes then meet somewhere the event is not). */
+#define AG_EXTRUDE_MEET_AGREE 1e-6
+/* ... which is done when a corner involved is ill-conditioned: its edges' angle has a sine
+ * below 1 / this (else the corners' motion is as exact and cheaper). */
+#define AG_EXTRUDE_MEET_COND 100.0
+/* Three planes whose elimination meets a pivot below this do not meet in one point. */
+#define AG_EXTRUDE_MEET_PIVOT 1e-12
+/* Slopes (dw/dz) closer than this are equal (collinear neighbours move as one plane). */
+#define AG_EXTRUDE_SAME_SLOPE 1e-9
+/* Rates (m of length per m of height) below this do not make an edge shrink or a corner
+ * close in on an edge. */
+#define AG_EXTRUDE_MIN_RATE 1e-12
+/* Rays leaving an intersection point whose angles differ less than this (radians) are
+ * ordered by the planes' offsets just above the point instead of by angle. */
+#define AG_EXTRUDE_RAY_TIE 1e-12
+/* Intersection events whose points are within this many delta2 are one point. */
+#define AG_EXTRUDE_CLUSTER_POINTS 10.0
+/* Two intersection events at one point whose heights differ by less than this many units
+ * in the last place (of height plus size), times their corners' condition (1 / sin of
+ * the angle between a corner's edges), are one event computed twice. */
+#define AG_EXTRUDE_HEIGHT_ULPS 16.0
+/* A corner arrives at an intersection point when it is within this many delta2 of it
+ * (plus its drift, up to AG_EXTRUDE_DRIFT_MAX delta3). */
+#define AG_EXTRUDE_NEAR_POINTS 2.0
+#define AG_EXTRUDE_DRIFT_MAX 100.0
+/* A cluster's points may spread by the speed of its fastest corner times its height
+ * spread, up to this many delta3 (a corner between nearly parallel edges is fast). */
+#define AG_EXTRUDE_DRIFT_ALONG 20.0
+/* A new corner is moved onto the line where its two planes meet when that line passes
+ * within this many delta3 of where it was made (else it keeps its point). */
+#define AG_EXTRUDE_ANCHOR 100.0
+/* Relative weight that pulls the least-squares apex of an intersection towards the
+ * events' mean along directions no plane fixes (parallel planes). */
+#define AG_EXTRUDE_APEX_DAMPING 1e-6
+/* Two ridge edges closing from both ends count as ending at one point when their lengths
+ * differ by less than this many delta2. */
+#define AG_EXTRUDE_ZIP_EQUAL 10.0
+/* Loops touching at a point (OGC-valid holes touching the outer ring, parts meeting at a
+ * corner) are moved this far apart, relative to the plan's size (1e-4 m at 10 m), so that
+ * walls on both never share an edge; well above the point tolerance and the 1e-6 m grids
+ * outside checks weld on. */
+#define AG_EXTRUDE_TOUCH_GAP 1e-5
+
+/* Forced steps and natural steps keep this many delta3 away from the active boundary. */
+#define AG_EXTRUDE_STEP_CLEARANCE 10.0
+/* Side of the protrusion a natural step grows from (m). */
+#define AG_EXTRUDE_STEP_SEED 1e-3
+
+/* Shell check: a face is planar when every corner lies within this fraction of the
+ * face's diameter of its Newell plane, plus an absolute floor and the rounding of its
+ * coordinates (AG_EXTRUDE_COORD_ULPS of the largest). */
+#define AG_EXTRUDE_PLANAR_REL 1e-6
+#define AG_EXTRUDE_PLANAR_ABS 1e-8
+
+/* Forced step polygons: an area (m²) below which the polygon has none, and the relative
+ * area below which three of its corners count as collinear when checking it is simple. */
+#define AG_EXTRUDE_FORCED_MIN_AREA 1e-6
+#define AG_EXTRUDE_FORCED_COLLINEAR 1e-12
+/* Natural steps: width and |depth| of at least this (m). */
+#define AG_EXTRUDE_STEP_MIN 2e-3
+
+/* An outward flat offset (a soffit) bevels a convex corner whose mitre would lead out
+ * more than this many times the offset (corners sharper than 60°). */
+#define AG_EXTRUDE_BEVEL_MITRE 2.0
+
+/* Building check (verify.c): an outward offset of `reach` may put a convex corner's
+ * mitre this many times reach away from the footprint (a 47° corner); sharper corners
+ * with an overhang fail the check and are retried or fall back. */
+#define AG_VERIFY_MITRE 2.5
+/* ... plus this fraction of the plan's size (and its point tolerance) of slack. */
+#define AG_VERIFY_REACH_REL 1e-6
+
+/* A face whose Newell normal (twice its area, m²) is shorter than this has no area and
+ * is not triangulated. */
+#define AG_EXTRUDE_NO_AREA 1e-18
+
+/* Ear clipping: a corner whose doubled area is below this fraction of the loop's squared
+ * extent is flat. */
+#define AG_EXTRUDE_EAR_FLAT 1e-14
+
+typedef struct {
+    double size;   /* the plan's size the relative tolerances were scaled by (m) */
+    double height; /* delta1 */
+    double point;  /* delta2 */
+    double along;  /* delta3 */
+} ag_extrude_tol;
+
+/* Tolerances for a plan of bounding-box diagonal `extent` whose largest coordinate (in
+ * the frame the computation runs in) has magnitude `magnitude`. */
+static inline ag_extrude_tol ag_extrude_tolerances(double extent, double magnitude)
+{
+    ag_extrude_tol t;
+    t.size = extent > AG_EXTRUDE_SIZE_MIN ? extent : AG_EXTRUDE_SIZE_MIN;
+    double ulps = AG_EXTRUDE_COORD_ULPS * DBL_EPSILON * fabs(magnitude);
+    t.height = AG_EXTRUDE_REL_HEIGHT * t.size + ulps;
+    t.point = AG_EXTRUDE_REL_POINT * t.size + ulps;
+    t.along = AG_EXTRUDE_REL_ALONG * t.size + ulps;
+    return t;
+}
 
 #endif

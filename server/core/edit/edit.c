@@ -12,6 +12,37 @@ struct ag_edit_cache {
     ag_edit_resize_solver *solver;
 };
 
+int ag_edit_budget_cancelled(const ag_edit_budget *b)
+{
+    return b && b->cancelled && b->cancelled(b->user);
+}
+
+/* The re-proceduralization's stage callback: the edit's budget. */
+static int budget_stage(void *user, ag_stage stage)
+{
+    (void)stage;
+    return ag_edit_budget_cancelled(user);
+}
+
+/* A result past the budget's limits is refused before it is proceduralized (an operation
+ * without an estimate of its own, or one whose estimate was below and the result not). */
+static ag_status check_result(const ag_edit_budget *b, const ag_mesh *mesh, ag_error *err)
+{
+    if (!b)
+        return AG_OK;
+    if (b->max_triangles && mesh->ntris > b->max_triangles)
+        return ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, 0,
+                            "the edit would make %zu triangles; this server takes at most %zu",
+                            mesh->ntris, b->max_triangles);
+    if (b->max_components && mesh->ncomponents > b->max_components)
+        return ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, 0,
+                            "the edit would place %zu terminals; this server takes at most %zu",
+                            mesh->ncomponents, b->max_components);
+    if (ag_edit_budget_cancelled(b))
+        return ag_error_set(err, AG_ERR_CANCELLED, 0, "the edit was stopped");
+    return AG_OK;
+}
+
 void ag_edit_op_clear(ag_edit_op *op)
 {
     if (!op)
@@ -243,12 +274,20 @@ ag_status ag_edit_apply_ex(ag_edit_model *m, const ag_edit_op *op, unsigned flag
         st = ag_error_set(err, AG_ERR_EMPTY, 0, "the edit leaves no geometry");
         goto done;
     }
-    /* proceduralize the result, then read it back through its grammar for stable ids */
+    if ((st = check_result(op->budget, mesh, err)))
+        goto done;
+    /* proceduralize the result, then read it back through its grammar for stable ids; the
+     * budget is asked between the stages */
+    ag_proceduralize_options po = m->opt;
+    if (op->budget && op->budget->cancelled) {
+        po.progress = budget_stage;
+        po.user = (void *)op->budget;
+    }
     ag_edit_model *first = NULL;
-    if ((st = ag_edit_model_create(mesh, &m->opt, &first, err)))
+    if ((st = ag_edit_model_create(mesh, &po, &first, err)))
         goto done;
     if (flags & AG_EDIT_READ_BACK) {
-        st = ag_edit_model_from_grammar(first->proc->grammar, &m->opt, out, err);
+        st = ag_edit_model_from_grammar(first->proc->grammar, &po, out, err);
         ag_edit_model_free(first);
         if (st)
             goto done;

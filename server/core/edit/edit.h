@@ -34,6 +34,20 @@ typedef enum { AG_EDIT_FILL = 0, AG_EDIT_DERIVE = 1 } ag_edit_fit;
 
 #define AG_EDIT_ROOT 0 /* node index of the root ("root" in op JSON) */
 
+/* What one edit may make and how long it may run (the service's limits and time budget):
+ * an edit whose result would pass a limit is refused with AG_ERR_RESULT_TOO_LARGE before the
+ * result is made (a resize counts what its emission would place first), and `cancelled` is
+ * polled while the result is emitted and between the stages of proceduralizing it. */
+typedef struct {
+    size_t max_triangles;  /* of the new mesh; 0: the operation's own ceiling */
+    size_t max_components; /* placed terminals (components) of the new mesh; 0: idem */
+    int (*cancelled)(void *user); /* non-zero stops the edit with AG_ERR_CANCELLED; may be NULL */
+    void *user;
+} ag_edit_budget;
+
+/* Non-zero when the budget's callback asks to stop (b may be NULL). */
+int ag_edit_budget_cancelled(const ag_edit_budget *b);
+
 typedef struct {
     int kind; /* ag_edit_kind */
 
@@ -71,6 +85,9 @@ typedef struct {
     int fit;        /* ag_edit_fit */
     /* paste across models: the source model (not owned); NULL = the edited model */
     const ag_proceduralize_result *source;
+
+    /* limits and cancellation (not owned); NULL: the built-in ceilings, never cancelled */
+    const ag_edit_budget *budget;
 } ag_edit_op;
 
 /* Frees the op's arrays and zeroes it. */

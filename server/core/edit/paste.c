@@ -101,11 +101,23 @@ ag_status ag_edit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
             goto done;
         }
         double total = (double)counts[0] * counts[1] * counts[2];
-        if (total * (double)stris > PASTE_MAX_TRIANGLES) {
-            st = ag_error_set(err, AG_ERR_TOO_LARGE, op->node,
+        double limit = op->budget && op->budget->max_triangles &&
+                               (double)op->budget->max_triangles < PASTE_MAX_TRIANGLES
+                           ? (double)op->budget->max_triangles
+                           : PASTE_MAX_TRIANGLES;
+        if (total * (double)stris > limit) {
+            st = ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, op->node,
                               "filling node %d needs %.0f copies of %zu triangles (limit %.0f "
                               "triangles)",
-                              (int)op->node, total, stris, PASTE_MAX_TRIANGLES);
+                              (int)op->node, total, stris, limit);
+            goto done;
+        }
+        if (op->budget && op->budget->max_components &&
+            total * (double)op->nnodes > (double)op->budget->max_components) {
+            st = ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, op->node,
+                              "filling node %d needs %.0f copies of %zu nodes (limit %zu "
+                              "terminals)",
+                              (int)op->node, total, op->nnodes, op->budget->max_components);
             goto done;
         }
     }

@@ -147,7 +147,8 @@ ag_status ag_edit_resize(const ag_proceduralize_result *in, const ag_edit_op *op
     if (rep)
         rep->solve_ms = ag_clock_ms() - t0; /* equations, factorization and solve */
     if (!st)
-        st = ag_edit_resize_emit_ratio(in, boxes, op->split_ratio, op->thin_share, out, rep, err);
+        st = ag_edit_resize_emit_ratio(in, boxes, op->split_ratio, op->thin_share, op->budget,
+                                       out, rep, err);
     free(boxes);
     ag_edit_resize_solver_free(s);
     return st;

@@ -30,7 +30,8 @@
 /* Squeezed plain siblings join only under nodes with at most this many children. */
 #define AG_EDIT_JOIN_SIBLINGS_MAX 20000
 
-/* Largest result of an emission (a huge stretch splits exponentially): AG_ERR_TOO_LARGE. */
+/* Largest result of an emission (a huge stretch splits exponentially) when the op's budget
+ * sets no lower limit: AG_ERR_RESULT_TOO_LARGE. */
 #define AG_EDIT_MAX_TRIANGLES 20000000
 
 typedef struct ag_edit_resize_solver ag_edit_resize_solver;
@@ -45,13 +46,16 @@ int ag_edit_resize_solver_matches(const ag_edit_resize_solver *s, const ag_edit_
 ag_status ag_edit_resize_solver_solve(ag_edit_resize_solver *s, const ag_edit_op *op,
                                       ag_box *boxes, ag_edit_report *rep, ag_error *err);
 
-/* The mesh of the model with the nodes moved to boxes, with pattern split/join. */
+/* The mesh of the model with the nodes moved to boxes, with pattern split/join. What it would
+ * place is counted first and refused past the budget's limits (budget may be NULL). */
 ag_status ag_edit_resize_emit(const ag_proceduralize_result *in, const ag_box *boxes,
-                              ag_mesh **out, ag_edit_report *rep, ag_error *err);
+                              const ag_edit_budget *budget, ag_mesh **out, ag_edit_report *rep,
+                              ag_error *err);
 /* The same with another split ratio (see ag_edit_op.split_ratio; 0 = AG_EDIT_SPLIT_RATIO) and
  * thin share (ag_edit_op.thin_share). */
 ag_status ag_edit_resize_emit_ratio(const ag_proceduralize_result *in, const ag_box *boxes,
-                                    double split_ratio, double thin_share, ag_mesh **out, ag_edit_report *rep,
-                                    ag_error *err);
+                                    double split_ratio, double thin_share,
+                                    const ag_edit_budget *budget, ag_mesh **out,
+                                    ag_edit_report *rep, ag_error *err);
 
 #endif

@@ -38,12 +38,21 @@ typedef struct {
     uint32_t *stamp;
     uint32_t emission;
     size_t splits, joins;
-    size_t max_components;
+    size_t max_components, max_triangles;
+    /* a first pass only counts what would be placed, so a result past the limits is refused
+     * before any of it is made */
+    int count_only;
+    size_t ncomponents, ntris;
+    const ag_edit_budget *budget;
+    unsigned since_poll;
     double split, join; /* the split ratio and its inverse */
     double thin_share;  /* axes thinner than this share of a node's largest are not split */
     ag_status st;
     ag_error *err;
 } emitter;
+
+/* Components placed between two polls of the budget's callback. */
+#define EMIT_POLL 1024
 
 static void emit_node(emitter *E, int32_t n, const ag__resize_map *g, int depth);
 
@@ -71,14 +80,32 @@ static void emit_component(emitter *E, int32_t n, const ag__resize_map *m)
     const ag_mesh *src = E->in->mesh;
     if (x->component < 0 || (size_t)x->component >= L->ncomponents)
         return;
-    if (E->out->ncomponents >= E->max_components ||
-        E->out->ntris + (L->tri_start[x->component + 1] - L->tri_start[x->component]) >
-            AG_EDIT_MAX_TRIANGLES) {
-        E->st = ag_error_set(E->err, AG_ERR_TOO_LARGE, 0,
-                             "resize: the result would exceed %zu components or %d triangles",
-                             E->max_components, AG_EDIT_MAX_TRIANGLES);
+    size_t tris = L->tri_start[x->component + 1] - L->tri_start[x->component];
+    if (E->ncomponents >= E->max_components) {
+        E->st = ag_error_set(E->err, AG_ERR_RESULT_TOO_LARGE, 0,
+                             "resize: the result would place more than %zu terminals, the "
+                             "most this server takes",
+                             E->max_components);
         return;
     }
+    if (E->ntris + tris > E->max_triangles) {
+        E->st = ag_error_set(E->err, AG_ERR_RESULT_TOO_LARGE, 0,
+                             "resize: the result would have more than %zu triangles, the most "
+                             "this server takes",
+                             E->max_triangles);
+        return;
+    }
+    if (++E->since_poll >= EMIT_POLL) {
+        E->since_poll = 0;
+        if (ag_edit_budget_cancelled(E->budget)) {
+            E->st = ag_error_set(E->err, AG_ERR_CANCELLED, 0, "resize: stopped");
+            return;
+        }
+    }
+    E->ncomponents++;
+    E->ntris += tris;
+    if (E->count_only)
+        return;
     int32_t gi = group_of(E, x->label >= 0 ? x->label : L->label[x->component]);
     if (E->st)
         return;
@@ -496,17 +523,19 @@ static void emit_node(emitter *E, int32_t n, const ag__resize_map *g, int depth)
 }
 
 ag_status ag_edit_resize_emit(const ag_proceduralize_result *in, const ag_box *boxes,
-                              ag_mesh **out, ag_edit_report *rep, ag_error *err)
+                              const ag_edit_budget *budget, ag_mesh **out, ag_edit_report *rep,
+                              ag_error *err)
 {
-    return ag_edit_resize_emit_ratio(in, boxes, 0, 0, out, rep, err);
+    return ag_edit_resize_emit_ratio(in, boxes, 0, 0, budget, out, rep, err);
 }
 
 ag_status ag_edit_resize_emit_ratio(const ag_proceduralize_result *in, const ag_box *boxes,
-                                    double split_ratio, double thin_share, ag_mesh **out, ag_edit_report *rep,
-                                    ag_error *err)
+                                    double split_ratio, double thin_share,
+                                    const ag_edit_budget *budget, ag_mesh **out,
+                                    ag_edit_report *rep, ag_error *err)
 {
     *out = NULL;
-    emitter E = {.in = in, .boxes = boxes, .err = err};
+    emitter E = {.in = in, .boxes = boxes, .err = err, .budget = budget};
     E.split = split_ratio > 1 ? split_ratio : AG_EDIT_SPLIT_RATIO;
     E.join = 1 / E.split;
     E.thin_share = thin_share;
@@ -516,12 +545,30 @@ ag_status ag_edit_resize_emit_ratio(const ag_proceduralize_result *in, const ag_
     E.vmap = malloc((in->mesh->nverts + 1) * sizeof *E.vmap);
     E.stamp = calloc(in->mesh->nverts + 1, sizeof *E.stamp);
     E.max_components = EMIT_MAX_COMPONENTS(in->tree->nnodes);
+    E.max_triangles = AG_EDIT_MAX_TRIANGLES;
+    if (budget && budget->max_components && budget->max_components < E.max_components)
+        E.max_components = budget->max_components;
+    if (budget && budget->max_triangles && budget->max_triangles < E.max_triangles)
+        E.max_triangles = budget->max_triangles;
     if (!E.out || !E.group_of_label || !E.vmap || !E.stamp) {
         E.st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         goto done;
     }
     for (size_t i = 0; i < L->nlabels; i++)
         E.group_of_label[i] = -1;
+    /* count first: a stretch that splits exponentially is refused having made nothing */
+    E.count_only = 1;
+    emit_node(&E, 0, NULL, 0);
+    if (E.st)
+        goto done;
+    size_t ntris = E.ntris;
+    E.count_only = 0;
+    E.ncomponents = E.ntris = 0;
+    E.splits = E.joins = 0;
+    if ((E.st = ag_mesh_reserve(E.out, 0, ntris))) {
+        ag_error_set(err, E.st, 0, "out of memory");
+        goto done;
+    }
     emit_node(&E, 0, NULL, 0);
 done:
     free(E.group_of_label);

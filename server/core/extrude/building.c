@@ -64,34 +64,24 @@ static void note_fixes(ag_building_result *out, const ag_plan_fixes *fx)
 
 enum { GOOD = 1, NOT_GOOD = 0, REFUSED = -1 };
 
-/* Styles and extrudes one set of loops. Returns GOOD (added to m), NOT_GOOD (why set,
- * m unchanged), REFUSED (validation: why set), or -2 with *st an error to pass on. */
-static int attempt(const ag_style *style, const double *const *loops, const size_t *sizes,
-                   size_t nloops, double height, size_t index, const ag_extrude_options *opt,
-                   ag_mesh *m, int32_t group, ag_building_result *out, int record_fixes,
-                   char *why, size_t nwhy, ag_status *st)
+/* Extrudes one plan (taking it). Returns GOOD (added to m), NOT_GOOD (why set, m
+ * unchanged), REFUSED (validation: why set), or -2 with *st an error to pass on. */
+static int extrude_one(ag_plan *plan, const ag_extrude_options *opt, ag_mesh *m, int32_t group,
+                       ag_building_result *out, int record_fixes, char *why, size_t nwhy,
+                       ag_status *st)
 {
     ag_error e = {0};
-    ag_plan *plan = NULL;
-    *st = ag_style_apply(style, loops, sizes, nloops, height, index, &plan, &e);
-    if (*st == AG_ERR_NOMEM)
-        return -2;
-    if (*st != AG_OK) {
-        snprintf(why, nwhy, "%s", e.text[0] ? e.text : ag_status_message(*st));
-        *st = AG_OK;
-        return REFUSED;
-    }
     ag_plan_fixes fixes = {0};
     ag_extrude_options o = opt ? *opt : (ag_extrude_options){0};
     o.fixes = &fixes;
     mark k = mark_of(m);
     ag_extrude_result r;
     ag_status s = ag_extrude_plan_with(plan, &o, m, group, &r, NULL, &e);
-    ag_plan_free(plan);
     if (record_fixes)
         note_fixes(out, &fixes);
     ag_plan_fixes_free(&fixes);
     out->events += r.stats.events;
+    *st = AG_OK;
     if (s == AG_ERR_NOMEM || s == AG_ERR_CANCELLED) {
         *st = s;
         snprintf(why, nwhy, "%s", e.text);
@@ -116,6 +106,27 @@ static int attempt(const ag_style *style, const double *const *loops, const size
     }
     out->triangles = r.triangles;
     return GOOD;
+}
+
+/* Styles and extrudes one set of loops: extrude_one's answers. */
+static int attempt(const ag_style *style, const double *const *loops, const size_t *sizes,
+                   size_t nloops, double height, size_t index, const ag_extrude_options *opt,
+                   ag_mesh *m, int32_t group, ag_building_result *out, int record_fixes,
+                   char *why, size_t nwhy, ag_status *st)
+{
+    ag_error e = {0};
+    ag_plan *plan = NULL;
+    *st = ag_style_apply(style, loops, sizes, nloops, height, index, &plan, &e);
+    if (*st == AG_ERR_NOMEM)
+        return -2;
+    if (*st != AG_OK) {
+        snprintf(why, nwhy, "%s", e.text[0] ? e.text : ag_status_message(*st));
+        *st = AG_OK;
+        return REFUSED;
+    }
+    int r = extrude_one(plan, opt, m, group, out, record_fixes, why, nwhy, st);
+    ag_plan_free(plan);
+    return r;
 }
 
 /* Copies of the loops that simplification may shorten. */
@@ -231,6 +242,23 @@ static ag_status block(const double *const *loops, const size_t *sizes, size_t n
     return st;
 }
 
+/* The last resort: the block, recorded in out (nothing added when none can be made). */
+static ag_status block_fallback(const double *const *loops, const size_t *sizes, size_t nloops,
+                                double height, ag_mesh *m, int32_t group, ag_building_result *out,
+                                ag_error *err)
+{
+    int made = 0;
+    mark k = mark_of(m);
+    ag_status st = block(loops, sizes, nloops, height, m, group, &out->triangles, &made);
+    if (st != AG_OK)
+        ag_error_set(err, st, 0, "out of memory");
+    if (st == AG_OK && made)
+        out->built = AG_BUILT_BLOCK;
+    if (st != AG_OK || !made)
+        roll_back(m, k);
+    return st;
+}
+
 ag_status ag_building_extrude(const ag_style *style, const double *const *loops,
                               const size_t *sizes, size_t nloops, double height, size_t index,
                               const ag_extrude_options *opt, ag_mesh *m, int32_t group,
@@ -287,20 +315,75 @@ ag_status ag_building_extrude(const ag_style *style, const double *const *loops,
     free_loops(cp, nloops);
     free(sz);
     /* 3. a block */
-    if ((r == NOT_GOOD || r == REFUSED) && st == AG_OK) {
-        int made = 0;
-        mark k = mark_of(m);
-        st = block(loops, sizes, nloops, h, m, group, &out->triangles, &made);
-        if (st != AG_OK)
-            ag_error_set(err, st, 0, "out of memory");
-        if (st == AG_OK && made)
-            out->built = AG_BUILT_BLOCK;
-        if (st != AG_OK || !made)
-            roll_back(m, k);
-    }
+    if ((r == NOT_GOOD || r == REFUSED) && st == AG_OK)
+        st = block_fallback(loops, sizes, nloops, h, m, group, out, err);
 done:
     if (r == -2 && st != AG_OK)
         ag_error_set(err, st, 0, "%s", out->reason[0] ? out->reason : why);
+    out->seconds = ag_budget_elapsed(&clock);
+    return st;
+}
+
+double ag_building_plan_height(const ag_plan *plan)
+{
+    if (plan->cap_height > 0)
+        return plan->cap_height;
+    double eave = 0, top = 0;
+    for (size_t L = 0; L < plan->nloops; L++)
+        for (size_t i = 0; i < plan->loops[L].n; i++) {
+            int32_t k = plan->loops[L].profile[i];
+            if (k < 0 || (size_t)k >= plan->nprofiles)
+                continue;
+            const ag_profile *pr = &plan->profiles[k];
+            size_t j = 0;
+            while (j + 1 < pr->npoints && pr->points[j + 1].w == 0)
+                j++;
+            if (pr->points[j].z > eave)
+                eave = pr->points[j].z;
+            if (pr->npoints && pr->points[pr->npoints - 1].z > top)
+                top = pr->points[pr->npoints - 1].z;
+        }
+    return eave > 0 ? eave : top > 0 ? top : AG_BUILDING_FLAT_HEIGHT;
+}
+
+ag_status ag_building_extrude_plan(ag_plan *plan, const ag_extrude_options *opt, ag_mesh *m,
+                                   int32_t group, ag_building_result *out, ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->built = AG_BUILT_NONE;
+    ag_budget clock;
+    ag_budget_start(&clock, NULL, 0);
+    ag_status st = AG_OK;
+    double h = ag_building_plan_height(plan);
+    char why[sizeof out->reason] = "";
+    int r = extrude_one(plan, opt, m, group, out, 1, out->reason, sizeof out->reason, &st);
+    if (r == GOOD)
+        out->built = AG_BUILT_STYLED;
+    if (r == NOT_GOOD) {
+        /* the loops as validation left them (cleaned, oriented) */
+        const double **loops = malloc((plan->nloops ? plan->nloops : 1) * sizeof *loops);
+        size_t *sizes = malloc((plan->nloops ? plan->nloops : 1) * sizeof *sizes);
+        ag_style flat;
+        if (!loops || !sizes) {
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        } else if (ag_style_builtin("flat", &flat, NULL) == AG_OK) {
+            for (size_t L = 0; L < plan->nloops; L++) {
+                loops[L] = plan->loops[L].xy;
+                sizes[L] = plan->loops[L].n;
+            }
+            r = attempt(&flat, (const double *const *)loops, sizes, plan->nloops, h, 0, opt, m,
+                        group, out, 0, why, sizeof why, &st);
+            if (r == GOOD)
+                out->built = AG_BUILT_FLAT;
+            if ((r == NOT_GOOD || r == REFUSED) && st == AG_OK)
+                st = block_fallback((const double *const *)loops, sizes, plan->nloops, h, m,
+                                    group, out, err);
+        }
+        free(loops);
+        free(sizes);
+    }
+    if (r == -2 && st != AG_OK)
+        ag_error_set(err, st, 0, "%s", why[0] ? why : out->reason);
     out->seconds = ag_budget_elapsed(&clock);
     return st;
 }

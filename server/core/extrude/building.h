@@ -52,4 +52,20 @@ ag_status ag_building_extrude(const ag_style *style, const double *const *loops,
                               const ag_extrude_options *opt, ag_mesh *m, int32_t group,
                               ag_building_result *out, ag_error *err);
 
+/* The same for a building description: the plan as it is (validated and cleaned in
+ * place, its anchors located); when that building is not good (or runs out of its
+ * budget), a flat roof on the plan's cleaned loops at its wall height
+ * (ag_building_plan_height), then a block. A plan is not simplified: its profiles
+ * belong to its edges. Refused by validation: nothing built (AG_BUILT_NONE) with the
+ * validation's message. Returns AG_OK whatever was built, AG_ERR_NOMEM, or
+ * AG_ERR_CANCELLED (nothing added). */
+ag_status ag_building_extrude_plan(ag_plan *plan, const ag_extrude_options *opt, ag_mesh *m,
+                                   int32_t group, ag_building_result *out, ag_error *err);
+
+/* The wall height of a plan for its flat fallback: the cap height when the plan has one,
+ * else the highest eave (where an edge's profile first leaves the vertical), else the
+ * top of the highest profile; AG_BUILDING_FLAT_HEIGHT when no profile rises at all. */
+double ag_building_plan_height(const ag_plan *plan);
+#define AG_BUILDING_FLAT_HEIGHT 3.0
+
 #endif

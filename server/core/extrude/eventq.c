@@ -2,6 +2,8 @@
 
 #include <stdlib.h>
 
+#include "../base/array.h"
+
 static int before(const ag_event *a, const ag_event *b)
 {
     if (a->z != b->z)
@@ -11,14 +13,9 @@ static int before(const ag_event *a, const ag_event *b)
 
 ag_status ag_eventq_push(ag_eventq *q, const ag_event *e)
 {
-    if (q->n == q->cap) {
-        size_t cap = q->cap ? 2 * q->cap : 64;
-        ag_event *n = realloc(q->h, cap * sizeof *n);
-        if (!n)
-            return AG_ERR_NOMEM;
-        q->h = n;
-        q->cap = cap;
-    }
+    ag_status st = AG_ARRAY_RESERVE(q->h, q->cap, q->n + 1);
+    if (st != AG_OK)
+        return st;
     size_t i = q->n++;
     while (i > 0) {
         size_t p = (i - 1) / 2;

@@ -20,20 +20,6 @@ typedef struct {
  * when needed, and AG_ERR_NOMEM is possible). */
 ag_status ag_keysort(ag_keyed *v, size_t n, ag_keyed *tmp);
 
-/* The first index of sorted v[0..n) whose key is not below key (n when none is). */
-static inline size_t ag_keysort_lower_bound(const ag_keyed *v, size_t n, uint64_t key)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (v[mid].key < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 /* A key that orders doubles as numbers (NaN after everything). */
 static inline uint64_t ag_keysort_double(double d)
 {

@@ -5,8 +5,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "predicates.h"
-#include "tolerance.h"
+#include "../base/tolerance.h"
 
 ag_plan *ag_plan_create(void)
 {
@@ -90,14 +91,8 @@ ag_status ag_plan_add_profile(ag_plan *p, const char *name, const ag_profile_poi
             return ag_error_set(err, AG_ERR_INVALID, idx + 1,
                                 "profile %s: segments %zu and %zu are both horizontal (join them)",
                                 name ? name : "", i, i + 1);
-    if (p->nprofiles == p->cap_profiles) {
-        size_t cap = p->cap_profiles ? 2 * p->cap_profiles : 4;
-        ag_profile *np = realloc(p->profiles, cap * sizeof *np);
-        if (!np)
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        p->profiles = np;
-        p->cap_profiles = cap;
-    }
+    if (AG_ARRAY_RESERVE(p->profiles, p->cap_profiles, p->nprofiles + 1) != AG_OK)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     ag_profile *pr = &p->profiles[p->nprofiles];
     memset(pr, 0, sizeof *pr);
     pr->points = malloc(n * sizeof *pr->points);
@@ -120,14 +115,8 @@ ag_status ag_plan_add_profile(ag_plan *p, const char *name, const ag_profile_poi
 ag_status ag_plan_add_loop(ag_plan *p, const double *xy, size_t n, const int32_t *profiles,
                            ag_error *err)
 {
-    if (p->nloops == p->cap_loops) {
-        size_t cap = p->cap_loops ? 2 * p->cap_loops : 4;
-        ag_plan_loop *nl = realloc(p->loops, cap * sizeof *nl);
-        if (!nl)
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        p->loops = nl;
-        p->cap_loops = cap;
-    }
+    if (AG_ARRAY_RESERVE(p->loops, p->cap_loops, p->nloops + 1) != AG_OK)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     ag_plan_loop *l = &p->loops[p->nloops];
     l->n = n;
     l->xy = malloc((n ? n : 1) * 2 * sizeof(double));
@@ -197,14 +186,8 @@ ag_status ag_plan_add_offset(ag_plan *p, const ag_plan_offset *o, ag_error *err)
     if (o->has_gap && (o->inside < 0 || !profile_ok(p, o->inside, 0) || !profile_ok(p, o->inner, 1)))
         return ag_error_set(err, AG_ERR_INVALID, idx, "offset %zu: the inside boundary needs an "
                             "inside profile, and profiles without horizontal segments", p->noffsets);
-    if (p->noffsets == p->cap_offsets) {
-        size_t cap = p->cap_offsets ? 2 * p->cap_offsets : 4;
-        ag_plan_offset *no = realloc(p->offsets, cap * sizeof *no);
-        if (!no)
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        p->offsets = no;
-        p->cap_offsets = cap;
-    }
+    if (AG_ARRAY_RESERVE(p->offsets, p->cap_offsets, p->noffsets + 1) != AG_OK)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     ag_plan_offset *d = &p->offsets[p->noffsets];
     *d = *o;
     d->edges = NULL;
@@ -223,15 +206,9 @@ ag_status ag_plan_add_mesh(ag_plan *p, const char *name, ag_mesh *mesh, size_t *
 {
     if (!mesh)
         return ag_error_set(err, AG_ERR_INVALID, 0, "mesh %s: no mesh", name ? name : "");
-    if (p->nmeshes == p->cap_meshes) {
-        size_t cap = p->cap_meshes ? 2 * p->cap_meshes : 4;
-        ag_plan_mesh *nm = realloc(p->meshes, cap * sizeof *nm);
-        if (!nm) {
-            ag_mesh_free(mesh);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
-        p->meshes = nm;
-        p->cap_meshes = cap;
+    if (AG_ARRAY_RESERVE(p->meshes, p->cap_meshes, p->nmeshes + 1) != AG_OK) {
+        ag_mesh_free(mesh);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
     ag_plan_mesh *d = &p->meshes[p->nmeshes];
     snprintf(d->name, sizeof d->name, "%s", name ? name : "");
@@ -260,14 +237,8 @@ ag_status ag_plan_add_anchor(ag_plan *p, const ag_anchor *a, ag_error *err)
         return ag_error_set(err, AG_ERR_INVALID, (long)p->nanchors + 1,
                             "anchor %zu: height must be >= 0 and a relative position in [0, 1]",
                             p->nanchors);
-    if (p->nanchors == p->cap_anchors) {
-        size_t cap = p->cap_anchors ? 2 * p->cap_anchors : 4;
-        ag_anchor *na = realloc(p->anchors, cap * sizeof *na);
-        if (!na)
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        p->anchors = na;
-        p->cap_anchors = cap;
-    }
+    if (AG_ARRAY_RESERVE(p->anchors, p->cap_anchors, p->nanchors + 1) != AG_OK)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     ag_anchor *d = &p->anchors[p->nanchors++];
     *d = *a;
     d->name[sizeof d->name - 1] = 0;
@@ -346,14 +317,8 @@ ag_status ag_plan_add_step(ag_plan *p, const ag_plan_step *s, ag_error *err)
         return ag_error_set(err, AG_ERR_INVALID, idx,
                             "step %zu: height must be > 0 and a relative position in [0, 1]",
                             p->nsteps);
-    if (p->nsteps == p->cap_steps) {
-        size_t cap = p->cap_steps ? 2 * p->cap_steps : 4;
-        ag_plan_step *ns = realloc(p->steps, cap * sizeof *ns);
-        if (!ns)
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        p->steps = ns;
-        p->cap_steps = cap;
-    }
+    if (AG_ARRAY_RESERVE(p->steps, p->cap_steps, p->nsteps + 1) != AG_OK)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     ag_plan_step *d = &p->steps[p->nsteps];
     *d = *s;
     d->name[sizeof s->name - 1] = 0;
@@ -420,14 +385,8 @@ static void add_fix(ag_plan_fixes *f, ag_plan_fix_kind kind, long loop, long cor
 {
     if (!f)
         return;
-    if (f->n == f->cap) {
-        size_t cap = f->cap ? 2 * f->cap : 8;
-        ag_plan_fix *nf = realloc(f->fixes, cap * sizeof *nf);
-        if (!nf)
-            return; /* the record is informative; losing it under memory pressure is fine */
-        f->fixes = nf;
-        f->cap = cap;
-    }
+    if (AG_ARRAY_RESERVE(f->fixes, f->cap, f->n + 1) != AG_OK)
+        return; /* the record is informative; losing it under memory pressure is fine */
     ag_plan_fix *x = &f->fixes[f->n++];
     x->kind = kind;
     x->loop = loop;

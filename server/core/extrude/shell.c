@@ -6,10 +6,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
+#include "../base/search.h"
 #include "keysort.h"
 #include "weld_points.h"
 #include "predicates.h"
-#include "tolerance.h"
+#include "../base/tolerance.h"
 
 #define NONE UINT32_MAX
 
@@ -33,24 +35,9 @@ void ag_shell_free(ag_shell *s)
     free(s);
 }
 
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 1;
-    size_t c = *cap ? *cap : 16;
-    while (c < need)
-        c *= 2;
-    void *n = realloc(*p, c * elem);
-    if (!n)
-        return 0;
-    *p = n;
-    *cap = c;
-    return 1;
-}
-
 ag_status ag_shell_add_vertex(ag_shell *s, double x, double y, double z, uint32_t *id)
 {
-    if (!grow((void **)&s->pos, &s->cap_verts, s->nverts + 1, 3 * sizeof(double)))
+    if (ag_array_reserve((void **)&s->pos, &s->cap_verts, s->nverts + 1, 3 * sizeof(double)) != AG_OK)
         return AG_ERR_NOMEM;
     double *p = &s->pos[3 * s->nverts];
     p[0] = x;
@@ -62,7 +49,7 @@ ag_status ag_shell_add_vertex(ag_shell *s, double x, double y, double z, uint32_
 
 ag_status ag_shell_add_face(ag_shell *s, const ag_shell_face *f, uint32_t *id)
 {
-    if (!grow((void **)&s->faces, &s->cap_faces, s->nfaces + 1, sizeof(ag_shell_face)))
+    if (ag_array_reserve((void **)&s->faces, &s->cap_faces, s->nfaces + 1, sizeof(ag_shell_face)) != AG_OK)
         return AG_ERR_NOMEM;
     s->faces[s->nfaces] = *f;
     s->faces[s->nfaces].first_loop = 0;
@@ -75,7 +62,7 @@ ag_status ag_shell_add_segment(ag_shell *s, uint32_t face, uint32_t from, uint32
 {
     if (from == to)
         return AG_OK;
-    if (!grow((void **)&s->segs, &s->cap_segs, s->nsegs + 1, 3 * sizeof(uint32_t)))
+    if (ag_array_reserve((void **)&s->segs, &s->cap_segs, s->nsegs + 1, 3 * sizeof(uint32_t)) != AG_OK)
         return AG_ERR_NOMEM;
     uint32_t *g = &s->segs[3 * s->nsegs++];
     g[0] = face;
@@ -269,7 +256,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
             if (dead[sg])
                 continue;
             uint64_t rev = (uint64_t)g[3 * sg + 2] << 32 | g[3 * sg + 1];
-            uint32_t lo = (uint32_t)ag_keysort_lower_bound(keys, k, rev);
+            uint32_t lo = (uint32_t)ag_search_lower_u64(&keys->key, k, sizeof *keys, rev);
             for (uint32_t j = lo; j < k && keys[j].key == rev; j++)
                 if (!dead[keys[j].val]) {
                     dead[keys[j].val] = 1;
@@ -295,7 +282,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
                     break;
                 }
                 uint64_t want = (uint64_t)to << 32;
-                uint32_t lo = (uint32_t)ag_keysort_lower_bound(keys, k, want);
+                uint32_t lo = (uint32_t)ag_search_lower_u64(&keys->key, k, sizeof *keys, want);
                 uint32_t next = NONE;
                 for (uint32_t j = lo; j < k && (keys[j].key >> 32) == to; j++)
                     if (!dead[keys[j].val]) {
@@ -355,7 +342,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
     for (size_t i = 0; i < nidx; i++) {
         uint32_t h = (uint32_t)i;
         uint64_t rev = (uint64_t)s->idx[s->he_next[h]] << 32 | s->idx[h];
-        size_t lo = ag_keysort_lower_bound(hk, nidx, rev);
+        size_t lo = ag_search_lower_u64(&hk->key, nidx, sizeof *hk, rev);
         /* exactly one opposite half-edge: twin; more than one: paired around the edge below */
         if (lo < nidx && hk[lo].key == rev && (lo + 1 >= nidx || hk[lo + 1].key != rev))
             s->he_twin[h] = hk[lo].val;
@@ -368,7 +355,7 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
             j++;
         uint64_t key = hk[i].key, rev = (key << 32) | (key >> 32);
         if (j - i > 1 && key < rev) {
-            size_t lo = ag_keysort_lower_bound(hk, nidx, rev);
+            size_t lo = ag_search_lower_u64(&hk->key, nidx, sizeof *hk, rev);
             size_t m = lo;
             while (m < nidx && hk[m].key == rev)
                 m++;

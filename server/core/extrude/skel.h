@@ -135,7 +135,6 @@ static inline void ag__skel_cpos(const sk_corner *c, double z, double *x, double
 }
 
 /* --- skel_sweep.c ------------------------------------------------------------------------ */
-int ag__skel_grow(void **p, size_t *cap, size_t need, size_t elem);
 int ag__skel_vpush(sk_u32vec *v, uint32_t x);
 void ag__skel_fail(sk *S, ag_status st);
 double ag__skel_real_z(const sk *S, double v);

@@ -6,9 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "skel.h"
 
-#include "tolerance.h"
+#include "../base/tolerance.h"
 
 static void edge_event(sk *S, uint32_t ei)
 {
@@ -154,7 +155,7 @@ static void schedule_corner(sk *S, uint32_t k, double after)
         ag_event ev;
         if (!split_event(S, k, S->live_e[q], &ev) || ev.z > best + S->d1 || ev.z <= after)
             continue;
-        if (!ag__skel_grow((void **)&W->cand, &W->cap_cand, n + 1, sizeof *W->cand)) {
+        if (ag_array_reserve((void **)&W->cand, &W->cap_cand, n + 1, sizeof *W->cand) != AG_OK) {
             ag__skel_fail(S, AG_ERR_NOMEM);
             return;
         }
@@ -271,7 +272,7 @@ void ag__skel_next_cluster(sk *S, const ag_event *ev0)
     sk_scratch *W = &S->W;
     /* the batch: ev0 and every valid intersection event within delta1 above it */
     size_t nb = 0;
-    if (!ag__skel_grow((void **)&W->batch, &W->cap_batch, 1, sizeof *W->batch)) {
+    if (ag_array_reserve((void **)&W->batch, &W->cap_batch, 1, sizeof *W->batch) != AG_OK) {
         ag__skel_fail(S, AG_ERR_NOMEM);
         return;
     }
@@ -286,15 +287,15 @@ void ag__skel_next_cluster(sk *S, const ag_event *ev0)
             ag__skel_event_dropped(S, &nx);
             continue;
         }
-        if (!ag__skel_grow((void **)&W->batch, &W->cap_batch, nb + 1, sizeof *W->batch) ||
-            !ag__skel_grow((void **)&W->uf, &W->cap_uf, nb + 1, sizeof *W->uf)) {
+        if (ag_array_reserve((void **)&W->batch, &W->cap_batch, nb + 1, sizeof *W->batch) != AG_OK ||
+            ag_array_reserve((void **)&W->uf, &W->cap_uf, nb + 1, sizeof *W->uf) != AG_OK) {
             ag__skel_fail(S, AG_ERR_NOMEM);
             return;
         }
         W->batch[nb++] = nx;
     }
-    if (!ag__skel_grow((void **)&W->uf, &W->cap_uf, nb, sizeof *W->uf) ||
-        !ag__skel_grow((void **)&W->speed, &W->cap_speed, 2 * nb, sizeof *W->speed)) {
+    if (ag_array_reserve((void **)&W->uf, &W->cap_uf, nb, sizeof *W->uf) != AG_OK ||
+        ag_array_reserve((void **)&W->speed, &W->cap_speed, 2 * nb, sizeof *W->speed) != AG_OK) {
         ag__skel_fail(S, AG_ERR_NOMEM);
         return;
     }

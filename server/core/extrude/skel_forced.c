@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "skel.h"
 
 #include "predicates.h"
@@ -137,7 +138,7 @@ void ag__skel_forced_step(sk *S, size_t k, double v)
              * edge distances, so the signs here are clear */
             if ((oa > 0) == (ob > 0) || (oc > 0) == (od > 0))
                 continue;
-            if (!ag__skel_grow((void **)&X, &capx, nx + 1, sizeof *X)) {
+            if (ag_array_reserve((void **)&X, &capx, nx + 1, sizeof *X) != AG_OK) {
                 ag__skel_fail(S, AG_ERR_NOMEM);
                 goto out;
             }

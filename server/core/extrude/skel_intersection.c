@@ -6,9 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "skel.h"
 
-#include "tolerance.h"
+#include "../base/tolerance.h"
 
 /* Rays in counter-clockwise order around the point, by angle. Ties between an outgoing
  * and an incoming ray (antiparallel edges through the point): the outgoing ray first, so
@@ -182,7 +183,7 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
     uint32_t vl = ag__skel_vertex(S, lx, ly, z);
     size_t nrays = 0;
     size_t need = 2 * (W->E.n + W->splits.n) + 2;
-    if (!ag__skel_grow((void **)&W->rays, &W->cap_rays, need, sizeof(sk_ray))) {
+    if (ag_array_reserve((void **)&W->rays, &W->cap_rays, need, sizeof(sk_ray)) != AG_OK) {
         ag__skel_fail(S, AG_ERR_NOMEM);
         return;
     }

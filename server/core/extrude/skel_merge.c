@@ -6,7 +6,7 @@
 
 #include "skel.h"
 
-#include "tolerance.h"
+#include "../base/tolerance.h"
 
 static int velocity(sk *S, sk_corner *c)
 {

@@ -5,9 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "skel.h"
 
-#include "tolerance.h"
+#include "../base/tolerance.h"
 
 static int offset_tuple(const ag_plan_offset *o, const sk_edge *e, double *w, int32_t *prof)
 {
@@ -195,8 +196,8 @@ static void insert_after(sk *S, uint32_t ck, uint32_t ne, double px, double py)
     c->out = ne;
     S->e[ne].start = ck;
     S->e[other].ver++;
-    if (!ag__skel_grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1,
-                       sizeof(uint32_t))) {
+    if (ag_array_reserve((void **)&S->touched, &S->cap_touched, S->ntouched + 1,
+                       sizeof(uint32_t)) != AG_OK) {
         ag__skel_fail(S, AG_ERR_NOMEM);
         return;
     }
@@ -402,11 +403,11 @@ static ag_status inset_plan(sk *S, double v, const double *dist, const uint32_t 
                 uint32_t hp = h == a ? b - 1 : h - 1, tp = sh->he_twin[hp];
                 if (tp != UINT32_MAX && sh->he_face[tp] == sh->he_face[t])
                     continue;
-                if (!ag__skel_grow((void **)&out->xy, &out->cap, out->n + 1, 2 * sizeof *out->xy)) {
+                if (ag_array_reserve((void **)&out->xy, &out->cap, out->n + 1, 2 * sizeof *out->xy) != AG_OK) {
                     st = AG_ERR_NOMEM;
                     break;
                 }
-                if (!ag__skel_grow((void **)&out->src, &out->cap_src, out->n + 1, sizeof *out->src)) {
+                if (ag_array_reserve((void **)&out->src, &out->cap_src, out->n + 1, sizeof *out->src) != AG_OK) {
                     st = AG_ERR_NOMEM;
                     break;
                 }
@@ -420,7 +421,7 @@ static ag_status inset_plan(sk *S, double v, const double *dist, const uint32_t 
                 out->n = first; /* nothing left of it */
                 continue;
             }
-            if (!ag__skel_grow((void **)&out->start, &out->cap_loops, out->nloops + 2, sizeof *out->start)) {
+            if (ag_array_reserve((void **)&out->start, &out->cap_loops, out->nloops + 2, sizeof *out->start) != AG_OK) {
                 st = AG_ERR_NOMEM;
                 break;
             }

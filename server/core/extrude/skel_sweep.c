@@ -5,27 +5,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "skel.h"
-#include "tolerance.h"
-
-int ag__skel_grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 1;
-    size_t c = *cap ? *cap : 64;
-    while (c < need)
-        c *= 2;
-    void *n = realloc(*p, c * elem);
-    if (!n)
-        return 0;
-    *p = n;
-    *cap = c;
-    return 1;
-}
+#include "../base/tolerance.h"
 
 int ag__skel_vpush(sk_u32vec *v, uint32_t x)
 {
-    if (!ag__skel_grow((void **)&v->arr, &v->cap, v->n + 1, sizeof(uint32_t)))
+    if (ag_array_reserve((void **)&v->arr, &v->cap, v->n + 1, sizeof(uint32_t)) != AG_OK)
         return 0;
     v->arr[v->n++] = x;
     return 1;
@@ -87,8 +73,8 @@ uint32_t ag__skel_new_face(sk *S, const sk_edge *e)
 
 uint32_t ag__skel_add_edge(sk *S)
 {
-    if (!ag__skel_grow((void **)&S->e, &S->cap_e, S->ne + 1, sizeof(sk_edge)) ||
-        !ag__skel_grow((void **)&S->live_e, &S->cap_live_e, S->nlive_e + 1, sizeof(uint32_t))) {
+    if (ag_array_reserve((void **)&S->e, &S->cap_e, S->ne + 1, sizeof(sk_edge)) != AG_OK ||
+        ag_array_reserve((void **)&S->live_e, &S->cap_live_e, S->nlive_e + 1, sizeof(uint32_t)) != AG_OK) {
         ag__skel_fail(S, AG_ERR_NOMEM);
         return NONE;
     }
@@ -103,9 +89,9 @@ uint32_t ag__skel_add_edge(sk *S)
 uint32_t ag__skel_add_corner(sk *S, uint32_t in, uint32_t out, double x, double y, double z,
                            uint32_t vert)
 {
-    if (!ag__skel_grow((void **)&S->c, &S->cap_c, S->nc + 1, sizeof(sk_corner)) ||
-        !ag__skel_grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1, sizeof(uint32_t)) ||
-        !ag__skel_grow((void **)&S->live_c, &S->cap_live_c, S->nlive_c + 1, sizeof(uint32_t))) {
+    if (ag_array_reserve((void **)&S->c, &S->cap_c, S->nc + 1, sizeof(sk_corner)) != AG_OK ||
+        ag_array_reserve((void **)&S->touched, &S->cap_touched, S->ntouched + 1, sizeof(uint32_t)) != AG_OK ||
+        ag_array_reserve((void **)&S->live_c, &S->cap_live_c, S->nlive_c + 1, sizeof(uint32_t)) != AG_OK) {
         ag__skel_fail(S, AG_ERR_NOMEM);
         return NONE;
     }

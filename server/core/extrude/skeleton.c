@@ -5,9 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "skel.h"
 
-#include "tolerance.h"
+#include "../base/tolerance.h"
 
 /* Settles the corners the intersections of one height level left unsettled. */
 static void settle_deferred(sk *S)
@@ -19,8 +20,8 @@ static void settle_deferred(sk *S)
         ag__skel_settle(S, k);
         /* its events are scheduled with the corners its settling made */
         if (S->c[k].alive &&
-            !ag__skel_grow((void **)&S->touched, &S->cap_touched, S->ntouched + 1,
-                           sizeof *S->touched))
+            ag_array_reserve((void **)&S->touched, &S->cap_touched, S->ntouched + 1,
+                           sizeof *S->touched) != AG_OK)
             ag__skel_fail(S, AG_ERR_NOMEM);
         else if (S->c[k].alive)
             S->touched[S->ntouched++] = k;
@@ -308,7 +309,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             continue;
         }
         size_t nb = 0;
-        if (!ag__skel_grow((void **)&batch, &cap_batch, 1, sizeof *batch)) {
+        if (ag_array_reserve((void **)&batch, &cap_batch, 1, sizeof *batch) != AG_OK) {
             ag__skel_fail(&S, AG_ERR_NOMEM);
             break;
         }
@@ -321,7 +322,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             ag_event nx;
             if (!ag__skel_pop(&S, &nx))
                 break;
-            if (!ag__skel_grow((void **)&batch, &cap_batch, nb + 1, sizeof *batch)) {
+            if (ag_array_reserve((void **)&batch, &cap_batch, nb + 1, sizeof *batch) != AG_OK) {
                 ag__skel_fail(&S, AG_ERR_NOMEM);
                 break;
             }

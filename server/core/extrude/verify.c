@@ -5,9 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/search.h"
 #include "keysort.h"
 #include "weld_points.h"
-#include "tolerance.h"
+#include "../base/tolerance.h"
 
 /* How far outwards profile p leads (m, >= 0) and, when its last segment leans inwards,
  * the height it rises per metre it moves in (0: it does not). */
@@ -87,7 +88,7 @@ static int weld(const ag_mesh *m, size_t t0, size_t t1, double tol, uint32_t *id
 /* Index of key in sorted e[0..n), or n. */
 static size_t find_key(const ag_keyed *e, size_t n, uint64_t key)
 {
-    size_t lo = ag_keysort_lower_bound(e, n, key);
+    size_t lo = ag_search_lower_u64(&e->key, n, sizeof *e, key);
     return lo < n && e[lo].key == key ? lo : n;
 }
 

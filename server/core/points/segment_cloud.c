@@ -674,3 +674,75 @@ ag_status ag_segment_cloud_refine(ag_cloud *c, ag_segment_cloud_result *r, const
     free(spec);
     return st;
 }
+
+ag_status ag_segment_cloud_restore(const ag_cloud *c, const ag_segment_cloud_ids *ids,
+                                   ag_segment_cloud_result **out, ag_error *err)
+{
+    *out = NULL;
+    size_t n = c->n;
+    if (ids->nplanes > ids->nsegments || ids->nsegments >= INT32_MAX ||
+        ids->npieces >= INT32_MAX)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "%zu planes among %zu segments and %zu pieces cannot be",
+                            ids->nplanes, ids->nsegments, ids->npieces);
+    for (size_t i = 0; i < n; i++) {
+        int32_t s = ids->segment[i], p = ids->piece[i];
+        if (s < -1 || s >= (int32_t)ids->nsegments || p < -1 || p >= (int32_t)ids->npieces ||
+            (s < 0) != (p < 0))
+            return ag_error_set(err, AG_ERR_INVALID, (long)i + 1,
+                                "point %zu has segment %d and piece %d (of %zu and %zu)", i + 1,
+                                s, p, ids->nsegments, ids->npieces);
+    }
+    ag_segment_cloud_result *r = NULL;
+    ag_status st = alloc_result(n, &r, err);
+    if (st != AG_OK)
+        return st;
+    memcpy(r->segment, ids->segment, n * sizeof *r->segment);
+    memcpy(r->piece, ids->piece, n * sizeof *r->piece);
+    r->nsegments = ids->nsegments;
+    r->npieces = ids->npieces;
+    r->spacing = ids->spacing;
+    r->diagonal = ag_cloud_diagonal(c);
+    st = finish(c, r, ids->nplanes, err);
+    if (st == AG_OK && ids->label) {
+        /* the labels given, checked against their segments and renumbered densely */
+        int32_t *dense = malloc((n + 1) * sizeof *dense);
+        for (size_t s = 0; dense && s < r->nsegments; s++)
+            r->segments[s].label = -1;
+        if (!dense)
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        for (size_t i = 0; st == AG_OK && i < n; i++) {
+            int32_t s = r->segment[i], l = ids->label[i];
+            if ((s < 0) != (l < 0) || l >= (int32_t)n ||
+                (s >= 0 && r->segments[s].label >= 0 && r->segments[s].label != l))
+                st = ag_error_set(err, AG_ERR_INVALID, (long)i + 1,
+                                  "point %zu has label %d, which its segment %d does not have",
+                                  i + 1, l, s);
+            else if (s >= 0)
+                r->segments[s].label = l;
+        }
+        size_t nlabels = 0;
+        for (size_t l = 0; st == AG_OK && l <= n; l++)
+            dense[l] = -1;
+        for (size_t s = 0; st == AG_OK && s < r->nsegments; s++) {
+            int32_t l = r->segments[s].label;
+            if (l < 0) /* a segment without points */
+                continue;
+            if (dense[l] < 0)
+                dense[l] = (int32_t)nlabels++;
+            r->segments[s].label = dense[l];
+        }
+        if (st == AG_OK) {
+            r->nlabels = nlabels;
+            for (size_t i = 0; i < n; i++)
+                r->label[i] = r->segment[i] >= 0 ? r->segments[r->segment[i]].label : -1;
+        }
+        free(dense);
+    }
+    if (st != AG_OK) {
+        ag_segment_cloud_free(r);
+        return st;
+    }
+    *out = r;
+    return AG_OK;
+}

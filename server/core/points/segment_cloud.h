@@ -111,6 +111,21 @@ ag_status ag_segment_cloud_refine(ag_cloud *c, ag_segment_cloud_result *r, const
                                   const double max[3], const ag_segment_cloud_options *opt,
                                   ag_error *err);
 
+/* A segmentation read back from its per-point ids (a stored one), with the segment table,
+ * members and labels that ag_segment_cloud_run or _refine made, so it can be refined again
+ * or handed to the stages after. segment[i] in [-1, nsegments) with the first nplanes ids
+ * planes, piece[i] in [-1, npieces); spacing as the run reported it (the label rule's
+ * slack). label (may be NULL: computed by the label rule, as a run does) gives each
+ * segment's label, the same for all its points. AG_ERR_INVALID naming the first point whose
+ * ids do not fit. */
+typedef struct {
+    const int32_t *segment, *label, *piece;
+    size_t nsegments, nplanes, npieces;
+    double spacing;
+} ag_segment_cloud_ids;
+ag_status ag_segment_cloud_restore(const ag_cloud *c, const ag_segment_cloud_ids *ids,
+                                   ag_segment_cloud_result **out, ag_error *err);
+
 void ag_segment_cloud_free(ag_segment_cloud_result *r);
 
 /* What a stage that reassigns points (ROI refinement, repetition) says about each segment id

@@ -1,0 +1,55 @@
+/* Template marking (§3.2 of "Procedural editing of building point clouds") by the label
+ * rule: a person marks a template — the points of one segment inside a box — and the
+ * copies of it along the segment are found and given one label with it.
+ *
+ * The template is slid along the axes of the segment's frame (the frame ag_segment_cloud
+ * gives it: a wall's horizontal direction and slope line, ...) wherever the segment has
+ * room, in steps of a tenth of the template's size on each axis (at least one point
+ * spacing). A window of the segment at a position is a copy when it passes the label rule
+ * of the segmentation: its point count within 10 % of the template's and its extents,
+ * sorted, within 5 % (plus two point spacings of slack) — and its points placed in it as
+ * the template's are in the template's box: their centre and their spread about it within
+ * 5 % of the template's size on each axis (a window shifted while the template's features
+ * stay inside it holds as many points, and one straddling two features may too: the centre
+ * and the spread tell them apart). Copies are taken best first (closest in all of it) where
+ * they do not overlap the template or a copy taken before. The template and every copy
+ * become segments of their own (of the segment's kind), all with one new label; what is
+ * left of the segment stays a segment. Shape is not compared beyond this (no registration):
+ * that is the template matching of the consensus stage. Deterministic. Core: no I/O. */
+#ifndef AG_POINTS_TEMPLATE_MARK_H
+#define AG_POINTS_TEMPLATE_MARK_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../status.h"
+#include "cloud.h"
+#include "segment_cloud.h"
+
+#define AG_TEMPLATE_MIN_POINTS 10 /* a template with fewer points is refused */
+
+typedef struct {
+    double min[3], max[3]; /* the copy's points' bounds, local coordinates */
+    size_t count;
+} ag_template_copy;
+
+typedef struct {
+    size_t template_points;
+    size_t positions;       /* window positions tried */
+    size_t copies;          /* copies found (the template not counted) */
+    ag_template_copy *copy; /* copies entries, malloc'd: ag_template_mark_report_clear */
+    int32_t label;          /* the label of the template and its copies */
+    int32_t template_segment; /* the template's segment id in the result */
+} ag_template_mark_report;
+
+void ag_template_mark_report_clear(ag_template_mark_report *rep);
+
+/* Marks the points of segment `segment` inside the box [min, max] (local coordinates) as a
+ * template and labels its copies; r is replaced by the new segmentation (segments and
+ * labels renumbered). AG_ERR_INVALID when there is no such segment or the box holds fewer
+ * than AG_TEMPLATE_MIN_POINTS of its points (the message says how many it holds). */
+ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **r, int32_t segment,
+                           const double min[3], const double max[3],
+                           ag_template_mark_report *rep, ag_error *err);
+
+#endif

@@ -1,0 +1,118 @@
+/* Uploads read by assimp in a child process (app/import_sandbox.h): the same mesh as reading
+ * in this process; a 189-byte PLY that sends assimp 5.2 into a loop that never ends stops at
+ * the deadline with AG_ERR_DEADLINE and leaves no child behind; progress asking to stop
+ * cancels; the importer's own refusals come through with their message. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+
+#include "app/import_sandbox.h"
+#include "file_fixture.h"
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* No child of this process is left (running or a zombie). */
+static void no_children(void)
+{
+    errno = 0;
+    assert_int_equal(waitpid(-1, NULL, WNOHANG), -1);
+    assert_int_equal(errno, ECHILD);
+}
+
+static void the_same_mesh_as_in_process(void **state)
+{
+    (void)state;
+    const char *files[] = {"proc/quad.ply", "proc/quad.stl", "proc/tri.dae", "proc/tri.gltf"};
+    for (size_t i = 0; i < 4; i++) {
+        size_t len = 0;
+        char *data = read_fixture(files[i], &len);
+        ag_format fmt = ag_format_sniff((const uint8_t *)data, len, files[i]);
+        ag_mesh *a = NULL, *b = NULL;
+        ag_error err;
+        assert_int_equal(ag_import_buffer((const uint8_t *)data, len, fmt, NULL, &a, &err), AG_OK);
+        if (ag_import_sandbox_read((const uint8_t *)data, len, fmt, NULL, 10, &b, &err) != AG_OK)
+            fail_msg("%s: %s", files[i], err.text);
+        assert_int_equal(a->nverts, b->nverts);
+        assert_int_equal(a->ntris, b->ntris);
+        assert_int_equal(a->ncomponents, b->ncomponents);
+        assert_memory_equal(a->tri, b->tri, 3 * a->ntris * sizeof *a->tri);
+        assert_memory_equal(a->pos, b->pos, 3 * a->nverts * sizeof *a->pos);
+        ag_mesh_free(a);
+        ag_mesh_free(b);
+        free(data);
+    }
+    no_children();
+}
+
+static void a_file_that_loops_the_importer_stops_at_the_deadline(void **state)
+{
+    (void)state;
+    size_t len = 0;
+    char *data = read_fixture("import_sandbox/loops.ply", &len);
+    ag_mesh *m = NULL;
+    ag_error err;
+    double t0 = now();
+    ag_status s = ag_import_sandbox_read((const uint8_t *)data, len, AG_FORMAT_PLY, NULL, 0.5, &m,
+                                         &err);
+    double took = now() - t0;
+    assert_int_equal(s, AG_ERR_DEADLINE);
+    assert_null(m);
+    assert_non_null(strstr(err.text, "longer than 0.5 s"));
+    assert_true(took >= 0.45 && took < 3.0);
+    no_children();
+    free(data);
+}
+
+static int calls;
+static int stop_now(void *user, double fraction)
+{
+    (void)user, (void)fraction;
+    return ++calls >= 2;
+}
+
+static void progress_cancels_and_refusals_come_through(void **state)
+{
+    (void)state;
+    size_t len = 0;
+    char *data = read_fixture("import_sandbox/loops.ply", &len);
+    ag_import_options opt = {.progress = stop_now};
+    ag_mesh *m = NULL;
+    ag_error err;
+    calls = 0;
+    assert_int_equal(ag_import_sandbox_read((const uint8_t *)data, len, AG_FORMAT_PLY, &opt, 30,
+                                            &m, &err),
+                     AG_ERR_CANCELLED);
+    no_children();
+    free(data);
+    /* not a glTF at all: the importer's problem, its message kept */
+    const char junk[] = "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": 7}";
+    ag_import_options plain = {0};
+    ag_status s = ag_import_sandbox_read((const uint8_t *)junk, sizeof junk - 1, AG_FORMAT_GLTF,
+                                         &plain, 10, &m, &err);
+    assert_int_not_equal(s, AG_OK);
+    assert_int_not_equal(s, AG_ERR_INTERNAL);
+    assert_true(err.text[0] != '\0');
+    no_children();
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(the_same_mesh_as_in_process),
+        cmocka_unit_test(a_file_that_loops_the_importer_stops_at_the_deadline),
+        cmocka_unit_test(progress_cancels_and_refusals_come_through),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
