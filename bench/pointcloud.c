@@ -1,6 +1,10 @@
 /* Point cloud benchmark: per-stage seconds and peak memory of reading, normals and
  * segmentation on the real clouds in ../shared/data and on generated buildings of 100k,
- * 500k and 1.8M points (area-uniform sampling with noise), and of cutting the AHN3 tile.
+ * 500k and 1.8M points (area-uniform sampling with noise), and of cutting the AHN3 tile;
+ * then of the whole pipeline (segmentation with its normals, repetition, consensus, tree,
+ * grammar: core/points/proceduralize_cloud.h) on the same clouds, and of the consensus
+ * models of 54 same-label windows of the 1.8M-point building (Algorithm 1, each member
+ * registered once to the base).
  * Each case runs in a child process so that its peak resident memory is its own. Each
  * case prints wall seconds per stage, then a line of processor seconds per stage: on a
  * shared machine wall time also counts the waiting for a processor. Not a test. */
@@ -13,7 +17,9 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "core/points/consensus.h"
 #include "core/points/cut.h"
+#include "core/points/proceduralize_cloud.h"
 #include "core/points/gen_building.h"
 #include "core/points/segment_cloud.h"
 #include "io/cloud_import.h"
@@ -235,6 +241,159 @@ static void cut_ahn3(void)
     ag_cloud_free(c);
 }
 
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static double peak_mib(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_maxrss / 1024;
+}
+
+static void pipeline_header(void)
+{
+    printf("%-28s %9s %7s %8s |", "cloud", "points", "read", "normals");
+    for (int s = 0; s < AG_PCLOUD_STAGES; s++)
+        printf(" %9s", ag_proceduralize_cloud_stage_name(s));
+    printf(" | %8s %6s %6s %6s %6s\n", "total", "labels", "terms", "places", "MiB");
+}
+
+static void pipeline_case(const char *name, ag_cloud *c, double t_read)
+{
+    ag_proceduralize_cloud_result *r;
+    ag_error err = {0};
+    double t0 = now();
+    if (ag_proceduralize_cloud_run(c, NULL, &r, &err)) {
+        printf("%-28s failed: %s\n", name, err.text);
+        return;
+    }
+    double t = now() - t0;
+    printf("%-28s %9zu %7.3f %8.3f |", name, c->n, t_read, r->seg->seconds[AG_SEGMENT_CLOUD_NORMALS]);
+    for (int s = 0; s < AG_PCLOUD_STAGES; s++)
+        printf(" %9.3f", r->seconds[s]);
+    printf(" | %8.3f %6zu %6zu %6zu %6.0f\n", t, r->ncompletion, r->model->nterminals,
+           r->model->nplacements, peak_mib());
+    printf("%-28s %9s %7s %8.3f |", "  (processor seconds)", "", "",
+           r->seg->cpu_seconds[AG_SEGMENT_CLOUD_NORMALS]);
+    double cpu = 0;
+    for (int s = 0; s < AG_PCLOUD_STAGES; s++) {
+        printf(" %9.3f", r->cpu_seconds[s]);
+        cpu += r->cpu_seconds[s];
+    }
+    printf(" | %8.3f\n", cpu);
+    fflush(stdout);
+    ag_proceduralize_cloud_free(r);
+}
+
+static ag_gen_building_options bench_building(size_t points)
+{
+    return (ag_gen_building_options){.points = points, .cols = 10, .rows = 4, .side_cols = 4,
+                                     .width = 40, .depth = 16, .height = 13, .noise = 0.01,
+                                     .origin = {486512, 5719877, 40}, .rotation = 23, .seed = 1};
+}
+
+static void pipeline_generated(const void *arg)
+{
+    size_t points = *(const size_t *)arg;
+    ag_gen_building_options o = bench_building(points);
+    ag_error err = {0};
+    ag_cloud *c;
+    double t0 = now();
+    if (ag_gen_building(&o, &c, &err)) {
+        printf("generated %zu: %s\n", points, err.text);
+        return;
+    }
+    char name[64];
+    snprintf(name, sizeof name, "generated %zuk", points / 1000);
+    pipeline_case(name, c, now() - t0);
+    ag_cloud_free(c);
+}
+
+static void pipeline_real(const char *name, const char *path)
+{
+    if (access(path, R_OK)) {
+        printf("%-28s skipped: %s is absent\n", name, path);
+        return;
+    }
+    ag_error err = {0};
+    ag_cloud *c;
+    double t0 = now();
+    if (ag_cloud_import_file(path, &c, &err)) {
+        printf("%-28s failed: %s\n", name, err.text);
+        return;
+    }
+    pipeline_case(name, c, now() - t0);
+    ag_cloud_free(c);
+}
+
+static void run_pipeline_cgal(const void *arg)
+{
+    (void)arg;
+    pipeline_real("CGAL building.ply", SHARED "/pointcloud_cgal_building/building.ply");
+}
+
+/* Consensus of 54 windows of one size (the generator's truth: windows 0..53 are the front's
+ * 40, the right side's 8 and 6 of the back's) in the 1.8M-point building. */
+static void consensus_54(const void *arg)
+{
+    (void)arg;
+    ag_gen_building_options o = bench_building(1800000);
+    ag_error err = {0};
+    ag_cloud *c;
+    if (ag_gen_building(&o, &c, &err)) {
+        printf("consensus: %s\n", err.text);
+        return;
+    }
+    /* kNN normals as the pipeline has them */
+    ag_segment_cloud_result *sr;
+    if (ag_segment_cloud_run(c, NULL, &sr, &err)) {
+        printf("consensus: %s\n", err.text);
+        return;
+    }
+    const ag_cloud_property *wp = ag_cloud_find(c, "window");
+    const int32_t *win = wp->values;
+    enum { K = 54 };
+    uint32_t start[K + 1] = {0};
+    for (size_t i = 0; i < c->n; i++)
+        if (win[i] >= 0 && win[i] < K)
+            start[win[i] + 1]++;
+    for (int w = 0; w < K; w++)
+        start[w + 1] += start[w];
+    uint32_t *idx = malloc(start[K] * sizeof *idx), fill[K];
+    memcpy(fill, start, sizeof fill);
+    ag_box boxes[K];
+    for (int w = 0; w < K; w++)
+        boxes[w] = ag_box_empty();
+    for (size_t i = 0; i < c->n; i++)
+        if (win[i] >= 0 && win[i] < K) {
+            idx[fill[win[i]]++] = (uint32_t)i;
+            ag_box_extend_point(&boxes[win[i]], c->xyz + 3 * i);
+        }
+    ag_consensus_options co = {.spacing = sr->spacing};
+    ag_consensus_model m;
+    double t0 = now(), c0 = cpu_now();
+    ag_status s = ag_consensus_build(c, idx, start, boxes, K, NULL, &co, &m, &err);
+    double t = now() - t0, tc = cpu_now() - c0;
+    if (s)
+        printf("consensus: %s\n", err.text);
+    else
+        printf("consensus of %d same-label windows (%u points) of the %zu-point building: %.3f s "
+               "(processor %.3f s), "
+               "%zu merged, %zu -> %zu points (pooled %zu); peak %.0f MiB\n",
+               K, start[K], c->n, t, tc, m.merged, m.points_before, m.points_after, m.pooled,
+               peak_mib());
+    if (!s)
+        ag_consensus_model_clear(&m);
+    free(idx);
+    ag_segment_cloud_free(sr);
+    ag_cloud_free(c);
+}
+
 /* Runs one case in a child so that its peak memory is measured alone. */
 static void isolated(void (*fn)(const void *), const void *arg)
 {
@@ -279,5 +438,14 @@ int main(void)
     for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
         isolated(run_generated, &sizes[i]);
     isolated(run_cut, NULL);
+    printf("\nthe whole pipeline (core/points/proceduralize_cloud.h): seconds per stage (wall;\n"
+           "below, processor), normals being part of segment; consensus labels, terminals,\n"
+           "placements, peak resident MiB of the case\n");
+    pipeline_header();
+    isolated(run_pipeline_cgal, NULL);
+    for (size_t i = 0; i < sizeof sizes / sizeof sizes[0]; i++)
+        isolated(pipeline_generated, &sizes[i]);
+    printf("\n");
+    isolated(consensus_54, NULL);
     return 0;
 }

@@ -1,5 +1,7 @@
 #include "workspace.h"
 
+#include "points_state.h"
+
 static ag_status unsupported(const char *what, ag_error *err)
 {
     return ag_error_set(err, AG_ERR_UNSUPPORTED, 0, "this workspace cannot %s", what);
@@ -106,6 +108,27 @@ ag_status ag_workspace_save_composed(ag_workspace *ws, ag_model_state *st,
         return unsupported("save a composed model", err);
     }
     return ws->ops->save_composed(ws, st, o, err);
+}
+
+ag_status ag_workspace_open_point_models(ag_workspace *ws, const ag_edit_op_origin *from,
+                                         struct ag_pointmodel **pm,
+                                         const struct ag_pointmodel **source, ag_error *err)
+{
+    *pm = NULL;
+    *source = NULL;
+    return ws->ops->open_point_models ? ws->ops->open_point_models(ws, from, pm, source, err)
+                                      : unsupported("open a point model", err);
+}
+
+ag_status ag_workspace_save_points(ag_workspace *ws, struct ag_points_state *st,
+                                   const ag_points_outcome *proc, const ag_edit_outcome *edit,
+                                   ag_error *err)
+{
+    if (!ws->ops->save_points) {
+        ag_points_state_clear(st);
+        return unsupported("save a point model", err);
+    }
+    return ws->ops->save_points(ws, st, proc, edit, err);
 }
 
 int ag_workspace_cancelled(ag_workspace *ws)

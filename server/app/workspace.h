@@ -14,6 +14,8 @@
  * Point clouds too (app/cloud_state.h): an upload becomes a cloud model
  * (app/usecase_import_cloud.h), segmentations are read and saved through it
  * (app/usecase_segment.h, app/usecase_mark_template.h); only the store keeps cloud models.
+ * A cloud is also proceduralized into a point model, point models are edited and their
+ * grammar and PLY terminals saved (app/usecase_points.h; app/points_folder_ws.h for folders).
  *
  * A workspace that cannot do something answers AG_ERR_UNSUPPORTED. */
 #ifndef AG_WORKSPACE_H
@@ -26,6 +28,8 @@
 #include "../core/edit/edit.h"
 #include "../core/parts/compose.h"
 #include "../core/parts/part.h"
+#include "../core/points/cloud.h"
+#include "../core/points/pointmodel.h"
 #include "../core/status.h"
 #include "../io/edit_op_json.h"
 #include "../io/import.h"
@@ -34,6 +38,9 @@
 
 typedef struct ag_workspace ag_workspace;
 struct ag_extrude_batch;
+struct ag_points_state;
+struct ag_pointmodel;
+struct ag_proceduralize_cloud_result;
 
 /* What a proceduralization found and how long it took, for the saved summary. */
 typedef struct {
@@ -52,6 +59,16 @@ typedef struct {
     double load_ms, edit_ms;
     int64_t source_version; /* a paste from another model of the store: its version */
 } ag_edit_outcome;
+
+/* What a point cloud proceduralization found and how long it took (app/usecase_points.h). */
+typedef struct {
+    const ag_cloud *input;                            /* the cloud proceduralized */
+    const struct ag_proceduralize_cloud_result *proc; /* its result */
+    ag_pointmodel_fidelity fidelity;                  /* the saved grammar's derivation against
+                                                       * the input */
+    size_t derived_points;
+    double verify_s, total_s;                         /* total: up to the save, verify excluded */
+} ag_points_outcome;
 
 /* Which part a composition brings, as the workspace knows parts. */
 typedef struct {
@@ -122,6 +139,17 @@ typedef struct {
      * model's, logged as o describes; st stays the caller's. */
     ag_status (*save_segmentation)(ag_workspace *ws, const ag_cloud_state *st,
                                    const ag_segment_outcome *o, ag_error *err);
+    /* Point models (app/usecase_points.h), each may be NULL (the cloud to proceduralize is
+     * input_cloud's). The point model to edit and, for a paste from elsewhere, its source (both the
+     * workspace's until close); */
+    ag_status (*open_point_models)(ag_workspace *ws, const ag_edit_op_origin *from,
+                                   struct ag_pointmodel **pm,
+                                   const struct ag_pointmodel **source, ag_error *err);
+    /* saves a proceduralized or edited point model (st taken and cleared; exactly one of proc
+     * and edit is given). */
+    ag_status (*save_points)(ag_workspace *ws, struct ag_points_state *st,
+                             const ag_points_outcome *proc, const ag_edit_outcome *edit,
+                             ag_error *err);
     /* Non-zero when the work should stop (a cancelled job). May be NULL. */
     int (*cancelled)(ag_workspace *ws);
     /* Progress of long work (0..1, stage name); may be NULL. */
@@ -161,6 +189,12 @@ ag_status ag_workspace_input_cloud(ag_workspace *ws, int with_properties, int ne
                                    ag_cloud_state *st, ag_error *err);
 ag_status ag_workspace_save_segmentation(ag_workspace *ws, const ag_cloud_state *st,
                                          const ag_segment_outcome *o, ag_error *err);
+ag_status ag_workspace_open_point_models(ag_workspace *ws, const ag_edit_op_origin *from,
+                                         struct ag_pointmodel **pm,
+                                         const struct ag_pointmodel **source, ag_error *err);
+ag_status ag_workspace_save_points(ag_workspace *ws, struct ag_points_state *st,
+                                   const ag_points_outcome *proc, const ag_edit_outcome *edit,
+                                   ag_error *err);
 int ag_workspace_cancelled(ag_workspace *ws);
 /* Reports progress; returns ag_workspace_cancelled. */
 int ag_workspace_progress(ag_workspace *ws, double fraction, const char *stage);

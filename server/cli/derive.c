@@ -92,6 +92,8 @@ static int write_obj_mtl(const ag_mesh *m, const char *path)
 
 int ag_cli_derive(int argc, char **argv)
 {
+    if (ag_cli_points_wanted(argc, argv, AG_CLI_POINTS_DERIVE)) /* a point cloud: cli/points.c */
+        return ag_cli_points_derive(argc, argv);
     const char *gpath = NULL, *out = NULL, *cmp = NULL;
     ag_up_axis up = AG_UP_DEFAULT;
     for (int i = 1; i < argc; i++) {

@@ -23,6 +23,8 @@ static int usage(void)
 
 int ag_cli_edit(int argc, char **argv)
 {
+    if (ag_cli_points_wanted(argc, argv, AG_CLI_POINTS_EDIT)) /* a point cloud: cli/points.c */
+        return ag_cli_points_edit(argc, argv);
     const char *dir = NULL, *oppath = NULL, *out = NULL;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--op")) {

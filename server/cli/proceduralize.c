@@ -23,6 +23,8 @@ static int usage(void)
 
 int ag_cli_proceduralize(int argc, char **argv)
 {
+    if (ag_cli_points_wanted(argc, argv, AG_CLI_POINTS_PROCEDURALIZE)) /* a point cloud: cli/points.c */
+        return ag_cli_points_proceduralize(argc, argv);
     const char *in = NULL, *dir = NULL;
     ag_up_axis up = AG_UP_DEFAULT;
     /* a grammar that misses triangles is still written, for a person to look at (exit 1) */

@@ -1,12 +1,15 @@
-/* archgram segment CLOUD --out SEG.ply [--roi BOX]... [--threshold F] [--coarse-threshold F]
- *                  [--recompute-normals] [--json]
- * Segments a point cloud into planes and clusters (§3.1) and writes every input point, in
- * input order, with its properties and int properties segment, label and piece. */
+/* archgram segment CLOUD --out SEG.ply [--roi BOX]... [--template BOX]... [--auto]
+ *                  [--threshold F] [--coarse-threshold F] [--recompute-normals] [--json]
+ * Segments a point cloud into planes and clusters (§3.1), then marks repetitions (§3.2: the
+ * copies of each template box in its facade, and with --auto the automatic elements), and
+ * writes every input point, in input order, with its properties and int properties segment,
+ * label and piece (a template's copies share its label). */
 #include <jansson.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/points/repeat.h"
 #include "../core/points/segment_cloud.h"
 #include "commands.h"
 
@@ -14,13 +17,18 @@
 
 static int usage(FILE *f)
 {
-    fputs("usage: archgram segment CLOUD --out SEG.ply|SEG.las [--roi XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX]\n"
+    fputs("usage: archgram segment CLOUD --out SEG.ply|SEG.las [--roi XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX]...\n"
+          "                        [--template XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX]... [--auto]\n"
           "                        [--threshold F] [--coarse-threshold F] [--recompute-normals]\n"
           "                        [--double] [--json]\n"
           "  --threshold F         refinement plane threshold, a fraction of the diagonal (0.01)\n"
           "  --coarse-threshold F  first pass threshold, a fraction of the diagonal (0.025)\n"
           "  --roi BOX             segment the points in BOX again, finer (input coordinates;\n"
           "                        may be given several times, applied in order)\n"
+          "  --template BOX        a box around one repeated element (a window): its copies in\n"
+          "                        the same facade become elements with its label (input\n"
+          "                        coordinates; may be given several times)\n"
+          "  --auto                mark the repeated elements found without a template too\n"
           "  --recompute-normals   use kNN normals even when the cloud has its own\n"
           "  --double              write absolute double coordinates instead of float + offset\n",
           f);
@@ -34,17 +42,6 @@ static int parse_fraction(const char *s, double *v)
     return *end || !(*v > 0 && *v < 1) ? -1 : 0;
 }
 
-static int parse_box(const char *s, double box[6])
-{
-    char *end;
-    for (int k = 0; k < 6; k++) {
-        box[k] = strtod(s, &end);
-        if (end == s || (k < 5 && *end != ',') || (k == 5 && *end))
-            return -1;
-        s = end + 1;
-    }
-    return box[0] <= box[3] && box[1] <= box[4] && box[2] <= box[5] ? 0 : -1;
-}
 
 /* Replaces (or adds) an int32 property with the given values. */
 static int set_ids(ag_cloud *c, const char *name, const int32_t *values)
@@ -63,8 +60,9 @@ static int set_ids(ag_cloud *c, const char *name, const int32_t *values)
 int ag_cli_segment(int argc, char **argv)
 {
     const char *in = NULL, *out = NULL;
-    double rois[MAX_ROI][6];
-    int nroi = 0, as_json = 0, dbl = 0;
+    double rois[MAX_ROI][6], tmpl[MAX_ROI][6];
+    const char *tmpl_arg[MAX_ROI];
+    int nroi = 0, ntmpl = 0, as_json = 0, dbl = 0, autorep = 0;
     ag_segment_cloud_options o = {0};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -88,13 +86,23 @@ int ag_cli_segment(int argc, char **argv)
                 return 2;
             }
         } else if (!strcmp(a, "--roi") && more) {
-            if (nroi == MAX_ROI || parse_box(argv[++i], rois[nroi])) {
+            if (nroi == MAX_ROI || ag_cli_parse_cloud_box(argv[++i], rois[nroi])) {
                 fprintf(stderr, "archgram segment: --roi takes XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX "
                                 "(at most %d boxes), not '%s'\n",
                         MAX_ROI, argv[i]);
                 return 2;
             }
             nroi++;
+        } else if (!strcmp(a, "--template") && more) {
+            if (ntmpl == MAX_ROI || ag_cli_parse_cloud_box(argv[++i], tmpl[ntmpl])) {
+                fprintf(stderr, "archgram segment: --template takes XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX "
+                                "(at most %d boxes), not '%s'\n",
+                        MAX_ROI, argv[i]);
+                return 2;
+            }
+            tmpl_arg[ntmpl++] = argv[i];
+        } else if (!strcmp(a, "--auto")) {
+            autorep = 1;
         } else if (!strcmp(a, "--recompute-normals")) {
             o.recompute_normals = 1;
         } else if (!strcmp(a, "--double")) {
@@ -133,6 +141,28 @@ int ag_cli_segment(int argc, char **argv)
         }
         st = ag_segment_cloud_refine(c, r, mn, mx, &o, &err);
     }
+    size_t matches = 0;
+    double t_rep = ag_cli_seconds();
+    for (int k = 0; st == AG_OK && k < ntmpl; k++) {
+        ag_box b;
+        for (int a = 0; a < 3; a++) {
+            b.min[a] = tmpl[k][a] - c->offset[a];
+            b.max[a] = tmpl[k][3 + a] - c->offset[a];
+        }
+        ag_repeat_report rep = {0};
+        st = ag_repeat_template(c, r, &b, NULL, &rep, &err);
+        if (st != AG_OK) {
+            fprintf(stderr, "%s: --template %s: %s\n", in, tmpl_arg[k], err.text);
+            ag_segment_cloud_free(r);
+            ag_cloud_free(c);
+            return 1;
+        }
+        matches += rep.nmatches;
+        ag_repeat_report_clear(&rep);
+    }
+    if (st == AG_OK && autorep)
+        st = ag_repeat_auto(c, r, NULL, NULL, &err);
+    t_rep = ag_cli_seconds() - t_rep;
     if (st != AG_OK) {
         ag_cli_report(in, &err);
         ag_segment_cloud_free(r);
@@ -158,6 +188,8 @@ int ag_cli_segment(int argc, char **argv)
             json_object_set_new(j, "planes", json_integer((json_int_t)r->nplanes));
             json_object_set_new(j, "clusters", json_integer((json_int_t)r->nclusters));
             json_object_set_new(j, "pieces", json_integer((json_int_t)r->npieces));
+            json_object_set_new(j, "elements", json_integer((json_int_t)r->nelements));
+            json_object_set_new(j, "template_matches", json_integer((json_int_t)matches));
             json_object_set_new(j, "labels", json_integer((json_int_t)r->nlabels));
             json_object_set_new(j, "unsegmented", json_integer((json_int_t)none));
             json_object_set_new(j, "diagonal", json_real(r->diagonal));
@@ -168,18 +200,22 @@ int ag_cli_segment(int argc, char **argv)
             json_object_set_new(sec, "read", json_real(t_read));
             for (int s = 0; s < AG_SEGMENT_CLOUD_STAGES; s++)
                 json_object_set_new(sec, ag_segment_cloud_stage_name(s), json_real(r->seconds[s]));
+            json_object_set_new(sec, "repeat", json_real(t_rep));
             json_object_set_new(sec, "write", json_real(t_write));
             json_object_set_new(j, "seconds", sec);
             json_dumpf(j, stdout, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(6));
             putchar('\n');
             json_decref(j);
         } else {
-            printf("%zu points: %zu planes, %zu clusters (%zu pieces), %zu labels, %zu unsegmented\n",
-                   r->n, r->nplanes, r->nclusters, r->npieces, r->nlabels, none);
+            printf("%zu points: %zu planes, %zu clusters, %zu elements (%zu pieces), %zu labels, "
+                   "%zu unsegmented\n",
+                   r->n, r->nplanes, r->nclusters, r->nelements, r->npieces, r->nlabels, none);
+            if (ntmpl)
+                printf("templates: %d, %zu matches (the templates included)\n", ntmpl, matches);
             printf("seconds: read %.3f", t_read);
             for (int s = 0; s < AG_SEGMENT_CLOUD_STAGES; s++)
                 printf(", %s %.3f", ag_segment_cloud_stage_name(s), r->seconds[s]);
-            printf(", write %.3f\n", t_write);
+            printf(", repeat %.3f, write %.3f\n", t_rep, t_write);
         }
     }
     ag_segment_cloud_free(r);

@@ -54,46 +54,54 @@ void ag_terminals_set_clear(ag_terminal_set *s)
     memset(s, 0, sizeof *s);
 }
 
-ag_status ag_terminals_collect(ag_grammar *g, ag_terminal_set *s, ag_error *err)
+ag_status ag_terminals_set_init(ag_terminal_set *s, size_t nterminals, ag_error *err)
 {
-    size_t cap = g->nterminals + 1;
+    size_t cap = nterminals + 1;
     s->path = calloc(cap, sizeof *s->path);
     s->obj = calloc(cap, sizeof *s->obj);
     s->len = calloc(cap, sizeof *s->len);
     if (!s->path || !s->obj || !s->len)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    for (size_t i = 0; i < g->nterminals; i++) {
-        ag_gterminal *t = &g->terminals[i];
+    return AG_OK;
+}
+
+ag_status ag_terminals_set_add(ag_terminal_set *s, ag_gterminal *t, char *bytes, size_t len,
+                               const char *ext, ag_error *err)
+{
+    char path[64];
+    snprintf(path, sizeof path, "terminals/%016llx.%s", (unsigned long long)fnv1a(bytes, len),
+             ext);
+    free(t->path);
+    if (!(t->path = strdup(path))) {
+        free(bytes);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t k = 0; k < s->n; k++)
+        if (!strcmp(s->path[k], path)) {
+            free(bytes); /* an equal terminal's file */
+            return AG_OK;
+        }
+    if (!(s->path[s->n] = strdup(path))) {
+        free(bytes);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    s->obj[s->n] = bytes;
+    s->len[s->n] = len;
+    s->bytes += len;
+    s->n++;
+    return AG_OK;
+}
+
+ag_status ag_terminals_collect(ag_grammar *g, ag_terminal_set *s, ag_error *err)
+{
+    ag_status st = ag_terminals_set_init(s, g->nterminals, err);
+    for (size_t i = 0; st == AG_OK && i < g->nterminals; i++) {
         char *text;
         size_t len;
-        ag_status st = ag_terminals_format(t, &text, &len, err);
-        if (st != AG_OK)
-            return st;
-        char path[64];
-        snprintf(path, sizeof path, "terminals/%016llx.obj",
-                 (unsigned long long)fnv1a(text, len));
-        free(t->path);
-        if (!(t->path = strdup(path))) {
-            free(text);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
-        size_t k = 0;
-        while (k < s->n && strcmp(s->path[k], path) != 0)
-            k++;
-        if (k < s->n) {
-            free(text);
-            continue;
-        }
-        if (!(s->path[s->n] = strdup(path))) {
-            free(text);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
-        s->obj[s->n] = text;
-        s->len[s->n] = len;
-        s->bytes += len;
-        s->n++;
+        if ((st = ag_terminals_format(&g->terminals[i], &text, &len, err)) == AG_OK)
+            st = ag_terminals_set_add(s, &g->terminals[i], text, len, "obj", err);
     }
-    return AG_OK;
+    return st;
 }
 
 ag_status ag_terminals_set_lookup(void *user, const char *path, char **obj, size_t *len,
@@ -151,6 +159,11 @@ static int safe_path(const char *p)
         s = e + 1;
     }
     return 1;
+}
+
+int ag_terminals_path_is_safe(const char *path)
+{
+    return path && safe_path(path);
 }
 
 ag_status ag_terminals_load_buffer(ag_gterminal *t, const char *data, size_t len, ag_error *err)

@@ -35,8 +35,20 @@ void ag_terminals_set_clear(ag_terminal_set *s);
 ag_status ag_terminals_set_lookup(void *user, const char *path, char **obj, size_t *len,
                                   ag_error *err);
 
+/* The parts of the collection, shared with point terminals (point_terminals.h): room in s for
+ * a grammar's terminals; and one terminal's file bytes (taken, also after a failure) named
+ * terminals/<hash of the bytes>.<ext>, set as t's path and added to s unless an equal file is
+ * there already. */
+ag_status ag_terminals_set_init(ag_terminal_set *s, size_t nterminals, ag_error *err);
+ag_status ag_terminals_set_add(ag_terminal_set *s, ag_gterminal *t, char *bytes, size_t len,
+                               const char *ext, ag_error *err);
+
 /* Sets one terminal's geometry from OBJ text in memory (e.g. a terminal kept in a database). */
 ag_status ag_terminals_load_buffer(ag_gterminal *t, const char *data, size_t len, ag_error *err);
+
+/* Whether a terminal path may be opened below the grammar's folder: relative, no "..", no
+ * empty part, no backslash. */
+int ag_terminals_path_is_safe(const char *path);
 
 /* Loads every terminal's geometry from dir/<path>. Paths must be relative and must not
  * leave dir ("..", absolute paths and backslashes are refused). */

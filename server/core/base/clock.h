@@ -6,5 +6,7 @@
 double ag_clock_ms(void);
 /* The same in seconds. */
 double ag_clock_seconds(void);
+/* Processor seconds this thread has used (per-stage figures on a shared machine). */
+double ag_clock_thread_cpu_seconds(void);
 
 #endif

@@ -112,6 +112,21 @@
 #define AG_EDIT_WEIGHT_SIZE 3.0
 #define AG_EDIT_WEIGHT_POSITION 1e-3
 
+/* ---- point clouds (core/points) ---------------------------------------------------------- */
+
+/* Resize of a point model: a node stretched past this splits in two, a pattern's cells double
+ * (the paper's 1.5 for point clouds: a stretched point set thins out sooner than a mesh). */
+#define AG_POINTS_SPLIT_RATIO 1.5
+/* ... but not on an axis thinner than this share of the node's largest extent: a wall's box
+ * has the thickness of its points (and of its windows' reveals), and a facade stretched along
+ * a side wall's thickness moves that wall, it does not make two walls of it. */
+#define AG_POINTS_THIN_SHARE 0.1
+/* Repetition (§3.2): template steps are this share of the template's size on each axis. */
+#define AG_POINTS_TEMPLATE_STEP 0.1
+/* The label rule (§3.2): box dimensions within this share, point counts within this share. */
+#define AG_POINTS_LABEL_DIMS 0.05
+#define AG_POINTS_LABEL_COUNT 0.10
+
 /* ---- extrusion (core/extrude) ------------------------------------------------------------ */
 
 /* The sweep computes every event from the planes of the edges involved, in a local frame

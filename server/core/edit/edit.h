@@ -63,6 +63,14 @@ typedef struct {
     int has_region; /* local mode: the area of effect (world box); without it, the node's
                        parent box */
     ag_box region;
+    /* resize: the stretch past which a node or a pattern's cells double (and its inverse,
+     * under which they join); 0 = AG_EDIT_SPLIT_RATIO (meshes). Point clouds use
+     * AG_POINTS_SPLIT_RATIO, the paper's 1.5. */
+    double split_ratio;
+    /* resize: a node is not split (nor a pattern's count changed) on an axis where it is
+     * thinner than this share of its largest extent (a wall's thickness); 0 =
+     * AG_EDIT_THIN_RATIO (meshes) */
+    double thin_share;
 
     /* split: axis 0..2 and the plane's world coordinate on it */
     int axis;

@@ -217,6 +217,9 @@ ag_status ag_edit_resize_solver_create(const ag_proceduralize_result *in, const 
     s->mode = op->mode;
     s->has_region = op->has_region;
     s->region = op->region;
+    s->split_ratio = op->split_ratio > 1 ? op->split_ratio : AG_EDIT_SPLIT_RATIO;
+    s->join_ratio = 1.0 / s->split_ratio;
+    s->thin_ratio = op->thin_share > 0 ? op->thin_share : AG_EDIT_THIN_RATIO;
     s->diag = ag_box_diagonal(&t->nodes[0].box);
     s->root = op->node == AG_EDIT_ROOT;
     s->frame_node = -1;

@@ -165,6 +165,9 @@ struct ag_edit_resize_solver {
     ag_box *old;              /* their boxes */
     ag__resize_system sys;
     const ag_edit_budget *budget; /* a commit's limits and stop flag (not owned), NULL */
+    /* the op's ratios for the layout: split past split_ratio, join under join_ratio, never on
+     * an axis thinner than thin_ratio of the largest (ag_edit_op.split_ratio, thin_share) */
+    double split_ratio, join_ratio, thin_ratio;
 };
 
 /* How far apart faces may be and still touch (attach): the tree's coincidence, or its exact

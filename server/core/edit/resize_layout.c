@@ -217,7 +217,7 @@ typedef struct {
 static size_t most_squeezed(const lay *L, const sibling *s, size_t m, int *axis)
 {
     size_t best = m;
-    double worst = AG_EDIT_JOIN_RATIO;
+    double worst = L->s->join_ratio;
     for (size_t i = 0; i < m; i++) {
         if (s[i].leader != (int32_t)i || s[i].stuck)
             continue;
@@ -287,7 +287,7 @@ static void merge_groups(sibling *s, size_t m, size_t a, size_t b, int axis)
             s[i].leader = (int32_t)lead;
 }
 
-/* Plain siblings of one rule (not cells of a pattern) squeezed under AG_EDIT_JOIN_RATIO on an
+/* Plain siblings of one rule (not cells of a pattern) squeezed under the join ratio on an
  * axis join with their nearest sibling of the same rule and turn along that axis, recursively,
  * until no group is squeezed or none has a neighbour: the group becomes its first member with
  * the members' sizes summed on that axis (at most the span they cover), centred on that span,
@@ -350,16 +350,16 @@ static void join_siblings(lay *L, const int32_t *units, size_t n)
 
 /* The axis on which a leaf stretched most past the split ratio from old box o to nb, -1 when
  * none did; thin axes never split. */
-static int split_axis(const ag_box *o, const ag_box *nb)
+static int split_axis(const lay *L, const ag_box *o, const ag_box *nb)
 {
     double e[3], emax = 0;
     ag_box_extents(o, e);
     for (int a = 0; a < 3; a++)
         emax = fmax(emax, e[a]);
     int axis = -1;
-    double best = AG_EDIT_SPLIT_RATIO;
+    double best = L->s->split_ratio;
     for (int a = 0; a < 3; a++) {
-        if (e[a] <= AG_EDIT_FLAT || e[a] < AG_EDIT_THIN_RATIO * emax)
+        if (e[a] <= AG_EDIT_FLAT || e[a] < L->s->thin_ratio * emax)
             continue;
         double r = ag_box_extent(nb, a) / e[a];
         if (r > best) {
@@ -377,7 +377,7 @@ static void split_leaf(lay *L, int32_t c, int depth)
     if (L->st || depth > LAYOUT_MAX_DEPTH)
         return;
     ag_box ob = oldb(L, c), nb = L->nt->nodes[c].box;
-    int axis = split_axis(&ob, &nb);
+    int axis = split_axis(L, &ob, &nb);
     if (axis < 0)
         return;
     int32_t slot, p = chain_parent(L->nt, c, &slot);
@@ -576,9 +576,9 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const ag
     } else if (L->structural && !thin) { /* thin elements are spaced out, never added */
         for (int it = 0; it < PATTERN_MAX_STEPS; it++) {
             double r = x->f * x->n / k;
-            if (r > AG_EDIT_SPLIT_RATIO && k < PATTERN_MAX_COUNT)
+            if (r > L->s->split_ratio && k < PATTERN_MAX_COUNT)
                 k *= 2;
-            else if (r < AG_EDIT_JOIN_RATIO && k > 1)
+            else if (r < L->s->join_ratio && k > 1)
                 k /= 2;
             else
                 break;
@@ -881,7 +881,7 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
             for (size_t j = 0; j < i && !ref; j++)
                 if (pl[j].grid && interleaved(&pl[j].ax[a], ax, tol))
                     ref = &pl[j].ax[a];
-            layout_axis(L, ax, &nb, &cont, a, e[a] < AG_EDIT_THIN_RATIO * emax, ref);
+            layout_axis(L, ax, &nb, &cont, a, e[a] < L->s->thin_ratio * emax, ref);
         }
     }
     for (size_t i = 0; i < n && !L->st; i++)

@@ -206,6 +206,19 @@ void ag_cloud_set(ag_cloud_property *p, size_t i, double v)
     }
 }
 
+/* s (new) gets c's frame, n points, and c's normals and properties, uninitialized. */
+static ag_status shape_like(const ag_cloud *c, size_t n, ag_cloud *s, ag_error *err)
+{
+    memcpy(s->offset, c->offset, sizeof s->offset);
+    memcpy(s->scale, c->scale, sizeof s->scale);
+    ag_status st = ag_cloud_resize(s, n, err);
+    if (st == AG_OK && c->normals)
+        st = ag_cloud_add_normals(s, err);
+    for (size_t p = 0; st == AG_OK && p < c->nprops; p++)
+        st = ag_cloud_add_property(s, c->props[p].name, c->props[p].type, NULL, err);
+    return st;
+}
+
 ag_status ag_cloud_subset(const ag_cloud *c, const uint32_t *idx, size_t k, ag_cloud **out,
                           ag_error *err)
 {
@@ -213,13 +226,7 @@ ag_status ag_cloud_subset(const ag_cloud *c, const uint32_t *idx, size_t k, ag_c
     ag_cloud *s = ag_cloud_create();
     if (!s)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    memcpy(s->offset, c->offset, sizeof s->offset);
-    memcpy(s->scale, c->scale, sizeof s->scale);
-    ag_status st = ag_cloud_resize(s, k, err);
-    if (st == AG_OK && c->normals)
-        st = ag_cloud_add_normals(s, err);
-    for (size_t p = 0; st == AG_OK && p < c->nprops; p++)
-        st = ag_cloud_add_property(s, c->props[p].name, c->props[p].type, NULL, err);
+    ag_status st = shape_like(c, k, s, err);
     if (st != AG_OK) {
         ag_cloud_free(s);
         return st;
@@ -241,20 +248,39 @@ ag_status ag_cloud_subset(const ag_cloud *c, const uint32_t *idx, size_t k, ag_c
     return AG_OK;
 }
 
+ag_status ag_cloud_clone(const ag_cloud *c, ag_cloud **out, ag_error *err)
+{
+    *out = NULL;
+    ag_cloud *s = ag_cloud_create();
+    if (!s)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    ag_status st = shape_like(c, c->n, s, err);
+    if (st != AG_OK) {
+        ag_cloud_free(s);
+        return st;
+    }
+    memcpy(s->xyz, c->xyz, 3 * c->n * sizeof *s->xyz);
+    if (c->normals)
+        memcpy(s->normals, c->normals, 3 * c->n * sizeof *s->normals);
+    for (size_t p = 0; p < c->nprops; p++)
+        memcpy(s->props[p].values, c->props[p].values, c->n * ag_scalar_size(c->props[p].type));
+    *out = s;
+    return AG_OK;
+}
+
 void ag_cloud_bounds(const ag_cloud *c, double min[3], double max[3])
 {
-    for (int a = 0; a < 3; a++) {
-        min[a] = INFINITY;
-        max[a] = -INFINITY;
-    }
+    ag_box b = ag_cloud_box(c);
+    memcpy(min, b.min, sizeof b.min);
+    memcpy(max, b.max, sizeof b.max);
+}
+
+ag_box ag_cloud_box(const ag_cloud *c)
+{
+    ag_box b = ag_box_empty();
     for (size_t i = 0; i < c->n; i++)
-        for (int a = 0; a < 3; a++) {
-            double v = c->xyz[3 * i + a];
-            if (v < min[a])
-                min[a] = v;
-            if (v > max[a])
-                max[a] = v;
-        }
+        ag_box_extend_point(&b, c->xyz + 3 * i);
+    return b;
 }
 
 double ag_cloud_diagonal(const ag_cloud *c)

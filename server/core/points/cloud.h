@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "../base/box.h"
 #include "../status.h"
 
 typedef enum {
@@ -86,8 +87,13 @@ void ag_cloud_set(ag_cloud_property *p, size_t i, double v);
 ag_status ag_cloud_subset(const ag_cloud *c, const uint32_t *idx, size_t k, ag_cloud **out,
                           ag_error *err);
 
+/* A deep copy (every property, the normals, the offset and the scale). */
+ag_status ag_cloud_clone(const ag_cloud *c, ag_cloud **out, ag_error *err);
+
 /* Local-coordinate bounds; an empty cloud gives min = +inf, max = -inf. */
 void ag_cloud_bounds(const ag_cloud *c, double min[3], double max[3]);
+/* The same as a box (the empty box for no points). */
+ag_box ag_cloud_box(const ag_cloud *c);
 /* Length of the bounds' diagonal (0 for fewer than two distinct points). */
 double ag_cloud_diagonal(const ag_cloud *c);
 

@@ -4,6 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
+#include "../base/box.h"
+#include "voxel.h"
 
 ag_status ag_cluster_components(const ag_cloud *c, const ag_ransac_graph *g, double radius,
                                 int32_t *labels, size_t min_size, size_t *ncomponents,
@@ -58,16 +61,11 @@ ag_status ag_cluster_components(const ag_cloud *c, const ag_ransac_graph *g, dou
             continue;
         }
         if (comp_of_label) {
-            if (nfrom == cap) {
-                cap = cap ? 2 * cap : 64;
-                int32_t *f = realloc(from, cap * sizeof *f);
-                if (!f) {
-                    free(comp);
-                    free(queue);
-                    free(from);
-                    return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-                }
-                from = f;
+            if (AG_ARRAY_RESERVE(from, cap, nfrom + 1)) {
+                free(comp);
+                free(queue);
+                free(from);
+                return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
             }
             from[nfrom++] = label;
         }
@@ -124,14 +122,6 @@ static uint64_t cell_key(uint64_t label, uint64_t x, uint64_t y, uint64_t z)
     return label << (3 * CELL_BITS) | x << (2 * CELL_BITS) | y << CELL_BITS | z;
 }
 
-static uint64_t mix(uint64_t k)
-{
-    k ^= k >> 33;
-    k *= 0xff51afd7ed558ccdull;
-    k ^= k >> 33;
-    k *= 0xc4ceb9fe1a85ec53ull;
-    return k ^ (k >> 33);
-}
 
 typedef struct {
     uint64_t *keys; /* UINT64_MAX = empty */
@@ -141,7 +131,7 @@ typedef struct {
 
 static uint32_t table_find(const cell_table *t, uint64_t key)
 {
-    for (size_t h = mix(key) & t->mask;; h = (h + 1) & t->mask) {
+    for (size_t h = ag__voxel_mix(key) & t->mask;; h = (h + 1) & t->mask) {
         if (t->keys[h] == key)
             return t->cell[h];
         if (t->keys[h] == UINT64_MAX)
@@ -154,7 +144,7 @@ ag_status ag_cluster_pieces(const ag_cloud *c, int32_t *labels, double cell, siz
 {
     size_t n = c->n;
     *npieces = 0;
-    double mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+    ag_box bounds = ag_box_empty();
     size_t m = 0;
     int32_t max_label = -1;
     for (size_t i = 0; i < n; i++) {
@@ -164,14 +154,9 @@ ag_status ag_cluster_pieces(const ag_cloud *c, int32_t *labels, double cell, siz
         m++;
         if (labels[i] > max_label)
             max_label = labels[i];
-        for (int a = 0; a < 3; a++) {
-            double v = c->xyz[3 * i + a];
-            if (v < mn[a])
-                mn[a] = v;
-            if (v > mx[a])
-                mx[a] = v;
-        }
+        ag_box_extend_point(&bounds, c->xyz + 3 * i);
     }
+    const double *mn = bounds.min, *mx = bounds.max;
     if (!m)
         return AG_OK;
     if ((uint64_t)max_label >= (1ull << LABEL_BITS))
@@ -204,7 +189,7 @@ ag_status ag_cluster_pieces(const ag_cloud *c, int32_t *labels, double cell, siz
         for (int a = 0; a < 3; a++)
             q[a] = (uint64_t)((c->xyz[3 * i + a] - mn[a]) / h) + 1; /* +1: room for -1 */
         uint64_t key = cell_key((uint64_t)labels[i], q[0], q[1], q[2]);
-        size_t slot = mix(key) & t.mask;
+        size_t slot = ag__voxel_mix(key) & t.mask;
         while (t.keys[slot] != UINT64_MAX && t.keys[slot] != key)
             slot = (slot + 1) & t.mask;
         if (t.keys[slot] == UINT64_MAX) {
@@ -248,14 +233,9 @@ ag_status ag_cluster_pieces(const ag_cloud *c, int32_t *labels, double cell, siz
                         }
                     }
         }
-        if (npiece == cap_sizes) {
-            cap_sizes = cap_sizes ? 2 * cap_sizes : 256;
-            uint32_t *ps = realloc(piece_size, cap_sizes * sizeof *ps);
-            if (!ps) {
-                st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-                goto out;
-            }
-            piece_size = ps;
+        if (AG_ARRAY_RESERVE(piece_size, cap_sizes, (size_t)npiece + 1)) {
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            goto out;
         }
         piece_size[npiece++] = (uint32_t)(size > UINT32_MAX ? UINT32_MAX : size);
     }

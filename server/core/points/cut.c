@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/box.h"
+#include "group.h"
 #include "ransac.h"
 
 #define RING 4.0 /* metres of ring outside the buffer where the ground plane is sampled */
@@ -82,16 +84,9 @@ typedef struct {
 
 static int grid_build(grid2 *g, const ag_cloud *c)
 {
-    double mn[2] = {INFINITY, INFINITY}, mx[2] = {-INFINITY, -INFINITY};
-    for (size_t i = 0; i < c->n; i++)
-        for (int a = 0; a < 2; a++) {
-            double v = c->xyz[3 * i + a];
-            if (v < mn[a])
-                mn[a] = v;
-            if (v > mx[a])
-                mx[a] = v;
-        }
-    double w = mx[0] - mn[0], d = mx[1] - mn[1];
+    ag_box b = ag_cloud_box(c);
+    const double *mn = b.min;
+    double w = ag_box_extent(&b, 0), d = ag_box_extent(&b, 1);
     /* about four points per cell, at least 1 m, at most 4 million cells */
     double h = c->n ? sqrt((w + 1) * (d + 1) / ((double)c->n / 4 + 1)) : 1;
     if (h < 1)
@@ -243,26 +238,9 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
             }
     } else if (method == AG_CUT_GROUND_PLANE) {
         /* each footprint's points (CSR by owner) */
-        size_t *fstart = calloc(nfp + 2, sizeof *fstart);
-        uint32_t *fmembers = malloc((n ? n : 1) * sizeof *fmembers);
-        size_t *ffill = malloc((nfp + 1) * sizeof *ffill);
-        if (!fstart || !fmembers || !ffill) {
-            free(fstart);
-            free(fmembers);
-            free(ffill);
-            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        ag_group fp;
+        if ((st = ag_group_build(&fp, owner, n, nfp, err)) != AG_OK)
             goto out;
-        }
-        for (size_t i = 0; i < n; i++)
-            if (owner[i] >= 0)
-                fstart[owner[i] + 1]++;
-        for (size_t f = 0; f < nfp; f++)
-            fstart[f + 1] += fstart[f];
-        memcpy(ffill, fstart, (nfp + 1) * sizeof *ffill);
-        for (size_t i = 0; i < n; i++)
-            if (owner[i] >= 0)
-                fmembers[ffill[owner[i]]++] = (uint32_t)i;
-        free(ffill);
         for (size_t f = 0; f < nfp; f++) {
             /* the ring around the footprint, its lowest third as the ground sample */
             double mn[2], mx[2];
@@ -280,8 +258,8 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
             int own = m < 10;
             if (own) {
                 m = 0;
-                for (size_t j = fstart[f]; j < fstart[f + 1]; j++)
-                    cand[m++] = fmembers[j];
+                for (size_t j = fp.start[f]; j < fp.start[f + 1]; j++)
+                    cand[m++] = fp.members[j];
             }
             if (!m)
                 continue;
@@ -304,8 +282,8 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
             double cxm = (mn[0] + mx[0]) / 2, cym = (mn[1] + mx[1]) / 2;
             if (stats)
                 stats[f].ground_z = -(pl.n[0] * cxm + pl.n[1] * cym + pl.d) / pl.n[2];
-            for (size_t j = fstart[f]; j < fstart[f + 1]; j++) {
-                size_t i = fmembers[j];
+            for (size_t j = fp.start[f]; j < fp.start[f + 1]; j++) {
+                size_t i = fp.members[j];
                 const double *p = c->xyz + 3 * i;
                 double zg = -(pl.n[0] * p[0] + pl.n[1] * p[1] + pl.d) / pl.n[2];
                 if (p[2] - zg < ground_height) {
@@ -315,8 +293,7 @@ ag_status ag_cut_assign(const ag_cloud *c, const ag_cut_footprint *fps, size_t n
                 }
             }
         }
-        free(fstart);
-        free(fmembers);
+        ag_group_free(&fp);
     }
     if (stats)
         for (size_t f = 0; f < nfp; f++)

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "rng.h"
 
 #define MAX_HOLES_PER_WALL 4096
@@ -36,14 +37,8 @@ static double len3(const double a[3])
 static int add_patch(patches *ps, const double o[3], const double u[3], const double v[3],
                      int triangle, int32_t plane, int32_t window)
 {
-    if (ps->n == ps->cap) {
-        size_t cap = ps->cap ? 2 * ps->cap : 64;
-        patch *p = realloc(ps->p, cap * sizeof *p);
-        if (!p)
-            return -1;
-        ps->p = p;
-        ps->cap = cap;
-    }
+    if (AG_ARRAY_RESERVE(ps->p, ps->cap, ps->n + 1))
+        return -1;
     patch *p = &ps->p[ps->n++];
     memset(p, 0, sizeof *p);
     memcpy(p->o, o, sizeof p->o);
@@ -97,14 +92,8 @@ static int add_windows(patches *ps, unsigned cols, unsigned rows, const ag_gen_b
             if (hl.s0 < 0 || hl.s1 > 1 || hl.t0 < 0 || hl.t1 > 1)
                 continue; /* does not fit this wall */
             /* the opening is a hole of the wall (patches added below do not move it) */
-            if (ps->nh == ps->caph) {
-                size_t cap = ps->caph ? 2 * ps->caph : 256;
-                hole *q = realloc(ps->h, cap * sizeof *q);
-                if (!q)
-                    return -1;
-                ps->h = q;
-                ps->caph = cap;
-            }
+            if (AG_ARRAY_RESERVE(ps->h, ps->caph, ps->nh + 1))
+                return -1;
             ps->h[ps->nh++] = hl;
             ps->p[wall_index].nholes++;
             int32_t win = (*next_window)++;

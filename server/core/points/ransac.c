@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "normals.h"
 #include "rng.h"
 
@@ -15,14 +16,8 @@ void ag_plane_list_free(ag_plane_list *l)
 
 static int list_push(ag_plane_list *l, const ag_plane *p)
 {
-    if (l->n == l->cap) {
-        size_t cap = l->cap ? 2 * l->cap : 64;
-        ag_plane *items = realloc(l->items, cap * sizeof *items);
-        if (!items)
-            return -1;
-        l->items = items;
-        l->cap = cap;
-    }
+    if (AG_ARRAY_RESERVE(l->items, l->cap, l->n + 1))
+        return -1;
     l->items[l->n++] = *p;
     return 0;
 }

@@ -3,10 +3,12 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "../base/clock.h"
 #include "../base/kdtree.h"
+#include "../base/tolerance.h"
 #include "cluster.h"
+#include "group.h"
 #include "normals.h"
 
 #define DEFAULT_SEED 0x61726368677261ull /* "archgra" */
@@ -19,20 +21,6 @@ static const char *const stage_names[AG_SEGMENT_CLOUD_STAGES] = {
 const char *ag_segment_cloud_stage_name(ag_segment_cloud_stage s)
 {
     return (unsigned)s < AG_SEGMENT_CLOUD_STAGES ? stage_names[s] : "?";
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
-static double cpu_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
 void ag_segment_cloud_free(ag_segment_cloud_result *r)
@@ -64,26 +52,14 @@ static ag_status build_members(ag_segment_cloud_result *r, ag_error *err)
 {
     free(r->member_start);
     free(r->members);
-    r->member_start = calloc(r->nsegments + 1, sizeof *r->member_start);
-    size_t total = 0;
-    for (size_t i = 0; i < r->n; i++)
-        total += r->segment[i] >= 0;
-    r->members = malloc((total ? total : 1) * sizeof *r->members);
-    if (!r->member_start || !r->members)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    for (size_t i = 0; i < r->n; i++)
-        if (r->segment[i] >= 0)
-            r->member_start[r->segment[i] + 1]++;
-    for (size_t s = 0; s < r->nsegments; s++)
-        r->member_start[s + 1] += r->member_start[s];
-    uint32_t *fill = malloc((r->nsegments + 1) * sizeof *fill);
-    if (!fill)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    memcpy(fill, r->member_start, (r->nsegments + 1) * sizeof *fill);
-    for (size_t i = 0; i < r->n; i++)
-        if (r->segment[i] >= 0)
-            r->members[fill[r->segment[i]]++] = (uint32_t)i;
-    free(fill);
+    r->member_start = NULL;
+    r->members = NULL;
+    ag_group g;
+    ag_status st = ag_group_build(&g, r->segment, r->n, r->nsegments, err);
+    if (st != AG_OK)
+        return st;
+    r->member_start = g.start;
+    r->members = g.members;
     return AG_OK;
 }
 
@@ -120,8 +96,9 @@ static void in_plane_axis(const ag_cloud *c, const uint32_t *idx, size_t m, cons
 /* A segment's frame and extents. The frame follows the building rather than the points'
  * principal axes, which turn freely for nearly square shapes: a wall or roof plane has its
  * horizontal direction and its slope line as axes, a level plane and a cluster the vertical
- * and the principal direction of their plan. */
-static void describe(const ag_cloud *c, const uint32_t *idx, size_t m, ag_segment_cloud_item *s)
+ * and the principal direction of their plan, an element its host's frame. */
+static void describe(const ag_cloud *c, const uint32_t *idx, size_t m, ag_segment_cloud_item *s,
+                     const ag_segment_cloud_item *host)
 {
     double mean[3], cov[6];
     ag_normals_covariance(c->xyz, idx, m, mean, cov);
@@ -129,7 +106,11 @@ static void describe(const ag_cloud *c, const uint32_t *idx, size_t m, ag_segmen
     ag_normals_smallest_eigenvector(cov, small, ev);
     double a0[3], a1[3], a2[3];
     const double up[3] = {0, 0, 1};
-    if (s->kind == AG_SEGMENT_CLOUD_PLANE && fabs(small[2]) < 0.9) {
+    if (host) {
+        memcpy(a0, host->axes[0], sizeof a0);
+        memcpy(a1, host->axes[1], sizeof a1);
+        memcpy(a2, host->axes[2], sizeof a2);
+    } else if (s->kind == AG_SEGMENT_CLOUD_PLANE && fabs(small[2]) < 0.9) {
         /* walls and roof planes: horizontal in-plane axis, then the slope line */
         cross3(up, small, a0);
         double l = sqrt(a0[0] * a0[0] + a0[1] * a0[1] + a0[2] * a0[2]);
@@ -143,7 +124,7 @@ static void describe(const ag_cloud *c, const uint32_t *idx, size_t m, ag_segmen
         cross3(small, a0, a1);
         memcpy(a2, small, sizeof a2);
     } else {
-        /* clusters: vertical, and the principal direction of the plan */
+        /* clusters and elements without a host: vertical, and the principal plan direction */
         in_plane_axis(c, idx, m, mean, up, a0);
         cross3(up, a0, a1);
         memcpy(a2, up, sizeof a2);
@@ -169,6 +150,9 @@ static void describe(const ag_cloud *c, const uint32_t *idx, size_t m, ag_segmen
     s->plane.d = -(small[0] * mean[0] + small[1] * mean[1] + small[2] * mean[2]);
     s->plane.count = m;
     s->count = m;
+    s->box = ag_box_empty();
+    for (size_t j = 0; j < m; j++)
+        ag_box_extend_point(&s->box, c->xyz + 3 * (size_t)idx[j]);
 }
 
 static int cmp_double_desc(const void *a, const void *b)
@@ -177,14 +161,13 @@ static int cmp_double_desc(const void *a, const void *b)
     return (x < y) - (x > y);
 }
 
-/* §3.2: same kind, sorted box dimensions within 5 %, point counts within 10 %. A small
- * absolute slack (two point spacings) keeps noise from splitting thin dimensions. */
-static int similar(const ag_segment_cloud_item *a, const ag_segment_cloud_item *b, double slack)
+int ag_segment_cloud_similar(const ag_segment_cloud_item *a, const ag_segment_cloud_item *b,
+                             double slack)
 {
     if (a->kind != b->kind)
         return 0;
     double ca = (double)a->count, cb = (double)b->count;
-    if (fabs(ca - cb) > 0.1 * (ca > cb ? ca : cb))
+    if (fabs(ca - cb) > AG_POINTS_LABEL_COUNT * (ca > cb ? ca : cb))
         return 0;
     double ea[3], eb[3];
     memcpy(ea, a->extent, sizeof ea);
@@ -192,48 +175,168 @@ static int similar(const ag_segment_cloud_item *a, const ag_segment_cloud_item *
     qsort(ea, 3, sizeof ea[0], cmp_double_desc);
     qsort(eb, 3, sizeof eb[0], cmp_double_desc);
     for (int k = 0; k < 3; k++)
-        if (fabs(ea[k] - eb[k]) > 0.05 * (ea[k] > eb[k] ? ea[k] : eb[k]) + slack)
+        if (fabs(ea[k] - eb[k]) > AG_POINTS_LABEL_DIMS * (ea[k] > eb[k] ? ea[k] : eb[k]) + slack)
             return 0;
     return 1;
 }
 
-/* Segment table, members and labels from r->segment; nplanes first ids are planes. */
+ag_status ag_segment_cloud_rebuild(const ag_cloud *c, ag_segment_cloud_result *r,
+                                   const ag_segment_cloud_spec *spec, size_t nspec,
+                                   ag_error *err)
+{
+    /* new ids: non-empty ids, planes then clusters then elements, each in id order */
+    size_t *count = calloc(nspec + 1, sizeof *count);
+    int32_t *map = malloc((nspec + 1) * sizeof *map);
+    if (!count || !map) {
+        free(count);
+        free(map);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t i = 0; i < r->n; i++)
+        if (r->segment[i] >= 0) {
+            if ((size_t)r->segment[i] >= nspec) {
+                free(count);
+                free(map);
+                return ag_error_set(err, AG_ERR_INTERNAL, 0, "point %zu has segment %d of %zu",
+                                    i + 1, (int)r->segment[i], nspec);
+            }
+            count[r->segment[i]]++;
+        }
+    int32_t next = 0;
+    size_t per_kind[3] = {0, 0, 0};
+    for (int kind = AG_SEGMENT_CLOUD_PLANE; kind <= AG_SEGMENT_CLOUD_ELEMENT; kind++)
+        for (size_t s = 0; s < nspec; s++)
+            if ((int)spec[s].kind == kind) {
+                map[s] = count[s] ? next++ : -1;
+                per_kind[kind] += count[s] > 0;
+            }
+    free(count);
+    for (size_t i = 0; i < r->n; i++)
+        if (r->segment[i] >= 0)
+            r->segment[i] = map[r->segment[i]];
+    r->nsegments = (size_t)next;
+    r->nplanes = per_kind[AG_SEGMENT_CLOUD_PLANE];
+    r->nclusters = per_kind[AG_SEGMENT_CLOUD_CLUSTERED];
+    r->nelements = per_kind[AG_SEGMENT_CLOUD_ELEMENT];
+    /* what each new id was */
+    int32_t *old_of = malloc((r->nsegments + 1) * sizeof *old_of);
+    if (!old_of) {
+        free(map);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t s = 0; s < nspec; s++)
+        if (map[s] >= 0)
+            old_of[map[s]] = (int32_t)s;
+    ag_status st = build_members(r, err);
+    if (st == AG_OK) {
+        free(r->segments);
+        r->segments = calloc(r->nsegments ? r->nsegments : 1, sizeof *r->segments);
+        if (!r->segments)
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    /* pieces: an element is one piece; the others keep theirs, renumbered densely */
+    int32_t *pmap = NULL;
+    size_t np = r->npieces + r->nsegments;
+    if (st == AG_OK && !(pmap = malloc((np + 1) * sizeof *pmap)))
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    if (st == AG_OK) {
+        for (size_t p = 0; p < np; p++)
+            pmap[p] = -1;
+        int32_t pn = 0;
+        for (size_t i = 0; i < r->n; i++) {
+            int32_t sg = r->segment[i];
+            int32_t p = sg < 0 ? -1
+                        : spec[old_of[sg]].kind == AG_SEGMENT_CLOUD_ELEMENT
+                            ? (int32_t)r->npieces + sg
+                            : r->piece[i];
+            if (p < 0 || (size_t)p >= np) {
+                r->piece[i] = -1;
+                continue;
+            }
+            if (pmap[p] < 0)
+                pmap[p] = pn++;
+            r->piece[i] = pmap[p];
+        }
+        r->npieces = (size_t)pn;
+    }
+    free(pmap);
+    /* descriptions: hosts (planes, clusters) before the elements that use their frames */
+    for (size_t s = 0; st == AG_OK && s < r->nsegments; s++) {
+        const ag_segment_cloud_spec *sp = &spec[old_of[s]];
+        ag_segment_cloud_item *it = &r->segments[s];
+        it->kind = sp->kind;
+        it->host = sp->kind == AG_SEGMENT_CLOUD_ELEMENT && sp->host >= 0 &&
+                           (size_t)sp->host < nspec
+                       ? map[sp->host]
+                       : -1;
+        describe(c, r->members + r->member_start[s], r->member_start[s + 1] - r->member_start[s],
+                 it, it->host >= 0 ? &r->segments[it->host] : NULL);
+        if (sp->kind == AG_SEGMENT_CLOUD_ELEMENT && !ag_box_is_empty(&sp->box))
+            ag_box_extend_box(&it->box, &sp->box);
+    }
+    for (size_t s = 0; st == AG_OK && s < r->nsegments; s++)
+        if (r->segments[s].host >= 0)
+            ag_box_extend_box(&r->segments[r->segments[s].host].box, &r->segments[s].box);
+    /* labels: a group's elements share one; the others by the rule within their kind */
+    int32_t *rep = NULL, *group_label = NULL;
+    int32_t max_group = -1;
+    for (size_t s = 0; s < nspec; s++)
+        if (spec[s].group > max_group)
+            max_group = spec[s].group;
+    if (st == AG_OK && (!(rep = malloc((r->nsegments + 1) * sizeof *rep)) ||
+                        !(group_label = malloc(((size_t)max_group + 2) * sizeof *group_label))))
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    if (st == AG_OK) {
+        for (int32_t g = 0; g <= max_group; g++)
+            group_label[g] = -1;
+        size_t nlabels = 0, nrep = 0;
+        for (size_t s = 0; s < r->nsegments; s++) {
+            ag_segment_cloud_item *it = &r->segments[s];
+            int32_t g = spec[old_of[s]].group;
+            it->label = -1;
+            if (it->kind == AG_SEGMENT_CLOUD_ELEMENT && g >= 0) {
+                if (group_label[g] < 0)
+                    group_label[g] = (int32_t)nlabels++;
+                it->label = group_label[g];
+                continue;
+            }
+            for (size_t l = 0; l < nrep; l++)
+                if (ag_segment_cloud_similar(&r->segments[rep[l]], it, 2 * r->spacing)) {
+                    it->label = r->segments[rep[l]].label;
+                    break;
+                }
+            if (it->label < 0) {
+                rep[nrep++] = (int32_t)s;
+                it->label = (int32_t)nlabels++;
+            }
+        }
+        r->nlabels = nlabels;
+        for (size_t i = 0; i < r->n; i++)
+            r->label[i] = r->segment[i] >= 0 ? r->segments[r->segment[i]].label : -1;
+    }
+    free(rep);
+    free(group_label);
+    free(old_of);
+    free(map);
+    return st;
+}
+
+/* Segment table, members and labels from r->segment; the nplanes first ids are planes, the
+ * rest clusters. */
 static ag_status finish(const ag_cloud *c, ag_segment_cloud_result *r, size_t nplanes,
                         ag_error *err)
 {
-    ag_status st = build_members(r, err);
-    if (st != AG_OK)
-        return st;
-    free(r->segments);
-    r->segments = calloc(r->nsegments ? r->nsegments : 1, sizeof *r->segments);
-    int32_t *rep = malloc((r->nsegments ? r->nsegments : 1) * sizeof *rep);
-    if (!r->segments || !rep) {
-        free(rep);
+    size_t ns = r->nsegments;
+    ag_segment_cloud_spec *spec = malloc((ns + 1) * sizeof *spec);
+    if (!spec)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
-    r->nplanes = nplanes;
-    r->nclusters = r->nsegments - nplanes;
-    size_t nlabels = 0;
-    for (size_t s = 0; s < r->nsegments; s++) {
-        ag_segment_cloud_item *it = &r->segments[s];
-        it->kind = s < nplanes ? AG_SEGMENT_CLOUD_PLANE : AG_SEGMENT_CLOUD_CLUSTERED;
-        describe(c, r->members + r->member_start[s], r->member_start[s + 1] - r->member_start[s], it);
-        it->label = -1;
-        for (size_t l = 0; l < nlabels; l++)
-            if (similar(&r->segments[rep[l]], it, 2 * r->spacing)) {
-                it->label = (int32_t)l;
-                break;
-            }
-        if (it->label < 0) {
-            rep[nlabels] = (int32_t)s;
-            it->label = (int32_t)nlabels++;
-        }
-    }
-    free(rep);
-    r->nlabels = nlabels;
-    for (size_t i = 0; i < r->n; i++)
-        r->label[i] = r->segment[i] >= 0 ? r->segments[r->segment[i]].label : -1;
-    return AG_OK;
+    for (size_t s = 0; s < ns; s++)
+        spec[s] = (ag_segment_cloud_spec){s < nplanes ? AG_SEGMENT_CLOUD_PLANE
+                                                      : AG_SEGMENT_CLOUD_CLUSTERED,
+                                          -1, -1, ag_box_empty()};
+    ag_status st = ag_segment_cloud_rebuild(c, r, spec, ns, err);
+    free(spec);
+    return st;
 }
 
 static ag_status alloc_result(size_t n, ag_segment_cloud_result **out, ag_error *err)
@@ -290,7 +393,7 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
     r->coarse_threshold = coarse > 0 ? coarse * r->diagonal : 0;
     progress_ctx pc = {&o, AG_SEGMENT_CLOUD_INDEX};
 
-    double t = now(), tc = cpu_now();
+    double t = ag_clock_seconds(), tc = ag_clock_thread_cpu_seconds();
     ag_kdtree *tree = NULL;
     float *variation = malloc(n * sizeof *variation);
     uint32_t *graph = malloc(n * (size_t)k * sizeof *graph);
@@ -306,12 +409,12 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
     st = ag_kdtree_build(c->xyz, NULL, n, &tree, err);
     if (st != AG_OK)
         goto done;
-    r->seconds[AG_SEGMENT_CLOUD_INDEX] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_INDEX] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_INDEX] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_INDEX] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     pc.stage = AG_SEGMENT_CLOUD_NORMALS;
     ag_normals_options no = {k, o.progress ? stage_progress : NULL, &pc};
     ag_normals_info info;
@@ -326,15 +429,15 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         view.normals = c->normals;
     }
     ag_ransac_graph g = {graph, k};
-    r->seconds[AG_SEGMENT_CLOUD_NORMALS] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_NORMALS] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_NORMALS] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_NORMALS] = ag_clock_thread_cpu_seconds() - tc;
 
     for (size_t i = 0; i < n; i++) {
         plane_of[i] = -1;
         idx[i] = (uint32_t)i;
     }
-    t = now();
-    tc = cpu_now();
+    t = ag_clock_seconds();
+    tc = ag_clock_thread_cpu_seconds();
     if (coarse > 0) {
         pc.stage = AG_SEGMENT_CLOUD_COARSE;
         ag_ransac_options ro = {.threshold = r->coarse_threshold,
@@ -351,12 +454,12 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         for (size_t i = 0; i < n; i++)
             plane_of[i] = -1;
     }
-    r->seconds[AG_SEGMENT_CLOUD_COARSE] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_COARSE] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_COARSE] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_COARSE] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     pc.stage = AG_SEGMENT_CLOUD_REFINE;
     double radius = 4 * r->spacing;
     ag_ransac_options lo = {.threshold = r->fine_threshold,
@@ -387,12 +490,12 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         if (st != AG_OK)
             goto done;
     }
-    r->seconds[AG_SEGMENT_CLOUD_REFINE] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_REFINE] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_REFINE] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_REFINE] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     size_t ncomp = 0;
     {
         /* pieces of each plane; stray pieces leave their plane (for the clustering) */
@@ -455,12 +558,12 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
         free(main_id);
         free(pseg);
     }
-    r->seconds[AG_SEGMENT_CLOUD_COMPONENTS] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_COMPONENTS] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_COMPONENTS] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_COMPONENTS] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     {
         size_t m = 0;
         for (size_t i = 0; i < n; i++) {
@@ -483,15 +586,15 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
                 r->piece[idx[j]] = (int32_t)r->npieces + (r->segment[idx[j]] - (int32_t)ncomp);
         r->npieces += ncl;
     }
-    r->seconds[AG_SEGMENT_CLOUD_CLUSTER] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_CLUSTER] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_CLUSTER] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_CLUSTER] = ag_clock_thread_cpu_seconds() - tc;
 
-    t = now();
+    t = ag_clock_seconds();
 
-    tc = cpu_now();
+    tc = ag_clock_thread_cpu_seconds();
     st = finish(c, r, ncomp, err);
-    r->seconds[AG_SEGMENT_CLOUD_LABEL] = now() - t;
-    r->cpu_seconds[AG_SEGMENT_CLOUD_LABEL] = cpu_now() - tc;
+    r->seconds[AG_SEGMENT_CLOUD_LABEL] = ag_clock_seconds() - t;
+    r->cpu_seconds[AG_SEGMENT_CLOUD_LABEL] = ag_clock_thread_cpu_seconds() - tc;
 
 done:
     if (view.normals && view.normals != c->normals)
@@ -539,71 +642,37 @@ ag_status ag_segment_cloud_refine(ag_cloud *c, ag_segment_cloud_result *r, const
         free(inside);
         return st;
     }
-    /* old segments keep their order (minus the points inside), new ones follow; planes
-     * first so that the plane/cluster split of the ids stays */
+    /* old segments keep their ids (minus the points inside), new ones follow; the rebuild
+     * orders them by kind (old planes, new planes, old clusters, new clusters, elements) */
     size_t old = r->nsegments, nnew = rs->nsegments;
-    int32_t *map = malloc((old + nnew + 1) * sizeof *map);
-    size_t *count = calloc(old + 1, sizeof *count);
-    if (!map || !count) {
-        free(map);
-        free(count);
+    ag_segment_cloud_spec *spec = malloc((old + nnew + 1) * sizeof *spec);
+    if (!spec) {
         ag_cloud_free(sub);
         free(inside);
         ag_segment_cloud_free(rs);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
-    for (size_t j = 0; j < m; j++)
-        r->segment[inside[j]] = r->piece[inside[j]] = -1;
-    for (size_t i = 0; i < c->n; i++)
-        if (r->segment[i] >= 0)
-            count[r->segment[i]]++;
-    /* new ids: surviving old planes, new planes, surviving old clusters, new clusters */
-    int32_t next = 0;
-    for (size_t s = 0; s < r->nplanes; s++)
-        map[s] = count[s] ? next++ : -1;
-    for (size_t s = 0; s < rs->nplanes; s++)
-        map[old + s] = next++;
-    size_t planes = (size_t)next;
-    for (size_t s = r->nplanes; s < old; s++)
-        map[s] = count[s] ? next++ : -1;
-    for (size_t s = rs->nplanes; s < nnew; s++)
-        map[old + s] = next++;
-    for (size_t i = 0; i < c->n; i++)
-        if (r->segment[i] >= 0)
-            r->segment[i] = map[r->segment[i]];
+    for (size_t s = 0; s < old; s++) {
+        const ag_segment_cloud_item *it = &r->segments[s];
+        /* an element keeps its host and shares a label with the elements it shared one with */
+        spec[s] = (ag_segment_cloud_spec){it->kind, it->host,
+                                          it->kind == AG_SEGMENT_CLOUD_ELEMENT ? it->label : -1,
+                                          it->kind == AG_SEGMENT_CLOUD_ELEMENT ? it->box
+                                                                               : ag_box_empty()};
+    }
+    for (size_t s = 0; s < nnew; s++)
+        spec[old + s] = (ag_segment_cloud_spec){rs->segments[s].kind, -1, -1, ag_box_empty()};
     for (size_t j = 0; j < m; j++) {
-        r->segment[inside[j]] = rs->segment[j] >= 0 ? map[old + (size_t)rs->segment[j]] : -1;
+        r->segment[inside[j]] = rs->segment[j] >= 0 ? (int32_t)(old + (size_t)rs->segment[j]) : -1;
         r->piece[inside[j]] = rs->piece[j] >= 0 ? (int32_t)r->npieces + rs->piece[j] : -1;
     }
-    r->nsegments = (size_t)next;
-    /* pieces renumbered densely */
-    size_t np = r->npieces + rs->npieces;
-    int32_t *pmap = malloc((np ? np : 1) * sizeof *pmap);
-    if (!pmap) {
-        free(map);
-        free(count);
-        free(inside);
-        ag_cloud_free(sub);
-        ag_segment_cloud_free(rs);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
-    for (size_t p = 0; p < np; p++)
-        pmap[p] = -1;
-    int32_t pn = 0;
-    for (size_t i = 0; i < c->n; i++)
-        if (r->piece[i] >= 0) {
-            if (pmap[r->piece[i]] < 0)
-                pmap[r->piece[i]] = pn++;
-            r->piece[i] = pmap[r->piece[i]];
-        }
-    r->npieces = (size_t)pn;
-    free(pmap);
-    free(map);
-    free(count);
+    r->npieces += rs->npieces;
     free(inside);
     ag_cloud_free(sub);
     ag_segment_cloud_free(rs);
-    return finish(c, r, planes, err);
+    st = ag_segment_cloud_rebuild(c, r, spec, old + nnew, err);
+    free(spec);
+    return st;
 }
 
 ag_status ag_segment_cloud_restore(const ag_cloud *c, const ag_segment_cloud_ids *ids,

@@ -18,6 +18,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "../base/box.h"
 #include "../status.h"
 #include "cloud.h"
 #include "ransac.h"
@@ -56,7 +57,12 @@ typedef struct {
     void *user;
 } ag_segment_cloud_options;
 
-typedef enum { AG_SEGMENT_CLOUD_PLANE, AG_SEGMENT_CLOUD_CLUSTERED } ag_segment_cloud_kind;
+typedef enum {
+    AG_SEGMENT_CLOUD_PLANE,
+    AG_SEGMENT_CLOUD_CLUSTERED,
+    AG_SEGMENT_CLOUD_ELEMENT, /* a repetition (§3.2, repeat.h): an element carved out of the
+                               * segments around it, sitting in a host segment (a wall) */
+} ag_segment_cloud_kind;
 
 typedef struct {
     ag_segment_cloud_kind kind;
@@ -69,6 +75,9 @@ typedef struct {
     double axes[3][3];
     double extent[3];       /* size along each axis */
     int32_t label;
+    int32_t host;           /* elements: the segment they sit in, else -1 */
+    ag_box box;             /* the node box (cloud-local, axis-aligned): the points' bounds, an
+                             * element's matched box, a host's grown to hold its elements */
 } ag_segment_cloud_item;
 
 typedef struct {
@@ -83,7 +92,8 @@ typedef struct {
     uint32_t *members;         /* point indices of each segment, ascending */
     size_t nlabels;
     size_t ncoarse;            /* planes of the coarse pass */
-    size_t nplanes, nclusters; /* segments of each kind */
+    size_t nplanes, nclusters; /* segments of each kind: planes first, then clusters, */
+    size_t nelements;          /* then elements */
     double diagonal, spacing;  /* metres */
     double coarse_threshold, fine_threshold, cluster_tolerance; /* metres, as used */
     double seconds[AG_SEGMENT_CLOUD_STAGES];     /* wall clock */
@@ -117,5 +127,29 @@ ag_status ag_segment_cloud_restore(const ag_cloud *c, const ag_segment_cloud_ids
                                    ag_segment_cloud_result **out, ag_error *err);
 
 void ag_segment_cloud_free(ag_segment_cloud_result *r);
+
+/* What a stage that reassigns points (ROI refinement, repetition) says about each segment id
+ * it uses in r->segment. */
+typedef struct {
+    ag_segment_cloud_kind kind;
+    int32_t host;   /* elements: the id of their host (a plane or cluster id), else -1 */
+    int32_t group;  /* elements of one group >= 0 share a label whatever the rule says (a
+                     * template's matches); -1: labelled by the rule */
+    ag_box box;     /* elements: the node box */
+} ag_segment_cloud_spec;
+
+/* After r->segment was reassigned to ids 0..nspec-1 described by spec: drops the ids left
+ * without points, renumbers (planes, clusters, elements, each in id order), and rebuilds the
+ * members, descriptions, node boxes (hosts grown to hold their elements) and labels (§3.2:
+ * within each kind, box dimensions within 5 % and point counts within 10 %; a group's
+ * elements one label of their own). Pieces are renumbered densely; an element is one piece. */
+ag_status ag_segment_cloud_rebuild(const ag_cloud *c, ag_segment_cloud_result *r,
+                                   const ag_segment_cloud_spec *spec, size_t nspec,
+                                   ag_error *err);
+
+/* The label rule of §3.2 for two segments (of one kind): sorted box dimensions within 5 %
+ * (plus slack metres) and point counts within 10 %. */
+int ag_segment_cloud_similar(const ag_segment_cloud_item *a, const ag_segment_cloud_item *b,
+                             double slack);
 
 #endif

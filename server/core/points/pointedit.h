@@ -1,0 +1,31 @@
+/* Edits of a point model (§5): the structural edits of core/edit (edit.h) run on the model's
+ * proxy, and their output read back as placements (pointmodel.h).
+ *
+ * - resize: the attachment equations and their sparse least squares (core/edit/resize*), with
+ *   the point-cloud split ratio 1.5 (AG_POINTS_SPLIT_RATIO: a node stretched past it, or a
+ *   pattern's cells, double; squeezed under its inverse, they join), the node's density kept
+ *   when it is derived (stretch compensation, resample.h) and the seams between placements that
+ *   now overlap thinned;
+ * - paste (insert or replace x fill or derive, also from another point model: its terminals
+ *   come along), the copied node turned by quarter turns to face the way the paste node faces;
+ * - split, remove; join keeps its placements (a joined node is a union of placements).
+ * An op names nodes of the model's tree (pm->em->proc->tree), as ops on meshes do. The result
+ * is a new model, built; a caller that keeps only the grammar reads it back through its
+ * grammar text (app/points_state.h) so that its node ids are the ones a reload gives. */
+#ifndef AG_POINTEDIT_H
+#define AG_POINTEDIT_H
+
+#include "../edit/edit.h"
+#include "../status.h"
+#include "pointmodel.h"
+
+/* Applies op to pm (unchanged); source: a paste's source model (NULL: pm itself). rep (may be
+ * NULL) gets the solve figures and the placements per terminal of the new model ("L<n>"). */
+ag_status ag_pointedit_apply(const ag_pointmodel *pm, const ag_edit_op *op,
+                             const ag_pointmodel *source, ag_pointmodel **out,
+                             ag_edit_report *rep, ag_error *err);
+
+/* A deep copy of a model's terminals and placements (not built). */
+ag_status ag_pointedit_copy(const ag_pointmodel *pm, ag_pointmodel **out, ag_error *err);
+
+#endif
