@@ -38,6 +38,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     memset(&S, 0, sizeof S);
     S.plan = plan;
     S.err = err;
+    S.no_winding_repair = opt && opt->no_winding_repair;
     ag_budget own;
     if (opt && opt->budget) {
         S.budget = opt->budget;
@@ -289,6 +290,17 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             settle_deferred(&S);
             continue;
         }
+        if (S.made.n && (!more || ev.z > S.made_z + AG_EXTRUDE_WINDING_PROBE * S.d1)) {
+            /* every event of the height the last corners were made at is handled: do the
+             * chains still form a valid plan just above it? */
+            if (ag__skel_winding_repair(&S)) {
+                /* the rebuilt plan's events may come before this one */
+                if (more)
+                    ag__skel_push(&S, &ev);
+                ag__skel_schedule_touched(&S);
+                continue;
+            }
+        }
         if (!more || ev.z > limit)
             break;
         if (ev.type == AG_EVENT_ANCHOR) {
@@ -368,6 +380,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     free(S.W.speed);
     free(S.W.cand);
     free(S.deferred.arr);
+    free(S.made.arr);
     ag_status st = S.st;
     if (st == AG_OK)
         st = ag_shell_finish(S.shell, S.d1);
