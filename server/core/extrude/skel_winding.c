@@ -77,6 +77,29 @@ static double seg_seg_dist(const double *a, const double *b, const double *c, co
                 fmin(seg_point_dist(c, a, b), seg_point_dist(d, a, b)));
 }
 
+/* The point where the lines of edges e and f are at height z; 0 when they are parallel. */
+static int lines_meet(const sk *S, uint32_t e, uint32_t f, double z, double *x, double *y)
+{
+    const sk_edge *a = &S->e[e], *b = &S->e[f];
+    double det = a->nx * b->ny - a->ny * b->nx;
+    if (fabs(det) <= AG_EXTRUDE_PARALLEL)
+        return 0;
+    double ca = a->c + a->s * z, cb = b->c + b->s * z;
+    *x = (ca * b->ny - cb * a->ny) / det;
+    *y = (a->nx * cb - b->nx * ca) / det;
+    return 1;
+}
+
+/* Is p, at the current height, at an end of segment ab or cd? Chains that cross just above
+ * an intersection's point part from that point, where they have their corners; a crossing
+ * away from every corner is older than this height (a missed event) and not repaired. */
+static int at_an_end(const double *p, const double *a, const double *b, const double *c,
+                     const double *d, double tol)
+{
+    return hypot(p[0] - a[0], p[1] - a[1]) <= tol || hypot(p[0] - b[0], p[1] - b[1]) <= tol ||
+           hypot(p[0] - c[0], p[1] - c[1]) <= tol || hypot(p[0] - d[0], p[1] - d[1]) <= tol;
+}
+
 /* Do edges e and f cross at the probe height while touching at the current one? */
 static int chains_cross(const sk *S, uint32_t e, uint32_t f, double z, double zp)
 {
@@ -92,6 +115,9 @@ static int chains_cross(const sk *S, uint32_t e, uint32_t f, double z, double zp
         fmin(a[1], b[1]) > fmax(c[1], d[1]) + tol || fmin(c[1], d[1]) > fmax(a[1], b[1]) + tol)
         return 0;
     if (seg_seg_dist(a, b, c, d) > tol)
+        return 0;
+    double p[2];
+    if (!lines_meet(S, e, f, z, &p[0], &p[1]) || !at_an_end(p, a, b, c, d, tol + (zp - z)))
         return 0;
     seg_at(S, e, zp, a, b);
     seg_at(S, f, zp, c, d);
@@ -120,19 +146,6 @@ static int cmp_cut(const void *x, const void *y)
 {
     const wcut *a = x, *b = y;
     return a->t < b->t ? -1 : a->t > b->t;
-}
-
-/* The point where the lines of edges e and f are at height z; 0 when they are parallel. */
-static int lines_meet(const sk *S, uint32_t e, uint32_t f, double z, double *x, double *y)
-{
-    const sk_edge *a = &S->e[e], *b = &S->e[f];
-    double det = a->nx * b->ny - a->ny * b->nx;
-    if (fabs(det) <= AG_EXTRUDE_PARALLEL)
-        return 0;
-    double ca = a->c + a->s * z, cb = b->c + b->s * z;
-    *x = (ca * b->ny - cb * a->ny) / det;
-    *y = (a->nx * cb - b->nx * ca) / det;
-    return 1;
 }
 
 /* One vertex per point of the current height (the pieces' ends at one point share it). */
@@ -169,7 +182,7 @@ static int rebuild(sk *S, double z, double zp)
     for (size_t i = 0; i < n; i++)
         if (!edge_ready(S, S->live_e[i]))
             return 0;
-    int ok = 0;
+    int ok = 0, why = 0;
     double *segs = malloc(4 * n * sizeof *segs);
     wcross *X = NULL;
     wcut *cuts = NULL;
@@ -199,10 +212,13 @@ static int rebuild(sk *S, double z, double zp)
                 const double *mid = E->end == F->start ? b : a;
                 if (ag_pred_orient2d(far_e, mid, far_f) != 0)
                     continue;
-                goto refuse;
+                { why = 1; goto refuse; }
             }
             if (adjacent || !ag_pred_segments_cross(a, b, c, d))
-                goto refuse; /* a two-edge loop, or a touch / overlap at the probe height */
+                { why = 2; goto refuse; } /* a two-edge loop, or a touch / overlap at the probe height */
+            if (E->s < 0 || F->s < 0)
+                { why = 3; goto refuse; } /* parts of a growing plan meeting from outside: their split
+                              * events unite them (skel_event.c) */
             if (ag_array_reserve((void **)&X, &capx, nx + 1, sizeof *X) != AG_OK)
                 goto nomem;
             /* parameters of the crossing along both (double: only for ordering) */
@@ -218,19 +234,20 @@ static int rebuild(sk *S, double z, double zp)
             /* where it is at the current height: it must be there already (touching) */
             double pz[2], sa[2], sb[2], sc[2], sd[2];
             if (!lines_meet(S, S->live_e[i], S->live_e[j], z, &w->x, &w->y))
-                goto refuse;
+                { why = 4; goto refuse; }
             pz[0] = w->x;
             pz[1] = w->y;
             seg_at(S, S->live_e[i], z, sa, sb);
             seg_at(S, S->live_e[j], z, sc, sd);
             double tol = AG_EXTRUDE_NEAR_POINTS * S->d2 + (zp - z);
-            if (seg_point_dist(pz, sa, sb) > tol || seg_point_dist(pz, sc, sd) > tol)
-                goto refuse;
+            if (seg_point_dist(pz, sa, sb) > tol || seg_point_dist(pz, sc, sd) > tol ||
+                !at_an_end(pz, sa, sb, sc, sd, tol))
+                { why = 5; goto refuse; }
         }
     }
     ag__skel_work(S, n * n / 16 + 1);
     if (!nx || S->st != AG_OK)
-        goto refuse;
+        { why = 6; goto refuse; }
     /* each edge's cuts, in order along it */
     cuts = malloc(2 * nx * sizeof *cuts);
     if (!cuts)
@@ -253,7 +270,7 @@ static int rebuild(sk *S, double z, double zp)
         qsort(&cuts[W[i].first], W[i].n, sizeof *cuts, cmp_cut);
         for (size_t k = 1; k < W[i].n; k++)
             if (!(cuts[W[i].first + k].t > cuts[W[i].first + k - 1].t))
-                goto refuse; /* three edges through one point at the probe height */
+                { why = 7; goto refuse; } /* three edges through one point at the probe height */
     }
     /* pieces: edge i has n_i + 1 of them; piece p of edge i is number first + i + p */
     npieces = ncuts + n;
@@ -276,7 +293,7 @@ static int rebuild(sk *S, double z, double zp)
             double pr[2] = {pt[0] - 2 * off * E->nx, pt[1] - 2 * off * E->ny};
             long wl = winding(S, segs, n, pt), wr = winding(S, segs, n, pr);
             if (wl != wr + 1)
-                goto refuse; /* the side points were not on the two sides of this piece only */
+                { why = 8; goto refuse; } /* the side points were not on the two sides of this piece only */
             keep[W[i].first + i + p] = wl >= 1 && wr <= 0;
         }
     }
@@ -290,9 +307,9 @@ static int rebuild(sk *S, double z, double zp)
         while (j < n && W[j].edge != f)
             j++;
         if (j == n)
-            goto refuse;
+            { why = 9; goto refuse; }
         if (keep[W[i].first + i + W[i].n] != keep[W[j].first + j])
-            goto refuse;
+            { why = 10; goto refuse; }
     }
     cpair = malloc(4 * nx * sizeof *cpair);
     if (!cpair)
@@ -306,7 +323,7 @@ static int rebuild(sk *S, double z, double zp)
         size_t ib = W[i].first + i + pi, ia = ib + 1, jb = W[j].first + j + pj, ja = jb + 1;
         int nin = keep[ib] + keep[jb], nout = keep[ia] + keep[ja];
         if (nin != nout)
-            goto refuse;
+            { why = 11; goto refuse; }
         for (int r = 0; r < 4; r++)
             cpair[4 * q + r] = NONE;
         if (nin == 2) {
@@ -429,6 +446,10 @@ nomem:
     ag__skel_fail(S, AG_ERR_NOMEM);
 refuse:
     ok = 0;
+#ifdef WDEBUG
+    fprintf(stderr, "refused (%d) at z %.9g, %zu edges, %zu crossings\n", why, z, n, nx);
+#endif
+    (void)why;
 done:
     free(segs);
     free(X);
