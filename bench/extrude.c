@@ -635,6 +635,9 @@ static void grid_stress_with(size_t count, int repair)
             w_refused += r.stats.winding_refused;
             w_dropped += r.stats.winding_pieces_dropped;
             w_good += r.stats.winding_repairs && !not_good(&r);
+            if (r.stats.winding_repairs)
+                printf("    rebuilt by the winding rule grid%zu: %s\n", i,
+                       not_good(&r) ? not_good(&r) : "good");
         }
         if (st == AG_ERR_INVALID || st == AG_ERR_EMPTY) {
             rejected++;

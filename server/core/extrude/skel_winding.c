@@ -10,7 +10,6 @@
  * or that has touching or overlapping pieces at the probe height, is left as it is and
  * counted as refused (the building's check judges the result). */
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -182,7 +181,7 @@ static int rebuild(sk *S, double z, double zp)
     for (size_t i = 0; i < n; i++)
         if (!edge_ready(S, S->live_e[i]))
             return 0;
-    int ok = 0, why = 0;
+    int ok = 0;
     double *segs = malloc(4 * n * sizeof *segs);
     wcross *X = NULL;
     wcut *cuts = NULL;
@@ -210,14 +209,16 @@ static int rebuild(sk *S, double z, double zp)
                 const double *far_e = E->end == F->start ? a : b;
                 const double *far_f = E->end == F->start ? d : c;
                 const double *mid = E->end == F->start ? b : a;
-                if (ag_pred_orient2d(far_e, mid, far_f) != 0)
+                if (ag_pred_orient2d(far_e, mid, far_f) != 0 ||
+                    (mid[0] - far_e[0]) * (far_f[0] - mid[0]) +
+                            (mid[1] - far_e[1]) * (far_f[1] - mid[1]) > 0)
                     continue;
-                { why = 1; goto refuse; }
+                goto refuse;
             }
             if (adjacent || !ag_pred_segments_cross(a, b, c, d))
-                { why = 2; goto refuse; } /* a two-edge loop, or a touch / overlap at the probe height */
+                goto refuse; /* a two-edge loop, or a touch / overlap at the probe height */
             if (E->s < 0 || F->s < 0)
-                { why = 3; goto refuse; } /* parts of a growing plan meeting from outside: their split
+                goto refuse; /* parts of a growing plan meeting from outside: their split
                               * events unite them (skel_event.c) */
             if (ag_array_reserve((void **)&X, &capx, nx + 1, sizeof *X) != AG_OK)
                 goto nomem;
@@ -234,7 +235,7 @@ static int rebuild(sk *S, double z, double zp)
             /* where it is at the current height: it must be there already (touching) */
             double pz[2], sa[2], sb[2], sc[2], sd[2];
             if (!lines_meet(S, S->live_e[i], S->live_e[j], z, &w->x, &w->y))
-                { why = 4; goto refuse; }
+                goto refuse;
             pz[0] = w->x;
             pz[1] = w->y;
             seg_at(S, S->live_e[i], z, sa, sb);
@@ -242,12 +243,12 @@ static int rebuild(sk *S, double z, double zp)
             double tol = AG_EXTRUDE_NEAR_POINTS * S->d2 + (zp - z);
             if (seg_point_dist(pz, sa, sb) > tol || seg_point_dist(pz, sc, sd) > tol ||
                 !at_an_end(pz, sa, sb, sc, sd, tol))
-                { why = 5; goto refuse; }
+                goto refuse;
         }
     }
     ag__skel_work(S, n * n / 16 + 1);
     if (!nx || S->st != AG_OK)
-        { why = 6; goto refuse; }
+        goto refuse;
     /* each edge's cuts, in order along it */
     cuts = malloc(2 * nx * sizeof *cuts);
     if (!cuts)
@@ -270,7 +271,7 @@ static int rebuild(sk *S, double z, double zp)
         qsort(&cuts[W[i].first], W[i].n, sizeof *cuts, cmp_cut);
         for (size_t k = 1; k < W[i].n; k++)
             if (!(cuts[W[i].first + k].t > cuts[W[i].first + k - 1].t))
-                { why = 7; goto refuse; } /* three edges through one point at the probe height */
+                goto refuse; /* three edges through one point at the probe height */
     }
     /* pieces: edge i has n_i + 1 of them; piece p of edge i is number first + i + p */
     npieces = ncuts + n;
@@ -293,7 +294,7 @@ static int rebuild(sk *S, double z, double zp)
             double pr[2] = {pt[0] - 2 * off * E->nx, pt[1] - 2 * off * E->ny};
             long wl = winding(S, segs, n, pt), wr = winding(S, segs, n, pr);
             if (wl != wr + 1)
-                { why = 8; goto refuse; } /* the side points were not on the two sides of this piece only */
+                goto refuse; /* the side points were not on the two sides of this piece only */
             keep[W[i].first + i + p] = wl >= 1 && wr <= 0;
         }
     }
@@ -307,10 +308,33 @@ static int rebuild(sk *S, double z, double zp)
         while (j < n && W[j].edge != f)
             j++;
         if (j == n)
-            { why = 9; goto refuse; }
+            goto refuse;
         if (keep[W[i].first + i + W[i].n] != keep[W[j].first + j])
-            { why = 10; goto refuse; }
+            goto refuse;
     }
+    /* what is removed must have no extent at this height: chains that overlap already (an
+     * older overlap, not this height's doing) would leave a hole where they are cut */
+    for (size_t i = 0; i < n; i++)
+        for (size_t p = 0; p <= W[i].n; p++) {
+            if (keep[W[i].first + i + p])
+                continue;
+            double a[2], b[2], pa[2], pb[2];
+            seg_at(S, W[i].edge, z, a, b);
+            if (p) {
+                const wcross *c = &X[cuts[W[i].first + p - 1].x];
+                pa[0] = c->x, pa[1] = c->y;
+            } else {
+                pa[0] = a[0], pa[1] = a[1];
+            }
+            if (p < W[i].n) {
+                const wcross *c = &X[cuts[W[i].first + p].x];
+                pb[0] = c->x, pb[1] = c->y;
+            } else {
+                pb[0] = b[0], pb[1] = b[1];
+            }
+            if (hypot(pb[0] - pa[0], pb[1] - pa[1]) > AG_EXTRUDE_NEAR_POINTS * S->d2)
+                goto refuse;
+        }
     cpair = malloc(4 * nx * sizeof *cpair);
     if (!cpair)
         goto nomem;
@@ -323,7 +347,7 @@ static int rebuild(sk *S, double z, double zp)
         size_t ib = W[i].first + i + pi, ia = ib + 1, jb = W[j].first + j + pj, ja = jb + 1;
         int nin = keep[ib] + keep[jb], nout = keep[ia] + keep[ja];
         if (nin != nout)
-            { why = 11; goto refuse; }
+            goto refuse;
         for (int r = 0; r < 4; r++)
             cpair[4 * q + r] = NONE;
         if (nin == 2) {
@@ -337,20 +361,6 @@ static int rebuild(sk *S, double z, double zp)
         }
     }
     /* --- nothing changed so far: now the plan is rebuilt ------------------------------- */
-#ifdef WDEBUG
-    fprintf(stderr, "repair at z %.9g (real %.9g) zp %.9g: %zu edges %zu crossings\n", z, ag__skel_real_z(S, z), zp, n, nx);
-    for (size_t q = 0; q < nx; q++)
-        fprintf(stderr, "  X%zu: edges %u (loop edge %d s %g) x %u (loop edge %d s %g) at %.9g %.9g t %.6g %.6g\n", q, W[X[q].i].edge, S->e[W[X[q].i].edge].edge, S->e[W[X[q].i].edge].s, W[X[q].j].edge, S->e[W[X[q].j].edge].edge,S->e[W[X[q].j].edge].s, X[q].x + S->ox, X[q].y + S->oy, X[q].ti, X[q].tj);
-    for (size_t i = 0; i < n; i++) {
-        const sk_edge *E = &S->e[W[i].edge];
-        double a[2], b[2];
-        seg_at(S, W[i].edge, z, a, b);
-        fprintf(stderr, "  edge %u (loop edge %d, s %g face %u): (%.6g %.6g)-(%.6g %.6g) keep", W[i].edge, E->edge, E->s, E->face, a[0] + S->ox, a[1] + S->oy, b[0] + S->ox, b[1] + S->oy);
-        for (size_t p = 0; p <= W[i].n; p++)
-            fprintf(stderr, " %d", keep[W[i].first + i + p]);
-        fprintf(stderr, "\n");
-    }
-#endif
     ok = 1;
     for (size_t i = 0; i < n && S->st == AG_OK; i++) {
         uint32_t e = W[i].edge;
@@ -446,10 +456,6 @@ nomem:
     ag__skel_fail(S, AG_ERR_NOMEM);
 refuse:
     ok = 0;
-#ifdef WDEBUG
-    fprintf(stderr, "refused (%d) at z %.9g, %zu edges, %zu crossings\n", why, z, n, nx);
-#endif
-    (void)why;
 done:
     free(segs);
     free(X);
