@@ -578,6 +578,7 @@ static void grid_profiles(ag_plan *p, double h)
     ag_plan_add_profile(p, "terrace", terrace, 5, NULL, NULL, NULL);
 }
 
+
 /* --grid-dump N: the description of stress plan N (before validation) goes to this file */
 static long dump_index = -1;
 static const char *dump_path = NULL;
@@ -585,7 +586,8 @@ static const char *dump_path = NULL;
 static void grid_stress_with(size_t count, int repair);
 static void grid_stress(size_t count)
 {
-    grid_stress_with(count, 0);
+    if (!dump_path)
+        grid_stress_with(count, 0);
     grid_stress_with(count, 1);
 }
 
@@ -622,6 +624,10 @@ static void grid_stress_with(size_t count, int repair)
             if (ag_plan_write_json(p, &doc, NULL) == AG_OK)
                 json_dump_file(doc, dump_path, JSON_INDENT(1));
             json_decref(doc);
+        }
+        if (dump_path && (long)i != dump_index) {
+            ag_plan_free(p); /* only the plan asked for is written and extruded */
+            continue;
         }
         ag_mesh *m = ag_mesh_create();
         ag_extrude_result r;
