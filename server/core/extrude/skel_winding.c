@@ -5,10 +5,13 @@
  * only when the region on its left has winding number 1 and the one on its right 0 (it
  * bounds a region of positive winding); the kept pieces are linked into new corners at the
  * crossings, the other pieces end at the current height. The new plan is again one of
- * simple loops. Only crossings that already touch at the current height are the
- * intersections' doing (others are later events): a plan whose crossings are not all such,
- * or that has touching or overlapping pieces at the probe height, is left as it is and
- * counted as refused (the building's check judges the result). */
+ * simple loops. Only crossings that already touch at the current height, at a corner, are
+ * this height's doing (others are later events or older overlaps), and only pieces of no
+ * extent at the current height can be removed there without a hole: a plan whose
+ * crossings or removed pieces are not all such, or that has touching or overlapping pieces
+ * at the probe height, is left as it is and counted as refused (the building's check
+ * judges the result). Parts of a growing plan (overhangs) that meet from outside are
+ * united the same way. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -217,9 +220,6 @@ static int rebuild(sk *S, double z, double zp)
             }
             if (adjacent || !ag_pred_segments_cross(a, b, c, d))
                 goto refuse; /* a two-edge loop, or a touch / overlap at the probe height */
-            if (E->s < 0 || F->s < 0)
-                goto refuse; /* parts of a growing plan meeting from outside: their split
-                              * events unite them (skel_event.c) */
             if (ag_array_reserve((void **)&X, &capx, nx + 1, sizeof *X) != AG_OK)
                 goto nomem;
             /* parameters of the crossing along both (double: only for ordering) */
@@ -429,7 +429,8 @@ static int rebuild(sk *S, double z, double zp)
                 ag__skel_seg(S, E->face, ve, vs);
         }
     }
-    /* new corners at the crossings, then the dropped pieces' edges go */
+    /* new corners at the crossings, then the dropped pieces' edges go (the pieces are
+     * live edges already: ag__skel_add_edge lists them) */
     for (size_t q = 0; q < nx && S->st == AG_OK; q++)
         for (int r = 0; r < 4; r += 2)
             if (cpair[4 * q + r] != NONE) {
@@ -443,14 +444,6 @@ static int rebuild(sk *S, double z, double zp)
         for (size_t p = 0; p <= W[i].n; p++)
             if (!keep[W[i].first + i + p])
                 ag__skel_kill_edge(S, piece_id[W[i].first + i + p]);
-    for (size_t i = 0; i < n && S->st == AG_OK; i++)
-        for (size_t p = 1; p <= W[i].n; p++) {
-            uint32_t g = piece_id[W[i].first + i + p];
-            if (S->e[g].alive &&
-                (ag_array_reserve((void **)&S->live_e, &S->cap_live_e, S->nlive_e + 1,
-                                  sizeof *S->live_e) == AG_OK))
-                S->live_e[S->nlive_e++] = g;
-        }
     goto done;
 nomem:
     ag__skel_fail(S, AG_ERR_NOMEM);
