@@ -131,7 +131,7 @@ int main(void)
            "request; bench/http.sh)\n",
            read, token, fresh, role, token + role, (token + role) / read * 100);
     json_decref(made);
-    ag_app_shutdown(app);
+    ag_app_shutdown(app, -1);
     ag_app_free(app);
     char cmd[200];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);

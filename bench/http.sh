@@ -45,7 +45,7 @@ start() {
   wsport=$2
   shift 2
   build/archgramd --port "$port" --ws-port "$wsport" --bind 127.0.0.1 --db "$TMP/$name.db" \
-    --demo --no-web "$@" >"$TMP/$name.out" 2>"$TMP/$name.err" &
+    --demo --no-web --rate-rest 0 "$@" >"$TMP/$name.out" 2>"$TMP/$name.err" &
   PIDS="$PIDS $!"
   pid=$!
   i=0

@@ -31,6 +31,7 @@ const ag_op_kind ag_optable[] = {
     {"plan",        ag_plan_edit_validate,         ag_plan_edit_apply,         NULL,                    AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL, AG_REBASE_OVER_CONTENT},
     {"profile",     ag_plan_edit_validate,         ag_plan_edit_apply,         NULL,                    AG_OP_CLIENT | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, NULL, AG_REBASE_OVER_CONTENT},
     {"proceduralize", NULL,                        NULL,                       NULL,                    AG_OP_GEOMETRY,               AG_OP_STRUCTURAL, "POST /api/v1/models/{id}/proceduralize", AG_REBASE_NEVER},
+    {"segment",     NULL,                          NULL,                       NULL,                    AG_OP_GEOMETRY,               AG_OP_STRUCTURAL, "POST /api/v1/models/{id}/segment", AG_REBASE_NEVER},
     {"grammar",     NULL,                          NULL,                       NULL,                    AG_OP_UNDOABLE | AG_OP_GEOMETRY, AG_OP_STRUCTURAL, "PUT /api/v1/models/{id}/grammar", AG_REBASE_NEVER},
 };
 const size_t ag_optable_count = sizeof ag_optable / sizeof ag_optable[0];

@@ -1,7 +1,5 @@
 #include "proceduralize_job.h"
 
-#include <stdio.h>
-
 #include "cloud_pipeline.h"
 #include "store_ws.h"
 #include "usecase_proceduralize.h"
@@ -16,16 +14,8 @@ static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_p
     ag_status s = ag_store_services_env(services, &env, err);
     if (s != AG_OK)
         return s;
-    char cid[48];
-    snprintf(cid, sizeof cid, "job-%lld", (long long)job);
     ag_store_ws w;
-    ag_store_ws_init(&w, &(ag_store_ws_options){.env = env,
-                                                .model = pj->model,
-                                                .base = pj->base,
-                                                .author = pj->author,
-                                                .cid = cid,
-                                                .job = ctx,
-                                                .job_id = job});
+    ag_store_ws_init_job(&w, &env, ctx, job, pj->model, pj->base, pj->author);
     int cloud = 0;
     s = ag_cloud_pipeline_is_cloud(env.db, pj->model, &cloud, err);
     ag_usecase_proceduralize_result r;

@@ -1,7 +1,5 @@
 #include "segment_job.h"
 
-#include <stdio.h>
-
 #include "store_ws.h"
 #include "usecase_segment.h"
 
@@ -15,16 +13,8 @@ static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_p
     ag_status s = ag_store_services_env(services, &env, err);
     if (s != AG_OK)
         return s;
-    char cid[48];
-    snprintf(cid, sizeof cid, "job-%lld", (long long)job);
     ag_store_ws w;
-    ag_store_ws_init(&w, &(ag_store_ws_options){.env = env,
-                                                .model = sj->model,
-                                                .base = sj->base,
-                                                .author = sj->author,
-                                                .cid = cid,
-                                                .job = ctx,
-                                                .job_id = job});
+    ag_store_ws_init_job(&w, &env, ctx, job, sj->model, sj->base, sj->author);
     ag_usecase_segment_params sp = {.threshold = sj->threshold,
                                     .coarse_threshold = sj->coarse_threshold,
                                     .cluster_tolerance = sj->cluster_tolerance,

@@ -600,6 +600,21 @@ void ag_store_ws_init_op(ag_store_ws *w, const ag_store_env *env, const ag_op_re
                                                .op = rq->op});
 }
 
+void ag_store_ws_init_job(ag_store_ws *w, const ag_store_env *env, ag_jobctx *ctx, int64_t job,
+                          int64_t model, int64_t base, const char *author)
+{
+    char cid[sizeof w->job_cid];
+    snprintf(cid, sizeof cid, "job-%lld", (long long)job);
+    ag_store_ws_init(w, &(ag_store_ws_options){.env = *env,
+                                               .model = model,
+                                               .base = base,
+                                               .author = author,
+                                               .job = ctx,
+                                               .job_id = job});
+    memcpy(w->job_cid, cid, sizeof cid);
+    w->o.cid = w->job_cid;
+}
+
 void ag_store_ws_end(ag_store_ws *w, ag_status outcome)
 {
     if (w->target && outcome != AG_OK && outcome != AG_ERR_STALE && outcome != AG_ERR_INVALID &&

@@ -40,12 +40,17 @@ typedef struct {
     int duplicate;                  /* the cid was used before: nothing was applied */
     ag_part *part;                  /* the part a composition read */
     int64_t part_id, part_version;  /* where a part save went */
+    char job_cid[32];               /* a job's cid, "job-<id>" */
 } ag_store_ws;
 
 void ag_store_ws_init(ag_store_ws *w, const ag_store_ws_options *o);
 /* The workspace of a client's op (a structural kind's run): its model, base, author, cid,
  * origin and the op as logged. */
 void ag_store_ws_init_op(ag_store_ws *w, const ag_store_env *env, const ag_op_request *rq);
+/* The workspace of a job's run on a model: its cid is "job-<id>", the job reports progress
+ * and is asked whether to stop. */
+void ag_store_ws_init_job(ag_store_ws *w, const ag_store_env *env, ag_jobctx *ctx, int64_t job,
+                          int64_t model, int64_t base, const char *author);
 /* Gives the sessions back; after a failure that is not the op's or the model's fault the
  * target's kept model is dropped (it is loaded afresh next time). */
 void ag_store_ws_end(ag_store_ws *w, ag_status outcome);

@@ -17,8 +17,8 @@
 
 /* Whether src is a point cloud rather than a mesh: its format is named las, laz, xyz (txt,
  * pts); or it is named ply or not named and the content is a cloud (LAS and LAZ signatures,
- * a PLY without faces, lines of numbers). A file that cannot be read is not one (the mesh
- * import then names the problem). */
+ * a PLY whose header parses and has no faces, lines of numbers). A file that cannot be read,
+ * or a PLY whose header does not parse, is not one (the mesh import then answers it). */
 int ag_usecase_import_cloud_accepts(const ag_mesh_source *src);
 
 ag_status ag_usecase_import_cloud_run(ag_workspace *ws, const ag_mesh_source *src,

@@ -29,8 +29,8 @@ const char *ag_cloud_format_name(ag_cloud_format f);
  * numbers); the file name's extension only for an empty .xyz/.txt/.pts file. */
 ag_cloud_format ag_cloud_format_sniff(const uint8_t *data, size_t len, const char *filename);
 
-/* Whether a file is a point cloud rather than a mesh: LAS, LAZ and XYZ always, PLY when it
- * declares no faces. */
+/* Whether a file is a point cloud rather than a mesh: LAS, LAZ and XYZ always, PLY when its
+ * header parses and declares no faces (one that does not parse is left to the mesh import). */
 int ag_cloud_import_is_cloud(const uint8_t *data, size_t len, const char *filename);
 
 /* How many points reading the data would make, from the header alone (LAS, LAZ, PLY) or an

@@ -1,19 +1,16 @@
 #include "obj.h"
 
 #include "external_ref.h"
+#include "filemap.h"
 #include "numtext.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #define DEFAULT_MAX_VERTICES 100000000u
 #define DEFAULT_MAX_TRIANGLES 200000000u
@@ -679,49 +676,15 @@ ag_status ag_obj_read_file(const char *path, const ag_obj_read_options *opt, ag_
         local = *opt;
     local.allow_external_files = 1;
     opt = &local;
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return ag_error_set(err, AG_ERR_IO, 0, "cannot open %s: %s", path, strerror(errno));
-    struct stat sb;
-    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
-        close(fd);
-        return ag_error_set(err, AG_ERR_IO, 0, "%s: not a regular file", path);
-    }
-    size_t len = (size_t)sb.st_size;
-    if (len == 0) {
-        close(fd);
-        return ag_error_set(err, AG_ERR_EMPTY, 0, "%s: empty file", path);
-    }
-    void *map = mmap(NULL, len, PROT_READ, MAP_PRIVATE, fd, 0);
-    if (map != MAP_FAILED) {
-        close(fd);
-        madvise(map, len, MADV_SEQUENTIAL);
-        ag_status st = ag_obj_read_buffer(map, len, opt, out, err);
-        munmap(map, len);
+    ag_filemap fm;
+    ag_status st = ag_filemap_open(path, &fm, err);
+    if (st != AG_OK)
         return st;
-    }
-    /* Some file systems cannot map: read it all. */
-    char *buf = malloc(len);
-    if (!buf) {
-        close(fd);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "%s: out of memory", path);
-    }
-    size_t got = 0;
-    while (got < len) {
-        ssize_t k = read(fd, buf + got, len - got);
-        if (k < 0 && errno == EINTR)
-            continue;
-        if (k <= 0) {
-            int e = k < 0 ? errno : EIO;
-            free(buf);
-            close(fd);
-            return ag_error_set(err, AG_ERR_IO, 0, "cannot read %s: %s", path, strerror(e));
-        }
-        got += (size_t)k;
-    }
-    close(fd);
-    ag_status st = ag_obj_read_buffer(buf, len, opt, out, err);
-    free(buf);
+    if (fm.len == 0)
+        st = ag_error_set(err, AG_ERR_EMPTY, 0, "%s: empty file", path);
+    else
+        st = ag_obj_read_buffer((const char *)fm.data, fm.len, opt, out, err);
+    ag_filemap_close(&fm);
     return st;
 }
 

@@ -89,6 +89,12 @@ static double refilled(const ag_ratelimit *rl, const bucket *b, double t)
 
 /* Makes room when the table is three quarters full: idle buckets go, and if that frees too
  * little, the least recently seen half. Rehashes what stays. */
+static int newest_first(const void *a, const void *b)
+{
+    double x = ((const bucket *)a)->seen, y = ((const bucket *)b)->seen;
+    return (x < y) - (x > y);
+}
+
 static void compact(ag_ratelimit *rl, double t)
 {
     bucket *old = rl->slots;
@@ -99,16 +105,10 @@ static void compact(ag_ratelimit *rl, double t)
     for (size_t i = 0; i < rl->cap; i++)
         if (old[i].key[0] && refilled(rl, &old[i], t) < rl->rate.burst)
             keep[n++] = old[i];
-    if (n > rl->cap / 2) { /* still busy: keep the most recently seen half */
-        double cut = 0;
-        for (size_t pass = 0; pass < 40 && n > rl->cap / 2; pass++) {
-            cut = t - (t - cut) / 2;
-            size_t m = 0;
-            for (size_t i = 0; i < n; i++)
-                if (keep[i].seen >= cut)
-                    keep[m++] = keep[i];
-            n = m;
-        }
+    if (n > rl->cap / 2) { /* still busy: keep the most recently seen half, exactly (a cut by
+                              * time could drop a busy key and give it a fresh burst) */
+        qsort(keep, n, sizeof *keep, newest_first);
+        n = rl->cap / 2;
     }
     memset(old, 0, rl->cap * sizeof *old);
     rl->used = 0;

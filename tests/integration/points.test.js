@@ -452,6 +452,8 @@ describe('point clouds in the service', () => {
       await bad({ kind: 'segment_roi', box: [1e6, 1e6, 1e6, 1e6 + 1, 1e6 + 1, 1e6 + 1] }, 'invalid', /no point of the cloud lies inside/);
       await bad({ kind: 'mark_template', segment: 9999, box: roi }, 'invalid', /segments 0 to/);
       await bad({ kind: 'mark_template', segment: 0, box: roi, report: {} }, 'invalid', /report/);
+      // the segment op is the segment job's: a client's is refused, naming the REST call
+      await bad({ kind: 'segment' }, 'invalid', /made by the server: POST \/api\/v1\/models\/\{id\}\/segment/);
     } finally {
       await A.close();
       await B.close();

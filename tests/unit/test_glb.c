@@ -14,19 +14,7 @@
 #include "core/demo_building.h"
 #include "core/mesh.h"
 #include "io/glb.h"
-
-static uint32_t u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static float f32(const uint8_t *p)
-{
-    uint32_t u = u32(p);
-    float f;
-    memcpy(&f, &u, 4);
-    return f;
-}
+#include "glb_fixture.h"
 
 /* Two components (one in a group, one group-less), an empty component between them,
  * far from the origin like UTM data. */
@@ -47,42 +35,6 @@ static ag_mesh *sample(void)
     ag_mesh_add_triangle(m, 0, 2, 3, 0);
     ag_mesh_add_triangle(m, 1, 5, 4, 2);
     return m;
-}
-
-typedef struct {
-    json_t *root;
-    const uint8_t *bin;
-    size_t binlen;
-} glb_view;
-
-/* Checks the container and returns the parsed JSON and the BIN chunk. */
-static glb_view check_container(const uint8_t *buf, size_t len)
-{
-    glb_view v = {0};
-    assert_true(len >= 20);
-    assert_int_equal(u32(buf), 0x46546C67);
-    assert_int_equal(u32(buf + 4), 2);
-    assert_int_equal(u32(buf + 8), len);
-    assert_int_equal(len % 4, 0);
-    uint32_t jlen = u32(buf + 12);
-    assert_int_equal(u32(buf + 16), 0x4E4F534A);
-    assert_int_equal(jlen % 4, 0);
-    assert_true(20 + (size_t)jlen <= len);
-    json_error_t je;
-    v.root = json_loadb((const char *)buf + 20, jlen, 0, &je);
-    if (!v.root)
-        print_error("JSON: %s\n", je.text);
-    assert_non_null(v.root);
-    size_t off = 20 + jlen;
-    if (off < len) {
-        uint32_t blen = u32(buf + off);
-        assert_int_equal(u32(buf + off + 4), 0x004E4942);
-        assert_int_equal(blen % 4, 0);
-        assert_int_equal(off + 8 + blen, len);
-        v.bin = buf + off + 8;
-        v.binlen = blen;
-    }
-    return v;
 }
 
 static void test_sample_structure(void **state)

@@ -16,60 +16,16 @@
 #include <string.h>
 
 #include "io/points_glb.h"
+#include "glb_fixture.h"
 #include "random_fixture.h"
 
-static uint32_t u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static float f32(const uint8_t *p)
-{
-    uint32_t u = u32(p);
-    float f;
-    memcpy(&f, &u, 4);
-    return f;
-}
-
-typedef struct {
-    json_t *doc;
-    const uint8_t *bin;
-    size_t binlen;
-} glb;
-
-static glb parse(const uint8_t *data, size_t len)
-{
-    glb g = {0};
-    assert_true(len >= 20);
-    assert_int_equal(u32(data), 0x46546C67u);
-    assert_int_equal(u32(data + 4), 2);
-    assert_int_equal(u32(data + 8), len);
-    size_t jlen = u32(data + 12);
-    assert_int_equal(u32(data + 16), 0x4E4F534Au);
-    assert_int_equal(jlen % 4, 0);
-    assert_true(20 + jlen <= len);
-    json_error_t je;
-    g.doc = json_loadb((const char *)data + 20, jlen, 0, &je);
-    if (!g.doc)
-        fail_msg("the JSON chunk does not parse: %s", je.text);
-    if (20 + jlen < len) {
-        const uint8_t *c = data + 20 + jlen;
-        g.binlen = u32(c);
-        assert_int_equal(u32(c + 4), 0x004E4942u);
-        assert_int_equal(g.binlen % 4, 0);
-        assert_int_equal(20 + jlen + 8 + g.binlen, len);
-        g.bin = c + 8;
-    }
-    return g;
-}
-
 /* The bytes of accessor a (checked against its view and the buffer). */
-static const uint8_t *accessor(const glb *g, json_int_t a, size_t *count, const char **type,
+static const uint8_t *accessor(const glb_view *g, json_int_t a, size_t *count, const char **type,
                                int *component)
 {
-    json_t *acc = json_array_get(json_object_get(g->doc, "accessors"), (size_t)a);
+    json_t *acc = json_array_get(json_object_get(g->root, "accessors"), (size_t)a);
     assert_non_null(acc);
-    json_t *view = json_array_get(json_object_get(g->doc, "bufferViews"),
+    json_t *view = json_array_get(json_object_get(g->root, "bufferViews"),
                                   (size_t)json_integer_value(json_object_get(acc, "bufferView")));
     assert_non_null(view);
     size_t off = (size_t)json_integer_value(json_object_get(view, "byteOffset"));
@@ -106,21 +62,21 @@ static void points_come_back_through_the_node(void **state)
         uint8_t *data;
         size_t len;
         assert_int_equal(ag_points_glb_write(&in, &data, &len, NULL), AG_OK);
-        glb g = parse(data, len);
-        json_t *node = json_array_get(json_object_get(g.doc, "nodes"), 0);
+        glb_view g = check_container(data, len);
+        json_t *node = json_array_get(json_object_get(g.root, "nodes"), 0);
         assert_int_equal(json_integer_value(json_object_get(json_object_get(node, "extras"),
                                                             "points")), 99);
         double t[3];
         for (int k = 0; k < 3; k++)
             t[k] = json_number_value(json_array_get(json_object_get(node, "translation"), (size_t)k));
         json_t *prim = json_array_get(
-            json_object_get(json_array_get(json_object_get(g.doc, "meshes"), 0), "primitives"), 0);
+            json_object_get(json_array_get(json_object_get(g.root, "meshes"), 0), "primitives"), 0);
         assert_int_equal(json_integer_value(json_object_get(prim, "mode")), 0);
         json_t *at = json_object_get(prim, "attributes");
         size_t count;
         const char *type;
         int comp;
-        json_t *pacc = json_array_get(json_object_get(g.doc, "accessors"),
+        json_t *pacc = json_array_get(json_object_get(g.root, "accessors"),
                                       (size_t)json_integer_value(json_object_get(at, "POSITION")));
         const uint8_t *pos = accessor(&g, json_integer_value(json_object_get(at, "POSITION")),
                                       &count, &type, &comp);
@@ -159,7 +115,7 @@ static void points_come_back_through_the_node(void **state)
             for (size_t i = 0; i < n; i++)
                 assert_true(f32(v + 4 * i) == want[a][i]);
         }
-        json_decref(g.doc);
+        json_decref(g.root);
         json_decref(extras);
         free(data);
         free(xyz);
@@ -176,11 +132,11 @@ static void an_empty_cloud_and_bad_names(void **state)
     uint8_t *data;
     size_t len;
     assert_int_equal(ag_points_glb_write(&in, &data, &len, NULL), AG_OK);
-    glb g = parse(data, len);
+    glb_view g = check_container(data, len);
     assert_null(g.bin);
-    assert_null(json_object_get(g.doc, "meshes"));
-    assert_true(json_is_array(json_object_get(g.doc, "scenes")));
-    json_decref(g.doc);
+    assert_null(json_object_get(g.root, "meshes"));
+    assert_true(json_is_array(json_object_get(g.root, "scenes")));
+    json_decref(g.root);
     free(data);
     double xyz[3] = {1, 2, 3};
     float v = 1;
@@ -190,13 +146,13 @@ static void an_empty_cloud_and_bad_names(void **state)
     assert_int_equal(ag_points_glb_write(&one, &data, &len, &err), AG_ERR_INVALID);
     one.nattributes = 0;
     assert_int_equal(ag_points_glb_write(&one, &data, &len, NULL), AG_OK);
-    g = parse(data, len);
+    g = check_container(data, len);
     json_t *at = json_object_get(json_array_get(json_object_get(
-                                     json_array_get(json_object_get(g.doc, "meshes"), 0),
+                                     json_array_get(json_object_get(g.root, "meshes"), 0),
                                      "primitives"), 0), "attributes");
     assert_null(json_object_get(at, "COLOR_0"));
     assert_non_null(json_object_get(at, "POSITION"));
-    json_decref(g.doc);
+    json_decref(g.root);
     free(data);
 }
 

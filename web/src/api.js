@@ -165,6 +165,22 @@ export class Api {
     return res.arrayBuffer();
   }
 
+  // --- point clouds ---------------------------------------------------------------------------
+  // The first `budget` points of a point cloud model's level-of-detail order as GLB POINTS.
+  async pointsBuffer(model, budget) {
+    const res = await this.request('GET', `/models/${model.id}/points.glb?budget=${budget}`, {
+      raw: true,
+      headers: { Accept: 'model/gltf-binary' },
+    });
+    return res.arrayBuffer();
+  }
+
+  // Starts the segment job against the version the person sees (412 if the model moved on).
+  segment(id, version, params = {}) {
+    const headers = version != null ? { 'If-Match': `"${version}"` } : {};
+    return this.request('POST', `/models/${id}/segment`, { body: params, headers });
+  }
+
   // REST fallbacks for edits when the live connection is down.
   rename(id, version, name) {
     return this.request('PATCH', `/models/${id}`, { body: { name }, headers: { 'If-Match': `"${version}"` } });

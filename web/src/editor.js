@@ -1,11 +1,13 @@
 // The editor: all client state plus the signals that announce its changes, and the one path
 // every op takes (execute). Panels and the viewport read state here and listen to signals;
 // they never talk to each other. Parts with state of their own are sub-editors it owns:
-// the selection (selection.js), the extrusion being edited (extrusioneditor.js) and the parts
-// library with the composition being prepared (library.js).
+// the selection (selection.js), the extrusion being edited (extrusioneditor.js), the parts
+// library with the composition being prepared (library.js) and the point cloud on view
+// (cloud.js).
+import { CloudEditor, isCloud } from './cloud.js';
 import { ExtrusionEditor } from './extrusioneditor.js';
 import { PartsLibrary } from './library.js';
-import { OP, REMESHING, isSendable } from './opkinds.js';
+import { OP, REMESHING, RESEGMENTING, isSendable } from './opkinds.js';
 import { Selection } from './selection.js';
 import { Signal } from './signal.js';
 
@@ -23,6 +25,7 @@ export class Editor {
       historyChanged: new Signal(),
       jobChanged: new Signal(),        // job (or null when the panel should clear)
       meshChanged: new Signal(),       // model: its mesh was replaced (proceduralize, grammar edit)
+      pointsChanged: new Signal(),     // model: a point cloud's segmentation changed (segment ops, undo)
       treeChanged: new Signal(),       // split tree (SplitTree or null)
       grammarChanged: new Signal(),    // grammar {text, version} (or null)
       procJobChanged: new Signal(),    // proceduralize job of the open model (or null)
@@ -52,6 +55,7 @@ export class Editor {
     this.transport = null;  // sends ops: the live connection (REST while it is down)
     this.extrusion = new ExtrusionEditor(this);
     this.library = new PartsLibrary(this);
+    this.cloud = new CloudEditor(this);
   }
 
   // The selection's value ({component, group, node?, nodes?, components?} or null).
@@ -161,7 +165,10 @@ export class Editor {
     this.model.version = entry.version;
     const op = entry.op || {};
     if (op.kind === OP.rename && typeof op.name === 'string') this.model.name = op.name;
-    const remeshed = REMESHING.has(op.kind);
+    // a point cloud has no mesh to replace: its segmentation is what those ops change
+    const cloud = isCloud(this.model);
+    const resegmented = cloud && RESEGMENTING.has(op.kind);
+    const remeshed = !cloud && REMESHING.has(op.kind);
     if (remeshed) this.model.proceduralized = true;
     const listed = this.models.find((m) => m.id === this.model.id);
     if (listed) {
@@ -176,6 +183,7 @@ export class Editor {
       this.selected.clear();
       this.signals.meshChanged.dispatch(this.model);
     }
+    if (resegmented) this.signals.pointsChanged.dispatch(this.model);
   }
 
   // Fresh figures of the open model (e.g. re-read after its mesh changed).

@@ -26,7 +26,12 @@ export class Inspector {
     const size = st.bounds
       ? st.bounds.max.map((v, i) => (v - st.bounds.min[i]).toFixed(2)).join(' × ') + ' m'
       : '–';
-    const rows = [
+    const rows = typeof st.points === 'number' ? [
+      ['points', fmt(st.points)],
+      ['properties', (st.properties || []).map((p) => p.name).join(', ') || '–'],
+      ['segments', st.segmented ? fmt(st.segments) : 'not segmented'],
+      ['size', size],
+    ] : [
       ['vertices', fmt(st.vertices)],
       ['triangles', fmt(st.triangles)],
       ['components', fmt(st.components)],

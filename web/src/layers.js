@@ -1,6 +1,7 @@
 // The viewport's layers: each a group in the scene that one part of the client draws into, so
 // no module reaches into the scene or another module's objects.
-//   model    the loaded model, its meshes by component (picking, colours, drag previews)
+//   model    the loaded model, its meshes by component (picking, colours, drag previews), or
+//            the points of a point cloud model
 //   preview  stand-ins drawn in place of model components (an extrusion's live preview)
 //   handles  tools drawn over the model (resize handles, the split plane)
 import * as THREE from 'three';
@@ -50,6 +51,7 @@ export class ModelLayer extends Layer {
     super(viewport, 'model');
     this.root = null;
     this.byComponent = new Map(); // component -> meshes
+    this.points = [];             // THREE.Points of a point cloud model
     this.tint = null;             // (mesh) => THREE.Color | null: a colouring that overrides labels
   }
 
@@ -58,6 +60,7 @@ export class ModelLayer extends Layer {
     this.clear();
     this.root = root;
     root.traverse((o) => {
+      if (o.isPoints) this.points.push(o);
       if (!o.isMesh) return;
       const owner = componentOwner(o);
       const component = owner ? owner.userData.component : -1;
@@ -74,6 +77,7 @@ export class ModelLayer extends Layer {
     super.clear();
     this.root = null;
     this.byComponent.clear();
+    this.points = [];
   }
 
   meshes(component) {

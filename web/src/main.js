@@ -30,6 +30,8 @@ import { WindowSelect } from './windowselect.js';
 import { TreeWalk } from './treewalk.js';
 import { LibraryPanel } from './librarypanel.js';
 import { NodeInfo } from './nodeinfo.js';
+import { CloudView } from './cloudview.js';
+import { CloudPanel } from './cloudpanel.js';
 
 const $ = (id) => document.getElementById(id);
 const editor = new Editor();
@@ -63,6 +65,8 @@ new SplitTreePanel(editor, procedural, $('tree'));
 const windowSelect = new WindowSelect(editor, viewport);
 const walk = new TreeWalk(editor);
 new NodeInfo(editor, viewport);
+const cloudView = new CloudView(editor, viewport);
+new CloudPanel(editor, api, live, $('points'));
 const library = new LibraryPanel(editor, api, viewport, windowSelect, $('library'));
 new GrammarPanel(editor, procedural, $('grammar'));
 collapsible(document.querySelectorAll('section[id]'));
@@ -78,7 +82,7 @@ window.addEventListener('unhandledrejection', (e) => {
 
 window.archgram = editor; // for poking at state from the console
 window.archgramAuth = auth;
-window.archgramTools = { viewport, preview, editTools, handles, windowSelect, walk, library }; // and at the edit tools (tests drive handles)
+window.archgramTools = { viewport, preview, editTools, handles, windowSelect, walk, library, cloudView }; // and at the edit tools (tests drive handles)
 
 function modelFromHash() {
   const m = /^#model=(\d+)$/.exec(location.hash);

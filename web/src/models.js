@@ -6,7 +6,7 @@ export class ModelsPanel {
     this.editor = editor;
     this.session = session;
 
-    this.file = el('input', { type: 'file', 'data-testid': 'upload-input', accept: '.obj,.ply,.glb,.gltf,.stl,.fbx,.dae,.3ds' });
+    this.file = el('input', { type: 'file', 'data-testid': 'upload-input', accept: '.obj,.ply,.glb,.gltf,.stl,.fbx,.dae,.3ds,.las,.laz,.xyz' });
     this.up = el(
       'select.up',
       { title: 'Up axis of the file', 'aria-label': 'Up axis' },
@@ -25,7 +25,7 @@ export class ModelsPanel {
       'label.drop',
       { 'data-testid': 'drop-zone' },
       this.file,
-      el('span.drop-main', {}, 'Import a mesh'),
+      el('span.drop-main', {}, 'Import a mesh or point cloud'),
       el('span.drop-sub', {}, 'drop a file here or click to choose'),
     );
     for (const type of ['dragenter', 'dragover']) {

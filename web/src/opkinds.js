@@ -32,6 +32,9 @@ export const STRUCTURAL = kinds('resize', 'split', 'join', 'paste', 'remove', 'c
 export const REMESHING = kinds('proceduralize', 'grammar', ...STRUCTURAL, 'undo', 'redo', 'restore');
 // Point cloud ops: each changes the segmentation (the segment and label of points).
 export const SEGMENTING = kinds('segment', 'segment_roi', 'mark_template');
+// After these a point cloud model's points.glb must be read again (undo and redo are logged
+// as the restore they become).
+export const RESEGMENTING = kinds(...SEGMENTING, 'undo', 'redo', 'restore');
 // The kinds in a person's undo history (the server's undo works on these).
 export const UNDOABLE = kinds(...STRUCTURAL, 'segment_roi', 'mark_template', 'restore', 'undo', 'redo');
 // Extrusion edits: each re-extrudes the buildings it touches.

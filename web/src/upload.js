@@ -1,4 +1,4 @@
-// Making a model from a file: a mesh to import, or footprints (GeoJSON) / a building
+// Making a model from a file: a mesh or a point cloud (PLY, LAS, LAZ, XYZ) to import, or footprints (GeoJSON) / a building
 // description to extrude. The file is uploaded, its job followed (websocket job.progress, or
 // polling when the live connection is unavailable), then the new model is listed and opened.
 import { followJob } from './jobs.js';
@@ -18,7 +18,7 @@ export class Upload {
     this.session = session;
   }
 
-  // A mesh file → an import job.
+  // A mesh or point cloud file → an import job.
   run(file, { up } = {}) {
     const format = formatOf(file.name);
     if (!format) {

@@ -1,10 +1,13 @@
 // The 3D view: loads a model's GLB, frames it, renders on demand and turns clicks into
 // component selections. It only reacts to editor signals and reports picks/camera moves back.
 // Once the model is proceduralized its components are coloured by label (the tree's colours).
+// A point cloud model is its points.glb at the cloud's budget (cloud.js); cloudview.js
+// colours its points and turns a picked point into a segment.
 // Other modules draw through its layers (layers.js) and its camera helpers, never its scene.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { isCloud } from './cloud.js';
 import { Layer, ModelLayer } from './layers.js';
 import { colourOf } from './peers.js';
 import { Signal } from './signal.js';
@@ -19,6 +22,7 @@ const PALETTE = [0xc4683f, 0x4f7cac, 0x6a994e, 0x9a6fa8, 0x3d8a8a, 0x8a6d5a, 0xa
 const HIGHLIGHT = new THREE.Color(0xffc820);
 const HIGHLIGHT_GLOW = new THREE.Color(0x3a2a00);
 const CLICK_SLOP_PX = 5;
+const POINT_PICK_PX = 6; // a click this close to a drawn point picks it
 
 export class Viewport {
   constructor(editor, api, container) {
@@ -27,6 +31,7 @@ export class Viewport {
     this.container = container;
     this.signals = {
       shown: new Signal(), // {model, version}: that model's mesh is on screen now
+      pointPicked: new Signal(), // {points, index} of a click on a point cloud (null: none)
     };
 
     this.renderer = new THREE.WebGLRenderer({ antialias: true });
@@ -87,6 +92,10 @@ export class Viewport {
     const s = editor.signals;
     s.modelOpened.add((model) => this.load(model));
     s.meshChanged.add((model) => this.load(model, { keepCamera: true }));
+    s.pointsChanged.add((model) => this.load(model, { keepCamera: true }));
+    editor.cloud.signals.budgetChanged.add(() => {
+      if (isCloud(editor.model)) this.load(editor.model, { keepCamera: true });
+    });
     s.treeChanged.add(() => this.colourize());
     s.selectionChanged.add(() => this.highlight());
     s.peersChanged.add(() => this.highlight());
@@ -135,9 +144,12 @@ export class Viewport {
       return;
     }
     const version = model.version;
-    if (reframe) this.setStatus('Loading mesh…');
+    const cloud = isCloud(model);
+    if (reframe) this.setStatus(cloud ? 'Loading points…' : 'Loading mesh…');
     try {
-      const buffer = await this.api.meshBuffer(model);
+      const buffer = cloud
+        ? await this.api.pointsBuffer(model, this.editor.cloud.budget)
+        : await this.api.meshBuffer(model);
       if (token !== this.loadToken) return;
       const gltf = await new GLTFLoader().parseAsync(buffer, '');
       if (token !== this.loadToken) return;
@@ -149,7 +161,7 @@ export class Viewport {
       this.signals.shown.dispatch(this.shown);
     } catch (err) {
       if (token !== this.loadToken) return;
-      this.setStatus('The mesh could not be shown');
+      this.setStatus(cloud ? 'The points could not be shown' : 'The mesh could not be shown');
       this.editor.fail(err.problem || { title: 'Cannot show the mesh', detail: err.message });
     }
   }
@@ -293,6 +305,10 @@ export class Viewport {
   pick(clientX, clientY, extend = false) {
     const layer = this.layers.model;
     if (!layer.root) return;
+    if (layer.points.length) {
+      this.signals.pointPicked.dispatch(this.hitPoint(clientX, clientY));
+      return;
+    }
     const owner = layer.hit(this.ray(clientX, clientY));
     const selected = this.editor.selected;
     if (!owner) {
@@ -305,6 +321,15 @@ export class Viewport {
       return;
     }
     selected.set({ component: owner.userData.component, group: owner.userData.group ?? null });
+  }
+
+  // The drawn point nearest the camera within a few pixels of a pointer position, as
+  // {points, index} (the THREE.Points object and the point's index in it), or null.
+  hitPoint(clientX, clientY) {
+    const rc = this.ray(clientX, clientY);
+    rc.params.Points.threshold = this.worldPerPixel(this.controls.target) * POINT_PICK_PX;
+    const hit = rc.intersectObjects(this.layers.model.points, false)[0];
+    return hit ? { points: hit.object, index: hit.index } : null;
   }
 
   // Our selection in yellow; what others have selected in their colours.
