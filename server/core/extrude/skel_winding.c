@@ -63,20 +63,12 @@ static int edge_ready(const sk *S, uint32_t e)
            S->c[f->end].alive && S->c[f->start].settled && S->c[f->end].settled;
 }
 
-static double seg_point_dist(const double *p, const double *a, const double *b)
-{
-    double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
-    double t = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0;
-    t = t < 0 ? 0 : t > 1 ? 1 : t;
-    return hypot(a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
-}
-
 static double seg_seg_dist(const double *a, const double *b, const double *c, const double *d)
 {
     if (ag_pred_segments_touch(a, b, c, d))
         return 0;
-    return fmin(fmin(seg_point_dist(a, c, d), seg_point_dist(b, c, d)),
-                fmin(seg_point_dist(c, a, b), seg_point_dist(d, a, b)));
+    return fmin(fmin(ag_pred_segment_dist(a, c, d), ag_pred_segment_dist(b, c, d)),
+                fmin(ag_pred_segment_dist(c, a, b), ag_pred_segment_dist(d, a, b)));
 }
 
 /* The point where the lines of edges e and f are at height z; 0 when they are parallel. */
@@ -241,7 +233,7 @@ static int rebuild(sk *S, double z, double zp)
             seg_at(S, S->live_e[i], z, sa, sb);
             seg_at(S, S->live_e[j], z, sc, sd);
             double tol = AG_EXTRUDE_NEAR_POINTS * S->d2 + (zp - z);
-            if (seg_point_dist(pz, sa, sb) > tol || seg_point_dist(pz, sc, sd) > tol ||
+            if (ag_pred_segment_dist(pz, sa, sb) > tol || ag_pred_segment_dist(pz, sc, sd) > tol ||
                 !at_an_end(pz, sa, sb, sc, sd, tol))
                 goto refuse;
         }
