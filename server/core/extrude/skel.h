@@ -123,7 +123,10 @@ typedef struct {
     double level; /* the height of that level */
     ag_budget *budget; /* events, time, memory, cancel (ag_budget_spend on every push/pop) */
     int no_winding_repair; /* the post inter-chain repair is off (comparisons in tests) */
-    sk_u32vec made;        /* corners made at the current height, for the repair's check */
+    sk_u32vec made;        /* corners the intersections (and flat intervals' starts and
+                            * ends) of the current height made, for the repair's check;
+                            * other direction events change no chain */
+    int track_made;        /* set while those are handled */
     double made_z;         /* that height */
     sk_scratch W;
 } sk;
