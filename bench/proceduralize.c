@@ -1,10 +1,16 @@
-/* Proceduralization benchmark: a generated ~200k-triangle building, then every OBJ mesh in
- * ../shared/data. Prints per-stage seconds and the peak resident memory. Not a test. */
+/* Proceduralization benchmark: a generated ~200k-triangle building and a generated 2M-triangle
+ * block (20 buildings of 100k triangles), each in process (per-stage seconds, peak resident
+ * memory) and as the whole `archgram proceduralize` process (wall and CPU seconds, the figure
+ * a user waits for), then every OBJ mesh in ../shared/data. Not a test.
+ *
+ * build/bench/proceduralize [--generated]   (--generated: the generated meshes only) */
 #include <dirent.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -117,17 +123,53 @@ static void run_dir(const char *dir, ag_up_axis up)
     free(names);
 }
 
-/* Generates, writes to a temporary OBJ and reads it back, so import is timed on a file. */
-static void run_generated(const char *name, const ag_gen_facade_options *go)
+/* `archgram proceduralize path --up z --out <temporary folder>` as a user runs it: wall and
+ * CPU seconds of the whole process (CPU as well, the machine may be shared). */
+static void run_cli(const char *name, const char *path)
 {
-    ag_mesh *g, *m;
-    ag_error err = {0};
-    if (ag_gen_facade(go, &g, &err)) {
-        printf("%-34s failed: %s\n", name, err.text);
+    char dir[] = "/tmp/archgram_bench_out_XXXXXX";
+    if (!mkdtemp(dir))
         return;
+    struct rusage before, after;
+    getrusage(RUSAGE_CHILDREN, &before);
+    double t0 = now();
+    pid_t pid = fork();
+    if (pid == 0) {
+        int devnull = open("/dev/null", O_WRONLY);
+        if (devnull >= 0)
+            dup2(devnull, STDOUT_FILENO);
+        execl(AG_REPO_DIR "/build/archgram", "archgram", "proceduralize", path, "--up", "z",
+              "--out", dir, (char *)NULL);
+        _exit(127);
     }
-    char path[] = "/tmp/archgram_bench_XXXXXX";
-    int fd = mkstemp(path);
+    int status = 0;
+    if (pid > 0)
+        waitpid(pid, &status, 0);
+    double wall = now() - t0;
+    getrusage(RUSAGE_CHILDREN, &after);
+    double cpu = (after.ru_utime.tv_sec - before.ru_utime.tv_sec) +
+                 (after.ru_utime.tv_usec - before.ru_utime.tv_usec) * 1e-6 +
+                 (after.ru_stime.tv_sec - before.ru_stime.tv_sec) +
+                 (after.ru_stime.tv_usec - before.ru_stime.tv_usec) * 1e-6;
+    if (pid < 0 || !WIFEXITED(status) || WEXITSTATUS(status))
+        printf("%-34s archgram proceduralize failed (status %d)\n", name, status);
+    else
+        printf("%-34s whole process: %.2f s wall, %.2f s CPU, peak %ld MiB\n", name, wall, cpu,
+               after.ru_maxrss / 1024);
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd)) {
+    }
+}
+
+/* Writes g to a temporary OBJ and reads it back, so import is timed on a file; then the
+ * whole CLI process on that file. Takes g. */
+static void run_mesh_file(const char *name, ag_mesh *g)
+{
+    ag_error err = {0};
+    ag_mesh *m;
+    char path[] = "/tmp/archgram_bench_XXXXXX.obj";
+    int fd = mkstemps(path, 4);
     if (fd < 0) {
         ag_mesh_free(g);
         return;
@@ -140,17 +182,75 @@ static void run_generated(const char *name, const ag_gen_facade_options *go)
     if (st == AG_OK)
         st = ag_obj_read_file(path, &ro, &m, &err);
     double t_import = now() - t0;
-    unlink(path);
     if (st) {
         printf("%-34s failed: %s\n", name, err.text);
+        unlink(path);
         return;
     }
     run(name, m, t_import);
     ag_mesh_free(m);
+    run_cli(name, path);
+    unlink(path);
 }
 
-int main(void)
+static void run_generated(const char *name, const ag_gen_facade_options *go)
 {
+    ag_mesh *g;
+    ag_error err = {0};
+    if (ag_gen_facade(go, &g, &err)) {
+        printf("%-34s failed: %s\n", name, err.text);
+        return;
+    }
+    run_mesh_file(name, g);
+}
+
+/* A city block: n copies of one building side by side on a grid (60 m apart), each group
+ * renamed per building, so the block has n times its components. */
+static void run_block(const char *name, const ag_gen_facade_options *go, unsigned n)
+{
+    ag_mesh *g, *b = ag_mesh_create();
+    ag_error err = {0};
+    if (!b || ag_gen_facade(go, &g, &err)) {
+        printf("%-34s failed: %s\n", name, b ? err.text : "out of memory");
+        ag_mesh_free(b);
+        return;
+    }
+    ag_status st = ag_mesh_reserve(b, n * g->nverts, n * g->ntris);
+    for (unsigned k = 0; k < n && st == AG_OK; k++) {
+        size_t v0 = b->nverts, c0 = b->ncomponents, g0 = b->ngroups;
+        for (size_t i = 0; i < g->ngroups && st == AG_OK; i++) {
+            char gn[256];
+            size_t idx;
+            snprintf(gn, sizeof gn, "b%u_%s", k, g->group_names[i]);
+            st = ag_mesh_add_group(b, gn, &idx);
+        }
+        for (size_t c = 0; c < g->ncomponents && st == AG_OK; c++) {
+            size_t idx;
+            int32_t gr = g->component_group[c];
+            st = ag_mesh_add_component(b, gr >= 0 ? (int32_t)(g0 + (size_t)gr) : -1, &idx);
+        }
+        double dx = 60.0 * (k % 5), dy = 60.0 * (k / 5);
+        for (size_t v = 0; v < g->nverts && st == AG_OK; v++)
+            st = ag_mesh_add_vertex(b, g->pos[3 * v] + dx, g->pos[3 * v + 1] + dy,
+                                    g->pos[3 * v + 2]);
+        for (size_t t = 0; t < g->ntris && st == AG_OK; t++)
+            st = ag_mesh_add_triangle(b, (uint32_t)(v0 + g->tri[3 * t]),
+                                      (uint32_t)(v0 + g->tri[3 * t + 1]),
+                                      (uint32_t)(v0 + g->tri[3 * t + 2]),
+                                      (uint32_t)(c0 + g->tri_component[t]));
+    }
+    ag_mesh_free(g);
+    if (st) {
+        printf("%-34s failed: out of memory\n", name);
+        ag_mesh_free(b);
+        return;
+    }
+    run_mesh_file(name, b);
+}
+
+int main(int argc, char **argv)
+{
+    int generated_only = argc > 1 && !strcmp(argv[1], "--generated");
     header();
     /* 4 facades of 40 x 20 / 30 x 20 windows: ~235k triangles, one group per element */
     ag_gen_facade_options go = {.cols = 40, .rows = 20, .side_cols = 30, .back = 1, .left = 1,
@@ -161,6 +261,13 @@ int main(void)
     go.cols = 34;
     go.side_cols = 26;
     run_generated("generated building (no groups)", &go);
+    /* 20 buildings of ~100k triangles and 166 groups each (160 windows of 624 triangles):
+     * ~2.08M triangles, 3,320 components */
+    ag_gen_facade_options bo = {.cols = 8, .rows = 5, .side_cols = 8, .back = 1, .left = 1,
+                                .annex = 1, .bars = 45};
+    run_block("generated block (20 buildings)", &bo, 20);
+    if (generated_only)
+        return 0;
     run_dir(SHARED "/lod3_ingolstadt/obj", AG_UP_Z);
     run_dir(SHARED "/meshes_0ad", AG_UP_Y);
     printf("seconds: import..export are stages; total = all stages without verify (derive and "

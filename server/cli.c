@@ -67,6 +67,8 @@ int ag_cli_parse_up(const char *value, ag_up_axis *up)
         *up = AG_UP_Y;
     else if (value && (!strcmp(value, "z") || !strcmp(value, "Z")))
         *up = AG_UP_Z;
+    else if (value && !strcmp(value, "auto"))
+        *up = AG_UP_DEFAULT;
     else
         return -1;
     return 0;

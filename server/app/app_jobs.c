@@ -32,8 +32,10 @@ ag_status ag_app_jobs_check_import(const ag_import_job *p, ag_error *err)
                          "unknown format \"%s\"; archgram reads obj, ply, stl, gltf, glb, fbx and "
                          "dae meshes and ply, las, laz and xyz point clouds",
                          p->format);
-    if (s == AG_OK && p->up && strcmp(p->up, "y") != 0 && strcmp(p->up, "z") != 0)
-        s = ag_error_set(err, AG_ERR_INVALID, 0, "up must be \"y\" or \"z\", not \"%s\"", p->up);
+    if (s == AG_OK && p->up && strcmp(p->up, "y") != 0 && strcmp(p->up, "z") != 0 &&
+        strcmp(p->up, "auto") != 0)
+        s = ag_error_set(err, AG_ERR_INVALID, 0, "up must be \"auto\", \"y\" or \"z\", not \"%s\"",
+                         p->up);
     return s;
 }
 
@@ -51,7 +53,8 @@ ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_impor
 }
 
 ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
-                                    const int64_t *if_match, int64_t *job, ag_error *err)
+                                    const int64_t *if_match, int exact, int64_t *job,
+                                    ag_error *err)
 {
     int64_t current;
     ag_status s = ag_app_query_version(app, model, &current, err);
@@ -72,7 +75,7 @@ ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t
     ag_job_params jp = {.type = AG_JOB_PROCEDURALIZE,
                         .user = who->user,
                         .u.proceduralize = {.model = model, .base = current,
-                                            .author = (char *)who->name}};
+                                            .author = (char *)who->name, .exact = exact != 0}};
     return submit(app, &jp, NULL, job, err);
 }
 

@@ -76,6 +76,7 @@ static ag_status input_mesh(ag_workspace *ws, ag_mesh **mesh, ag_error *err)
     blame(w, w->o.mesh_path);
     ag_status s = ag_usecase_import_read(&src, NULL, NULL, mesh, &file, err);
     w->input_bytes = file.len;
+    w->up = file.up;
     ag_usecase_import_release(&file);
     w->import_s = now() - t0;
     return s;
@@ -204,15 +205,14 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
     json_object_set_new(ji, "bytes", json_integer((json_int_t)w->input_bytes));
     /* what import did to reach z-up metres (see io/import.h and io/assimp_import.h) */
     ag_format fmt = ag_format_sniff(NULL, 0, in);
-    int zup = w->o.up == AG_UP_Z ||
-              (w->o.up == AG_UP_DEFAULT && (fmt == AG_FORMAT_PLY || fmt == AG_FORMAT_STL));
+    int zup = w->up.axis == AG_UP_Z;
     char norm[160];
     snprintf(norm, sizeof norm, "%s; %s",
              zup ? "input taken as z-up, kept" : "y-up input turned to z-up: (x, y, z) -> (x, -z, y)",
              fmt == AG_FORMAT_FBX ? "FBX units (UnitScaleFactor) converted to metres"
                                   : "units taken as metres");
     json_object_set_new(ji, "format", json_string(ag_format_name(fmt)));
-    json_object_set_new(ji, "up", json_string(zup ? "z" : "y"));
+    json_object_set_new(ji, "up", ag_import_up_json(&w->up));
     json_object_set_new(ji, "normalization", json_string(norm));
     json_object_set_new(ji, "groups_split", json_integer((json_int_t)r->segment.groups_split));
     json_object_set_new(ji, "planar_fallback", json_boolean(r->segment.planar_fallback));
@@ -240,6 +240,11 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
         json_array_append_new(jl, lo);
     }
     json_object_set_new(j, "labels", jl);
+    /* how labels and shared terminals were decided (README, "Labels and shared terminals") */
+    json_object_set_new(j, "labeling",
+                        json_pack("{s:f, s:f, s:b, s:I}", "tolerance", L->tol, "share",
+                                  L->share, "exact_copies", L->exact_copies,
+                                  "surface_checks", (json_int_t)L->surface_checks));
 
     json_t *jc = json_array();
     for (size_t c = 0; c < r->mesh->ncomponents; c++) {
@@ -251,6 +256,7 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
         json_object_set_new(co, "variant",
                             L->variant[c] >= 0 ? json_integer(L->variant[c]) : json_null());
         json_object_set_new(co, "rot", json_integer(90 * L->rot[c]));
+        json_object_set_new(co, "mirror", json_boolean(L->mirror[c]));
         json_object_set_new(co, "node", r->tree->comp_node[c] >= 0
                                             ? json_integer(r->tree->comp_node[c])
                                             : json_null());
@@ -299,6 +305,7 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
     json_object_set_new(jf, "max_error", json_real(o->fidelity.max_error));
     json_object_set_new(jf, "relative", json_real(o->fidelity.relative));
     json_object_set_new(jf, "unmatched", json_integer((json_int_t)o->fidelity.unmatched));
+    json_object_set_new(jf, "spurious", json_integer((json_int_t)o->fidelity.spurious));
     json_object_set_new(jf, "derived_triangles",
                         json_integer((json_int_t)o->fidelity.derived_triangles));
     json_object_set_new(j, "fidelity", jf);

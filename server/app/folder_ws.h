@@ -41,6 +41,7 @@ typedef struct {
     ag_part **parts;       /* the bundle a composition read */
     size_t nparts;
     size_t input_bytes;    /* the mesh file's size */
+    ag_up_decision up;     /* how its up axis was decided */
     double import_s;       /* reading it */
     int blamed;
     char blame[4200];

@@ -12,7 +12,7 @@ static ag_up_axis up_from(const char *s)
         return AG_UP_Z;
     if (s && (strcmp(s, "y") == 0 || strcmp(s, "Y") == 0))
         return AG_UP_Y;
-    return AG_UP_DEFAULT;
+    return AG_UP_DEFAULT; /* absent or "auto": the format, else the content decides */
 }
 
 static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_params *p,

@@ -79,6 +79,12 @@ static void child(int fd, const uint8_t *data, size_t len, ag_format fmt, ag_up_
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != parent)
         _exit(4); /* the parent went before the signal was asked for */
+    /* a crash of the importer kills the child by its signal, which the parent reports as a
+     * refusal of the file; handlers inherited from the parent (a sanitizer's, a fuzzer's)
+     * would turn it into an exit code instead */
+    static const int fatal[] = {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL};
+    for (size_t i = 0; i < sizeof fatal / sizeof fatal[0]; i++)
+        signal(fatal[i], SIG_DFL);
     if (seconds > 0) {
         rlim_t cpu = (rlim_t)seconds + 2;
         struct rlimit rl = {cpu, cpu};

@@ -34,8 +34,8 @@ char *ag_job_params_encode(const ag_job_params *p)
     }
     case AG_JOB_PROCEDURALIZE: {
         const ag_proceduralize_job *q = &p->u.proceduralize;
-        j = json_pack("{s:I, s:I, s:s}", "model", (json_int_t)q->model, "base",
-                      (json_int_t)q->base, "author", q->author);
+        j = json_pack("{s:I, s:I, s:s, s:b}", "model", (json_int_t)q->model, "base",
+                      (json_int_t)q->base, "author", q->author, "exact", q->exact != 0);
         break;
     }
     case AG_JOB_EXTRUDE: {
@@ -109,8 +109,10 @@ ag_status ag_job_params_decode(const char *kind, const char *json, ag_job_params
         out->type = AG_JOB_PROCEDURALIZE;
         ag_proceduralize_job *q = &out->u.proceduralize;
         json_t *m = json_object_get(o, "model"), *b = json_object_get(o, "base");
+        json_t *x = json_object_get(o, "exact");
         q->model = json_integer_value(m);
         q->base = json_integer_value(b);
+        q->exact = json_is_true(x);
         bad = !json_is_integer(m) || !json_is_integer(b) || q->model <= 0 || q->base <= 0 ||
               take(o, "author", 1, &q->author);
     } else if (strcmp(kind, "segment") == 0) {

@@ -27,11 +27,13 @@ typedef struct {
     char *filename; /* the name it was uploaded as, or NULL */
 } ag_import_job;
 
-/* A model at version base → proceduralized, by author. */
+/* A model at version base → proceduralized, by author; exact: terminals shared by exact
+ * copies only (every instance derives as it was). */
 typedef struct {
     int64_t model;
     int64_t base;
     char *author;
+    int exact;
 } ag_proceduralize_job;
 
 /* A point cloud model at version base → segmented (§3.1), by author. Thresholds are

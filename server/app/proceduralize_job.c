@@ -21,6 +21,7 @@ static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_p
     ag_usecase_proceduralize_result r;
     ag_usecase_proceduralize_params up = {
         .max_triangles = ag_work_limits_resolved(env.limits).max_triangles};
+    up.label.exact_copies = pj->exact;
     if (s == AG_OK && cloud)
         s = ag_cloud_pipeline_proceduralize ? ag_cloud_pipeline_proceduralize(&w.ws, err)
                                             : ag_cloud_pipeline_missing(pj->model, "proceduralize",

@@ -428,19 +428,31 @@ static ag_status save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcom
     return s;
 }
 
-ag_status ag_store_ws_insert_model(ag_db *db, const char *name, const ag_mesh *mesh,
-                                   const void *source, size_t source_len,
-                                   const char *source_format, int64_t *model, ag_error *err)
+/* A new model row; up (may be NULL) is how its file's up axis was decided. */
+static ag_status insert_model(ag_db *db, const char *name, const ag_mesh *mesh,
+                              const void *source, size_t source_len, const char *source_format,
+                              const ag_up_decision *up, int64_t *model, ag_error *err)
 {
     uint8_t *blob = NULL;
     size_t blob_len = 0;
-    char *stats = NULL;
+    char *stats = NULL, *up_json = NULL;
     ag_status s = encode_mesh(mesh, &blob, &blob_len, &stats, err);
     if (s != AG_OK)
         return s;
+    if (up) {
+        json_t *j = ag_import_up_json(up);
+        up_json = j ? json_dumps(j, JSON_COMPACT | JSON_REAL_PRECISION(6)) : NULL;
+        json_decref(j);
+        if (!up_json) {
+            free(stats);
+            free(blob);
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory describing the up axis");
+        }
+    }
     ag_model_new m = {
         .name = name,
         .stats_json = stats,
+        .up_json = up_json,
         .source = source,
         .source_len = source_len,
         .source_format = source_format,
@@ -450,20 +462,28 @@ ag_status ag_store_ws_insert_model(ag_db *db, const char *name, const ag_mesh *m
     };
     s = ag_models_insert(db, &m, model, err);
     free(stats);
+    free(up_json);
     free(blob);
     return s;
 }
 
+ag_status ag_store_ws_insert_model(ag_db *db, const char *name, const ag_mesh *mesh,
+                                   const void *source, size_t source_len,
+                                   const char *source_format, int64_t *model, ag_error *err)
+{
+    return insert_model(db, name, mesh, source, source_len, source_format, NULL, model, err);
+}
+
 static ag_status add_model(ag_workspace *ws, const char *name, const ag_mesh *mesh,
                            const void *source, size_t source_len, const char *source_format,
-                           int64_t *model, ag_error *err)
+                           const ag_up_decision *up, int64_t *model, ag_error *err)
 {
     ag_store_ws *w = (ag_store_ws *)ws;
     ag_db *db = w->o.env.db;
     ag_status s = ag_db_begin(db, err);
     if (s != AG_OK)
         return s;
-    s = ag_store_ws_insert_model(db, name, mesh, source, source_len, source_format, model, err);
+    s = insert_model(db, name, mesh, source, source_len, source_format, up, model, err);
     if (s == AG_OK && w->o.job_id)
         s = ag_members_own_from_job(db, *model, w->o.job_id, err);
     if (s == AG_OK && w->o.job && ag_jobctx_cancelled(w->o.job))

@@ -77,6 +77,7 @@ ag_status ag_usecase_import_read(const ag_mesh_source *src, int (*progress)(void
                          src->format_hint);
     if (s == AG_OK) {
         ag_import_options iopt = {.up = src->up,
+                                  .up_decision = &file->up,
                                   .progress = progress,
                                   .user = user,
                                   .allow_external_files = src->own_file,
@@ -109,7 +110,8 @@ ag_status ag_usecase_import_run(ag_workspace *ws, const ag_mesh_source *src, con
     if (ag_workspace_progress(ws, 0.9, "store"))
         s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
     else
-        s = ag_workspace_add_model(ws, name, mesh, file.data, file.len, file.format, model, err);
+        s = ag_workspace_add_model(ws, name, mesh, file.data, file.len, file.format, &file.up,
+                                   model, err);
     ag_mesh_free(mesh);
     ag_usecase_import_release(&file);
     return s;

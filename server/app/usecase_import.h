@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "../core/mesh.h"
+#include "../io/import.h"
 #include "../io/obj.h"
 #include "../core/status.h"
 #include "workspace.h"
@@ -37,6 +38,7 @@ typedef struct {
     void *data;
     size_t len;
     const char *format; /* the format read */
+    ag_up_decision up;  /* the up axis the mesh was read with, why, and the content's cues */
 } ag_mesh_file;
 
 /* Maps src's file (the checks and messages of ag_usecase_import_read: AG_ERR_IO, AG_ERR_EMPTY);

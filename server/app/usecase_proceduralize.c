@@ -3,6 +3,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "../core/base/tolerance.h"
+
 /* Where each stage starts on the 0..1 progress scale. */
 static const double stage_start[AG_STAGE_COUNT] = {0.02, 0.2, 0.4, 0.5, 0.6, 0.7, 0.8};
 
@@ -59,7 +61,7 @@ ag_status ag_usecase_proceduralize_run(ag_workspace *ws, const ag_usecase_proced
      * derived, proceduralized anew (the saved tree) and compared with the input */
     double t0 = now();
     if ((s = ag_model_state_make(&made, AG_MODEL_READ_BACK, &st, err)) != AG_OK ||
-        (s = ag_grammar_fidelity(r->mesh, st.derived, 10 * r->labels->tol, &o.fidelity, err)) !=
+        (s = ag_grammar_fidelity(r->mesh, st.derived, AG_PROC_VERIFY_FACTOR * r->labels->tol, &o.fidelity, err)) !=
             AG_OK)
         goto done;
     o.seconds[AG_STAGE_VERIFY] = now() - t0;
@@ -84,6 +86,7 @@ ag_status ag_usecase_proceduralize_run(ag_workspace *ws, const ag_usecase_proced
     out->grammar_bytes = st.text_len;
     out->terminal_bytes = st.terms.bytes;
     out->fidelity = o.fidelity;
+    out->label_tolerance = r->labels->tol;
     o.total_s = now() - t_all - o.seconds[AG_STAGE_VERIFY];
     s = ag_workspace_save(ws, &st, &o, NULL, err);
     out->total_s = now() - t_all - o.seconds[AG_STAGE_VERIFY];

@@ -27,6 +27,7 @@ typedef struct {
 typedef struct {
     size_t triangles, components, labels, variants, rules, patterns, terminals;
     size_t grammar_bytes, terminal_bytes;
+    double label_tolerance; /* metres: labels and shared terminals */
     ag_fidelity fidelity;
     double total_s; /* up to the save, verify excluded */
 } ag_usecase_proceduralize_result;

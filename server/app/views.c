@@ -16,13 +16,13 @@ json_t *ag_view_model(const ag_model_row *row)
     char href[64], mesh[80];
     snprintf(href, sizeof href, "/api/v1/models/%lld", (long long)row->id);
     snprintf(mesh, sizeof mesh, "/api/v1/models/%lld/mesh.glb", (long long)row->id);
-    return json_pack("{s:I, s:s, s:s, s:I, s:s, s:s, s:s, s:s, s:o, s:o, s:b}", "id",
+    return json_pack("{s:I, s:s, s:s, s:I, s:s, s:s, s:s, s:s, s:o, s:o, s:b, s:o}", "id",
                      (json_int_t)row->id, "name", row->name, "kind", row->kind, "version",
                      (json_int_t)row->version, "created_at", row->created_at, "updated_at",
                      row->updated_at, "href", href, "mesh", mesh, "stats",
                      parse_or_null(row->stats_json), "source_format",
                      row->source_format[0] ? json_string(row->source_format) : json_null(),
-                     "public_read", row->public_read);
+                     "public_read", row->public_read, "up", parse_or_null(row->up_json));
 }
 
 json_t *ag_view_job(const ag_job_row *row)

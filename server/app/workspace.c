@@ -7,11 +7,11 @@ static ag_status unsupported(const char *what, ag_error *err)
 
 ag_status ag_workspace_add_model(ag_workspace *ws, const char *name, const ag_mesh *mesh,
                                  const void *source, size_t source_len, const char *source_format,
-                                 int64_t *model, ag_error *err)
+                                 const ag_up_decision *up, int64_t *model, ag_error *err)
 {
     *model = 0;
-    return ws->ops->add_model
-               ? ws->ops->add_model(ws, name, mesh, source, source_len, source_format, model, err)
+    return ws->ops->add_model ? ws->ops->add_model(ws, name, mesh, source, source_len,
+                                                   source_format, up, model, err)
                : unsupported("store a new model", err);
 }
 

@@ -28,6 +28,7 @@
 #include "../core/parts/part.h"
 #include "../core/status.h"
 #include "../io/edit_op_json.h"
+#include "../io/import.h"
 #include "cloud_state.h"
 #include "model_state.h"
 
@@ -75,11 +76,12 @@ typedef struct {
 } ag_compose_outcome;
 
 typedef struct {
-    /* Stores a mesh as a new model (an import); source (the file as it came, may be NULL) and
-     * its format are kept with it. *model gets its id. */
+    /* Stores a mesh as a new model (an import); source (the file as it came, may be NULL),
+     * its format and how its up axis was decided (may be NULL) are kept with it. *model gets
+     * its id. */
     ag_status (*add_model)(ag_workspace *ws, const char *name, const ag_mesh *mesh,
                            const void *source, size_t source_len, const char *source_format,
-                           int64_t *model, ag_error *err);
+                           const ag_up_decision *up, int64_t *model, ag_error *err);
     /* Stores an extruded batch (app/usecase_extrude.h) as a new model of kind "extrusion":
      * its mesh, each building's description, mesh and outcome, the input as its source, and
      * the report (for a job's result). */
@@ -136,7 +138,7 @@ struct ag_workspace {
 /* Dispatch, answering AG_ERR_UNSUPPORTED where the workspace has no such operation. */
 ag_status ag_workspace_add_model(ag_workspace *ws, const char *name, const ag_mesh *mesh,
                                  const void *source, size_t source_len, const char *source_format,
-                                 int64_t *model, ag_error *err);
+                                 const ag_up_decision *up, int64_t *model, ag_error *err);
 ag_status ag_workspace_add_extrusion(ag_workspace *ws, const char *name,
                                     const struct ag_extrude_batch *batch, const ag_mesh *mesh,
                                     const char *source, size_t source_len, const json_t *report,

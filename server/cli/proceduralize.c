@@ -1,4 +1,5 @@
-/* archgram proceduralize IN --out DIR [--up y|z] [--tolerance REL] [--exact REL] [--keep-groups]
+/* archgram proceduralize IN --out DIR [--up auto|y|z] [--tolerance REL] [--exact]
+ *                          [--keep-groups]
  *
  * The proceduralize use case (app/usecase_proceduralize.h) from a mesh file into a folder
  * workspace (app/folder_ws.h): DIR/grammar.txt, terminals/, tree.json, summary.json. */
@@ -10,11 +11,13 @@
 #include "../app/usecase_proceduralize.h"
 #include "commands.h"
 
+#define USAGE                                                                                 \
+    "usage: archgram proceduralize IN --out DIR [--up auto|y|z] [--tolerance REL] [--exact]\n" \
+    "                              [--keep-groups]\n"
+
 static int usage(void)
 {
-    fputs("usage: archgram proceduralize IN --out DIR [--up y|z] [--tolerance REL] "
-          "[--exact REL] [--keep-groups]\n",
-          stderr);
+    fputs(USAGE, stderr);
     return 2;
 }
 
@@ -31,7 +34,7 @@ int ag_cli_proceduralize(int argc, char **argv)
             dir = argv[i];
         } else if (!strcmp(argv[i], "--up")) {
             if (++i >= argc || ag_cli_parse_up(argv[i], &up)) {
-                fputs("archgram: --up takes y or z\n", stderr);
+                fputs("archgram: --up takes auto, y or z\n", stderr);
                 return 2;
             }
         } else if (!strcmp(argv[i], "--tolerance")) {
@@ -42,17 +45,18 @@ int ag_cli_proceduralize(int argc, char **argv)
                 return 2;
             }
         } else if (!strcmp(argv[i], "--exact")) {
-            char *e;
-            if (++i >= argc || (p.label.exact = strtod(argv[i], &e), *e) ||
-                !(p.label.exact > 0 && p.label.exact < 0.1)) {
-                fputs("archgram: --exact takes a number in (0, 0.1)\n", stderr);
-                return 2;
-            }
+            p.label.exact_copies = 1;
         } else if (!strcmp(argv[i], "--keep-groups")) {
             p.segment.keep_groups = 1;
         } else if (!strcmp(argv[i], "--help")) {
-            fputs("usage: archgram proceduralize IN --out DIR [--up y|z] [--tolerance REL] "
-                  "[--keep-groups]\n",
+            fputs(USAGE
+                  "  --up auto|y|z    the file's up axis (auto: the format's, else the "
+                  "content's)\n"
+                  "  --tolerance REL  labels and shared terminals, relative to the diagonal "
+                  "(default 2e-4, at most 5 mm)\n"
+                  "  --exact          share terminals between exact copies only: every "
+                  "instance derives as it was\n"
+                  "  --keep-groups    never split a group into its loose parts\n",
                   stdout);
             return 0;
         } else if (argv[i][0] == '-' && argv[i][1]) {
@@ -84,6 +88,9 @@ int ag_cli_proceduralize(int argc, char **argv)
            in, r.triangles, r.components, r.labels, r.variants, r.rules, r.patterns, r.terminals,
            r.grammar_bytes, r.terminal_bytes, w.input_bytes, r.fidelity.max_error,
            r.fidelity.relative, r.fidelity.unmatched, r.total_s);
+    printf("%s: up axis %s (%s, score %.2f); label tolerance %.3g m%s\n", in,
+           w.up.axis == AG_UP_Z ? "z" : "y", ag_import_up_basis_name(w.up.basis),
+           w.up.evidence.score, r.label_tolerance, p.label.exact_copies ? ", exact copies" : "");
     if (r.fidelity.unmatched) {
         fprintf(stderr, "archgram: %s: the grammar does not reproduce %zu input triangles\n", in,
                 r.fidelity.unmatched);

@@ -113,6 +113,53 @@ ag_format ag_format_sniff(const uint8_t *data, size_t len, const char *filename)
     return AG_FORMAT_UNKNOWN;
 }
 
+const char *ag_import_up_basis_name(ag_up_basis b)
+{
+    switch (b) {
+    case AG_UP_BY_REQUEST: return "request";
+    case AG_UP_BY_FILE: return "file";
+    case AG_UP_BY_CONTENT: return "content";
+    case AG_UP_BY_CONVENTION: return "convention";
+    }
+    return "convention";
+}
+
+static json_t *cues_json(const ag_upaxis_cues *c)
+{
+    return json_pack("{s:f, s:f, s:f, s:f, s:f}", "base", c->base, "top", c->top, "vertical",
+                     c->vertical, "extent", c->extent, "origin", c->origin);
+}
+
+json_t *ag_import_up_json(const ag_up_decision *d)
+{
+    const ag_upaxis_evidence *e = &d->evidence;
+    json_t *ev = json_pack("{s:o, s:f, s:b, s:b, s:[f,f,f], s:o, s:o}", "content",
+                           e->axis ? json_string(e->axis == 2 ? "z" : "y") : json_null(),
+                           "score", e->score, "georeferenced", e->georeferenced, "storey",
+                           e->storey, "centre",
+                           e->centre[0], e->centre[1], e->centre[2], "y", cues_json(&e->cue[0]),
+                           "z", cues_json(&e->cue[1]));
+    return json_pack("{s:s, s:s, s:o}", "axis", d->axis == AG_UP_Z ? "z" : "y", "decided",
+                     ag_import_up_basis_name(d->basis), "evidence", ev ? ev : json_null());
+}
+
+/* Reads the file as it is (no axis change), then decides the axis and turns a y-up mesh to
+ * z up: the decision needs the coordinates as the file holds them. */
+static ag_status read_raw(const uint8_t *data, size_t len, ag_format fmt,
+                          const ag_import_options *opt, ag_mesh **out, ag_error *err)
+{
+    ag_import_options raw = opt ? *opt : (ag_import_options){0};
+    raw.up = AG_UP_Z;
+    if (fmt == AG_FORMAT_OBJ) {
+        ag_obj_read_options o = {.up = AG_UP_Z,
+                                 .progress = raw.progress,
+                                 .user = raw.user,
+                                 .allow_external_files = raw.allow_external_files};
+        return ag_obj_read_buffer((const char *)data, len, &o, out, err);
+    }
+    return ag_assimp_import_buffer(data, len, fmt, &raw, out, NULL, err);
+}
+
 ag_status ag_import_buffer(const uint8_t *data, size_t len, ag_format fmt,
                            const ag_import_options *opt, ag_mesh **out, ag_error *err)
 {
@@ -120,23 +167,44 @@ ag_status ag_import_buffer(const uint8_t *data, size_t len, ag_format fmt,
     if (fmt == AG_FORMAT_UNKNOWN)
         fmt = ag_format_sniff(data, len, NULL);
     switch (fmt) {
-    case AG_FORMAT_OBJ: {
-        ag_obj_read_options o = {0};
-        if (opt) {
-            o.up = opt->up;
-            o.progress = opt->progress;
-            o.user = opt->user;
-            o.allow_external_files = opt->allow_external_files;
-        }
-        return ag_obj_read_buffer((const char *)data, len, &o, out, err);
-    }
+    case AG_FORMAT_OBJ:
     case AG_FORMAT_PLY:
     case AG_FORMAT_STL:
     case AG_FORMAT_GLTF:
     case AG_FORMAT_GLB:
     case AG_FORMAT_FBX:
-    case AG_FORMAT_DAE:
-        return ag_assimp_import_buffer(data, len, fmt, opt, out, NULL, err);
+    case AG_FORMAT_DAE: {
+        ag_status st = read_raw(data, len, fmt, opt, out, err);
+        if (st)
+            return st;
+        ag_up_decision d = {.basis = AG_UP_BY_REQUEST, .axis = opt ? opt->up : AG_UP_DEFAULT};
+        if ((st = ag_upaxis_decide(*out, &d.evidence, err))) {
+            ag_mesh_free(*out);
+            *out = NULL;
+            return st;
+        }
+        if (d.axis != AG_UP_Y && d.axis != AG_UP_Z) {
+            /* glTF is y-up by its specification; assimp hands out Collada and FBX scenes
+             * y-up; OBJ, PLY and STL say nothing */
+            int declared = fmt == AG_FORMAT_GLTF || fmt == AG_FORMAT_GLB ||
+                           fmt == AG_FORMAT_FBX || fmt == AG_FORMAT_DAE;
+            if (declared) {
+                d.basis = AG_UP_BY_FILE;
+                d.axis = AG_UP_Y;
+            } else if (d.evidence.axis) {
+                d.basis = AG_UP_BY_CONTENT;
+                d.axis = d.evidence.axis == 2 ? AG_UP_Z : AG_UP_Y;
+            } else {
+                d.basis = AG_UP_BY_CONVENTION;
+                d.axis = fmt == AG_FORMAT_OBJ ? AG_UP_Y : AG_UP_Z;
+            }
+        }
+        if (d.axis == AG_UP_Y)
+            ag_upaxis_turn_y_to_z(*out);
+        if (opt && opt->up_decision)
+            *opt->up_decision = d;
+        return AG_OK;
+    }
     case AG_FORMAT_UNKNOWN:
         return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
                             "unrecognised file format (archgram reads obj, ply, stl, gltf, "

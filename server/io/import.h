@@ -5,7 +5,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <jansson.h>
+
 #include "../core/mesh.h"
+#include "../core/proc/upaxis.h"
 #include "../core/status.h"
 #include "obj.h"
 
@@ -27,8 +30,31 @@ const char *ag_format_name(ag_format f);
 /* Guess from content (and an optional file name's extension); AG_FORMAT_UNKNOWN when unsure. */
 ag_format ag_format_sniff(const uint8_t *data, size_t len, const char *filename);
 
+/* What the up axis was taken from. */
+typedef enum {
+    AG_UP_BY_REQUEST = 1, /* the caller said it (--up, ?up=) */
+    AG_UP_BY_FILE,        /* the format says it: glTF, Collada and FBX scenes are y-up */
+    AG_UP_BY_CONTENT,     /* decided from the geometry (core/proc/upaxis.h) */
+    AG_UP_BY_CONVENTION,  /* the content decided nothing: the format's convention (OBJ y,
+                             PLY and STL z) */
+} ag_up_basis;
+
 typedef struct {
+    ag_up_axis axis;              /* AG_UP_Y or AG_UP_Z: what the input was taken as */
+    ag_up_basis basis;
+    ag_upaxis_evidence evidence;  /* the content's cues, measured whatever the basis */
+} ag_up_decision;
+
+/* {"axis": "z", "decided": "content", "evidence": {...}} (schema/openapi.json, UpAxis). */
+json_t *ag_import_up_json(const ag_up_decision *d);
+const char *ag_import_up_basis_name(ag_up_basis b);
+
+typedef struct {
+    /* The input's up axis: AG_UP_Y or AG_UP_Z, or AG_UP_DEFAULT to take it from the format
+     * when it says it, else from the content, else from the format's convention. */
     ag_up_axis up;
+    /* Filled with the decision and its evidence when not NULL. */
+    ag_up_decision *up_decision;
     int (*progress)(void *user, double fraction); /* non-zero return cancels */
     void *user;
     /* Whether the input may bring in other files: glTF buffers and images by URI, OBJ

@@ -33,21 +33,33 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
 {
     ag_error err;
     ag_error_clear(&err);
-    /* an empty body or {} */
+    /* an empty body, {} or {"exact": true|false} */
+    int exact = 0;
     if (r->body_len) {
         json_t *body;
         ag_status s = ag_request_json(r, &body, &err);
         if (s != AG_OK)
             return ag_reply_problem(r, s, &err);
-        const char *key = NULL;
+        const char *key = NULL, *bad = NULL;
         json_t *v;
-        json_object_foreach(body, key, v) break;
-        if (key)
+        json_object_foreach(body, key, v) {
+            if (!strcmp(key, "exact") && json_is_boolean(v)) {
+                exact = json_is_true(v);
+            } else {
+                bad = key;
+                break;
+            }
+        }
+        if (bad && !strcmp(bad, "exact"))
+            ag_error_set(&err, AG_ERR_INVALID, 0, "\"exact\" takes true or false");
+        else if (bad)
             ag_error_set(&err, AG_ERR_INVALID, 0, "\"%s\" is not an option of proceduralize",
-                         key);
-        json_decref(body);
-        if (key)
+                         bad);
+        if (bad) {
+            json_decref(body);
             return ag_reply_problem(r, AG_ERR_INVALID, &err);
+        }
+        json_decref(body);
     }
     int64_t current, base;
     ag_status s = ag_app_query_version(r->cfg->app, r->ids[0], &current, &err);
@@ -56,7 +68,7 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
     int64_t job = 0;
-    s = ag_app_jobs_proceduralize(r->cfg->app, &r->who, r->ids[0], &current, &job, &err);
+    s = ag_app_jobs_proceduralize(r->cfg->app, &r->who, r->ids[0], &current, exact, &job, &err);
     return ag_reply_new_job(r, s, job, &err);
 }
 

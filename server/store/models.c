@@ -8,6 +8,8 @@ void ag_models_row_clear(ag_model_row *row)
     if (row) {
         free(row->stats_json);
         row->stats_json = NULL;
+        free(row->up_json);
+        row->up_json = NULL;
     }
 }
 
@@ -75,8 +77,8 @@ ag_status ag_models_insert(ag_db *db, const ag_model_new *m, int64_t *id, ag_err
         return s;
     sqlite3_stmt *st = ag_db_prepare(
         db,
-        "INSERT INTO models (name, kind, mesh_blob, source_blob, source_format, stats) "
-        "VALUES (?, ?, ?, ?, ?, ?)",
+        "INSERT INTO models (name, kind, mesh_blob, source_blob, source_format, stats, up_axis) "
+        "VALUES (?, ?, ?, ?, ?, ?, ?)",
         err);
     if (!st)
         return err ? err->code : AG_ERR_DB;
@@ -92,6 +94,10 @@ ag_status ag_models_insert(ag_db *db, const ag_model_new *m, int64_t *id, ag_err
     else
         sqlite3_bind_null(st, 5);
     sqlite3_bind_text(st, 6, m->stats_json ? m->stats_json : "{}", -1, SQLITE_STATIC);
+    if (m->up_json)
+        sqlite3_bind_text(st, 7, m->up_json, -1, SQLITE_STATIC);
+    else
+        sqlite3_bind_null(st, 7);
     ag_status done = ag_db_step_done(db, st, "storing the model", err);
     if (done != AG_OK)
         return done;
@@ -101,7 +107,7 @@ ag_status ag_models_insert(ag_db *db, const ag_model_new *m, int64_t *id, ag_err
 
 #define MODEL_COLUMNS                                                                     \
     "id, name, kind, version, mesh_blob, coalesce(source_blob, 0), coalesce(source_format, " \
-    "''), created_at, updated_at, stats, public_read"
+    "''), created_at, updated_at, stats, public_read, up_axis"
 
 static ag_status read_row(sqlite3_stmt *st, ag_model_row *row)
 {
@@ -118,7 +124,9 @@ static ag_status read_row(sqlite3_stmt *st, ag_model_row *row)
     row->public_read = sqlite3_column_int(st, 10) != 0;
     const unsigned char *stats = sqlite3_column_text(st, 9);
     row->stats_json = strdup(stats ? (const char *)stats : "{}");
-    return row->stats_json ? AG_OK : AG_ERR_NOMEM;
+    const unsigned char *up = sqlite3_column_text(st, 11);
+    row->up_json = up ? strdup((const char *)up) : NULL;
+    return row->stats_json && (row->up_json || !up) ? AG_OK : AG_ERR_NOMEM;
 }
 
 ag_status ag_models_get(ag_db *db, int64_t id, ag_model_row *row, ag_error *err)
@@ -165,7 +173,7 @@ ag_status ag_models_list(ag_db *db, int64_t visible_to, int64_t after_id, size_t
     while (n < limit && (rc = sqlite3_step(st)) == SQLITE_ROW) {
         if ((s = read_row(st, &out[n])) != AG_OK)
             break;
-        ag_db_column_copy(st, 11, out[n].member_role, sizeof out[n].member_role);
+        ag_db_column_copy(st, 12, out[n].member_role, sizeof out[n].member_role);
         n++;
     }
     if (s == AG_OK && n < limit && rc != SQLITE_DONE)

@@ -20,6 +20,7 @@ typedef struct {
     char created_at[32];
     char updated_at[32];
     char *stats_json; /* malloc'd; ag_models_row_clear frees it */
+    char *up_json;    /* how the import decided the up axis, malloc'd; NULL when not imported */
     int public_read;  /* readable by every account */
     char member_role[8]; /* ag_models_list: the role of its visible_to on it ("" none) */
 } ag_model_row;
@@ -30,6 +31,7 @@ typedef struct {
     const char *name;
     const char *kind;          /* NULL = "mesh" */
     const char *stats_json;    /* NULL = "{}" */
+    const char *up_json;       /* the import's up-axis decision (JSON); may be NULL */
     const char *source_format; /* may be NULL */
     const void *source;        /* may be NULL */
     size_t source_len;

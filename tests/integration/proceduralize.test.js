@@ -277,6 +277,27 @@ describe('proceduralization over REST and websockets', () => {
     assert.equal((await getModel()).version, model.version);
   });
 
+  it('the body takes exact (a boolean) and nothing else; exact copies derive the input back', async () => {
+    const m = await importModel(d, facadeObj(3, 2), { name: 'exact' });
+    for (const [body, detail] of [[{ exact: 'yes' }, '"exact" takes true or false'],
+      [{ tolerance: 1 }, '"tolerance" is not an option of proceduralize']]) {
+      const r = await http(d, 'POST', `/api/v1/models/${m.id}/proceduralize`, { body });
+      assert.ok(r.status >= 400 && r.status < 500, r.text);
+      assert.equal(r.headers.get('content-type'), 'application/problem+json');
+      assert.equal(r.json.detail, detail);
+    }
+    assert.equal((await getModel(m.id)).version, m.version, 'a refused request stores nothing');
+    const r = await http(d, 'POST', `/api/v1/models/${m.id}/proceduralize`, { body: { exact: true } });
+    assert.equal(r.status, 202, r.text);
+    const job = await waitJob(d, r.json.id);
+    assert.equal(job.status, 'succeeded', JSON.stringify(job));
+    const after = await getModel(m.id);
+    assert.equal(after.proceduralized, true);
+    assert.equal(after.stats.triangles, m.stats.triangles);
+    const del = await http(d, 'DELETE', `/api/v1/models/${m.id}`, { headers: { 'If-Match': `"${after.version}"` } });
+    assert.equal(del.status, 204, del.text);
+  });
+
   it('a model that changes while the job waits makes it fail as stale, storing nothing', async () => {
     const blocker = await occupyWorker();
     const r = await proceduralize(model.id);

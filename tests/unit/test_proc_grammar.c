@@ -214,6 +214,48 @@ static void test_deep_nesting_and_rule_chains(void **state)
     ag_grammar_free(g);
 }
 
+/* A flat component on its parent's upper face, where min + (c.min - min) rounds past max
+ * (these coordinates come from a building read with the other up axis): the child box must
+ * not come out inverted, and the grammar must export and resolve. */
+static void test_flat_child_on_the_upper_face(void **state)
+{
+    (void)state;
+    const double lo = -21.133, hi = -0.929;
+    ag_box parent = {{0, lo, 0}, {1, hi, 1}};
+    double pivot[3] = {0, hi - lo, 0};
+    ag_box child = ag_splittree_child_box(&parent, pivot, 1 + 2); /* upper part along y */
+    assert_true(child.min[1] <= child.max[1]);
+    assert_true(child.min[1] == hi);
+
+    ag_mesh *m = ag_mesh_create();
+    size_t c;
+    const double box[8][3] = {{0, lo, 0}, {1, lo, 0}, {0, hi, 0}, {1, hi, 0},
+                              {0, lo, 1}, {1, lo, 1}, {0, hi, 1}, {1, hi, 1}};
+    static const int f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    ag_mesh_add_component(m, -1, &c);
+    for (int i = 0; i < 8; i++)
+        ag_mesh_add_vertex(m, box[i][0], box[i][1], box[i][2]);
+    for (int i = 0; i < 12; i++)
+        ag_mesh_add_triangle(m, f[i][0], f[i][1], f[i][2], (uint32_t)c);
+    /* a quad lying on the box's y = hi face, 10 cm inside its edges */
+    ag_mesh_add_component(m, -1, &c);
+    ag_mesh_add_vertex(m, 0.1, hi, 0.1);
+    ag_mesh_add_vertex(m, 0.9, hi, 0.1);
+    ag_mesh_add_vertex(m, 0.9, hi, 0.9);
+    ag_mesh_add_vertex(m, 0.1, hi, 0.9);
+    ag_mesh_add_triangle(m, 8, 10, 9, (uint32_t)c);
+    ag_mesh_add_triangle(m, 8, 11, 10, (uint32_t)c);
+    ag_error err;
+    ag_proceduralize_result *r = run(m, AG_OK, &err);
+    for (size_t i = 0; i < r->tree->nnodes; i++)
+        for (int a = 0; a < 3; a++)
+            assert_true(r->tree->nodes[i].box.min[a] <= r->tree->nodes[i].box.max[a]);
+    assert_int_equal(r->fidelity.unmatched, 0);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -222,6 +264,7 @@ int main(void)
         cmocka_unit_test(test_one_triangle_and_degenerate_triangles),
         cmocka_unit_test(test_derivation_limits_and_turns),
         cmocka_unit_test(test_deep_nesting_and_rule_chains),
+        cmocka_unit_test(test_flat_child_on_the_upper_face),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -143,7 +143,7 @@ static void the_store_and_a_folder_run_the_same_pipeline(void **state)
     /* what a workspace cannot do, and problems naming what they are about */
     int64_t none;
     ag_folder_ws_init(&f, &(ag_folder_ws_options){.out_dir = p1});
-    assert_int_equal(ag_workspace_add_model(&f.ws, "x", NULL, NULL, 0, NULL, &none, &err),
+    assert_int_equal(ag_workspace_add_model(&f.ws, "x", NULL, NULL, 0, NULL, NULL, &none, &err),
                      AG_ERR_UNSUPPORTED);
     ag_folder_ws_init(&f, &(ag_folder_ws_options){.in_dir = "/nonexistent", .out_dir = p2});
     assert_int_not_equal(ag_usecase_edit_run(&f.ws, &(ag_usecase_edit_params){&op, NULL}, &er, &err),

@@ -29,12 +29,22 @@
 /* Segment: a group with at least this many pieces may be split into them. */
 #define AG_PROC_SPLIT_MIN_PIECES 4
 
-/* Label: variants (shapes equal within this, relative) are one label. 1e-4 of a 30 m
- * building is 3 mm: near-exact copies a person sees as one element (windows modelled by hand
- * a millimetre apart) share a label. */
-#define AG_PROC_LABEL_TOLERANCE 1e-4
-/* Label: components equal within this (relative) are one variant, i.e. one terminal; it is
- * the precision derivation reproduces, 1e-7 of the diagonal (3 µm on a 30 m building). */
+/* Label: components whose surfaces are equal within this (relative; see label.h) share a
+ * label and, by default, a terminal. 2e-4 of a 20 m building is 4 mm: near-exact copies a
+ * person sees as one element (windows modelled by hand a few millimetres apart, or set into
+ * facades a fraction of a degree apart) share a label; a window a centimetre larger does
+ * not. The default is capped by AG_PROC_LABEL_TOLERANCE_MAX, so sharing a terminal never
+ * moves a surface by more than that on large sites (fidelity reports what it did move). */
+#define AG_PROC_LABEL_TOLERANCE 2e-4
+#define AG_PROC_LABEL_TOLERANCE_MAX 0.005
+/* Label: copies whose orientations about the up axis differ (beyond quarter turns) share a
+ * label when that turn moves their plan corners by at most this (metres): a facade a degree
+ * or two off square holds the same windows; a window on a facade turned further is set
+ * otherwise and labelled apart (no terminal could serve both anyway). */
+#define AG_PROC_LABEL_TURN_MOVE 0.02
+/* Label, exact copies (--exact): components equal within this (relative) share a terminal;
+ * it is the precision derivation then reproduces, 1e-7 of the diagonal (3 µm on a 30 m
+ * building). */
 #define AG_PROC_LABEL_EXACT 1e-7
 /* A positive stand-in for a tolerance or size of 0 where one divides by it (a cell size, a
  * scale): near the bottom of the double range, so building-sized values divided by it stay
@@ -55,6 +65,10 @@
 
 /* Fidelity: the default tolerance (relative) for matching a derived mesh to its input. */
 #define AG_PROC_FIDELITY 1e-5
+/* Fidelity: surfaces are compared at the tolerance divided by this first, then at the
+ * tolerance: a certified bound is only as fine as the tolerance it was proven at, so a close
+ * match is proven at the finer one. */
+#define AG_PROC_FIDELITY_REFINE 10.0
 /* Verify: derivation must reproduce the input within this many label tolerances. */
 #define AG_PROC_VERIFY_FACTOR 10
 

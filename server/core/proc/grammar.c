@@ -9,6 +9,8 @@
 #include "../base/array.h"
 #include "../base/tolerance.h"
 #include "gframe.h"
+#include "surface.h"
+#include "weld.h"
 
 /* Work limits: a subdivide or repeat of more cells is refused (its derivation would not fit
  * in memory); a derivation stops past this many triangles (unless the caller sets its own)
@@ -402,7 +404,9 @@ typedef struct {
     uint8_t *in_pattern; /* per class: used by a subdivide */
     int32_t *rule_of;    /* per class: grammar rule */
     int32_t *term_of;    /* per variant: terminal */
-    uint32_t *vmap;      /* scratch: vertex → terminal vertex */
+    uint32_t *wslot;     /* scratch: terminal vertices by position (index + 1, 0 empty) */
+    size_t wcap;         /* its size, a power of two */
+    uint32_t *wused;     /* per terminal vertex: its slot, to empty the table again */
     double *tpos;
     uint32_t *ttri;
     ag_status st;
@@ -444,24 +448,41 @@ static int32_t terminal_for(exctx *x, int32_t variant)
         x->st = AG_ERR_NOMEM;
         return 0;
     }
+    /* vertices at the same position are one terminal vertex: files that repeat a vertex for
+     * every polygon (most exports) store it once */
     size_t nv = 0, nt = 0;
     for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++) {
         uint32_t tr = L->tris[s];
         for (int k = 0; k < 3; k++) {
-            uint32_t v = x->m->tri[3 * tr + k];
-            if (x->vmap[v] == UINT32_MAX) {
-                x->vmap[v] = (uint32_t)nv;
-                for (int a = 0; a < 3; a++)
-                    x->tpos[3 * nv + a] = x->m->pos[3 * v + a] - nb->min[a];
-                nv++;
+            const double *p = x->m->pos + 3 * (size_t)x->m->tri[3 * tr + k];
+            double q[3] = {p[0] - nb->min[0], p[1] - nb->min[1], p[2] - nb->min[2]};
+            uint64_t bits[3];
+            memcpy(bits, q, sizeof bits);
+            size_t h = ag__mix64(bits[0] ^ ag__mix64(bits[1] + 0x632BE59BD9B4E019ULL) ^
+                                 ag__mix64(bits[2] * 0x85EBCA77C2B2AE63ULL + 1)) &
+                       (x->wcap - 1);
+            uint32_t id;
+            for (;;) {
+                uint32_t w = x->wslot[h];
+                if (!w) {
+                    id = (uint32_t)nv++;
+                    memcpy(x->tpos + 3 * id, q, sizeof q);
+                    x->wslot[h] = id + 1;
+                    x->wused[id] = (uint32_t)h;
+                    break;
+                }
+                if (!memcmp(x->tpos + 3 * (w - 1), q, sizeof q)) {
+                    id = w - 1;
+                    break;
+                }
+                h = (h + 1) & (x->wcap - 1);
             }
-            x->ttri[3 * nt + k] = x->vmap[v];
+            x->ttri[3 * nt + k] = id;
         }
         nt++;
     }
-    for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++)
-        for (int k = 0; k < 3; k++)
-            x->vmap[x->m->tri[3 * L->tris[s] + k]] = UINT32_MAX;
+    for (size_t i = 0; i < nv; i++)
+        x->wslot[x->wused[i]] = 0;
     if ((x->st = ag_grammar_set_terminal_geometry(&x->g->terminals[ti], x->tpos, nv, x->ttri, nt)))
         return 0;
     x->term_of[variant] = (int32_t)ti;
@@ -594,19 +615,21 @@ ag_status ag_grammar_export(const ag_mesh *m, const ag_labels *L, const ag_split
     x.in_pattern = calloc(nc + 1, 1);
     x.rule_of = malloc((nc + 1) * sizeof *x.rule_of);
     x.term_of = malloc((L->nvariants + 1) * sizeof *x.term_of);
-    x.vmap = malloc((m->nverts + 1) * sizeof *x.vmap);
+    /* maxt < 2^32 (triangle indices are 32 bits): the table's size always fits */
+    if (ag_array_hash_size(3 * maxt, &x.wcap))
+        x.wcap = 0;
+    x.wslot = x.wcap ? calloc(x.wcap, sizeof *x.wslot) : NULL;
+    x.wused = malloc((3 * maxt + 3) * sizeof *x.wused);
     x.tpos = malloc((9 * maxt + 3) * sizeof *x.tpos);
     x.ttri = malloc((3 * maxt + 3) * sizeof *x.ttri);
     ag_status st = AG_ERR_NOMEM;
-    if (!x.g || !x.apps || !x.exemplar || !x.visited || !x.in_pattern || !x.rule_of || !x.term_of || !x.vmap ||
-        !x.tpos || !x.ttri)
+    if (!x.g || !x.apps || !x.exemplar || !x.visited || !x.in_pattern || !x.rule_of || !x.term_of || !x.wslot ||
+        !x.wused || !x.tpos || !x.ttri)
         goto done;
     for (size_t i = 0; i < nc; i++)
         x.rule_of[i] = -1;
     for (size_t i = 0; i < L->nvariants; i++)
         x.term_of[i] = -1;
-    for (size_t i = 0; i < m->nverts; i++)
-        x.vmap[i] = UINT32_MAX;
     unsigned counter = 0;
     x.pass = 1;
     emit_content(&x, &scratch_rule, 0, "p", &counter);
@@ -620,10 +643,13 @@ ag_status ag_grammar_export(const ag_mesh *m, const ag_labels *L, const ag_split
         goto done;
     {
         long col;
-        st = ag_grammar_resolve(x.g, err, &col);
+        ag_error why;
+        ag_error_clear(&why);
+        st = ag_grammar_resolve(x.g, &why, &col);
         if (st) {
+            /* the reason is copied first: err may not be both the source and the target */
             st = ag_error_set(err, AG_ERR_INTERNAL, 0, "exported grammar does not resolve: %s",
-                              err ? err->text : "");
+                              why.text);
             goto done;
         }
     }
@@ -648,7 +674,8 @@ done:
     free(x.in_pattern);
     free(x.rule_of);
     free(x.term_of);
-    free(x.vmap);
+    free(x.wslot);
+    free(x.wused);
     free(x.tpos);
     free(x.ttri);
     return st;
@@ -797,45 +824,317 @@ ag_status ag_grammar_derive(const ag_grammar *g, const ag_grammar_derive_options
     return AG_OK;
 }
 
-/* ---- fidelity --------------------------------------------------------------------------- */
+/* ---- fidelity ------------------------------------------------------------------------- */
 
-static double *soup_of(const ag_mesh *m)
+/* Triangles of a mesh grouped by component, with each component's box. */
+typedef struct {
+    uint32_t *start, *tris;
+    ag_box *box;
+    size_t n;
+} bycomp;
+
+static void bycomp_free(bycomp *b)
 {
-    double *s = malloc((9 * m->ntris + 1) * sizeof *s);
-    if (!s)
-        return NULL;
+    free(b->start);
+    free(b->tris);
+    free(b->box);
+}
+
+static int bycomp_of(const ag_mesh *m, bycomp *b)
+{
+    b->n = m->ncomponents;
+    b->start = calloc(b->n + 2, sizeof *b->start);
+    b->tris = malloc((m->ntris + 1) * sizeof *b->tris);
+    b->box = malloc((b->n + 1) * sizeof *b->box);
+    uint32_t *fill = malloc((b->n + 1) * sizeof *fill);
+    if (!b->start || !b->tris || !b->box || !fill) {
+        free(fill);
+        return -1;
+    }
+    for (size_t c = 0; c < b->n; c++)
+        b->box[c] = ag_box_empty();
+    for (size_t t = 0; t < m->ntris; t++) {
+        uint32_t c = m->tri_component[t];
+        b->start[c + 1]++;
+        for (int v = 0; v < 3; v++)
+            ag_box_extend_point(&b->box[c], m->pos + 3 * (size_t)m->tri[3 * t + v]);
+    }
+    for (size_t c = 0; c < b->n; c++)
+        b->start[c + 1] += b->start[c];
+    memcpy(fill, b->start, b->n * sizeof *fill);
     for (size_t t = 0; t < m->ntris; t++)
+        b->tris[fill[m->tri_component[t]]++] = (uint32_t)t;
+    free(fill);
+    return 0;
+}
+
+/* The triangles l (n of them) as a soup relative to origin o. */
+static void soup_of(const ag_mesh *m, const uint32_t *l, size_t n, const double o[3], double *s)
+{
+    for (size_t i = 0; i < n; i++)
         for (int k = 0; k < 3; k++)
-            memcpy(s + 9 * t + 3 * k, m->pos + 3 * m->tri[3 * t + k], 3 * sizeof *s);
-    return s;
+            for (int a = 0; a < 3; a++)
+                s[9 * i + 3 * k + a] = m->pos[3 * (size_t)m->tri[3 * (size_t)l[i] + k] + a] - o[a];
+}
+
+typedef struct {
+    uint64_t key;
+    int32_t head;
+} pslot;
+
+typedef struct {
+    double dev;
+    int32_t d;
+} pcand;
+
+static int cmp_cand(const void *a, const void *b)
+{
+    const pcand *x = a, *y = b;
+    if (x->dev != y->dev)
+        return x->dev < y->dev ? -1 : 1;
+    return (x->d > y->d) - (x->d < y->d);
+}
+
+/* A's triangles l (n of them) on surface B: the count not within tol, and the bound. */
+static void cover_count(const ag_mesh *A, const uint32_t *l, size_t n, ag_surface *B,
+                        const double o[3], double tol, double *scratch, double *upper,
+                        size_t *missing)
+{
+    soup_of(A, l, n, o, scratch);
+    ag_surface_cover_result r;
+    ag_surface_cover(B, scratch, n, tol, 0, 0, &r);
+    if (r.upper > *upper)
+        *upper = r.upper;
+    *missing += r.uncovered;
 }
 
 ag_status ag_grammar_fidelity(const ag_mesh *input, const ag_mesh *derived, double tol,
                               ag_fidelity *f, ag_error *err)
 {
     memset(f, 0, sizeof *f);
+    f->input_triangles = input->ntris;
+    f->derived_triangles = derived->ntris;
     ag_box b = ag_mesh_bounds(input);
     double diag = ag_box_diagonal(&b);
     if (!(diag > 0))
         diag = 1;
     if (tol <= 0)
         tol = AG_PROC_FIDELITY * diag;
-    double *a = soup_of(derived), *s = soup_of(input);
-    if (!a || !s) {
-        free(a);
-        free(s);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    /* components are paired by their boxes (a placed terminal spans its node's box, which
+     * is its component's), then compared surface to surface; what pairs with nothing is
+     * compared with the whole other mesh */
+    double pair_tol = 2 * tol + AG_PROC_COINCIDENT * diag;
+    double fast_tol = fmin(tol, AG_PROC_FIDELITY * diag);
+    double cell = 2 * pair_tol;
+    bycomp I = {0}, D = {0};
+    pslot *tab = NULL;
+    int32_t *next = NULL, *pair = NULL;
+    uint8_t *taken = NULL;
+    double *sa = NULL, *sb = NULL;
+    pcand *cand = NULL;
+    uint32_t *left_i = NULL, *left_d = NULL;
+    size_t nli = 0, nld = 0, cap = 0, maxt = 0;
+    ag_status st = AG_ERR_NOMEM;
+    if (bycomp_of(input, &I) || bycomp_of(derived, &D) || ag_array_hash_size(D.n, &cap))
+        goto done;
+    tab = malloc(cap * sizeof *tab);
+    next = malloc((D.n + 1) * sizeof *next);
+    pair = malloc((I.n + 1) * sizeof *pair);
+    taken = calloc(D.n + 1, 1);
+    left_i = malloc((input->ntris + 1) * sizeof *left_i);
+    left_d = malloc((derived->ntris + 1) * sizeof *left_d);
+    if (!tab || !next || !pair || !taken || !left_i || !left_d)
+        goto done;
+    for (size_t i = 0; i < cap; i++)
+        tab[i].head = -1;
+    for (size_t c = 0; c < D.n; c++) {
+        size_t k = D.start[c + 1] - D.start[c];
+        if (k > maxt)
+            maxt = k;
+        if (!k)
+            continue;
+        const double *p = D.box[c].min;
+        uint64_t key = ag__cell_hash((int64_t)floor(p[0] / cell), (int64_t)floor(p[1] / cell),
+                                     (int64_t)floor(p[2] / cell));
+        size_t h = key & (cap - 1);
+        while (tab[h].head >= 0 && tab[h].key != key)
+            h = (h + 1) & (cap - 1);
+        tab[h].key = key;
+        next[c] = tab[h].head;
+        tab[h].head = (int32_t)c;
     }
-    size_t miss = 0;
-    double w = ag_label_match_triangles(a, derived->ntris, s, input->ntris, tol, &miss);
-    free(a);
-    free(s);
-    if (w < 0)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    f->max_error = w;
-    f->relative = w / diag;
-    f->unmatched = miss;
-    f->input_triangles = input->ntris;
-    f->derived_triangles = derived->ntris;
+    for (size_t c = 0; c < I.n; c++) {
+        size_t k = I.start[c + 1] - I.start[c];
+        if (k > maxt)
+            maxt = k;
+    }
+    sa = malloc((9 * maxt + 1) * sizeof *sa);
+    sb = malloc((9 * maxt + 1) * sizeof *sb);
+    cand = malloc((D.n + 1) * sizeof *cand);
+    if (!sa || !sb || !cand)
+        goto done;
+    /* pass 0: copies by their triangle lists; 1: surfaces at a finer tolerance (a certified
+     * bound is only as fine as the tolerance it was proven at, so a close match reports a
+     * close bound); 2: surfaces at tol; 3: what is left is a difference. Each pass runs
+     * over every component before the next, so a loose match never takes a component's
+     * partner from a closer one. pair: -1 open, -2 done without a partner. */
+    for (size_t c = 0; c < I.n; c++)
+        pair[c] = I.start[c + 1] > I.start[c] ? -1 : -2;
+    for (int pass = 0; pass < 4; pass++)
+        for (size_t c = 0; c < I.n; c++) {
+            if (pair[c] != -1)
+                continue;
+            const uint32_t *li = I.tris + I.start[c];
+            size_t ni = I.start[c + 1] - I.start[c];
+            /* the derived components on the same box, closest first */
+            const double *p = I.box[c].min;
+            int64_t k0 = (int64_t)floor(p[0] / cell), k1 = (int64_t)floor(p[1] / cell),
+                    k2 = (int64_t)floor(p[2] / cell);
+            size_t nc = 0;
+            for (int nb = 0; nb < 27; nb++) {
+                uint64_t key =
+                    ag__cell_hash(k0 + nb % 3 - 1, k1 + nb / 3 % 3 - 1, k2 + nb / 9 - 1);
+                size_t h = key & (cap - 1);
+                while (tab[h].head >= 0 && tab[h].key != key)
+                    h = (h + 1) & (cap - 1);
+                for (int32_t d = tab[h].head; d >= 0; d = next[d]) {
+                    if (taken[d])
+                        continue;
+                    double dev = 0;
+                    for (int a = 0; a < 3; a++)
+                        dev = fmax(dev, fmax(fabs(D.box[d].min[a] - I.box[c].min[a]),
+                                             fabs(D.box[d].max[a] - I.box[c].max[a])));
+                    if (dev <= pair_tol) {
+                        cand[nc].dev = dev;
+                        cand[nc++].d = d;
+                    }
+                }
+            }
+            qsort(cand, nc, sizeof *cand, cmp_cand);
+            double o[3];
+            ag_box_centre(&I.box[c], o);
+            soup_of(input, li, ni, o, sa);
+            if (pass < 3) {
+                /* several components on one box (copies in one place, a wall and its
+                 * opening's frame): the closest that matches */
+                for (size_t j = 0; j < nc; j++) {
+                    int32_t d = cand[j].d;
+                    const uint32_t *ld = D.tris + D.start[d];
+                    size_t nd = D.start[d + 1] - D.start[d];
+                    if (pass == 0 && nd != ni)
+                        continue;
+                    soup_of(derived, ld, nd, o, sb);
+                    double w;
+                    int same;
+                    if (pass == 0) {
+                        /* copies, at a tolerance tight enough that the pairing of triangles
+                         * is the true one (a loose one could pair neighbours and report
+                         * their gap) */
+                        size_t miss = 0;
+                        w = ag_label_match_triangles(sb, nd, sa, ni, fast_tol, &miss);
+                        if (w < 0)
+                            goto done;
+                        same = miss == 0;
+                    } else {
+                        double t = pass == 1 ? tol / AG_PROC_FIDELITY_REFINE : tol;
+                        if ((same = ag_label_same_surface(sa, ni, sb, nd, t, &w)) < 0)
+                            goto done;
+                    }
+                    if (same) {
+                        pair[c] = d;
+                        taken[d] = 1;
+                        f->max_error = fmax(f->max_error, w);
+                        break;
+                    }
+                }
+                continue;
+            }
+            if (!nc) {
+                pair[c] = -2;
+                memcpy(left_i + nli, li, ni * sizeof *li);
+                nli += ni;
+                continue;
+            }
+            /* a difference: counted both ways */
+            int32_t d = cand[0].d;
+            pair[c] = d;
+            taken[d] = 1;
+            const uint32_t *ld = D.tris + D.start[d];
+            size_t nd = D.start[d + 1] - D.start[d];
+            soup_of(derived, ld, nd, o, sb);
+            ag_surface S;
+            if (ag_surface_init(&S, sb, nd)) {
+                ag_surface_free(&S);
+                goto done;
+            }
+            ag_surface_cover_result r;
+            ag_surface_cover(&S, sa, ni, tol, 0, 0, &r);
+            ag_surface_free(&S);
+            f->unmatched += r.uncovered;
+            f->max_error = fmax(f->max_error, r.upper);
+            if (ag_surface_init(&S, sa, ni)) {
+                ag_surface_free(&S);
+                goto done;
+            }
+            ag_surface_cover(&S, sb, nd, tol, 0, 0, &r);
+            ag_surface_free(&S);
+            f->spurious += r.uncovered;
+            f->max_error = fmax(f->max_error, r.upper);
+        }
+    for (size_t d = 0; d < D.n; d++)
+        if (!taken[d]) {
+            size_t nd = D.start[d + 1] - D.start[d];
+            memcpy(left_d + nld, D.tris + D.start[d], nd * sizeof *left_d);
+            nld += nd;
+        }
+    if (nli || nld) {
+        /* what did not pair, against the whole of the other mesh */
+        double o[3];
+        ag_box_centre(&b, o);
+        size_t most = derived->ntris > input->ntris ? derived->ntris : input->ntris;
+        size_t part_n = nli > nld ? nli : nld;
+        double *whole = malloc((9 * most + 1) * sizeof *whole);
+        double *part = malloc((9 * part_n + 1) * sizeof *part);
+        uint32_t *every = malloc((most + 1) * sizeof *every);
+        int ok = whole && part && every;
+        for (size_t t = 0; ok && t < most; t++)
+            every[t] = (uint32_t)t;
+        for (int side = 0; side < 2 && ok; side++) {
+            const ag_mesh *of = side ? derived : input, *on = side ? input : derived;
+            const uint32_t *left = side ? left_d : left_i;
+            size_t nleft = side ? nld : nli;
+            if (!nleft)
+                continue;
+            ag_surface S;
+            soup_of(on, every, on->ntris, o, whole);
+            if (ag_surface_init(&S, whole, on->ntris) == AG_OK)
+                cover_count(of, left, nleft, &S, o, tol, part, &f->max_error,
+                            side ? &f->spurious : &f->unmatched);
+            else
+                ok = 0;
+            ag_surface_free(&S);
+        }
+        free(whole);
+        free(part);
+        free(every);
+        if (!ok)
+            goto done;
+    }
+    f->relative = f->max_error / diag;
+    st = AG_OK;
+done:
+    bycomp_free(&I);
+    bycomp_free(&D);
+    free(tab);
+    free(next);
+    free(pair);
+    free(taken);
+    free(sa);
+    free(sb);
+    free(cand);
+    free(left_i);
+    free(left_d);
+    if (st)
+        return ag_error_set(err, st, 0, "out of memory measuring the fidelity");
     return AG_OK;
 }

@@ -121,14 +121,20 @@ ag_status ag_grammar_derive(const ag_grammar *g, const ag_grammar_derive_options
                             ag_mesh **out, ag_error *err);
 
 typedef struct {
-    double max_error;   /* metres, over matched triangles */
+    double max_error;   /* metres: certified bound on the distance between the input and the
+                           derived surfaces where they are within tol of each other */
     double relative;    /* max_error / diagonal of the input */
-    size_t unmatched;   /* input triangles without a derived partner within tol */
+    size_t unmatched;   /* input triangles not reproduced within tol */
+    size_t spurious;    /* derived triangles farther than tol from the input */
     size_t input_triangles, derived_triangles;
 } ag_fidelity;
 
-/* Matches every input triangle to a derived one within tol (absolute; 0 = 1e-5 of the
- * diagonal). */
+/* Compares the input with its derivation within tol (absolute; 0 = 1e-5 of the diagonal),
+ * surface to surface (surface.h), so a terminal shared by copies triangulated otherwise is
+ * measured by what it moves, not by its triangle list. Components are paired by their boxes
+ * (a derivation places one terminal per input component, on its box); a pair with equal
+ * triangle lists is compared triangle by triangle, else by the surfaces both ways; what pairs
+ * with nothing is compared with the whole other mesh. */
 ag_status ag_grammar_fidelity(const ag_mesh *input, const ag_mesh *derived, double tol,
                               ag_fidelity *f, ag_error *err);
 

@@ -7,7 +7,24 @@
 #include "../base/array.h"
 #include "../base/search.h"
 #include "../base/tolerance.h"
+#include "gframe.h"
+#include "surface.h"
 #include "weld.h"
+
+/* Orientation of a component: the 4-fold direction of its faces' horizontal normals,
+ * weighted by area times their horizontal part, when it is clear: the weighted directions
+ * agree at least this much (1: all faces square to one frame; a cylinder's facets give about
+ * 0), and at least this share of the area is not horizontal. Otherwise the axes are its
+ * frame. Below ORIENT_SNAP radians it is the axes' frame exactly. */
+#define ORIENT_MIN_AGREEMENT 0.5
+#define ORIENT_MIN_VERTICAL 0.05
+#define ORIENT_SNAP 1e-9
+/* Surfaces are compared only when their areas agree this closely (relative; areas_close). */
+#define AREA_SLACK 0.02
+/* Surface comparisons one component may make (against exemplars and under turns) before it
+ * is taken as new: many different shapes with equal boxes and areas cost linear time, and
+ * such a component only shares less. */
+#define MAX_SURFACE_CHECKS 64
 
 void ag_label_rotate(int k, double *x, double *y)
 {
@@ -59,6 +76,25 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
     double worst = 0;
     if (tol <= 0)
         tol = AG_PROC_TINY;
+    /* the same order is the common case (copies): one pass, no table */
+    if (na == nb) {
+        size_t i = 0;
+        for (; i < na; i++) {
+            double d = INFINITY;
+            for (int sh = 0; sh < 3 && !(d <= tol); sh++)
+                d = fmin(d, tri_dist(b + 9 * i, a + 9 * i, sh));
+            if (!(d <= tol))
+                break;
+            if (d > worst)
+                worst = d;
+        }
+        if (i == na) {
+            if (unmatched)
+                *unmatched = 0;
+            return worst;
+        }
+        worst = 0;
+    }
     double cell = 2 * tol; /* a match within tol lies in a neighbouring cell */
     hidx *ha = malloc((na + 1) * sizeof *ha);
     uint8_t *used = calloc(na + 1, 1);
@@ -116,6 +152,48 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
     return worst;
 }
 
+/* The surfaces of soups a and b, each on the other. */
+static int surfaces_match(const double *a, size_t na, const double *b, size_t nb, double tol,
+                          double *deviation)
+{
+    ag_surface sa, sb;
+    ag_surface_cover_result ab, ba;
+    if (ag_surface_init(&sb, b, nb)) {
+        ag_surface_free(&sb);
+        return -1;
+    }
+    ag_surface_cover(&sb, a, na, tol, 0, 1, &ab);
+    ag_surface_free(&sb);
+    if (ab.uncovered)
+        return 0;
+    if (ag_surface_init(&sa, a, na)) {
+        ag_surface_free(&sa);
+        return -1;
+    }
+    ag_surface_cover(&sa, b, nb, tol, 0, 1, &ba);
+    ag_surface_free(&sa);
+    if (ba.uncovered)
+        return 0;
+    *deviation = fmax(ab.upper, ba.upper);
+    return 1;
+}
+
+int ag_label_same_surface(const double *a, size_t na, const double *b, size_t nb, double tol,
+                          double *deviation)
+{
+    if (na == nb) {
+        size_t miss = 0;
+        double w = ag_label_match_triangles(a, na, b, nb, tol, &miss);
+        if (w < 0)
+            return -1;
+        if (!miss) {
+            *deviation = w;
+            return 1;
+        }
+    }
+    return surfaces_match(a, na, b, nb, tol, deviation);
+}
+
 void ag_labels_free(ag_labels *l)
 {
     if (!l)
@@ -124,6 +202,8 @@ void ag_labels_free(ag_labels *l)
     free(l->ntris);
     free(l->label);
     free(l->rot);
+    free(l->mirror);
+    free(l->turn);
     free(l->tri_start);
     free(l->tris);
     free(l->exemplar);
@@ -133,42 +213,152 @@ void ag_labels_free(ag_labels *l)
     free(l->variant_exemplar);
     free(l->variant_count);
     free(l->variant_label);
+    free(l->variant_deviation);
     free(l);
 }
 
-/* Triangle soup of component c, centred on its box centre, rotated by k. */
-static void soup(const ag_mesh *m, const ag_labels *L, uint32_t c, int k, double *out)
+/* A component's own frame: turned by -phi about its box centre, its oriented box there has
+ * extents ext and its centre lies at oc (relative to the box centre, in the turned frame). */
+typedef struct {
+    double phi;
+    double oc[2];
+    double ext[3];
+} frame;
+
+static const double *vertex(const ag_mesh *m, uint32_t t, int v)
+{
+    return m->pos + 3 * (size_t)m->tri[3 * (size_t)t + v];
+}
+
+static void frame_of(const ag_mesh *m, const ag_labels *L, uint32_t c, int oriented, frame *f)
+{
+    double sx = 0, sy = 0, wh = 0, wall = 0;
+    if (oriented)
+        for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++) {
+            const double *p = vertex(m, L->tris[s], 0), *q = vertex(m, L->tris[s], 1),
+                         *r = vertex(m, L->tris[s], 2);
+            double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+            double v[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+            double nx = u[1] * v[2] - u[2] * v[1], ny = u[2] * v[0] - u[0] * v[2],
+                   nz = u[0] * v[1] - u[1] * v[0];
+            double h = sqrt(nx * nx + ny * ny);
+            wall += sqrt(nx * nx + ny * ny + nz * nz);
+            if (!(h > 0))
+                continue;
+            /* cos and sin of 4 alpha from the unit direction (nx, ny) / h */
+            double c1 = nx / h, s1 = ny / h;
+            double c2 = c1 * c1 - s1 * s1, s2 = 2 * c1 * s1;
+            sx += h * (c2 * c2 - s2 * s2);
+            sy += h * (2 * c2 * s2);
+            wh += h;
+        }
+    f->phi = 0;
+    if (wh > 0 && wh >= ORIENT_MIN_VERTICAL * wall &&
+        sqrt(sx * sx + sy * sy) >= ORIENT_MIN_AGREEMENT * wh) {
+        f->phi = atan2(sy, sx) / 4;
+        if (fabs(f->phi) < ORIENT_SNAP)
+            f->phi = 0;
+    }
+    double ctr[3];
+    ag_box_centre(&L->box[c], ctr);
+    if (f->phi == 0) {
+        f->oc[0] = f->oc[1] = 0;
+        ag_box_extents(&L->box[c], f->ext);
+        return;
+    }
+    double cs = cos(f->phi), sn = sin(f->phi);
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++)
+        for (int v = 0; v < 3; v++) {
+            const double *p = vertex(m, L->tris[s], v);
+            double x = p[0] - ctr[0], y = p[1] - ctr[1];
+            double xr = cs * x + sn * y, yr = -sn * x + cs * y;
+            lo[0] = fmin(lo[0], xr);
+            hi[0] = fmax(hi[0], xr);
+            lo[1] = fmin(lo[1], yr);
+            hi[1] = fmax(hi[1], yr);
+        }
+    for (int a = 0; a < 2; a++) {
+        f->oc[a] = 0.5 * (lo[a] + hi[a]);
+        f->ext[a] = hi[a] - lo[a];
+    }
+    f->ext[2] = ag_box_extent(&L->box[c], 2);
+}
+
+/* Component c in its own frame, centred on its oriented box, mirrored (x -> -x, winding
+ * reversed so it still faces out) and turned by k quarter turns. */
+static void oriented_soup(const ag_mesh *m, const ag_labels *L, const frame *f, uint32_t c, int k,
+                          int mirror, double *out)
+{
+    double ctr[3];
+    ag_box_centre(&L->box[c], ctr);
+    double cs = cos(f->phi), sn = sin(f->phi);
+    size_t o = 0;
+    for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++)
+        for (int v = 0; v < 3; v++) {
+            const double *p = vertex(m, L->tris[s], mirror && v ? 3 - v : v);
+            double x = p[0] - ctr[0], y = p[1] - ctr[1];
+            double xr = cs * x + sn * y - f->oc[0], yr = -sn * x + cs * y - f->oc[1];
+            if (f->phi == 0) { /* exactly the box frame */
+                xr = x;
+                yr = y;
+            }
+            if (mirror)
+                xr = -xr;
+            ag_label_rotate(k, &xr, &yr);
+            out[o++] = xr;
+            out[o++] = yr;
+            out[o++] = p[2] - ctr[2];
+        }
+}
+
+/* Component c's triangles relative to its box centre. */
+static void box_soup(const ag_mesh *m, const ag_labels *L, uint32_t c, double *out)
 {
     double ctr[3];
     ag_box_centre(&L->box[c], ctr);
     size_t o = 0;
-    for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++) {
-        uint32_t t = L->tris[s];
+    for (uint32_t s = L->tri_start[c]; s < L->tri_start[c + 1]; s++)
         for (int v = 0; v < 3; v++) {
-            const double *p = m->pos + 3 * m->tri[3 * t + v];
-            double x = p[0] - ctr[0], y = p[1] - ctr[1];
-            ag_label_rotate(k, &x, &y);
-            out[o++] = x;
-            out[o++] = y;
-            out[o++] = p[2] - ctr[2];
+            const double *p = vertex(m, L->tris[s], v);
+            for (int a = 0; a < 3; a++)
+                out[o++] = p[a] - ctr[a];
         }
-    }
 }
 
-static int dims_match(const ag_box *e, const ag_box *c, int k, double tol)
+/* The terminal of e (its triangles in its box) placed on c's box with k quarter turns as
+ * derivation places it (gframe.h), relative to c's box centre. */
+static void placed_soup(const ag_mesh *m, const ag_labels *L, uint32_t e, uint32_t c, int k,
+                        double *out)
 {
-    double de[3], dc[3];
-    ag_box_extents(e, de);
-    ag_box_extents(c, dc);
-    if (k & 1) {
-        double s = de[0];
-        de[0] = de[1];
-        de[1] = s;
+    double S[3], ctr[3];
+    ag_box_extents(&L->box[e], S);
+    ag_box_centre(&L->box[c], ctr);
+    ag_box B = L->box[c];
+    for (int a = 0; a < 3; a++) {
+        B.min[a] -= ctr[a];
+        B.max[a] -= ctr[a];
     }
-    for (int a = 0; a < 3; a++)
-        if (fabs(de[a] - dc[a]) > tol)
-            return 0;
-    return 1;
+    ag_gframe G = ag_gframe_place(&ag_gframe_identity, S, k, &B);
+    size_t o = 0;
+    for (uint32_t s = L->tri_start[e]; s < L->tri_start[e + 1]; s++)
+        for (int v = 0; v < 3; v++) {
+            const double *p = vertex(m, L->tris[s], v);
+            double x[3] = {p[0] - L->box[e].min[0], p[1] - L->box[e].min[1],
+                           p[2] - L->box[e].min[2]};
+            ag_gframe_apply(&G, x, out + o);
+            o += 3;
+        }
+}
+
+static int extents_match(const double *de, const double *dc, int k, double tol)
+{
+    double x = de[0], y = de[1];
+    if (k & 1) {
+        x = de[1];
+        y = de[0];
+    }
+    return fabs(x - dc[0]) <= tol && fabs(y - dc[1]) <= tol && fabs(de[2] - dc[2]) <= tol;
 }
 
 typedef struct {
@@ -176,13 +366,74 @@ typedef struct {
     int32_t head; /* first class in the bucket */
 } bucket;
 
-/* Classifies the components in `comps` (in order) with tolerance tol: cls[c] and rot[c] for
- * each, exemplar[k] and count[k] for each class; returns the number of classes, or -1 when
- * out of memory. */
-static long classify(const ag_mesh *m, const ag_labels *L, const uint32_t *comps, size_t n,
-                     double tol, int no_rotation, int32_t *cls, uint8_t *rot, uint32_t *exemplar,
-                     uint32_t *count, double *sa, double *sb)
+typedef struct {
+    const ag_mesh *m;
+    ag_labels *L;
+    const frame *F;
+    double *sa, *sb;
+    double *area; /* per component: its surface area */
+    double *ldev; /* per component: the label match's bound when it matched its exemplar's
+                     triangle list in the box frames, unmirrored (else -1): variant_pass's
+                     shortcut */
+    int no_rotation;
+    int nomem;
+    unsigned checks_left; /* surface comparisons the current component may still make */
+} lctx;
+
+/* A necessary-looking condition before surfaces are compared: the areas agree within
+ * AREA_SLACK. Two surfaces within a few millimetres of each other could differ more (a
+ * folded sliver), so this may miss such a match, never make one: what matches is still
+ * proven by the comparison. It keeps the comparison for what is likely to match. */
+static int areas_close(const lctx *x, uint32_t e, uint32_t c)
 {
+    double a = x->area[e], b = x->area[c];
+    return fabs(a - b) <= AREA_SLACK * fmax(a, b);
+}
+
+/* Compares candidate c (its soup in sb) with the soup in sa; 1 when they match. fast: the
+ * triangle lists only; else the surfaces only. */
+static int compare(lctx *x, size_t na, size_t nb, double tol, int fast, double *dev)
+{
+    if (fast) {
+        if (na != nb)
+            return 0;
+        size_t miss = 0;
+        double w = ag_label_match_triangles(x->sa, na, x->sb, nb, tol, &miss);
+        if (w < 0) {
+            x->nomem = 1;
+            return 0;
+        }
+        if (miss)
+            return 0;
+        *dev = w;
+        return 1;
+    }
+    if (!x->checks_left)
+        return 0; /* past the budget: no match, never a wrong one */
+    x->checks_left--;
+    x->L->surface_checks++;
+    int r = surfaces_match(x->sa, na, x->sb, nb, tol, dev);
+    if (r < 0)
+        x->nomem = 1;
+    return r > 0;
+}
+
+/* Whether c's orientation is close enough to e's, beyond quarter turns, for one label: the
+ * turn between them moves c's plan corners by at most AG_PROC_LABEL_TURN_MOVE. */
+static int turn_close(const frame *e, const frame *c)
+{
+    double d = fmod(fabs(c->phi - e->phi), M_PI / 2);
+    if (d > M_PI / 4)
+        d = M_PI / 2 - d;
+    return 0.5 * hypot(c->ext[0], c->ext[1]) * d <= AG_PROC_LABEL_TURN_MOVE;
+}
+
+/* Labels: every component against the exemplars of the labels in its bucket and the
+ * neighbouring ones, in its own frame. */
+static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
+{
+    ag_labels *L = x->L;
+    const frame *F = x->F;
     size_t cap;
     if (ag_array_hash_size(n, &cap))
         return -1;
@@ -196,63 +447,71 @@ static long classify(const ag_mesh *m, const ag_labels *L, const uint32_t *comps
     for (size_t i = 0; i < cap; i++)
         bk[i].head = -1;
     long ncls = 0;
-    /* buckets: triangle count and the box's height and sorted plan sizes in cells of 4 tol,
-     * so a match within tol is always in a neighbouring cell */
+    /* buckets: the oriented box's height and sorted plan sizes in cells of 4 tol, so a match
+     * within tol is always in a neighbouring cell */
     double q = 4 * tol > 0 ? 4 * tol : AG_PROC_TINY;
-    for (size_t i = 0; i < n; i++) {
+    int nk = x->no_rotation ? 1 : 8;
+    for (size_t i = 0; i < n && !x->nomem; i++) {
         uint32_t c = comps[i];
-        double dx = ag_box_extent(&L->box[c], 0), dy = ag_box_extent(&L->box[c], 1);
-        double dz = ag_box_extent(&L->box[c], 2);
-        int64_t kb[3] = {(int64_t)floor(dz / q), (int64_t)floor(fmin(dx, dy) / q),
-                         (int64_t)floor(fmax(dx, dy) / q)};
-        int found = -1, fk = 0;
-        for (int nb = 0; nb < 27 && found < 0; nb++) {
-            int64_t k0 = kb[0] + nb % 3 - 1, k1 = kb[1] + nb / 3 % 3 - 1, k2 = kb[2] + nb / 9 - 1;
-            uint64_t key = ag__mix64(L->ntris[c] * 0x9E3779B97F4A7C15ULL ^ ag__cell_hash(k0, k1, k2));
-            size_t h = key & (cap - 1);
-            while (bk[h].head >= 0 && bk[h].key != key)
-                h = (h + 1) & (cap - 1);
-            for (int32_t l = bk[h].head; l >= 0 && found < 0; l = next_in_bucket[l]) {
-                uint32_t e = exemplar[l];
-                if (L->ntris[e] != L->ntris[c])
-                    continue;
-                int have_cb = 0;
-                for (int k = 0; k < (no_rotation ? 1 : 4) && found < 0; k++) {
-                    if (!dims_match(&L->box[e], &L->box[c], k, tol))
+        x->checks_left = MAX_SURFACE_CHECKS;
+        const double *dc = F[c].ext;
+        int64_t kb[3] = {(int64_t)floor(dc[2] / q), (int64_t)floor(fmin(dc[0], dc[1]) / q),
+                         (int64_t)floor(fmax(dc[0], dc[1]) / q)};
+        int found = -1, fk = 0, have_cb = 0, ffast = 0;
+        double fdev = 0;
+        for (int fast = 1; fast >= 0 && found < 0 && !x->nomem; fast--)
+            for (int nb = 0; nb < 27 && found < 0 && !x->nomem; nb++) {
+                int64_t k0 = kb[0] + nb % 3 - 1, k1 = kb[1] + nb / 3 % 3 - 1,
+                        k2 = kb[2] + nb / 9 - 1;
+                uint64_t key = ag__cell_hash(k0, k1, k2);
+                size_t h = key & (cap - 1);
+                while (bk[h].head >= 0 && bk[h].key != key)
+                    h = (h + 1) & (cap - 1);
+                for (int32_t l = bk[h].head; l >= 0 && found < 0 && !x->nomem;
+                     l = next_in_bucket[l]) {
+                    uint32_t e = L->exemplar[l];
+                    if (fast ? L->ntris[e] != L->ntris[c] : !areas_close(x, e, c))
                         continue;
-                    if (!have_cb) {
-                        soup(m, L, c, 0, sb);
-                        have_cb = 1;
-                    }
-                    soup(m, L, e, k, sa);
-                    size_t miss = 0;
-                    double w = ag_label_match_triangles(sa, L->ntris[e], sb, L->ntris[c], tol,
-                                                        &miss);
-                    if (w < 0) {
-                        free(bk);
-                        free(next_in_bucket);
-                        return -1;
-                    }
-                    if (miss == 0) {
-                        found = l;
-                        fk = k;
+                    if (!turn_close(&F[e], &F[c]))
+                        continue;
+                    for (int k = 0; k < nk && found < 0; k++) {
+                        if (!extents_match(F[e].ext, dc, k, tol))
+                            continue;
+                        if (!have_cb) {
+                            oriented_soup(x->m, L, &F[c], c, 0, 0, x->sb);
+                            have_cb = 1;
+                        }
+                        oriented_soup(x->m, L, &F[e], e, k & 3, k >> 2, x->sa);
+                        double dev;
+                        if (compare(x, L->ntris[e], L->ntris[c], tol, fast, &dev)) {
+                            found = l;
+                            fk = k;
+                            fdev = dev;
+                            ffast = fast;
+                        }
                     }
                 }
             }
-        }
+        x->ldev[c] = -1;
         if (found >= 0) {
-            cls[c] = found;
-            rot[c] = (uint8_t)fk;
-            count[found]++;
+            uint32_t e = L->exemplar[found];
+            if (ffast && !(fk >> 2) && F[c].phi == 0 && F[e].phi == 0)
+                x->ldev[c] = fdev;
+            L->label[c] = found;
+            L->rot[c] = (uint8_t)(fk & 3);
+            L->mirror[c] = (uint8_t)(fk >> 2);
+            L->turn[c] = F[c].phi - F[e].phi + (fk & 3) * (M_PI / 2);
+            L->count[found]++;
             continue;
         }
         int32_t l = (int32_t)ncls++;
-        exemplar[l] = c;
-        count[l] = 1;
-        cls[c] = l;
-        rot[c] = 0;
-        uint64_t key = ag__mix64(L->ntris[c] * 0x9E3779B97F4A7C15ULL ^
-                                 ag__cell_hash(kb[0], kb[1], kb[2]));
+        L->exemplar[l] = c;
+        L->count[l] = 1;
+        L->label[c] = l;
+        L->rot[c] = 0;
+        L->mirror[c] = 0;
+        L->turn[c] = 0;
+        uint64_t key = ag__cell_hash(kb[0], kb[1], kb[2]);
         size_t h = key & (cap - 1);
         while (bk[h].head >= 0 && bk[h].key != key)
             h = (h + 1) & (cap - 1);
@@ -262,13 +521,104 @@ static long classify(const ag_mesh *m, const ag_labels *L, const uint32_t *comps
     }
     free(bk);
     free(next_in_bucket);
-    return ncls;
+    return x->nomem ? -1 : ncls;
+}
+
+/* Variants: within each label, every member against the exemplars of its label's variants,
+ * the exemplar's terminal placed on the member's box as derivation would place it. */
+static long variant_pass(lctx *x, const uint32_t *comps, size_t n, double tol, int surfaces)
+{
+    ag_labels *L = x->L;
+    /* per label, its variants as a list (newest first) */
+    int32_t *head = malloc((L->nlabels + 1) * sizeof *head);
+    int32_t *next = malloc((n + 1) * sizeof *next);
+    if (!head || !next) {
+        free(head);
+        free(next);
+        return -1;
+    }
+    for (size_t l = 0; l < L->nlabels; l++)
+        head[l] = -1;
+    long nv = 0;
+    int nk = x->no_rotation ? 1 : 4;
+    for (size_t i = 0; i < n && !x->nomem; i++) {
+        uint32_t c = comps[i];
+        x->checks_left = MAX_SURFACE_CHECKS;
+        int32_t l = L->label[c];
+        double dc[3];
+        ag_box_extents(&L->box[c], dc);
+        int found = -1, fk = 0, have_cb = 0;
+        double fdev = 0;
+        if (x->ldev[c] >= 0) {
+            /* matched its label's exemplar by triangle lists in the box frames: placing the
+             * exemplar's terminal on c's box differs from that match by the scaling to c's
+             * extents, at most half the extents' difference per axis */
+            uint32_t e = L->exemplar[l];
+            int32_t v0 = L->variant[e];
+            int k = L->rot[c];
+            double de[3];
+            ag_box_extents(&L->box[e], de);
+            double ex = (k & 1) ? de[1] : de[0], ey = (k & 1) ? de[0] : de[1];
+            double bound = x->ldev[c] + 0.5 * sqrt((dc[0] - ex) * (dc[0] - ex) +
+                                                   (dc[1] - ey) * (dc[1] - ey) +
+                                                   (dc[2] - de[2]) * (dc[2] - de[2]));
+            if (v0 >= 0 && L->variant_exemplar[v0] == e && bound <= tol) {
+                found = v0;
+                fk = k;
+                fdev = bound;
+            }
+        }
+        for (int fast = 1; fast >= (surfaces ? 0 : 1) && found < 0 && !x->nomem; fast--)
+            for (int32_t v = head[l]; v >= 0 && found < 0 && !x->nomem; v = next[v]) {
+                uint32_t e = L->variant_exemplar[v];
+                if (fast ? L->ntris[e] != L->ntris[c] : !areas_close(x, e, c))
+                    continue;
+                double de[3];
+                ag_box_extents(&L->box[e], de);
+                for (int k = 0; k < nk && found < 0; k++) {
+                    if (!extents_match(de, dc, k, tol))
+                        continue;
+                    if (!have_cb) {
+                        box_soup(x->m, L, c, x->sb);
+                        have_cb = 1;
+                    }
+                    placed_soup(x->m, L, e, c, k, x->sa);
+                    double dev;
+                    if (compare(x, L->ntris[e], L->ntris[c], tol, fast, &dev)) {
+                        found = v;
+                        fk = k;
+                        fdev = dev;
+                    }
+                }
+            }
+        if (found >= 0) {
+            L->variant[c] = found;
+            L->vrot[c] = (uint8_t)fk;
+            L->variant_count[found]++;
+            if (fdev > L->variant_deviation[found])
+                L->variant_deviation[found] = fdev;
+            continue;
+        }
+        int32_t v = (int32_t)nv++;
+        L->variant_exemplar[v] = c;
+        L->variant_count[v] = 1;
+        L->variant_label[v] = l;
+        L->variant_deviation[v] = 0;
+        L->variant[c] = v;
+        L->vrot[c] = 0;
+        next[v] = head[l];
+        head[l] = v;
+    }
+    free(head);
+    free(next);
+    return x->nomem ? -1 : nv;
 }
 
 ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_labels **out,
                               ag_error *err)
 {
     ag_label_options o = opt ? *opt : (ag_label_options){0};
+    int capped = o.tolerance <= 0;
     if (o.tolerance <= 0)
         o.tolerance = AG_PROC_LABEL_TOLERANCE;
     if (o.exact <= 0)
@@ -285,6 +635,8 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
     L->ntris = calloc(nc + 1, sizeof *L->ntris);
     L->label = malloc((nc + 1) * sizeof *L->label);
     L->rot = calloc(nc + 1, 1);
+    L->mirror = calloc(nc + 1, 1);
+    L->turn = calloc(nc + 1, sizeof *L->turn);
     L->tri_start = calloc(nc + 2, sizeof *L->tri_start);
     L->tris = malloc((m->ntris + 1) * sizeof *L->tris);
     L->exemplar = malloc((nc + 1) * sizeof *L->exemplar);
@@ -294,20 +646,28 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
     L->variant_exemplar = malloc((nc + 1) * sizeof *L->variant_exemplar);
     L->variant_count = calloc(nc + 1, sizeof *L->variant_count);
     L->variant_label = malloc((nc + 1) * sizeof *L->variant_label);
-    double *sa = NULL, *sb = NULL;
+    L->variant_deviation = calloc(nc + 1, sizeof *L->variant_deviation);
+    frame *F = malloc((nc + 1) * sizeof *F);
+    uint32_t *list = malloc((nc + 1) * sizeof *list);
+    lctx x = {.m = m, .L = L, .F = F, .no_rotation = o.no_rotation};
     size_t maxt = 0;
-    ag_status st = AG_ERR_NOMEM;
-    if (!L->box || !L->ntris || !L->label || !L->rot || !L->tri_start || !L->tris ||
-        !L->exemplar || !L->count || !L->variant || !L->vrot || !L->variant_exemplar ||
-        !L->variant_count || !L->variant_label)
+    if (!L->box || !L->ntris || !L->label || !L->rot || !L->mirror || !L->turn ||
+        !L->tri_start || !L->tris || !L->exemplar || !L->count || !L->variant || !L->vrot ||
+        !L->variant_exemplar || !L->variant_count || !L->variant_label ||
+        !L->variant_deviation || !F || !list)
         goto fail;
 
     ag_box all = ag_mesh_bounds(m);
     L->diagonal = ag_box_diagonal(&all);
     if (!(L->diagonal > 0))
         L->diagonal = 0;
-    L->tol = o.tolerance * (L->diagonal > 0 ? L->diagonal : 1.0);
-    L->exact = o.exact * (L->diagonal > 0 ? L->diagonal : 1.0);
+    double scale = L->diagonal > 0 ? L->diagonal : 1.0;
+    L->tol = o.tolerance * scale;
+    if (capped && L->tol > AG_PROC_LABEL_TOLERANCE_MAX)
+        L->tol = AG_PROC_LABEL_TOLERANCE_MAX;
+    L->exact_copies = o.exact_copies != 0;
+    L->exact = fmin(o.exact * scale, L->tol);
+    L->share = o.exact_copies ? L->exact : L->tol;
 
     for (size_t c = 0; c < nc; c++)
         L->box[c] = ag_box_empty();
@@ -331,62 +691,53 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
             L->tris[fill[m->tri_component[t]]++] = (uint32_t)t;
         free(fill);
     }
-    sa = malloc((9 * maxt + 1) * sizeof *sa);
-    sb = malloc((9 * maxt + 1) * sizeof *sb);
-    if (!sa || !sb)
+    x.sa = malloc((9 * maxt + 1) * sizeof *x.sa);
+    x.sb = malloc((9 * maxt + 1) * sizeof *x.sb);
+    x.area = calloc(nc + 1, sizeof *x.area);
+    x.ldev = malloc((nc + 1) * sizeof *x.ldev);
+    if (!x.sa || !x.sb || !x.area || !x.ldev)
         goto fail;
-
-    {
-        uint32_t *list = malloc((nc + 1) * sizeof *list);
-        int32_t *vl = malloc((nc + 1) * sizeof *vl);
-        uint8_t *vr = calloc(nc + 1, 1);
-        if (!list || !vl || !vr) {
-            free(list);
-            free(vl);
-            free(vr);
-            goto fail;
-        }
-        size_t n = 0;
-        for (size_t c = 0; c < nc; c++) {
-            L->label[c] = L->variant[c] = -1;
-            if (L->ntris[c])
-                list[n++] = (uint32_t)c;
-        }
-        long nv = classify(m, L, list, n, L->exact, o.no_rotation, L->variant, L->vrot,
-                           L->variant_exemplar, L->variant_count, sa, sb);
-        long nl = nv < 0 ? -1
-                         : classify(m, L, L->variant_exemplar, (size_t)nv, L->tol, o.no_rotation,
-                                    vl, vr, L->exemplar, L->count, sa, sb);
-        if (nl < 0) {
-            free(list);
-            free(vl);
-            free(vr);
-            goto fail;
-        }
-        L->nvariants = (size_t)nv;
-        L->nlabels = (size_t)nl;
-        for (long k = 0; k < nl; k++)
-            L->count[k] = 0;
-        for (long v = 0; v < nv; v++)
-            L->variant_label[v] = vl[L->variant_exemplar[v]];
-        for (size_t i = 0; i < n; i++) {
-            uint32_t c = list[i];
-            uint32_t e = L->variant_exemplar[L->variant[c]];
-            L->label[c] = vl[e];
-            L->rot[c] = (uint8_t)((L->vrot[c] + vr[e]) & 3);
-            L->count[L->label[c]]++;
-        }
-        free(list);
-        free(vl);
-        free(vr);
+    for (size_t t = 0; t < m->ntris; t++) {
+        const double *p = m->pos + 3 * (size_t)m->tri[3 * t], *q = m->pos + 3 * (size_t)m->tri[3 * t + 1],
+                     *r = m->pos + 3 * (size_t)m->tri[3 * t + 2];
+        double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+        double v[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+        double nx = u[1] * v[2] - u[2] * v[1], ny = u[2] * v[0] - u[0] * v[2],
+               nz = u[0] * v[1] - u[1] * v[0];
+        x.area[m->tri_component[t]] += 0.5 * sqrt(nx * nx + ny * ny + nz * nz);
     }
-    free(sa);
-    free(sb);
+
+    size_t n = 0;
+    for (size_t c = 0; c < nc; c++) {
+        L->label[c] = L->variant[c] = -1;
+        if (L->ntris[c]) {
+            list[n++] = (uint32_t)c;
+            frame_of(m, L, (uint32_t)c, !o.no_rotation, &F[c]);
+        }
+    }
+    long nl = label_pass(&x, list, n, L->tol);
+    if (nl < 0)
+        goto fail;
+    L->nlabels = (size_t)nl;
+    long nv = variant_pass(&x, list, n, L->share, !o.exact_copies);
+    if (nv < 0)
+        goto fail;
+    L->nvariants = (size_t)nv;
+    free(x.sa);
+    free(x.sb);
+    free(x.area);
+    free(x.ldev);
+    free(F);
+    free(list);
     *out = L;
     return AG_OK;
 fail:
-    free(sa);
-    free(sb);
+    free(x.sa);
+    free(x.sb);
+    free(x.area);
+    free(x.ldev);
+    free(F);
+    free(list);
     ag_labels_free(L);
-    return ag_error_set(err, st, 0, "out of memory while labeling");
+    return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling");
 }

@@ -26,7 +26,9 @@ ag_box ag_splittree_child_box(const ag_box *p, const double pivot[3], int octant
     ag_box b;
     int q = octant - 1;
     for (int a = 0; a < 3; a++) {
-        double v = p->min[a] + pivot[a];
+        /* min + pivot can round past max (a flat child on the parent's upper face, far from
+         * the origin): the cut stays inside the parent, so a child box is never inverted */
+        double v = fmin(fmax(p->min[a] + pivot[a], p->min[a]), p->max[a]);
         if (q >> a & 1) {
             b.min[a] = v;
             b.max[a] = p->max[a];
