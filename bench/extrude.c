@@ -578,12 +578,24 @@ static void grid_profiles(ag_plan *p, double h)
     ag_plan_add_profile(p, "terrace", terrace, 5, NULL, NULL, NULL);
 }
 
+
 /* --grid-dump N: the description of stress plan N (before validation) goes to this file */
 static long dump_index = -1;
 static const char *dump_path = NULL;
 
+static void grid_stress_with(size_t count, int repair);
 static void grid_stress(size_t count)
 {
+    if (!dump_path)
+        grid_stress_with(count, 0);
+    grid_stress_with(count, 1);
+}
+
+/* repair: with the post inter-chain winding-rule repair (the default) or without */
+static void grid_stress_with(size_t count, int repair)
+{
+    srng = 0x9E3779B97F4A7C15ULL;
+    size_t w_invalid = 0, w_repairs = 0, w_refused = 0, w_dropped = 0, w_good = 0;
     size_t failed = 0, leaky = 0, rejected = 0, leaky_nested = 0, good_nested = 0;
     size_t kinds[2] = {0, 0}, leaky_kind[2] = {0, 0};
     static double xy[2 * 1200];
@@ -613,10 +625,26 @@ static void grid_stress(size_t count)
                 json_dump_file(doc, dump_path, JSON_INDENT(1));
             json_decref(doc);
         }
+        if (dump_path && (long)i != dump_index) {
+            ag_plan_free(p); /* only the plan asked for is written and extruded */
+            continue;
+        }
         ag_mesh *m = ag_mesh_create();
         ag_extrude_result r;
         ag_error err = {0};
-        ag_status st = ag_extrude_plan(p, m, -1, &r, NULL, &err);
+        ag_extrude_options eo = {0};
+        eo.no_winding_repair = !repair;
+        ag_status st = ag_extrude_plan_with(p, &eo, m, -1, &r, NULL, &err);
+        if (st == AG_OK) {
+            w_invalid += r.stats.winding_invalid;
+            w_repairs += r.stats.winding_repairs;
+            w_refused += r.stats.winding_refused;
+            w_dropped += r.stats.winding_pieces_dropped;
+            w_good += r.stats.winding_repairs && !not_good(&r);
+            if (r.stats.winding_repairs)
+                printf("    rebuilt by the winding rule grid%zu: %s\n", i,
+                       not_good(&r) ? not_good(&r) : "good");
+        }
         if (st == AG_ERR_INVALID || st == AG_ERR_EMPTY) {
             rejected++;
         } else if (st != AG_OK) {
@@ -626,8 +654,10 @@ static void grid_stress(size_t count)
             leaky++;
             leaky_nested += r.stats.irregular > 0;
             leaky_kind[kind]++;
-            printf("    not good grid%zu (%s, %zu nested intersections): %s\n", i,
-                   kind ? "star" : "grid", r.stats.irregular, not_good(&r));
+            if (repair)
+                printf("    not good grid%zu (%s, %zu nested intersections, %zu winding repairs, "
+                       "%zu refused): %s\n", i, kind ? "star" : "grid", r.stats.irregular,
+                       r.stats.winding_repairs, r.stats.winding_refused, not_good(&r));
         } else {
             good_nested += r.stats.irregular > 0;
         }
@@ -639,11 +669,15 @@ static void grid_stress(size_t count)
     size_t valid = count - rejected;
     printf("  %-22s %5zu plans  %.3f s  rejected by validation %zu  failed %zu  not watertight %zu "
            "(%.3f%% of %zu valid)\n",
-           "integer-grid stress", count, dt, rejected, failed, leaky,
+           repair ? "integer-grid stress" : "grid, no winding repair", count, dt, rejected, failed, leaky,
            100.0 * (failed + leaky) / (valid ? valid : 1), valid);
     printf("    not good: %zu of %zu grid shapes, %zu of %zu stars; %zu of them with nested "
            "intersections (as are %zu good ones)\n", leaky_kind[0], kinds[0], leaky_kind[1],
            kinds[1], leaky_nested, good_nested);
+    if (repair)
+        printf("    winding rule: %zu levels with crossing chains, %zu rebuilt (%zu pieces removed), "
+               "%zu refused; %zu plans with a rebuild are good\n", w_invalid, w_repairs, w_dropped,
+               w_refused, w_good);
 }
 
 int main(int argc, char **argv)

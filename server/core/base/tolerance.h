@@ -188,6 +188,12 @@
  * (plus its drift, up to AG_EXTRUDE_DRIFT_MAX delta3). */
 #define AG_EXTRUDE_NEAR_POINTS 2.0
 #define AG_EXTRUDE_DRIFT_MAX 100.0
+/* The post inter-chain repair probes the chains this many delta1 above the current height
+ * (far enough for chains leaving one point to have parted by many ulps, below the next
+ * event's resolution), and tells a piece's two sides apart by points this fraction of the
+ * piece's length (at most delta2) off its middle. */
+#define AG_EXTRUDE_WINDING_PROBE 100.0
+#define AG_EXTRUDE_WINDING_SIDE 1e-3
 /* A cluster's points may spread by the speed of its fastest corner times its height
  * spread, up to this many delta3 (a corner between nearly parallel edges is fast). */
 #define AG_EXTRUDE_DRIFT_ALONG 20.0

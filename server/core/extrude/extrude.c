@@ -40,7 +40,7 @@ ag_status ag_extrude_plan_with(ag_plan *plan, const ag_extrude_options *opt, ag_
     if (ag_budget_poll(&budget, 0) != AG_OK)
         return over_budget(&budget, "after validating the plan", err);
     ag_shell *sh = NULL;
-    ag_skeleton_options so = {&budget, plan->anchors};
+    ag_skeleton_options so = {&budget, plan->anchors, opt && opt->no_winding_repair};
     st = ag_skeleton_build(plan, extent, &so, &sh, &res->stats, err);
     if (st != AG_OK)
         return st;

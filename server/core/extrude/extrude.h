@@ -37,6 +37,8 @@ typedef struct {
     ag_extrude_budget budget;
     /* receives what validation changed (may be NULL; free with ag_plan_fixes_free) */
     ag_plan_fixes *fixes;
+    /* 1: no post inter-chain repair by the winding rule (to compare with it) */
+    int no_winding_repair;
 } ag_extrude_options;
 
 /* Validates (and cleans) plan, extrudes it and appends the triangles to m as one new

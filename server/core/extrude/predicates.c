@@ -149,3 +149,11 @@ int ag_pred_point_in_polygon(const double *xy, size_t n, double px, double py)
     }
     return in;
 }
+
+double ag_pred_segment_dist(const double *p, const double *a, const double *b)
+{
+    double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
+    double t = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0;
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    return hypot(a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
+}

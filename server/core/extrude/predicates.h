@@ -35,4 +35,8 @@ int ag_pred_segments_cross(const double *a, const double *b, const double *c, co
  * boundary may go either way. */
 int ag_pred_point_in_polygon(const double *xy, size_t n, double px, double py);
 
+/* Distance of p from the closed segment ab (a double approximation, not exact; a
+ * degenerate segment is its point a). */
+double ag_pred_segment_dist(const double *p, const double *a, const double *b);
+
 #endif

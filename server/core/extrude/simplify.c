@@ -4,17 +4,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "predicates.h"
+
 static double tri_area(const double *a, const double *b, const double *c)
 {
     return fabs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])) / 2;
-}
-
-static double seg_dist(const double *p, const double *a, const double *b)
-{
-    double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
-    double t = l2 > 0 ? ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2 : 0;
-    t = t < 0 ? 0 : t > 1 ? 1 : t;
-    return hypot(a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
 }
 
 /* One loop: a linked ring; each round removes the corner of least area (loops of
@@ -72,7 +66,7 @@ static ag_status simplify_loop(double *xy, size_t *n, double area, double *moved
     for (size_t i = 0; i < m && k < m; i++) {
         double d = INFINITY;
         for (size_t j = 0; j < k; j++)
-            d = fmin(d, seg_dist(&orig[2 * i], &xy[2 * j], &xy[2 * ((j + 1) % k)]));
+            d = fmin(d, ag_pred_segment_dist(&orig[2 * i], &xy[2 * j], &xy[2 * ((j + 1) % k)]));
         *moved = fmax(*moved, d);
     }
     *n = k;

@@ -8,6 +8,7 @@
  *   skel_step.c          plan edits grown as natural steps
  *   skel_forced.c        forced steps: a polygon united with the active plan
  *   skel_anchor.c        anchors located on the active plan, the flat cap
+ *   skel_winding.c       the post inter-chain repair: region boundaries by the winding rule
  *   skeleton.c           the driver: initial plan, event loop
  *
  * Not part of the public interface: only the files above include it. */
@@ -121,6 +122,12 @@ typedef struct {
     sk_u32vec deferred;
     double level; /* the height of that level */
     ag_budget *budget; /* events, time, memory, cancel (ag_budget_spend on every push/pop) */
+    int no_winding_repair; /* the post inter-chain repair is off (comparisons in tests) */
+    sk_u32vec made;        /* corners the intersections (and flat intervals' starts and
+                            * ends) of the current height made, for the repair's check;
+                            * other direction events change no chain */
+    int track_made;        /* set while those are handled */
+    double made_z;         /* that height */
     sk_scratch W;
 } sk;
 
@@ -183,6 +190,13 @@ void ag__skel_next_cluster(sk *S, const ag_event *ev0);
 
 /* --- skel_intersection.c ----------------------------------------------------------------- */
 void ag__skel_intersection(sk *S, ag_event *evs, size_t n);
+
+/* --- skel_winding.c ---------------------------------------------------------------------- */
+/* Once every event of a height has been handled: checks whether the edges of the corners
+ * made there (S->made) cross live edges just above and, if they do, recomputes the active
+ * plan's region boundaries by the winding rule (§4.4, post inter-chain intersections).
+ * Empties S->made; 1 when the plan was rebuilt (new corners in S->touched). */
+int ag__skel_winding_repair(sk *S);
 
 /* --- skel_merge.c ------------------------------------------------------------------------ */
 void ag__skel_settle(sk *S, uint32_t k);

@@ -40,14 +40,6 @@ static int cmp_xing_q(const void *a, const void *b)
     return x->tq < y->tq ? -1 : x->tq > y->tq;
 }
 
-static double seg_dist(double px, double py, double ax, double ay, double bx, double by)
-{
-    double dx = bx - ax, dy = by - ay, l2 = dx * dx + dy * dy;
-    double t = l2 > 0 ? ((px - ax) * dx + (py - ay) * dy) / l2 : 0;
-    t = t < 0 ? 0 : t > 1 ? 1 : t;
-    return hypot(ax + t * dx - px, ay + t * dy - py);
-}
-
 /* Is (x, y) inside the active plan at height v? Even-odd over the live edges. */
 static int in_active(sk *S, double v, double x, double y)
 {
@@ -129,8 +121,7 @@ void ag__skel_forced_step(sk *S, size_t k, double v)
         ag__skel_cpos(&S->c[e->end], v, &b[0], &b[1]);
         for (size_t j = 0; j < n; j++) {
             const double *c = &q[2 * j], *d = &q[2 * ((j + 1) % n)];
-            if (seg_dist(c[0], c[1], a[0], a[1], b[0], b[1]) <= tol ||
-                seg_dist(a[0], a[1], c[0], c[1], d[0], d[1]) <= tol)
+            if (ag_pred_segment_dist(c, a, b) <= tol || ag_pred_segment_dist(a, c, d) <= tol)
                 goto skip;
             double oa = ag_pred_orient2d(c, d, a), ob = ag_pred_orient2d(c, d, b);
             double oc = ag_pred_orient2d(a, b, c), od = ag_pred_orient2d(a, b, d);

@@ -377,7 +377,7 @@ static ag_status inset_plan(sk *S, double v, const double *dist, const uint32_t 
         st = ag_plan_validate(P, NULL, &extent, &e2);
         if (st == AG_OK)
             {
-            ag_skeleton_options so = {S->budget, NULL};
+            ag_skeleton_options so = {S->budget, NULL, S->no_winding_repair};
             st = ag_skeleton_build(P, extent, &so, &sh, NULL, &e2);
         }
     }

@@ -112,6 +112,12 @@ uint32_t ag__skel_add_corner(sk *S, uint32_t in, uint32_t out, double x, double 
     S->e[out].ver++;
     S->touched[S->ntouched++] = k;
     S->live_c[S->nlive_c++] = k;
+    if (S->track_made && !S->no_winding_repair) {
+        if (!S->made.n)
+            S->made_z = S->zcur;
+        if (!ag__skel_vpush(&S->made, k))
+            ag__skel_fail(S, AG_ERR_NOMEM);
+    }
     return k;
 }
 

@@ -13,6 +13,7 @@
 /* Settles the corners the intersections of one height level left unsettled. */
 static void settle_deferred(sk *S)
 {
+    S->track_made = 1;
     for (size_t i = 0; i < S->deferred.n && S->st == AG_OK; i++) {
         uint32_t k = S->deferred.arr[i];
         if (!S->c[k].alive || S->c[k].settled)
@@ -27,6 +28,7 @@ static void settle_deferred(sk *S)
             S->touched[S->ntouched++] = k;
     }
     S->deferred.n = 0;
+    S->track_made = 0;
     ag__skel_schedule_touched(S);
 }
 
@@ -38,6 +40,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     memset(&S, 0, sizeof S);
     S.plan = plan;
     S.err = err;
+    S.no_winding_repair = opt && opt->no_winding_repair;
     ag_budget own;
     if (opt && opt->budget) {
         S.budget = opt->budget;
@@ -289,6 +292,17 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             settle_deferred(&S);
             continue;
         }
+        if (S.made.n && (!more || ev.z > S.made_z + AG_EXTRUDE_WINDING_PROBE * S.d1)) {
+            /* every event of the height the last corners were made at is handled: do the
+             * chains still form a valid plan just above it? */
+            if (ag__skel_winding_repair(&S)) {
+                /* the rebuilt plan's events may come before this one */
+                if (more)
+                    ag__skel_push(&S, &ev);
+                ag__skel_schedule_touched(&S);
+                continue;
+            }
+        }
         if (!more || ev.z > limit)
             break;
         if (ev.type == AG_EVENT_ANCHOR) {
@@ -303,7 +317,9 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             if (!S.deferred.n)
                 S.level = ev.z;
             S.defer_settle = 1;
+            S.track_made = 1;
             ag__skel_next_cluster(&S, &ev);
+            S.track_made = 0;
             S.defer_settle = 0;
             ag__skel_schedule_touched(&S);
             continue;
@@ -329,8 +345,12 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
             batch[nb++] = nx;
         }
         int only_forced = 1;
-        for (size_t i = 0; i < nb; i++)
+        for (size_t i = 0; i < nb; i++) {
             only_forced &= batch[i].a == FORCED_MARK;
+            /* a flat interval's start or end moves parts of the plan against each other
+             * (overhangs growing out, terraces in): its corners are checked too */
+            S.track_made |= batch[i].a == FLAT_MARK;
+        }
         if (!only_forced)
             ag__skel_direction(&S, batch, nb);
         for (size_t i = 0; i < nb && S.st == AG_OK; i++)
@@ -349,6 +369,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
         for (size_t i = 0; i < nb && S.st == AG_OK; i++)
             if (batch[i].a == GAP_MARK)
                 ag__skel_insert_gap(&S, batch[i].b, batch[i].z);
+        S.track_made = 0;
         ag__skel_schedule_touched(&S);
     }
     if (S.st == AG_OK) {
@@ -368,6 +389,7 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     free(S.W.speed);
     free(S.W.cand);
     free(S.deferred.arr);
+    free(S.made.arr);
     ag_status st = S.st;
     if (st == AG_OK)
         st = ag_shell_finish(S.shell, S.d1);

@@ -34,6 +34,8 @@ typedef struct {
     ag_budget *budget;
     /* plan->nanchors entries to locate (usually plan->anchors), or NULL */
     ag_anchor *anchors;
+    /* 1: no post inter-chain repair (to compare with it in tests) */
+    int no_winding_repair;
 } ag_skeleton_options;
 
 typedef struct {
@@ -44,6 +46,10 @@ typedef struct {
      * chains, §4.4's non-connected class): resolved by nesting the pairs, but the shape
      * there may be undesirable */
     size_t irregular;
+    /* post inter-chain repair (§4.4): levels after which chains crossed just above, how
+     * many of them were rebuilt by the winding rule and how many were left (a degenerate
+     * contact the repair does not take), chain pieces the winding rule removed */
+    size_t winding_invalid, winding_repairs, winding_refused, winding_pieces_dropped;
     size_t steps, steps_skipped; /* plan edits made / not made (anchor not on the plan) */
     size_t offsets, offset_sides; /* offset events handled, side edges they made */
     size_t offset_gaps;   /* inside boundaries (gaps) opened by offset events */
