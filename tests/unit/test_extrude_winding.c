@@ -208,7 +208,7 @@ static void run_plan(const double *xy, size_t n, const ag_profile_point *const *
     for (int repair = 0; repair < 2; repair++) {
         ag_plan *p = ag_plan_create();
         for (size_t k = 0; k < nprof; k++) {
-            char name[8];
+            char name[24];
             snprintf(name, sizeof name, "p%zu", k);
             ag_plan_add_profile(p, name, profs[k], nprofs[k], NULL, NULL, NULL);
         }
