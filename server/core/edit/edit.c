@@ -286,8 +286,11 @@ ag_status ag_edit_apply_ex(ag_edit_model *m, const ag_edit_op *op, unsigned flag
         ag_edit_report_clear(rep);
     ag_mesh *mesh = NULL;
     ag_status st;
-    if (op->kind == AG_EDIT_RESIZE)
-        return apply_resize(m, op, flags, out, rep, err);
+    if (op->kind == AG_EDIT_RESIZE) {
+        st = apply_resize(m, op, flags, out, rep, err);
+        ag_edit_report_clear(&local); /* the caller asked for no report */
+        return st;
+    }
     switch (op->kind) {
     case AG_EDIT_SPLIT:
         st = ag_edit_split(m->proc, op, &mesh, rep, err);

@@ -512,7 +512,8 @@ ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, cons
     size_t nlines = 0, caplines = 0;
     ag_segment_cloud_spec *spec = NULL;
     size_t *hcount = NULL;
-    uint32_t *hidx = NULL;
+    uint32_t *hidx = NULL;  /* the host's points: in r->members until the rebuild frees it */
+    uint32_t *hkept = NULL; /* their copy that outlives the rebuild */
     size_t nh = 0;
     M.skip = calloc(c->n ? c->n : 1, 1);
     hcount = calloc(r->nsegments + 1, sizeof *hcount);
@@ -718,6 +719,14 @@ ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, cons
         adopt_fragments(c, r, spec, before, nacc, is_host);
         free(is_host);
     }
+    if (rep && nh) {
+        if (!(hkept = malloc(nh * sizeof *hkept))) {
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            goto done;
+        }
+        memcpy(hkept, hidx, nh * sizeof *hkept);
+    }
+    hidx = hkept;
     if ((st = ag_segment_cloud_rebuild(c, r, spec, before + nacc, err)) != AG_OK)
         goto done;
     if (rep) {
@@ -734,6 +743,7 @@ ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, cons
         acc = NULL;
     }
 done:
+    free(hkept);
     free(spec);
     free(hcount);
     free(acc);
