@@ -51,6 +51,8 @@ typedef struct {
     size_t splits, joins;
     size_t max_nodes;         /* the new tree's bound (the budget's, when it sets a lower one) */
     unsigned since_poll;      /* copies since the budget's callback was last asked */
+    int32_t *walk;            /* the one stack of the subtree walks (none nests in another) */
+    size_t cap_walk;
     ag_status st;
     ag_error *err;
 } lay;
@@ -65,6 +67,17 @@ static void fail_nomem(lay *L)
 {
     if (!L->st)
         L->st = ag_error_set(L->err, AG_ERR_NOMEM, 0, "out of memory");
+}
+
+/* The walks' stack, room for n entries: one buffer for the whole layout, since a walk per cell
+ * that allocated the tree's size made a large pattern quadratic. */
+static int32_t *walk_stack(lay *L, size_t n)
+{
+    if (AG_ARRAY_RESERVE(L->walk, L->cap_walk, n)) {
+        fail_nomem(L);
+        return NULL;
+    }
+    return L->walk;
 }
 
 static ag_box oldb(const lay *L, int32_t x)
@@ -146,11 +159,9 @@ static void kill_subtree(lay *L, int32_t x)
     if (p >= 0 && t->nodes[p].kind == AG_NODE_SPLIT)
         x = p;
     ag_splittree_detach(t, x);
-    int32_t *stack = malloc((t->nnodes + 1) * sizeof *stack);
-    if (!stack) {
-        fail_nomem(L);
+    int32_t *stack = walk_stack(L, t->nnodes + 1);
+    if (!stack)
         return;
-    }
     size_t sp = 0;
     stack[sp++] = x;
     while (sp) {
@@ -161,18 +172,15 @@ static void kill_subtree(lay *L, int32_t x)
         n->kind = AG_NODE_DEAD;
         n->parent = n->first_child = n->last_child = n->next_sibling = -1;
     }
-    free(stack);
 }
 
 /* Everything below x moves by d. */
 static void translate_below(lay *L, int32_t x, const double d[3])
 {
     ag_splittree *t = L->nt;
-    int32_t *stack = malloc((t->nnodes + 1) * sizeof *stack);
-    if (!stack) {
-        fail_nomem(L);
+    int32_t *stack = walk_stack(L, t->nnodes + 1);
+    if (!stack)
         return;
-    }
     size_t sp = 0;
     for (int32_t c = t->nodes[x].first_child; c >= 0; c = t->nodes[c].next_sibling)
         stack[sp++] = c;
@@ -185,7 +193,6 @@ static void translate_below(lay *L, int32_t x, const double d[3])
         for (int32_t c = t->nodes[v].first_child; c >= 0; c = t->nodes[c].next_sibling)
             stack[sp++] = c;
     }
-    free(stack);
 }
 
 /* The node whose child list holds x's split chain (x's parent, or its intermediate's). */
@@ -629,11 +636,11 @@ static int interleaved(const axis_layout *x, const axis_layout *y, double tol)
 
 /* Does cell c's subtree have the shape of cell c0's (kinds, children, old places relative to
  * the cell)? Then c's new boxes are c0's moved. */
-static int parallel(const lay *L, int32_t c0, int32_t c, double tol)
+static int parallel(lay *L, int32_t c0, int32_t c, double tol)
 {
     const ag_splittree *t = L->nt;
     ag_box b0 = oldb(L, c0), b1 = oldb(L, c);
-    int32_t *st = malloc(2 * (t->nnodes + 1) * sizeof *st);
+    int32_t *st = walk_stack(L, 2 * (t->nnodes + 1));
     if (!st)
         return 0;
     size_t sp = 0;
@@ -667,7 +674,6 @@ static int parallel(const lay *L, int32_t c0, int32_t c, double tol)
             st[sp++] = q;
         }
     }
-    free(st);
     return ok;
 }
 
@@ -678,11 +684,9 @@ static void copy_layout(lay *L, int32_t c0, int32_t c)
     double d[3];
     for (int a = 0; a < 3; a++)
         d[a] = t->nodes[c].box.min[a] - t->nodes[c0].box.min[a];
-    int32_t *st = malloc(2 * (t->nnodes + 1) * sizeof *st);
-    if (!st) {
-        fail_nomem(L);
+    int32_t *st = walk_stack(L, 2 * (t->nnodes + 1));
+    if (!st)
         return;
-    }
     size_t sp = 0;
     for (int32_t x = t->nodes[c0].first_child, y = t->nodes[c].first_child; x >= 0 && y >= 0;
          x = t->nodes[x].next_sibling, y = t->nodes[y].next_sibling) {
@@ -701,7 +705,6 @@ static void copy_layout(lay *L, int32_t c0, int32_t c)
             st[sp++] = q;
         }
     }
-    free(st);
 }
 
 /* Lays out the cells of pattern P (its new box set) with layout pl: new cells, their boxes,
@@ -950,6 +953,7 @@ ag_status ag__resize_layout(const ag_edit_resize_solver *s, const ag_box *unit_b
     if (s->root)
         L.nt->nodes[0].box = *frame_box;
     layout_units(&L, s->level, s->nunits, unit_boxes, 0);
+    free(L.walk);
     if (!L.st && span_invisible(L.nt))
         fail_nomem(&L);
     if (L.st) {
