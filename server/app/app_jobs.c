@@ -1,5 +1,6 @@
 #include "app_jobs.h"
 
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -53,8 +54,8 @@ ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_impor
 }
 
 ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
-                                    const int64_t *if_match, int exact, int64_t *job,
-                                    ag_error *err)
+                                    const int64_t *if_match, int exact, const json_t *cloud_options,
+                                    int64_t *job, ag_error *err)
 {
     int64_t current;
     ag_status s = ag_app_query_version(app, model, &current, err);
@@ -72,11 +73,18 @@ ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t
         return s;
     if (cloud && !ag_cloud_pipeline_proceduralize)
         return ag_cloud_pipeline_missing(model, "proceduralize", err);
+    char *options = NULL;
+    if (cloud_options && json_object_size(cloud_options) &&
+        (s = ag_cloud_pipeline_check_options(model, cloud, cloud_options, &options, err)) != AG_OK)
+        return s;
     ag_job_params jp = {.type = AG_JOB_PROCEDURALIZE,
                         .user = who->user,
                         .u.proceduralize = {.model = model, .base = current,
-                                            .author = (char *)who->name, .exact = exact != 0}};
-    return submit(app, &jp, NULL, job, err);
+                                            .author = (char *)who->name, .exact = exact != 0,
+                                            .cloud = options}};
+    s = submit(app, &jp, NULL, job, err);
+    free(options);
+    return s;
 }
 
 /* An optional fraction of the diagonal in (0, 1). */

@@ -22,10 +22,11 @@ ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_impor
                              int64_t *job, ag_error *err);
 /* Proceduralizing a model at its current version, the op authored by who; if_match (NULL:
  * none; -1: any) must be the current version (AG_ERR_STALE otherwise); exact: terminals
- * shared by exact copies only. */
+ * shared by exact copies only; cloud: a point cloud's options (app/points_proc_options.h;
+ * NULL: none; refused for a mesh). */
 ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
-                                    const int64_t *if_match, int exact, int64_t *job,
-                                    ag_error *err);
+                                    const int64_t *if_match, int exact, const json_t *cloud,
+                                    int64_t *job, ag_error *err);
 /* Segmenting a point cloud model at its current version (app/usecase_segment.h), the op
  * authored by who; body: {"threshold", "coarse_threshold", "cluster_tolerance": fractions of
  * the diagonal, "recompute_normals": bool}, each optional (AG_ERR_INVALID naming a bad or

@@ -6,7 +6,9 @@
 
 #include "../io/ply.h"
 #include "../io/points_glb.h"
+#include "../store/grammars.h"
 #include "../store/pointclouds.h"
+#include "store_ws.h"
 
 /* Adds (or replaces) an int32 property with the given values. */
 static ag_status set_ids(ag_cloud *c, const char *name, const int32_t *values, ag_error *err)
@@ -52,6 +54,27 @@ static void etag_of(char *buf, size_t len, const char *what, const ag_pointcloud
              (long long)info->segmentation, info->normals, shown);
 }
 
+/* c as binary little-endian PLY in out. */
+static ag_status ply_bytes(const ag_cloud *c, ag_app_bytes *out, ag_error *err)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory writing PLY");
+    ag_ply_write_options po = {.encoding = AG_PLY_BINARY_LE};
+    ag_status s = ag_ply_write(c, &po, f, err);
+    if (fclose(f) != 0 && s == AG_OK)
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory writing PLY");
+    if (s == AG_OK) {
+        out->data = (uint8_t *)buf;
+        out->len = len;
+    } else {
+        free(buf);
+    }
+    return s;
+}
+
 ag_status ag_app_points_ply(ag_app *app, int64_t id, int (*fresh)(void *user, const char *etag),
                             void *user, ag_app_bytes *out, ag_error *err)
 {
@@ -83,23 +106,8 @@ ag_status ag_app_points_ply(ag_app *app, int64_t id, int (*fresh)(void *user, co
         if (s == AG_OK)
             s = set_ids(c, "piece", seg.piece, err);
     }
-    char *buf = NULL;
-    size_t len = 0;
-    FILE *f = s == AG_OK ? open_memstream(&buf, &len) : NULL;
-    if (s == AG_OK && !f)
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory writing PLY");
-    if (f) {
-        ag_ply_write_options po = {.encoding = AG_PLY_BINARY_LE};
-        s = ag_ply_write(c, &po, f, err);
-        if (fclose(f) != 0 && s == AG_OK)
-            s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory writing PLY");
-    }
-    if (s == AG_OK) {
-        out->data = (uint8_t *)buf;
-        out->len = len;
-    } else {
-        free(buf);
-    }
+    if (s == AG_OK)
+        s = ply_bytes(c, out, err);
     ag_cloud_free(c);
     ag_pointcloud_segmentation_clear(&seg);
     return s;
@@ -217,5 +225,47 @@ ag_status ag_app_points_glb(ag_app *app, int64_t id, size_t budget,
     free(rgba);
     ag_cloud_free(c);
     ag_pointcloud_segmentation_clear(&seg);
+    return s;
+}
+
+ag_status ag_app_points_derived_ply(ag_app *app, int64_t id,
+                                    int (*fresh)(void *user, const char *etag), void *user,
+                                    ag_app_bytes *out, ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    ag_db *db = ag_app_db(app, err);
+    if (!db)
+        return err ? err->code : AG_ERR_DB;
+    /* the grammar row names the state: each saved point model state has its own mesh file */
+    ag_grammar_row g;
+    ag_status s = ag_grammars_current(db, id, 0, &g, err);
+    if (s == AG_OK) {
+        snprintf(out->etag, sizeof out->etag, "\"derived-%lld-%lld\"", (long long)id,
+                 (long long)g.mesh_blob);
+        ag_grammars_row_clear(&g);
+        if (fresh && fresh(user, out->etag))
+            return AG_OK;
+    }
+    ag_pointmodel *pm = NULL;
+    ag_cloud *c = NULL;
+    int64_t version = 0, blob = 0;
+    if ((s = ag_pointclouds_read_begin(db, err)) != AG_OK)
+        return s;
+    s = ag_store_ws_read_point_model(db, id, "", &pm, &version, err);
+    /* the tag of what was read (a change may have come in between) */
+    if (s == AG_OK && (s = ag_grammars_current(db, id, 0, &g, err)) == AG_OK) {
+        blob = g.mesh_blob;
+        ag_grammars_row_clear(&g);
+    }
+    ag_pointclouds_read_end(db);
+    if (s == AG_OK) {
+        snprintf(out->etag, sizeof out->etag, "\"derived-%lld-%lld\"", (long long)id,
+                 (long long)blob);
+        s = ag_pointmodel_derive(pm, 0, &c, NULL, err);
+    }
+    if (s == AG_OK)
+        s = ply_bytes(c, out, err);
+    ag_cloud_free(c);
+    ag_pointmodel_free(pm);
     return s;
 }

@@ -13,6 +13,16 @@
 
 #define AG_POINTS_GLB_DEFAULT_BUDGET ((size_t)1000000)
 
+/* GET …/derived.ply: the cloud a proceduralized (and edited) cloud's grammar derives
+ * (core/points/pointmodel.h: every placement's terminal points, the density kept where a
+ * placement stretches), binary little-endian PLY as points.ply writes it, with normals, every
+ * terminal property, int `label` (terminal) and `segment` (placement). AG_ERR_CONFLICT for a
+ * model that is not a point cloud, AG_ERR_NOT_PROCEDURALIZED without a grammar. The ETag
+ * names the model's grammar state; fresh as for ag_app_query_glb. */
+ag_status ag_app_points_derived_ply(ag_app *app, int64_t id,
+                                    int (*fresh)(void *user, const char *etag), void *user,
+                                    ag_app_bytes *out, ag_error *err);
+
 /* GET …/points.ply: every point in input order with every property, binary little-endian,
  * float positions with a `comment offset X Y Z` line (absolute = position + offset), normals
  * when the cloud has them, and int segment, label and piece once it is segmented.

@@ -1,12 +1,54 @@
 #include "cloud_pipeline.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 #include "../store/models.h"
+#include "points_proc_options.h"
+#include "usecase_points.h"
 
-/* Not built yet: consensus terminals and the point split tree come from the point pipeline's
- * later stages (§4 of the point cloud paper). */
-const ag_cloud_proceduralize_fn ag_cloud_pipeline_proceduralize = NULL;
+/* The point pipeline of `archgram proceduralize CLOUD` (app/usecase_points.h): segments,
+ * automatic repetition, consensus terminals, the split tree, rules, patterns and grammar. */
+static ag_status proceduralize(ag_workspace *ws, const char *options, ag_error *err)
+{
+    json_t *o = options ? json_loads(options, 0, NULL) : NULL;
+    if (options && !o)
+        return ag_error_set(err, AG_ERR_INTERNAL, 0, "the job's point cloud options do not read");
+    ag_usecase_points_proceduralize_params p;
+    ag_box *boxes = NULL;
+    ag_status s = ag_points_proc_options_read(o, &p, &boxes, err);
+    json_decref(o);
+    ag_usecase_points_proceduralize_result r;
+    if (s == AG_OK)
+        s = ag_usecase_points_proceduralize_run(ws, &p, &r, err);
+    free(boxes);
+    return s;
+}
+
+ag_status ag_cloud_pipeline_check_options(int64_t model, int cloud, const json_t *options,
+                                          char **text, ag_error *err)
+{
+    *text = NULL;
+    if (!cloud) {
+        const char *key = json_object_iter_key(json_object_iter((json_t *)options));
+        if (key && ag_points_proc_options_is_key(key))
+            return ag_error_set(err, AG_ERR_INVALID, 0,
+                                "\"%s\": model %lld is a mesh; templates, rois and auto are "
+                                "options of point clouds",
+                                key, (long long)model);
+        return ag_error_set(err, AG_ERR_INVALID, 0, "\"%s\" is not an option of proceduralize",
+                            key ? key : "");
+    }
+    ag_usecase_points_proceduralize_params p;
+    ag_box *boxes = NULL;
+    ag_status s = ag_points_proc_options_read(options, &p, &boxes, err);
+    free(boxes);
+    if (s == AG_OK && !(*text = json_dumps(options, JSON_COMPACT)))
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    return s;
+}
+
+const ag_cloud_proceduralize_fn ag_cloud_pipeline_proceduralize = proceduralize;
 
 ag_status ag_cloud_pipeline_missing(int64_t model, const char *step, ag_error *err)
 {

@@ -4,8 +4,10 @@
  * what is missing, before anything is queued, and a job that meets one anyway fails the same
  * way. Wiring a stage in is setting its pointer (app/cloud_pipeline.c).
  *
- *   proceduralize   segments, labels and consensus terminals → split tree → grammar, over a
- *                   workspace whose model is a segmented cloud (POST …/proceduralize) */
+ *   proceduralize   segments, labels and consensus terminals → split tree → grammar with PLY
+ *                   terminals (app/usecase_points.h), over a workspace whose model is a cloud
+ *                   (POST …/proceduralize; a segmentation it has is not used: the pipeline
+ *                   segments with its repetition stages together) */
 #ifndef AG_CLOUD_PIPELINE_H
 #define AG_CLOUD_PIPELINE_H
 
@@ -14,8 +16,17 @@
 #include "../core/status.h"
 #include "workspace.h"
 
-typedef ag_status (*ag_cloud_proceduralize_fn)(ag_workspace *ws, ag_error *err);
+/* options: the job's point cloud options (app/points_proc_options.h) as JSON text, or NULL */
+typedef ag_status (*ag_cloud_proceduralize_fn)(ag_workspace *ws, const char *options,
+                                               ag_error *err);
 extern const ag_cloud_proceduralize_fn ag_cloud_pipeline_proceduralize;
+
+/* The point cloud options of a proceduralization, checked (AG_ERR_INVALID naming the member;
+ * for a model that is not a cloud, naming the first member) and as the job's text (*text,
+ * malloc'd). */
+#include <jansson.h>
+ag_status ag_cloud_pipeline_check_options(int64_t model, int cloud, const json_t *options,
+                                          char **text, ag_error *err);
 
 /* The problem of a stage that is not there: AG_ERR_NOT_AVAILABLE naming the model, the step
  * ("proceduralize") and what it needs. */

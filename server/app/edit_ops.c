@@ -9,11 +9,13 @@
 #include "../io/edit_op_json.h"
 #include "../store/ops.h"
 #include "../store/states.h"
+#include "cloud_pipeline.h"
 #include "edit_session.h"
 #include "model_tree.h"
 #include "modelops.h"
 #include "store_ws.h"
 #include "usecase_edit.h"
+#include "usecase_points.h"
 
 ag_status ag_edit_ops_validate(const json_t *op, ag_error *err)
 {
@@ -83,13 +85,21 @@ ag_status ag_edit_ops_run_edit(const ag_store_env *env, const ag_op_request *rq,
     ag_store_ws w;
     ag_store_ws_init_op(&w, env, rq);
     ag_usecase_edit_result r;
-    s = ag_usecase_edit_run(&w.ws, &(ag_usecase_edit_params){&e, &from}, &r, err);
+    ag_usecase_points_edit_result pr;
+    /* a proceduralized point cloud is edited as a point model, keeping its density */
+    int cloud = 0;
+    s = ag_cloud_pipeline_is_cloud(env->db, rq->model, &cloud, err);
+    if (s == AG_OK && cloud)
+        s = ag_usecase_points_edit_run(&w.ws, &(ag_usecase_points_edit_params){&e, &from}, &pr,
+                                       err);
+    else if (s == AG_OK)
+        s = ag_usecase_edit_run(&w.ws, &(ag_usecase_edit_params){&e, &from}, &r, err);
     s = ag_task_budget_explain(rq->budget, s, "the edit", err);
     ag_store_ws_end(&w, s);
     if (s == AG_OK) {
         *version = w.version;
         *duplicate = w.duplicate;
-        ag_edit_report_clear(&r.report);
+        ag_edit_report_clear(cloud ? &pr.report : &r.report);
     }
     ag_edit_op_clear(&e);
     ag_edit_op_origin_clear(&from);

@@ -34,8 +34,9 @@ char *ag_job_params_encode(const ag_job_params *p)
     }
     case AG_JOB_PROCEDURALIZE: {
         const ag_proceduralize_job *q = &p->u.proceduralize;
-        j = json_pack("{s:I, s:I, s:s, s:b}", "model", (json_int_t)q->model, "base",
-                      (json_int_t)q->base, "author", q->author, "exact", q->exact != 0);
+        j = json_pack("{s:I, s:I, s:s, s:b, s:s?}", "model", (json_int_t)q->model, "base",
+                      (json_int_t)q->base, "author", q->author, "exact", q->exact != 0, "cloud",
+                      q->cloud);
         break;
     }
     case AG_JOB_EXTRUDE: {
@@ -114,7 +115,7 @@ ag_status ag_job_params_decode(const char *kind, const char *json, ag_job_params
         q->base = json_integer_value(b);
         q->exact = json_is_true(x);
         bad = !json_is_integer(m) || !json_is_integer(b) || q->model <= 0 || q->base <= 0 ||
-              take(o, "author", 1, &q->author);
+              take(o, "author", 1, &q->author) | take(o, "cloud", 0, &q->cloud);
     } else if (strcmp(kind, "segment") == 0) {
         out->type = AG_JOB_SEGMENT;
         ag_segment_job *q = &out->u.segment;
@@ -170,7 +171,7 @@ ag_status ag_job_params_copy(ag_job_params *dst, const ag_job_params *src, ag_er
             DUP(u.import.filename);
         break;
     case AG_JOB_PROCEDURALIZE:
-        DUP(u.proceduralize.author);
+        DUP(u.proceduralize.author), DUP(u.proceduralize.cloud);
         break;
     case AG_JOB_SEGMENT:
         DUP(u.segment.author);
@@ -200,7 +201,7 @@ void ag_job_params_clear(ag_job_params *p)
             free(p->u.import.up), free(p->u.import.filename);
         break;
     case AG_JOB_PROCEDURALIZE:
-        free(p->u.proceduralize.author);
+        free(p->u.proceduralize.author), free(p->u.proceduralize.cloud);
         break;
     case AG_JOB_SEGMENT:
         free(p->u.segment.author);

@@ -34,6 +34,7 @@ typedef struct {
     int64_t base;
     char *author;
     int exact;
+    char *cloud; /* a point cloud's options (app/points_proc_options.h) as JSON text, or NULL */
 } ag_proceduralize_job;
 
 /* A point cloud model at version base → segmented (§3.1), by author. Thresholds are

@@ -598,6 +598,8 @@ static const ag_workspace_ops store_ops = {
     .add_cloud = ag__store_ws_add_cloud,
     .input_cloud = ag__store_ws_input_cloud,
     .save_segmentation = ag__store_ws_save_segmentation,
+    .open_point_models = ag__store_ws_open_point_models,
+    .save_points = ag__store_ws_save_points,
     .cancelled = cancelled,
     .progress = progress,
     .state_flags = 0, /* the mesh is kept: a reload gives the saved model itself */
@@ -649,4 +651,7 @@ void ag_store_ws_end(ag_store_ws *w, ag_status outcome)
     w->source = w->target = NULL;
     ag_part_free(w->part);
     w->part = NULL;
+    ag_pointmodel_free(w->points);
+    ag_pointmodel_free(w->points_source);
+    w->points = w->points_source = NULL;
 }

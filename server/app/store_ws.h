@@ -41,6 +41,8 @@ typedef struct {
     ag_part *part;                  /* the part a composition read */
     int64_t part_id, part_version;  /* where a part save went */
     char job_cid[32];               /* a job's cid, "job-<id>" */
+    struct ag_pointmodel *points, *points_source; /* a point model edit's (app/store_ws_points.c) */
+    int64_t source_version;         /* a paste from another point model: its version */
 } ag_store_ws;
 
 void ag_store_ws_init(ag_store_ws *w, const ag_store_ws_options *o);
@@ -78,6 +80,24 @@ ag_status ag__store_ws_input_cloud(ag_workspace *ws, int with_properties, int ne
                                    ag_cloud_state *st, ag_error *err);
 ag_status ag__store_ws_save_segmentation(ag_workspace *ws, const ag_cloud_state *st,
                                          const ag_segment_outcome *o, ag_error *err);
+/* The point model operations (app/store_ws_points.c): the point model of a proceduralized
+ * cloud (its grammar and PLY terminals as stored) and a paste's source, and a proceduralized
+ * or edited point model saved as a sequenced op (its grammar, served tree, summary and
+ * terminals, with the states before and after kept for undo). */
+ag_status ag__store_ws_open_point_models(ag_workspace *ws, const ag_edit_op_origin *from,
+                                         struct ag_pointmodel **pm,
+                                         const struct ag_pointmodel **source, ag_error *err);
+ag_status ag__store_ws_save_points(ag_workspace *ws, struct ag_points_state *st,
+                                   const ag_points_outcome *proc, const ag_edit_outcome *edit,
+                                   ag_error *err);
+/* The point model of a proceduralized cloud's current grammar, read from the stored text and
+ * PLY terminals (inside a read transaction of the caller's, for one snapshot). field names
+ * the op member the model comes from in problems ("" for none); *version gets the model's
+ * version. AG_ERR_CONFLICT for a model that is not a point cloud, AG_ERR_NOT_PROCEDURALIZED
+ * for one without a grammar. */
+ag_status ag_store_ws_read_point_model(ag_db *db, int64_t model, const char *field,
+                                       struct ag_pointmodel **pm, int64_t *version,
+                                       ag_error *err);
 /* Keeps st's edit model (taken) as the model's edit session at version. */
 void ag__store_ws_keep_model(ag_edit_sessions *reg, int64_t model, int64_t version,
                              ag_model_state *st);

@@ -33,8 +33,10 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
 {
     ag_error err;
     ag_error_clear(&err);
-    /* an empty body, {} or {"exact": true|false} */
+    /* an empty body, {} or {"exact": true|false}; any other member goes to the app, which
+     * knows a point cloud's options (app/points_proc_options.h) */
     int exact = 0;
+    json_t *cloud = NULL;
     if (r->body_len) {
         json_t *body;
         ag_status s = ag_request_json(r, &body, &err);
@@ -45,6 +47,10 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
         json_object_foreach(body, key, v) {
             if (!strcmp(key, "exact") && json_is_boolean(v)) {
                 exact = json_is_true(v);
+            } else if (strcmp(key, "exact")) {
+                if (!cloud)
+                    cloud = json_object();
+                json_object_set(cloud, key, v);
             } else {
                 bad = key;
                 break;
@@ -56,6 +62,7 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
             ag_error_set(&err, AG_ERR_INVALID, 0, "\"%s\" is not an option of proceduralize",
                          bad);
         if (bad) {
+            json_decref(cloud);
             json_decref(body);
             return ag_reply_problem(r, AG_ERR_INVALID, &err);
         }
@@ -65,10 +72,13 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
     ag_status s = ag_app_query_version(r->cfg->app, r->ids[0], &current, &err);
     if (s == AG_OK)
         s = if_match(r, 0, current, &base, &err);
+    int64_t job = 0;
+    if (s == AG_OK)
+        s = ag_app_jobs_proceduralize(r->cfg->app, &r->who, r->ids[0], &current, exact, cloud,
+                                      &job, &err);
+    json_decref(cloud);
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
-    int64_t job = 0;
-    s = ag_app_jobs_proceduralize(r->cfg->app, &r->who, r->ids[0], &current, exact, &job, &err);
     return ag_reply_new_job(r, s, job, &err);
 }
 

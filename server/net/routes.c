@@ -32,6 +32,9 @@ const ag_route ag_routes[] = {
     {"GET", "/api/v1/models/{id}/points.glb", ag_api_model_points_glb, NONE, AG_NEED_MODEL_VIEWER,
      0},
     {"POST", "/api/v1/models/{id}/segment", ag_api_model_segment, JSON, AG_NEED_MODEL_EDITOR, JOB},
+    /* the cloud a proceduralized cloud's grammar derives, as edited */
+    {"GET", "/api/v1/models/{id}/derived.ply", ag_api_model_derived_ply, NONE,
+     AG_NEED_MODEL_VIEWER, 0},
     {"GET", "/api/v1/models/{id}/grammar", ag_api_model_grammar_get, NONE, AG_NEED_MODEL_VIEWER, 0},
     /* spooled like an upload; api_grammar.c takes at most 8 MiB of it */
     {"PUT", "/api/v1/models/{id}/grammar", ag_api_model_grammar_put, UPLOAD,

@@ -57,6 +57,7 @@ enum MHD_Result ag_api_model_mesh_glb(ag_request *r);
 enum MHD_Result ag_api_model_proceduralize(ag_request *r);
 enum MHD_Result ag_api_model_tree(ag_request *r);
 enum MHD_Result ag_api_model_points_ply(ag_request *r);
+enum MHD_Result ag_api_model_derived_ply(ag_request *r);
 enum MHD_Result ag_api_model_points_glb(ag_request *r);
 enum MHD_Result ag_api_model_segment(ag_request *r);
 enum MHD_Result ag_api_model_grammar_get(ag_request *r);

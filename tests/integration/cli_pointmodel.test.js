@@ -9,6 +9,7 @@ import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { REPO, tempDir, removeDir } from './harness.js';
+import { ORIGIN, countWindows, windowBox, writeBuilding } from './points_building.js';
 
 const CLI = process.env.ARCHGRAM ? path.resolve(process.env.ARCHGRAM) : path.join(REPO, 'build', 'archgram');
 const POINTS = path.join(REPO, 'tests', 'data', 'points');
@@ -51,112 +52,6 @@ function readCloud(file) {
   }
   return { n, props: out };
 }
-
-function rng(seed) {
-  let s = seed >>> 0;
-  return () => ((s = (Math.imul(s, 1664525) + 1013904223) >>> 0) / 4294967296);
-}
-
-// A 16 x 8 x 7 m block with a flat roof and 5 x 2 recessed windows (1.2 x 1.5 m, glass 0.25 m
-// behind the wall) in its front (y = 0), at RD New-like coordinates, as double x y z plus the
-// int `window` (-1 for wall and roof). Area-uniform samples, 2 mm noise along the normal.
-const ORIGIN = [85000.5, 446000.25, 1.5];
-const WIN = [];
-for (const z0 of [1.0, 4.4]) for (let k = 0; k < 5; k++) WIN.push([1.0 + 3.2 * k, z0]);
-function building(n) {
-  const r = rng(5);
-  const surfaces = []; // [area, sample(u, v) -> [x, y, z], window]
-  const add = (area, f, w = -1) => surfaces.push([area, f, w]);
-  add(16 * 7, (u, v) => [u * 16, 0, v * 7], -2); // the front, holes rejected below
-  add(16 * 7, (u, v) => [u * 16, 8, v * 7]);
-  add(8 * 7, (u, v) => [0, u * 8, v * 7]);
-  add(8 * 7, (u, v) => [16, u * 8, v * 7]);
-  add(16 * 8, (u, v) => [u * 16, v * 8, 7]);
-  WIN.forEach(([x0, z0], w) => {
-    add(1.2 * 1.5, (u, v) => [x0 + 1.2 * u, 0.25, z0 + 1.5 * v], w);
-    add(0.25 * 1.5, (u, v) => [x0, 0.25 * u, z0 + 1.5 * v], w);
-    add(0.25 * 1.5, (u, v) => [x0 + 1.2, 0.25 * u, z0 + 1.5 * v], w);
-    add(1.2 * 0.25, (u, v) => [x0 + 1.2 * u, 0.25 * v, z0], w);
-    add(1.2 * 0.25, (u, v) => [x0 + 1.2 * u, 0.25 * v, z0 + 1.5], w);
-  });
-  const total = surfaces.reduce((s, [a]) => s + a, 0);
-  const x = [], y = [], z = [], window = [];
-  while (x.length < n) {
-    let pick = r() * total, s = 0;
-    while (pick > surfaces[s][0]) pick -= surfaces[s++][0];
-    const [, f, w] = surfaces[s];
-    const p = f(r(), r());
-    if (w === -2 && WIN.some(([x0, z0]) => p[0] > x0 && p[0] < x0 + 1.2 && p[2] > z0 && p[2] < z0 + 1.5)) continue;
-    const e = (r() - 0.5) * 0.004;
-    x.push(p[0] + ORIGIN[0] + (p[0] === 0 || p[0] === 16 ? e : 0));
-    y.push(p[1] + ORIGIN[1] + (p[1] === 0 || p[1] === 8 || p[1] === 0.25 ? e : 0));
-    z.push(p[2] + ORIGIN[2] + (p[2] === 7 ? e : 0));
-    window.push(w < 0 ? -1 : w);
-  }
-  return { x, y, z, window };
-}
-
-function writePly(file, cols) {
-  const n = cols[0][2].length;
-  let header = `ply\nformat binary_little_endian 1.0\nelement vertex ${n}\n`;
-  for (const [name, type] of cols) header += `property ${type} ${name}\n`;
-  header += 'end_header\n';
-  const row = cols.reduce((s, [, t]) => s + SIZES[t], 0);
-  const body = new DataView(new ArrayBuffer(row * n));
-  let at = 0;
-  for (let i = 0; i < n; i++) {
-    for (const [, type, values] of cols) {
-      body['set' + GET[type].slice(3)](at, values[i], true);
-      at += SIZES[type];
-    }
-  }
-  fs.writeFileSync(file, Buffer.concat([Buffer.from(header, 'latin1'), Buffer.from(body.buffer)]));
-}
-
-function writeBuilding(file) {
-  const b = building(60000);
-  writePly(file, [['x', 'double', b.x], ['y', 'double', b.y], ['z', 'double', b.z], ['window', 'int', b.window]]);
-  return b;
-}
-
-// Windows in a cloud, found geometrically: glass points (0.15..0.35 m behind the front, off the
-// side walls at both ends) binned by 0.2 m in x and z, 4-connected runs of occupied bins counted.
-function countWindows(c) {
-  const cells = new Map();
-  // the far side wall: the 99.5th percentile of x (a few stray points may lie beyond)
-  const xs = Float64Array.from(c.props.x, (v) => v - ORIGIN[0]).sort();
-  const xmax = xs[Math.floor(0.995 * (xs.length - 1))];
-  for (let i = 0; i < c.n; i++) {
-    const y = c.props.y[i] - ORIGIN[1], x = c.props.x[i] - ORIGIN[0], z = c.props.z[i] - ORIGIN[2];
-    if (y < 0.15 || y > 0.35 || x < 0.4 || x > xmax - 0.4 || z < 0.3 || z > 6.7) continue;
-    const k = `${Math.floor(x / 0.2)},${Math.floor(z / 0.2)}`;
-    cells.set(k, (cells.get(k) || 0) + 1);
-  }
-  const seen = new Set();
-  let blobs = 0;
-  for (const [k, cnt] of cells) {
-    if (cnt < 2 || seen.has(k)) continue;
-    let size = 0;
-    const stack = [k];
-    seen.add(k);
-    while (stack.length) {
-      const [a, b] = stack.pop().split(',').map(Number);
-      size++;
-      for (const [da, db] of [[1, 0], [-1, 0], [0, 1], [0, -1]]) {
-        const q = `${a + da},${b + db}`;
-        if (!seen.has(q) && (cells.get(q) || 0) >= 2) { seen.add(q); stack.push(q); }
-      }
-    }
-    if (size >= 10) blobs++;
-  }
-  return blobs;
-}
-
-const windowBox = (w, pad = 0.1) => {
-  const [x0, z0] = WIN[w];
-  return [x0 - pad + ORIGIN[0], -pad + ORIGIN[1], z0 - pad + ORIGIN[2],
-    x0 + 1.2 + pad + ORIGIN[0], 0.25 + pad + ORIGIN[1], z0 + 1.5 + pad + ORIGIN[2]].join(',');
-};
 
 test('proceduralize, derive and edit a point cloud building with a template', () => {
   const dir = tempDir();

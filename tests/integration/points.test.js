@@ -3,8 +3,8 @@
 // bad clouds fail their job with a precise problem; points.glb holds a budget of points that
 // is a prefix of one order, the same on every request; the segment job reports its stages
 // and finds the planes; ROI refinement and template marking are ops logged with a report,
-// seen by a second client, undone and redone exactly; proceduralize, tree, grammar and
-// structural edits answer precise problems; and the AHN3 crop goes through the service.
+// seen by a second client, undone and redone exactly; tree, grammar and structural edits of a
+// cloud not proceduralized answer precise problems; and the AHN3 crop goes through the service.
 // Clouds are written by the test's own writers (clouds.js), not archgram's.
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
@@ -470,11 +470,9 @@ describe('point clouds in the service', () => {
     assert.match(r.json.detail, /not a point cloud/);
   });
 
-  it('proceduralize, tree, grammar and structural edits of a cloud answer precise problems', async () => {
+  // (proceduralizing a cloud and editing its point model: points_model.test.js)
+  it('tree, grammar and structural edits of a cloud not proceduralized answer precise problems', async () => {
     const id = models.ply.id;
-    const p = await http(d, 'POST', `/api/v1/models/${id}/proceduralize`, { body: {} });
-    assertProblem(p, 422, 'not-available', 'proceduralize a cloud');
-    assert.match(p.json.detail, /point split tree/);
     assertProblem(await http(d, 'GET', `/api/v1/models/${id}/tree`), 404, 'not-found', 'tree');
     assertProblem(await http(d, 'GET', `/api/v1/models/${id}/grammar`), 404, 'not-found', 'grammar');
     const v = (await http(d, 'GET', `/api/v1/models/${id}`)).json.version;

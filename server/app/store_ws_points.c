@@ -1,0 +1,263 @@
+/* The store workspace's point model operations (app/store_ws.h): the point model of a
+ * proceduralized cloud read from its stored grammar and PLY terminals, and a proceduralized
+ * or edited point model saved as a sequenced op.
+ *
+ * A point model is kept in the tables meshes use: its grammar text, served tree (boxes in the
+ * input's coordinates, numbering AG_MODEL_TREE_NUMBERING) and summary in grammars, its PLY
+ * terminals in terminals (paths name their content, so the terminals of every kept state stay
+ * readable), and a new empty mesh file per saved state, so that the grammar describes the
+ * model exactly while that state is current (store/grammars.h) and undo, redo and restore
+ * bring a version's grammar back with its states (store/states.h). Nothing is cached: a model
+ * is read back from its text each time (the ids of its tree are those the text gives). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../io/edit_op_json.h"
+#include "../io/meshblob.h"
+#include "../store/grammars.h"
+#include "../store/jobs.h"
+#include "../store/models.h"
+#include "../store/pointclouds.h"
+#include "../store/states.h"
+#include "model_tree.h"
+#include "points_state.h"
+#include "points_summary.h"
+#include "store_ws.h"
+
+/* ---- reading ------------------------------------------------------------------------------ */
+
+typedef struct {
+    ag_db *db;
+    int64_t model;
+} terminal_source;
+
+static ag_status db_lookup(void *user, const char *path, char **data, size_t *len,
+                           ag_error *err)
+{
+    const terminal_source *t = user;
+    return ag_grammars_get_terminal(t->db, t->model, path, data, len, err);
+}
+
+ag_status ag_store_ws_read_point_model(ag_db *db, int64_t model, const char *field,
+                                       ag_pointmodel **pm, int64_t *version, ag_error *err)
+{
+    *pm = NULL;
+    ag_model_row row;
+    ag_status s = ag_models_get(db, model, &row, err);
+    if (s == AG_ERR_NOT_FOUND && field[0])
+        return ag_error_set(err, s, 0, "%s: there is no model %lld", field, (long long)model);
+    if (s != AG_OK)
+        return s;
+    int cloud = strcmp(row.kind, "pointcloud") == 0;
+    *version = row.version;
+    ag_models_row_clear(&row);
+    if (!cloud)
+        return ag_error_set(err, AG_ERR_CONFLICT, 0,
+                            "%s%smodel %lld is not a point cloud: a point model is edited with "
+                            "point models",
+                            field, field[0] ? ": " : "", (long long)model);
+    ag_grammar_row g;
+    ag_error e;
+    ag_error_clear(&e);
+    if ((s = ag_grammars_current(db, model, 0, &g, &e)) == AG_ERR_NOT_FOUND)
+        return ag_error_set(err, AG_ERR_NOT_PROCEDURALIZED, 0,
+                            "%s%smodel %lld is not proceduralized: structural edits need a "
+                            "grammar (POST /api/v1/models/%lld/proceduralize)",
+                            field, field[0] ? ": " : "", (long long)model, (long long)model);
+    if (s != AG_OK) {
+        if (err)
+            *err = e;
+        return s;
+    }
+    terminal_source ts = {db, model};
+    long col = 0;
+    s = ag_points_state_read(g.text, g.text_len, db_lookup, &ts, pm, &e, &col);
+    ag_grammars_row_clear(&g);
+    if (s != AG_OK) /* what the store saved does not read back: not the caller's fault */
+        s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
+                         "the stored point grammar of model %lld does not read: %s",
+                         (long long)model, e.text);
+    return s;
+}
+
+ag_status ag__store_ws_open_point_models(ag_workspace *ws, const ag_edit_op_origin *from,
+                                         ag_pointmodel **pm, const ag_pointmodel **source,
+                                         ag_error *err)
+{
+    ag_store_ws *w = (ag_store_ws *)ws;
+    *pm = NULL;
+    *source = NULL;
+    if (from && from->dir)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "source_dir: a folder is for `archgram edit`; the service names the "
+                            "model to paste from with source_model");
+    /* held, so edits of one model wait for each other as mesh edits do */
+    ag_status s = AG_OK;
+    if (!w->target &&
+        (s = ag_edit_session_hold(w->o.env.sessions, w->o.model, &w->target, err)) != AG_OK)
+        return s;
+    ag_db *db = w->o.env.db;
+    /* the version, the grammar and its terminals of one snapshot */
+    if ((s = ag_pointclouds_read_begin(db, err)) != AG_OK)
+        return s;
+    int64_t version = 0, source_version = 0;
+    s = ag_store_ws_read_point_model(db, w->o.model, "", &w->points, &version, err);
+    if (s == AG_OK && version != w->o.base)
+        s = ag_error_set(err, AG_ERR_STALE, (long)version, "model %lld is at version %lld, not %lld",
+                         (long long)w->o.model, (long long)version, (long long)w->o.base);
+    int64_t src = from && from->model != w->o.model ? from->model : 0;
+    if (s == AG_OK && src)
+        s = ag_store_ws_read_point_model(db, src, "source_model", &w->points_source, &source_version, err);
+    ag_pointclouds_read_end(db);
+    if (s != AG_OK)
+        return s;
+    w->source_version = source_version;
+    *pm = w->points;
+    *source = w->points_source;
+    return AG_OK;
+}
+
+/* ---- writing ------------------------------------------------------------------------------ */
+
+/* The model's stats as they are (a point model's state keeps the cloud's figures). */
+static ag_status current_stats(ag_db *db, int64_t model, char **stats, ag_error *err)
+{
+    ag_model_row row;
+    ag_status s = ag_models_get(db, model, &row, err);
+    if (s != AG_OK)
+        return s;
+    *stats = strdup(row.stats_json ? row.stats_json : "{}");
+    ag_models_row_clear(&row);
+    return *stats ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+}
+
+/* The state st as the model's at version (inside the caller's transaction): a new empty mesh
+ * file, the grammar with its tree and summary, the terminals. */
+static ag_status put_points_state(ag_db *db, int64_t model, int64_t version,
+                                  const ag_points_state *st, const char *summary, ag_error *err)
+{
+    ag_mesh *empty = ag_mesh_create();
+    uint8_t *mesh = NULL;
+    size_t mesh_len = 0;
+    char *stats = NULL, *tree_text = NULL;
+    json_t *tree = ag_model_tree_served(st->pm->em);
+    if (tree)
+        ag_points_summary_shift_tree(tree, st->pm->offset);
+    tree_text = tree ? json_dumps(tree, JSON_COMPACT | JSON_REAL_PRECISION(12)) : NULL;
+    json_decref(tree);
+    ag_status s = empty && tree_text ? ag_meshblob_encode(empty, &mesh, &mesh_len) : AG_ERR_NOMEM;
+    ag_mesh_free(empty);
+    if (s != AG_OK)
+        s = ag_error_set(err, s, 0, "out of memory describing the point model");
+    if (s == AG_OK)
+        s = current_stats(db, model, &stats, err);
+    int64_t mesh_blob = 0;
+    if (s == AG_OK)
+        s = ag_models_set_mesh(db, model, mesh, mesh_len, stats, &mesh_blob, err);
+    if (s == AG_OK) {
+        ag_grammar_new g = {.model = model,
+                            .version = version,
+                            .mesh_blob = mesh_blob,
+                            .text = st->text,
+                            .text_len = st->text_len,
+                            .tree_json = tree_text,
+                            .tree_numbering = AG_MODEL_TREE_NUMBERING,
+                            .summary_json = summary};
+        s = ag_grammars_put(db, &g, err);
+    }
+    for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
+        s = ag_grammars_put_terminal(db, model, st->terms.path[i], st->terms.obj[i],
+                                     st->terms.len[i], err);
+    free(mesh);
+    free(stats);
+    free(tree_text);
+    return s;
+}
+
+/* The op logged: the proceduralization's figures, or the client's op with the edit's report. */
+static json_t *logged_op(const ag_store_ws *w, const ag_points_state *st,
+                         const ag_points_outcome *proc, const ag_edit_outcome *edit)
+{
+    if (proc)
+        return json_pack("{s:s, s:s, s:I, s:I, s:I, s:I}", "kind", "proceduralize", "input",
+                         "pointcloud", "rules", (json_int_t)st->pm->em->proc->grammar->nrules,
+                         "terminals", (json_int_t)st->pm->nterminals, "placements",
+                         (json_int_t)st->pm->nplacements, "patterns",
+                         (json_int_t)st->pm->em->proc->tree->npatterns);
+    json_t *body = json_deep_copy(w->o.op);
+    json_t *report = ag_edit_op_json_report(&edit->report);
+    if (!body || !report) {
+        json_decref(body);
+        json_decref(report);
+        return NULL;
+    }
+    json_object_set_new(report, "edit_ms", json_real(edit->edit_ms));
+    json_object_set_new(report, "placements", json_integer((json_int_t)st->pm->nplacements));
+    if (w->source_version) /* the version of the source model whose nodes were copied */
+        json_object_set_new(report, "source_version", json_integer((json_int_t)w->source_version));
+    json_object_set_new(body, "report", report);
+    return body;
+}
+
+ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
+                                   const ag_points_outcome *proc, const ag_edit_outcome *edit,
+                                   ag_error *err)
+{
+    ag_store_ws *w = (ag_store_ws *)ws;
+    json_t *summary_json = proc ? ag_points_summary_proc(st, proc, NULL)
+                                : edit ? ag_points_summary_edit(st, edit) : NULL;
+    char *summary = summary_json ? json_dumps(summary_json, JSON_COMPACT | JSON_PRESERVE_ORDER |
+                                                                JSON_REAL_PRECISION(10))
+                                 : NULL;
+    json_decref(summary_json);
+    json_t *body = logged_op(w, st, proc, edit);
+    ag_status s = summary && body ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    ag_seq_txn t;
+    int64_t seen = 0;
+    /* a proceduralization is the job's (no client id); an edit is the client's op */
+    if (s == AG_OK)
+        s = ag_sequencer_begin(w->o.env.seq, w->o.env.db, w->o.model, w->o.base,
+                               proc ? NULL : w->o.author, proc ? NULL : w->o.cid, &t,
+                               proc ? NULL : &seen, err);
+    if (s == AG_ERR_STALE && proc)
+        ag_error_set(err, AG_ERR_STALE, err ? err->element : 0,
+                     "model %lld changed while it was being proceduralized (it is at version "
+                     "%ld, the job started from %lld); nothing was stored",
+                     (long long)w->o.model, err ? err->element : 0, (long long)w->o.base);
+    if (s == AG_OK && seen) { /* the same op came in meanwhile: answered, not applied again */
+        w->duplicate = 1;
+        w->version = seen;
+    } else if (s == AG_OK) {
+        t.origin = w->o.origin;
+        /* the states around the change, so undo and restore come back to either side */
+        s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
+        if (s == AG_OK)
+            s = put_points_state(t.db, w->o.model, t.version, st, summary, err);
+        if (s == AG_OK)
+            s = ag_states_keep(t.db, w->o.model, t.version, err);
+        if (s == AG_OK && w->o.job && ag_jobctx_cancelled(w->o.job))
+            s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
+        if (s == AG_OK && w->o.job_id) {
+            char result[400];
+            long long m = (long long)w->o.model;
+            snprintf(result, sizeof result,
+                     "{\"model\":%lld,\"version\":%lld,\"href\":\"/api/v1/models/%lld\","
+                     "\"tree\":\"/api/v1/models/%lld/tree\",\"grammar\":\"/api/v1/models/%lld/"
+                     "grammar\"}",
+                     m, (long long)t.version, m, m, m);
+            s = ag_jobs_finish(t.db, w->o.job_id, "succeeded", result, NULL, w->o.model, err);
+        }
+        int64_t v = t.version;
+        if (s == AG_OK)
+            s = ag_sequencer_commit(&t, w->o.author, w->o.cid, body, err);
+        else
+            ag_sequencer_abort(&t);
+        if (s == AG_OK)
+            w->version = v;
+    }
+    json_decref(body);
+    free(summary);
+    ag_points_state_clear(st);
+    return s;
+}

@@ -1,0 +1,260 @@
+// Point clouds proceduralized and edited in the service, as meshes are: the proceduralize job on
+// a pointcloud model (progress by stage, a template's copies found), GET …/tree and …/grammar,
+// GET …/derived.ply (the cloud the grammar derives), resize and paste ops over REST and the
+// websocket (broadcast, logged with their report, undone and redone by their author), with the
+// density kept. The checks are the test's own: windows are counted and densities measured on
+// the derived points (points_building.js), never taken from archgram's report.
+import assert from 'node:assert/strict';
+import { after, before, describe, it } from 'node:test';
+import { assertProblem, http, importModel, PROBLEM, removeDir, sql, startDaemon, waitJob, WsClient, facadeObj } from './harness.js';
+import { parsePly } from './clouds.js';
+import { buildingPly, countWindows, ORIGIN, WIN, windowBox } from './points_building.js';
+
+// A PLY answer with absolute coordinates (its offset comment added).
+function absolute(buf) {
+  const c = parsePly(buf);
+  const line = c.comments.find((x) => x.startsWith('offset'));
+  const o = line ? line.split(' ').slice(1).map(Number) : [0, 0, 0];
+  const n = c.props.x.length;
+  for (let i = 0; i < n; i++) { c.props.x[i] += o[0]; c.props.y[i] += o[1]; c.props.z[i] += o[2]; }
+  return { n, props: c.props };
+}
+
+// Points per m² of the front wall (the plane y = 0 between the windows) and of the windows'
+// glass (0.25 m behind it), measured on a cloud of a front `width` m wide with `windows` windows.
+function densities(c, width, windows) {
+  let wall = 0, glass = 0;
+  for (let i = 0; i < c.n; i++) {
+    const x = c.props.x[i] - ORIGIN[0], y = c.props.y[i] - ORIGIN[1], z = c.props.z[i] - ORIGIN[2];
+    if (x < 0.05 || x > width - 0.05 || z < 0.05 || z > 6.95) continue;
+    if (Math.abs(y) < 0.02) wall++;
+    else if (Math.abs(y - 0.25) < 0.02) glass++;
+  }
+  const wallArea = (width - 0.1) * 6.9 - windows * 1.2 * 1.5;
+  return { wall: wall / wallArea, glass: glass / (windows * 1.2 * 1.5) };
+}
+
+const within = (a, b, rel, what) => assert.ok(Math.abs(a / b - 1) <= rel, `${what}: ${a.toFixed(1)} against ${b.toFixed(1)} per m²`);
+const box6 = (s) => s.split(',').map(Number);
+
+describe('point models in the service', () => {
+  let d;
+  let id;
+  let mesh;
+  const input = buildingPly(60000);
+  before(async () => {
+    d = await startDaemon();
+  });
+  after(async () => {
+    if (d) { try { await d.stop(); } finally { await d.kill(); removeDir(d.dir); } }
+  });
+
+  const state = async () => ({
+    version: (await http(d, 'GET', `/api/v1/models/${id}`)).json.version,
+    ops: (await http(d, 'GET', `/api/v1/models/${id}/ops`)).json.items.length,
+    grammar: (await http(d, 'GET', `/api/v1/models/${id}/grammar`)).text,
+    rows: sql(d.db, `SELECT (SELECT count(*) FROM model_states WHERE model_id = ${id}), (SELECT count(*) FROM grammars WHERE model_id = ${id}), (SELECT count(*) FROM terminals WHERE model_id = ${id}), (SELECT count(*) FROM blobs)`),
+  });
+  const derived = async () => {
+    const r = await http(d, 'GET', `/api/v1/models/${id}/derived.ply`, { timeout: 60000 });
+    assert.equal(r.status, 200, r.text.slice(0, 300));
+    assert.equal(r.headers.get('content-type'), 'application/x-ply');
+    return absolute(r.body);
+  };
+
+  it('a cloud that is not proceduralized has no tree, grammar or derived cloud, and refuses edits', async () => {
+    const q = new URLSearchParams({ name: 'house', format: 'ply' });
+    const up = await http(d, 'POST', `/api/v1/models?${q}`, { body: input.bytes, headers: { 'Content-Type': 'application/octet-stream' }, timeout: 120000 });
+    assert.equal(up.status, 202, up.text);
+    const job = await waitJob(d, up.json.id, { timeout: 120000 });
+    assert.equal(job.status, 'succeeded', JSON.stringify(job.error));
+    id = job.result.model;
+    assertProblem(await http(d, 'GET', `/api/v1/models/${id}/tree`), 404, 'not-found', 'tree');
+    assertProblem(await http(d, 'GET', `/api/v1/models/${id}/grammar`), 404, 'not-found', 'grammar');
+    assertProblem(await http(d, 'GET', `/api/v1/models/${id}/derived.ply`), 409, 'not-proceduralized', 'derived.ply');
+    const v = (await http(d, 'GET', `/api/v1/models/${id}`)).json.version;
+    const r = await http(d, 'POST', `/api/v1/models/${id}/ops`, { body: { op: { kind: 'resize', node: 'root', scale: [2, 1, 1] } }, headers: { 'If-Match': `"${v}"` } });
+    assertProblem(r, 409, 'not-proceduralized', 'resize a cloud');
+    assert.match(r.json.detail, /not proceduralized/);
+  });
+
+  it('bad proceduralize options are refused before a job is queued', async () => {
+    mesh = await importModel(d, facadeObj(3, 2), { name: 'a mesh' });
+    const bad = async (model, body, detail) => {
+      const r = await http(d, 'POST', `/api/v1/models/${model}/proceduralize`, { body });
+      assertProblem(r, 400, 'invalid', JSON.stringify(body));
+      assert.match(r.json.detail, detail);
+    };
+    await bad(id, { templates: [[1, 2, 3]] }, /templates\[0\]: a box/);
+    await bad(id, { templates: [[0, 0, 0, 1, 1, 'x']] }, /templates\[0\]\[5\] is not a finite number/);
+    await bad(id, { rois: [[0, 0, 2, 1, 1, 1]] }, /rois\[0\]: its minimum 2 lies above its maximum 1 on axis z/);
+    await bad(id, { templates: Array(65).fill([0, 0, 0, 1, 1, 1]) }, /at most 64/);
+    await bad(id, { auto: 'no' }, /"auto" takes true or false/);
+    await bad(id, { colour: 1 }, /"colour" is not an option of proceduralize/);
+    await bad(mesh.id, { templates: [[0, 0, 0, 1, 1, 1]] }, /is a mesh; templates, rois and auto are options of point clouds/);
+    await bad(mesh.id, { colour: 1 }, /"colour" is not an option of proceduralize/);
+    assert.equal((await http(d, 'GET', `/api/v1/models/${id}`)).json.version, 1);
+  });
+
+  it('the proceduralize job finds the template\'s copies and stores tree, grammar and terminals', async () => {
+    const W = await WsClient.open(d.wsUrl);
+    try {
+      const r = await http(d, 'POST', `/api/v1/models/${id}/proceduralize`, { body: { templates: [box6(windowBox(2))], auto: false } });
+      assert.equal(r.status, 202, r.text);
+      W.send({ type: 'watch', job: r.json.id });
+      const done = await W.next((m) => m.type === 'job.done' && m.job === r.json.id, 120000, 'job.done');
+      assert.equal(done.status, 'succeeded', JSON.stringify(done));
+      assert.deepEqual(Object.keys(done.result).sort(), ['grammar', 'href', 'model', 'tree', 'version']);
+      assert.equal(done.result.version, 2);
+      const stages = new Set(['start', 'segment', 'repeat', 'absorb', 'consensus', 'tree', 'grammar', 'verify']);
+      let last = 0;
+      for (const p of W.all.filter((m) => m.type === 'job.progress' && m.job === r.json.id)) {
+        assert.ok(p.progress >= last && p.progress <= 1, JSON.stringify(p));
+        if (p.stage) assert.ok(stages.has(p.stage), `stage ${p.stage}`);
+        last = p.progress;
+      }
+    } finally {
+      await W.close();
+    }
+    const t = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
+    assert.equal(t.version, 2);
+    assert.equal(t.summary.kind, 'pointcloud');
+    for (const s of ['segment', 'repeat', 'absorb', 'consensus', 'tree', 'grammar', 'verify', 'total']) assert.equal(typeof t.summary.seconds[s], 'number', s);
+    assert.equal(t.summary.repetition.templates[0].matches, 10, JSON.stringify(t.summary.repetition));
+    assert.ok(t.summary.completion.some((c) => c.members === 10), JSON.stringify(t.summary.completion));
+    assert.ok(t.summary.fidelity.coverage >= 0.97, JSON.stringify(t.summary.fidelity));
+    // the tree's boxes are in the cloud's coordinates: the root holds the building
+    const root = t.nodes[t.root];
+    assert.ok(Math.abs(root.box[0] - ORIGIN[0]) < 0.1 && Math.abs(root.box[3] - ORIGIN[0] - 16) < 0.1, JSON.stringify(root.box));
+    // the grammar names PLY terminals; the log has the proceduralization
+    const g = await http(d, 'GET', `/api/v1/models/${id}/grammar`);
+    assert.equal(g.status, 200);
+    assert.ok([...g.text.matchAll(/"terminals\/[0-9a-f]{16}\.ply"/g)].length >= 5, g.text.slice(0, 400));
+    const log = (await http(d, 'GET', `/api/v1/models/${id}/ops`)).json.items;
+    assert.equal(log.at(-1).op.kind, 'proceduralize');
+    assert.equal(log.at(-1).op.input, 'pointcloud');
+    // the derived cloud: the input's windows, at its density
+    const c = await derived();
+    assert.ok(c.n > 55000 && c.n < 66000, String(c.n));
+    assert.ok('label' in c.props && 'segment' in c.props);
+    assert.equal(countWindows(c), 10);
+    const i = absolute(input.bytes), a = densities(i, 16, 10), b = densities(c, 16, 10);
+    within(b.wall, a.wall, 0.1, 'the front wall derived');
+    within(b.glass, a.glass, 0.1, 'the glass derived');
+    // an ETag that names the state
+    const again = await http(d, 'GET', `/api/v1/models/${id}/derived.ply`, { headers: { 'If-None-Match': (await http(d, 'GET', `/api/v1/models/${id}/derived.ply`)).headers.get('etag') } });
+    assert.equal(again.status, 304);
+  });
+
+  it('a resize doubling the front doubles its windows at the input density; undo and redo over the websocket', async () => {
+    const t = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
+    const front = t.nodes.find((nd) => nd.kind === 'component' && nd.box[3] - nd.box[0] > 14 &&
+      nd.box[4] - nd.box[1] < 0.6 && Math.abs(nd.box[1] - ORIGIN[1]) < 0.2 && nd.box[5] - nd.box[2] > 6);
+    assert.ok(front, 'a front wall node');
+    const box = [...front.box];
+    box[3] = box[0] + 2 * (box[3] - box[0]);
+    const before = await state();
+    const c0 = await derived();
+    const A = await WsClient.open(d.wsUrl), B = await WsClient.open(d.wsUrl);
+    try {
+      await A.request({ type: 'hello', model: id, user: 'ana' }, 'welcome');
+      await B.request({ type: 'hello', model: id, user: 'bo' }, 'welcome');
+      let version = before.version;
+      const send = async (cid, op) => {
+        const seen = B.next((m) => m.type === 'op' && m.cid === cid, 120000, `${cid} at the other client`);
+        const reply = await A.request({ type: 'op', base: version, cid, op }, (m) => (m.type === 'ack' || m.type === 'nack') && m.cid === cid, 120000);
+        assert.equal(reply.type, 'ack', JSON.stringify(reply));
+        const other = await seen;
+        assert.equal(other.version, reply.version);
+        version = reply.version;
+        return other;
+      };
+      const r = await send('wide-1', { kind: 'resize', node: front.id, box });
+      assert.equal(r.op.kind, 'resize');
+      assert.ok(r.op.report.equations > 0 && r.op.report.placements > 80, JSON.stringify(r.op.report));
+      const w = await derived();
+      assert.equal(countWindows(w), 20);
+      const a = densities(absolute(input.bytes), 16, 10), b = densities(w, 32, 20);
+      within(b.wall, a.wall, 0.1, 'the doubled front wall');
+      within(b.glass, a.glass, 0.1, 'the doubled windows\' glass');
+      let far = 0;
+      for (let i = 0; i < w.n; i++) far += w.props.x[i] - ORIGIN[0] > 32.5;
+      assert.ok(far < 0.01 * w.n, `${far} points past x = 32.5`);
+      const wideTree = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
+      assert.equal(wideTree.version, version);
+      assert.ok(Math.abs(wideTree.nodes[wideTree.root].box[3] - ORIGIN[0] - 32) < 0.1, JSON.stringify(wideTree.nodes[wideTree.root].box));
+      const wideGrammar = (await http(d, 'GET', `/api/v1/models/${id}/grammar`)).text;
+      // bo has nothing of his own to undo; ana's undo brings the model back exactly
+      const bo = await B.request({ type: 'op', base: version, cid: 'bo-undo', op: { kind: 'undo' } }, (m) => m.cid === 'bo-undo', 60000);
+      assert.equal(bo.type, 'nack');
+      assert.equal(bo.problem.type, `${PROBLEM}undo-conflict`);
+      const u = await send('undo-1', { kind: 'undo' });
+      assert.equal(u.op.kind, 'restore');
+      assert.equal((await http(d, 'GET', `/api/v1/models/${id}/grammar`)).text, before.grammar);
+      const back = await derived();
+      assert.equal(back.n, c0.n);
+      assert.deepEqual(back.props.x, c0.props.x);
+      assert.equal(countWindows(back), 10);
+      assert.deepEqual((await http(d, 'GET', `/api/v1/models/${id}/tree`)).json.nodes, t.nodes);
+      await send('redo-1', { kind: 'redo' });
+      assert.equal((await http(d, 'GET', `/api/v1/models/${id}/grammar`)).text, wideGrammar);
+      assert.equal(countWindows(await derived()), 20);
+      await send('undo-2', { kind: 'undo' });
+      assert.equal((await http(d, 'GET', `/api/v1/models/${id}/grammar`)).text, before.grammar);
+    } finally {
+      await A.close();
+      await B.close();
+    }
+    // the log: the resize with its report, the undo and redo as restores
+    const log = (await http(d, 'GET', `/api/v1/models/${id}/ops`)).json.items.slice(-4);
+    assert.deepEqual(log.map((e) => [e.op.kind, e.author]), [['resize', 'ana'], ['restore', 'ana'], ['restore', 'ana'], ['restore', 'ana']]);
+    assert.ok(log[0].op.report.unknowns > 0);
+  });
+
+  it('a paste over REST copies another model\'s window onto a window; bad ops get problems and store nothing', async () => {
+    // a second point model to paste into: the same building, proceduralized automatically
+    const q = new URLSearchParams({ name: 'house 2', format: 'ply' });
+    const up = await waitJob(d, (await http(d, 'POST', `/api/v1/models?${q}`, { body: input.bytes, headers: { 'Content-Type': 'application/octet-stream' }, timeout: 120000 })).json.id, { timeout: 120000 });
+    const other = up.result.model;
+    const pj = await waitJob(d, (await http(d, 'POST', `/api/v1/models/${other}/proceduralize`, { body: {} })).json.id, { timeout: 120000 });
+    assert.equal(pj.status, 'succeeded', JSON.stringify(pj.error));
+    const t = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
+    // a window of model id (window 0) pasted over window 1
+    const glassOf = (tree, w) => tree.nodes.find((nd) => nd.kind === 'component' && nd.box &&
+      Math.abs((nd.box[0] + nd.box[3]) / 2 - (WIN[w][0] + 0.6 + ORIGIN[0])) < 0.2 &&
+      Math.abs((nd.box[2] + nd.box[5]) / 2 - (WIN[w][1] + 0.75 + ORIGIN[2])) < 0.2 &&
+      nd.box[3] - nd.box[0] < 2 && nd.box[5] - nd.box[2] < 2.2 && nd.box[4] - ORIGIN[1] < 0.6);
+    const src = glassOf(t, 0), dst = glassOf(t, 1);
+    assert.ok(src && dst, 'window nodes');
+    const before = await state();
+    const post = (op, headers = { 'If-Match': `"${before.version}"` }) => http(d, 'POST', `/api/v1/models/${id}/ops`, { body: { op }, headers, timeout: 60000 });
+    // refused, naming what is wrong, and nothing is stored
+    assertProblem(await post({ kind: 'resize', node: 99999, scale: [2, 1, 1] }), 404, 'not-found', 'an unknown node');
+    let r = await post({ kind: 'resize', node: src.id, box: [0, 0, 0, -1, 1, 1] });
+    assertProblem(r, 400, 'invalid', 'a box upside down');
+    r = await post({ kind: 'paste', source: [src.id], target: dst.id, source_model: mesh.id });
+    assertProblem(r, 409, 'conflict', 'a paste from a mesh');
+    assert.match(r.json.detail, /source_model: model \d+ is not a point cloud/);
+    r = await post({ kind: 'paste', source: [src.id], target: dst.id, source_model: 987654 });
+    assertProblem(r, 404, 'not-found', 'a paste from nowhere');
+    assert.match(r.json.detail, /source_model: there is no model 987654/);
+    r = await post({ kind: 'paste', source: [src.id], target: dst.id, source_dir: '../x' });
+    assertProblem(r, 400, 'invalid', 'a folder');
+    assertProblem(await post({ kind: 'resize', node: src.id, scale: [2, 1, 1] }, { 'If-Match': '"1"' }), 412, null, 'a stale version');
+    assert.deepEqual(await state(), before);
+    assert.deepEqual(sql(d.db, 'PRAGMA integrity_check'), [['ok']]);
+    // a paste from the other model: its window onto this one's
+    const ot = (await http(d, 'GET', `/api/v1/models/${other}/tree`)).json;
+    const osrc = glassOf(ot, 0);
+    assert.ok(osrc, 'a window node of the other model');
+    r = await post({ kind: 'paste', source: [osrc.id], target: dst.id, source_model: other, placement: 'replace' });
+    assert.equal(r.status, 200, r.text);
+    const log = (await http(d, 'GET', `/api/v1/models/${id}/ops`)).json.items.at(-1);
+    assert.equal(log.op.kind, 'paste');
+    assert.equal(log.op.report.source_version, 2);
+    const c = await derived();
+    assert.equal(countWindows(c), 10);
+    const a = densities(absolute(input.bytes), 16, 10), b = densities(c, 16, 10);
+    within(b.glass, a.glass, 0.1, 'the glass after the paste');
+  });
+});
