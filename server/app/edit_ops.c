@@ -288,23 +288,34 @@ ag_status ag_edit_ops_preview(const ag_store_env *env, int64_t model, int64_t ba
     ag_status s = ag_edit_op_json_from(op, &e, err);
     if (s != AG_OK)
         return s;
-    ag_edit_state *st = NULL;
-    if ((s = ag_edit_session_acquire(env->sessions, env->db, model, &st, err)) != AG_OK) {
-        ag_edit_op_clear(&e);
-        return s;
-    }
     ag_box *solved = NULL;
     ag_edit_report rep = {0};
-    if (base != st->version)
-        s = ag_error_set(err, AG_ERR_STALE, (long)st->version,
-                         "model %lld is at version %lld, not %lld", (long long)model,
-                         (long long)st->version, (long long)base);
-    if (s == AG_OK && (s = ag_model_tree_check_node(st->em, e.node, "node", err)) == AG_OK)
-        s = ag_edit_preview(st->em, &e, &solved, &rep, err);
+    ag_edit_state *st = NULL;
+    ag_pointmodel *pm = NULL;
+    const ag_splittree *t = NULL;
+    double offset[3] = {0, 0, 0}; /* a point model's boxes are solved local to its offset */
+    int cloud = 0;
+    s = ag_cloud_pipeline_is_cloud(env->db, model, &cloud, err);
+    if (s == AG_OK && cloud) {
+        if ((s = ag_store_ws_points_preview(env, model, base, &e, &pm, &solved, &rep, err)) ==
+            AG_OK) {
+            t = pm->em->proc->tree;
+            memcpy(offset, pm->offset, sizeof offset);
+        }
+    } else if (s == AG_OK &&
+               (s = ag_edit_session_acquire(env->sessions, env->db, model, &st, err)) == AG_OK) {
+        if (base != st->version)
+            s = ag_error_set(err, AG_ERR_STALE, (long)st->version,
+                             "model %lld is at version %lld, not %lld", (long long)model,
+                             (long long)st->version, (long long)base);
+        if (s == AG_OK && (s = ag_model_tree_check_node(st->em, e.node, "node", err)) == AG_OK)
+            s = ag_edit_preview(st->em, &e, &solved, &rep, err);
+        if (s == AG_OK)
+            t = st->em->proc->tree;
+    }
     json_t *list = s == AG_OK ? json_array() : NULL;
     if (s == AG_OK && !list)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    const ag_splittree *t = s == AG_OK ? st->em->proc->tree : NULL;
     double eps = t ? 1e-9 * fmax(1.0, ag_box_diagonal(&t->nodes[0].box)) : 0;
     for (size_t n = 0; s == AG_OK && n < t->nnodes; n++) {
         if (t->nodes[n].kind == AG_NODE_DEAD)
@@ -316,8 +327,9 @@ ag_status ag_edit_ops_preview(const ag_store_env *env, int64_t model, int64_t ba
         if (d <= eps)
             continue;
         json_array_append_new(list, json_pack("{s:I, s:[f,f,f,f,f,f]}", "node", (json_int_t)n,
-                                              "box", b->min[0], b->min[1], b->min[2], b->max[0],
-                                              b->max[1], b->max[2]));
+                                              "box", b->min[0] + offset[0], b->min[1] + offset[1],
+                                              b->min[2] + offset[2], b->max[0] + offset[0],
+                                              b->max[1] + offset[1], b->max[2] + offset[2]));
     }
     if (s == AG_OK) {
         *boxes = list;
@@ -325,7 +337,9 @@ ag_status ag_edit_ops_preview(const ag_store_env *env, int64_t model, int64_t ba
     } else {
         json_decref(list);
     }
-    ag_edit_session_release(env->sessions, st);
+    if (st)
+        ag_edit_session_release(env->sessions, st);
+    ag_pointmodel_free(pm);
     free(solved);
     ag_edit_report_clear(&rep);
     ag_edit_op_clear(&e);

@@ -98,6 +98,13 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, struct ag_points_state *st,
 ag_status ag_store_ws_read_point_model(ag_db *db, int64_t model, const char *field,
                                        struct ag_pointmodel **pm, int64_t *version,
                                        ag_error *err);
+/* A live drag of a point model (app/edit_ops.h): its model at base read (AG_ERR_STALE
+ * otherwise) and op's resize solved (ag_edit_preview on the point model's proxy, op's boxes
+ * in the cloud's coordinates); *pm (the caller frees it) numbers the nodes of *solved, which
+ * are local to pm->offset. */
+ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int64_t base,
+                                     const ag_edit_op *op, struct ag_pointmodel **pm,
+                                     ag_box **solved, ag_edit_report *rep, ag_error *err);
 /* Keeps st's edit model (taken) as the model's edit session at version. */
 void ag__store_ws_keep_model(ag_edit_sessions *reg, int64_t model, int64_t version,
                              ag_model_state *st);

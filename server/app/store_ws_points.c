@@ -261,3 +261,45 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
     ag_points_state_clear(st);
     return s;
 }
+
+/* ---- live drag ------------------------------------------------------------------------------ */
+
+ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int64_t base,
+                                     const ag_edit_op *op, ag_pointmodel **pm, ag_box **solved,
+                                     ag_edit_report *rep, ag_error *err)
+{
+    *pm = NULL;
+    *solved = NULL;
+    /* held, so a preview waits for an edit of the model being committed */
+    ag_edit_state *held = NULL;
+    ag_status s = ag_edit_session_hold(env->sessions, model, &held, err);
+    if (s != AG_OK)
+        return s;
+    int64_t version = 0;
+    if ((s = ag_pointclouds_read_begin(env->db, err)) == AG_OK) {
+        s = ag_store_ws_read_point_model(env->db, model, "", pm, &version, err);
+        ag_pointclouds_read_end(env->db);
+    }
+    if (s == AG_OK && version != base)
+        s = ag_error_set(err, AG_ERR_STALE, (long)version, "model %lld is at version %lld, not %lld",
+                         (long long)model, (long long)version, (long long)base);
+    if (s == AG_OK)
+        s = ag_model_tree_check_node((*pm)->em, op->node, "node", err);
+    if (s == AG_OK) {
+        /* the op's box in the model's local frame, as the edit use case moves it */
+        ag_edit_op local = *op;
+        for (int a = 0; a < 3; a++) {
+            local.box.min[a] -= (*pm)->offset[a];
+            local.box.max[a] -= (*pm)->offset[a];
+            local.region.min[a] -= (*pm)->offset[a];
+            local.region.max[a] -= (*pm)->offset[a];
+        }
+        s = ag_edit_preview((*pm)->em, &local, solved, rep, err);
+    }
+    ag_edit_session_release(env->sessions, held);
+    if (s != AG_OK) {
+        ag_pointmodel_free(*pm);
+        *pm = NULL;
+    }
+    return s;
+}

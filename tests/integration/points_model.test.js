@@ -1,7 +1,7 @@
 // Point clouds proceduralized and edited in the service, as meshes are: the proceduralize job on
 // a pointcloud model (progress by stage, a template's copies found), GET …/tree and …/grammar,
 // GET …/derived.ply (the cloud the grammar derives), resize and paste ops over REST and the
-// websocket (broadcast, logged with their report, undone and redone by their author), with the
+// websocket (with live drag previews) (broadcast, logged with their report, undone and redone by their author), with the
 // density kept. The checks are the test's own: windows are counted and densities measured on
 // the derived points (points_building.js), never taken from archgram's report.
 import assert from 'node:assert/strict';
@@ -169,6 +169,17 @@ describe('point models in the service', () => {
         version = reply.version;
         return other;
       };
+      // a live drag: the solved boxes reach the other client, in the cloud's coordinates
+      const shown = B.next((m) => m.type === 'preview', 60000, 'the preview at the other client');
+      A.send({ type: 'preview', model: id, base: version, op: { kind: 'resize', node: front.id, box } });
+      const pv = await shown;
+      assert.equal(pv.author, 'ana');
+      const moved = pv.boxes.find((b) => b.node === front.id);
+      assert.ok(moved && Math.abs(moved.box[3] - box[3]) < 0.05, JSON.stringify(pv.boxes.slice(0, 5)));
+      assert.ok(pv.boxes.length > 1, 'the neighbours move with it');
+      const stale = await A.request({ type: 'preview', model: id, base: version - 1, op: { kind: 'resize', node: front.id, box } }, (m) => m.type === 'preview.error', 60000);
+      assert.equal(stale.version, version);
+      A.send({ type: 'preview.end' });
       const r = await send('wide-1', { kind: 'resize', node: front.id, box });
       assert.equal(r.op.kind, 'resize');
       assert.ok(r.op.report.equations > 0 && r.op.report.placements > 80, JSON.stringify(r.op.report));
