@@ -22,7 +22,7 @@ static double now(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-static void blame(ag_folder_ws *w, const char *file)
+void ag__folder_ws_blame(ag_folder_ws *w, const char *file)
 {
     snprintf(w->blame, sizeof w->blame, "%s", file ? file : "");
     w->blamed = 1;
@@ -42,8 +42,8 @@ int ag_folder_ws_make_dirs(const char *dir)
     return mkdir(p, 0777) && errno != EEXIST ? -1 : 0;
 }
 
-static ag_status write_file(ag_folder_ws *w, const char *path, const char *data, size_t len,
-                            ag_error *err)
+ag_status ag__folder_ws_write_file(ag_folder_ws *w, const char *path, const char *data,
+                                   size_t len, ag_error *err)
 {
     FILE *f = fopen(path, "wb");
     int ok = f && fwrite(data, 1, len, f) == len;
@@ -52,16 +52,16 @@ static ag_status write_file(ag_folder_ws *w, const char *path, const char *data,
         ok = 0, e = errno;
     if (ok)
         return AG_OK;
-    blame(w, NULL);
+    ag__folder_ws_blame(w, NULL);
     return ag_error_set(err, AG_ERR_IO, 0, "cannot write %s: %s", path, strerror(e));
 }
 
-static ag_status write_json(ag_folder_ws *w, const char *path, json_t *j, size_t flags,
-                            ag_error *err)
+ag_status ag__folder_ws_write_json(ag_folder_ws *w, const char *path, json_t *j, size_t flags,
+                                   ag_error *err)
 {
     if (j && json_dump_file(j, path, flags) == 0)
         return AG_OK;
-    blame(w, NULL);
+    ag__folder_ws_blame(w, NULL);
     return ag_error_set(err, AG_ERR_IO, 0, "cannot write %s", path);
 }
 
@@ -73,7 +73,7 @@ static ag_status input_mesh(ag_workspace *ws, ag_mesh **mesh, ag_error *err)
     double t0 = now();
     ag_mesh_source src = {.path = w->o.mesh_path, .up = w->o.up, .own_file = 1};
     ag_mesh_file file;
-    blame(w, w->o.mesh_path);
+    ag__folder_ws_blame(w, w->o.mesh_path);
     ag_status s = ag_usecase_import_read(&src, NULL, NULL, mesh, &file, err);
     w->input_bytes = file.len;
     w->up = file.up;
@@ -87,7 +87,7 @@ static ag_status read_folder(ag_folder_ws *w, const char *dir, ag_edit_model **e
 {
     char path[4200];
     snprintf(path, sizeof path, "%s/grammar.txt", dir);
-    blame(w, path);
+    ag__folder_ws_blame(w, path);
     ag_grammar *g = NULL;
     ag_mesh *d = NULL;
     long col = 0;
@@ -100,20 +100,40 @@ static ag_status read_folder(ag_folder_ws *w, const char *dir, ag_edit_model **e
     return s;
 }
 
+ag_status ag__folder_ws_source_dir(ag_folder_ws *w, const char *sdir, char *dir, size_t cap,
+                                   ag_error *err)
+{
+    const char *oppath = w->o.op_path ? w->o.op_path : "";
+    const char *slash = strrchr(oppath, '/');
+    if (sdir[0] == '/' || !slash)
+        snprintf(dir, cap, "%s", sdir);
+    else
+        snprintf(dir, cap, "%.*s/%s", (int)(slash - oppath), oppath, sdir);
+    ag__folder_ws_blame(w, oppath);
+    struct stat sb;
+    if (stat(dir, &sb) || !S_ISDIR(sb.st_mode))
+        return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "source_dir: %s is not a folder", dir);
+    return AG_OK;
+}
+
+ag_status ag__folder_ws_check_origin(ag_folder_ws *w, const ag_edit_op_origin *from,
+                                     ag_error *err)
+{
+    if (!from || !from->model)
+        return AG_OK;
+    ag__folder_ws_blame(w, w->o.op_path);
+    return ag_error_set(err, AG_ERR_INVALID, 0,
+                        "source_model: names a model of the service; an op file names the "
+                        "folder to paste from with source_dir");
+}
+
 /* The folder a paste copies from ("source_dir", relative to the op file's folder). */
 static ag_status read_source(ag_folder_ws *w, const char *sdir, ag_error *err)
 {
     char dir[4096], path[4200];
-    const char *oppath = w->o.op_path ? w->o.op_path : "";
-    const char *slash = strrchr(oppath, '/');
-    if (sdir[0] == '/' || !slash)
-        snprintf(dir, sizeof dir, "%s", sdir);
-    else
-        snprintf(dir, sizeof dir, "%.*s/%s", (int)(slash - oppath), oppath, sdir);
-    blame(w, oppath);
-    struct stat sb;
-    if (stat(dir, &sb) || !S_ISDIR(sb.st_mode))
-        return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "source_dir: %s is not a folder", dir);
+    ag_status s = ag__folder_ws_source_dir(w, sdir, dir, sizeof dir, err);
+    if (s != AG_OK)
+        return s;
     snprintf(path, sizeof path, "%s/grammar.txt", dir);
     if (access(path, R_OK))
         return ag_error_set(err, AG_ERR_NOT_PROCEDURALIZED, 0,
@@ -129,14 +149,10 @@ static ag_status open_models(ag_workspace *ws, const ag_edit_op_origin *from, ag
     ag_folder_ws *w = (ag_folder_ws *)ws;
     (void)source_version;
     ag_status s = read_folder(w, w->o.in_dir, &w->em, err);
+    if (s == AG_OK)
+        s = ag__folder_ws_check_origin(w, from, err);
     if (s != AG_OK)
         return s;
-    if (from && from->model) {
-        blame(w, w->o.op_path);
-        return ag_error_set(err, AG_ERR_INVALID, 0,
-                            "source_model: names a model of the service; an op file names the "
-                            "folder to paste from with source_dir");
-    }
     if (from && from->dir && (s = read_source(w, from->dir, err)) != AG_OK)
         return s;
     *em = w->em;
@@ -148,34 +164,56 @@ static ag_status open_models(ag_workspace *ws, const ag_edit_op_origin *from, ag
 
 /* --- writing --------------------------------------------------------------------------- */
 
+ag_status ag__folder_ws_make_out(ag_folder_ws *w, int terminals, ag_error *err)
+{
+    const char *dir = w->o.out_dir;
+    char path[4200];
+    if (ag_folder_ws_make_dirs(dir)) {
+        ag__folder_ws_blame(w, NULL);
+        return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", dir, strerror(errno));
+    }
+    if (terminals) {
+        snprintf(path, sizeof path, "%s/terminals", dir);
+        if (ag_folder_ws_make_dirs(path)) {
+            ag__folder_ws_blame(w, dir);
+            return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", path, strerror(errno));
+        }
+    }
+    return AG_OK;
+}
+
+json_t *ag__folder_ws_tree_figures(const ag_splittree *t)
+{
+    ag_splittree_stats ts = ag_splittree_stats_of(t);
+    return json_pack("{s:I, s:I, s:I, s:I, s:I}", "nodes", (json_int_t)ts.nodes, "visible",
+                     (json_int_t)ts.visible, "invisible", (json_int_t)ts.invisible, "depth",
+                     (json_int_t)ts.depth, "adjacent_pairs", (json_int_t)t->nadj);
+}
+
+ag_status ag__folder_ws_write_grammar(ag_folder_ws *w, const char *text, size_t len,
+                                      const ag_terminal_set *terms, ag_error *err)
+{
+    const char *dir = w->o.out_dir;
+    char path[4200];
+    ag_status s = ag__folder_ws_make_out(w, terms->n != 0, err);
+    for (size_t i = 0; s == AG_OK && i < terms->n; i++) {
+        snprintf(path, sizeof path, "%s/%s", dir, terms->path[i]);
+        s = ag__folder_ws_write_file(w, path, terms->obj[i], terms->len[i], err);
+    }
+    snprintf(path, sizeof path, "%s/grammar.txt", dir);
+    return s == AG_OK ? ag__folder_ws_write_file(w, path, text, len, err) : s;
+}
+
 /* grammar.txt, terminals/ and tree.json of st. */
 static ag_status write_model(ag_folder_ws *w, const ag_model_state *st, ag_error *err)
 {
     const char *dir = w->o.out_dir;
     char path[4200];
-    if (ag_folder_ws_make_dirs(dir)) {
-        blame(w, NULL);
-        return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", dir, strerror(errno));
-    }
-    if (st->terms.n) {
-        snprintf(path, sizeof path, "%s/terminals", dir);
-        if (ag_folder_ws_make_dirs(path)) {
-            blame(w, dir);
-            return ag_error_set(err, AG_ERR_IO, 0, "cannot create %s: %s", path, strerror(errno));
-        }
-    }
-    ag_status s = AG_OK;
-    for (size_t i = 0; s == AG_OK && i < st->terms.n; i++) {
-        snprintf(path, sizeof path, "%s/%s", dir, st->terms.path[i]);
-        s = write_file(w, path, st->terms.obj[i], st->terms.len[i], err);
-    }
-    snprintf(path, sizeof path, "%s/grammar.txt", dir);
-    if (s == AG_OK)
-        s = write_file(w, path, st->text, st->text_len, err);
+    ag_status s = ag__folder_ws_write_grammar(w, st->text, st->text_len, &st->terms, err);
     snprintf(path, sizeof path, "%s/tree.json", dir);
     json_t *tree = s == AG_OK ? ag_model_tree_folder(st->em) : NULL;
     if (s == AG_OK) /* the served tree's precision (model_tree.c) */
-        s = write_json(w, path, tree, JSON_INDENT(1) | JSON_REAL_PRECISION(15), err);
+        s = ag__folder_ws_write_json(w, path, tree, JSON_INDENT(1) | JSON_REAL_PRECISION(15), err);
     json_decref(tree);
     return s;
 }
@@ -264,14 +302,7 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
     }
     json_object_set_new(j, "components", jc);
 
-    ag_splittree_stats ts = ag_splittree_stats_of(r->tree);
-    json_t *jt = json_object();
-    json_object_set_new(jt, "nodes", json_integer((json_int_t)ts.nodes));
-    json_object_set_new(jt, "visible", json_integer((json_int_t)ts.visible));
-    json_object_set_new(jt, "invisible", json_integer((json_int_t)ts.invisible));
-    json_object_set_new(jt, "depth", json_integer((json_int_t)ts.depth));
-    json_object_set_new(jt, "adjacent_pairs", json_integer((json_int_t)r->tree->nadj));
-    json_object_set_new(j, "tree", jt);
+    json_object_set_new(j, "tree", ag__folder_ws_tree_figures(r->tree));
     json_object_set_new(j, "rules", json_integer((json_int_t)r->grammar->nrules));
     json_object_set_new(j, "terminals", json_integer((json_int_t)r->grammar->nterminals));
 
@@ -341,14 +372,14 @@ static ag_status open_part(ag_workspace *ws, const ag_part_ref *ref, const ag_pa
 {
     ag_folder_ws *w = (ag_folder_ws *)ws;
     if (!ref->path) {
-        blame(w, "");
+        ag__folder_ws_blame(w, "");
         return ag_error_set(err, AG_ERR_INVALID, 0,
                             "a folder composes a part from a bundle file; name one");
     }
     if (!w->parts) {
         ag_status s = ag_part_bundle_read_file(ref->path, &w->parts, &w->nparts, err);
         if (s != AG_OK) {
-            blame(w, ref->path);
+            ag__folder_ws_blame(w, ref->path);
             if (err)
                 err->element = 0; /* the message names the place in the bundle */
             return s;
@@ -359,7 +390,7 @@ static ag_status open_part(ag_workspace *ws, const ag_part_ref *ref, const ag_pa
         if (ref->name ? !strcmp(w->parts[i]->name, ref->name) : w->nparts == 1)
             found = w->parts[i];
     if (!found) {
-        blame(w, ref->path);
+        ag__folder_ws_blame(w, ref->path);
         if (ref->name)
             return ag_error_set(err, AG_ERR_NOT_FOUND, 0, "no part named '%s'", ref->name);
         return ag_error_set(err, AG_ERR_INVALID, 0,
@@ -398,7 +429,7 @@ static ag_status save_part(ag_workspace *ws, ag_part *part, const ag_part_outcom
     if (s == AG_OK && !w->o.bundle_out)
         s = ag_error_set(err, AG_ERR_INVALID, 0, "no bundle file to save the part in");
     if (s == AG_OK && (s = ag_part_bundle_write_file(one, 1, w->o.bundle_out, err)) != AG_OK)
-        blame(w, w->o.bundle_out);
+        ag__folder_ws_blame(w, w->o.bundle_out);
     ag_part_free(part);
     return s;
 }
@@ -429,7 +460,7 @@ static ag_status save_composed(ag_workspace *ws, ag_model_state *st, const ag_co
         char path[4200];
         snprintf(path, sizeof path, "%s/summary.json", w->o.out_dir);
         json_t *j = compose_summary(st, o);
-        s = write_json(w, path, j, JSON_INDENT(1) | JSON_REAL_PRECISION(12), err);
+        s = ag__folder_ws_write_json(w, path, j, JSON_INDENT(1) | JSON_REAL_PRECISION(12), err);
         json_decref(j);
     }
     ag_model_state_clear(st);
@@ -447,7 +478,7 @@ static ag_status save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcom
         char path[4200];
         snprintf(path, sizeof path, "%s/summary.json", w->o.out_dir);
         json_t *j = proc ? proc_summary(w, st, proc, write_s) : edit_summary(st, edit);
-        s = write_json(w, path, j,
+        s = ag__folder_ws_write_json(w, path, j,
                        proc ? JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10)
                             : JSON_INDENT(1) | JSON_REAL_PRECISION(12),
                        err);
@@ -463,6 +494,9 @@ static void close_ws(ag_workspace *ws)
     ag_edit_model_free(w->em);
     ag_edit_model_free(w->source);
     w->em = w->source = NULL;
+    ag_pointmodel_free(w->pm);
+    ag_pointmodel_free(w->pm_source);
+    w->pm = w->pm_source = NULL;
     ag_part_bundle_free(w->parts, w->nparts);
     w->parts = NULL;
     w->nparts = 0;
@@ -475,6 +509,9 @@ static const ag_workspace_ops folder_ops = {
     .open_part = open_part,
     .save_part = save_part,
     .save_composed = save_composed,
+    .input_cloud = ag__folder_ws_input_cloud,
+    .open_point_models = ag__folder_ws_open_point_models,
+    .save_points = ag__folder_ws_save_points,
     .close = close_ws,
     .state_flags = AG_MODEL_READ_BACK,
 };

@@ -5,6 +5,7 @@
 #include "../core/points/proceduralize_cloud.h"
 #include "../core/proc/splittree.h"
 #include "../io/edit_op_json.h"
+#include "folder_ws.h"
 
 static json_t *vec3(const double *v)
 {
@@ -42,14 +43,7 @@ static void model_summary(json_t *j, const ag_points_state *st)
 {
     const ag_pointmodel *pm = st->pm;
     const ag_proceduralize_result *r = pm->em->proc;
-    ag_splittree_stats ts = ag_splittree_stats_of(r->tree);
-    json_t *jt = json_object();
-    json_object_set_new(jt, "nodes", json_integer((json_int_t)ts.nodes));
-    json_object_set_new(jt, "visible", json_integer((json_int_t)ts.visible));
-    json_object_set_new(jt, "invisible", json_integer((json_int_t)ts.invisible));
-    json_object_set_new(jt, "depth", json_integer((json_int_t)ts.depth));
-    json_object_set_new(jt, "adjacent_pairs", json_integer((json_int_t)r->tree->nadj));
-    json_object_set_new(j, "tree", jt);
+    json_object_set_new(j, "tree", ag__folder_ws_tree_figures(r->tree));
     json_object_set_new(j, "terminals", json_integer((json_int_t)pm->nterminals));
     json_object_set_new(j, "placements", json_integer((json_int_t)pm->nplacements));
     json_object_set_new(j, "rules", json_integer((json_int_t)r->grammar->nrules));

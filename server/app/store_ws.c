@@ -141,6 +141,37 @@ ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
     return s;
 }
 
+ag_status ag__store_ws_commit(ag_store_ws *w, ag_seq_txn *t, ag_status s,
+                              ag__store_ws_links links, const json_t *op, ag_error *err)
+{
+    if (s == AG_OK && w->o.job && ag_jobctx_cancelled(w->o.job))
+        s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
+    if (s == AG_OK && w->o.job_id) {
+        char result[400];
+        long long m = (long long)w->o.model;
+        int n = snprintf(result, sizeof result,
+                         "{\"model\":%lld,\"version\":%lld,\"href\":\"/api/v1/models/%lld\"", m,
+                         (long long)t->version, m);
+        if (links == AG__STORE_WS_LINKS_GRAMMAR)
+            snprintf(result + n, sizeof result - (size_t)n,
+                     ",\"tree\":\"/api/v1/models/%lld/tree\",\"grammar\":\"/api/v1/models/%lld/"
+                     "grammar\"}",
+                     m, m);
+        else
+            snprintf(result + n, sizeof result - (size_t)n,
+                     ",\"points\":\"/api/v1/models/%lld/points.glb\"}", m);
+        s = ag_jobs_finish(t->db, w->o.job_id, "succeeded", result, NULL, w->o.model, err);
+    }
+    int64_t v = t->version;
+    if (s == AG_OK)
+        s = ag_sequencer_commit(t, w->o.author, w->o.cid, op, err);
+    else
+        ag_sequencer_abort(t);
+    if (s == AG_OK)
+        w->version = v;
+    return s;
+}
+
 void ag__store_ws_keep_model(ag_edit_sessions *reg, int64_t model, int64_t version,
                              ag_model_state *st)
 {
@@ -254,27 +285,9 @@ static ag_status save_proc(ag_store_ws *w, ag_model_state *st, const ag_proc_out
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
         s = ag_grammars_put_terminal(t.db, w->o.model, st->terms.path[i], st->terms.obj[i],
                                      st->terms.len[i], err);
-    if (s == AG_OK && w->o.job && ag_jobctx_cancelled(w->o.job))
-        s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
-    if (s == AG_OK && w->o.job_id) {
-        char result[320];
-        long long m = (long long)w->o.model;
-        snprintf(result, sizeof result,
-                 "{\"model\":%lld,\"version\":%lld,\"href\":\"/api/v1/models/%lld\","
-                 "\"tree\":\"/api/v1/models/%lld/tree\",\"grammar\":\"/api/v1/models/%lld/"
-                 "grammar\"}",
-                 m, (long long)t.version, m, m, m);
-        s = ag_jobs_finish(t.db, w->o.job_id, "succeeded", result, NULL, w->o.model, err);
-    }
-    int64_t v = t.version;
+    s = ag__store_ws_commit(w, &t, s, AG__STORE_WS_LINKS_GRAMMAR, op, err);
     if (s == AG_OK)
-        s = ag_sequencer_commit(&t, w->o.author, w->o.cid, op, err);
-    else
-        ag_sequencer_abort(&t);
-    if (s == AG_OK) {
-        w->version = v;
-        ag__store_ws_keep_model(w->o.env.sessions, w->o.model, v, st);
-    }
+        ag__store_ws_keep_model(w->o.env.sessions, w->o.model, w->version, st);
     free(summary);
     json_decref(op);
     return s;

@@ -105,6 +105,13 @@ ag_status ag_store_ws_read_point_model(ag_db *db, int64_t model, const char *fie
 ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int64_t base,
                                      const ag_edit_op *op, struct ag_pointmodel **pm,
                                      ag_box **solved, ag_edit_report *rep, ag_error *err);
+/* Ends a save begun with ag_sequencer_begin, with s the status of its writes: a last
+ * cancellation check of a job, the job's success with its result ({"model","version","href"}
+ * and the links of what it made: the tree and grammar, or the points), then op logged and
+ * committed (w->version set) — or everything rolled back. */
+typedef enum { AG__STORE_WS_LINKS_GRAMMAR, AG__STORE_WS_LINKS_POINTS } ag__store_ws_links;
+ag_status ag__store_ws_commit(ag_store_ws *w, ag_seq_txn *t, ag_status s,
+                              ag__store_ws_links links, const json_t *op, ag_error *err);
 /* Keeps st's edit model (taken) as the model's edit session at version. */
 void ag__store_ws_keep_model(ag_edit_sessions *reg, int64_t model, int64_t version,
                              ag_model_state *st);

@@ -217,24 +217,7 @@ ag_status ag__store_ws_save_segmentation(ag_workspace *ws, const ag_cloud_state 
             s = update_stats(t.db, w->o.model, figures, add_normals, err);
         if (s == AG_OK)
             s = ag_states_keep(t.db, w->o.model, t.version, err);
-        if (s == AG_OK && w->o.job && ag_jobctx_cancelled(w->o.job))
-            s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
-        if (s == AG_OK && w->o.job_id) {
-            char result[320];
-            long long m = (long long)w->o.model;
-            snprintf(result, sizeof result,
-                     "{\"model\":%lld,\"version\":%lld,\"href\":\"/api/v1/models/%lld\","
-                     "\"points\":\"/api/v1/models/%lld/points.glb\"}",
-                     m, (long long)t.version, m, m);
-            s = ag_jobs_finish(t.db, w->o.job_id, "succeeded", result, NULL, w->o.model, err);
-        }
-        int64_t v = t.version;
-        if (s == AG_OK)
-            s = ag_sequencer_commit(&t, w->o.author, w->o.cid, body, err);
-        else
-            ag_sequencer_abort(&t);
-        if (s == AG_OK)
-            w->version = v;
+        s = ag__store_ws_commit(w, &t, s, AG__STORE_WS_LINKS_POINTS, body, err);
     }
     json_decref(figures);
     json_decref(body);

@@ -236,25 +236,7 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
             s = put_points_state(t.db, w->o.model, t.version, st, summary, err);
         if (s == AG_OK)
             s = ag_states_keep(t.db, w->o.model, t.version, err);
-        if (s == AG_OK && w->o.job && ag_jobctx_cancelled(w->o.job))
-            s = ag_error_set(err, AG_ERR_CANCELLED, 0, "the job was cancelled");
-        if (s == AG_OK && w->o.job_id) {
-            char result[400];
-            long long m = (long long)w->o.model;
-            snprintf(result, sizeof result,
-                     "{\"model\":%lld,\"version\":%lld,\"href\":\"/api/v1/models/%lld\","
-                     "\"tree\":\"/api/v1/models/%lld/tree\",\"grammar\":\"/api/v1/models/%lld/"
-                     "grammar\"}",
-                     m, (long long)t.version, m, m, m);
-            s = ag_jobs_finish(t.db, w->o.job_id, "succeeded", result, NULL, w->o.model, err);
-        }
-        int64_t v = t.version;
-        if (s == AG_OK)
-            s = ag_sequencer_commit(&t, w->o.author, w->o.cid, body, err);
-        else
-            ag_sequencer_abort(&t);
-        if (s == AG_OK)
-            w->version = v;
+        s = ag__store_ws_commit(w, &t, s, AG__STORE_WS_LINKS_GRAMMAR, body, err);
     }
     json_decref(body);
     free(summary);

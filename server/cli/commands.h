@@ -45,16 +45,14 @@ int ag_cli_cloud_info(const char *file, int as_json);
 int ag_cli_cloud_convert(const char *in, const char *out, int double_xyz);
 
 /* Point models (server/cli/points.c): whether a command line is for a point cloud (a cloud to
- * proceduralize, a point model's folder to edit, a point grammar to derive), and the point
- * branches of those commands. */
+ * proceduralize, a point grammar to derive), and the point branches of those commands
+ * (`archgram edit` of a point model's folder: server/cli/edit.c). */
 typedef enum {
     AG_CLI_POINTS_PROCEDURALIZE,
-    AG_CLI_POINTS_EDIT,
     AG_CLI_POINTS_DERIVE,
 } ag_cli_points_command;
 int ag_cli_points_wanted(int argc, char **argv, ag_cli_points_command cmd);
 int ag_cli_points_proceduralize(int argc, char **argv);
-int ag_cli_points_edit(int argc, char **argv);
 int ag_cli_points_derive(int argc, char **argv);
 /* "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX" (min <= max); 0, or -1 for a bad box. */
 int ag_cli_parse_cloud_box(const char *s, double box[6]);

@@ -1,13 +1,13 @@
-/* Point models in the CLI: the point branches of `archgram proceduralize`, `edit` and
- * `derive`, run when the input is a point cloud, a point model's folder or a point grammar.
+/* Point models in the CLI: the point branches of `archgram proceduralize` and `derive`, run
+ * when the input is a point cloud or a point grammar (`archgram edit` of a point model's folder
+ * is cli/edit.c's, over the same folder workspace).
  *
  *   archgram proceduralize CLOUD --out DIR [--template BOX]... [--roi BOX]... [--no-auto]
  *                          [--threshold F] [--coarse-threshold F] [--json]
- *   archgram edit DIR --op OP.json --out DIR2
  *   archgram derive DIR/grammar.txt --out CLOUD.ply|.las|.xyz [--compare CLOUD] [--double]
  *
- * proceduralize and edit are the use cases of app/usecase_points.h over folders
- * (app/points_folder_ws.h); derive reads the grammar with its PLY terminals and writes the
+ * proceduralize is the use case of app/usecase_points.h over a folder (app/folder_ws.h, its
+ * point operations app/points_folder_ws.h); derive reads the grammar with its PLY terminals and writes the
  * derived cloud in the input's coordinates. BOX is XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX in the cloud's
  * own coordinates. */
 #include <jansson.h>
@@ -68,8 +68,6 @@ int ag_cli_points_wanted(int argc, char **argv, ag_cli_points_command cmd)
     const char *in = positional(argc, argv, plain_flags, 0);
     if (!in)
         return 0;
-    if (cmd == AG_CLI_POINTS_EDIT)
-        return ag_points_folder_is_point_model(in);
     return ag_points_grammar_file_is_points(in);
 }
 
@@ -152,8 +150,8 @@ int ag_cli_points_proceduralize(int argc, char **argv)
     if (!in || !dir)
         return proc_usage(stderr);
     /* boxes are in the cloud's coordinates (the use case moves them to its local frame) */
-    ag_points_folder_ws w;
-    ag_points_folder_ws_init(&w, &(ag_points_folder_ws_options){.cloud_path = in, .out_dir = dir});
+    ag_folder_ws w;
+    ag_folder_ws_init(&w, &(ag_folder_ws_options){.cloud_path = in, .out_dir = dir});
     ag_box templates[MAX_BOXES], rois[MAX_BOXES];
     p.boxes_in_input = 1;
     for (int k = 0; k < nt; k++)
@@ -200,58 +198,6 @@ int ag_cli_points_proceduralize(int argc, char **argv)
                r.fidelity.tolerance, r.total_s);
     }
     return 0;
-}
-
-int ag_cli_points_edit(int argc, char **argv)
-{
-    const char *dir = NULL, *oppath = NULL, *out = NULL;
-    for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--op") && i + 1 < argc)
-            oppath = argv[++i];
-        else if (!strcmp(argv[i], "--out") && i + 1 < argc)
-            out = argv[++i];
-        else if (argv[i][0] == '-' && argv[i][1]) {
-            fprintf(stderr, "archgram: edit: unknown or incomplete option %s\n", argv[i]);
-            return 2;
-        } else if (!dir)
-            dir = argv[i];
-        else
-            return 2;
-    }
-    if (!dir || !oppath || !out) {
-        fputs("usage: archgram edit DIR --op OP.json --out DIR2\n", stderr);
-        return 2;
-    }
-    ag_error err;
-    ag_error_clear(&err);
-    ag_edit_op op;
-    ag_edit_op_origin from;
-    if (ag_edit_op_json_read_file_ex(oppath, &op, &from, &err)) {
-        ag_cli_report(oppath, &err);
-        return 1;
-    }
-    ag_points_folder_ws w;
-    ag_points_folder_ws_init(&w, &(ag_points_folder_ws_options){.in_dir = dir, .op_path = oppath,
-                                                                .out_dir = out});
-    ag_usecase_points_edit_result r;
-    ag_status s = ag_usecase_points_edit_run(&w.ws, &(ag_usecase_points_edit_params){&op, &from},
-                                             &r, &err);
-    ag_workspace_close(&w.ws);
-    if (s != AG_OK) {
-        const char *file = w.blamed                                    ? w.blame
-                           : s == AG_ERR_INVALID || s == AG_ERR_NOT_FOUND ? oppath
-                                                                          : dir;
-        ag_cli_report(file, &err);
-    } else {
-        printf("edit: %zu equations, %zu unknowns, solve %.3f ms, max residual %.3g m, %zu splits, "
-               "%zu joins, %zu placements -> %s\n",
-               r.report.equations, r.report.unknowns, r.report.solve_ms, r.report.max_residual,
-               r.report.splits, r.report.joins, r.placements, out);
-        ag_edit_report_clear(&r.report);
-    }
-    ag_edit_op_clear(&op);
-    ag_edit_op_origin_clear(&from);
-    return s == AG_OK ? 0 : 1;
 }
 
 int ag_cli_points_derive(int argc, char **argv)
