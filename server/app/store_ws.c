@@ -108,6 +108,26 @@ static ag_status encode_mesh(const ag_mesh *mesh, uint8_t **blob, size_t *len, c
     return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory summarising the mesh");
 }
 
+ag_status ag__store_ws_put_grammar(ag_db *db, int64_t model, int64_t version, const void *mesh,
+                                   size_t mesh_len, const char *stats, const char *text,
+                                   size_t text_len, const char *tree_json, const char *summary_json,
+                                   ag_error *err)
+{
+    int64_t mesh_blob = 0;
+    ag_status s = ag_models_set_mesh(db, model, mesh, mesh_len, stats, &mesh_blob, err);
+    if (s != AG_OK)
+        return s;
+    ag_grammar_new g = {.model = model,
+                        .version = version,
+                        .mesh_blob = mesh_blob,
+                        .text = text,
+                        .text_len = text_len,
+                        .tree_json = tree_json,
+                        .tree_numbering = AG_MODEL_TREE_NUMBERING,
+                        .summary_json = summary_json};
+    return ag_grammars_put(db, &g, err);
+}
+
 ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
                                  const ag_model_state *st, const char *summary_json,
                                  ag_error *err)
@@ -119,26 +139,39 @@ ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
     if (s != AG_OK)
         return s;
     char *tree = ag_model_kept_tree_text(st->em); /* a reload gives this model back */
-    int64_t mesh_blob = 0;
     if (!tree)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory describing the model");
     if (s == AG_OK)
-        s = ag_models_set_mesh(db, model, blob, blob_len, stats, &mesh_blob, err);
-    if (s == AG_OK) {
-        ag_grammar_new g = {.model = model,
-                            .version = version,
-                            .mesh_blob = mesh_blob,
-                            .text = st->text,
-                            .text_len = st->text_len,
-                            .tree_json = tree,
-                            .tree_numbering = AG_MODEL_TREE_NUMBERING,
-                            .summary_json = summary_json};
-        s = ag_grammars_put(db, &g, err);
-    }
+        s = ag__store_ws_put_grammar(db, model, version, blob, blob_len, stats, st->text,
+                                     st->text_len, tree, summary_json, err);
     free(tree);
     free(stats);
     free(blob);
     return s;
+}
+
+ag_status ag__store_ws_begin(ag_store_ws *w, const char *doing, int by_client, ag_seq_txn *t,
+                             int *duplicate, ag_error *err)
+{
+    int64_t seen = 0;
+    *duplicate = 0;
+    ag_status s = ag_sequencer_begin(w->o.env.seq, w->o.env.db, w->o.model, w->o.base,
+                                     by_client ? w->o.author : NULL, by_client ? w->o.cid : NULL,
+                                     t, by_client ? &seen : NULL, err);
+    if (s == AG_ERR_STALE && w->o.job)
+        ag_error_set(err, AG_ERR_STALE, err ? err->element : 0,
+                     "model %lld changed while it was being %s (it is at version %ld, the job "
+                     "started from %lld); nothing was stored",
+                     (long long)w->o.model, doing, err ? err->element : 0, (long long)w->o.base);
+    if (s != AG_OK)
+        return s;
+    if (seen) { /* the same op came in meanwhile: answered, not applied again */
+        w->duplicate = *duplicate = 1;
+        w->version = seen;
+    } else {
+        t->origin = w->o.origin;
+    }
+    return AG_OK;
 }
 
 ag_status ag__store_ws_commit(ag_store_ws *w, ag_seq_txn *t, ag_status s,
@@ -265,20 +298,14 @@ static ag_status save_proc(ag_store_ws *w, ag_model_state *st, const ag_proc_out
                            (json_int_t)o->proc->tree->npatterns);
     ag_status s = summary && op ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     ag_seq_txn t;
-    if (s == AG_OK &&
-        (s = ag_sequencer_begin(w->o.env.seq, w->o.env.db, w->o.model, w->o.base, NULL, NULL, &t,
-                                NULL, err)) != AG_OK &&
-        s == AG_ERR_STALE)
-        ag_error_set(err, AG_ERR_STALE, err ? err->element : 0,
-                     "model %lld changed while it was being proceduralized (it is at version "
-                     "%ld, the job started from %lld); nothing was stored",
-                     (long long)w->o.model, err ? err->element : 0, (long long)w->o.base);
+    int dup = 0;
+    if (s == AG_OK)
+        s = ag__store_ws_begin(w, "proceduralized", 0, &t, &dup, err);
     if (s != AG_OK) {
         free(summary);
         json_decref(op);
         return s;
     }
-    t.origin = w->o.origin;
     s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, err);
     if (s == AG_OK)
         s = ag_grammars_clear_terminals(t.db, w->o.model, err);
@@ -299,17 +326,10 @@ static ag_status commit_change(ag_store_ws *w, ag_model_state *st, json_t *body,
                                const char *summary, ag_error *err)
 {
     ag_seq_txn t;
-    int64_t seen = 0;
-    ag_status s = ag_sequencer_begin(w->o.env.seq, w->o.env.db, w->o.model, w->o.base,
-                                     w->o.author, w->o.cid, &t, &seen, err);
-    if (s != AG_OK)
+    int dup = 0;
+    ag_status s = ag__store_ws_begin(w, "edited", 1, &t, &dup, err);
+    if (s != AG_OK || dup)
         return s;
-    if (seen) { /* the same op came in meanwhile: answered, not applied again */
-        w->duplicate = 1;
-        w->version = seen;
-        return AG_OK;
-    }
-    t.origin = w->o.origin;
     s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
     if (s == AG_OK)
         s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, err);

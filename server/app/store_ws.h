@@ -63,6 +63,13 @@ ag_status ag_store_ws_insert_model(ag_db *db, const char *name, const ag_mesh *m
                                    const void *source, size_t source_len,
                                    const char *source_format, int64_t *model, ag_error *err);
 
+/* A model state's mesh file (the model's mesh and stats from now on) and the grammar that
+ * describes it, with its stored tree (numbering AG_MODEL_TREE_NUMBERING) and summary, for
+ * `version`, inside the caller's transaction. */
+ag_status ag__store_ws_put_grammar(ag_db *db, int64_t model, int64_t version, const void *mesh,
+                                   size_t mesh_len, const char *stats, const char *text,
+                                   size_t text_len, const char *tree_json, const char *summary_json,
+                                   ag_error *err);
 /* For the store's other writers of model states (a grammar text edit): writes st's mesh (its
  * edit model's mesh, with its stats), grammar text, served tree and summary for `version`
  * inside the caller's transaction. */
@@ -105,7 +112,13 @@ ag_status ag_store_ws_read_point_model(ag_db *db, int64_t model, const char *fie
 ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int64_t base,
                                      const ag_edit_op *op, struct ag_pointmodel **pm,
                                      ag_box **solved, ag_edit_report *rep, ag_error *err);
-/* Ends a save begun with ag_sequencer_begin, with s the status of its writes: a last
+/* Begins a save (ag_sequencer_begin at the workspace's base; by_client: under the client's
+ * author and cid, so a retry is seen): a job's stale model is named as having changed while
+ * it was being `doing`; *duplicate set (and w->duplicate, w->version) when the same op came in
+ * meanwhile: nothing to do, nothing open. */
+ag_status ag__store_ws_begin(ag_store_ws *w, const char *doing, int by_client, ag_seq_txn *t,
+                             int *duplicate, ag_error *err);
+/* Ends a save begun with ag__store_ws_begin, with s the status of its writes: a last
  * cancellation check of a job, the job's success with its result ({"model","version","href"}
  * and the links of what it made: the tree and grammar, or the points), then op logged and
  * committed (w->version set) — or everything rolled back. */

@@ -192,20 +192,10 @@ ag_status ag__store_ws_save_segmentation(ag_workspace *ws, const ag_cloud_state 
     ag_status s = figures && body && summary ? AG_OK
                                              : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     ag_seq_txn t;
-    int64_t seen = 0;
+    int dup = 0;
     if (s == AG_OK)
-        s = ag_sequencer_begin(w->o.env.seq, w->o.env.db, w->o.model, w->o.base, w->o.author,
-                               w->o.cid, &t, &seen, err);
-    if (s == AG_ERR_STALE && w->o.job)
-        ag_error_set(err, AG_ERR_STALE, err ? err->element : 0,
-                     "model %lld changed while it was being segmented (it is at version %ld, "
-                     "the job started from %lld); nothing was stored",
-                     (long long)w->o.model, err ? err->element : 0, (long long)w->o.base);
-    if (s == AG_OK && seen) { /* the same op came in meanwhile: answered, not applied again */
-        w->duplicate = 1;
-        w->version = seen;
-    } else if (s == AG_OK) {
-        t.origin = w->o.origin;
+        s = ag__store_ws_begin(w, "segmented", 1, &t, &dup, err);
+    if (s == AG_OK && !dup) {
         int add_normals = !st->had_normals && st->cloud->normals;
         s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
         if (s == AG_OK && add_normals)

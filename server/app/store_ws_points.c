@@ -152,20 +152,9 @@ static ag_status put_points_state(ag_db *db, int64_t model, int64_t version,
         s = ag_error_set(err, s, 0, "out of memory describing the point model");
     if (s == AG_OK)
         s = current_stats(db, model, &stats, err);
-    int64_t mesh_blob = 0;
     if (s == AG_OK)
-        s = ag_models_set_mesh(db, model, mesh, mesh_len, stats, &mesh_blob, err);
-    if (s == AG_OK) {
-        ag_grammar_new g = {.model = model,
-                            .version = version,
-                            .mesh_blob = mesh_blob,
-                            .text = st->text,
-                            .text_len = st->text_len,
-                            .tree_json = tree_text,
-                            .tree_numbering = AG_MODEL_TREE_NUMBERING,
-                            .summary_json = summary};
-        s = ag_grammars_put(db, &g, err);
-    }
+        s = ag__store_ws_put_grammar(db, model, version, mesh, mesh_len, stats, st->text,
+                                     st->text_len, tree_text, summary, err);
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
         s = ag_grammars_put_terminal(db, model, st->terms.path[i], st->terms.obj[i],
                                      st->terms.len[i], err);
@@ -214,22 +203,11 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
     json_t *body = logged_op(w, st, proc, edit);
     ag_status s = summary && body ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     ag_seq_txn t;
-    int64_t seen = 0;
+    int dup = 0;
     /* a proceduralization is the job's (no client id); an edit is the client's op */
     if (s == AG_OK)
-        s = ag_sequencer_begin(w->o.env.seq, w->o.env.db, w->o.model, w->o.base,
-                               proc ? NULL : w->o.author, proc ? NULL : w->o.cid, &t,
-                               proc ? NULL : &seen, err);
-    if (s == AG_ERR_STALE && proc)
-        ag_error_set(err, AG_ERR_STALE, err ? err->element : 0,
-                     "model %lld changed while it was being proceduralized (it is at version "
-                     "%ld, the job started from %lld); nothing was stored",
-                     (long long)w->o.model, err ? err->element : 0, (long long)w->o.base);
-    if (s == AG_OK && seen) { /* the same op came in meanwhile: answered, not applied again */
-        w->duplicate = 1;
-        w->version = seen;
-    } else if (s == AG_OK) {
-        t.origin = w->o.origin;
+        s = ag__store_ws_begin(w, proc ? "proceduralized" : "edited", !proc, &t, &dup, err);
+    if (s == AG_OK && !dup) {
         /* the states around the change, so undo and restore come back to either side */
         s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
         if (s == AG_OK)
