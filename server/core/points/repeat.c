@@ -248,7 +248,6 @@ typedef struct {
     uint32_t *tidx;
     size_t nt;
     double *txyz;         /* their positions relative to nothing (cloud-local) */
-    float *tnorm;
     ag_kdtree *ttree;
     double tau;
     double min_explained, min_covered;
@@ -477,47 +476,253 @@ typedef struct {
     long k1, k2;
 } line_key;
 
+static void matcher_free(matcher *M)
+{
+    free(M->skip);
+    free(M->tidx);
+    free(M->txyz);
+    free(M->cand);
+    free(M->cxyz);
+    ag_kdtree_free(M->ttree);
+    ag__voxel_set_free(&M->tcells);
+    free(M->stamp);
+    memset(M, 0, sizeof *M);
+}
+
+/* A matcher of the template box over c's segmentation r, with its grid (built here) and a
+ * cleared skip mask. */
+static ag_status matcher_init(matcher *M, const ag_cloud *c, const ag_segment_cloud_result *r,
+                              const ag_box *tmpl, const ag_repeat_options *opt, pgrid *grid,
+                              ag_error *err)
+{
+    memset(M, 0, sizeof *M);
+    memset(grid, 0, sizeof *grid);
+    if (r->n != c->n)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "the segmentation is of another cloud");
+    if (ag_box_is_empty(tmpl))
+        return ag_error_set(err, AG_ERR_INVALID, 0, "template: the box is empty");
+    *M = (matcher){.c = c, .r = r, .tmpl = tmpl, .grid = grid};
+    M->min_explained = opt->min_explained > 0 ? opt->min_explained : DEFAULT_MIN_EXPLAINED;
+    M->min_covered = opt->min_covered > 0 ? opt->min_covered : DEFAULT_MIN_COVERED;
+    double spacing = r->spacing > 0 ? r->spacing : 0.01;
+    M->tau = opt->tolerance > 0 ? opt->tolerance : 2 * spacing;
+    double te[3];
+    ag_box_extents(tmpl, te);
+    double tsize = fmax(te[0], fmax(te[1], te[2]));
+    ag_status st = grid_build(grid, c, tsize > 0 ? tsize / 2 : 1, err);
+    if (st == AG_OK && !(M->skip = calloc(c->n ? c->n : 1, 1)))
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    return st;
+}
+
+/* The template matching itself, for both callers: the template (the points in the box that
+ * are the host's when in_host, else those that are not) slid along the host's frame as the
+ * header says. *out gets the matches, the template first (the caller frees them). */
+static ag_status match(matcher *M, int32_t host, int in_host, size_t max_matches,
+                       const ag_repeat_options *opt, ag_repeat_match **out, size_t *nout,
+                       ag_error *err)
+{
+    const ag_cloud *c = M->c;
+    const ag_segment_cloud_result *r = M->r;
+    const ag_box *tmpl = M->tmpl;
+    double spacing = r->spacing > 0 ? r->spacing : 0.01;
+    *out = NULL;
+    *nout = 0;
+    M->host = host;
+    ag_repeat_match *acc = NULL, *tried = NULL;
+    size_t nacc = 0, capacc = 0, ntried = 0, captried = 0;
+    size_t *queue = NULL, qn = 0, capq = 0;
+    line_key *lines = NULL;
+    size_t nlines = 0, caplines = 0;
+    ag_status st = AG_OK;
+    const ag_segment_cloud_item *H = &r->segments[host];
+    for (size_t i = 0; i < c->n; i++)
+        M->skip[i] = in_host ? r->segment[i] != host : r->segment[i] == host;
+    /* the template's own points */
+    if (grid_query(M->grid, c, tmpl, M->skip, &M->cand, &M->ncand, &M->capcand) ||
+        !(M->tidx = malloc((M->ncand ? M->ncand : 1) * sizeof *M->tidx))) {
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        goto done;
+    }
+    M->nt = M->ncand;
+    memcpy(M->tidx, M->cand, M->nt * sizeof *M->tidx);
+    if (M->nt < 8) {
+        st = in_host ? ag_error_set(err, AG_ERR_INVALID, 0,
+                                    "template: the box holds only %zu points of segment %d",
+                                    M->nt, (int)host)
+                     : ag_error_set(err, AG_ERR_INVALID, 0,
+                                    "template: the box holds only %zu points besides its host "
+                                    "plane's (an element flush with its wall cannot be told "
+                                    "from the wall)",
+                                    M->nt);
+        goto done;
+    }
+    if (!(M->txyz = malloc(3 * M->nt * sizeof *M->txyz))) {
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        goto done;
+    }
+    for (size_t j = 0; j < M->nt; j++)
+        memcpy(M->txyz + 3 * j, c->xyz + 3 * (size_t)M->tidx[j], 3 * sizeof *M->txyz);
+    if ((st = ag_kdtree_build(M->txyz, NULL, M->nt, &M->ttree, err)) != AG_OK)
+        goto done;
+    for (int a = 0; a < 3; a++)
+        M->vo[a] = tmpl->min[a] - 1e5 * M->tau;
+    if (ag__voxel_set_init(&M->tcells, M->nt) ||
+        !(M->stamp = calloc(M->nt + 1, sizeof *M->stamp))) {
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        goto done;
+    }
+    for (size_t j = 0; j < M->nt; j++)
+        ag__voxel_set_add(&M->tcells, ag__voxel_key_of(M->txyz + 3 * j, M->vo, M->tau));
+    /* the host's frame, its extent and the template's */
+    memcpy(M->o, H->centroid, sizeof M->o);
+    const uint32_t *hidx = r->members + r->member_start[host];
+    size_t nh = r->member_start[host + 1] - r->member_start[host];
+    for (int a = 0; a < 3; a++) {
+        memcpy(M->e[a], H->axes[a], sizeof M->e[a]);
+        double lo, hi;
+        box_range(tmpl, M->o, M->e[a], &lo, &hi);
+        M->ext[a] = hi - lo;
+        M->q0[a] = 0.5 * (lo + hi);
+        M->step[a] = fmax(AG_POINTS_TEMPLATE_STEP * M->ext[a], 0.5 * spacing);
+        project_range(c, hidx, nh, M->o, M->e[a], &M->lo[a], &M->hi[a]);
+    }
+    /* match 0: the template itself */
+    if (AG_ARRAY_RESERVE(acc, capacc, 1) || AG_ARRAY_RESERVE(queue, capq, 1)) {
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        goto done;
+    }
+    acc[0] = (ag_repeat_match){*tmpl, {0, 0, 0}, 1, 1, M->nt};
+    nacc = 1;
+    queue[qn++] = 0;
+    for (size_t j = 0; j < M->nt; j++)
+        M->skip[M->tidx[j]] = 1;
+    for (size_t qh = 0; qh < qn && st == AG_OK && nacc < max_matches; qh++) {
+        if (opt->progress && opt->progress(opt->user, (double)qh / (double)(qn + 1))) {
+            st = ag_error_set(err, AG_ERR_CANCELLED, 0, "cancelled");
+            break;
+        }
+        double u0[3];
+        frame_of(M, acc[queue[qh]].offset, u0);
+        for (int a = 0; a < 3 && st == AG_OK; a++) {
+            int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
+            line_key key = {a, lround(u0[b1] / M->step[b1]), lround(u0[b2] / M->step[b2])};
+            int seen = 0;
+            for (size_t l = 0; l < nlines && !seen; l++)
+                seen = lines[l].axis == key.axis && lines[l].k1 == key.k1 && lines[l].k2 == key.k2;
+            if (seen)
+                continue;
+            if (AG_ARRAY_RESERVE(lines, caplines, nlines + 1)) {
+                st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+                break;
+            }
+            lines[nlines++] = key;
+            for (int dir = -1; dir <= 1 && st == AG_OK; dir += 2)
+                for (long k = 1;; k++) {
+                    double u[3] = {u0[0], u0[1], u0[2]};
+                    u[a] += dir * k * M->step[a];
+                    /* the moved box's centre stays on the host */
+                    double centre = M->q0[a] + u[a];
+                    if (centre < M->lo[a] - M->step[a] || centre > M->hi[a] + M->step[a])
+                        break;
+                    if (overlaps(M, u, acc, nacc) || overlaps(M, u, tried, ntried))
+                        continue;
+                    double d[3];
+                    for (int x = 0; x < 3; x++)
+                        d[x] = u[0] * M->e[0][x] + u[1] * M->e[1][x] + u[2] * M->e[2][x];
+                    ag_repeat_match m;
+                    size_t before = M->positions;
+                    if (!try_position(M, d, &m, &st, err)) {
+                        if (st != AG_OK)
+                            break;
+                        /* a climb that found nothing: no other climb from around here */
+                        if (M->positions > before + 1) {
+                            if (AG_ARRAY_RESERVE(tried, captried, ntried + 1)) {
+                                st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+                                break;
+                            }
+                            tried[ntried] = (ag_repeat_match){*tmpl, {d[0], d[1], d[2]}, 0, 0, 0};
+                            ntried++;
+                        }
+                        continue;
+                    }
+                    double um[3];
+                    frame_of(M, m.offset, um);
+                    if (overlaps(M, um, acc, nacc))
+                        continue;
+                    if (AG_ARRAY_RESERVE(acc, capacc, nacc + 1) ||
+                        AG_ARRAY_RESERVE(queue, capq, qn + 1)) {
+                        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+                        break;
+                    }
+                    acc[nacc] = m;
+                    for (size_t j = 0; j < M->ncand; j++)
+                        M->skip[M->cand[j]] = 1;
+                    queue[qn++] = nacc++;
+                    if (nacc >= max_matches)
+                        break;
+                }
+        }
+    }
+done:
+    if (st == AG_OK) {
+        *out = acc;
+        *nout = nacc;
+        acc = NULL;
+    }
+    free(acc);
+    free(tried);
+    free(queue);
+    free(lines);
+    return st;
+}
+
+ag_status ag_repeat_in_segment(const ag_cloud *c, const ag_segment_cloud_result *r,
+                               const ag_box *tmpl, int32_t segment, const ag_repeat_options *o,
+                               ag_repeat_match **matches, size_t *nmatches, size_t *positions,
+                               ag_error *err)
+{
+    ag_repeat_options opt = o ? *o : (ag_repeat_options){0};
+    *matches = NULL;
+    *nmatches = 0;
+    *positions = 0;
+    if (segment < 0 || (size_t)segment >= r->nsegments)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "there is no segment %d", (int)segment);
+    matcher M;
+    pgrid grid;
+    ag_status st = matcher_init(&M, c, r, tmpl, &opt, &grid, err);
+    if (st == AG_OK)
+        st = match(&M, segment, 1, opt.max_matches ? opt.max_matches : DEFAULT_MAX_MATCHES, &opt,
+                   matches, nmatches, err);
+    *positions = M.positions;
+    matcher_free(&M);
+    grid_free(&grid);
+    return st;
+}
+
 ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, const ag_box *tmpl,
                              const ag_repeat_options *o, ag_repeat_report *rep, ag_error *err)
 {
     ag_repeat_options opt = o ? *o : (ag_repeat_options){0};
     if (rep)
         memset(rep, 0, sizeof *rep);
-    if (r->n != c->n)
-        return ag_error_set(err, AG_ERR_INVALID, 0, "the segmentation is of another cloud");
-    if (ag_box_is_empty(tmpl))
-        return ag_error_set(err, AG_ERR_INVALID, 0, "template: the box is empty");
     if (!c->normals)
         return ag_error_set(err, AG_ERR_INVALID, 0, "template: the cloud has no normals");
-    matcher M = {.c = c, .r = r, .tmpl = tmpl};
-    M.min_explained = opt.min_explained > 0 ? opt.min_explained : DEFAULT_MIN_EXPLAINED;
-    M.min_covered = opt.min_covered > 0 ? opt.min_covered : DEFAULT_MIN_COVERED;
-    double spacing = r->spacing > 0 ? r->spacing : 0.01;
-    M.tau = opt.tolerance > 0 ? opt.tolerance : 2 * spacing;
     size_t max_matches = opt.max_matches ? opt.max_matches : DEFAULT_MAX_MATCHES;
+    matcher M;
     pgrid grid;
-    double te[3];
-    ag_box_extents(tmpl, te);
-    double tsize = fmax(te[0], fmax(te[1], te[2]));
-    ag_status st = grid_build(&grid, c, tsize > 0 ? tsize / 2 : 1, err);
-    if (st != AG_OK) {
-        grid_free(&grid);
-        return st;
-    }
-    M.grid = &grid;
-    ag_repeat_match *acc = NULL, *tried = NULL;
-    size_t nacc = 0, capacc = 0, ntried = 0, captried = 0;
-    size_t *queue = NULL, qn = 0, capq = 0;
-    line_key *lines = NULL;
-    size_t nlines = 0, caplines = 0;
+    ag_repeat_match *acc = NULL;
+    size_t nacc = 0;
     ag_segment_cloud_spec *spec = NULL;
     size_t *hcount = NULL;
     uint32_t *hidx = NULL;  /* the host's points: in r->members until the rebuild frees it */
     uint32_t *hkept = NULL; /* their copy that outlives the rebuild */
     size_t nh = 0;
-    M.skip = calloc(c->n ? c->n : 1, 1);
-    hcount = calloc(r->nsegments + 1, sizeof *hcount);
-    if (!M.skip || !hcount) {
+    int32_t host = -1;
+    ag_status st = matcher_init(&M, c, r, tmpl, &opt, &grid, err);
+    if (st != AG_OK)
+        goto done;
+    if (!(hcount = calloc(r->nsegments + 1, sizeof *hcount))) {
         st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         goto done;
     }
@@ -533,7 +738,6 @@ ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, cons
     for (size_t j = 0; j < M.ncand; j++)
         if (r->segment[M.cand[j]] >= 0)
             hcount[r->segment[M.cand[j]]]++;
-    M.host = -1;
     for (size_t s = 0; s < r->nsegments; s++) {
         const ag_segment_cloud_item *it = &r->segments[s];
         if (!hcount[s] || it->kind != AG_SEGMENT_CLOUD_PLANE)
@@ -544,148 +748,17 @@ ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, cons
             if (it->extent[a] >= HOST_LARGER * (hi - lo))
                 larger = 1;
         }
-        if (larger && (M.host < 0 || it->count > r->segments[M.host].count))
-            M.host = (int32_t)s;
+        if (larger && (host < 0 || it->count > r->segments[host].count))
+            host = (int32_t)s;
     }
-    if (M.host < 0) {
+    if (host < 0) {
         st = ag_error_set(err, AG_ERR_INVALID, 0,
                           "template: the box crosses no plane larger than itself to slide along");
         goto done;
     }
-    const ag_segment_cloud_item *H = &r->segments[M.host];
-    for (size_t i = 0; i < c->n; i++)
-        M.skip[i] = r->segment[i] == M.host;
-    /* the template's own points */
-    M.nt = 0;
-    M.tidx = malloc(M.ncand * sizeof *M.tidx);
-    if (!M.tidx) {
-        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        goto done;
-    }
-    for (size_t j = 0; j < M.ncand; j++)
-        if (!M.skip[M.cand[j]])
-            M.tidx[M.nt++] = M.cand[j];
-    if (M.nt < 8) {
-        st = ag_error_set(err, AG_ERR_INVALID, 0,
-                          "template: the box holds only %zu points besides its host plane's (an "
-                          "element flush with its wall cannot be told from the wall)",
-                          M.nt);
-        goto done;
-    }
-    M.txyz = malloc(3 * M.nt * sizeof *M.txyz);
-    M.tnorm = malloc(3 * M.nt * sizeof *M.tnorm);
-    if (!M.txyz || !M.tnorm) {
-        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        goto done;
-    }
-    for (size_t j = 0; j < M.nt; j++) {
-        memcpy(M.txyz + 3 * j, c->xyz + 3 * (size_t)M.tidx[j], 3 * sizeof *M.txyz);
-        memcpy(M.tnorm + 3 * j, c->normals + 3 * (size_t)M.tidx[j], 3 * sizeof *M.tnorm);
-    }
-    if ((st = ag_kdtree_build(M.txyz, NULL, M.nt, &M.ttree, err)) != AG_OK)
-        goto done;
-    for (int a = 0; a < 3; a++)
-        M.vo[a] = tmpl->min[a] - 1e5 * M.tau;
-    if (ag__voxel_set_init(&M.tcells, M.nt) || !(M.stamp = calloc(M.nt + 1, sizeof *M.stamp))) {
-        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        goto done;
-    }
-    for (size_t j = 0; j < M.nt; j++)
-        ag__voxel_set_add(&M.tcells, ag__voxel_key_of(M.txyz + 3 * j, M.vo, M.tau));
-    /* the host's frame, its extent and the template's */
-    memcpy(M.o, H->centroid, sizeof M.o);
-    hidx = r->members + r->member_start[M.host];
-    nh = r->member_start[M.host + 1] - r->member_start[M.host];
-    double maxstep = 0;
-    for (int a = 0; a < 3; a++) {
-        memcpy(M.e[a], H->axes[a], sizeof M.e[a]);
-        double lo, hi;
-        box_range(tmpl, M.o, M.e[a], &lo, &hi);
-        M.ext[a] = hi - lo;
-        M.q0[a] = 0.5 * (lo + hi);
-        M.step[a] = fmax(AG_POINTS_TEMPLATE_STEP * M.ext[a], 0.5 * spacing);
-        maxstep = fmax(maxstep, M.step[a]);
-        project_range(c, hidx, nh, M.o, M.e[a], &M.lo[a], &M.hi[a]);
-    }
-    (void)maxstep;
-    /* match 0: the template itself */
-    if (AG_ARRAY_RESERVE(acc, capacc, 1) || AG_ARRAY_RESERVE(queue, capq, 1)) {
-        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        goto done;
-    }
-    acc[0] = (ag_repeat_match){*tmpl, {0, 0, 0}, 1, 1, M.nt};
-    nacc = 1;
-    queue[qn++] = 0;
-    for (size_t j = 0; j < M.nt; j++)
-        M.skip[M.tidx[j]] = 1;
-    for (size_t qh = 0; qh < qn && st == AG_OK && nacc < max_matches; qh++) {
-        if (opt.progress && opt.progress(opt.user, (double)qh / (double)(qn + 1))) {
-            st = ag_error_set(err, AG_ERR_CANCELLED, 0, "cancelled");
-            break;
-        }
-        double u0[3];
-        frame_of(&M, acc[queue[qh]].offset, u0);
-        for (int a = 0; a < 3 && st == AG_OK; a++) {
-            int b1 = (a + 1) % 3, b2 = (a + 2) % 3;
-            line_key key = {a, lround(u0[b1] / M.step[b1]), lround(u0[b2] / M.step[b2])};
-            int seen = 0;
-            for (size_t l = 0; l < nlines && !seen; l++)
-                seen = lines[l].axis == key.axis && lines[l].k1 == key.k1 && lines[l].k2 == key.k2;
-            if (seen)
-                continue;
-            if (AG_ARRAY_RESERVE(lines, caplines, nlines + 1)) {
-                st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-                break;
-            }
-            lines[nlines++] = key;
-            for (int dir = -1; dir <= 1 && st == AG_OK; dir += 2)
-                for (long k = 1;; k++) {
-                    double u[3] = {u0[0], u0[1], u0[2]};
-                    u[a] += dir * k * M.step[a];
-                    /* the moved box's centre stays on the host */
-                    double centre = M.q0[a] + u[a];
-                    if (centre < M.lo[a] - M.step[a] || centre > M.hi[a] + M.step[a])
-                        break;
-                    if (overlaps(&M, u, acc, nacc) || overlaps(&M, u, tried, ntried))
-                        continue;
-                    double d[3];
-                    for (int x = 0; x < 3; x++)
-                        d[x] = u[0] * M.e[0][x] + u[1] * M.e[1][x] + u[2] * M.e[2][x];
-                    ag_repeat_match m;
-                    size_t before = M.positions;
-                    if (!try_position(&M, d, &m, &st, err)) {
-                        if (st != AG_OK)
-                            break;
-                        /* a climb that found nothing: no other climb from around here */
-                        if (M.positions > before + 1) {
-                            if (AG_ARRAY_RESERVE(tried, captried, ntried + 1)) {
-                                st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-                                break;
-                            }
-                            tried[ntried] = (ag_repeat_match){*tmpl, {d[0], d[1], d[2]}, 0, 0, 0};
-                            ntried++;
-                        }
-                        continue;
-                    }
-                    double um[3];
-                    frame_of(&M, m.offset, um);
-                    if (overlaps(&M, um, acc, nacc))
-                        continue;
-                    if (AG_ARRAY_RESERVE(acc, capacc, nacc + 1) ||
-                        AG_ARRAY_RESERVE(queue, capq, qn + 1)) {
-                        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-                        break;
-                    }
-                    acc[nacc] = m;
-                    for (size_t j = 0; j < M.ncand; j++)
-                        M.skip[M.cand[j]] = 1;
-                    queue[qn++] = nacc++;
-                    if (nacc >= max_matches)
-                        break;
-                }
-        }
-    }
-    if (st != AG_OK)
+    hidx = r->members + r->member_start[host];
+    nh = r->member_start[host + 1] - r->member_start[host];
+    if ((st = match(&M, host, 0, max_matches, &opt, &acc, &nacc, err)) != AG_OK)
         goto done;
     /* the matches become elements of one group: the points in each box but the host's */
     int32_t group;
@@ -695,14 +768,14 @@ ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, cons
     }
     memset(M.skip, 0, c->n);
     for (size_t i = 0; i < c->n; i++)
-        M.skip[i] = r->segment[i] == M.host;
+        M.skip[i] = r->segment[i] == host;
     for (size_t k = 0; k < nacc; k++) {
         if ((st = grid_query(&grid, c, &acc[k].box, M.skip, &M.cand, &M.ncand, &M.capcand))) {
             st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
             goto done;
         }
         int32_t id = (int32_t)(r->nsegments + k);
-        spec[id] = (ag_segment_cloud_spec){AG_SEGMENT_CLOUD_ELEMENT, M.host, group, acc[k].box};
+        spec[id] = (ag_segment_cloud_spec){AG_SEGMENT_CLOUD_ELEMENT, host, group, acc[k].box};
         for (size_t j = 0; j < M.ncand; j++) {
             r->segment[M.cand[j]] = id;
             M.skip[M.cand[j]] = 1;
@@ -715,7 +788,7 @@ ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, cons
             st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
             goto done;
         }
-        is_host[M.host] = 1;
+        is_host[host] = 1;
         adopt_fragments(c, r, spec, before, nacc, is_host);
         free(is_host);
     }
@@ -747,18 +820,7 @@ done:
     free(spec);
     free(hcount);
     free(acc);
-    free(tried);
-    free(queue);
-    free(lines);
-    free(M.skip);
-    free(M.tidx);
-    free(M.txyz);
-    free(M.tnorm);
-    free(M.cand);
-    free(M.cxyz);
-    ag_kdtree_free(M.ttree);
-    ag__voxel_set_free(&M.tcells);
-    free(M.stamp);
+    matcher_free(&M);
     grid_free(&grid);
     return st;
 }

@@ -7,7 +7,9 @@
  * the host's node box grows to hold it, so that the split tree nests it under its wall.
  *
  * Template matching (a person marks a template): the template is a box around one element;
- * its host is the largest plane crossing it that is larger than the box. The template is
+ * its host is the largest plane crossing it that is larger than the box. This is archgram's
+ * one template matcher: template marking (core/points/template_mark.h) runs it inside one
+ * segment (ag_repeat_in_segment). The template is
  * slid along the host frame's three axes, one at a time, in steps of 10 % of the template's
  * size on that axis (the template-to-segment size ratio's 10 % of the segment), over the
  * host's extent; from every match on again (so a grid of windows is reached row by row). At
@@ -70,6 +72,17 @@ void ag_repeat_report_clear(ag_repeat_report *rep);
  * with its wall cannot be told from the wall). rep may be NULL. */
 ag_status ag_repeat_template(const ag_cloud *c, ag_segment_cloud_result *r, const ag_box *tmpl,
                              const ag_repeat_options *o, ag_repeat_report *rep, ag_error *err);
+
+/* The same matcher with the template inside one segment (template marking,
+ * core/points/template_mark.h): the template is the points of `segment` in the box, slid along
+ * that segment's frame, and compared with the segment's points in the moved box; nothing is
+ * changed. *matches (malloc'd, the caller frees it) gets the matches, the template first;
+ * *positions the positions compared. AG_ERR_INVALID for no such segment or a box with fewer
+ * than 8 of its points. */
+ag_status ag_repeat_in_segment(const ag_cloud *c, const ag_segment_cloud_result *r,
+                               const ag_box *tmpl, int32_t segment, const ag_repeat_options *o,
+                               ag_repeat_match **matches, size_t *nmatches, size_t *positions,
+                               ag_error *err);
 
 /* The automatic decomposition; rep (optional) gets the number of elements. */
 ag_status ag_repeat_auto(const ag_cloud *c, ag_segment_cloud_result *r,

@@ -2,20 +2,15 @@
  * rule: a person marks a template — the points of one segment inside a box — and the
  * copies of it along the segment are found and given one label with it.
  *
- * The template is slid along the axes of the segment's frame (the frame ag_segment_cloud
- * gives it: a wall's horizontal direction and slope line, ...) wherever the segment has
- * room, in steps of a tenth of the template's size on each axis (at least one point
- * spacing). A window of the segment at a position is a copy when it passes the label rule
- * of the segmentation: its point count within 10 % of the template's and its extents,
- * sorted, within 5 % (plus two point spacings of slack) — and its points placed in it as
- * the template's are in the template's box: their centre and their spread about it within
- * 5 % of the template's size on each axis (a window shifted while the template's features
- * stay inside it holds as many points, and one straddling two features may too: the centre
- * and the spread tell them apart). Copies are taken best first (closest in all of it) where
- * they do not overlap the template or a copy taken before. The template and every copy
- * become segments of their own (of the segment's kind), all with one new label; what is
- * left of the segment stays a segment. Shape is not compared beyond this (no registration):
- * that is the template matching of the consensus stage. Deterministic. Core: no I/O. */
+ * The copies are found by archgram's one template matcher (core/points/repeat.h,
+ * ag_repeat_in_segment): the box slid along the segment's frame in steps of a tenth of its
+ * size, the segment's points in the moved box compared with the template's by how well they
+ * explain each other, each match placed where they agree best and not overlapping another.
+ * A match is a copy when it also passes the label rule of the segmentation: its point count
+ * within 10 % of the template's and its extents in the segment's frame, sorted, within 5 %
+ * (plus two point spacings of slack). The template and every copy become segments of their
+ * own (of the segment's kind), all with one new label; what is left of the segment stays a
+ * segment. Deterministic. Core: no I/O. */
 #ifndef AG_POINTS_TEMPLATE_MARK_H
 #define AG_POINTS_TEMPLATE_MARK_H
 
