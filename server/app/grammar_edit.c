@@ -5,6 +5,7 @@
 
 #include "../store/grammars.h"
 #include "../store/states.h"
+#include "cloud_pipeline.h"
 #include "store_ws.h"
 
 typedef struct {
@@ -35,6 +36,12 @@ ag_status ag_grammar_edit_apply(const ag_store_env *env, int64_t model, int64_t 
     if (s != AG_OK)
         return s;
     ag_grammars_row_clear(&cur);
+    int cloud = 0; /* a point model's grammar names PLY terminals: app/store_ws_points.c */
+    if ((s = ag_cloud_pipeline_is_cloud(env->db, model, &cloud, err)) != AG_OK)
+        return s;
+    if (cloud)
+        return ag_store_ws_points_grammar_edit(env, model, base, author, cid, text, len, version,
+                                               err, col);
 
     stored_terminals ctx = {env->db, model};
     ag_model_state st;

@@ -125,6 +125,13 @@ ag_status ag__store_ws_begin(ag_store_ws *w, const char *doing, int by_client, a
 typedef enum { AG__STORE_WS_LINKS_GRAMMAR, AG__STORE_WS_LINKS_POINTS } ag__store_ws_links;
 ag_status ag__store_ws_commit(ag_store_ws *w, ag_seq_txn *t, ag_status s,
                               ag__store_ws_links links, const json_t *op, ag_error *err);
+/* PUT …/grammar of a proceduralized point cloud (app/grammar_edit.h): the text read with the
+ * model's stored PLY terminals (a parse error: AG_ERR_PARSE with its line in err->element and
+ * column in *col; a terminal the model does not keep: AG_ERR_PARSE naming it), read back and
+ * saved as the op {"kind":"grammar","bytes"} with the states around it. */
+ag_status ag_store_ws_points_grammar_edit(const ag_store_env *env, int64_t model, int64_t base,
+                                          const char *author, const char *cid, const char *text,
+                                          size_t len, int64_t *version, ag_error *err, long *col);
 /* Keeps st's edit model (taken) as the model's edit session at version. */
 void ag__store_ws_keep_model(ag_edit_sessions *reg, int64_t model, int64_t version,
                              ag_model_state *st);

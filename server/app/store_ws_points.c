@@ -175,6 +175,8 @@ static json_t *logged_op(const ag_store_ws *w, const ag_points_state *st,
                          (json_int_t)st->pm->nplacements, "patterns",
                          (json_int_t)st->pm->em->proc->tree->npatterns);
     json_t *body = json_deep_copy(w->o.op);
+    if (!edit->op) /* a grammar text edit: logged as it came */
+        return body;
     json_t *report = ag_edit_op_json_report(&edit->report);
     if (!body || !report) {
         json_decref(body);
@@ -261,5 +263,44 @@ ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int
         ag_pointmodel_free(*pm);
         *pm = NULL;
     }
+    return s;
+}
+
+/* ---- grammar text edits ------------------------------------------------------------------- */
+
+ag_status ag_store_ws_points_grammar_edit(const ag_store_env *env, int64_t model, int64_t base,
+                                          const char *author, const char *cid, const char *text,
+                                          size_t len, int64_t *version, ag_error *err, long *col)
+{
+    *version = 0;
+    /* the text names terminals the model keeps (a text edit brings no new point sets, so none
+     * is stored again); the state is the text as it came and the model it reads as */
+    terminal_source ts = {env->db, model};
+    ag_points_state st = {0};
+    ag_status s = ag_points_state_read(text, len, db_lookup, &ts, &st.pm, err, col);
+    if (s != AG_OK)
+        return s;
+    if (!(st.text = malloc(len + 1))) {
+        ag_points_state_clear(&st);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    memcpy(st.text, text, len);
+    st.text[len] = 0;
+    st.text_len = len;
+    json_t *op = json_pack("{s:s, s:I}", "kind", "grammar", "bytes", (json_int_t)len);
+    if (!op) {
+        ag_points_state_clear(&st);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    ag_store_ws w;
+    ag_store_ws_init(&w, &(ag_store_ws_options){
+                             .env = *env, .model = model, .base = base, .author = author,
+                             .cid = cid, .op = op});
+    ag_edit_outcome o = {0};
+    s = ag__store_ws_save_points(&w.ws, &st, NULL, &o, err);
+    if (s == AG_OK)
+        *version = w.version;
+    ag_store_ws_end(&w, s);
+    json_decref(op);
     return s;
 }

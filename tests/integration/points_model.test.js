@@ -146,6 +146,35 @@ describe('point models in the service', () => {
     assert.equal(again.status, 304);
   });
 
+  it('PUT grammar of a point model re-derives it; bad text is refused and nothing changes', async () => {
+    const g = await http(d, 'GET', `/api/v1/models/${id}/grammar`);
+    const v = (await http(d, 'GET', `/api/v1/models/${id}`)).json.version;
+    const tree0 = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
+    const n0 = (await derived()).n;
+    const r = await http(d, 'PUT', `/api/v1/models/${id}/grammar`, { body: g.text, headers: { 'If-Match': `"${v}"`, 'Content-Type': 'text/plain' } });
+    assert.equal(r.status, 200, r.text);
+    assert.equal(r.json.version, v + 1);
+    assert.equal((await http(d, 'GET', `/api/v1/models/${id}/grammar`)).text, g.text);
+    assert.deepEqual((await http(d, 'GET', `/api/v1/models/${id}/tree`)).json.nodes, tree0.nodes);
+    assert.equal((await derived()).n, n0);
+    const log = (await http(d, 'GET', `/api/v1/models/${id}/ops`)).json.items.at(-1);
+    assert.deepEqual(log.op, { kind: 'grammar', bytes: Buffer.byteLength(g.text) });
+    const before = await state();
+    const lines = g.text.split('\n');
+    const at = lines.findIndex((l) => l.startsWith('terminal '));
+    const broken = [...lines];
+    broken[at] = broken[at].replace(' size ', ' size , ');
+    const p = await http(d, 'PUT', `/api/v1/models/${id}/grammar`, { body: broken.join('\n'), headers: { 'If-Match': `"${v + 1}"` } });
+    assertProblem(p, 422, 'parse', 'a syntax error');
+    assert.equal(p.json.line, at + 1);
+    const t = await http(d, 'PUT', `/api/v1/models/${id}/grammar`, { body: g.text.replace(/terminals\/[0-9a-f]{16}\.ply/, 'terminals/0123456789abcdef.ply'), headers: { 'If-Match': `"${v + 1}"` } });
+    assertProblem(t, 422, 'parse', 'a terminal the model does not keep');
+    assert.match(t.json.detail, /terminals\/0123456789abcdef\.ply/);
+    const mesh = await http(d, 'PUT', `/api/v1/models/${id}/grammar`, { body: g.text.replace(/(terminals\/[0-9a-f]{16})\.ply/g, '$1.obj'), headers: { 'If-Match': `"${v + 1}"` } });
+    assertProblem(mesh, 422, 'parse', 'mesh terminals on a point model');
+    assert.deepEqual(await state(), before);
+  });
+
   it('a resize doubling the front doubles its windows at the input density; undo and redo over the websocket', async () => {
     const t = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
     const front = t.nodes.find((nd) => nd.kind === 'component' && nd.box[3] - nd.box[0] > 14 &&
