@@ -73,6 +73,14 @@ ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t
         return s;
     if (cloud && !ag_cloud_pipeline_proceduralize)
         return ag_cloud_pipeline_missing(model, "proceduralize", err);
+    ag_pointcloud_info info;
+    if (cloud && (s = ag_pointclouds_info(db, model, &info, err)) != AG_OK)
+        return s;
+    if (cloud && info.points > AG_CLOUD_MAX_SEGMENT_POINTS) /* the pipeline segments it first */
+        return ag_error_set(err, AG_ERR_TOO_LARGE, 0,
+                            "model %lld holds %zu points; archgram proceduralizes at most %zu at "
+                            "once (cut it into buildings first: archgram cut)",
+                            (long long)model, info.points, AG_CLOUD_MAX_SEGMENT_POINTS);
     char *options = NULL;
     if (cloud_options && json_object_size(cloud_options) &&
         (s = ag_cloud_pipeline_check_options(model, cloud, cloud_options, &options, err)) != AG_OK)

@@ -261,7 +261,7 @@ ag_status ag_app_points_derived_ply(ag_app *app, int64_t id,
     if (s == AG_OK) {
         snprintf(out->etag, sizeof out->etag, "\"derived-%lld-%lld\"", (long long)id,
                  (long long)blob);
-        s = ag_pointmodel_derive(pm, 0, &c, NULL, err);
+        s = ag_pointmodel_derive(pm, AG_CLOUD_MAX_POINTS, &c, NULL, err);
     }
     if (s == AG_OK)
         s = ply_bytes(c, out, err);
