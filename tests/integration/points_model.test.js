@@ -1,9 +1,10 @@
 // Point clouds proceduralized and edited in the service, as meshes are: the proceduralize job on
-// a pointcloud model (progress by stage, a template's copies found), GET …/tree and …/grammar,
-// GET …/derived.ply (the cloud the grammar derives), resize and paste ops over REST and the
-// websocket (with live drag previews) (broadcast, logged with their report, undone and redone by their author), with the
-// density kept. The checks are the test's own: windows are counted and densities measured on
-// the derived points (points_building.js), never taken from archgram's report.
+// a pointcloud model (progress by stage, a template's copies found, bad options refused), GET
+// …/tree and …/grammar, GET …/derived.ply (the cloud the grammar derives), PUT …/grammar, resize
+// and paste ops over REST and the websocket (live drag previews, broadcast, logged with their
+// report, undone and redone by their author, rebased or nacked when made on an older version),
+// with the density kept. The checks are the test's own: windows are counted and densities
+// measured on the derived points (points_building.js), never taken from archgram's report.
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
 import { assertProblem, http, importModel, PROBLEM, removeDir, sql, startDaemon, waitJob, WsClient, facadeObj } from './harness.js';
@@ -33,6 +34,13 @@ function densities(c, width, windows) {
   const wallArea = (width - 0.1) * 6.9 - windows * 1.2 * 1.5;
   return { wall: wall / wallArea, glass: glass / (windows * 1.2 * 1.5) };
 }
+
+// The tree node of window w (its box centred on the window, at most a little larger).
+const glassOf = (tree, w) => tree.nodes.find((nd) => nd.kind === 'component' && nd.box &&
+  Math.abs((nd.box[0] + nd.box[3]) / 2 - (WIN[w][0] + 0.6 + ORIGIN[0])) < 0.2 &&
+  Math.abs((nd.box[2] + nd.box[5]) / 2 - (WIN[w][1] + 0.75 + ORIGIN[2])) < 0.2 &&
+  nd.box[3] - nd.box[0] < 2 && nd.box[5] - nd.box[2] < 2.2 && nd.box[4] - ORIGIN[1] < 0.6);
+const near = (a, b, eps = 1e-6) => a.every((v, i) => Math.abs(v - b[i]) <= eps);
 
 const within = (a, b, rel, what) => assert.ok(Math.abs(a / b - 1) <= rel, `${what}: ${a.toFixed(1)} against ${b.toFixed(1)} per m²`);
 const box6 = (s) => s.split(',').map(Number);
@@ -251,6 +259,54 @@ describe('point models in the service', () => {
     assert.ok(log[0].op.report.unknowns > 0);
   });
 
+  it('live resizes made on an older version: rebased when nothing since changed their node, else nacked naming the op', async () => {
+    const A = await WsClient.open(d.wsUrl), B = await WsClient.open(d.wsUrl);
+    try {
+      const wel = await A.request({ type: 'hello', model: id, user: 'cy' }, 'welcome');
+      await B.request({ type: 'hello', model: id, user: 'di' }, 'welcome');
+      const t = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
+      assert.equal(t.version, wel.version);
+      const wa = glassOf(t, 5), wb = glassOf(t, 7);
+      assert.ok(wa && wb, 'window nodes');
+      // the back wall: the node spanning the building at y = 8
+      const back = t.nodes.find((nd) => nd.kind === 'component' && nd.box[3] - nd.box[0] > 14 && nd.box[5] - nd.box[2] > 6 &&
+        Math.abs(nd.box[4] - ORIGIN[1] - 8) < 0.2 && nd.box[4] - nd.box[1] < 0.6);
+      assert.ok(back, 'the back wall');
+      const grow = (w) => ({ kind: 'resize', node: w.id, box: [w.box[0], w.box[1], w.box[2], w.box[3] + 0.1, w.box[4], w.box[5] + 0.1] });
+      const reply = (cid) => (m) => (m.type === 'ack' || m.type === 'nack') && m.cid === cid;
+      const rb = await B.request({ type: 'op', cid: 'di-1', base: t.version, op: grow(wb) }, reply('di-1'), 60000);
+      assert.equal(rb.type, 'ack', JSON.stringify(rb));
+      const now = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
+      // the windows share a rule: b's resize resized a too, so a's op made before it is stale
+      const wa2 = glassOf(now, 5);
+      assert.ok(wa2 && near(wa2.box, grow(wa).box, 1e-3), `window a went with window b: ${JSON.stringify(wa2?.box)}`);
+      const ra = await A.request({ type: 'op', cid: 'cy-1', base: t.version, op: grow(wa) }, reply('cy-1'), 60000);
+      assert.equal(ra.type, 'nack', JSON.stringify(ra));
+      assert.equal(ra.problem.type, `${PROBLEM}stale`);
+      assert.equal(ra.version, rb.version);
+      assert.match(ra.problem.detail, new RegExp(`the resize op of version ${rb.version} by di changed node ${wa.id}`));
+      // the back wall is not changed by it: the same op is rebased onto the current version
+      const taller = [...back.box.slice(0, 5), back.box[5] + 0.5];
+      const rc = await A.request({ type: 'op', cid: 'cy-2', base: t.version, op: { kind: 'resize', node: back.id, box: taller } }, reply('cy-2'), 60000);
+      assert.equal(rc.type, 'ack', JSON.stringify(rc));
+      assert.equal(rc.version, rb.version + 1);
+      const last = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
+      assert.ok(last.nodes.some((n) => n.kind === 'component' && near(n.box, taller, 1e-3)), 'the back wall has its new box');
+      assert.equal(countWindows(await derived()), 10);
+      // bo's undo would reach over cy's op: refused; a restore of the version before both is not
+      const v = (await http(d, 'GET', `/api/v1/models/${id}`)).json.version;
+      const ru = await B.request({ type: 'op', cid: 'di-undo', base: v, op: { kind: 'undo' } }, reply('di-undo'), 60000);
+      assert.equal(ru.type, 'nack', JSON.stringify(ru));
+      assert.equal(ru.problem.type, `${PROBLEM}undo-conflict`);
+      const rr = await B.request({ type: 'op', cid: 'di-restore', base: v, op: { kind: 'restore', version: t.version } }, reply('di-restore'), 60000);
+      assert.equal(rr.type, 'ack', JSON.stringify(rr));
+      assert.deepEqual((await http(d, 'GET', `/api/v1/models/${id}/tree`)).json.nodes, t.nodes);
+    } finally {
+      await A.close();
+      await B.close();
+    }
+  });
+
   it('a paste over REST copies another model\'s window onto a window; bad ops get problems and store nothing', async () => {
     // a second point model to paste into: the same building, proceduralized automatically
     const q = new URLSearchParams({ name: 'house 2', format: 'ply' });
@@ -260,10 +316,6 @@ describe('point models in the service', () => {
     assert.equal(pj.status, 'succeeded', JSON.stringify(pj.error));
     const t = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
     // a window of model id (window 0) pasted over window 1
-    const glassOf = (tree, w) => tree.nodes.find((nd) => nd.kind === 'component' && nd.box &&
-      Math.abs((nd.box[0] + nd.box[3]) / 2 - (WIN[w][0] + 0.6 + ORIGIN[0])) < 0.2 &&
-      Math.abs((nd.box[2] + nd.box[5]) / 2 - (WIN[w][1] + 0.75 + ORIGIN[2])) < 0.2 &&
-      nd.box[3] - nd.box[0] < 2 && nd.box[5] - nd.box[2] < 2.2 && nd.box[4] - ORIGIN[1] < 0.6);
     const src = glassOf(t, 0), dst = glassOf(t, 1);
     assert.ok(src && dst, 'window nodes');
     const before = await state();
