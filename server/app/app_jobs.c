@@ -73,6 +73,11 @@ ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t
         return s;
     if (cloud && !ag_cloud_pipeline_proceduralize)
         return ag_cloud_pipeline_missing(model, "proceduralize", err);
+    if (cloud && exact)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "\"exact\": model %lld is a point cloud; its terminals are consensus "
+                            "models of each label's members, exact is an option of meshes",
+                            (long long)model);
     ag_pointcloud_info info;
     if (cloud && (s = ag_pointclouds_info(db, model, &info, err)) != AG_OK)
         return s;

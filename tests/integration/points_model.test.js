@@ -99,6 +99,7 @@ describe('point models in the service', () => {
     await bad(id, { templates: Array(65).fill([0, 0, 0, 1, 1, 1]) }, /at most 64/);
     await bad(id, { auto: 'no' }, /"auto" takes true or false/);
     await bad(id, { colour: 1 }, /"colour" is not an option of proceduralize/);
+    await bad(id, { exact: true }, /"exact": model \d+ is a point cloud/);
     await bad(mesh.id, { templates: [[0, 0, 0, 1, 1, 1]] }, /is a mesh; templates, rois and auto are options of point clouds/);
     await bad(mesh.id, { colour: 1 }, /"colour" is not an option of proceduralize/);
     assert.equal((await http(d, 'GET', `/api/v1/models/${id}`)).json.version, 1);
@@ -225,6 +226,7 @@ describe('point models in the service', () => {
       const a = densities(absolute(input.bytes), 16, 10), b = densities(w, 32, 20);
       within(b.wall, a.wall, 0.1, 'the doubled front wall');
       within(b.glass, a.glass, 0.1, 'the doubled windows\' glass');
+      console.log(`# doubled front: ${countWindows(w)} windows; wall ${b.wall.toFixed(1)} points/m² (input ${a.wall.toFixed(1)}), glass ${b.glass.toFixed(1)} (input ${a.glass.toFixed(1)}); ${w.n} points derived`);
       let far = 0;
       for (let i = 0; i < w.n; i++) far += w.props.x[i] - ORIGIN[0] > 32.5;
       assert.ok(far < 0.01 * w.n, `${far} points past x = 32.5`);
