@@ -11,8 +11,9 @@
  *                   → saved
  *
  * `archgram proceduralize CLOUD` and `archgram edit DIR` (for a point model) run them between
- * folders (app/points_folder_ws.h); a store workspace that implements the point operations
- * runs them for the service. Progress goes to the workspace by stage; a cancellation is
+ * folders (app/points_folder_ws.h); the store workspace (app/store_ws.h, its point operations
+ * in app/store_ws_points.c) runs them for the service: the proceduralize job of a pointcloud
+ * model (app/cloud_pipeline.h) and its structural ops (app/edit_ops.h). Progress goes to the workspace by stage; a cancellation is
  * honoured between stages and before the save. */
 #ifndef AG_USECASE_POINTS_H
 #define AG_USECASE_POINTS_H

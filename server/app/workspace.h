@@ -15,7 +15,8 @@
  * (app/usecase_import_cloud.h), segmentations are read and saved through it
  * (app/usecase_segment.h, app/usecase_mark_template.h); only the store keeps cloud models.
  * A cloud is also proceduralized into a point model, point models are edited and their
- * grammar and PLY terminals saved (app/usecase_points.h; app/points_folder_ws.h for folders).
+ * grammar and PLY terminals saved (app/usecase_points.h; app/points_folder_ws.h for folders,
+ * app/store_ws.h for the store).
  *
  * A workspace that cannot do something answers AG_ERR_UNSUPPORTED. */
 #ifndef AG_WORKSPACE_H
