@@ -8,6 +8,7 @@
 #include "../io/meshblob.h"
 #include "../store/grammars.h"
 #include "../store/models.h"
+#include "cloud_pipeline.h"
 #include "model_kept.h"
 #include "model_state.h"
 #include "model_tree.h"
@@ -96,7 +97,18 @@ static ag_status load(ag_db *db, ag_edit_state *st, int64_t version, ag_error *e
     ag_grammar_row g;
     ag_error e;
     ag_error_clear(&e);
-    ag_status s = ag_grammars_current(db, st->model, 1, &g, &e);
+    /* a point cloud's model is a point model (app/store_ws_points.c), not an edit model */
+    int cloud = 0;
+    ag_status s = ag_cloud_pipeline_is_cloud(db, st->model, &cloud, err);
+    if (s != AG_OK)
+        return s;
+    if (cloud)
+        return ag_error_set(err, AG_ERR_CONFLICT, 0,
+                            "model %lld is a point cloud: its point model takes the structural "
+                            "ops (resize, split, join, paste, remove); parts and compositions "
+                            "are for meshes",
+                            (long long)st->model);
+    s = ag_grammars_current(db, st->model, 1, &g, &e);
     if (s == AG_ERR_NOT_FOUND && strstr(e.text, "proceduralized"))
         return ag_error_set(err, AG_ERR_NOT_PROCEDURALIZED, 0,
                             "model %lld is not proceduralized: structural edits need a grammar "

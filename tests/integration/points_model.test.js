@@ -335,6 +335,11 @@ describe('point models in the service', () => {
     r = await post({ kind: 'paste', source: [src.id], target: dst.id, source_dir: '../x' });
     assertProblem(r, 400, 'invalid', 'a folder');
     assertProblem(await post({ kind: 'resize', node: src.id, scale: [2, 1, 1] }, { 'If-Match': '"1"' }), 412, null, 'a stale version');
+    // parts are saved from meshes and composed into meshes
+    r = await http(d, 'POST', '/api/v1/parts', { body: { model: id, version: before.version, node: src.id, name: 'a window' } });
+    assertProblem(r, 409, 'conflict', 'a part of a point model');
+    assert.match(r.json.detail, /is a point cloud/);
+    assertProblem(await http(d, 'GET', `/api/v1/models/${id}/selection?nodes=${src.id}`), 409, 'conflict', 'a selection of a point model');
     assert.deepEqual(await state(), before);
     assert.deepEqual(sql(d.db, 'PRAGMA integrity_check'), [['ok']]);
     // a paste from the other model: its window onto this one's
