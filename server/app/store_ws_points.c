@@ -104,11 +104,13 @@ ag_status ag__store_ws_open_point_models(ag_workspace *ws, const ag_edit_op_orig
     int64_t version = 0, source_version = 0;
     s = ag_store_ws_read_point_model(db, w->o.model, "", &w->points, &version, err);
     if (s == AG_OK && version != w->o.base)
-        s = ag_error_set(err, AG_ERR_STALE, (long)version, "model %lld is at version %lld, not %lld",
-                         (long long)w->o.model, (long long)version, (long long)w->o.base);
+        s = ag_error_set(err, AG_ERR_STALE, (long)version,
+                         "model %lld is at version %lld, not %lld", (long long)w->o.model,
+                         (long long)version, (long long)w->o.base);
     int64_t src = from && from->model != w->o.model ? from->model : 0;
     if (s == AG_OK && src)
-        s = ag_store_ws_read_point_model(db, src, "source_model", &w->points_source, &source_version, err);
+        s = ag_store_ws_read_point_model(db, src, "source_model", &w->points_source,
+                                         &source_version, err);
     ag_pointclouds_read_end(db);
     if (s != AG_OK)
         return s;
@@ -243,8 +245,9 @@ ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int
         ag_pointclouds_read_end(env->db);
     }
     if (s == AG_OK && version != base)
-        s = ag_error_set(err, AG_ERR_STALE, (long)version, "model %lld is at version %lld, not %lld",
-                         (long long)model, (long long)version, (long long)base);
+        s = ag_error_set(err, AG_ERR_STALE, (long)version,
+                         "model %lld is at version %lld, not %lld", (long long)model,
+                         (long long)version, (long long)base);
     if (s == AG_OK)
         s = ag_model_tree_check_node((*pm)->em, op->node, "node", err);
     if (s == AG_OK) {
