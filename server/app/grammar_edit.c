@@ -8,18 +8,6 @@
 #include "cloud_pipeline.h"
 #include "store_ws.h"
 
-typedef struct {
-    ag_db *db;
-    int64_t model;
-} stored_terminals;
-
-static ag_status lookup_stored(void *user, const char *path, char **obj, size_t *len,
-                               ag_error *err)
-{
-    const stored_terminals *st = user;
-    return ag_grammars_get_terminal(st->db, st->model, path, obj, len, err);
-}
-
 ag_status ag_grammar_edit_apply(const ag_store_env *env, int64_t model, int64_t base,
                                 const char *author, const char *cid, const char *text,
                                 size_t len, ag_task_budget *budget, int64_t *version,
@@ -43,14 +31,14 @@ ag_status ag_grammar_edit_apply(const ag_store_env *env, int64_t model, int64_t 
         return ag_store_ws_points_grammar_edit(env, model, base, author, cid, text, len, version,
                                                err, col);
 
-    stored_terminals ctx = {env->db, model};
+    ag__store_ws_terminals ctx = {env->db, model};
     ag_model_state st;
     ag_work_limits limits = ag_work_limits_resolved(env->limits);
     ag_edit_budget eb = {.max_triangles = limits.max_triangles,
                          .max_components = limits.max_nodes,
                          .cancelled = budget ? ag_task_budget_exhausted : NULL,
                          .user = budget};
-    if ((s = ag_model_state_from_text(text, len, lookup_stored, &ctx, &eb, &st, err, col)) !=
+    if ((s = ag_model_state_from_text(text, len, ag__store_ws_terminal_lookup, &ctx, &eb, &st, err, col)) !=
         AG_OK)
         return ag_task_budget_explain(budget, s, "the grammar edit", err);
     const ag_grammar *g = st.em->proc->grammar;

@@ -132,6 +132,14 @@ ag_status ag__store_ws_commit(ag_store_ws *w, ag_seq_txn *t, ag_status s,
 ag_status ag_store_ws_points_grammar_edit(const ag_store_env *env, int64_t model, int64_t base,
                                           const char *author, const char *cid, const char *text,
                                           size_t len, int64_t *version, ag_error *err, long *col);
+/* The terminals the store keeps for a model, as an ag_terminal_lookup (io/terminals.h): user
+ * is an ag__store_ws_terminals. */
+typedef struct {
+    ag_db *db;
+    int64_t model;
+} ag__store_ws_terminals;
+ag_status ag__store_ws_terminal_lookup(void *user, const char *path, char **data, size_t *len,
+                                       ag_error *err);
 /* Keeps st's edit model (taken) as the model's edit session at version. */
 void ag__store_ws_keep_model(ag_edit_sessions *reg, int64_t model, int64_t version,
                              ag_model_state *st);

@@ -27,15 +27,10 @@
 
 /* ---- reading ------------------------------------------------------------------------------ */
 
-typedef struct {
-    ag_db *db;
-    int64_t model;
-} terminal_source;
-
-static ag_status db_lookup(void *user, const char *path, char **data, size_t *len,
-                           ag_error *err)
+ag_status ag__store_ws_terminal_lookup(void *user, const char *path, char **data, size_t *len,
+                                       ag_error *err)
 {
-    const terminal_source *t = user;
+    const ag__store_ws_terminals *t = user;
     return ag_grammars_get_terminal(t->db, t->model, path, data, len, err);
 }
 
@@ -70,9 +65,9 @@ ag_status ag_store_ws_read_point_model(ag_db *db, int64_t model, const char *fie
             *err = e;
         return s;
     }
-    terminal_source ts = {db, model};
+    ag__store_ws_terminals ts = {db, model};
     long col = 0;
-    s = ag_points_state_read(g.text, g.text_len, db_lookup, &ts, pm, &e, &col);
+    s = ag_points_state_read(g.text, g.text_len, ag__store_ws_terminal_lookup, &ts, pm, &e, &col);
     ag_grammars_row_clear(&g);
     if (s != AG_OK) /* what the store saved does not read back: not the caller's fault */
         s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
@@ -278,9 +273,9 @@ ag_status ag_store_ws_points_grammar_edit(const ag_store_env *env, int64_t model
     *version = 0;
     /* the text names terminals the model keeps (a text edit brings no new point sets, so none
      * is stored again); the state is the text as it came and the model it reads as */
-    terminal_source ts = {env->db, model};
+    ag__store_ws_terminals ts = {env->db, model};
     ag_points_state st = {0};
-    ag_status s = ag_points_state_read(text, len, db_lookup, &ts, &st.pm, err, col);
+    ag_status s = ag_points_state_read(text, len, ag__store_ws_terminal_lookup, &ts, &st.pm, err, col);
     if (s != AG_OK)
         return s;
     if (!(st.text = malloc(len + 1))) {
