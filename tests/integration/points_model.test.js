@@ -103,6 +103,17 @@ describe('point models in the service', () => {
     await bad(mesh.id, { templates: [[0, 0, 0, 1, 1, 1]] }, /is a mesh; templates, rois and auto are options of point clouds/);
     await bad(mesh.id, { colour: 1 }, /"colour" is not an option of proceduralize/);
     assert.equal((await http(d, 'GET', `/api/v1/models/${id}`)).json.version, 1);
+    // a template in the air passes the request's checks and fails the job, storing nothing
+    const air = [ORIGIN[0] + 4, ORIGIN[1] + 3, ORIGIN[2] + 30, ORIGIN[0] + 5, ORIGIN[1] + 4, ORIGIN[2] + 31];
+    const r = await http(d, 'POST', `/api/v1/models/${id}/proceduralize`, { body: { templates: [air] } });
+    assert.equal(r.status, 202, r.text);
+    const job = await waitJob(d, r.json.id, { timeout: 120000 });
+    assert.equal(job.status, 'failed', JSON.stringify(job));
+    assert.match(job.error.detail, /template/, JSON.stringify(job.error));
+    assert.equal((await http(d, 'GET', `/api/v1/models/${id}`)).json.version, 1);
+    assertProblem(await http(d, 'GET', `/api/v1/models/${id}/tree`), 404, 'not-found', 'tree after a failed job');
+    assert.deepEqual(sql(d.db, `SELECT count(*) FROM grammars WHERE model_id = ${id}`), [['0']]);
+    assert.deepEqual(sql(d.db, `SELECT count(*) FROM terminals WHERE model_id = ${id}`), [['0']]);
   });
 
   it('the proceduralize job finds the template\'s copies and stores tree, grammar and terminals', async () => {
