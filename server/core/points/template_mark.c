@@ -8,6 +8,8 @@
 
 #define COUNT_SHARE 0.1   /* the label rule: point counts within 10 % */
 #define EXTENT_SHARE 0.05 /* and extents within 5 % */
+#define STEP_SHARE 0.1    /* the slide step: a tenth of the template on each axis */
+#define REFINE 2          /* a copy is placed to a quarter step: 2 sub-steps either side */
 
 void ag_template_mark_report_clear(ag_template_mark_report *rep)
 {
@@ -64,6 +66,40 @@ static int same_label(size_t n, const double dims[3], size_t tn, const double td
     return 1;
 }
 
+/* Where a match is a copy by the label rule: the match's box, or moved within half a step
+ * along the segment's plane (the shape matcher places a box where the points agree, the label
+ * rule counts what it holds: a shifted box holds a little more or less wall), the place that
+ * passes closest to the template's count and extents. 0 when none passes. */
+static int place_copy(const ag_cloud *c, const uint32_t *mem, size_t m, const double *u,
+                      const double axes[3][3], const double step[3], const ag_box *match,
+                      size_t tc, const double tdims[3], double slack, ag_box *out)
+{
+    double best = INFINITY;
+    *out = *match;
+    for (int i = -REFINE; i <= REFINE; i++)
+        for (int j = -REFINE; j <= REFINE; j++) {
+            ag_box b = *match;
+            for (int a = 0; a < 3; a++) {
+                double d = (step[0] * i * axes[0][a] + step[1] * j * axes[1][a]) / (2.0 * REFINE);
+                b.min[a] += d;
+                b.max[a] += d;
+            }
+            double dims[3];
+            size_t n = box_figures(c, mem, m, u, &b, dims);
+            if (!same_label(n, dims, tc, tdims, slack))
+                continue;
+            double big = (double)(n > tc ? n : tc);
+            double score = fabs((double)n - (double)tc) / big + (abs(i) + abs(j)) * 1e-3;
+            for (int k = 0; k < 3; k++)
+                score += fabs(dims[k] - tdims[k]) / fmax(fmax(dims[k], tdims[k]), 1e-9);
+            if (score < best) {
+                best = score;
+                *out = b;
+            }
+        }
+    return best < INFINITY;
+}
+
 ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **rp, int32_t segment,
                            const double min[3], const double max[3],
                            ag_template_mark_report *rep, ag_error *err)
@@ -103,24 +139,31 @@ ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **rp, int3
                           "the box holds %zu points of segment %d; a template needs at least %d",
                           tc, segment, AG_TEMPLATE_MIN_POINTS);
     /* the copies: the template matcher of repetition (core/points/repeat.h) run inside the
-     * segment, its matches kept when they pass the label rule */
+     * segment, its matches kept where they pass the label rule */
     ag_box box = {{min[0], min[1], min[2]}, {max[0], max[1], max[2]}};
     if (st == AG_OK)
-        st = ag_repeat_in_segment(c, r, &box, segment, NULL, &matches, &nmatches, &rep->positions,
-                                  err);
+        st = ag_repeat_in_segment(c, r, &box, segment, NULL, &matches, &nmatches,
+                                  &rep->positions, err);
     rep->template_points = tc;
-    double tdims[3];
+    double tdims[3], step[3];
     box_figures(c, mem, m, u, &box, tdims);
+    for (int a = 0; a < 3; a++) { /* a tenth of the template along each of the frame's axes */
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t j = 0; j < m; j++)
+            if (group[j] == 0) {
+                lo = fmin(lo, u[3 * j + a]);
+                hi = fmax(hi, u[3 * j + a]);
+            }
+        step[a] = tc ? STEP_SHARE * (hi - lo) : 0;
+    }
     size_t ntaken = st == AG_OK ? 1 : 0; /* the template itself is group 0 */
     for (size_t i = 1; st == AG_OK && i < nmatches; i++) {
-        double dims[3];
-        size_t n = box_figures(c, mem, m, u, &matches[i].box, dims);
-        if (!same_label(n, dims, tc, tdims, slack))
+        ag_box placed;
+        if (!place_copy(c, mem, m, u, it->axes, step, &matches[i].box, tc, tdims, slack, &placed))
             continue;
         int32_t gid = (int32_t)ntaken++;
         for (size_t j = 0; j < m; j++)
-            if (group[j] < 0 && inside(c->xyz + 3 * (size_t)mem[j], matches[i].box.min,
-                                       matches[i].box.max))
+            if (group[j] < 0 && inside(c->xyz + 3 * (size_t)mem[j], placed.min, placed.max))
                 group[j] = gid;
     }
     /* the new segmentation: the template and its copies become segments of the segment's

@@ -8,7 +8,8 @@
  * explain each other, each match placed where they agree best and not overlapping another.
  * A match is a copy when it also passes the label rule of the segmentation: its point count
  * within 10 % of the template's and its extents in the segment's frame, sorted, within 5 %
- * (plus two point spacings of slack). The template and every copy become segments of their
+ * (plus two point spacings of slack) — at the match's place or moved by up to half a step
+ * along the segment's plane, where it passes closest. The template and every copy become segments of their
  * own (of the segment's kind), all with one new label; what is left of the segment stays a
  * segment. Deterministic. Core: no I/O. */
 #ifndef AG_POINTS_TEMPLATE_MARK_H
