@@ -128,11 +128,13 @@ describe('point models in the service', () => {
       assert.equal(done.result.version, 2);
       const stages = new Set(['start', 'segment', 'repeat', 'absorb', 'consensus', 'tree', 'grammar', 'verify']);
       let last = 0;
-      for (const p of W.all.filter((m) => m.type === 'job.progress' && m.job === r.json.id)) {
+      const progress = W.all.filter((m) => m.type === 'job.progress' && m.job === r.json.id);
+      for (const p of progress) {
         assert.ok(p.progress >= last && p.progress <= 1, JSON.stringify(p));
         if (p.stage) assert.ok(stages.has(p.stage), `stage ${p.stage}`);
         last = p.progress;
       }
+      console.log(`# proceduralize job: ${progress.length} job.progress messages, stages ${[...new Set(progress.map((p) => p.stage))].join(', ')}`);
     } finally {
       await W.close();
     }
