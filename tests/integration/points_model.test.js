@@ -138,6 +138,9 @@ describe('point models in the service', () => {
     } finally {
       await W.close();
     }
+    const m = (await http(d, 'GET', `/api/v1/models/${id}`)).json;
+    assert.equal(m.proceduralized, true);
+    assert.equal(m.stats.points, 60000); // the cloud's figures stay
     const t = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
     assert.equal(t.version, 2);
     assert.equal(t.summary.kind, 'pointcloud');
