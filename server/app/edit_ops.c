@@ -276,48 +276,12 @@ ag_status ag_edit_ops_run_restore(const ag_store_env *env, const ag_op_request *
 
 /* --- live drag ----------------------------------------------------------------------------- */
 
-ag_status ag_edit_ops_preview(const ag_store_env *env, int64_t model, int64_t base,
-                              const json_t *op, json_t **boxes, double *solve_ms, ag_error *err)
+json_t *ag__edit_ops_moved_boxes(const ag_splittree *t, const ag_box *solved,
+                                 const double offset[3])
 {
-    *boxes = NULL;
-    *solve_ms = 0;
-    const char *kind = json_string_value(json_object_get(op, "kind"));
-    if (!kind || strcmp(kind, "resize") != 0)
-        return ag_error_set(err, AG_ERR_INVALID, 0, "a preview carries a resize op");
-    ag_edit_op e = {0};
-    ag_status s = ag_edit_op_json_from(op, &e, err);
-    if (s != AG_OK)
-        return s;
-    ag_box *solved = NULL;
-    ag_edit_report rep = {0};
-    ag_edit_state *st = NULL;
-    ag_pointmodel *pm = NULL;
-    const ag_splittree *t = NULL;
-    double offset[3] = {0, 0, 0}; /* a point model's boxes are solved local to its offset */
-    int cloud = 0;
-    s = ag_cloud_pipeline_is_cloud(env->db, model, &cloud, err);
-    if (s == AG_OK && cloud) {
-        if ((s = ag_store_ws_points_preview(env, model, base, &e, &pm, &solved, &rep, err)) ==
-            AG_OK) {
-            t = pm->em->proc->tree;
-            memcpy(offset, pm->offset, sizeof offset);
-        }
-    } else if (s == AG_OK &&
-               (s = ag_edit_session_acquire(env->sessions, env->db, model, &st, err)) == AG_OK) {
-        if (base != st->version)
-            s = ag_error_set(err, AG_ERR_STALE, (long)st->version,
-                             "model %lld is at version %lld, not %lld", (long long)model,
-                             (long long)st->version, (long long)base);
-        if (s == AG_OK && (s = ag_model_tree_check_node(st->em, e.node, "node", err)) == AG_OK)
-            s = ag_edit_preview(st->em, &e, &solved, &rep, err);
-        if (s == AG_OK)
-            t = st->em->proc->tree;
-    }
-    json_t *list = s == AG_OK ? json_array() : NULL;
-    if (s == AG_OK && !list)
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    double eps = t ? 1e-9 * fmax(1.0, ag_box_diagonal(&t->nodes[0].box)) : 0;
-    for (size_t n = 0; s == AG_OK && n < t->nnodes; n++) {
+    json_t *list = json_array();
+    double eps = 1e-9 * fmax(1.0, ag_box_diagonal(&t->nodes[0].box));
+    for (size_t n = 0; list && n < t->nnodes; n++) {
         if (t->nodes[n].kind == AG_NODE_DEAD)
             continue;
         const ag_box *a = &t->nodes[n].box, *b = &solved[n];
@@ -331,15 +295,50 @@ ag_status ag_edit_ops_preview(const ag_store_env *env, int64_t model, int64_t ba
                                               b->min[2] + offset[2], b->max[0] + offset[0],
                                               b->max[1] + offset[1], b->max[2] + offset[2]));
     }
+    return list;
+}
+
+ag_status ag_edit_ops_preview(const ag_store_env *env, int64_t model, int64_t base,
+                              const json_t *op, json_t **boxes, double *solve_ms, ag_error *err)
+{
+    *boxes = NULL;
+    *solve_ms = 0;
+    const char *kind = json_string_value(json_object_get(op, "kind"));
+    if (!kind || strcmp(kind, "resize") != 0)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "a preview carries a resize op");
+    ag_edit_op e = {0};
+    ag_status s = ag_edit_op_json_from(op, &e, err);
+    if (s != AG_OK)
+        return s;
+    int cloud = 0;
+    s = ag_cloud_pipeline_is_cloud(env->db, model, &cloud, err);
+    if (s == AG_OK && cloud) { /* boxes in the cloud's coordinates: app/store_ws_points.c */
+        s = ag_store_ws_points_preview(env, model, base, &e, boxes, solve_ms, err);
+        ag_edit_op_clear(&e);
+        return s;
+    }
+    ag_box *solved = NULL;
+    ag_edit_report rep = {0};
+    ag_edit_state *st = NULL;
+    if (s == AG_OK &&
+        (s = ag_edit_session_acquire(env->sessions, env->db, model, &st, err)) == AG_OK) {
+        if (base != st->version)
+            s = ag_error_set(err, AG_ERR_STALE, (long)st->version,
+                             "model %lld is at version %lld, not %lld", (long long)model,
+                             (long long)st->version, (long long)base);
+        if (s == AG_OK && (s = ag_model_tree_check_node(st->em, e.node, "node", err)) == AG_OK)
+            s = ag_edit_preview(st->em, &e, &solved, &rep, err);
+    }
+    static const double origin[3] = {0, 0, 0};
+    json_t *list = s == AG_OK ? ag__edit_ops_moved_boxes(st->em->proc->tree, solved, origin) : NULL;
+    if (s == AG_OK && !list)
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     if (s == AG_OK) {
         *boxes = list;
         *solve_ms = rep.solve_ms;
-    } else {
-        json_decref(list);
     }
     if (st)
         ag_edit_session_release(env->sessions, st);
-    ag_pointmodel_free(pm);
     free(solved);
     ag_edit_report_clear(&rep);
     ag_edit_op_clear(&e);

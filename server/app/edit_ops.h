@@ -45,4 +45,10 @@ ag_status ag_edit_ops_run_restore(const ag_store_env *env, const ag_op_request *
 ag_status ag_edit_ops_preview(const ag_store_env *env, int64_t model, int64_t base,
                               const json_t *op, json_t **boxes, double *solve_ms, ag_error *err);
 
+/* The nodes of tree t whose box the solve moved (solved: one box per node) as
+ * [{"node","box"}], boxes moved by offset (a point model's local origin; zeros for a mesh); a
+ * new reference, NULL when out of memory. */
+json_t *ag__edit_ops_moved_boxes(const ag_splittree *t, const ag_box *solved,
+                                 const double offset[3]);
+
 #endif

@@ -40,6 +40,10 @@ void ag_edit_session_reset(ag_edit_state *st)
     ag_edit_model_free(st->em);
     st->em = NULL;
     st->version = 0;
+    if (st->points_free)
+        st->points_free(st->points);
+    st->points = NULL;
+    st->points_free = NULL;
 }
 
 static void entry_free(entry *e)

@@ -28,6 +28,10 @@ typedef struct {
     int64_t version;  /* the model version em describes; 0 = nothing loaded */
     ag_edit_model *em;
     double load_ms;   /* time of the last load */
+    /* a point cloud's point model kept for live drags (app/store_ws_points.c), freed with the
+     * state (reset, replace, eviction) by points_free */
+    void *points;
+    void (*points_free)(void *points);
 } ag_edit_state;
 
 ag_edit_sessions *ag_edit_sessions_create(void);

@@ -105,13 +105,13 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, struct ag_points_state *st,
 ag_status ag_store_ws_read_point_model(ag_db *db, int64_t model, const char *field,
                                        struct ag_pointmodel **pm, int64_t *version,
                                        ag_error *err);
-/* A live drag of a point model (app/edit_ops.h): its model at base read (AG_ERR_STALE
- * otherwise) and op's resize solved (ag_edit_preview on the point model's proxy, op's boxes
- * in the cloud's coordinates); *pm (the caller frees it) numbers the nodes of *solved, which
- * are local to pm->offset. */
+/* A live drag of a point model (app/edit_ops.h, ag_edit_ops_preview): its model at base
+ * (AG_ERR_STALE otherwise; kept in the model's edit session while its grammar stays, so a
+ * drag reuses the solve's factorization as for meshes) and op's resize solved on its proxy;
+ * *boxes as ag__edit_ops_moved_boxes, in the cloud's coordinates. */
 ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int64_t base,
-                                     const ag_edit_op *op, struct ag_pointmodel **pm,
-                                     ag_box **solved, ag_edit_report *rep, ag_error *err);
+                                     const ag_edit_op *op, json_t **boxes, double *solve_ms,
+                                     ag_error *err);
 /* Begins a save (ag_sequencer_begin at the workspace's base; by_client: under the client's
  * author and cid, so a retry is seen): a job's stale model is named as having changed while
  * it was being `doing`; *duplicate set (and w->duplicate, w->version) when the same op came in

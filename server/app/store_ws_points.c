@@ -20,6 +20,7 @@
 #include "../store/models.h"
 #include "../store/pointclouds.h"
 #include "../store/states.h"
+#include "edit_ops.h"
 #include "model_tree.h"
 #include "points_state.h"
 #include "points_summary.h"
@@ -223,44 +224,110 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
 
 /* ---- live drag ------------------------------------------------------------------------------ */
 
-ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int64_t base,
-                                     const ag_edit_op *op, ag_pointmodel **pm, ag_box **solved,
-                                     ag_edit_report *rep, ag_error *err)
+/* The point model a model's edit session keeps for drags, with the grammar text it was read
+ * from: a text names its terminals by their content, so the same text is the same model. */
+typedef struct {
+    char *text;
+    size_t len;
+    ag_pointmodel *pm;
+} kept_points;
+
+static void kept_points_free(void *p)
 {
-    *pm = NULL;
-    *solved = NULL;
-    /* held, so a preview waits for an edit of the model being committed */
+    kept_points *k = p;
+    if (!k)
+        return;
+    free(k->text);
+    ag_pointmodel_free(k->pm);
+    free(k);
+}
+
+/* The model's point model at its current grammar (from the held state when it is that one),
+ * and its version. */
+static ag_status drag_model(const ag_store_env *env, int64_t model, ag_edit_state *held,
+                            kept_points **out, int64_t *version, ag_error *err)
+{
+    ag_grammar_row g;
+    ag_status s = ag_grammars_current(env->db, model, 0, &g, err);
+    if (s == AG_ERR_NOT_FOUND) /* not proceduralized, or no such model: the reader says which */
+        return ag_store_ws_read_point_model(env->db, model, "", &(ag_pointmodel *){NULL}, version,
+                                            err);
+    if (s != AG_OK)
+        return s;
+    *version = g.model_version;
+    kept_points *k = held->points;
+    if (k && k->len == g.text_len && !memcmp(k->text, g.text, g.text_len)) {
+        ag_grammars_row_clear(&g);
+        *out = k;
+        return AG_OK;
+    }
+    if (!(k = calloc(1, sizeof *k))) {
+        ag_grammars_row_clear(&g);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    k->text = g.text;
+    k->len = g.text_len;
+    g.text = NULL;
+    ag_grammars_row_clear(&g);
+    int64_t v = 0;
+    if ((s = ag_store_ws_read_point_model(env->db, model, "", &k->pm, &v, err)) != AG_OK) {
+        kept_points_free(k);
+        return s;
+    }
+    /* the held state keeps it for the next drag (freed with the state) */
+    if (held->points_free)
+        held->points_free(held->points);
+    held->points = k;
+    held->points_free = kept_points_free;
+    *out = k;
+    return AG_OK;
+}
+
+ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int64_t base,
+                                     const ag_edit_op *op, json_t **boxes, double *solve_ms,
+                                     ag_error *err)
+{
+    *boxes = NULL;
+    *solve_ms = 0;
+    /* held, so a preview waits for an edit of the model being committed, and the model kept
+     * is used by one drag at a time */
     ag_edit_state *held = NULL;
     ag_status s = ag_edit_session_hold(env->sessions, model, &held, err);
     if (s != AG_OK)
         return s;
     int64_t version = 0;
+    kept_points *k = NULL;
     if ((s = ag_pointclouds_read_begin(env->db, err)) == AG_OK) {
-        s = ag_store_ws_read_point_model(env->db, model, "", pm, &version, err);
+        s = drag_model(env, model, held, &k, &version, err);
         ag_pointclouds_read_end(env->db);
     }
     if (s == AG_OK && version != base)
         s = ag_error_set(err, AG_ERR_STALE, (long)version,
                          "model %lld is at version %lld, not %lld", (long long)model,
                          (long long)version, (long long)base);
+    ag_pointmodel *pm = s == AG_OK ? k->pm : NULL;
     if (s == AG_OK)
-        s = ag_model_tree_check_node((*pm)->em, op->node, "node", err);
+        s = ag_model_tree_check_node(pm->em, op->node, "node", err);
+    ag_box *solved = NULL;
+    ag_edit_report rep = {0};
     if (s == AG_OK) {
         /* the op's box in the model's local frame, as the edit use case moves it */
         ag_edit_op local = *op;
         for (int a = 0; a < 3; a++) {
-            local.box.min[a] -= (*pm)->offset[a];
-            local.box.max[a] -= (*pm)->offset[a];
-            local.region.min[a] -= (*pm)->offset[a];
-            local.region.max[a] -= (*pm)->offset[a];
+            local.box.min[a] -= pm->offset[a];
+            local.box.max[a] -= pm->offset[a];
+            local.region.min[a] -= pm->offset[a];
+            local.region.max[a] -= pm->offset[a];
         }
-        s = ag_edit_preview((*pm)->em, &local, solved, rep, err);
+        s = ag_edit_preview(pm->em, &local, &solved, &rep, err);
     }
+    if (s == AG_OK && !(*boxes = ag__edit_ops_moved_boxes(pm->em->proc->tree, solved, pm->offset)))
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    if (s == AG_OK)
+        *solve_ms = rep.solve_ms;
+    ag_edit_report_clear(&rep);
+    free(solved);
     ag_edit_session_release(env->sessions, held);
-    if (s != AG_OK) {
-        ag_pointmodel_free(*pm);
-        *pm = NULL;
-    }
     return s;
 }
 
