@@ -25,6 +25,7 @@
 #include "points_state.h"
 #include "points_summary.h"
 #include "store_ws.h"
+#include "usecase_points.h"
 
 /* ---- reading ------------------------------------------------------------------------------ */
 
@@ -311,14 +312,7 @@ ag_status ag_store_ws_points_preview(const ag_store_env *env, int64_t model, int
     ag_box *solved = NULL;
     ag_edit_report rep = {0};
     if (s == AG_OK) {
-        /* the op's box in the model's local frame, as the edit use case moves it */
-        ag_edit_op local = *op;
-        for (int a = 0; a < 3; a++) {
-            local.box.min[a] -= pm->offset[a];
-            local.box.max[a] -= pm->offset[a];
-            local.region.min[a] -= pm->offset[a];
-            local.region.max[a] -= pm->offset[a];
-        }
+        ag_edit_op local = ag_usecase_points_local_op(pm, op);
         s = ag_edit_preview(pm->em, &local, &solved, &rep, err);
     }
     if (s == AG_OK && !(*boxes = ag__edit_ops_moved_boxes(pm->em->proc->tree, solved, pm->offset)))

@@ -124,6 +124,20 @@ static ag_status check_nodes(const ag_edit_op *op, const ag_pointmodel *pm,
     return s;
 }
 
+ag_edit_op ag_usecase_points_local_op(const ag_pointmodel *pm, const ag_edit_op *in)
+{
+    ag_edit_op op = *in;
+    for (int a = 0; a < 3; a++) {
+        op.box.min[a] -= pm->offset[a];
+        op.box.max[a] -= pm->offset[a];
+        op.region.min[a] -= pm->offset[a];
+        op.region.max[a] -= pm->offset[a];
+    }
+    if (op.kind == AG_EDIT_SPLIT && op.axis >= 0 && op.axis < 3)
+        op.at -= pm->offset[op.axis];
+    return op;
+}
+
 ag_status ag_usecase_points_edit_run(ag_workspace *ws, const ag_usecase_points_edit_params *p,
                                      ag_usecase_points_edit_result *out, ag_error *err)
 {
@@ -139,17 +153,7 @@ ag_status ag_usecase_points_edit_run(ag_workspace *ws, const ag_usecase_points_e
     t0 = ag_clock_ms();
     if ((s = check_nodes(p->op, pm, source, err)) != AG_OK)
         return s;
-    /* boxes and split planes come in the input's coordinates (tree.json's), the model works
-     * in its local frame */
-    ag_edit_op op = *p->op;
-    for (int a = 0; a < 3; a++) {
-        op.box.min[a] -= pm->offset[a];
-        op.box.max[a] -= pm->offset[a];
-        op.region.min[a] -= pm->offset[a];
-        op.region.max[a] -= pm->offset[a];
-    }
-    if (op.kind == AG_EDIT_SPLIT && op.axis >= 0 && op.axis < 3)
-        op.at -= pm->offset[op.axis];
+    ag_edit_op op = ag_usecase_points_local_op(pm, p->op);
     if ((s = ag_pointedit_apply(pm, &op, source, &made, &out->report, err)) != AG_OK ||
         (s = ag_points_state_make(made, &st, err)) != AG_OK)
         goto done;

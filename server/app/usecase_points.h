@@ -51,6 +51,11 @@ typedef struct {
     size_t placements;
 } ag_usecase_points_edit_result;
 
+/* op as the model works on it: boxes and split planes come in the input's coordinates
+ * (tree.json's, the service's tree), the model works in its local frame (pm->offset). A
+ * shallow copy (it shares op's lists). */
+ag_edit_op ag_usecase_points_local_op(const ag_pointmodel *pm, const ag_edit_op *op);
+
 /* Problems that name an op field are AG_ERR_INVALID or AG_ERR_NOT_FOUND (a node). */
 ag_status ag_usecase_points_edit_run(ag_workspace *ws, const ag_usecase_points_edit_params *p,
                                      ag_usecase_points_edit_result *out, ag_error *err);
