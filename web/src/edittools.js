@@ -3,6 +3,7 @@
 // is one op (editor.execute); the op's broadcast reloads mesh, tree and grammar for everyone.
 // The tools work on the selected split-tree nodes (Shift+click selects several).
 import * as THREE from 'three';
+import { isCloud } from './cloud.js';
 import { el } from './dom.js';
 import { OP } from './opkinds.js';
 import { worldBox } from './previewlayer.js';
@@ -200,7 +201,12 @@ export class EditTools {
 
   render() {
     const ed = this.editor;
-    const ready = !!(ed.model && ed.tree);
+    // a point model is edited through the API for now (its tree is in the cloud's coordinates)
+    const cloud = isCloud(ed.model);
+    const ready = !!(ed.model && ed.tree) && !cloud;
+    this.empty.textContent = cloud && ed.tree
+      ? 'Point models are edited through the API (POST …/ops) for now.'
+      : 'Proceduralize the model to edit it.';
     // viewers get no edit tools at all (and no undo: they have no edits)
     if (ed.model && !ed.canEdit && this.splitting) this.splitting = false;
     this.readOnly.hidden = !ed.model || ed.canEdit;

@@ -3,6 +3,7 @@
 // 30 a second); the server's re-solved boxes for the whole area of effect reach everyone in the
 // room. Releasing sends one resize op — one undo step.
 import * as THREE from 'three';
+import { isCloud } from './cloud.js';
 import { worldBox } from './previewlayer.js';
 
 const PREVIEW_INTERVAL_MS = 1000 / 30;
@@ -68,7 +69,10 @@ export class Handles {
     if (this.drag) this.cancel();
     const tree = this.editor.tree;
     const id = this.editor.selected.single();
-    const n = id !== null && tree && this.editor.canEdit ? tree.node(id) : null;
+    // a point model's tree is in the cloud's coordinates, its points on screen in their local
+    // ones: it is edited through the API (POST …/ops) for now, not by handles
+    const editable = tree && this.editor.canEdit && !isCloud(this.editor.model);
+    const n = id !== null && editable ? tree.node(id) : null;
     if (!n || !Array.isArray(n.box) || n.box.length !== 6) {
       this.node = null;
       this.box = null;
