@@ -613,7 +613,8 @@ static void grid_stress_with(size_t count, int repair)
             starts[1] = n;
         }
         ag_plan *p = ag_plan_create();
-        grid_profiles(p, 1 + (int)(srnd() * 3));
+        double h = 1 + (int)(srnd() * 3);
+        grid_profiles(p, h);
         int mode = (int)(srnd() * 3), base = (int)(srnd() * 8);
         for (size_t k = 0; k < n; k++)
             prof[k] = mode == 0 ? 6 : mode == 1 ? base : (int)(srnd() * 8);
@@ -654,10 +655,25 @@ static void grid_stress_with(size_t count, int repair)
             leaky++;
             leaky_nested += r.stats.irregular > 0;
             leaky_kind[kind]++;
-            if (repair)
+            if (repair) {
+                /* what the plan has, for sorting the failures by cause: the profiles its
+                 * edges use and the height of the defect against the step height h */
+                static const char *const pname[] = {"hip", "steep", "wall", "r2", "over",
+                                                    "soffit", "r45", "terrace"};
+                char used[96] = "";
+                unsigned mask = 0;
+                for (size_t k = 0; k < n; k++)
+                    mask |= 1u << prof[k];
+                for (int b = 0; b < 8; b++)
+                    if (mask & (1u << b)) {
+                        strcat(used, used[0] ? "+" : "");
+                        strcat(used, pname[b]);
+                    }
                 printf("    not good grid%zu (%s, %zu nested intersections, %zu winding repairs, "
-                       "%zu refused): %s\n", i, kind ? "star" : "grid", r.stats.irregular,
-                       r.stats.winding_repairs, r.stats.winding_refused, not_good(&r));
+                       "%zu refused; h %g, profiles %s): %s\n", i, kind ? "star" : "grid",
+                       r.stats.irregular, r.stats.winding_repairs, r.stats.winding_refused, h,
+                       used, not_good(&r));
+            }
         } else {
             good_nested += r.stats.irregular > 0;
         }

@@ -44,10 +44,16 @@ typedef struct {
 } wedge;
 
 /* Probe height above z: far enough for the chains around one point to have parted, well
- * below anything the tolerances of the next events resolve. */
+ * below anything the tolerances of the next events resolve, and below the next event in
+ * the queue (halfway to it): chains elsewhere that meet a little higher (the same level
+ * jittered apart) are not crossings of this height. */
 static double probe_height(const sk *S, double z)
 {
-    return z + AG_EXTRUDE_WINDING_PROBE * S->d1;
+    double zp = z + AG_EXTRUDE_WINDING_PROBE * S->d1;
+    const ag_event *next = ag_eventq_peek(&S->q);
+    if (next && next->z > z && next->z < zp)
+        zp = z + (next->z - z) / 2;
+    return zp;
 }
 
 static void seg_at(const sk *S, uint32_t e, double z, double *a, double *b)
