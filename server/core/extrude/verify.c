@@ -220,6 +220,147 @@ static int within(const ag_plan *plan, double x, double y, double allowed, doubl
     return 0;
 }
 
+
+/* --- a shell that overlaps itself ---------------------------------------------------------
+ * A closed 2-manifold can still pass through itself (two parts of a roof swept over each
+ * other): the edge counts do not see it, the winding number does. Just inside each face
+ * the shell must wind once; it winds twice where that face lies inside another part. The
+ * winding number about q is counted along a ray from q: +1 for each face it leaves
+ * through, -1 for each it enters through. The rays lean off the vertical by amounts no
+ * plan of whole or decimal metres lines up with, so a ray meets no edge or corner of a
+ * grid-aligned roof exactly; a probe counts as overlapping only when two rays of
+ * different leans agree, so a graze within rounding of an edge cannot make a defect. */
+
+/* How far behind a face its probe lies, relative to the building's size. */
+#define AG_VERIFY_WINDING_PROBE 1e-7
+/* Faces whose inscribed circle is so small that the probe would lie closer than this
+ * (relative to the building's size) are slivers with no inside to probe. */
+#define AG_VERIFY_WINDING_THIN 1e-10
+
+typedef struct {
+    double a[3], e1[3], e2[3]; /* a corner and the two edges from it (about the origin o) */
+    double lo[2], hi[2], zhi;
+} vtri;
+
+static void cross3(const double *u, const double *v, double *w)
+{
+    w[0] = u[1] * v[2] - u[2] * v[1];
+    w[1] = u[2] * v[0] - u[0] * v[2];
+    w[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+static double dot3(const double *u, const double *v)
+{
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+}
+
+/* Winding number of the faces about q along the ray q + t (dx, dy, 1), t > 0. */
+static long winding_along(const vtri *T, size_t n, const double *q, double dx, double dy)
+{
+    const double d[3] = {dx, dy, 1};
+    long w = 0;
+    for (size_t t = 0; t < n; t++) {
+        const vtri *f = &T[t];
+        if (f->zhi < q[2])
+            continue;
+        /* where the ray is while it is below the face's top */
+        double rise = f->zhi - q[2];
+        double x0 = q[0], x1 = q[0] + rise * dx, y0 = q[1], y1 = q[1] + rise * dy;
+        if (fmax(x0, x1) < f->lo[0] || fmin(x0, x1) > f->hi[0] || fmax(y0, y1) < f->lo[1] ||
+            fmin(y0, y1) > f->hi[1])
+            continue;
+        /* Moller-Trumbore */
+        double p[3], s[3], qv[3];
+        cross3(d, f->e2, p);
+        double det = dot3(f->e1, p);
+        if (det == 0)
+            continue;
+        for (int k = 0; k < 3; k++)
+            s[k] = q[k] - f->a[k];
+        double u = dot3(s, p) / det;
+        if (u < 0 || u > 1)
+            continue;
+        cross3(s, f->e1, qv);
+        double v = dot3(d, qv) / det;
+        if (v < 0 || u + v > 1)
+            continue;
+        if (dot3(f->e2, qv) / det <= 0)
+            continue;
+        double nrm[3];
+        cross3(f->e1, f->e2, nrm);
+        w += dot3(nrm, d) > 0 ? 1 : -1;
+    }
+    return w;
+}
+
+/* 1 when the shell winds once just inside each of its faces; else 0 with why. */
+static int winds_once(const ag_mesh *m, size_t t0, size_t t1, double tol, double size,
+                      char *why, size_t nwhy)
+{
+    size_t nt = t1 - t0, n = 0;
+    vtri *T = malloc((nt ? nt : 1) * sizeof *T);
+    uint32_t *id = malloc((m->nverts ? m->nverts : 1) * sizeof *id);
+    ag_keyed *e = malloc((3 * nt + 1) * sizeof *e);
+    if (!T || !id || !e || !weld(m, t0, t1, tol, id, e)) {
+        free(T);
+        free(id);
+        free(e);
+        snprintf(why, nwhy, "out of memory checking the building");
+        return 0;
+    }
+    free(e);
+    /* welded corners: faces that share an edge share its points exactly, so no ray slips
+     * between them */
+    const double *o = &m->pos[3 * id[m->tri[3 * t0]]];
+    for (size_t t = t0; t < t1; t++) {
+        uint32_t v[3] = {id[m->tri[3 * t]], id[m->tri[3 * t + 1]], id[m->tri[3 * t + 2]]};
+        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
+            continue;
+        vtri *f = &T[n++];
+        double p[3][3];
+        for (int c = 0; c < 3; c++)
+            for (int d = 0; d < 3; d++)
+                p[c][d] = m->pos[3 * v[c] + d] - o[d];
+        for (int d = 0; d < 3; d++) {
+            f->a[d] = p[0][d];
+            f->e1[d] = p[1][d] - p[0][d];
+            f->e2[d] = p[2][d] - p[0][d];
+        }
+        for (int d = 0; d < 2; d++) {
+            f->lo[d] = fmin(p[0][d], fmin(p[1][d], p[2][d]));
+            f->hi[d] = fmax(p[0][d], fmax(p[1][d], p[2][d]));
+        }
+        f->zhi = fmax(p[0][2], fmax(p[1][2], p[2][2]));
+    }
+    int ok = 1;
+    for (size_t t = 0; t < n && ok; t++) {
+        const vtri *f = &T[t];
+        double nrm[3];
+        cross3(f->e1, f->e2, nrm);
+        double len = sqrt(dot3(nrm, nrm));
+        double e3[3] = {f->e2[0] - f->e1[0], f->e2[1] - f->e1[1], f->e2[2] - f->e1[2]};
+        double per = sqrt(dot3(f->e1, f->e1)) + sqrt(dot3(f->e2, f->e2)) + sqrt(dot3(e3, e3));
+        /* the probe: a hair behind the centre, well within the face's inscribed circle
+         * (len / per is its radius) and far above rounding */
+        double eps = fmin(AG_VERIFY_WINDING_PROBE * size, 0.01 * len / per);
+        if (!(eps > AG_VERIFY_WINDING_THIN * size))
+            continue; /* a sliver too thin to probe */
+        double q[3];
+        for (int d = 0; d < 3; d++)
+            q[d] = f->a[d] + (f->e1[d] + f->e2[d]) / 3 - eps * nrm[d] / len;
+        long w = winding_along(T, n, q, 0.0123456789, 0.00713286);
+        if (w != 1 && winding_along(T, n, q, -0.00871234, 0.0151112) == w) {
+            snprintf(why, nwhy, "the building overlaps itself near (%.3f, %.3f, %.3f): it winds "
+                     "%ld times there (parts swept through each other)", q[0] + o[0],
+                     q[1] + o[1], q[2] + o[2], w);
+            ok = 0;
+        }
+    }
+    free(T);
+    free(id);
+    return ok;
+}
+
 int ag_verify_building(const ag_mesh *m, size_t t0, size_t t1, const ag_plan *plan, char *why,
                        size_t nwhy)
 {
@@ -279,5 +420,5 @@ int ag_verify_building(const ag_mesh *m, size_t t0, size_t t1, const ag_plan *pl
                  zmin, zmax, top);
         return 0;
     }
-    return 1;
+    return winds_once(m, t0, t1, tol.point, fmax(tol.size, extent), why, nwhy);
 }
