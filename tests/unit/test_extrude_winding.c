@@ -574,14 +574,15 @@ static long max_winding(const ag_mesh *m)
                      sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) +
                      sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
                           (u[2] - v[2]) * (u[2] - v[2]));
-        /* a hair behind the centre, well inside the face's inscribed circle (radius
-         * len / per); a sliver too thin for that has no inside to probe */
+        /* a hair behind a point near the centre (off the thirds where grid-aligned walls
+         * pass), well inside the face's inscribed circle (radius len / per); a sliver too
+         * thin for that has no inside to probe */
         double eps = fmin(1e-6, 0.01 * len / (per > 0 ? per : 1));
         if (!(eps > 1e-9))
             continue;
         double q[3];
         for (int d = 0; d < 3; d++)
-            q[d] = (p[0][d] + p[1][d] + p[2][d]) / 3 - eps * n[d] / len;
+            q[d] = 0.3137 * p[0][d] + 0.3311 * p[1][d] + 0.3552 * p[2][d] - eps * n[d] / len;
         double omega = 0;
         for (size_t t = 0; t < m->ntris; t++) {
             double a[3][3];

@@ -340,14 +340,15 @@ static int winds_once(const ag_mesh *m, size_t t0, size_t t1, double tol, double
         double len = sqrt(dot3(nrm, nrm));
         double e3[3] = {f->e2[0] - f->e1[0], f->e2[1] - f->e1[1], f->e2[2] - f->e1[2]};
         double per = sqrt(dot3(f->e1, f->e1)) + sqrt(dot3(f->e2, f->e2)) + sqrt(dot3(e3, e3));
-        /* the probe: a hair behind the centre, well within the face's inscribed circle
-         * (len / per is its radius) and far above rounding */
+        /* the probe: a hair behind a point near the centre (weights no grid of whole or
+         * decimal metres lines up with), well within the face's inscribed circle (len /
+         * per is its radius) and far above rounding */
         double eps = fmin(AG_VERIFY_WINDING_PROBE * size, 0.01 * len / per);
         if (!(eps > AG_VERIFY_WINDING_THIN * size))
             continue; /* a sliver too thin to probe */
         double q[3];
         for (int d = 0; d < 3; d++)
-            q[d] = f->a[d] + (f->e1[d] + f->e2[d]) / 3 - eps * nrm[d] / len;
+            q[d] = f->a[d] + 0.3311 * f->e1[d] + 0.3552 * f->e2[d] - eps * nrm[d] / len;
         long w = winding_along(T, n, q, 0.0123456789, 0.00713286);
         if (w != 1 && winding_along(T, n, q, -0.00871234, 0.0151112) == w) {
             snprintf(why, nwhy, "the building overlaps itself near (%.3f, %.3f, %.3f): it winds "
