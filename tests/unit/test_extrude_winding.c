@@ -199,6 +199,21 @@ typedef struct {
     size_t invalid, repairs, refused;
 } tally;
 
+/* Extrudes plan p (freed) into m with or without the repair; AG_OK, or the refusal of
+ * validation (AG_ERR_INVALID, AG_ERR_EMPTY); any other failure of the sweep fails the test. */
+static ag_status extrude_with(ag_plan *p, int repair, ag_mesh *m, ag_extrude_result *r,
+                              const char *what)
+{
+    ag_extrude_options eo = {0};
+    eo.no_winding_repair = !repair;
+    ag_error err = {0};
+    ag_status st = ag_extrude_plan_with(p, &eo, m, -1, r, NULL, &err);
+    ag_plan_free(p);
+    if (st != AG_OK && st != AG_ERR_INVALID && st != AG_ERR_EMPTY)
+        fail_msg("%s: extrusion failed: %s", what, err.text);
+    return st;
+}
+
 /* Extrudes one plan (the loop xy of n corners, profile index prof per edge or all `uni`)
  * with and without the repair and checks both results independently. */
 static void run_plan(const double *xy, size_t n, const ag_profile_point *const *profs,
@@ -219,15 +234,8 @@ static void run_plan(const double *xy, size_t n, const ag_profile_point *const *
         ag_plan_add_loop(p, xy, n, pr, NULL);
         ag_mesh *m = ag_mesh_create();
         ag_extrude_result r;
-        ag_extrude_options eo = {0};
-        eo.no_winding_repair = !repair;
-        ag_error err = {0};
-        ag_status st = ag_extrude_plan_with(p, &eo, m, -1, &r, NULL, &err);
-        ag_plan_free(p);
-        if (st != AG_OK) {
-            /* validation may refuse a generated plan; the sweep may not fail otherwise */
-            if (st != AG_ERR_INVALID && st != AG_ERR_EMPTY)
-                fail_msg("%s: extrusion failed: %s", what, err.text);
+        if (extrude_with(p, repair, m, &r, what) != AG_OK) {
+            /* validation may refuse a generated plan */
             ag_mesh_free(m);
             if (repair)
                 t->plans--;
@@ -512,8 +520,16 @@ static void test_grid_plans_fall_back_honestly(void **state)
 /* Indices of grid_profiles(). */
 enum { GP_HIP, GP_STEEP, GP_WALL, GP_R2, GP_OVER, GP_SOFFIT, GP_R45, GP_TERRACE };
 
-/* Volume of the triangles (about their first vertex: UTM-sized coordinates keep their
- * digits), computed here from the mesh alone. */
+/* The corners of triangle t of m about the point o (UTM-sized coordinates keep their
+ * digits). */
+static void corners_about(const ag_mesh *m, size_t t, const double *o, double p[3][3])
+{
+    for (int k = 0; k < 3; k++)
+        for (int d = 0; d < 3; d++)
+            p[k][d] = m->pos[3 * m->tri[3 * t + k] + d] - o[d];
+}
+
+/* Volume of the triangles, computed here from the mesh alone. */
 static double mesh_volume(const ag_mesh *m)
 {
     if (!m->ntris)
@@ -522,16 +538,13 @@ static double mesh_volume(const ag_mesh *m)
     double v = 0;
     for (size_t t = 0; t < m->ntris; t++) {
         double p[3][3];
-        for (int k = 0; k < 3; k++)
-            for (int d = 0; d < 3; d++)
-                p[k][d] = m->pos[3 * m->tri[3 * t + k] + d] - o[d];
+        corners_about(m, t, o, p);
         v += p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) -
              p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
              p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0]);
     }
     return v / 6;
 }
-
 
 /* Solid angle of triangle (a, b, c) seen from the origin (van Oosterom and Strackee). */
 static double solid_angle(const double a[3], const double b[3], const double c[3])
@@ -548,7 +561,7 @@ static double solid_angle(const double a[3], const double b[3], const double c[3
 }
 
 /* The winding number of the triangles about a point just inside each of them (a hair
- * behind its centre) that is furthest from 1: 1 everywhere for a shell that bounds its
+ * behind a point near its centre) that is furthest from 1: 1 everywhere for a shell that bounds its
  * solid once; 2 or more where a face of the shell lies inside another part of it (a shell
  * overlapping itself), 0 behind a face with no solid behind it (a fin of two faces back to
  * back, a double-sided sliver): neither shows in welding and counting faces per edge. */
@@ -560,9 +573,7 @@ static long max_winding(const ag_mesh *m)
     long worst = 1;
     for (size_t s = 0; s < m->ntris; s++) {
         double p[3][3];
-        for (int c = 0; c < 3; c++)
-            for (int d = 0; d < 3; d++)
-                p[c][d] = m->pos[3 * m->tri[3 * s + c] + d] - o[d];
+        corners_about(m, s, o, p);
         double u[3], v[3], n[3];
         for (int d = 0; d < 3; d++)
             u[d] = p[1][d] - p[0][d], v[d] = p[2][d] - p[0][d];
@@ -585,10 +596,8 @@ static long max_winding(const ag_mesh *m)
             q[d] = 0.3137 * p[0][d] + 0.3311 * p[1][d] + 0.3552 * p[2][d] - eps * n[d] / len;
         double omega = 0;
         for (size_t t = 0; t < m->ntris; t++) {
-            double a[3][3];
-            for (int c = 0; c < 3; c++)
-                for (int d = 0; d < 3; d++)
-                    a[c][d] = m->pos[3 * m->tri[3 * t + c] + d] - o[d] - q[d];
+            double a[3][3], oq[3] = {o[0] + q[0], o[1] + q[1], o[2] + q[2]};
+            corners_about(m, t, oq, a);
             omega += solid_angle(a[0], a[1], a[2]);
         }
         long w = lround(omega / (4 * M_PI));
@@ -624,14 +633,7 @@ static xoutcome extrude_grid(const double *xy, size_t n, const int32_t *prof, do
     ag_plan_add_loop(p, xy, n, prof, NULL);
     ag_mesh *m = ag_mesh_create();
     ag_extrude_result r;
-    ag_extrude_options eo = {0};
-    eo.no_winding_repair = !repair;
-    ag_error err = {0};
-    ag_status st = ag_extrude_plan_with(p, &eo, m, -1, &r, NULL, &err);
-    ag_plan_free(p);
-    if (st != AG_OK) {
-        if (st != AG_ERR_INVALID && st != AG_ERR_EMPTY)
-            fail_msg("%s: extrusion failed: %s", what, err.text);
+    if (extrude_with(p, repair, m, &r, what) != AG_OK) {
         ag_mesh_free(m);
         return o;
     }
