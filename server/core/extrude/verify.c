@@ -254,13 +254,138 @@ static double dot3(const double *u, const double *v)
     return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
 }
 
+/* The faces in cells of the plan, so that a ray, which leans little, meets only the faces
+ * over the few cells it passes (a building of 12,000 triangles would otherwise test every
+ * face for every probe). Faces over more cells than VGRID_MAX_CELLS are kept in a list
+ * every ray tests. */
+#define VGRID_MAX_CELLS 16
+
+typedef struct {
+    double x0, y0, cell;
+    size_t nx, ny;
+    uint32_t *start; /* nx * ny + 1 offsets into items */
+    uint32_t *items;
+    uint32_t *big;
+    size_t nbig;
+    uint32_t *seen; /* the query that last took each face */
+    uint32_t query;
+    uint32_t *cand; /* one query's faces */
+    double zmax;
+} vgrid;
+
+static void vgrid_free(vgrid *g)
+{
+    free(g->start);
+    free(g->items);
+    free(g->big);
+    free(g->seen);
+    free(g->cand);
+}
+
+static void vgrid_cells(const vgrid *g, double lo_x, double lo_y, double hi_x, double hi_y,
+                        size_t *ix0, size_t *iy0, size_t *ix1, size_t *iy1)
+{
+    double fx0 = floor((lo_x - g->x0) / g->cell), fy0 = floor((lo_y - g->y0) / g->cell);
+    double fx1 = floor((hi_x - g->x0) / g->cell), fy1 = floor((hi_y - g->y0) / g->cell);
+    *ix0 = fx0 < 0 ? 0 : fx0 >= (double)g->nx ? g->nx - 1 : (size_t)fx0;
+    *iy0 = fy0 < 0 ? 0 : fy0 >= (double)g->ny ? g->ny - 1 : (size_t)fy0;
+    *ix1 = fx1 < 0 ? 0 : fx1 >= (double)g->nx ? g->nx - 1 : (size_t)fx1;
+    *iy1 = fy1 < 0 ? 0 : fy1 >= (double)g->ny ? g->ny - 1 : (size_t)fy1;
+}
+
+static int vgrid_build(vgrid *g, const vtri *T, size_t n)
+{
+    memset(g, 0, sizeof *g);
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    g->zmax = -INFINITY;
+    for (size_t t = 0; t < n; t++)
+        for (int d = 0; d < 2; d++) {
+            lo[d] = fmin(lo[d], T[t].lo[d]);
+            hi[d] = fmax(hi[d], T[t].hi[d]);
+            g->zmax = fmax(g->zmax, T[t].zhi);
+        }
+    double side = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+    size_t cells = (size_t)ceil(sqrt((double)n)) + 1;
+    g->cell = side > 0 ? side / (double)cells : 1;
+    g->x0 = lo[0];
+    g->y0 = lo[1];
+    g->nx = (size_t)((hi[0] - lo[0]) / g->cell) + 1;
+    g->ny = (size_t)((hi[1] - lo[1]) / g->cell) + 1;
+    g->start = calloc(g->nx * g->ny + 1, sizeof *g->start);
+    g->big = malloc((n ? n : 1) * sizeof *g->big);
+    g->seen = calloc(n ? n : 1, sizeof *g->seen);
+    g->cand = malloc((n ? n : 1) * sizeof *g->cand);
+    if (!g->start || !g->big || !g->seen || !g->cand)
+        return 0;
+    size_t total = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t t = 0; t < n; t++) {
+            size_t ix0, iy0, ix1, iy1;
+            vgrid_cells(g, T[t].lo[0], T[t].lo[1], T[t].hi[0], T[t].hi[1], &ix0, &iy0, &ix1,
+                        &iy1);
+            if ((ix1 - ix0 + 1) * (iy1 - iy0 + 1) > VGRID_MAX_CELLS) {
+                if (pass == 0)
+                    g->big[g->nbig++] = (uint32_t)t;
+                continue;
+            }
+            for (size_t iy = iy0; iy <= iy1; iy++)
+                for (size_t ix = ix0; ix <= ix1; ix++) {
+                    size_t c = iy * g->nx + ix;
+                    if (pass == 0)
+                        g->start[c + 1]++;
+                    else
+                        g->items[g->start[c]++] = (uint32_t)t;
+                }
+        }
+        if (pass == 0) {
+            for (size_t c = 0; c < g->nx * g->ny; c++)
+                g->start[c + 1] += g->start[c];
+            total = g->start[g->nx * g->ny];
+            g->items = malloc((total ? total : 1) * sizeof *g->items);
+            if (!g->items)
+                return 0;
+        }
+    }
+    /* the fill moved each start to the next cell's: move them back */
+    for (size_t c = g->nx * g->ny; c > 0; c--)
+        g->start[c] = g->start[c - 1];
+    g->start[0] = 0;
+    return 1;
+}
+
+/* The faces a ray from q along (dx, dy, 1) may meet, into g->cand; their number. */
+static size_t vgrid_query(vgrid *g, const double *q, double dx, double dy)
+{
+    double rise = fmax(0, g->zmax - q[2]);
+    double ex = q[0] + rise * dx, ey = q[1] + rise * dy;
+    size_t ix0, iy0, ix1, iy1, n = 0;
+    vgrid_cells(g, fmin(q[0], ex), fmin(q[1], ey), fmax(q[0], ex), fmax(q[1], ey), &ix0, &iy0,
+                &ix1, &iy1);
+    g->query++;
+    for (size_t iy = iy0; iy <= iy1; iy++)
+        for (size_t ix = ix0; ix <= ix1; ix++) {
+            size_t c = iy * g->nx + ix;
+            for (uint32_t k = g->start[c]; k < g->start[c + 1]; k++) {
+                uint32_t t = g->items[k];
+                if (g->seen[t] != g->query) {
+                    g->seen[t] = g->query;
+                    g->cand[n++] = t;
+                }
+            }
+        }
+    for (size_t k = 0; k < g->nbig; k++)
+        g->cand[n++] = g->big[k];
+    return n;
+}
+
 /* Winding number of the faces about q along the ray q + t (dx, dy, 1), t > 0. */
-static long winding_along(const vtri *T, size_t n, const double *q, double dx, double dy)
+static long winding_along(const vtri *T, vgrid *g, const double *q, double dx, double dy)
 {
     const double d[3] = {dx, dy, 1};
     long w = 0;
-    for (size_t t = 0; t < n; t++) {
-        const vtri *f = &T[t];
+    size_t n = vgrid_query(g, q, dx, dy);
+    for (size_t k = 0; k < n; k++) {
+        const vtri *f = &T[g->cand[k]];
         if (f->zhi < q[2])
             continue;
         /* where the ray is while it is below the face's top */
@@ -275,8 +400,8 @@ static long winding_along(const vtri *T, size_t n, const double *q, double dx, d
         double det = dot3(f->e1, p);
         if (det == 0)
             continue;
-        for (int k = 0; k < 3; k++)
-            s[k] = q[k] - f->a[k];
+        for (int i = 0; i < 3; i++)
+            s[i] = q[i] - f->a[i];
         double u = dot3(s, p) / det;
         if (u < 0 || u > 1)
             continue;
@@ -332,7 +457,10 @@ static int winds_once(const ag_mesh *m, size_t t0, size_t t1, double tol, double
         }
         f->zhi = fmax(p[0][2], fmax(p[1][2], p[2][2]));
     }
-    int ok = 1;
+    vgrid g;
+    int ok = vgrid_build(&g, T, n);
+    if (!ok)
+        snprintf(why, nwhy, "out of memory checking the building");
     for (size_t t = 0; t < n && ok; t++) {
         const vtri *f = &T[t];
         double nrm[3];
@@ -349,14 +477,15 @@ static int winds_once(const ag_mesh *m, size_t t0, size_t t1, double tol, double
         double q[3];
         for (int d = 0; d < 3; d++)
             q[d] = f->a[d] + 0.3311 * f->e1[d] + 0.3552 * f->e2[d] - eps * nrm[d] / len;
-        long w = winding_along(T, n, q, 0.0123456789, 0.00713286);
-        if (w != 1 && winding_along(T, n, q, -0.00871234, 0.0151112) == w) {
+        long w = winding_along(T, &g, q, 0.0123456789, 0.00713286);
+        if (w != 1 && winding_along(T, &g, q, -0.00871234, 0.0151112) == w) {
             snprintf(why, nwhy, "the building overlaps itself near (%.3f, %.3f, %.3f): it winds "
                      "%ld times there (parts swept through each other)", q[0] + o[0],
                      q[1] + o[1], q[2] + o[2], w);
             ok = 0;
         }
     }
+    vgrid_free(&g);
     free(T);
     free(id);
     return ok;
