@@ -7,7 +7,9 @@
  * repair may not make fewer buildings good. The winding number of each shell about a point
  * just inside each face must be 1 (no part overlapping another, no fin of faces back to
  * back). Uniform 45° roofs must rise as high as CGAL's
- * highest offset time where the oracle is built. */
+ * highest offset time where the oracle is built. Plans built to cross after the
+ * inter-chain stage (arrowheads, combs of them, a grid core) must be rebuilt into good
+ * shells; plans whose parts touch or whose flat steps fold must fall back. */
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -405,6 +407,9 @@ static void test_against_cgal(void **state)
            worst);
 }
 
+/* Indices of grid_profiles(). */
+enum { GP_HIP, GP_STEEP, GP_WALL, GP_R2, GP_OVER, GP_SOFFIT, GP_R45, GP_TERRACE };
+
 /* The integer-grid stress profiles (bench/extrude.c): horizontal segments inwards and
  * outwards at whole heights, so parts of a building touch exactly along edges. */
 static void grid_profiles(ag_plan *p, double h)
@@ -448,6 +453,10 @@ static ag_built build_checked(const double *xy, size_t n, const int32_t *prof, d
         if (!xc_closed_manifold(m, -1, 1e-7, why, sizeof why))
             fail_msg("%s (repair %s): built %s but %s", what, repair ? "on" : "off",
                      ag_built_name(r.built), why);
+        long w = max_winding(m);
+        if (w != 1)
+            fail_msg("%s (repair %s): built %s but the shell winds %ld times just inside a face",
+                     what, repair ? "on" : "off", ag_built_name(r.built), w);
         const double *loops[1] = {xy};
         size_t sizes[1] = {n};
         double out = xc_outside(m, -1, loops, sizes, 1, 0);
@@ -477,6 +486,29 @@ static void test_touching_parts_fall_back(void **state)
         ag_built b = build_checked(sq, 4, prof, 1, repair, "touching square");
         assert_int_not_equal(b, AG_BUILT_STYLED);
         assert_int_not_equal(b, AG_BUILT_NONE);
+    }
+}
+
+/* A triangle whose one edge's terrace moves in a metre at height 1 while the next edge's
+ * soffit moves out a metre: the horizontal faces the two sweep overlap inside out (the
+ * shell winds 0 times behind part of them). It must be reported and fall back, with the
+ * repair as without; the fallback is checked like any building. Turned and at UTM-sized
+ * coordinates too. */
+static void test_terrace_meets_soffit_falls_back(void **state)
+{
+    (void)state;
+    static const double tri[] = {4, 4, 6, 4, 5, 6};
+    const int32_t prof[] = {GP_HIP, GP_TERRACE, GP_SOFFIT};
+    double xy[6];
+    for (int variant = 0; variant < 16; variant += 5) {
+        transform(tri, 3, variant, xy);
+        char what[64];
+        snprintf(what, sizeof what, "terrace meets soffit, variant %d", variant);
+        for (int repair = 0; repair < 2; repair++) {
+            ag_built b = build_checked(xy, 3, prof, 1, repair, what);
+            assert_int_not_equal(b, AG_BUILT_STYLED);
+            assert_int_not_equal(b, AG_BUILT_NONE);
+        }
     }
 }
 
@@ -516,9 +548,6 @@ static void test_grid_plans_fall_back_honestly(void **state)
 }
 
 /* --- plans whose chains cross after the inter-chain stage --------------------------------- */
-
-/* Indices of grid_profiles(). */
-enum { GP_HIP, GP_STEEP, GP_WALL, GP_R2, GP_OVER, GP_SOFFIT, GP_R45, GP_TERRACE };
 
 /* The corners of triangle t of m about the point o (UTM-sized coordinates keep their
  * digits). */
@@ -846,6 +875,7 @@ int main(void)
         cmocka_unit_test(test_generated_shapes),
         cmocka_unit_test(test_against_cgal),
         cmocka_unit_test(test_touching_parts_fall_back),
+        cmocka_unit_test(test_terrace_meets_soffit_falls_back),
         cmocka_unit_test(test_grid_plans_fall_back_honestly),
         cmocka_unit_test(test_crossing_chains_rebuilt),
         cmocka_unit_test(test_grid_coincidence_rebuilt),
