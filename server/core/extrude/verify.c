@@ -282,15 +282,21 @@ static void vgrid_free(vgrid *g)
     free(g->cand);
 }
 
+/* Cell f clamped to [0, n) (a NaN to 0). */
+static size_t vgrid_index(double f, size_t n)
+{
+    if (!(f >= 0))
+        return 0;
+    return f < (double)n ? (size_t)f : n - 1;
+}
+
 static void vgrid_cells(const vgrid *g, double lo_x, double lo_y, double hi_x, double hi_y,
                         size_t *ix0, size_t *iy0, size_t *ix1, size_t *iy1)
 {
-    double fx0 = floor((lo_x - g->x0) / g->cell), fy0 = floor((lo_y - g->y0) / g->cell);
-    double fx1 = floor((hi_x - g->x0) / g->cell), fy1 = floor((hi_y - g->y0) / g->cell);
-    *ix0 = fx0 < 0 ? 0 : fx0 >= (double)g->nx ? g->nx - 1 : (size_t)fx0;
-    *iy0 = fy0 < 0 ? 0 : fy0 >= (double)g->ny ? g->ny - 1 : (size_t)fy0;
-    *ix1 = fx1 < 0 ? 0 : fx1 >= (double)g->nx ? g->nx - 1 : (size_t)fx1;
-    *iy1 = fy1 < 0 ? 0 : fy1 >= (double)g->ny ? g->ny - 1 : (size_t)fy1;
+    *ix0 = vgrid_index(floor((lo_x - g->x0) / g->cell), g->nx);
+    *iy0 = vgrid_index(floor((lo_y - g->y0) / g->cell), g->ny);
+    *ix1 = vgrid_index(floor((hi_x - g->x0) / g->cell), g->nx);
+    *iy1 = vgrid_index(floor((hi_y - g->y0) / g->cell), g->ny);
 }
 
 static int vgrid_build(vgrid *g, const vtri *T, size_t n)
@@ -306,11 +312,12 @@ static int vgrid_build(vgrid *g, const vtri *T, size_t n)
         }
     double side = fmax(hi[0] - lo[0], hi[1] - lo[1]);
     size_t cells = (size_t)ceil(sqrt((double)n)) + 1;
-    g->cell = side > 0 ? side / (double)cells : 1;
-    g->x0 = lo[0];
-    g->y0 = lo[1];
-    g->nx = (size_t)((hi[0] - lo[0]) / g->cell) + 1;
-    g->ny = (size_t)((hi[1] - lo[1]) / g->cell) + 1;
+    int finite = isfinite(side) && isfinite(lo[0]) && isfinite(lo[1]);
+    g->cell = finite && side > 0 ? side / (double)cells : 1;
+    g->x0 = finite ? lo[0] : 0;
+    g->y0 = finite ? lo[1] : 0;
+    g->nx = finite ? vgrid_index((hi[0] - lo[0]) / g->cell, cells + 1) + 1 : 1;
+    g->ny = finite ? vgrid_index((hi[1] - lo[1]) / g->cell, cells + 1) + 1 : 1;
     g->start = calloc(g->nx * g->ny + 1, sizeof *g->start);
     g->big = malloc((n ? n : 1) * sizeof *g->big);
     g->seen = calloc(n ? n : 1, sizeof *g->seen);
