@@ -3,7 +3,9 @@
  * memory) and as the whole `archgram proceduralize` process (wall and CPU seconds, the figure
  * a user waits for), then every OBJ mesh in ../shared/data. Not a test.
  *
- * build/bench/proceduralize [--generated]   (--generated: the generated meshes only) */
+ * build/bench/proceduralize [--generated] [--keep DIR]
+ *   --generated  the generated meshes only
+ *   --keep DIR   also keep each generated mesh as DIR/<name>.obj, to profile the CLI on it */
 #include <dirent.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -21,6 +23,8 @@
 #include "io/terminals.h"
 
 #define SHARED AG_REPO_DIR "/../shared/data"
+
+static const char *keep_dir; /* --keep DIR */
 
 static double now(void)
 {
@@ -190,6 +194,15 @@ static void run_mesh_file(const char *name, ag_mesh *g)
     run(name, m, t_import);
     ag_mesh_free(m);
     run_cli(name, path);
+    if (keep_dir) {
+        char kept[1024], *k;
+        snprintf(kept, sizeof kept, "%s/%s.obj", keep_dir, name);
+        for (k = kept + strlen(keep_dir) + 1; *k; k++)
+            if (*k == ' ' || *k == '(' || *k == ')')
+                *k = '_';
+        if (rename(path, kept))
+            printf("%-34s could not keep it as %s\n", name, kept);
+    }
     unlink(path);
 }
 
@@ -250,7 +263,17 @@ static void run_block(const char *name, const ag_gen_facade_options *go, unsigne
 
 int main(int argc, char **argv)
 {
-    int generated_only = argc > 1 && !strcmp(argv[1], "--generated");
+    int generated_only = 0;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--generated")) {
+            generated_only = 1;
+        } else if (!strcmp(argv[i], "--keep") && i + 1 < argc) {
+            keep_dir = argv[++i];
+        } else {
+            fprintf(stderr, "usage: %s [--generated] [--keep DIR]\n", argv[0]);
+            return 2;
+        }
+    }
     header();
     /* 4 facades of 40 x 20 / 30 x 20 windows: ~235k triangles, one group per element */
     ag_gen_facade_options go = {.cols = 40, .rows = 20, .side_cols = 30, .back = 1, .left = 1,

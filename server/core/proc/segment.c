@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/radix.h"
 #include "../base/tolerance.h"
 #include "../base/uf.h"
 #include "weld.h"
@@ -36,18 +37,9 @@ ag_status ag_segment_validate(const ag_mesh *m, ag_error *err)
     return AG_OK;
 }
 
-typedef struct {
-    uint64_t key;
-    uint32_t tri;
-} keyed;
-
-static int cmp_keyed(const void *a, const void *b)
-{
-    const keyed *x = a, *y = b;
-    if (x->key != y->key)
-        return x->key < y->key ? -1 : 1;
-    return x->tri < y->tri ? -1 : x->tri > y->tri;
-}
+/* Records sorted by key with ag_radix_sort; val is a triangle, and the records are filled
+ * in ascending triangle order, so equal keys stay in triangle order. */
+typedef ag_radix_item keyed;
 
 static void tri_normal(const ag_mesh *m, size_t t, double n[3], double *area2)
 {
@@ -86,9 +78,13 @@ static ag_status planar_regions(const ag_mesh *m, const uint32_t *wid, double co
                 b = s;
             }
             e[3 * t + k].key = a << 32 | b;
-            e[3 * t + k].tri = (uint32_t)t;
+            e[3 * t + k].val = (uint32_t)t;
         }
-    qsort(e, 3 * n, sizeof *e, cmp_keyed);
+    if (ag_radix_sort(e, 3 * n)) {
+        free(e);
+        free(queue);
+        return AG_ERR_NOMEM;
+    }
     /* per triangle, positions of its three edges in the sorted array */
     uint32_t *at = malloc(3 * n * sizeof *at);
     uint8_t *seen = calloc(3 * n, 1);
@@ -100,7 +96,7 @@ static ag_status planar_regions(const ag_mesh *m, const uint32_t *wid, double co
         return AG_ERR_NOMEM;
     }
     for (size_t i = 0; i < 3 * n; i++) {
-        uint32_t t = e[i].tri;
+        uint32_t t = e[i].val;
         int k = 0;
         while (seen[3 * t + k])
             k++;
@@ -130,7 +126,7 @@ static ag_status planar_regions(const ag_mesh *m, const uint32_t *wid, double co
                 while (hi + 1 < 3 * n && e[hi + 1].key == e[i].key)
                     hi++;
                 for (size_t j = lo; j <= hi; j++) {
-                    uint32_t u = e[j].tri;
+                    uint32_t u = e[j].val;
                     if (piece[u] != UINT32_MAX)
                         continue;
                     double nu[3], au;
@@ -206,12 +202,13 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
     for (size_t t = 0; t < n; t++)
         for (int k = 0; k < 3; k++) {
             kv[3 * t + k].key = (uint64_t)in->tri_component[t] << 32 | wid[in->tri[3 * t + k]];
-            kv[3 * t + k].tri = (uint32_t)t;
+            kv[3 * t + k].val = (uint32_t)t;
         }
-    qsort(kv, 3 * n, sizeof *kv, cmp_keyed);
+    if (ag_radix_sort(kv, 3 * n))
+        goto done;
     for (size_t i = 1; i < 3 * n; i++)
         if (kv[i].key == kv[i - 1].key)
-            ag_uf_union(&uf, kv[i].tri, kv[i - 1].tri);
+            ag_uf_union(&uf, kv[i].val, kv[i - 1].val);
     for (size_t t = 0; t < n; t++)
         piece[t] = ag_uf_find(&uf, (uint32_t)t); /* root: a triangle of the piece */
     ag_uf_free(&uf);
@@ -264,11 +261,11 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
                     h = ag__mix64(h ^ (uint64_t)(int64_t)floor(ag_box_extent(&pbox[t], a) / q +
                                                                 0.5));
                 kv[nk].key = h;
-                kv[nk++].tri = (uint32_t)t;
+                kv[nk++].val = (uint32_t)t;
             }
-        qsort(kv, nk, sizeof *kv, cmp_keyed);
         size_t *twin_tris = calloc(nc, sizeof *twin_tris);
-        if (!twin_tris) {
+        if (!twin_tris || ag_radix_sort(kv, nk)) {
+            free(twin_tris);
             free(pcount);
             free(pbox);
             free(npieces);
@@ -278,7 +275,7 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
             int tw = (i > 0 && kv[i - 1].key == kv[i].key) ||
                      (i + 1 < nk && kv[i + 1].key == kv[i].key);
             if (tw)
-                twin_tris[in->tri_component[kv[i].tri]] += pcount[kv[i].tri];
+                twin_tris[in->tri_component[kv[i].val]] += pcount[kv[i].val];
         }
         for (size_t c = 0; c < nc; c++) {
             if (npieces[c] < 2 || o.keep_groups)

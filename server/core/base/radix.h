@@ -1,0 +1,37 @@
+/* Stable LSD radix sort of (64-bit key, 32-bit value) records, O(n) per digit.
+ *
+ * Several stages of proceduralization sort millions of such records (a triangle's edges or
+ * corners keyed by vertex and component); a comparison sort through a function pointer
+ * (qsort) spends most of their time. Stability makes the result equal to a sort by (key,
+ * then position in the input): records filled in ascending value order come out exactly as
+ * a qsort comparing (key, value) would leave them. Digits where every key agrees are
+ * skipped, so keys that use few bits cost few passes. libc has no radix sort and the
+ * Debian libraries the core may use offer none, hence this one. */
+#ifndef AG_RADIX_H
+#define AG_RADIX_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "../status.h"
+
+typedef struct {
+    uint64_t key;
+    uint32_t val;
+} ag_radix_item;
+
+/* A key that sorts as the double x does (x not NaN; -0 and +0 equal). */
+static inline uint64_t ag_radix_key_double(double x)
+{
+    x += 0.0; /* -0 -> +0 */
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    return u >> 63 ? ~u : u | (1ull << 63);
+}
+
+/* Sorts a[0..n) by key, stably. Needs n records of scratch: AG_ERR_NOMEM when it cannot get
+ * them (a is then unchanged). */
+ag_status ag_radix_sort(ag_radix_item *a, size_t n);
+
+#endif
