@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "../base/array.h"
+#include "../base/radix.h"
 #include "../base/search.h"
 #include "../base/tolerance.h"
 #include "gframe.h"
@@ -37,19 +38,6 @@ void ag_label_rotate(int k, double *x, double *y)
     }
 }
 
-typedef struct {
-    uint64_t h;
-    uint32_t i;
-} hidx;
-
-static int cmp_hidx(const void *a, const void *b)
-{
-    const hidx *x = a, *y = b;
-    if (x->h != y->h)
-        return x->h < y->h ? -1 : 1;
-    return x->i < y->i ? -1 : x->i > y->i;
-}
-
 static void centroid(const double *t, double c[3])
 {
     for (int a = 0; a < 3; a++)
@@ -69,8 +57,11 @@ static double tri_dist(const double *x, const double *y, int shift)
     return sqrt(m);
 }
 
-double ag_label_match_triangles(const double *a, size_t na, const double *b, size_t nb,
-                                double tol, size_t *unmatched)
+/* ag_label_match_triangles; with stop_at_miss it returns at the first triangle of b without
+ * a partner (*unmatched then 1): a comparison that only asks whether all match stops there
+ * instead of probing every other triangle. */
+static double match_soups(const double *a, size_t na, const double *b, size_t nb, double tol,
+                          size_t *unmatched, int stop_at_miss)
 {
     size_t miss = 0;
     double worst = 0;
@@ -96,7 +87,8 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
         worst = 0;
     }
     double cell = 2 * tol; /* a match within tol lies in a neighbouring cell */
-    hidx *ha = malloc((na + 1) * sizeof *ha);
+    /* records keyed by the cell hash of a's centroids (ag_radix_item: h = key, i = val) */
+    ag_radix_item *ha = malloc((na + 1) * sizeof *ha);
     uint8_t *used = calloc(na + 1, 1);
     if (!ha || !used) {
         free(ha);
@@ -106,11 +98,15 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
     for (size_t i = 0; i < na; i++) {
         double c[3];
         centroid(a + 9 * i, c);
-        ha[i].h = ag__cell_hash((int64_t)floor(c[0] / cell), (int64_t)floor(c[1] / cell),
-                                (int64_t)floor(c[2] / cell));
-        ha[i].i = (uint32_t)i;
+        ha[i].key = ag__cell_hash((int64_t)floor(c[0] / cell), (int64_t)floor(c[1] / cell),
+                                  (int64_t)floor(c[2] / cell));
+        ha[i].val = (uint32_t)i;
     }
-    qsort(ha, na, sizeof *ha, cmp_hidx);
+    if (ag_radix_sort(ha, na)) {
+        free(ha);
+        free(used);
+        return -1;
+    }
     for (size_t j = 0; j < nb; j++) {
         const double *tb = b + 9 * j;
         double c[3];
@@ -123,9 +119,9 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
             for (int dy = -1; dy <= 1; dy++)
                 for (int dz = -1; dz <= 1; dz++) {
                     uint64_t h = ag__cell_hash(k0 + dx, k1 + dy, k2 + dz);
-                    size_t lo = ag_search_lower_u64(&ha[0].h, na, sizeof *ha, h);
-                    for (size_t s = lo; s < na && ha[s].h == h; s++) {
-                        uint32_t i = ha[s].i;
+                    size_t lo = ag_search_lower_u64(&ha[0].key, na, sizeof *ha, h);
+                    for (size_t s = lo; s < na && ha[s].key == h; s++) {
+                        uint32_t i = ha[s].val;
                         if (used[i])
                             continue;
                         for (int sh = 0; sh < 3; sh++) {
@@ -139,6 +135,8 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
                 }
         if (besti == SIZE_MAX) {
             miss++;
+            if (stop_at_miss)
+                break;
             continue;
         }
         used[besti] = 1;
@@ -150,6 +148,23 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
     if (unmatched)
         *unmatched = miss;
     return worst;
+}
+
+double ag_label_match_triangles(const double *a, size_t na, const double *b, size_t nb,
+                                double tol, size_t *unmatched)
+{
+    return match_soups(a, na, b, nb, tol, unmatched, 0);
+}
+
+int ag_label_soups_match(const double *a, size_t na, const double *b, size_t nb, double tol,
+                         double *worst)
+{
+    size_t miss = 0;
+    double w = match_soups(a, na, b, nb, tol, &miss, 1);
+    if (w < 0)
+        return -1;
+    *worst = w;
+    return miss == 0;
 }
 
 /* The surfaces of soups a and b, each on the other. */
@@ -182,14 +197,9 @@ int ag_label_same_surface(const double *a, size_t na, const double *b, size_t nb
                           double *deviation)
 {
     if (na == nb) {
-        size_t miss = 0;
-        double w = ag_label_match_triangles(a, na, b, nb, tol, &miss);
-        if (w < 0)
-            return -1;
-        if (!miss) {
-            *deviation = w;
-            return 1;
-        }
+        int same = ag_label_soups_match(a, na, b, nb, tol, deviation);
+        if (same)
+            return same;
     }
     return surfaces_match(a, na, b, nb, tol, deviation);
 }
@@ -397,16 +407,10 @@ static int compare(lctx *x, size_t na, size_t nb, double tol, int fast, double *
     if (fast) {
         if (na != nb)
             return 0;
-        size_t miss = 0;
-        double w = ag_label_match_triangles(x->sa, na, x->sb, nb, tol, &miss);
-        if (w < 0) {
+        int same = ag_label_soups_match(x->sa, na, x->sb, nb, tol, dev);
+        if (same < 0)
             x->nomem = 1;
-            return 0;
-        }
-        if (miss)
-            return 0;
-        *dev = w;
-        return 1;
+        return same > 0;
     }
     if (!x->checks_left)
         return 0; /* past the budget: no match, never a wrong one */
