@@ -173,10 +173,16 @@ static ag_status write_model(ag_folder_ws *w, const ag_model_state *st, ag_error
     if (s == AG_OK)
         s = write_file(w, path, st->text, st->text_len, err);
     snprintf(path, sizeof path, "%s/tree.json", dir);
-    json_t *tree = s == AG_OK ? ag_model_tree_folder(st->em) : NULL;
-    if (s == AG_OK) /* the served tree's precision (model_tree.c) */
-        s = write_json(w, path, tree, JSON_INDENT(1) | JSON_REAL_PRECISION(15), err);
-    json_decref(tree);
+    if (s != AG_OK)
+        return s;
+    /* the served tree's precision (model_tree.c), printed directly */
+    char *tree = ag_model_tree_folder_text(st->em);
+    if (!tree) {
+        blame(w, NULL);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory writing %s", path);
+    }
+    s = write_file(w, path, tree, strlen(tree), err);
+    free(tree);
     return s;
 }
 
