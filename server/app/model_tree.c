@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../core/base/array.h"
+#include "../io/numtext.h"
 
 
 static const char *kind_name(int k)
@@ -248,9 +249,12 @@ static void out_str(text_out *o, const char *s, size_t n)
 
 static void out_int(text_out *o, long long v)
 {
-    char b[32];
-    int n = snprintf(b, sizeof b, "%lld", v);
-    out_str(o, b, (size_t)n);
+    char b[AG_NUMTEXT_MAX + 1];
+    size_t n = 0;
+    if (v < 0)
+        b[n++] = '-';
+    n += ag_numtext_u64(b + n, v < 0 ? 0 - (unsigned long long)v : (unsigned long long)v);
+    out_str(o, b, n);
 }
 
 /* A real as jansson prints it with REAL_PRECISION(15): %.15g, ".0" added to integral forms
@@ -260,7 +264,7 @@ static void out_real(text_out *o, double v)
     char b[40];
     if (v == 0)
         v = 0; /* no "-0.0" */
-    int n = snprintf(b, sizeof b, "%.15g", v);
+    int n = (int)ag_numtext_double_g15(b, v); /* "%.15g", fast */
     char *e = strchr(b, 'e');
     if (e) { /* jansson drops the exponent's '+' and leading zeros: 1e-07 is 1e-7, 1e+20 1e20 */
         char *d = e + 1;
@@ -497,7 +501,11 @@ fail:
  * json_dumps(ag_model_tree_folder(em), JSON_INDENT(1) | JSON_REAL_PRECISION(15)) prints. */
 static void out_indent(text_out *o, int depth)
 {
-    out_reserve(o, (size_t)depth + 1);
+    static const char line[] = "\n        "; /* the tree's indents are at most 4 */
+    if (depth < (int)sizeof line - 1) {
+        out_str(o, line, (size_t)depth + 1);
+        return;
+    }
     OUT_LIT(o, "\n");
     for (int i = 0; i < depth; i++)
         OUT_LIT(o, " ");
