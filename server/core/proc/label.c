@@ -1,5 +1,6 @@
 #include "label.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,24 +87,51 @@ static double match_soups(const double *a, size_t na, const double *b, size_t nb
         }
         worst = 0;
     }
-    double cell = 2 * tol; /* a match within tol lies in a neighbouring cell */
-    /* records keyed by the cell hash of a's centroids (ag_radix_item: h = key, i = val) */
-    ag_radix_item *ha = malloc((na + 1) * sizeof *ha);
+    /* A match within tol has its centroid within tol of b's on every axis. a's triangles
+     * are registered in the cells of size >= 4 r that [c - r, c + r] meets (r: tol, a
+     * little more for the centroids' rounding; at most 2 cells per axis), so one look-up of
+     * b's own cell finds every candidate. The choice among candidates is that of a scan of
+     * the 27 cells of size 2 tol around b's centroid, in cell order, then triangle order:
+     * the nearest, the first of that scan on a tie. */
+    double cell = 2 * tol, amax = 0;
+    for (size_t i = 0; i < 9 * na; i++)
+        amax = fmax(amax, fabs(a[i]));
+    double r = 1.01 * tol + 16 * DBL_EPSILON * (amax + 1), icell = 4 * r;
+    ag_radix_item *ha = NULL;
+    size_t nh = 0, cap_h = 0;
+    int64_t *acell = malloc((3 * na + 1) * sizeof *acell); /* a's cells of size 2 tol */
     uint8_t *used = calloc(na + 1, 1);
-    if (!ha || !used) {
+    if (!acell || !used || AG_ARRAY_RESERVE(ha, cap_h, 2 * na + 1)) {
         free(ha);
+        free(acell);
         free(used);
         return -1;
     }
     for (size_t i = 0; i < na; i++) {
         double c[3];
         centroid(a + 9 * i, c);
-        ha[i].key = ag__cell_hash((int64_t)floor(c[0] / cell), (int64_t)floor(c[1] / cell),
-                                  (int64_t)floor(c[2] / cell));
-        ha[i].val = (uint32_t)i;
+        int64_t lo[3], hi[3];
+        for (int q = 0; q < 3; q++) {
+            acell[3 * i + q] = (int64_t)floor(c[q] / cell);
+            lo[q] = (int64_t)floor((c[q] - r) / icell);
+            hi[q] = (int64_t)floor((c[q] + r) / icell);
+        }
+        for (int64_t x = lo[0]; x <= hi[0]; x++)
+            for (int64_t y = lo[1]; y <= hi[1]; y++)
+                for (int64_t z = lo[2]; z <= hi[2]; z++) {
+                    if (AG_ARRAY_RESERVE(ha, cap_h, nh + 1)) {
+                        free(ha);
+                        free(acell);
+                        free(used);
+                        return -1;
+                    }
+                    ha[nh].key = ag__cell_hash(x, y, z);
+                    ha[nh++].val = (uint32_t)i;
+                }
     }
-    if (ag_radix_sort(ha, na)) {
+    if (ag_radix_sort(ha, nh)) {
         free(ha);
+        free(acell);
         free(used);
         return -1;
     }
@@ -111,28 +139,37 @@ static double match_soups(const double *a, size_t na, const double *b, size_t nb
         const double *tb = b + 9 * j;
         double c[3];
         centroid(tb, c);
-        int64_t k0 = (int64_t)floor(c[0] / cell), k1 = (int64_t)floor(c[1] / cell),
-                k2 = (int64_t)floor(c[2] / cell);
+        int64_t k[3] = {(int64_t)floor(c[0] / cell), (int64_t)floor(c[1] / cell),
+                        (int64_t)floor(c[2] / cell)};
+        uint64_t h = ag__cell_hash((int64_t)floor(c[0] / icell), (int64_t)floor(c[1] / icell),
+                                   (int64_t)floor(c[2] / icell));
         double best = INFINITY;
         size_t besti = SIZE_MAX;
-        for (int dx = -1; dx <= 1; dx++)
-            for (int dy = -1; dy <= 1; dy++)
-                for (int dz = -1; dz <= 1; dz++) {
-                    uint64_t h = ag__cell_hash(k0 + dx, k1 + dy, k2 + dz);
-                    size_t lo = ag_search_lower_u64(&ha[0].key, na, sizeof *ha, h);
-                    for (size_t s = lo; s < na && ha[s].key == h; s++) {
-                        uint32_t i = ha[s].val;
-                        if (used[i])
-                            continue;
-                        for (int sh = 0; sh < 3; sh++) {
-                            double d = tri_dist(tb, a + 9 * (size_t)i, sh);
-                            if (d <= tol && d < best) {
-                                best = d;
-                                besti = i;
-                            }
-                        }
-                    }
-                }
+        int best_rank = 27;
+        size_t lo = ag_search_lower_u64(&ha[0].key, nh, sizeof *ha, h);
+        for (size_t s = lo; s < nh && ha[s].key == h; s++) {
+            uint32_t i = ha[s].val;
+            if (used[i])
+                continue;
+            int rank = 0, near = 1;
+            for (int q = 0; q < 3 && near; q++) {
+                int64_t off = acell[3 * (size_t)i + q] - k[q];
+                near = off >= -1 && off <= 1;
+                rank = 3 * rank + (int)(off + 1);
+            }
+            if (!near)
+                continue; /* outside the 27 cells */
+            double d = INFINITY;
+            for (int sh = 0; sh < 3; sh++)
+                d = fmin(d, tri_dist(tb, a + 9 * (size_t)i, sh));
+            if (!(d <= tol))
+                continue;
+            if (d < best || (d == best && (rank < best_rank || (rank == best_rank && i < besti)))) {
+                best = d;
+                besti = i;
+                best_rank = rank;
+            }
+        }
         if (besti == SIZE_MAX) {
             miss++;
             if (stop_at_miss)
@@ -144,6 +181,7 @@ static double match_soups(const double *a, size_t na, const double *b, size_t nb
             worst = best;
     }
     free(ha);
+    free(acell);
     free(used);
     if (unmatched)
         *unmatched = miss;
