@@ -3,11 +3,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define RADIX_BITS 11
+#define RADIX_BITS 8
 #define RADIX_SIZE (1u << RADIX_BITS)
-#define RADIX_PASSES ((64 + RADIX_BITS - 1) / RADIX_BITS) /* 6 */
+#define RADIX_PASSES (64 / RADIX_BITS)
 
-/* Below this a comparison-free insertion sort beats the histogram set-up. */
+/* Below this an insertion sort beats the histograms. */
 #define RADIX_SMALL 64
 
 static void insertion_sort(ag_radix_item *a, size_t n)
@@ -23,20 +23,18 @@ static void insertion_sort(ag_radix_item *a, size_t n)
     }
 }
 
-ag_status ag_radix_sort(ag_radix_item *a, size_t n)
+ag_status ag_radix_sort_with(ag_radix_item *a, size_t n, ag_radix_item *tmp)
 {
     if (n < RADIX_SMALL) {
         insertion_sort(a, n);
         return AG_OK;
     }
-    size_t(*count)[RADIX_SIZE] = calloc(RADIX_PASSES, sizeof *count);
-    ag_radix_item *tmp = malloc(n * sizeof *tmp);
-    if (!count || !tmp) {
-        free(count);
-        free(tmp);
+    ag_radix_item *own = NULL;
+    if (!tmp && !(tmp = own = malloc(n * sizeof *tmp)))
         return AG_ERR_NOMEM;
-    }
     /* every digit's histogram in one read of the keys */
+    size_t count[RADIX_PASSES][RADIX_SIZE];
+    memset(count, 0, sizeof count);
     for (size_t i = 0; i < n; i++) {
         uint64_t k = a[i].key;
         for (int p = 0; p < RADIX_PASSES; p++)
@@ -46,10 +44,7 @@ ag_status ag_radix_sort(ag_radix_item *a, size_t n)
     for (int p = 0; p < RADIX_PASSES; p++) {
         size_t *c = count[p];
         /* a digit every key shares leaves the order as it is */
-        int trivial = 0;
-        for (size_t d = 0; d < RADIX_SIZE && !trivial; d++)
-            trivial = c[d] == n;
-        if (trivial)
+        if (c[(a[0].key >> (p * RADIX_BITS)) & (RADIX_SIZE - 1)] == n)
             continue;
         size_t sum = 0;
         for (size_t d = 0; d < RADIX_SIZE; d++) {
@@ -66,7 +61,11 @@ ag_status ag_radix_sort(ag_radix_item *a, size_t n)
     }
     if (src != a)
         memcpy(a, src, n * sizeof *a);
-    free(tmp);
-    free(count);
+    free(own);
     return AG_OK;
+}
+
+ag_status ag_radix_sort(ag_radix_item *a, size_t n)
+{
+    return ag_radix_sort_with(a, n, NULL);
 }

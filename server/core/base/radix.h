@@ -5,7 +5,7 @@
  * (qsort) spends most of their time. Stability makes the result equal to a sort by (key,
  * then position in the input): records filled in ascending value order come out exactly as
  * a qsort comparing (key, value) would leave them. Digits where every key agrees are
- * skipped, so keys that use few bits cost few passes. libc has no radix sort and the
+ * skipped, so keys that use few bits cost few passes (byte digits). libc has no radix sort and the
  * Debian libraries the core may use offer none, hence this one. */
 #ifndef AG_RADIX_H
 #define AG_RADIX_H
@@ -33,5 +33,7 @@ static inline uint64_t ag_radix_key_double(double x)
 /* Sorts a[0..n) by key, stably. Needs n records of scratch: AG_ERR_NOMEM when it cannot get
  * them (a is then unchanged). */
 ag_status ag_radix_sort(ag_radix_item *a, size_t n);
+/* The same with the caller's scratch tmp (n records; NULL: allocated as above). */
+ag_status ag_radix_sort_with(ag_radix_item *a, size_t n, ag_radix_item *tmp);
 
 #endif
