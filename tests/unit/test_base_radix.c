@@ -72,9 +72,40 @@ static void test_double_keys_keep_order(void **state)
     }
 }
 
+/* The run index finds the first position of every present key and n for absent ones, as a
+ * lower bound on the sorted array would. */
+static void test_index_finds_runs(void **state)
+{
+    (void)state;
+    uint64_t s = 29;
+    const size_t sizes[] = {0, 1, 5, 300, 20000};
+    for (size_t si = 0; si < sizeof sizes / sizeof *sizes; si++) {
+        size_t n = sizes[si];
+        ag_radix_item *a = malloc((n + 1) * sizeof *a);
+        assert_non_null(a);
+        for (size_t i = 0; i < n; i++) {
+            a[i].key = (next_random(&s) % (n / 3 + 2)) * 0x9E3779B97F4A7C15ULL;
+            a[i].val = (uint32_t)i;
+        }
+        assert_int_equal(ag_radix_sort(a, n), AG_OK);
+        ag_radix_index x;
+        assert_int_equal(ag_radix_index_build(&x, a, n), AG_OK);
+        for (size_t q = 0; q < n / 3 + 40; q++) {
+            uint64_t key = q * 0x9E3779B97F4A7C15ULL;
+            size_t lo = 0;
+            while (lo < n && a[lo].key != key)
+                lo++;
+            assert_int_equal(ag_radix_index_find(&x, key), lo); /* n when absent */
+        }
+        ag_radix_index_free(&x);
+        free(a);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_index_finds_runs),
         cmocka_unit_test(test_sort_against_qsort),
         cmocka_unit_test(test_double_keys_keep_order),
     };

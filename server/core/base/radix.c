@@ -3,6 +3,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "array.h"
+
 #define RADIX_BITS 8
 #define RADIX_SIZE (1u << RADIX_BITS)
 #define RADIX_PASSES (64 / RADIX_BITS)
@@ -68,4 +70,50 @@ ag_status ag_radix_sort_with(ag_radix_item *a, size_t n, ag_radix_item *tmp)
 ag_status ag_radix_sort(ag_radix_item *a, size_t n)
 {
     return ag_radix_sort_with(a, n, NULL);
+}
+
+ag_status ag_radix_index_build(ag_radix_index *x, const ag_radix_item *sorted, size_t n)
+{
+    memset(x, 0, sizeof *x);
+    x->items = sorted;
+    x->n = n;
+    if (n == 0)
+        return AG_OK;
+    if (n >= UINT32_MAX)
+        return AG_ERR_TOO_LARGE;
+    size_t runs = 1;
+    for (size_t i = 1; i < n; i++)
+        runs += sorted[i].key != sorted[i - 1].key;
+    size_t cap;
+    ag_status st = ag_array_hash_size(runs, &cap);
+    if (st)
+        return st;
+    x->key = malloc(cap * sizeof *x->key);
+    x->start = malloc(cap * sizeof *x->start);
+    if (!x->key || !x->start) {
+        ag_radix_index_free(x);
+        return AG_ERR_NOMEM;
+    }
+    x->mask = cap - 1;
+    for (size_t i = 0; i < cap; i++)
+        x->start[i] = UINT32_MAX;
+    for (size_t i = 0; i < n; i++) {
+        if (i > 0 && sorted[i].key == sorted[i - 1].key)
+            continue;
+        uint64_t k = sorted[i].key, h = (k ^ (k >> 29)) * 0xbf58476d1ce4e5b9ULL;
+        size_t j = (size_t)(h >> 17) & x->mask;
+        while (x->start[j] != UINT32_MAX)
+            j = (j + 1) & x->mask;
+        x->key[j] = k;
+        x->start[j] = (uint32_t)i;
+    }
+    return AG_OK;
+}
+
+void ag_radix_index_free(ag_radix_index *x)
+{
+    free(x->key);
+    free(x->start);
+    x->key = NULL;
+    x->start = NULL;
 }

@@ -129,7 +129,8 @@ static double match_soups(const double *a, size_t na, const double *b, size_t nb
                     ha[nh++].val = (uint32_t)i;
                 }
     }
-    if (ag_radix_sort(ha, nh)) {
+    ag_radix_index cells;
+    if (ag_radix_sort(ha, nh) || ag_radix_index_build(&cells, ha, nh)) {
         free(ha);
         free(acell);
         free(used);
@@ -146,7 +147,7 @@ static double match_soups(const double *a, size_t na, const double *b, size_t nb
         double best = INFINITY;
         size_t besti = SIZE_MAX;
         int best_rank = 27;
-        size_t lo = ag_search_lower_u64(&ha[0].key, nh, sizeof *ha, h);
+        size_t lo = ag_radix_index_find(&cells, h);
         for (size_t s = lo; s < nh && ha[s].key == h; s++) {
             uint32_t i = ha[s].val;
             if (used[i])
@@ -180,6 +181,7 @@ static double match_soups(const double *a, size_t na, const double *b, size_t nb
         if (best > worst)
             worst = best;
     }
+    ag_radix_index_free(&cells);
     free(ha);
     free(acell);
     free(used);

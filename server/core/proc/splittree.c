@@ -364,6 +364,7 @@ ag_status ag_splittree_adjacency(ag_splittree *t)
     ag_radix_item *ord = malloc(nv * sizeof *ord);
     int *level = malloc(nv * sizeof *level);
     ag_radix_item *ent = NULL, *pairs = NULL;
+    ag_radix_index cells = {0};
     size_t nent = 0, npairs = 0, cap_pairs = 0;
     ag_status st = AG_ERR_NOMEM;
     if (!node || !rank || !ord || !level)
@@ -431,7 +432,7 @@ ag_status ag_splittree_adjacency(ag_splittree *t)
                     ent[nent++].val = (uint32_t)i;
                 }
     }
-    if (ag_radix_sort(ent, nent))
+    if (ag_radix_sort(ent, nent) || ag_radix_index_build(&cells, ent, nent))
         goto done;
 
     for (size_t i = 0; i < nv; i++) {
@@ -450,7 +451,7 @@ ag_status ag_splittree_adjacency(ag_splittree *t)
                 for (int64_t y = clo[1]; y <= chi[1]; y++)
                     for (int64_t z = clo[2]; z <= chi[2]; z++) {
                         uint64_t key = gkey(l, x, y, z);
-                        size_t e = ag_search_lower_u64(&ent[0].key, nent, sizeof *ent, key);
+                        size_t e = ag_radix_index_find(&cells, key);
                         for (; e < nent && ent[e].key == key; e++) {
                             uint32_t j = ent[e].val;
                             /* boxes of one level meet from the later one */
@@ -479,6 +480,7 @@ ag_status ag_splittree_adjacency(ag_splittree *t)
                     }
         }
     }
+    ag_radix_index_free(&cells);
     free(ent);
     ent = NULL;
     if (ag_radix_sort(pairs, npairs))
@@ -496,6 +498,7 @@ ag_status ag_splittree_adjacency(ag_splittree *t)
     }
     st = AG_OK;
 done:
+    ag_radix_index_free(&cells);
     free(node);
     free(rank);
     free(ord);
