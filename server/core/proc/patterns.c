@@ -232,16 +232,20 @@ static int cmp_by_x(const void *a, const void *b)
  * P[ii]) in kk order: the same pairs, in the same order, as a scan of all pairs, which is
  * n^2 on a facade whose windows share one x. Until then (and for every ii while nothing
  * qualifies), a scan in x order that stops where the x gap alone exceeds the best. */
+/* Below this many points the scan is cheaper than the grid. */
+#define CLOSEST_GRID_MIN 64
+
 static double closest_offset(const double *P, size_t n, double tol, const double *line,
                              double ll, double off_min, double out[3], int *nomem)
 {
     double best = INFINITY, h = 0;
     ag_radix_item *cells = NULL;
+    ag_radix_index index = {0};
     uint32_t *cand = NULL;
     size_t ncand = 0, cap_cand = 0;
     for (size_t ii = 0; ii < n && !*nomem; ii++) {
         const double *x = P + 3 * ii;
-        if (isfinite(best) && !cells) { /* the grid, once */
+        if (isfinite(best) && !cells && n > CLOSEST_GRID_MIN) { /* the grid, once */
             h = best > 0 ? best : 1;
             cells = malloc(n * sizeof *cells);
             if (!cells) {
@@ -254,7 +258,7 @@ static double closest_offset(const double *P, size_t n, double tol, const double
                                              (int64_t)floor(P[3 * k + 2] / h));
                 cells[k].val = (uint32_t)k;
             }
-            if (ag_radix_sort(cells, n)) {
+            if (ag_radix_sort(cells, n) || ag_radix_index_build(&index, cells, n)) {
                 *nomem = 1;
                 break;
             }
@@ -272,7 +276,7 @@ static double closest_offset(const double *P, size_t n, double tol, const double
                 for (int64_t cy = lo[1]; cy <= hi[1]; cy++)
                     for (int64_t cz = lo[2]; cz <= hi[2]; cz++) {
                         uint64_t key = ag__cell_hash(cx, cy, cz);
-                        for (size_t e = ag_search_lower_u64(&cells[0].key, n, sizeof *cells, key);
+                        for (size_t e = ag_radix_index_find(&index, key);
                              e < n && cells[e].key == key; e++) {
                             if (cells[e].val <= ii)
                                 continue;
@@ -322,6 +326,7 @@ static double closest_offset(const double *P, size_t n, double tol, const double
             memcpy(out, d, 3 * sizeof *d);
         }
     }
+    ag_radix_index_free(&index);
     free(cells);
     free(cand);
     return best;
