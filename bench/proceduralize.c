@@ -285,7 +285,8 @@ int main(int argc, char **argv)
     go.side_cols = 26;
     run_generated("generated building (no groups)", &go);
     /* 20 buildings of ~100k triangles and 166 groups each (160 windows of 624 triangles):
-     * ~2.08M triangles, 3,320 components */
+     * 1,998,480 triangles in 3,320 groups, 156,920 components once segmentation splits the
+     * groups into their loose parts */
     ag_gen_facade_options bo = {.cols = 8, .rows = 5, .side_cols = 8, .back = 1, .left = 1,
                                 .annex = 1, .bars = 45};
     run_block("generated block (20 buildings)", &bo, 20);
