@@ -427,6 +427,7 @@ typedef struct {
                      shortcut */
     int no_rotation;
     int nomem;
+    int64_t sa_of; /* label_pass: the (exemplar, turn) whose oriented soup sa holds, -1 */
     unsigned checks_left; /* surface comparisons the current component may still make */
 } lctx;
 
@@ -491,6 +492,7 @@ static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
     for (size_t i = 0; i < cap; i++)
         bk[i].head = -1;
     long ncls = 0;
+    x->sa_of = -1;
     /* buckets: the oriented box's height and sorted plan sizes in cells of 4 tol, so a match
      * within tol is always in a neighbouring cell */
     double q = 4 * tol > 0 ? 4 * tol : AG_PROC_TINY;
@@ -525,7 +527,12 @@ static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
                             oriented_soup(x->m, L, &F[c], c, 0, 0, x->sb);
                             have_cb = 1;
                         }
-                        oriented_soup(x->m, L, &F[e], e, k & 3, k >> 2, x->sa);
+                        /* the soups of one exemplar repeat for the members that follow
+                         * it (the inputs are const in the comparisons) */
+                        if (x->sa_of != (int64_t)e * 8 + k) {
+                            oriented_soup(x->m, L, &F[e], e, k & 3, k >> 2, x->sa);
+                            x->sa_of = (int64_t)e * 8 + k;
+                        }
                         double dev;
                         if (compare(x, L->ntris[e], L->ntris[c], tol, fast, &dev)) {
                             found = l;
