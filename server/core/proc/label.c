@@ -58,6 +58,73 @@ static double tri_dist(const double *x, const double *y, int shift)
     return sqrt(m);
 }
 
+/* Soups with at most this many pairs are matched by comparing every pair (a window of a few
+ * dozen triangles): cheaper than building a cell index for them. */
+#define SMALL_PAIRS 4096
+
+/* The cell of 2 tol holding a triangle's centroid. */
+static void centroid_cell(const double *t, double cell, int64_t k[3])
+{
+    double c[3];
+    centroid(t, c);
+    for (int q = 0; q < 3; q++)
+        k[q] = (int64_t)floor(c[q] / cell);
+}
+
+/* match_soups below SMALL_PAIRS: every pair, with the same choice (the nearest within tol
+ * among the triangles of a whose centroid cell is next to b's, then the first in cell order,
+ * then in a's order). */
+static double match_small(const double *a, size_t na, const double *b, size_t nb, double tol,
+                          double cell, size_t *unmatched, int stop_at_miss)
+{
+    uint8_t used[SMALL_PAIRS];
+    size_t miss = 0;
+    double worst = 0;
+    memset(used, 0, na);
+    for (size_t j = 0; j < nb; j++) {
+        const double *tb = b + 9 * j;
+        int64_t kb[3];
+        centroid_cell(tb, cell, kb);
+        double best = INFINITY;
+        size_t besti = SIZE_MAX;
+        int best_rank = 27;
+        for (size_t i = 0; i < na; i++) {
+            if (used[i])
+                continue;
+            int64_t ka[3];
+            centroid_cell(a + 9 * i, cell, ka);
+            int rank = 0, near = 1;
+            for (int q = 0; q < 3 && near; q++) {
+                int64_t off = ka[q] - kb[q];
+                near = off >= -1 && off <= 1;
+                rank = 3 * rank + (int)(off + 1);
+            }
+            if (!near)
+                continue;
+            double d = INFINITY;
+            for (int sh = 0; sh < 3; sh++)
+                d = fmin(d, tri_dist(tb, a + 9 * i, sh));
+            if (d <= tol && (d < best || (d == best && rank < best_rank))) {
+                best = d;
+                besti = i;
+                best_rank = rank;
+            }
+        }
+        if (besti == SIZE_MAX) {
+            miss++;
+            if (stop_at_miss)
+                break;
+            continue;
+        }
+        used[besti] = 1;
+        if (best > worst)
+            worst = best;
+    }
+    if (unmatched)
+        *unmatched = miss;
+    return worst;
+}
+
 /* ag_label_match_triangles; with stop_at_miss it returns at the first triangle of b without
  * a partner (*unmatched then 1): a comparison that only asks whether all match stops there
  * instead of probing every other triangle. */
@@ -94,6 +161,8 @@ static double match_soups(const double *a, size_t na, const double *b, size_t nb
      * the 27 cells of size 2 tol around b's centroid, in cell order, then triangle order:
      * the nearest, the first of that scan on a tie. */
     double cell = 2 * tol, amax = 0;
+    if (na <= SMALL_PAIRS && (uint64_t)na * nb <= SMALL_PAIRS)
+        return match_small(a, na, b, nb, tol, cell, unmatched, stop_at_miss);
     for (size_t i = 0; i < 9 * na; i++)
         amax = fmax(amax, fabs(a[i]));
     double r = 1.01 * tol + 16 * DBL_EPSILON * (amax + 1), icell = 4 * r;
