@@ -79,7 +79,7 @@ typedef struct {
 
 /* Above this many children a's are found through the cell index instead of a scan of all of
  * them per child of b (a wall holding thousands of windows: n^2). */
-#define SAME_INDEX_MIN 16
+#define SAME_INDEX_MIN 64
 
 /* Is child x of a (turned by k) the same as child y of b, boxes lo/hi relative to the
  * nodes' centres? */
