@@ -71,6 +71,48 @@ static void centroid_cell(const double *t, double cell, int64_t k[3])
         k[q] = (int64_t)floor(c[q] / cell);
 }
 
+/* The choice of a partner for one triangle of b: the nearest within tol of the triangles of a
+ * whose centroid cell is next to b's, then the first in the order of a scan of those 27
+ * cells, then in a's order. */
+typedef struct {
+    double d;
+    size_t i; /* SIZE_MAX: none yet */
+    int rank; /* the cell's place in the scan */
+} choice;
+
+static void offer(choice *c, const double *tb, const int64_t kb[3], const double *ta,
+                  const int64_t ka[3], size_t i, double tol)
+{
+    int rank = 0;
+    for (int q = 0; q < 3; q++) {
+        int64_t off = ka[q] - kb[q];
+        if (off < -1 || off > 1)
+            return; /* outside the 27 cells */
+        rank = 3 * rank + (int)(off + 1);
+    }
+    double d = INFINITY;
+    for (int sh = 0; sh < 3; sh++)
+        d = fmin(d, tri_dist(tb, ta, sh));
+    if (d <= tol && (d < c->d || (d == c->d && (rank < c->rank || (rank == c->rank && i < c->i))))) {
+        c->d = d;
+        c->i = i;
+        c->rank = rank;
+    }
+}
+
+/* Takes c's partner; 0 when there is none (one more miss). */
+static int settle(const choice *c, uint8_t *used, double *worst, size_t *miss)
+{
+    if (c->i == SIZE_MAX) {
+        (*miss)++;
+        return 0;
+    }
+    used[c->i] = 1;
+    if (c->d > *worst)
+        *worst = c->d;
+    return 1;
+}
+
 /* match_soups below SMALL_PAIRS: every pair, with the same choice (the nearest within tol
  * among the triangles of a whose centroid cell is next to b's, then the first in cell order,
  * then in a's order). */
@@ -85,40 +127,16 @@ static double match_small(const double *a, size_t na, const double *b, size_t nb
         const double *tb = b + 9 * j;
         int64_t kb[3];
         centroid_cell(tb, cell, kb);
-        double best = INFINITY;
-        size_t besti = SIZE_MAX;
-        int best_rank = 27;
+        choice c = {INFINITY, SIZE_MAX, 27};
         for (size_t i = 0; i < na; i++) {
             if (used[i])
                 continue;
             int64_t ka[3];
             centroid_cell(a + 9 * i, cell, ka);
-            int rank = 0, near = 1;
-            for (int q = 0; q < 3 && near; q++) {
-                int64_t off = ka[q] - kb[q];
-                near = off >= -1 && off <= 1;
-                rank = 3 * rank + (int)(off + 1);
-            }
-            if (!near)
-                continue;
-            double d = INFINITY;
-            for (int sh = 0; sh < 3; sh++)
-                d = fmin(d, tri_dist(tb, a + 9 * i, sh));
-            if (d <= tol && (d < best || (d == best && rank < best_rank))) {
-                best = d;
-                besti = i;
-                best_rank = rank;
-            }
+            offer(&c, tb, kb, a + 9 * i, ka, i, tol);
         }
-        if (besti == SIZE_MAX) {
-            miss++;
-            if (stop_at_miss)
-                break;
-            continue;
-        }
-        used[besti] = 1;
-        if (best > worst)
-            worst = best;
+        if (!settle(&c, used, &worst, &miss) && stop_at_miss)
+            break;
     }
     if (unmatched)
         *unmatched = miss;
@@ -213,42 +231,14 @@ static double match_soups(const double *a, size_t na, const double *b, size_t nb
                         (int64_t)floor(c[2] / cell)};
         uint64_t h = ag__cell_hash((int64_t)floor(c[0] / icell), (int64_t)floor(c[1] / icell),
                                    (int64_t)floor(c[2] / icell));
-        double best = INFINITY;
-        size_t besti = SIZE_MAX;
-        int best_rank = 27;
-        size_t lo = ag_radix_index_find(&cells, h);
-        for (size_t s = lo; s < nh && ha[s].key == h; s++) {
-            uint32_t i = ha[s].val;
-            if (used[i])
-                continue;
-            int rank = 0, near = 1;
-            for (int q = 0; q < 3 && near; q++) {
-                int64_t off = acell[3 * (size_t)i + q] - k[q];
-                near = off >= -1 && off <= 1;
-                rank = 3 * rank + (int)(off + 1);
-            }
-            if (!near)
-                continue; /* outside the 27 cells */
-            double d = INFINITY;
-            for (int sh = 0; sh < 3; sh++)
-                d = fmin(d, tri_dist(tb, a + 9 * (size_t)i, sh));
-            if (!(d <= tol))
-                continue;
-            if (d < best || (d == best && (rank < best_rank || (rank == best_rank && i < besti)))) {
-                best = d;
-                besti = i;
-                best_rank = rank;
-            }
+        choice ch = {INFINITY, SIZE_MAX, 27};
+        for (size_t e = ag_radix_index_find(&cells, h); e < nh && ha[e].key == h; e++) {
+            uint32_t i = ha[e].val;
+            if (!used[i])
+                offer(&ch, tb, k, a + 9 * (size_t)i, acell + 3 * (size_t)i, i, tol);
         }
-        if (besti == SIZE_MAX) {
-            miss++;
-            if (stop_at_miss)
-                break;
-            continue;
-        }
-        used[besti] = 1;
-        if (best > worst)
-            worst = best;
+        if (!settle(&ch, used, &worst, &miss) && stop_at_miss)
+            break;
     }
     ag_radix_index_free(&cells);
     free(ha);

@@ -163,17 +163,9 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
     lvpt *lo = malloc((nused + 1) * sizeof *lo), *hi = malloc((nused + 1) * sizeof *hi);
     lvpt *h = malloc((2 * nused + 2) * sizeof *h);
     sorter so = {malloc((nused + 1) * sizeof *so.it), malloc((nused + 1) * sizeof *so.tmp)};
-    if (!lo || !hi || !h || !so.it || !so.tmp) {
-        free(used);
-        free(lo);
-        free(hi);
-        free(h);
-        free(so.it);
-        free(so.tmp);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory deciding the up axis");
-    }
+    int nomem = !lo || !hi || !h || !so.it || !so.tmp;
     double step = LEVEL_STEP * diag;
-    for (int a = 1; a < 3; a++) {
+    for (int a = 1; a < 3 && !nomem; a++) {
         int o1 = (a + 1) % 3, o2 = (a + 2) % 3;
         double band = END_SHARE * ext[a];
         size_t nl = 0, nh = 0;
@@ -196,13 +188,8 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
         double bottom = fail ? -1 : end_support(lo, nl, step, cross_area, h, &so);
         c->top = fail ? -1 : end_support(hi, nh, step, cross_area, h, &so);
         if (bottom < 0 || c->top < 0) {
-            free(used);
-            free(lo);
-            free(hi);
-            free(h);
-            free(so.it);
-            free(so.tmp);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory deciding the up axis");
+            nomem = 1;
+            break;
         }
         c->base = bottom - c->top;
         if (c->base < 0)
@@ -221,6 +208,8 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
     free(h);
     free(so.it);
     free(so.tmp);
+    if (nomem)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory deciding the up axis");
     ev->cue[0].extent = ext[1];
     ev->cue[1].extent = ext[2];
     if (ev->georeferenced)
