@@ -383,7 +383,7 @@ ag_status ag_splittree_adjacency(ag_splittree *t)
     for (size_t r = 0; r < nv; r++)
         rank[ord[r].val] = (uint32_t)r;
 
-    /* the grid levels: level 0 holds the largest grown box in one cell per axis */
+    /* the grid levels, halving: a cell of level 0 is as large as the largest grown box */
     double o[3] = {INFINITY, INFINITY, INFINITY}, top = 0, bottom = INFINITY;
     for (size_t i = 0; i < nv; i++) {
         const ag_box *b = &t->nodes[node[i]].box;
