@@ -58,9 +58,11 @@ static double tri_dist(const double *x, const double *y, int shift)
     return sqrt(m);
 }
 
-/* Soups with at most this many pairs are matched by comparing every pair (a window of a few
- * dozen triangles): cheaper than building a cell index for them. */
+/* Soups with at most this many pairs, and a of at most SMALL_A triangles, are matched by
+ * comparing every pair (a window of a few dozen triangles): cheaper than building a cell
+ * index for them. */
 #define SMALL_PAIRS 4096
+#define SMALL_A 128
 
 /* The cell of 2 tol holding a triangle's centroid. */
 static void centroid_cell(const double *t, double cell, int64_t k[3])
@@ -119,22 +121,21 @@ static int settle(const choice *c, uint8_t *used, double *worst, size_t *miss)
 static double match_small(const double *a, size_t na, const double *b, size_t nb, double tol,
                           double cell, size_t *unmatched, int stop_at_miss)
 {
-    uint8_t used[SMALL_PAIRS];
+    uint8_t used[SMALL_A];
+    int64_t ka[3 * SMALL_A];
     size_t miss = 0;
     double worst = 0;
     memset(used, 0, na);
+    for (size_t i = 0; i < na; i++)
+        centroid_cell(a + 9 * i, cell, ka + 3 * i);
     for (size_t j = 0; j < nb; j++) {
         const double *tb = b + 9 * j;
         int64_t kb[3];
         centroid_cell(tb, cell, kb);
         choice c = {INFINITY, SIZE_MAX, 27};
-        for (size_t i = 0; i < na; i++) {
-            if (used[i])
-                continue;
-            int64_t ka[3];
-            centroid_cell(a + 9 * i, cell, ka);
-            offer(&c, tb, kb, a + 9 * i, ka, i, tol);
-        }
+        for (size_t i = 0; i < na; i++)
+            if (!used[i])
+                offer(&c, tb, kb, a + 9 * i, ka + 3 * i, i, tol);
         if (!settle(&c, used, &worst, &miss) && stop_at_miss)
             break;
     }
@@ -179,7 +180,7 @@ static double match_soups(const double *a, size_t na, const double *b, size_t nb
      * the 27 cells of size 2 tol around b's centroid, in cell order, then triangle order:
      * the nearest, the first of that scan on a tie. */
     double cell = 2 * tol, amax = 0;
-    if (na <= SMALL_PAIRS && (uint64_t)na * nb <= SMALL_PAIRS)
+    if (na <= SMALL_A && (uint64_t)na * nb <= SMALL_PAIRS)
         return match_small(a, na, b, nb, tol, cell, unmatched, stop_at_miss);
     for (size_t i = 0; i < 9 * na; i++)
         amax = fmax(amax, fabs(a[i]));
