@@ -8,7 +8,9 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "../core/base/array.h"
 #include "../io/grammar_text.h"
+#include "../io/numtext.h"
 #include "../io/import.h"
 #include "../io/part_bundle.h"
 #include "usecase_compose.h"
@@ -211,10 +213,16 @@ static ag_status write_model(ag_folder_ws *w, const ag_model_state *st, ag_error
     char path[4200];
     ag_status s = ag__folder_ws_write_grammar(w, st->text, st->text_len, &st->terms, err);
     snprintf(path, sizeof path, "%s/tree.json", dir);
-    json_t *tree = s == AG_OK ? ag_model_tree_folder(st->em) : NULL;
-    if (s == AG_OK) /* the served tree's precision (model_tree.c) */
-        s = ag__folder_ws_write_json(w, path, tree, JSON_INDENT(1) | JSON_REAL_PRECISION(15), err);
-    json_decref(tree);
+    if (s != AG_OK)
+        return s;
+    /* the served tree's precision (model_tree.c), printed directly */
+    char *tree = ag_model_tree_folder_text(st->em);
+    if (!tree) {
+        ag__folder_ws_blame(w, NULL);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory writing %s", path);
+    }
+    s = ag__folder_ws_write_file(w, path, tree, strlen(tree), err);
+    free(tree);
     return s;
 }
 
@@ -224,6 +232,131 @@ static json_t *vec3(const double *v)
     for (int i = 0; i < 3; i++)
         json_array_append_new(a, json_real(v[i]));
     return a;
+}
+
+/* summary.json's "components" list (one object per component) is printed directly and
+ * spliced into jansson's dump of the rest at a marker: through jansson objects it took a
+ * sixth of `archgram proceduralize` on a 2M-triangle block. The text is what jansson prints
+ * with JSON_INDENT(2) (test_folder_summary compares the two). */
+#define COMPONENTS_MARK "\x01" "components" "\x01"
+static const char components_at[] = "\n  \"components\": \"\\u0001components\\u0001\"";
+
+typedef struct {
+    char *p;
+    size_t n, cap;
+    int fail;
+} text_buf;
+
+static void put(text_buf *b, const char *s, size_t n)
+{
+    if (b->fail || (b->fail = AG_ARRAY_RESERVE_MORE(b->p, b->cap, b->n, n + 1) != AG_OK))
+        return;
+    memcpy(b->p + b->n, s, n);
+    b->n += n;
+    b->p[b->n] = '\0';
+}
+
+#define PUT_LIT(b, lit) put(b, lit, sizeof lit - 1)
+
+static void put_key_int(text_buf *b, const char *key_line, size_t key_len, int64_t v)
+{
+    put(b, key_line, key_len);
+    if (v < 0) {
+        PUT_LIT(b, "null");
+        return;
+    }
+    char d[AG_NUMTEXT_MAX];
+    put(b, d, ag_numtext_u64(d, (uint64_t)v));
+}
+#define PUT_KEY_INT(b, key_line, v) put_key_int(b, key_line, sizeof key_line - 1, v)
+
+static char *components_text(const ag_proceduralize_result *r)
+{
+    const ag_labels *L = r->labels;
+    const ag_mesh *m = r->mesh;
+    text_buf b = {0};
+    if (!m->ncomponents) {
+        PUT_LIT(&b, "[]");
+        return b.fail ? (free(b.p), NULL) : b.p;
+    }
+    for (size_t c = 0; c < m->ncomponents && !b.fail; c++) {
+        if (c)
+            PUT_LIT(&b, ",\n    {");
+        else
+            PUT_LIT(&b, "[\n    {");
+        PUT_KEY_INT(&b, "\n      \"index\": ", (int64_t)c);
+        int32_t g = m->component_group[c];
+        const char *name = g >= 0 ? m->group_names[g] : NULL;
+        size_t len = 0;
+        while (name && name[len] >= 0x20 && name[len] < 0x7f && name[len] != '"' &&
+               name[len] != '\\')
+            len++;
+        if (!name) {
+            PUT_LIT(&b, ",\n      \"group\": null");
+        } else if (!name[len]) { /* plain ASCII: as it is */
+            PUT_LIT(&b, ",\n      \"group\": \"");
+            put(&b, name, len);
+            PUT_LIT(&b, "\"");
+        } else { /* escaped as jansson escapes it; a name it refuses (not UTF-8) has no key */
+            json_t *js = json_string(name);
+            char *e = js ? json_dumps(js, JSON_ENCODE_ANY) : NULL;
+            if (js && !e)
+                b.fail = 1;
+            if (e) {
+                PUT_LIT(&b, ",\n      \"group\": ");
+                put(&b, e, strlen(e));
+            }
+            free(e);
+            json_decref(js);
+        }
+        PUT_KEY_INT(&b, ",\n      \"label\": ", L->label[c]);
+        PUT_KEY_INT(&b, ",\n      \"variant\": ", L->variant[c]);
+        PUT_KEY_INT(&b, ",\n      \"rot\": ", 90 * (int64_t)L->rot[c]);
+        if (L->mirror[c])
+            PUT_LIT(&b, ",\n      \"mirror\": true");
+        else
+            PUT_LIT(&b, ",\n      \"mirror\": false");
+        PUT_KEY_INT(&b, ",\n      \"node\": ", r->tree->comp_node[c]);
+        PUT_LIT(&b, "\n    }");
+    }
+    PUT_LIT(&b, "\n  ]");
+    if (b.fail) {
+        free(b.p);
+        return NULL;
+    }
+    return b.p;
+}
+
+/* The proceduralize summary: jansson's dump with the components list put in at its marker. */
+static ag_status write_proc_summary(ag_folder_ws *w, const char *path, json_t *j,
+                                    const ag_proceduralize_result *r, ag_error *err)
+{
+    char *rest = j ? json_dumps(j, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10))
+                   : NULL;
+    char *comps = rest ? components_text(r) : NULL;
+    char *at = comps ? strstr(rest, components_at) : NULL;
+    ag_status s;
+    if (!at) {
+        ag__folder_ws_blame(w, NULL);
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory writing %s", path);
+    } else {
+        text_buf b = {0};
+        put(&b, rest, (size_t)(at - rest));
+        PUT_LIT(&b, "\n  \"components\": ");
+        put(&b, comps, strlen(comps));
+        const char *tail = at + sizeof components_at - 1;
+        put(&b, tail, strlen(tail));
+        if (b.fail) {
+            ag__folder_ws_blame(w, NULL);
+            s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory writing %s", path);
+        } else {
+            s = ag__folder_ws_write_file(w, path, b.p, b.n, err);
+        }
+        free(b.p);
+    }
+    free(rest);
+    free(comps);
+    return s;
 }
 
 /* summary.json of `archgram proceduralize`. */
@@ -284,23 +417,8 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
                                   L->share, "exact_copies", L->exact_copies,
                                   "surface_checks", (json_int_t)L->surface_checks));
 
-    json_t *jc = json_array();
-    for (size_t c = 0; c < r->mesh->ncomponents; c++) {
-        json_t *co = json_object();
-        int32_t g = r->mesh->component_group[c];
-        json_object_set_new(co, "index", json_integer((json_int_t)c));
-        json_object_set_new(co, "group", g >= 0 ? json_string(r->mesh->group_names[g]) : json_null());
-        json_object_set_new(co, "label", L->label[c] >= 0 ? json_integer(L->label[c]) : json_null());
-        json_object_set_new(co, "variant",
-                            L->variant[c] >= 0 ? json_integer(L->variant[c]) : json_null());
-        json_object_set_new(co, "rot", json_integer(90 * L->rot[c]));
-        json_object_set_new(co, "mirror", json_boolean(L->mirror[c]));
-        json_object_set_new(co, "node", r->tree->comp_node[c] >= 0
-                                            ? json_integer(r->tree->comp_node[c])
-                                            : json_null());
-        json_array_append_new(jc, co);
-    }
-    json_object_set_new(j, "components", jc);
+    /* one object per component: printed directly in save (components_text) */
+    json_object_set_new(j, "components", json_string(COMPONENTS_MARK));
 
     json_object_set_new(j, "tree", ag__folder_ws_tree_figures(r->tree));
     json_object_set_new(j, "rules", json_integer((json_int_t)r->grammar->nrules));
@@ -478,10 +596,10 @@ static ag_status save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcom
         char path[4200];
         snprintf(path, sizeof path, "%s/summary.json", w->o.out_dir);
         json_t *j = proc ? proc_summary(w, st, proc, write_s) : edit_summary(st, edit);
-        s = ag__folder_ws_write_json(w, path, j,
-                       proc ? JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10)
-                            : JSON_INDENT(1) | JSON_REAL_PRECISION(12),
-                       err);
+        if (proc)
+            s = write_proc_summary(w, path, j, proc->proc, err);
+        else
+            s = ag__folder_ws_write_json(w, path, j, JSON_INDENT(1) | JSON_REAL_PRECISION(12), err);
         json_decref(j);
     }
     ag_model_state_clear(st);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../core/base/array.h"
+#include "../io/numtext.h"
 
 
 static const char *kind_name(int k)
@@ -248,9 +249,12 @@ static void out_str(text_out *o, const char *s, size_t n)
 
 static void out_int(text_out *o, long long v)
 {
-    char b[32];
-    int n = snprintf(b, sizeof b, "%lld", v);
-    out_str(o, b, (size_t)n);
+    char b[AG_NUMTEXT_MAX + 1];
+    size_t n = 0;
+    if (v < 0)
+        b[n++] = '-';
+    n += ag_numtext_u64(b + n, v < 0 ? 0 - (unsigned long long)v : (unsigned long long)v);
+    out_str(o, b, n);
 }
 
 /* A real as jansson prints it with REAL_PRECISION(15): %.15g, ".0" added to integral forms
@@ -260,7 +264,7 @@ static void out_real(text_out *o, double v)
     char b[40];
     if (v == 0)
         v = 0; /* no "-0.0" */
-    int n = snprintf(b, sizeof b, "%.15g", v);
+    int n = (int)ag_numtext_double_g15(b, v); /* "%.15g", fast */
     char *e = strchr(b, 'e');
     if (e) { /* jansson drops the exponent's '+' and leading zeros: 1e-07 is 1e-7, 1e+20 1e20 */
         char *d = e + 1;
@@ -488,6 +492,154 @@ fail:
     json_decref(o);
     json_decref(nodes);
     return NULL;
+}
+
+/* ---- the folder's tree.json as text ------------------------------------------------------ */
+
+/* tree.json of a folder is printed directly too (it took most of `archgram proceduralize`'s
+ * time on large buildings through jansson objects): character for character what
+ * json_dumps(ag_model_tree_folder(em), JSON_INDENT(1) | JSON_REAL_PRECISION(15)) prints. */
+static void out_indent(text_out *o, int depth)
+{
+    static const char line[] = "\n        "; /* the tree's indents are at most 4 */
+    if (depth < (int)sizeof line - 1) {
+        out_str(o, line, (size_t)depth + 1);
+        return;
+    }
+    OUT_LIT(o, "\n");
+    for (int i = 0; i < depth; i++)
+        OUT_LIT(o, " ");
+}
+
+/* ",\n<indent>\"key\": " (the comma unless first) */
+static void out_key(text_out *o, int depth, const char *key, int first)
+{
+    if (!first)
+        OUT_LIT(o, ",");
+    out_indent(o, depth);
+    OUT_LIT(o, "\"");
+    out_str(o, key, strlen(key));
+    OUT_LIT(o, "\": ");
+}
+
+static void out_int_list(text_out *o, int depth, const long long *v, size_t n)
+{
+    if (!n) {
+        OUT_LIT(o, "[]");
+        return;
+    }
+    OUT_LIT(o, "[");
+    for (size_t i = 0; i < n; i++) {
+        if (i)
+            OUT_LIT(o, ",");
+        out_indent(o, depth + 1);
+        out_int(o, v[i]);
+    }
+    out_indent(o, depth);
+    OUT_LIT(o, "]");
+}
+
+char *ag_model_tree_folder_text(const ag_edit_model *em)
+{
+    const ag_proceduralize_result *r = em->proc;
+    const ag_splittree *t = r->tree;
+    text_out o = {0};
+    long long *ids = NULL;
+    size_t cap_ids = 0;
+    out_reserve(&o, 160 * t->nnodes + 256);
+    OUT_LIT(&o, "{");
+    out_key(&o, 1, "root", 1);
+    OUT_LIT(&o, "0");
+    out_key(&o, 1, "nodes", 0);
+    int any = 0;
+    for (size_t n = 0; n < t->nnodes && !o.fail; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        if (x->kind == AG_NODE_DEAD)
+            continue;
+        out_str(&o, any ? "," : "[", 1);
+        any = 1;
+        out_indent(&o, 2);
+        OUT_LIT(&o, "{");
+        out_key(&o, 3, "id", 1);
+        out_int(&o, (long long)n);
+        out_key(&o, 3, "parent", 0);
+        if (x->parent >= 0)
+            out_int(&o, x->parent);
+        else
+            OUT_LIT(&o, "null");
+        out_key(&o, 3, "kind", 0);
+        out_name(&o, kind_name(x->kind));
+        out_key(&o, 3, "box", 0);
+        OUT_LIT(&o, "[");
+        for (int a = 0; a < 6; a++) {
+            if (a)
+                OUT_LIT(&o, ",");
+            out_indent(&o, 4);
+            out_real(&o, a < 3 ? x->box.min[a] : x->box.max[a - 3]);
+        }
+        out_indent(&o, 3);
+        OUT_LIT(&o, "]");
+        out_key(&o, 3, "children", 0);
+        size_t nc = 0;
+        for (int32_t c = x->first_child; c >= 0 && !o.fail; c = t->nodes[c].next_sibling) {
+            if (AG_ARRAY_RESERVE(ids, cap_ids, nc + 1))
+                o.fail = 1;
+            else
+                ids[nc++] = c;
+        }
+        out_int_list(&o, 3, ids, nc);
+        if (x->kind == AG_NODE_COMPONENT) {
+            char fallback[32];
+            const char *label = label_of(r, x, fallback);
+            json_t *js = label ? json_string(label) : NULL;
+            if (!label || js) { /* a name jansson refuses (not UTF-8) leaves the key out */
+                out_key(&o, 3, "label", 0);
+                out_name(&o, label);
+            }
+            json_decref(js);
+            out_key(&o, 3, "component", 0);
+            out_int(&o, x->component);
+            out_key(&o, 3, "rule", 0);
+            if (x->rule >= 0)
+                out_int(&o, x->rule);
+            else
+                OUT_LIT(&o, "null");
+        }
+        const ag_pattern *p = pattern_of(t, x);
+        if (p) {
+            long long c3[3] = {p->counts[0], p->counts[1], p->counts[2]};
+            out_key(&o, 3, "counts", 0);
+            out_int_list(&o, 3, c3, 3);
+        }
+        out_indent(&o, 2);
+        OUT_LIT(&o, "}");
+    }
+    if (any) {
+        out_indent(&o, 1);
+        OUT_LIT(&o, "]");
+    } else {
+        OUT_LIT(&o, "[]");
+    }
+    ag_splittree_stats st = ag_splittree_stats_of(t);
+    const char *names[] = {"nodes", "visible", "invisible", "depth", "patterns", "rules"};
+    long long vals[] = {(long long)st.nodes, (long long)st.visible, (long long)st.invisible,
+                        (long long)st.depth, (long long)t->npatterns, (long long)t->nrules};
+    out_key(&o, 1, "stats", 0);
+    OUT_LIT(&o, "{");
+    for (int k = 0; k < 6; k++) {
+        out_key(&o, 2, names[k], k == 0);
+        out_int(&o, vals[k]);
+    }
+    out_indent(&o, 1);
+    OUT_LIT(&o, "}");
+    out_indent(&o, 0);
+    OUT_LIT(&o, "}");
+    free(ids);
+    if (o.fail) {
+        free(o.p);
+        return NULL;
+    }
+    return o.p;
 }
 
 ag_status ag_model_tree_check_node(const ag_edit_model *em, int32_t id, const char *field,

@@ -34,6 +34,10 @@
 /* New references, NULL when out of memory. */
 json_t *ag_model_tree_served(const ag_edit_model *em);
 json_t *ag_model_tree_folder(const ag_edit_model *em);
+/* The folder tree as json_dumps(ag_model_tree_folder(em), JSON_INDENT(1) |
+ * JSON_REAL_PRECISION(15)) prints it, printed directly (fast on large trees); malloc'd, NULL
+ * when out of memory. */
+char *ag_model_tree_folder_text(const ag_edit_model *em);
 /* The folder tree's "stats" alone. */
 json_t *ag_model_tree_folder_stats(const ag_edit_model *em);
 

@@ -154,3 +154,64 @@ size_t ag_numtext_double(char *out, double v)
     out[n] = '\0';
     return n;
 }
+
+size_t ag_numtext_double_g15(char *out, double v)
+{
+    double a = fabs(v);
+    if (!(a >= 1e-4 && a < 1e15)) { /* exponent notation, zero, NaN and inf: printf's */
+        int n = snprintf(out, AG_NUMTEXT_MAX, "%.15g", v);
+        return n > 0 ? (size_t)n : 0;
+    }
+    uint64_t bits;
+    memcpy(&bits, &a, sizeof bits);
+    int be = (int)(bits >> 52); /* a >= 1e-4: normal */
+    uint64_t m = (bits & ((1ull << 52) - 1)) | (1ull << 52);
+    int sh = 1075 - be; /* a = m / 2^sh, 3 <= sh <= 66 here */
+    /* x = floor(log10(a)), estimated; a wrong estimate gives digits out of [1e14, 1e15)
+     * below and goes to printf */
+    int x = (int)floor(log10(a));
+    int s = 14 - x; /* a * 10^s has 15 digits before the point */
+    if (s < 0 || s > 18) {
+        int n = snprintf(out, AG_NUMTEXT_MAX, "%.15g", v);
+        return n > 0 ? (size_t)n : 0;
+    }
+    u128 q = (u128)m * pow10_u64[s]; /* < 2^53 * 10^18 < 2^113 */
+    u128 rem = q & (((u128)1 << sh) - 1), half = (u128)1 << (sh - 1);
+    uint64_t d = (uint64_t)(q >> sh);
+    int below = d < pow10_u64[14]; /* the estimate was one too high */
+    if (rem > half)
+        d++;
+    if (rem == half || below || d >= pow10_u64[15]) {
+        /* a tie (the rounding mode decides), the estimate off next to a power of ten, or
+         * rounding up to the next power of ten */
+        int n = snprintf(out, AG_NUMTEXT_MAX, "%.15g", v);
+        return n > 0 ? (size_t)n : 0;
+    }
+    char dg[24];
+    ag_numtext_u64(dg, d); /* 15 digits */
+    int nd = 15;
+    while (nd > 1 && dg[nd - 1] == '0')
+        nd--;
+    size_t n = 0;
+    if (v < 0)
+        out[n++] = '-';
+    if (x >= 0) {
+        int ip = x + 1; /* digits before the point */
+        memcpy(out + n, dg, (size_t)ip);
+        n += (size_t)ip;
+        if (nd > ip) {
+            out[n++] = '.';
+            memcpy(out + n, dg + ip, (size_t)(nd - ip));
+            n += (size_t)(nd - ip);
+        }
+    } else {
+        out[n++] = '0';
+        out[n++] = '.';
+        for (int i = 0; i < -x - 1; i++)
+            out[n++] = '0';
+        memcpy(out + n, dg, (size_t)nd);
+        n += (size_t)nd;
+    }
+    out[n] = '\0';
+    return n;
+}

@@ -20,6 +20,12 @@
 
 /* Writes v to out (AG_NUMTEXT_MAX bytes) with a terminating NUL; returns the length. */
 size_t ag_numtext_double(char *out, double v);
+/* Writes v to out (AG_NUMTEXT_MAX bytes) with a NUL exactly as printf's "%.15g" does, and
+ * returns the length: for magnitudes from 1e-4 to below 1e15 (plain notation) the 15 digits
+ * are found with exact integer arithmetic; the rest, and exact ties (printf rounds those
+ * by the rounding mode), go to snprintf itself. For writers of large JSON files (jansson's
+ * REAL_PRECISION(15) prints "%.15g"), where snprintf takes most of the time. */
+size_t ag_numtext_double_g15(char *out, double v);
 /* Writes v in decimal to out (AG_NUMTEXT_MAX bytes) with a NUL; returns the length. */
 size_t ag_numtext_u64(char *out, uint64_t v);
 

@@ -210,9 +210,73 @@ static void test_round_trip(void **state_)
            "longer than printf's shortest\n", checked, plain);
 }
 
+/* ag_numtext_double_g15 prints what "%.15g" prints, byte for byte */
+static size_t g15_checked;
+static void check_g15(double v)
+{
+    char a[AG_NUMTEXT_MAX], b[64];
+    size_t n = ag_numtext_double_g15(a, v);
+    snprintf(b, sizeof b, "%.15g", v);
+    if (strcmp(a, b) || n != strlen(b))
+        fail_msg("%.17g: \"%s\" instead of printf's \"%s\"", v, a, b);
+    g15_checked++;
+}
+
+static void test_g15_is_printf(void **state)
+{
+    (void)state;
+    const double fixed[] = {0.0, -0.0, 1e-4, 1e-5, 0.5, 1.0, 85.5, 64.9, -0.200000000000003,
+                            0.1, 0.3, 2.675, 1e15, 999999999999999.0, 999999999999999.5,
+                            123456789012345.5, 100000000000000.5, 1e14, 0.000099999999999999,
+                            9.99999999999999e-5, 512345.25, 5812345.123456789, INFINITY,
+                            -INFINITY, NAN, 1e300, 5e-324};
+    for (size_t i = 0; i < sizeof fixed / sizeof *fixed; i++) {
+        check_g15(fixed[i]);
+        check_g15(-fixed[i]);
+    }
+    for (int e = -6; e <= 16; e++) {
+        double p = pow(10.0, e);
+        for (int k = 0; k < 40; k++) {
+            check_g15(p);
+            check_g15(-p);
+            p = nextafter(p, INFINITY);
+        }
+        p = pow(10.0, e);
+        for (int k = 0; k < 40; k++) {
+            p = nextafter(p, 0);
+            check_g15(p);
+        }
+    }
+    /* building and UTM coordinates: short decimals and their neighbours */
+    for (int i = 0; i < 200000; i++) {
+        double base = (double)(next() % 20000000) / (double)pow(10.0, (double)(next() % 7));
+        if (i % 3 == 0)
+            base += 5400000;
+        check_g15(base);
+        check_g15(nextafter(base, 0));
+        check_g15(-nextafter(base, INFINITY));
+    }
+    /* halves at 15 digits: exact ties between two 15-digit decimals */
+    for (int i = 0; i < 20000; i++) {
+        double t = (double)(100000000000000ull + next() % 900000000000000ull) + 0.5;
+        check_g15(t);
+        check_g15(t * 0.001);
+    }
+    /* every magnitude, random bits */
+    for (int i = 0; i < 200000; i++) {
+        double v = ldexp(1 + unit(), (int)(next() % 80) - 30);
+        check_g15(next() & 1 ? v : -v);
+        uint64_t b = next();
+        memcpy(&v, &b, sizeof v);
+        check_g15(v);
+    }
+    printf("numtext: %zu doubles printed as %%.15g prints them\n", g15_checked);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_g15_is_printf),
         cmocka_unit_test(test_special),
         cmocka_unit_test(test_integers),
         cmocka_unit_test(test_round_trip),

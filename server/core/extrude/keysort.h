@@ -1,20 +1,18 @@
 /* Sorting of (64-bit key, 32-bit value) pairs by key, without a comparison callback: the
  * shell's linking, welding and the building check sort many small arrays per building,
  * where qsort's indirect comparisons were a tenth of a city's time. Insertion sort for
- * short arrays, quicksort (median of three) for medium ones, radix sort (byte digits,
- * passes where every key has the same digit skipped) for long ones. Not stable. */
+ * short arrays, quicksort (median of three) for medium ones, radix sort (core/base/radix)
+ * for long ones. Not stable. */
 #ifndef AG_EXTRUDE_KEYSORT_H
 #define AG_EXTRUDE_KEYSORT_H
 
 #include <stddef.h>
 #include <stdint.h>
 
+#include "../base/radix.h"
 #include "../status.h"
 
-typedef struct {
-    uint64_t key;
-    uint32_t val;
-} ag_keyed;
+typedef ag_radix_item ag_keyed;
 
 /* Sorts v (n entries) by key; tmp must hold n entries (may be NULL: then it is allocated
  * when needed, and AG_ERR_NOMEM is possible). */

@@ -1030,11 +1030,8 @@ ag_status ag_grammar_fidelity(const ag_mesh *input, const ag_mesh *derived, doub
                         /* copies, at a tolerance tight enough that the pairing of triangles
                          * is the true one (a loose one could pair neighbours and report
                          * their gap) */
-                        size_t miss = 0;
-                        w = ag_label_match_triangles(sb, nd, sa, ni, fast_tol, &miss);
-                        if (w < 0)
+                        if ((same = ag_label_soups_match(sb, nd, sa, ni, fast_tol, &w)) < 0)
                             goto done;
-                        same = miss == 0;
                     } else {
                         double t = pass == 1 ? tol / AG_PROC_FIDELITY_REFINE : tol;
                         if ((same = ag_label_same_surface(sa, ni, sb, nd, t, &w)) < 0)

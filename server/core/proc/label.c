@@ -1,10 +1,12 @@
 #include "label.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "../base/array.h"
+#include "../base/radix.h"
 #include "../base/search.h"
 #include "../base/tolerance.h"
 #include "gframe.h"
@@ -37,19 +39,6 @@ void ag_label_rotate(int k, double *x, double *y)
     }
 }
 
-typedef struct {
-    uint64_t h;
-    uint32_t i;
-} hidx;
-
-static int cmp_hidx(const void *a, const void *b)
-{
-    const hidx *x = a, *y = b;
-    if (x->h != y->h)
-        return x->h < y->h ? -1 : 1;
-    return x->i < y->i ? -1 : x->i > y->i;
-}
-
 static void centroid(const double *t, double c[3])
 {
     for (int a = 0; a < 3; a++)
@@ -69,8 +58,97 @@ static double tri_dist(const double *x, const double *y, int shift)
     return sqrt(m);
 }
 
-double ag_label_match_triangles(const double *a, size_t na, const double *b, size_t nb,
-                                double tol, size_t *unmatched)
+/* Soups with at most this many pairs, and a of at most SMALL_A triangles, are matched by
+ * comparing every pair (a window of a few dozen triangles): cheaper than building a cell
+ * index for them. */
+#define SMALL_PAIRS 4096
+#define SMALL_A 128
+
+/* The cell of 2 tol holding a triangle's centroid. */
+static void centroid_cell(const double *t, double cell, int64_t k[3])
+{
+    double c[3];
+    centroid(t, c);
+    for (int q = 0; q < 3; q++)
+        k[q] = (int64_t)floor(c[q] / cell);
+}
+
+/* The choice of a partner for one triangle of b: the nearest within tol of the triangles of a
+ * whose centroid cell is next to b's, then the first in the order of a scan of those 27
+ * cells, then in a's order. */
+typedef struct {
+    double d;
+    size_t i; /* SIZE_MAX: none yet */
+    int rank; /* the cell's place in the scan */
+} choice;
+
+static void offer(choice *c, const double *tb, const int64_t kb[3], const double *ta,
+                  const int64_t ka[3], size_t i, double tol)
+{
+    int rank = 0;
+    for (int q = 0; q < 3; q++) {
+        int64_t off = ka[q] - kb[q];
+        if (off < -1 || off > 1)
+            return; /* outside the 27 cells */
+        rank = 3 * rank + (int)(off + 1);
+    }
+    double d = INFINITY;
+    for (int sh = 0; sh < 3; sh++)
+        d = fmin(d, tri_dist(tb, ta, sh));
+    if (d <= tol && (d < c->d || (d == c->d && (rank < c->rank || (rank == c->rank && i < c->i))))) {
+        c->d = d;
+        c->i = i;
+        c->rank = rank;
+    }
+}
+
+/* Takes c's partner; 0 when there is none (one more miss). */
+static int settle(const choice *c, uint8_t *used, double *worst, size_t *miss)
+{
+    if (c->i == SIZE_MAX) {
+        (*miss)++;
+        return 0;
+    }
+    used[c->i] = 1;
+    if (c->d > *worst)
+        *worst = c->d;
+    return 1;
+}
+
+/* match_soups below SMALL_PAIRS: every pair, with the same choice (the nearest within tol
+ * among the triangles of a whose centroid cell is next to b's, then the first in cell order,
+ * then in a's order). */
+static double match_small(const double *a, size_t na, const double *b, size_t nb, double tol,
+                          double cell, size_t *unmatched, int stop_at_miss)
+{
+    uint8_t used[SMALL_A];
+    int64_t ka[3 * SMALL_A];
+    size_t miss = 0;
+    double worst = 0;
+    memset(used, 0, na);
+    for (size_t i = 0; i < na; i++)
+        centroid_cell(a + 9 * i, cell, ka + 3 * i);
+    for (size_t j = 0; j < nb; j++) {
+        const double *tb = b + 9 * j;
+        int64_t kb[3];
+        centroid_cell(tb, cell, kb);
+        choice c = {INFINITY, SIZE_MAX, 27};
+        for (size_t i = 0; i < na; i++)
+            if (!used[i])
+                offer(&c, tb, kb, a + 9 * i, ka + 3 * i, i, tol);
+        if (!settle(&c, used, &worst, &miss) && stop_at_miss)
+            break;
+    }
+    if (unmatched)
+        *unmatched = miss;
+    return worst;
+}
+
+/* ag_label_match_triangles; with stop_at_miss it returns at the first triangle of b without
+ * a partner (*unmatched then 1): a comparison that only asks whether all match stops there
+ * instead of probing every other triangle. */
+static double match_soups(const double *a, size_t na, const double *b, size_t nb, double tol,
+                          size_t *unmatched, int stop_at_miss)
 {
     size_t miss = 0;
     double worst = 0;
@@ -95,61 +173,98 @@ double ag_label_match_triangles(const double *a, size_t na, const double *b, siz
         }
         worst = 0;
     }
-    double cell = 2 * tol; /* a match within tol lies in a neighbouring cell */
-    hidx *ha = malloc((na + 1) * sizeof *ha);
+    /* A match within tol has its centroid within tol of b's on every axis. a's triangles
+     * are registered in the cells of size >= 4 r that [c - r, c + r] meets (r: tol, a
+     * little more for the centroids' rounding; at most 2 cells per axis), so one look-up of
+     * b's own cell finds every candidate. The choice among candidates is that of a scan of
+     * the 27 cells of size 2 tol around b's centroid, in cell order, then triangle order:
+     * the nearest, the first of that scan on a tie. */
+    double cell = 2 * tol, amax = 0;
+    if (na <= SMALL_A && (uint64_t)na * nb <= SMALL_PAIRS)
+        return match_small(a, na, b, nb, tol, cell, unmatched, stop_at_miss);
+    for (size_t i = 0; i < 9 * na; i++)
+        amax = fmax(amax, fabs(a[i]));
+    double r = 1.01 * tol + 16 * DBL_EPSILON * (amax + 1), icell = 4 * r;
+    ag_radix_item *ha = NULL;
+    size_t nh = 0, cap_h = 0;
+    int64_t *acell = malloc((3 * na + 1) * sizeof *acell); /* a's cells of size 2 tol */
     uint8_t *used = calloc(na + 1, 1);
-    if (!ha || !used) {
+    if (!acell || !used || AG_ARRAY_RESERVE(ha, cap_h, 2 * na + 1)) {
         free(ha);
+        free(acell);
         free(used);
         return -1;
     }
     for (size_t i = 0; i < na; i++) {
         double c[3];
         centroid(a + 9 * i, c);
-        ha[i].h = ag__cell_hash((int64_t)floor(c[0] / cell), (int64_t)floor(c[1] / cell),
-                                (int64_t)floor(c[2] / cell));
-        ha[i].i = (uint32_t)i;
+        int64_t lo[3], hi[3];
+        for (int q = 0; q < 3; q++) {
+            acell[3 * i + q] = (int64_t)floor(c[q] / cell);
+            lo[q] = (int64_t)floor((c[q] - r) / icell);
+            hi[q] = (int64_t)floor((c[q] + r) / icell);
+        }
+        for (int64_t x = lo[0]; x <= hi[0]; x++)
+            for (int64_t y = lo[1]; y <= hi[1]; y++)
+                for (int64_t z = lo[2]; z <= hi[2]; z++) {
+                    if (AG_ARRAY_RESERVE(ha, cap_h, nh + 1)) {
+                        free(ha);
+                        free(acell);
+                        free(used);
+                        return -1;
+                    }
+                    ha[nh].key = ag__cell_hash(x, y, z);
+                    ha[nh++].val = (uint32_t)i;
+                }
     }
-    qsort(ha, na, sizeof *ha, cmp_hidx);
+    ag_radix_index cells;
+    if (ag_radix_sort(ha, nh) || ag_radix_index_build(&cells, ha, nh)) {
+        free(ha);
+        free(acell);
+        free(used);
+        return -1;
+    }
     for (size_t j = 0; j < nb; j++) {
         const double *tb = b + 9 * j;
         double c[3];
         centroid(tb, c);
-        int64_t k0 = (int64_t)floor(c[0] / cell), k1 = (int64_t)floor(c[1] / cell),
-                k2 = (int64_t)floor(c[2] / cell);
-        double best = INFINITY;
-        size_t besti = SIZE_MAX;
-        for (int dx = -1; dx <= 1; dx++)
-            for (int dy = -1; dy <= 1; dy++)
-                for (int dz = -1; dz <= 1; dz++) {
-                    uint64_t h = ag__cell_hash(k0 + dx, k1 + dy, k2 + dz);
-                    size_t lo = ag_search_lower_u64(&ha[0].h, na, sizeof *ha, h);
-                    for (size_t s = lo; s < na && ha[s].h == h; s++) {
-                        uint32_t i = ha[s].i;
-                        if (used[i])
-                            continue;
-                        for (int sh = 0; sh < 3; sh++) {
-                            double d = tri_dist(tb, a + 9 * (size_t)i, sh);
-                            if (d <= tol && d < best) {
-                                best = d;
-                                besti = i;
-                            }
-                        }
-                    }
-                }
-        if (besti == SIZE_MAX) {
-            miss++;
-            continue;
+        int64_t k[3] = {(int64_t)floor(c[0] / cell), (int64_t)floor(c[1] / cell),
+                        (int64_t)floor(c[2] / cell)};
+        uint64_t h = ag__cell_hash((int64_t)floor(c[0] / icell), (int64_t)floor(c[1] / icell),
+                                   (int64_t)floor(c[2] / icell));
+        choice ch = {INFINITY, SIZE_MAX, 27};
+        for (size_t e = ag_radix_index_find(&cells, h); e < nh && ha[e].key == h; e++) {
+            uint32_t i = ha[e].val;
+            if (!used[i])
+                offer(&ch, tb, k, a + 9 * (size_t)i, acell + 3 * (size_t)i, i, tol);
         }
-        used[besti] = 1;
-        if (best > worst)
-            worst = best;
+        if (!settle(&ch, used, &worst, &miss) && stop_at_miss)
+            break;
     }
+    ag_radix_index_free(&cells);
     free(ha);
+    free(acell);
     free(used);
     if (unmatched)
         *unmatched = miss;
     return worst;
+}
+
+double ag_label_match_triangles(const double *a, size_t na, const double *b, size_t nb,
+                                double tol, size_t *unmatched)
+{
+    return match_soups(a, na, b, nb, tol, unmatched, 0);
+}
+
+int ag_label_soups_match(const double *a, size_t na, const double *b, size_t nb, double tol,
+                         double *worst)
+{
+    size_t miss = 0;
+    double w = match_soups(a, na, b, nb, tol, &miss, 1);
+    if (w < 0)
+        return -1;
+    *worst = w;
+    return miss == 0;
 }
 
 /* The surfaces of soups a and b, each on the other. */
@@ -182,14 +297,9 @@ int ag_label_same_surface(const double *a, size_t na, const double *b, size_t nb
                           double *deviation)
 {
     if (na == nb) {
-        size_t miss = 0;
-        double w = ag_label_match_triangles(a, na, b, nb, tol, &miss);
-        if (w < 0)
-            return -1;
-        if (!miss) {
-            *deviation = w;
-            return 1;
-        }
+        int same = ag_label_soups_match(a, na, b, nb, tol, deviation);
+        if (same)
+            return same;
     }
     return surfaces_match(a, na, b, nb, tol, deviation);
 }
@@ -377,6 +487,7 @@ typedef struct {
                      shortcut */
     int no_rotation;
     int nomem;
+    int64_t sa_of; /* label_pass: the (exemplar, turn) whose oriented soup sa holds, -1 */
     unsigned checks_left; /* surface comparisons the current component may still make */
 } lctx;
 
@@ -397,16 +508,10 @@ static int compare(lctx *x, size_t na, size_t nb, double tol, int fast, double *
     if (fast) {
         if (na != nb)
             return 0;
-        size_t miss = 0;
-        double w = ag_label_match_triangles(x->sa, na, x->sb, nb, tol, &miss);
-        if (w < 0) {
+        int same = ag_label_soups_match(x->sa, na, x->sb, nb, tol, dev);
+        if (same < 0)
             x->nomem = 1;
-            return 0;
-        }
-        if (miss)
-            return 0;
-        *dev = w;
-        return 1;
+        return same > 0;
     }
     if (!x->checks_left)
         return 0; /* past the budget: no match, never a wrong one */
@@ -447,6 +552,7 @@ static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
     for (size_t i = 0; i < cap; i++)
         bk[i].head = -1;
     long ncls = 0;
+    x->sa_of = -1;
     /* buckets: the oriented box's height and sorted plan sizes in cells of 4 tol, so a match
      * within tol is always in a neighbouring cell */
     double q = 4 * tol > 0 ? 4 * tol : AG_PROC_TINY;
@@ -481,7 +587,12 @@ static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
                             oriented_soup(x->m, L, &F[c], c, 0, 0, x->sb);
                             have_cb = 1;
                         }
-                        oriented_soup(x->m, L, &F[e], e, k & 3, k >> 2, x->sa);
+                        /* the soups of one exemplar repeat for the members that follow
+                         * it (the inputs are const in the comparisons) */
+                        if (x->sa_of != (int64_t)e * 8 + k) {
+                            oriented_soup(x->m, L, &F[e], e, k & 3, k >> 2, x->sa);
+                            x->sa_of = (int64_t)e * 8 + k;
+                        }
                         double dev;
                         if (compare(x, L->ntris[e], L->ntris[c], tol, fast, &dev)) {
                             found = l;

@@ -90,6 +90,12 @@ void ag_label_rotate(int k, double *x, double *y);
 double ag_label_match_triangles(const double *a, size_t na, const double *b, size_t nb,
                                 double tol, size_t *unmatched);
 
+/* Whether every triangle of b has a partner in a (ag_label_match_triangles), stopping at the
+ * first that has none: 1 with *worst the largest vertex distance, 0 for a miss (*worst
+ * untouched), -1 when out of memory. */
+int ag_label_soups_match(const double *a, size_t na, const double *b, size_t nb, double tol,
+                         double *worst);
+
 /* Whether soups a and b are the same surface within tol (each within tol of the other,
  * certified; surface.h), through their triangle lists when those match. *deviation gets the
  * certified bound. Returns 1 for the same surface, 0 for not, -1 when out of memory. */

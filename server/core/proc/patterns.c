@@ -5,7 +5,10 @@
 #include <string.h>
 
 #include "../base/array.h"
+#include "../base/radix.h"
+#include "../base/search.h"
 #include "../base/tolerance.h"
+#include "weld.h"
 
 /* Work limits of the fits: a grid of more steps per axis, a lattice over more instances or
  * with larger indices is not looked for (the instances stay as they are). */
@@ -204,8 +207,7 @@ static void flip_positive(double v[3])
  * line). On success ij[2k], ij[2k+1] hold instance k's indices (from 0) and counts the
  * extent; *complete tells whether every lattice cell holds an instance. */
 /* Instances in the order of their boxes' min x (then index): the closest-pair searches
- * below stop scanning once the x gap alone exceeds the best length found, which keeps them
- * near n log n on facades of thousands of windows instead of n^2. */
+ * below visit the pairs in that order. */
 typedef struct {
     double x;
     size_t k;
@@ -219,55 +221,162 @@ static int cmp_by_x(const void *a, const void *b)
     return p->k < q->k ? -1 : p->k > q->k;
 }
 
+/* One closest-offset search of lattice_fit over points P (3 per position, in sweep order):
+ * for every pair of positions ii < kk in order, d = P[kk] - P[ii] becomes the best when it
+ * is longer than tol, shorter than the best by more than tol and, with a line (direction
+ * line, line . line = ll), farther than off_min from it. Returns the best length (INFINITY
+ * for none), its offset in out.
+ *
+ * Only a pair shorter than the best at the start of ii can replace it, so once a best is
+ * known the pairs of ii are taken from a grid of cells of that size (the 27 cells around
+ * P[ii]) in kk order: the same pairs, in the same order, as a scan of all pairs, which is
+ * n^2 on a facade whose windows share one x. Until then (and for every ii while nothing
+ * qualifies), a scan in x order that stops where the x gap alone exceeds the best. */
+/* Below this many points the scan is cheaper than the grid. */
+#define CLOSEST_GRID_MIN 64
+
+static double closest_offset(const double *P, size_t n, double tol, const double *line,
+                             double ll, double off_min, double out[3], int *nomem)
+{
+    double best = INFINITY, h = 0;
+    ag_radix_item *cells = NULL;
+    ag_radix_index index = {0};
+    uint32_t *cand = NULL;
+    size_t ncand = 0, cap_cand = 0;
+    for (size_t ii = 0; ii < n && !*nomem; ii++) {
+        const double *x = P + 3 * ii;
+        if (isfinite(best) && !cells && n > CLOSEST_GRID_MIN) { /* the grid, once */
+            h = best > 0 ? best : 1;
+            cells = malloc(n * sizeof *cells);
+            if (!cells) {
+                *nomem = 1;
+                break;
+            }
+            for (size_t k = 0; k < n; k++) {
+                cells[k].key = ag__cell_hash((int64_t)floor(P[3 * k] / h),
+                                             (int64_t)floor(P[3 * k + 1] / h),
+                                             (int64_t)floor(P[3 * k + 2] / h));
+                cells[k].val = (uint32_t)k;
+            }
+            if (ag_radix_sort(cells, n) || ag_radix_index_build(&index, cells, n)) {
+                *nomem = 1;
+                break;
+            }
+        }
+        ncand = 0;
+        if (cells) {
+            /* every point within the best of x on each axis (a little more: rounding) */
+            double R = best * (1 + 1e-12) + 1e-300;
+            int64_t lo[3], hi[3];
+            for (int a = 0; a < 3; a++) {
+                lo[a] = (int64_t)floor((x[a] - R) / h);
+                hi[a] = (int64_t)floor((x[a] + R) / h);
+            }
+            for (int64_t cx = lo[0]; cx <= hi[0]; cx++)
+                for (int64_t cy = lo[1]; cy <= hi[1]; cy++)
+                    for (int64_t cz = lo[2]; cz <= hi[2]; cz++) {
+                        uint64_t key = ag__cell_hash(cx, cy, cz);
+                        for (size_t e = ag_radix_index_find(&index, key);
+                             e < n && cells[e].key == key; e++) {
+                            if (cells[e].val <= ii)
+                                continue;
+                            if (AG_ARRAY_RESERVE(cand, cap_cand, ncand + 1)) {
+                                *nomem = 1;
+                                break;
+                            }
+                            cand[ncand++] = cells[e].val;
+                        }
+                    }
+            /* in kk order, once each (two cells may share a hash) */
+            for (size_t i = 1; i < ncand; i++) {
+                uint32_t v = cand[i];
+                size_t j = i;
+                while (j > 0 && cand[j - 1] > v) {
+                    cand[j] = cand[j - 1];
+                    j--;
+                }
+                cand[j] = v;
+            }
+        }
+        size_t m = cells ? ncand : n;
+        for (size_t c = 0; c < m; c++) {
+            size_t kk;
+            if (cells) {
+                if (c > 0 && cand[c] == cand[c - 1])
+                    continue;
+                kk = cand[c];
+            } else {
+                kk = ii + 1 + c;
+                if (kk >= n || P[3 * kk] - x[0] > best)
+                    break;
+            }
+            const double *y = P + 3 * kk;
+            double d[3] = {y[0] - x[0], y[1] - x[1], y[2] - x[2]};
+            double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            if (line) {
+                double s = (d[0] * line[0] + d[1] * line[1] + d[2] * line[2]) / ll;
+                double r[3] = {d[0] - s * line[0], d[1] - s * line[1], d[2] - s * line[2]};
+                double off = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+                if (!(off > off_min && l < best - tol))
+                    continue;
+            } else if (!(l > tol && l < best - tol)) {
+                continue;
+            }
+            best = l;
+            memcpy(out, d, 3 * sizeof *d);
+        }
+    }
+    ag_radix_index_free(&index);
+    free(cells);
+    free(cand);
+    return best;
+}
+
 static int lattice_fit(const ag_splittree *t, const inst *g, size_t n, double tol, int *nvec,
                        double vec[2][3], uint32_t counts[2], int64_t *ij, int *complete)
 {
     if (n < 2 || n > LATTICE_MAX_INSTANCES)
         return 0;
     by_x *ord = malloc(n * sizeof *ord);
-    if (!ord)
+    double *P = malloc(3 * n * sizeof *P);
+    if (!ord || !P) {
+        free(ord);
+        free(P);
         return 0;
+    }
     for (size_t k = 0; k < n; k++) {
         ord[k].x = t->nodes[g[k].node].box.min[0];
         ord[k].k = k;
     }
     qsort(ord, n, sizeof *ord, cmp_by_x);
+    for (size_t k = 0; k < n; k++)
+        memcpy(P + 3 * k, t->nodes[g[ord[k].k].node].box.min, 3 * sizeof *P);
+    free(ord);
     const ag_box *B0 = &t->nodes[g[0].node].box;
-    double best = INFINITY, a[3] = {0, 0, 0};
-    for (size_t ii = 0; ii < n; ii++)
-        for (size_t kk = ii + 1; kk < n && ord[kk].x - ord[ii].x <= best; kk++) {
-            const ag_box *x = &t->nodes[g[ord[ii].k].node].box;
-            const ag_box *y = &t->nodes[g[ord[kk].k].node].box;
-            double d[3] = {y->min[0] - x->min[0], y->min[1] - x->min[1], y->min[2] - x->min[2]};
-            double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            if (l > tol && l < best - tol) {
-                best = l;
-                memcpy(a, d, sizeof a);
-            }
-        }
-    if (!isfinite(best)) {
-        free(ord);
+    double a[3] = {0, 0, 0};
+    int nomem = 0;
+    double best = closest_offset(P, n, tol, NULL, 0, 0, a, &nomem);
+    if (nomem || !isfinite(best)) {
+        free(P);
         return 0;
     }
     flip_positive(a);
     double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-    /* b: the shortest offset farther than tol from a's line */
-    double bestb = INFINITY, b[3] = {0, 0, 0};
-    for (size_t ii = 0; ii < n; ii++)
-        for (size_t kk = ii + 1; kk < n && ord[kk].x - ord[ii].x <= bestb; kk++) {
-            const ag_box *x = &t->nodes[g[ord[ii].k].node].box;
-            const ag_box *y = &t->nodes[g[ord[kk].k].node].box;
-            double d[3] = {y->min[0] - x->min[0], y->min[1] - x->min[1], y->min[2] - x->min[2]};
-            double s = (d[0] * a[0] + d[1] * a[1] + d[2] * a[2]) / aa;
-            double r[3] = {d[0] - s * a[0], d[1] - s * a[1], d[2] - s * a[2]};
-            double off = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-            double l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-            if (off > AG_PROC_LATTICE_OFF_LINE * tol && l < bestb - tol) {
-                bestb = l;
-                memcpy(b, d, sizeof b);
-            }
-        }
-    free(ord);
+    /* b: the shortest offset farther than OFF_LINE tol from a's line; none when every point
+     * lies within half that of the line through the first (no pair can then be farther) */
+    double off_min = AG_PROC_LATTICE_OFF_LINE * tol, b[3] = {0, 0, 0}, bestb = INFINITY;
+    double spread = 0;
+    for (size_t k = 1; k < n; k++) {
+        double d[3] = {P[3 * k] - P[0], P[3 * k + 1] - P[1], P[3 * k + 2] - P[2]};
+        double s = (d[0] * a[0] + d[1] * a[1] + d[2] * a[2]) / aa;
+        double r[3] = {d[0] - s * a[0], d[1] - s * a[1], d[2] - s * a[2]};
+        spread = fmax(spread, sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]));
+    }
+    if (!(spread <= 0.45 * off_min))
+        bestb = closest_offset(P, n, tol, a, aa, off_min, b, &nomem);
+    free(P);
+    if (nomem)
+        return 0;
     int nv = isfinite(bestb) ? 2 : 1;
     flip_positive(b);
     double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2], bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];

@@ -1,9 +1,15 @@
 #include "rules.h"
 
 #include <assert.h>
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "../base/array.h"
+#include "../base/radix.h"
+#include "../base/search.h"
+#include "weld.h"
 
 /* Box of child e relative to the centre of node v, rotated by k quarter turns. */
 static void rel_box(const ag_splittree *t, int32_t v, int32_t e, int k, double lo[3], double hi[3])
@@ -62,12 +68,49 @@ static int same_pattern(const ag_splittree *t, const ag_tnode *x, const ag_tnode
     return 1;
 }
 
+/* Scratch of same() for nodes with many children, kept across calls: a's children's boxes
+ * and a cell index of their lower corners. */
+typedef struct {
+    double *lo, *hi;   /* 3 per child of a */
+    ag_radix_item *ent;
+    size_t cap_ent;
+    int nomem;
+} same_scratch;
+
+/* Above this many children a's are found through the cell index instead of a scan of all of
+ * them per child of b (a wall holding thousands of windows: n^2). */
+#define SAME_INDEX_MIN 64
+
+/* Is child x of a (turned by k) the same as child y of b, boxes lo/hi relative to the
+ * nodes' centres? */
+static int same_child(const ag_splittree *t, const ag_tnode *x, const ag_tnode *y, int k,
+                      const double alo[3], const double ahi[3], const double blo[3],
+                      const double bhi[3])
+{
+    if (x->kind != y->kind)
+        return 0;
+    if (x->kind == AG_NODE_PATTERN ? !same_pattern(t, x, y, k)
+                                   : x->rule != y->rule || ((x->rule_rot + k) & 3) != y->rule_rot)
+        return 0;
+    for (int d = 0; d < 3; d++)
+        if (!(fabs(alo[d] - blo[d]) <= t->tol && fabs(ahi[d] - bhi[d]) <= t->tol))
+            return 0;
+    return 1;
+}
+
+static uint64_t corner_cell(const double p[3], double cell, const int64_t add[3])
+{
+    return ag__cell_hash((int64_t)floor(p[0] / cell) + add[0], (int64_t)floor(p[1] / cell) + add[1],
+                         (int64_t)floor(p[2] / cell) + add[2]);
+}
+
 /* Does b match rep a with b = rotate(a, k)? b must also have a's size: a rule is placed scaled
  * to the box it is applied to (its children would move with it) and a pattern's cells are of
  * one size (nodes of one variant have it anyway; an edited model's stretched copies of a
- * variant do not). Pattern children repeat the same rule the same way. */
+ * variant do not). Pattern children repeat the same rule the same way. Each child of b, in
+ * order, takes the first unused child of a that is the same. */
 static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca, int32_t *cb,
-                uint8_t *used, size_t n)
+                uint8_t *used, size_t n, same_scratch *sc)
 {
     size_t na = children(t, a, ca, n), nb = children(t, b, cb, n);
     assert(na == n && nb == n); /* the caller compared the counts */
@@ -84,33 +127,79 @@ static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca,
             fabs(ea[2] - eb[2]) > tol)
             return 0;
     }
+    if (n <= SAME_INDEX_MIN) {
+        for (size_t j = 0; j < n; j++) {
+            double blo[3], bhi[3];
+            rel_box(t, b, cb[j], 0, blo, bhi);
+            int ok = 0;
+            for (size_t i = 0; i < n && !ok; i++) {
+                if (used[i])
+                    continue;
+                double alo[3], ahi[3];
+                rel_box(t, a, ca[i], k, alo, ahi);
+                if (same_child(t, &t->nodes[ca[i]], &t->nodes[cb[j]], k, alo, ahi, blo, bhi)) {
+                    used[i] = 1;
+                    ok = 1;
+                }
+            }
+            if (!ok)
+                return 0;
+        }
+        return 1;
+    }
+    /* a's children by the cell of their lower corner: a child within tol lies in the cells
+     * (of 4 r) that [lo - r, lo + r] meets, at most 2 per axis, so b's child looks up its
+     * own cell only; of the candidates, the first unused in a's order is the one a scan
+     * would take */
+    double amax = 0;
+    for (size_t i = 0; i < n; i++) {
+        rel_box(t, a, ca[i], k, sc->lo + 3 * i, sc->hi + 3 * i);
+        for (int d = 0; d < 3; d++)
+            amax = fmax(amax, fabs(sc->lo[3 * i + d]));
+    }
+    double r = 1.01 * tol + 16 * DBL_EPSILON * (amax + 1), cell = 4 * r;
+    size_t ne = 0;
+    for (size_t i = 0; i < n; i++) {
+        const double *lo = sc->lo + 3 * i;
+        double l[3] = {lo[0] - r, lo[1] - r, lo[2] - r}, h[3] = {lo[0] + r, lo[1] + r, lo[2] + r};
+        int64_t c0[3], c1[3];
+        for (int d = 0; d < 3; d++) {
+            c0[d] = (int64_t)floor(l[d] / cell);
+            c1[d] = (int64_t)floor(h[d] / cell) - c0[d];
+        }
+        for (int64_t x = 0; x <= c1[0]; x++)
+            for (int64_t y = 0; y <= c1[1]; y++)
+                for (int64_t z = 0; z <= c1[2]; z++) {
+                    if (AG_ARRAY_RESERVE(sc->ent, sc->cap_ent, ne + 1)) {
+                        sc->nomem = 1;
+                        return 0;
+                    }
+                    int64_t add[3] = {x, y, z};
+                    sc->ent[ne].key = corner_cell(l, cell, add);
+                    sc->ent[ne++].val = (uint32_t)i;
+                }
+    }
+    if (ag_radix_sort(sc->ent, ne)) {
+        sc->nomem = 1;
+        return 0;
+    }
+    static const int64_t none[3] = {0, 0, 0};
     for (size_t j = 0; j < n; j++) {
-        const ag_tnode *y = &t->nodes[cb[j]];
         double blo[3], bhi[3];
         rel_box(t, b, cb[j], 0, blo, bhi);
-        int ok = 0;
-        for (size_t i = 0; i < n && !ok; i++) {
-            if (used[i])
-                continue;
-            const ag_tnode *x = &t->nodes[ca[i]];
-            if (x->kind != y->kind)
-                continue;
-            if (x->kind == AG_NODE_PATTERN ? !same_pattern(t, x, y, k)
-                                           : x->rule != y->rule ||
-                                                 ((x->rule_rot + k) & 3) != y->rule_rot)
-                continue;
-            double alo[3], ahi[3];
-            rel_box(t, a, ca[i], k, alo, ahi);
-            int fit = 1;
-            for (int d = 0; d < 3 && fit; d++)
-                fit = fabs(alo[d] - blo[d]) <= tol && fabs(ahi[d] - bhi[d]) <= tol;
-            if (fit) {
-                used[i] = 1;
-                ok = 1;
-            }
+        uint64_t key = corner_cell(blo, cell, none);
+        size_t best = SIZE_MAX;
+        for (size_t e = ag_search_lower_u64(&sc->ent[0].key, ne, sizeof *sc->ent, key);
+             e < ne && sc->ent[e].key == key; e++) {
+            size_t i = sc->ent[e].val;
+            if (i < best && !used[i] &&
+                same_child(t, &t->nodes[ca[i]], &t->nodes[cb[j]], k, sc->lo + 3 * i,
+                           sc->hi + 3 * i, blo, bhi))
+                best = i;
         }
-        if (!ok)
+        if (best == SIZE_MAX)
             return 0;
+        used[best] = 1;
     }
     return 1;
 }
@@ -191,12 +280,17 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     int32_t *rnext = malloc((N + 1) * sizeof *rnext);
     int32_t *ca = malloc((N + 1) * sizeof *ca), *cb = malloc((N + 1) * sizeof *cb);
     uint8_t *used = malloc(N + 1);
+    same_scratch sc = {malloc((3 * N + 1) * sizeof *sc.lo), malloc((3 * N + 1) * sizeof *sc.hi),
+                       NULL, 0, 0};
     free(t->rule_count);
     free(t->rule_rep);
     t->rule_count = malloc((N + 1) * sizeof *t->rule_count);
     t->rule_rep = malloc((N + 1) * sizeof *t->rule_rep);
     t->nrules = 0;
-    if (!lhead || !rnext || !ca || !cb || !used || !t->rule_count || !t->rule_rep) {
+    if (!lhead || !rnext || !ca || !cb || !used || !t->rule_count || !t->rule_rep || !sc.lo ||
+        !sc.hi) {
+        free(sc.lo);
+        free(sc.hi);
         free(lhead);
         free(rnext);
         free(ca);
@@ -210,6 +304,8 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     size_t norder = 0;
     int32_t *order = children_first(t, &norder);
     if (!order) {
+        free(sc.lo);
+        free(sc.hi);
         free(lhead);
         free(rnext);
         free(ca);
@@ -228,7 +324,7 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
             if (children(t, a, NULL, 0) != nb)
                 continue;
             int k = (b->rot - t->nodes[a].rot) & 3;
-            if (same(t, a, (int32_t)ii, k, ca, cb, used, nb)) {
+            if (same(t, a, (int32_t)ii, k, ca, cb, used, nb, &sc)) {
                 found = r;
                 fk = k;
             }
@@ -246,6 +342,9 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
         t->rule_count[found]++;
     }
     free(order);
+    free(sc.lo);
+    free(sc.hi);
+    free(sc.ent);
     /* a pattern repeats its cells' rule */
     for (size_t p = 0; p < t->npatterns; p++) {
         int32_t pn = t->patterns[p].node;
@@ -260,5 +359,7 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     free(ca);
     free(cb);
     free(used);
+    if (sc.nomem)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     return AG_OK;
 }

@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
+#include "../base/radix.h"
 #include "../base/tolerance.h"
 #include "../base/uf.h"
 #include "weld.h"
@@ -36,18 +38,9 @@ ag_status ag_segment_validate(const ag_mesh *m, ag_error *err)
     return AG_OK;
 }
 
-typedef struct {
-    uint64_t key;
-    uint32_t tri;
-} keyed;
-
-static int cmp_keyed(const void *a, const void *b)
-{
-    const keyed *x = a, *y = b;
-    if (x->key != y->key)
-        return x->key < y->key ? -1 : 1;
-    return x->tri < y->tri ? -1 : x->tri > y->tri;
-}
+/* Records sorted by key with ag_radix_sort; val is a triangle, and the records are filled
+ * in ascending triangle order, so equal keys stay in triangle order. */
+typedef ag_radix_item keyed;
 
 static void tri_normal(const ag_mesh *m, size_t t, double n[3], double *area2)
 {
@@ -86,9 +79,13 @@ static ag_status planar_regions(const ag_mesh *m, const uint32_t *wid, double co
                 b = s;
             }
             e[3 * t + k].key = a << 32 | b;
-            e[3 * t + k].tri = (uint32_t)t;
+            e[3 * t + k].val = (uint32_t)t;
         }
-    qsort(e, 3 * n, sizeof *e, cmp_keyed);
+    if (ag_radix_sort(e, 3 * n)) {
+        free(e);
+        free(queue);
+        return AG_ERR_NOMEM;
+    }
     /* per triangle, positions of its three edges in the sorted array */
     uint32_t *at = malloc(3 * n * sizeof *at);
     uint8_t *seen = calloc(3 * n, 1);
@@ -100,7 +97,7 @@ static ag_status planar_regions(const ag_mesh *m, const uint32_t *wid, double co
         return AG_ERR_NOMEM;
     }
     for (size_t i = 0; i < 3 * n; i++) {
-        uint32_t t = e[i].tri;
+        uint32_t t = e[i].val;
         int k = 0;
         while (seen[3 * t + k])
             k++;
@@ -130,7 +127,7 @@ static ag_status planar_regions(const ag_mesh *m, const uint32_t *wid, double co
                 while (hi + 1 < 3 * n && e[hi + 1].key == e[i].key)
                     hi++;
                 for (size_t j = lo; j <= hi; j++) {
-                    uint32_t u = e[j].tri;
+                    uint32_t u = e[j].val;
                     if (piece[u] != UINT32_MAX)
                         continue;
                     double nu[3], au;
@@ -190,7 +187,7 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
     ag_uf uf = {0};
     uint32_t *newc = NULL; /* per triangle: its new component */
     uint32_t *piece = malloc(n * sizeof *piece);
-    keyed *kv = malloc(3 * n * sizeof *kv);
+    keyed *kv = malloc(n * sizeof *kv); /* twin keys, one per piece */
     size_t *ctris = calloc(nc + 1, sizeof *ctris);
     uint8_t *split = calloc(nc + 1, 1);
     ag_mesh *m = ag_mesh_create();
@@ -202,16 +199,51 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
         goto done;
     st = AG_ERR_NOMEM; /* what every failure up to the new mesh is */
 
-    /* connected pieces inside each component */
-    for (size_t t = 0; t < n; t++)
-        for (int k = 0; k < 3; k++) {
-            kv[3 * t + k].key = (uint64_t)in->tri_component[t] << 32 | wid[in->tri[3 * t + k]];
-            kv[3 * t + k].tri = (uint32_t)t;
+    /* connected pieces inside each component: its triangles that share a welded vertex. A
+     * welded vertex keeps the first component and triangle on it; the corners of other
+     * components on it (a vertex two components share, rare) are sorted by (component,
+     * vertex) instead, so the pieces cost O(n) and a sort of those corners only */
+    {
+        uint32_t *owner = malloc((nw + 1) * sizeof *owner), *first = malloc((nw + 1) * sizeof *first);
+        keyed *shared = NULL;
+        size_t nshared = 0, cap_shared = 0;
+        if (!owner || !first) {
+            free(owner);
+            free(first);
+            goto done;
         }
-    qsort(kv, 3 * n, sizeof *kv, cmp_keyed);
-    for (size_t i = 1; i < 3 * n; i++)
-        if (kv[i].key == kv[i - 1].key)
-            ag_uf_union(&uf, kv[i].tri, kv[i - 1].tri);
+        for (size_t w = 0; w < nw; w++)
+            owner[w] = UINT32_MAX;
+        int fail = 0;
+        for (size_t t = 0; t < n && !fail; t++) {
+            uint32_t c = in->tri_component[t];
+            for (int k = 0; k < 3; k++) {
+                uint32_t w = wid[in->tri[3 * t + k]];
+                if (owner[w] == UINT32_MAX) {
+                    owner[w] = c;
+                    first[w] = (uint32_t)t;
+                } else if (owner[w] == c) {
+                    ag_uf_union(&uf, (uint32_t)t, first[w]);
+                } else if (AG_ARRAY_RESERVE(shared, cap_shared, nshared + 1)) {
+                    fail = 1;
+                    break;
+                } else {
+                    shared[nshared].key = (uint64_t)c << 32 | w;
+                    shared[nshared++].val = (uint32_t)t;
+                }
+            }
+        }
+        free(owner);
+        free(first);
+        if (fail || ag_radix_sort(shared, nshared)) {
+            free(shared);
+            goto done;
+        }
+        for (size_t i = 1; i < nshared; i++)
+            if (shared[i].key == shared[i - 1].key)
+                ag_uf_union(&uf, shared[i].val, shared[i - 1].val);
+        free(shared);
+    }
     for (size_t t = 0; t < n; t++)
         piece[t] = ag_uf_find(&uf, (uint32_t)t); /* root: a triangle of the piece */
     ag_uf_free(&uf);
@@ -235,18 +267,24 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
         free(gused);
     }
     {
-        /* roots are triangles: compute per root stats in arrays indexed by triangle */
-        uint32_t *pcount = calloc(n, sizeof *pcount);
-        ag_box *pbox = malloc(n * sizeof *pbox);
+        /* roots are triangles: per root its dense piece index, per piece its stats */
+        uint32_t *pidx = malloc((n + 1) * sizeof *pidx);
+        size_t np = 0;
+        for (size_t t = 0; pidx && t < n; t++)
+            if (piece[t] == t)
+                pidx[t] = (uint32_t)np++;
+        uint32_t *pcount = calloc(np + 1, sizeof *pcount);
+        ag_box *pbox = malloc((np + 1) * sizeof *pbox);
         size_t *npieces = calloc(nc, sizeof *npieces);
-        if (!pcount || !pbox || !npieces) {
+        if (!pidx || !pcount || !pbox || !npieces) {
+            free(pidx);
             free(pcount);
             free(pbox);
             free(npieces);
             goto done;
         }
         for (size_t t = 0; t < n; t++) {
-            uint32_t r = piece[t];
+            uint32_t r = pidx[piece[t]];
             if (pcount[r]++ == 0) {
                 npieces[in->tri_component[t]]++;
                 pbox[r] = ag_box_empty();
@@ -259,16 +297,18 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
         double q = AG_PROC_TWIN_STEP * (diag > 0 ? diag : 1.0);
         for (size_t t = 0; t < n; t++)
             if (piece[t] == t) {
-                uint64_t h = ag__mix64(in->tri_component[t] * 31ULL + pcount[t]);
+                uint32_t r = pidx[t];
+                uint64_t h = ag__mix64(in->tri_component[t] * 31ULL + pcount[r]);
                 for (int a = 0; a < 3; a++)
-                    h = ag__mix64(h ^ (uint64_t)(int64_t)floor(ag_box_extent(&pbox[t], a) / q +
+                    h = ag__mix64(h ^ (uint64_t)(int64_t)floor(ag_box_extent(&pbox[r], a) / q +
                                                                 0.5));
                 kv[nk].key = h;
-                kv[nk++].tri = (uint32_t)t;
+                kv[nk++].val = (uint32_t)t;
             }
-        qsort(kv, nk, sizeof *kv, cmp_keyed);
         size_t *twin_tris = calloc(nc, sizeof *twin_tris);
-        if (!twin_tris) {
+        if (!twin_tris || ag_radix_sort(kv, nk)) {
+            free(twin_tris);
+            free(pidx);
             free(pcount);
             free(pbox);
             free(npieces);
@@ -278,7 +318,7 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
             int tw = (i > 0 && kv[i - 1].key == kv[i].key) ||
                      (i + 1 < nk && kv[i + 1].key == kv[i].key);
             if (tw)
-                twin_tris[in->tri_component[kv[i].tri]] += pcount[kv[i].tri];
+                twin_tris[in->tri_component[kv[i].val]] += pcount[pidx[kv[i].val]];
         }
         for (size_t c = 0; c < nc; c++) {
             if (npieces[c] < 2 || o.keep_groups)
@@ -292,6 +332,7 @@ ag_status ag_segment_run(const ag_mesh *in, const ag_segment_options *opt, ag_me
             }
         }
         free(twin_tris);
+        free(pidx);
         free(pcount);
         free(pbox);
         free(npieces);
