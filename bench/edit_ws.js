@@ -11,6 +11,11 @@ import { execFileSync } from 'node:child_process';
 import path from 'node:path';
 import { DAEMON, http, importModel, removeDir, sleep, startDaemon, waitJob, WsClient } from '../tests/integration/harness.js';
 
+// `node bench/edit_ws.js [--sizes 20k,200k] [--no-demo]` runs a part of it (to profile one size)
+const argv = process.argv.slice(2);
+const sizesArg = argv.indexOf('--sizes');
+const SIZES = sizesArg >= 0 ? argv[sizesArg + 1].split(',') : ['20k', '200k'];
+const DEMO = !argv.includes('--no-demo');
 const OPS = 60;
 const PREVIEWS = 200;
 
@@ -67,43 +72,45 @@ let B;
 try {
   // the demo's first building, once its proceduralize job has run
   let model;
-  for (const t0 = Date.now(); Date.now() - t0 < 60000; await sleep(100)) {
-    model = (await http(d, 'GET', '/api/v1/models/1')).json;
-    if (model && model.proceduralized) break;
+  if (DEMO) {
+    for (const t0 = Date.now(); Date.now() - t0 < 60000; await sleep(100)) {
+      model = (await http(d, 'GET', '/api/v1/models/1')).json;
+      if (model && model.proceduralized) break;
+    }
+    if (!model || !model.proceduralized) throw new Error('the demo building was not proceduralized');
+    const tree = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`)).json;
+    console.log(`edit ws: model "${model.name}", ${tree.nodes.length} tree nodes, ${model.stats.triangles} triangles`);
+
+    A = await WsClient.open(d.wsUrl);
+    B = await WsClient.open(d.wsUrl);
+    let version = (await A.request({ type: 'hello', model: model.id, user: 'a' }, 'welcome')).version;
+    await B.request({ type: 'hello', model: model.id, user: 'b' }, 'welcome');
+    await A.next('join');
+
+    // drag previews: root stretched by a varying amount, one at a time (the server keeps 30/s
+    // per connection, so they are spaced 34 ms apart)
+    const box0 = tree.nodes.find((n) => n.id === tree.root).box;
+    const toRoom = [];
+    for (let i = 0; i < PREVIEWS; i++) {
+      const box = [...box0];
+      box[3] = box0[0] + (box0[3] - box0[0]) * (1 + 0.3 * ((i % 20) / 20));
+      const seen = B.next((m) => m.type === 'preview', 10000);
+      const ts = performance.now();
+      A.send({ type: 'preview', model: model.id, base: version, op: { kind: 'resize', node: 'root', box, mode: 'global' } });
+      await seen;
+      toRoom.push(performance.now() - ts);
+      B.all.length = 0;
+      await sleep(34);
+    }
+    A.send({ type: 'preview.end' });
+
+    console.log(`edit ws preview→room:   ${summary(toRoom)}`);
+    await committedOps(model, A, B, version, 'demo building');
   }
-  if (!model || !model.proceduralized) throw new Error('the demo building was not proceduralized');
-  const tree = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`)).json;
-  console.log(`edit ws: model "${model.name}", ${tree.nodes.length} tree nodes, ${model.stats.triangles} triangles`);
-
-  A = await WsClient.open(d.wsUrl);
-  B = await WsClient.open(d.wsUrl);
-  let version = (await A.request({ type: 'hello', model: model.id, user: 'a' }, 'welcome')).version;
-  await B.request({ type: 'hello', model: model.id, user: 'b' }, 'welcome');
-  await A.next('join');
-
-  // drag previews: root stretched by a varying amount, one at a time (the server keeps 30/s
-  // per connection, so they are spaced 34 ms apart)
-  const box0 = tree.nodes.find((n) => n.id === tree.root).box;
-  const toRoom = [];
-  for (let i = 0; i < PREVIEWS; i++) {
-    const box = [...box0];
-    box[3] = box0[0] + (box0[3] - box0[0]) * (1 + 0.3 * ((i % 20) / 20));
-    const seen = B.next((m) => m.type === 'preview', 10000);
-    const ts = performance.now();
-    A.send({ type: 'preview', model: model.id, base: version, op: { kind: 'resize', node: 'root', box, mode: 'global' } });
-    await seen;
-    toRoom.push(performance.now() - ts);
-    B.all.length = 0;
-    await sleep(34);
-  }
-  A.send({ type: 'preview.end' });
-
-  console.log(`edit ws preview→room:   ${summary(toRoom)}`);
-  await committedOps(model, A, B, version, 'demo building');
 
   // the generated buildings, uploaded z-up and proceduralized
   const bench = path.join(path.dirname(DAEMON), 'bench', 'edit');
-  for (const size of ['20k', '200k']) {
+  for (const size of SIZES) {
     if (!fs.existsSync(bench)) {
       console.log(`edit ws: ${bench} is missing (make build/bench/edit); generated buildings skipped`);
       break;

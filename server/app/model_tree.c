@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../core/base/array.h"
+#include "real_text.h"
 
 
 static const char *kind_name(int k)
@@ -260,7 +261,7 @@ static void out_real(text_out *o, double v)
     char b[40];
     if (v == 0)
         v = 0; /* no "-0.0" */
-    int n = snprintf(b, sizeof b, "%.15g", v);
+    int n = (int)ag_real_text_g15(b, v);
     char *e = strchr(b, 'e');
     if (e) { /* jansson drops the exponent's '+' and leading zeros: 1e-07 is 1e-7, 1e+20 1e20 */
         char *d = e + 1;

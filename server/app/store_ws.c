@@ -1,5 +1,6 @@
 #include "store_ws.h"
 
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -108,33 +109,54 @@ static ag_status encode_mesh(const ag_mesh *mesh, uint8_t **blob, size_t *len, c
     return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory summarising the mesh");
 }
 
+/* The stored tree text of a model, printed on a thread of its own while the mesh is encoded
+ * and written: the two are the largest parts of a version and need nothing of each other. */
+typedef struct {
+    const ag_edit_model *em;
+    char *text;
+} tree_job;
+
+static void *print_tree(void *arg)
+{
+    tree_job *j = arg;
+    j->text = ag_model_kept_tree_text(j->em); /* a reload gives this model back */
+    return NULL;
+}
+
 ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
-                                 const ag_model_state *st, const char *summary_json,
+                                 const ag_model_state *st, const char *summary_json, int keep,
                                  ag_error *err)
 {
     uint8_t *blob = NULL;
     size_t blob_len = 0;
     char *stats = NULL;
-    ag_status s = encode_mesh(st->em->proc->mesh, &blob, &blob_len, &stats, err);
-    if (s != AG_OK)
-        return s;
-    char *tree = ag_model_kept_tree_text(st->em); /* a reload gives this model back */
+    tree_job job = {.em = st->em};
+    pthread_t printer;
+    int threaded = pthread_create(&printer, NULL, print_tree, &job) == 0;
+    if (!threaded)
+        print_tree(&job);
     int64_t mesh_blob = 0;
-    if (!tree)
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory describing the model");
+    ag_status s = encode_mesh(st->em->proc->mesh, &blob, &blob_len, &stats, err);
     if (s == AG_OK)
         s = ag_models_set_mesh(db, model, blob, blob_len, stats, &mesh_blob, err);
+    if (threaded)
+        pthread_join(printer, NULL);
+    char *tree = job.text;
+    if (s == AG_OK && !tree)
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory describing the model");
     if (s == AG_OK) {
         ag_grammar_new g = {.model = model,
                             .version = version,
                             .mesh_blob = mesh_blob,
                             .text = st->text,
                             .text_len = st->text_len,
-                            .tree_json = tree,
+                            .tree_json = keep ? "" : tree,
                             .tree_numbering = AG_MODEL_TREE_NUMBERING,
                             .summary_json = summary_json};
         s = ag_grammars_put(db, &g, err);
     }
+    if (s == AG_OK && keep)
+        s = ag_states_keep_with_tree(db, model, version, tree, err);
     free(tree);
     free(stats);
     free(blob);
@@ -248,7 +270,7 @@ static ag_status save_proc(ag_store_ws *w, ag_model_state *st, const ag_proc_out
         return s;
     }
     t.origin = w->o.origin;
-    s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, err);
+    s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, 0, err);
     if (s == AG_OK)
         s = ag_grammars_clear_terminals(t.db, w->o.model, err);
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
@@ -299,12 +321,10 @@ static ag_status commit_change(ag_store_ws *w, ag_model_state *st, json_t *body,
     t.origin = w->o.origin;
     s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
     if (s == AG_OK)
-        s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, err);
+        s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, 1, err);
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
         s = ag_grammars_put_terminal(t.db, w->o.model, st->terms.path[i], st->terms.obj[i],
                                      st->terms.len[i], err);
-    if (s == AG_OK)
-        s = ag_states_keep(t.db, w->o.model, t.version, err);
     int64_t v = t.version;
     if (s == AG_OK)
         s = ag_sequencer_commit(&t, w->o.author, w->o.cid, body, err);

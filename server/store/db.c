@@ -53,6 +53,12 @@ ag_status ag_db_open(const char *path, const ag_db_options *opt, ag_db **out, ag
         s = exec(db, "PRAGMA foreign_keys = ON", err);
     if (s == AG_OK)
         s = exec(db, "PRAGMA synchronous = NORMAL", err);
+    if (s == AG_OK && opt && opt->no_autocheckpoint)
+        s = exec(db, "PRAGMA wal_autocheckpoint = 0", err);
+    /* the WAL is cut back to this size when it is reset, so one large write does not keep
+     * its file large */
+    if (s == AG_OK)
+        s = exec(db, "PRAGMA journal_size_limit = 67108864", err);
     if (s == AG_OK && opt && opt->max_bytes) {
         sqlite3_stmt *st = NULL;
         long long page = 4096;
@@ -94,6 +100,17 @@ void ag_db_close(ag_db *db)
     sqlite3_close(db->handle);
     free(db->path);
     free(db);
+}
+
+ag_status ag_db_checkpoint(ag_db *db, int *pending, ag_error *err)
+{
+    int log = 0, done = 0;
+    int rc = sqlite3_wal_checkpoint_v2(db->handle, NULL, SQLITE_CHECKPOINT_PASSIVE, &log, &done);
+    if (pending)
+        *pending = log > done ? log - done : 0;
+    if (rc == SQLITE_OK || rc == SQLITE_BUSY || rc == SQLITE_LOCKED)
+        return AG_OK; /* busy: another checkpoint is under way */
+    return ag_db_fail(db, err, "copying the write-ahead log into the database");
 }
 
 sqlite3 *ag_db_handle(ag_db *db) { return db->handle; }
