@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../core/base/array.h"
+#include "../io/numtext.h"
 #include "real_text.h"
 
 
@@ -249,9 +250,12 @@ static void out_str(text_out *o, const char *s, size_t n)
 
 static void out_int(text_out *o, long long v)
 {
-    char b[32];
-    int n = snprintf(b, sizeof b, "%lld", v);
-    out_str(o, b, (size_t)n);
+    char b[AG_NUMTEXT_MAX + 1];
+    size_t n = 0;
+    if (v < 0)
+        b[n++] = '-';
+    n += ag_numtext_u64(b + n, v < 0 ? 0 - (unsigned long long)v : (unsigned long long)v);
+    out_str(o, b, n);
 }
 
 /* A real as jansson prints it with REAL_PRECISION(15): %.15g, ".0" added to integral forms

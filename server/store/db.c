@@ -48,7 +48,17 @@ ag_status ag_db_open(const char *path, const ag_db_options *opt, ag_db **out, ag
     }
     sqlite3_extended_result_codes(db->handle, 1);
     sqlite3_busy_timeout(db->handle, opt && opt->busy_timeout_ms ? opt->busy_timeout_ms : 10000);
-    ag_status s = exec(db, "PRAGMA journal_mode = WAL", err);
+    /* A new database gets 64 KiB pages: a version's mesh file is megabytes, and a commit
+     * writes the log page by page, sixteen times the calls with SQLite's 4 KiB. A database
+     * capped below 64 MiB keeps 4 KiB pages so that a small cap still holds its schema. An
+     * existing database keeps the size it was made with (the pragma does nothing then). */
+    ag_status s = exec(db,
+                       opt && opt->max_bytes && opt->max_bytes < ((size_t)64 << 20)
+                           ? "PRAGMA page_size = 4096"
+                           : "PRAGMA page_size = 65536",
+                       err);
+    if (s == AG_OK)
+        s = exec(db, "PRAGMA journal_mode = WAL", err);
     if (s == AG_OK)
         s = exec(db, "PRAGMA foreign_keys = ON", err);
     if (s == AG_OK)
