@@ -6,11 +6,11 @@
 #include <string.h>
 #include <time.h>
 
-/* How often the log is copied into the database, and the log size (frames) past which the
- * copy waits for writers to let it finish (a log that writers keep ahead of the copy would
- * otherwise never start over). */
+/* How often the log is copied into the database, and the log size past which the copy waits
+ * for writers to let it finish (a log that writers keep ahead of the copy would otherwise
+ * never start over). */
 #define CHECKPOINT_EVERY_MS 100
-#define CHECKPOINT_RESTART_FRAMES 65536
+#define CHECKPOINT_RESTART_BYTES ((long long)256 << 20)
 
 struct ag_dbpool {
     char *path;
@@ -29,6 +29,13 @@ struct ag_dbpool {
 static void *checkpoint_loop(void *arg)
 {
     ag_dbpool *p = arg;
+    long long page = 4096;
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(ag_db_handle(p->checkpoint_db), "PRAGMA page_size", -1, &st, NULL) ==
+            SQLITE_OK &&
+        sqlite3_step(st) == SQLITE_ROW && sqlite3_column_int64(st, 0) > 0)
+        page = sqlite3_column_int64(st, 0);
+    sqlite3_finalize(st);
     pthread_mutex_lock(&p->lock);
     while (!p->stop) {
         struct timespec until;
@@ -46,7 +53,7 @@ static void *checkpoint_loop(void *arg)
         pthread_mutex_unlock(&p->lock);
         int pending = 0;
         ag_db_checkpoint(p->checkpoint_db, &pending, NULL); /* a failure is tried again */
-        if (pending > CHECKPOINT_RESTART_FRAMES)
+        if ((long long)pending * page > CHECKPOINT_RESTART_BYTES)
             sqlite3_wal_checkpoint_v2(ag_db_handle(p->checkpoint_db), NULL,
                                       SQLITE_CHECKPOINT_RESTART, NULL, NULL);
         pthread_mutex_lock(&p->lock);
