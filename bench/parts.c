@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "app/compose_ops.h"
+#include "app/heap.h"
 #include "app/edit_session.h"
 #include "app/events.h"
 #include "app/modelops.h"
@@ -388,6 +389,7 @@ static void bench_compose(const ag_proceduralize_result *r, const ag_part *p, in
 
 int main(void)
 {
+    ag_heap_keep_large_blocks(); /* as archgramd runs */
     /* every box its own component: 1720 windows of 9 boxes on three facades, a blank back */
     ag_gen_facade_options go = {.cols = 34, .rows = 20, .side_cols = 26, .left = 1, .bars = 3,
                                 .no_groups = 1, .annex = 1};
