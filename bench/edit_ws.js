@@ -6,6 +6,7 @@
 // --write-obj`). Target: an op reaches the other clients ≤ 50 ms after it is sent at 200k.
 // Prints figures; not a test.
 import fs from 'node:fs';
+import os from 'node:os';
 import { performance } from 'node:perf_hooks';
 import { execFileSync } from 'node:child_process';
 import path from 'node:path';
@@ -30,11 +31,23 @@ if (!fs.existsSync(DAEMON)) {
   process.exit(0);
 }
 
+// archgramd's CPU time so far (user + system, ms), from /proc: the op's cost apart from what
+// else the machine runs (the wall times above depend on the load of a shared machine).
+function daemonCpuMs() {
+  try {
+    const f = fs.readFileSync(`/proc/${d.proc.pid}/stat`, 'utf8').split(') ')[1].split(' ');
+    return (Number(f[11]) + Number(f[12])) * 10; // fields 14 and 15, at 100 ticks/s
+  } catch {
+    return NaN;
+  }
+}
+
 // Committed resize ops on a model: the root alternately 1.25x wider and back (global), then a
 // window alternately 0.2 m taller and back (global: every window of its rule follows).
 async function committedOps(model, A, B, version, what) {
   const toAck = [];
   const toPeer = [];
+  let cpu = 0;
   for (let i = 0; i < OPS; i++) {
     const cid = `edit-${model.id}-${i}`;
     const t = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`, { timeout: 60000 })).json;
@@ -51,12 +64,14 @@ async function committedOps(model, A, B, version, what) {
     }
     const ack = A.next((m) => (m.type === 'ack' || m.type === 'nack') && m.cid === cid, 60000);
     const seen = B.next((m) => m.type === 'op' && m.cid === cid, 60000);
+    const c0 = daemonCpuMs();
     const ts = performance.now();
     A.send({ type: 'op', base: version, cid, op: { kind: 'resize', node, box, mode: 'global' } });
     const [a] = await Promise.all([
       ack.then((m) => { toAck.push(performance.now() - ts); return m; }),
       seen.then(() => { toPeer.push(performance.now() - ts); }),
     ]);
+    cpu += daemonCpuMs() - c0;
     if (a.type !== 'ack') throw new Error(`op ${i} on ${what} refused: ${JSON.stringify(a)}`);
     version = a.version;
     A.all.length = 0;
@@ -64,6 +79,8 @@ async function committedOps(model, A, B, version, what) {
   }
   console.log(`edit ws ${what}: op→ack ${summary(toAck)}`);
   console.log(`edit ws ${what}: op→broadcast ${summary(toPeer)}   (target ≤ 50 ms at 200k)`);
+  console.log(`edit ws ${what}: archgramd CPU per op ${(cpu / OPS).toFixed(1)} ms (user + system, ` +
+    `all threads, from op sent to ack and broadcast received; load average ${os.loadavg()[0].toFixed(2)})`);
 }
 
 const d = await startDaemon({ args: ['--demo'] });
