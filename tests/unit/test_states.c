@@ -61,8 +61,11 @@ static int teardown(void **state)
     return 0;
 }
 
-/* One op: raises the version; a geometry op also gets a new mesh file and a grammar. */
-static int64_t op(fixture *f, const char *kind, int geometry, const char *grammar)
+/* One op: raises the version; a geometry op also gets a new mesh file and a grammar, its tree
+ * in the grammar row and copied into the kept state, or (tree_once) written once, in the kept
+ * state only, as an edit stores it. */
+static int64_t op_ex(fixture *f, const char *kind, int geometry, const char *grammar,
+                     const char *tree_once)
 {
     ag_error err;
     int64_t v = 0;
@@ -82,9 +85,14 @@ static int64_t op(fixture *f, const char *kind, int geometry, const char *gramma
                                               &err),
                          AG_OK);
         ag_grammar_new g = {.model = f->model, .version = v, .mesh_blob = blob, .text = grammar,
-                            .text_len = strlen(grammar), .tree_json = "{\"nodes\":[]}"};
+                            .text_len = strlen(grammar),
+                            .tree_json = tree_once ? "" : "{\"nodes\":[]}",
+                            .tree_numbering = tree_once ? 2 : 0};
         assert_int_equal(ag_grammars_put(f->db, &g, &err), AG_OK);
-        assert_int_equal(ag_states_keep(f->db, f->model, v, &err), AG_OK);
+        if (tree_once)
+            assert_int_equal(ag_states_keep_with_tree(f->db, f->model, v, tree_once, &err), AG_OK);
+        else
+            assert_int_equal(ag_states_keep(f->db, f->model, v, &err), AG_OK);
     }
     char cid[32];
     snprintf(cid, sizeof cid, "c%lld", (long long)v);
@@ -93,6 +101,11 @@ static int64_t op(fixture *f, const char *kind, int geometry, const char *gramma
     assert_int_equal(ag_ops_insert(f->db, &o, &err), AG_OK);
     assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
     return v;
+}
+
+static int64_t op(fixture *f, const char *kind, int geometry, const char *grammar)
+{
+    return op_ex(f, kind, geometry, grammar, NULL);
 }
 
 static void kept_states_come_back_and_gaps_are_named(void **state)
@@ -199,29 +212,7 @@ static char *big_tree(int64_t v)
 /* A geometry op as an edit stores it: its tree only in its version's state row. */
 static int64_t edit_once(fixture *f, const char *tree)
 {
-    ag_error err;
-    int64_t v = 0;
-    ag_model_row row;
-    assert_int_equal(ag_models_get(f->db, f->model, &row, NULL), AG_OK);
-    int64_t base = row.version;
-    ag_models_row_clear(&row);
-    assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
-    assert_int_equal(ag_models_bump_version(f->db, f->model, base, &v, &err), AG_OK);
-    assert_int_equal(ag_states_keep(f->db, f->model, v - 1, &err), AG_OK);
-    char mesh[64];
-    snprintf(mesh, sizeof mesh, "mesh of version %lld", (long long)v);
-    int64_t blob = 0;
-    assert_int_equal(ag_models_set_mesh(f->db, f->model, mesh, strlen(mesh), "{}", &blob, &err),
-                     AG_OK);
-    ag_grammar_new g = {.model = f->model, .version = v, .mesh_blob = blob, .text = "g",
-                        .text_len = 1, .tree_json = "", .tree_numbering = 2};
-    assert_int_equal(ag_grammars_put(f->db, &g, &err), AG_OK);
-    assert_int_equal(ag_states_keep_with_tree(f->db, f->model, v, tree, &err), AG_OK);
-    ag_op_row o = {.model = f->model, .version = v, .author = "ana", .cid = mesh, .kind = "resize",
-                   .body_json = "{}"};
-    assert_int_equal(ag_ops_insert(f->db, &o, &err), AG_OK);
-    assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
-    return v;
+    return op_ex(f, "resize", 1, "g", tree);
 }
 
 static void a_tree_kept_once_reads_back_everywhere(void **state)
