@@ -30,7 +30,8 @@ typedef struct {
 
 static void put_bytes(packer *k, const void *v, size_t n)
 {
-    if (k->fail || (k->fail = AG_ARRAY_RESERVE_MORE(k->p, k->cap, k->n, n) != AG_OK))
+    if (k->fail || (k->n + n > k->cap &&
+                    (k->fail = AG_ARRAY_RESERVE_MORE(k->p, k->cap, k->n, n) != AG_OK)))
         return;
     memcpy(k->p + k->n, v, n);
     k->n += n;

@@ -20,8 +20,11 @@ size_t ag_real_text_g15(char *out, double v)
     double a = fabs(v);
     if (!(a >= 1e-4 && a < 1e15)) /* also zero, NaN and the infinities */
         return slow(out, v);
-    /* the decimal exponent: 10^e <= a < 10^(e + 1), found by log10 and checked exactly */
-    int e = (int)floor(log10(a));
+    /* the decimal exponent: 10^e <= a < 10^(e + 1), estimated from the binary one (off by
+     * one at most) and checked exactly below */
+    int bexp;
+    frexp(a, &bexp);
+    int e = (int)floor((bexp - 1) * 0.30102999566398120);
     if (e < -4)
         e = -4;
     if (e > 14)
