@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "app/compose_ops.h"
+#include "app/dbpool.h"
 #include "app/heap.h"
 #include "app/edit_session.h"
 #include "app/events.h"
@@ -119,6 +120,7 @@ static void die(const char *what, const ag_error *err)
 
 typedef struct {
     char path[64];
+    ag_dbpool *pool; /* as archgramd keeps its connections (checkpoints off the commits) */
     ag_db *db;
     ag_events *bus;
     ag_store_env env;
@@ -136,7 +138,7 @@ static void service_open(service *sv, const ag_mesh *m)
     }
     close(fd);
     unlink(sv->path);
-    if (ag_db_open(sv->path, NULL, &sv->db, &err))
+    if (ag_dbpool_create(sv->path, &sv->pool, &err) || !(sv->db = ag_dbpool_get(sv->pool, &err)))
         die("database", &err);
     sv->bus = ag_events_create();
     sv->env = (ag_store_env){.db = sv->db, .seq = ag_sequencer_create(sv->bus),
@@ -173,7 +175,7 @@ static void service_close(service *sv)
     ag_edit_sessions_free(sv->env.sessions);
     ag_sequencer_free(sv->env.seq);
     ag_events_free(sv->bus);
-    ag_db_close(sv->db);
+    ag_dbpool_free(sv->pool);
     char side[96];
     unlink(sv->path);
     snprintf(side, sizeof side, "%s-wal", sv->path);
