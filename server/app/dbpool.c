@@ -150,7 +150,8 @@ void ag_dbpool_free(ag_dbpool *p)
         pthread_mutex_unlock(&p->lock);
         pthread_join(p->checkpointer, NULL);
     }
-    ag_db_close(p->checkpoint_db); /* the last connection closed copies what is left */
+    ag_db_close(p->checkpoint_db); /* the last of the connections closed below copies what is
+                                    * left in the log */
     pthread_cond_destroy(&p->wake);
     for (size_t i = 0; i < p->n; i++)
         ag_db_close(p->conns[i]);
