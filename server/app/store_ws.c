@@ -109,39 +109,63 @@ static ag_status encode_mesh(const ag_mesh *mesh, uint8_t **blob, size_t *len, c
     return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory summarising the mesh");
 }
 
-/* The stored tree text of a model, printed on a thread of its own while the mesh is encoded
- * and written: the two are the largest parts of a version and need nothing of each other. */
+/* A state's largest parts as the store keeps them, made outside the transaction where they
+ * can be: the mesh encoded, and the stored tree text printed on a thread of its own meanwhile
+ * (and while the mesh is written); the two need nothing of each other. */
 typedef struct {
     const ag_edit_model *em;
-    char *text;
-} tree_job;
+    char *tree;
+    pthread_t printer;
+    int threaded;
+    uint8_t *blob;
+    size_t blob_len;
+    char *stats;
+    ag_status mesh_status;
+} encoded_state;
 
 static void *print_tree(void *arg)
 {
-    tree_job *j = arg;
-    j->text = ag_model_kept_tree_text(j->em); /* a reload gives this model back */
+    encoded_state *e = arg;
+    e->tree = ag_model_kept_tree_text(e->em); /* a reload gives this model back */
     return NULL;
 }
 
-ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
-                                 const ag_model_state *st, const char *summary_json, int keep,
-                                 ag_error *err)
+static void encode_state(const ag_model_state *st, encoded_state *e, ag_error *err)
 {
-    uint8_t *blob = NULL;
-    size_t blob_len = 0;
-    char *stats = NULL;
-    tree_job job = {.em = st->em};
-    pthread_t printer;
-    int threaded = pthread_create(&printer, NULL, print_tree, &job) == 0;
-    if (!threaded)
-        print_tree(&job);
+    memset(e, 0, sizeof *e);
+    e->em = st->em;
+    e->threaded = pthread_create(&e->printer, NULL, print_tree, e) == 0;
+    if (!e->threaded)
+        print_tree(e);
+    e->mesh_status = encode_mesh(st->em->proc->mesh, &e->blob, &e->blob_len, &e->stats, err);
+}
+
+/* The tree text, once printed. */
+static char *encoded_tree(encoded_state *e)
+{
+    if (e->threaded) {
+        pthread_join(e->printer, NULL);
+        e->threaded = 0;
+    }
+    return e->tree;
+}
+
+static void encoded_clear(encoded_state *e)
+{
+    free(encoded_tree(e));
+    free(e->stats);
+    free(e->blob);
+    memset(e, 0, sizeof *e);
+}
+
+static ag_status write_state(ag_db *db, int64_t model, int64_t version, const ag_model_state *st,
+                             encoded_state *e, const char *summary_json, int keep, ag_error *err)
+{
     int64_t mesh_blob = 0;
-    ag_status s = encode_mesh(st->em->proc->mesh, &blob, &blob_len, &stats, err);
+    ag_status s = e->mesh_status;
     if (s == AG_OK)
-        s = ag_models_set_mesh(db, model, blob, blob_len, stats, &mesh_blob, err);
-    if (threaded)
-        pthread_join(printer, NULL);
-    char *tree = job.text;
+        s = ag_models_set_mesh(db, model, e->blob, e->blob_len, e->stats, &mesh_blob, err);
+    char *tree = encoded_tree(e);
     if (s == AG_OK && !tree)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory describing the model");
     if (s == AG_OK) {
@@ -157,9 +181,17 @@ ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
     }
     if (s == AG_OK && keep)
         s = ag_states_keep_with_tree(db, model, version, tree, err);
-    free(tree);
-    free(stats);
-    free(blob);
+    return s;
+}
+
+ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
+                                 const ag_model_state *st, const char *summary_json, int keep,
+                                 ag_error *err)
+{
+    encoded_state e;
+    encode_state(st, &e, err);
+    ag_status s = write_state(db, model, version, st, &e, summary_json, keep, err);
+    encoded_clear(&e);
     return s;
 }
 
@@ -307,21 +339,31 @@ static ag_status save_proc(ag_store_ws *w, ag_model_state *st, const ag_proc_out
 static ag_status commit_change(ag_store_ws *w, ag_model_state *st, json_t *body,
                                const char *summary, ag_error *err)
 {
+    /* encoded before the sequencer's lock is taken: it serializes every model's changes */
+    encoded_state e;
+    encode_state(st, &e, err);
+    if (e.mesh_status != AG_OK) {
+        ag_status s = e.mesh_status;
+        encoded_clear(&e);
+        return s;
+    }
     ag_seq_txn t;
     int64_t seen = 0;
     ag_status s = ag_sequencer_begin(w->o.env.seq, w->o.env.db, w->o.model, w->o.base,
                                      w->o.author, w->o.cid, &t, &seen, err);
-    if (s != AG_OK)
+    if (s != AG_OK || seen) {
+        encoded_clear(&e);
+        if (s == AG_OK) { /* the same op came in meanwhile: answered, not applied again */
+            w->duplicate = 1;
+            w->version = seen;
+        }
         return s;
-    if (seen) { /* the same op came in meanwhile: answered, not applied again */
-        w->duplicate = 1;
-        w->version = seen;
-        return AG_OK;
     }
     t.origin = w->o.origin;
     s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
     if (s == AG_OK)
-        s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, 1, err);
+        s = write_state(t.db, w->o.model, t.version, st, &e, summary, 1, err);
+    encoded_clear(&e);
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
         s = ag_grammars_put_terminal(t.db, w->o.model, st->terms.path[i], st->terms.obj[i],
                                      st->terms.len[i], err);
