@@ -598,6 +598,7 @@ static void grid_stress_with(size_t count, int repair)
     size_t w_invalid = 0, w_repairs = 0, w_refused = 0, w_dropped = 0, w_good = 0;
     size_t failed = 0, leaky = 0, rejected = 0, leaky_nested = 0, good_nested = 0;
     size_t kinds[2] = {0, 0}, leaky_kind[2] = {0, 0};
+    size_t cause[4][2] = {{0}}; /* overlap / open / shared edge / other, elsewhere or at h */
     static double xy[2 * 1200];
     size_t starts[300];
     static int32_t prof[1200];
@@ -613,7 +614,8 @@ static void grid_stress_with(size_t count, int repair)
             starts[1] = n;
         }
         ag_plan *p = ag_plan_create();
-        grid_profiles(p, 1 + (int)(srnd() * 3));
+        double h = 1 + (int)(srnd() * 3);
+        grid_profiles(p, h);
         int mode = (int)(srnd() * 3), base = (int)(srnd() * 8);
         for (size_t k = 0; k < n; k++)
             prof[k] = mode == 0 ? 6 : mode == 1 ? base : (int)(srnd() * 8);
@@ -652,12 +654,37 @@ static void grid_stress_with(size_t count, int repair)
             printf("    failed grid%zu: %s\n", i, err.text);
         } else if (not_good(&r)) {
             leaky++;
+            /* by cause: the defect's kind, and whether it lies at the height of the
+             * horizontal profile segments (every flat step of a stress plan is at h) */
+            const char *why = not_good(&r);
+            int kind_i = strstr(why, "overlaps itself") ? 0 : strstr(why, "is open") ? 1
+                         : strstr(why, "more than two") ? 2 : 3;
+            const char *zs = strchr(why, '(');
+            double wx, wy, wz;
+            int at_h = zs && sscanf(zs, "(%lf, %lf, %lf)", &wx, &wy, &wz) == 3 &&
+                       fabs(wz - h) < 1e-6;
+            cause[kind_i][at_h]++;
             leaky_nested += r.stats.irregular > 0;
             leaky_kind[kind]++;
-            if (repair)
+            if (repair) {
+                /* what the plan has, for sorting the failures by cause: the profiles its
+                 * edges use and the height of the defect against the step height h */
+                static const char *const pname[] = {"hip", "steep", "wall", "r2", "over",
+                                                    "soffit", "r45", "terrace"};
+                char used[96] = "";
+                unsigned mask = 0;
+                for (size_t k = 0; k < n; k++)
+                    mask |= 1u << prof[k];
+                for (int b = 0; b < 8; b++)
+                    if (mask & (1u << b)) {
+                        strcat(used, used[0] ? "+" : "");
+                        strcat(used, pname[b]);
+                    }
                 printf("    not good grid%zu (%s, %zu nested intersections, %zu winding repairs, "
-                       "%zu refused): %s\n", i, kind ? "star" : "grid", r.stats.irregular,
-                       r.stats.winding_repairs, r.stats.winding_refused, not_good(&r));
+                       "%zu refused; h %g, profiles %s): %s\n", i, kind ? "star" : "grid",
+                       r.stats.irregular, r.stats.winding_repairs, r.stats.winding_refused, h,
+                       used, not_good(&r));
+            }
         } else {
             good_nested += r.stats.irregular > 0;
         }
@@ -674,6 +701,10 @@ static void grid_stress_with(size_t count, int repair)
     printf("    not good: %zu of %zu grid shapes, %zu of %zu stars; %zu of them with nested "
            "intersections (as are %zu good ones)\n", leaky_kind[0], kinds[0], leaky_kind[1],
            kinds[1], leaky_nested, good_nested);
+    printf("    by cause (at the flat steps' height / elsewhere): winding other than once %zu / "
+           "%zu, open %zu / %zu, an edge of more than two faces %zu / %zu, other %zu / %zu\n",
+           cause[0][1], cause[0][0], cause[1][1], cause[1][0], cause[2][1], cause[2][0],
+           cause[3][1], cause[3][0]);
     if (repair)
         printf("    winding rule: %zu levels with crossing chains, %zu rebuilt (%zu pieces removed), "
                "%zu refused; %zu plans with a rebuild are good\n", w_invalid, w_repairs, w_dropped,

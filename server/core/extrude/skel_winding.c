@@ -6,11 +6,12 @@
  * bounds a region of positive winding); the kept pieces are linked into new corners at the
  * crossings, the other pieces end at the current height. The new plan is again one of
  * simple loops. Only crossings that already touch at the current height, at a corner, are
- * this height's doing (others are later events or older overlaps), and only pieces of no
- * extent at the current height can be removed there without a hole: a plan whose
- * crossings or removed pieces are not all such, or that has touching or overlapping pieces
- * at the probe height, is left as it is and counted as refused (the building's check
- * judges the result). Parts of a growing plan (overhangs) that meet from outside are
+ * this height's doing; the edges of the others (older overlaps, refused at their own
+ * height) are kept whole and the rest is repaired around them, as long as no edge has
+ * both kinds and nothing nests in such an overlap. Only pieces of no extent at the
+ * current height can be removed there without a hole: a plan whose removed pieces are
+ * not all such, or that has touching or overlapping pieces at the probe height, is left
+ * as it is and counted as refused (the building's check judges the result). Parts of a growing plan (overhangs) that meet from outside are
  * united the same way. */
 #include <math.h>
 #include <stdlib.h>
@@ -44,10 +45,16 @@ typedef struct {
 } wedge;
 
 /* Probe height above z: far enough for the chains around one point to have parted, well
- * below anything the tolerances of the next events resolve. */
+ * below anything the tolerances of the next events resolve, and below the next event in
+ * the queue (halfway to it): chains elsewhere that meet a little higher (the same level
+ * jittered apart) are not crossings of this height. */
 static double probe_height(const sk *S, double z)
 {
-    return z + AG_EXTRUDE_WINDING_PROBE * S->d1;
+    double zp = z + AG_EXTRUDE_WINDING_PROBE * S->d1;
+    const ag_event *next = ag_eventq_peek(&S->q);
+    if (next && next->z > z && next->z < zp)
+        zp = z + (next->z - z) / 2;
+    return zp;
 }
 
 static void seg_at(const sk *S, uint32_t e, double z, double *a, double *b)
@@ -181,11 +188,12 @@ static int rebuild(sk *S, double z, double zp)
     wcross *X = NULL;
     wcut *cuts = NULL;
     wedge *W = calloc(n, sizeof *W);
-    uint8_t *keep = NULL;
+    uint8_t *keep = NULL, *foreign = calloc(n ? n : 1, 1);
+    size_t nforeign = 0;
     uint32_t *piece_id = NULL, *cpair = NULL;
     size_t nx = 0, capx = 0, ncuts = 0, npieces = 0;
     wverts V = {0};
-    if (!segs || !W)
+    if (!segs || !W || !foreign)
         goto nomem;
     for (size_t i = 0; i < n; i++)
         seg_at(S, S->live_e[i], zp, &segs[4 * i], &segs[4 * i + 2]);
@@ -234,10 +242,19 @@ static int rebuild(sk *S, double z, double zp)
             seg_at(S, S->live_e[j], z, sc, sd);
             double tol = AG_EXTRUDE_NEAR_POINTS * S->d2 + (zp - z);
             if (ag_pred_segment_dist(pz, sa, sb) > tol || ag_pred_segment_dist(pz, sc, sd) > tol ||
-                !at_an_end(pz, sa, sb, sc, sd, tol))
-                goto refuse;
+                !at_an_end(pz, sa, sb, sc, sd, tol)) {
+                /* not this height's doing (an overlap left at a lower height, refused
+                 * there): its two edges stay as they are, and the rest is repaired
+                 * around them if it can be */
+                nx--;
+                foreign[i] = foreign[j] = 1;
+                nforeign++;
+            }
         }
     }
+    for (size_t q = 0; q < nx; q++)
+        if (foreign[X[q].i] || foreign[X[q].j])
+            goto refuse; /* an edge crossed both at this height and by an older overlap */
     ag__skel_work(S, n * n / 16 + 1);
     if (!nx || S->st != AG_OK)
         goto refuse;
@@ -284,9 +301,17 @@ static int rebuild(sk *S, double z, double zp)
             double pt[2] = {a[0] + tm * (b[0] - a[0]) + off * E->nx,
                             a[1] + tm * (b[1] - a[1]) + off * E->ny};
             double pr[2] = {pt[0] - 2 * off * E->nx, pt[1] - 2 * off * E->ny};
+            if (foreign[i]) {
+                keep[W[i].first + i + p] = 1; /* whole, uncut: an older overlap's */
+                continue;
+            }
             long wl = winding(S, segs, n, pt), wr = winding(S, segs, n, pr);
             if (wl != wr + 1)
                 goto refuse; /* the side points were not on the two sides of this piece only */
+            /* beside an older overlap only plain boundaries (1 | 0) and this height's
+             * crossings (2 | 1 inside them) are decided: nothing nested in the overlap */
+            if (nforeign && (wl > 2 || wr < 0))
+                goto refuse;
             keep[W[i].first + i + p] = wl >= 1 && wr <= 0;
         }
     }
@@ -447,6 +472,7 @@ done:
     free(cuts);
     free(W);
     free(keep);
+    free(foreign);
     free(piece_id);
     free(cpair);
     free(V.xy);

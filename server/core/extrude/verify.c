@@ -220,6 +220,284 @@ static int within(const ag_plan *plan, double x, double y, double allowed, doubl
     return 0;
 }
 
+
+/* --- a shell that overlaps itself ---------------------------------------------------------
+ * A closed 2-manifold can still pass through itself (two parts of a roof swept over each
+ * other): the edge counts do not see it, the winding number does. Just inside each face
+ * the shell must wind once; it winds twice where that face lies inside another part. The
+ * winding number about q is counted along a ray from q: +1 for each face it leaves
+ * through, -1 for each it enters through. The rays lean off the vertical by amounts no
+ * plan of whole or decimal metres lines up with, so a ray meets no edge or corner of a
+ * grid-aligned roof exactly; a probe counts as overlapping only when two rays of
+ * different leans agree, so a graze within rounding of an edge cannot make a defect. */
+
+/* How far behind a face its probe lies, relative to the building's size. */
+#define AG_VERIFY_WINDING_PROBE 1e-7
+/* Faces whose inscribed circle is so small that the probe would lie closer than this
+ * (relative to the building's size) are slivers with no inside to probe. */
+#define AG_VERIFY_WINDING_THIN 1e-10
+
+typedef struct {
+    double a[3], e1[3], e2[3]; /* a corner and the two edges from it (about the origin o) */
+    double lo[2], hi[2], zhi;
+} vtri;
+
+static void cross3(const double *u, const double *v, double *w)
+{
+    w[0] = u[1] * v[2] - u[2] * v[1];
+    w[1] = u[2] * v[0] - u[0] * v[2];
+    w[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+static double dot3(const double *u, const double *v)
+{
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+}
+
+/* The faces in cells of the plan, so that a ray, which leans little, meets only the faces
+ * over the few cells it passes (a building of 12,000 triangles would otherwise test every
+ * face for every probe). Faces over more cells than VGRID_MAX_CELLS are kept in a list
+ * every ray tests. */
+#define VGRID_MAX_CELLS 16
+
+typedef struct {
+    double x0, y0, cell;
+    size_t nx, ny;
+    uint32_t *start; /* nx * ny + 1 offsets into items */
+    uint32_t *items;
+    uint32_t *big;
+    size_t nbig;
+    uint32_t *seen; /* the query that last took each face */
+    uint32_t query;
+    uint32_t *cand; /* one query's faces */
+    double zmax;
+} vgrid;
+
+static void vgrid_free(vgrid *g)
+{
+    free(g->start);
+    free(g->items);
+    free(g->big);
+    free(g->seen);
+    free(g->cand);
+}
+
+/* Cell f clamped to [0, n) (a NaN to 0). */
+static size_t vgrid_index(double f, size_t n)
+{
+    if (!(f >= 0))
+        return 0;
+    return f < (double)n ? (size_t)f : n - 1;
+}
+
+static void vgrid_cells(const vgrid *g, double lo_x, double lo_y, double hi_x, double hi_y,
+                        size_t *ix0, size_t *iy0, size_t *ix1, size_t *iy1)
+{
+    *ix0 = vgrid_index(floor((lo_x - g->x0) / g->cell), g->nx);
+    *iy0 = vgrid_index(floor((lo_y - g->y0) / g->cell), g->ny);
+    *ix1 = vgrid_index(floor((hi_x - g->x0) / g->cell), g->nx);
+    *iy1 = vgrid_index(floor((hi_y - g->y0) / g->cell), g->ny);
+}
+
+static int vgrid_build(vgrid *g, const vtri *T, size_t n)
+{
+    memset(g, 0, sizeof *g);
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    g->zmax = -INFINITY;
+    for (size_t t = 0; t < n; t++)
+        for (int d = 0; d < 2; d++) {
+            lo[d] = fmin(lo[d], T[t].lo[d]);
+            hi[d] = fmax(hi[d], T[t].hi[d]);
+            g->zmax = fmax(g->zmax, T[t].zhi);
+        }
+    double side = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+    size_t cells = (size_t)ceil(sqrt((double)n)) + 1;
+    int finite = isfinite(side) && isfinite(lo[0]) && isfinite(lo[1]);
+    g->cell = finite && side > 0 ? side / (double)cells : 1;
+    g->x0 = finite ? lo[0] : 0;
+    g->y0 = finite ? lo[1] : 0;
+    g->nx = finite ? vgrid_index((hi[0] - lo[0]) / g->cell, cells + 1) + 1 : 1;
+    g->ny = finite ? vgrid_index((hi[1] - lo[1]) / g->cell, cells + 1) + 1 : 1;
+    g->start = calloc(g->nx * g->ny + 1, sizeof *g->start);
+    g->big = malloc((n ? n : 1) * sizeof *g->big);
+    g->seen = calloc(n ? n : 1, sizeof *g->seen);
+    g->cand = malloc((n ? n : 1) * sizeof *g->cand);
+    if (!g->start || !g->big || !g->seen || !g->cand)
+        return 0;
+    size_t total = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t t = 0; t < n; t++) {
+            size_t ix0, iy0, ix1, iy1;
+            vgrid_cells(g, T[t].lo[0], T[t].lo[1], T[t].hi[0], T[t].hi[1], &ix0, &iy0, &ix1,
+                        &iy1);
+            if ((ix1 - ix0 + 1) * (iy1 - iy0 + 1) > VGRID_MAX_CELLS) {
+                if (pass == 0)
+                    g->big[g->nbig++] = (uint32_t)t;
+                continue;
+            }
+            for (size_t iy = iy0; iy <= iy1; iy++)
+                for (size_t ix = ix0; ix <= ix1; ix++) {
+                    size_t c = iy * g->nx + ix;
+                    if (pass == 0)
+                        g->start[c + 1]++;
+                    else
+                        g->items[g->start[c]++] = (uint32_t)t;
+                }
+        }
+        if (pass == 0) {
+            for (size_t c = 0; c < g->nx * g->ny; c++)
+                g->start[c + 1] += g->start[c];
+            total = g->start[g->nx * g->ny];
+            g->items = malloc((total ? total : 1) * sizeof *g->items);
+            if (!g->items)
+                return 0;
+        }
+    }
+    /* the fill moved each start to the next cell's: move them back */
+    for (size_t c = g->nx * g->ny; c > 0; c--)
+        g->start[c] = g->start[c - 1];
+    g->start[0] = 0;
+    return 1;
+}
+
+/* The faces a ray from q along (dx, dy, 1) may meet, into g->cand; their number. */
+static size_t vgrid_query(vgrid *g, const double *q, double dx, double dy)
+{
+    double rise = fmax(0, g->zmax - q[2]);
+    double ex = q[0] + rise * dx, ey = q[1] + rise * dy;
+    size_t ix0, iy0, ix1, iy1, n = 0;
+    vgrid_cells(g, fmin(q[0], ex), fmin(q[1], ey), fmax(q[0], ex), fmax(q[1], ey), &ix0, &iy0,
+                &ix1, &iy1);
+    g->query++;
+    for (size_t iy = iy0; iy <= iy1; iy++)
+        for (size_t ix = ix0; ix <= ix1; ix++) {
+            size_t c = iy * g->nx + ix;
+            for (uint32_t k = g->start[c]; k < g->start[c + 1]; k++) {
+                uint32_t t = g->items[k];
+                if (g->seen[t] != g->query) {
+                    g->seen[t] = g->query;
+                    g->cand[n++] = t;
+                }
+            }
+        }
+    for (size_t k = 0; k < g->nbig; k++)
+        g->cand[n++] = g->big[k];
+    return n;
+}
+
+/* Winding number of the faces about q along the ray q + t (dx, dy, 1), t > 0. */
+static long winding_along(const vtri *T, vgrid *g, const double *q, double dx, double dy)
+{
+    const double d[3] = {dx, dy, 1};
+    long w = 0;
+    size_t n = vgrid_query(g, q, dx, dy);
+    for (size_t k = 0; k < n; k++) {
+        const vtri *f = &T[g->cand[k]];
+        if (f->zhi < q[2])
+            continue;
+        /* where the ray is while it is below the face's top */
+        double rise = f->zhi - q[2];
+        double x0 = q[0], x1 = q[0] + rise * dx, y0 = q[1], y1 = q[1] + rise * dy;
+        if (fmax(x0, x1) < f->lo[0] || fmin(x0, x1) > f->hi[0] || fmax(y0, y1) < f->lo[1] ||
+            fmin(y0, y1) > f->hi[1])
+            continue;
+        /* Moller-Trumbore */
+        double p[3], s[3], qv[3];
+        cross3(d, f->e2, p);
+        double det = dot3(f->e1, p);
+        if (det == 0)
+            continue;
+        for (int i = 0; i < 3; i++)
+            s[i] = q[i] - f->a[i];
+        double u = dot3(s, p) / det;
+        if (u < 0 || u > 1)
+            continue;
+        cross3(s, f->e1, qv);
+        double v = dot3(d, qv) / det;
+        if (v < 0 || u + v > 1)
+            continue;
+        if (dot3(f->e2, qv) / det <= 0)
+            continue;
+        double nrm[3];
+        cross3(f->e1, f->e2, nrm);
+        w += dot3(nrm, d) > 0 ? 1 : -1;
+    }
+    return w;
+}
+
+/* 1 when the shell winds once just inside each of its faces; else 0 with why. */
+static int winds_once(const ag_mesh *m, size_t t0, size_t t1, double tol, double size,
+                      char *why, size_t nwhy)
+{
+    size_t nt = t1 - t0, n = 0;
+    vtri *T = malloc((nt ? nt : 1) * sizeof *T);
+    uint32_t *id = malloc((m->nverts ? m->nverts : 1) * sizeof *id);
+    ag_keyed *e = malloc((3 * nt + 1) * sizeof *e);
+    if (!T || !id || !e || !weld(m, t0, t1, tol, id, e)) {
+        free(T);
+        free(id);
+        free(e);
+        snprintf(why, nwhy, "out of memory checking the building");
+        return 0;
+    }
+    free(e);
+    /* welded corners: faces that share an edge share its points exactly, so no ray slips
+     * between them */
+    const double *o = &m->pos[3 * id[m->tri[3 * t0]]];
+    for (size_t t = t0; t < t1; t++) {
+        uint32_t v[3] = {id[m->tri[3 * t]], id[m->tri[3 * t + 1]], id[m->tri[3 * t + 2]]};
+        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2])
+            continue;
+        vtri *f = &T[n++];
+        double p[3][3];
+        for (int c = 0; c < 3; c++)
+            for (int d = 0; d < 3; d++)
+                p[c][d] = m->pos[3 * v[c] + d] - o[d];
+        for (int d = 0; d < 3; d++) {
+            f->a[d] = p[0][d];
+            f->e1[d] = p[1][d] - p[0][d];
+            f->e2[d] = p[2][d] - p[0][d];
+        }
+        for (int d = 0; d < 2; d++) {
+            f->lo[d] = fmin(p[0][d], fmin(p[1][d], p[2][d]));
+            f->hi[d] = fmax(p[0][d], fmax(p[1][d], p[2][d]));
+        }
+        f->zhi = fmax(p[0][2], fmax(p[1][2], p[2][2]));
+    }
+    vgrid g;
+    int ok = vgrid_build(&g, T, n);
+    if (!ok)
+        snprintf(why, nwhy, "out of memory checking the building");
+    for (size_t t = 0; t < n && ok; t++) {
+        const vtri *f = &T[t];
+        double nrm[3];
+        cross3(f->e1, f->e2, nrm);
+        double len = sqrt(dot3(nrm, nrm));
+        double e3[3] = {f->e2[0] - f->e1[0], f->e2[1] - f->e1[1], f->e2[2] - f->e1[2]};
+        double per = sqrt(dot3(f->e1, f->e1)) + sqrt(dot3(f->e2, f->e2)) + sqrt(dot3(e3, e3));
+        /* the probe: a hair behind a point near the centre (weights no grid of whole or
+         * decimal metres lines up with), well within the face's inscribed circle (len /
+         * per is its radius) and far above rounding */
+        double eps = fmin(AG_VERIFY_WINDING_PROBE * size, 0.01 * len / per);
+        if (!(eps > AG_VERIFY_WINDING_THIN * size))
+            continue; /* a sliver too thin to probe */
+        double q[3];
+        for (int d = 0; d < 3; d++)
+            q[d] = f->a[d] + 0.3311 * f->e1[d] + 0.3552 * f->e2[d] - eps * nrm[d] / len;
+        long w = winding_along(T, &g, q, 0.0123456789, 0.00713286);
+        if (w != 1 && winding_along(T, &g, q, -0.00871234, 0.0151112) == w) {
+            snprintf(why, nwhy, "the building overlaps itself near (%.3f, %.3f, %.3f): it winds "
+                     "%ld times there (parts swept through each other)", q[0] + o[0],
+                     q[1] + o[1], q[2] + o[2], w);
+            ok = 0;
+        }
+    }
+    vgrid_free(&g);
+    free(T);
+    free(id);
+    return ok;
+}
+
 int ag_verify_building(const ag_mesh *m, size_t t0, size_t t1, const ag_plan *plan, char *why,
                        size_t nwhy)
 {
@@ -279,5 +557,5 @@ int ag_verify_building(const ag_mesh *m, size_t t0, size_t t1, const ag_plan *pl
                  zmin, zmax, top);
         return 0;
     }
-    return 1;
+    return winds_once(m, t0, t1, tol.point, fmax(tol.size, extent), why, nwhy);
 }

@@ -7,6 +7,10 @@
  *     exactly once (so no edge is shared by more than two triangles), and no two
  *     triangles use the same three vertices (a zero-area, double-sided sliver passes the
  *     edge count but not this);
+ *   - bound their solid once: just inside each face (a hair behind its centre) the
+ *     shell winds exactly once, counted along rays — not twice (two parts swept through
+ *     each other, which the edge counts cannot see) nor zero (a fold or fin turned inside
+ *     out);
  *   - stay within reach of the plan: every vertex within `reach` of the footprint (inside
  *     it or that close to its boundary), where reach is how far the plan's profiles,
  *     offset events and steps may lead outwards, plus a tolerance; forced steps' polygons
