@@ -17,6 +17,7 @@
 #include <sys/resource.h>
 #include <time.h>
 
+#include "app/heap.h"
 #include "app/model_kept.h"
 #include "app/model_state.h"
 #include "core/edit/edit.h"
@@ -162,7 +163,7 @@ static void run(const char *name, const ag_mesh *m)
 /* A committed resize on a generated building, phase by phase, as the service makes it: one
  * window 0.2 m taller in global mode (every window of its rule follows), then the front wall
  * 1.5x wider in global mode. */
-static void run_generated(const char *name, const ag_gen_facade_options *go)
+static void run_generated(const char *name, const ag_gen_facade_options *go, int repeat)
 {
     ag_mesh *m = NULL;
     ag_error err = {0};
@@ -195,9 +196,9 @@ static void run_generated(const char *name, const ag_gen_facade_options *go)
             wall = (int32_t)n;
         }
     }
-    for (int k = 0; k < 2 && win > 0 && wall > 0; k++) {
+    for (int k = 0; k < 2 * repeat && win > 0 && wall > 0; k++) {
         ag_edit_op op = {.kind = AG_EDIT_RESIZE, .mode = AG_EDIT_GLOBAL};
-        if (k == 0) {
+        if (k % 2 == 0) {
             op.node = win;
             op.has_box = 1;
             op.box = t->nodes[win].box;
@@ -218,7 +219,7 @@ static void run_generated(const char *name, const ag_gen_facade_options *go)
             s = ag_model_state_make(&out, 0, &next, &err);
         double t_state = now_ms() - a;
         if (s) {
-            printf("%-28s %s failed: %s\n", name, k ? "wall x1.5" : "window taller", err.text);
+            printf("%-28s %s failed: %s\n", name, k % 2 ? "wall x1.5" : "window taller", err.text);
             ag_edit_model_free(out);
             ag_edit_report_clear(&rep);
             break;
@@ -233,7 +234,7 @@ static void run_generated(const char *name, const ag_gen_facade_options *go)
         double t_blob = now_ms() - a;
         printf("%-28s %8zu %8zu %-14s | %8.0f | %7.1f %7.1f %7.1f %7.1f %7.1f | %7.1f | %6zu "
                "%6zu %5ld\n",
-               name, m->ntris, next.em->proc->mesh->ntris, k ? "wall x1.5" : "window +0.2 m",
+               name, m->ntris, next.em->proc->mesh->ntris, k % 2 ? "wall x1.5" : "window +0.2 m",
                t_proc, rep.solve_ms, t_edit, t_state, t_tree, t_blob,
                t_edit + t_state + t_tree + t_blob, tree ? strlen(tree) >> 10 : 0, len >> 10,
                peak_mib());
@@ -274,6 +275,7 @@ static const struct {
 
 int main(int argc, char **argv)
 {
+    ag_heap_keep_large_blocks(); /* as archgramd runs */
     /* edit --write-obj 20k|200k|2M PATH: one generated building as a z-up OBJ (bench/edit_ws.js
      * sends it to the service) */
     if (argc == 4 && !strcmp(argv[1], "--write-obj")) {
@@ -291,6 +293,17 @@ int main(int argc, char **argv)
             return s ? 1 : 0;
         }
         fprintf(stderr, "edit: --write-obj takes 20k, 200k or 2M\n");
+        return 2;
+    }
+    /* edit --generated 20k|200k|2M [N]: only that building's committed resizes, N times each
+     * (to profile them) */
+    if ((argc == 3 || argc == 4) && !strcmp(argv[1], "--generated")) {
+        for (size_t i = 0; i < sizeof gens / sizeof *gens; i++)
+            if (!strcmp(argv[2], gens[i].key)) {
+                run_generated(gens[i].name, &gens[i].go, argc == 4 ? atoi(argv[3]) : 1);
+                return 0;
+            }
+        fprintf(stderr, "edit: --generated takes 20k, 200k or 2M\n");
         return 2;
     }
     printf("%-28s %8s %8s %8s | %9s %9s %9s %10s %10s %9s | %8s %5s\n", "model", "tris",
@@ -317,6 +330,6 @@ int main(int argc, char **argv)
            "tris", "after", "edit", "proc ms", "solve", "edit", "state", "tree", "blob", "total",
            "treeKB", "blobKB", "MiB");
     for (size_t i = 0; i < sizeof gens / sizeof *gens; i++)
-        run_generated(gens[i].name, &gens[i].go);
+        run_generated(gens[i].name, &gens[i].go, 1);
     return 0;
 }

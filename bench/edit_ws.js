@@ -6,11 +6,17 @@
 // --write-obj`). Target: an op reaches the other clients ≤ 50 ms after it is sent at 200k.
 // Prints figures; not a test.
 import fs from 'node:fs';
+import os from 'node:os';
 import { performance } from 'node:perf_hooks';
 import { execFileSync } from 'node:child_process';
 import path from 'node:path';
 import { DAEMON, http, importModel, removeDir, sleep, startDaemon, waitJob, WsClient } from '../tests/integration/harness.js';
 
+// `node bench/edit_ws.js [--sizes 20k,200k] [--no-demo]` runs a part of it (to profile one size)
+const argv = process.argv.slice(2);
+const sizesArg = argv.indexOf('--sizes');
+const SIZES = sizesArg >= 0 ? argv[sizesArg + 1].split(',') : ['20k', '200k'];
+const DEMO = !argv.includes('--no-demo');
 const OPS = 60;
 const PREVIEWS = 200;
 
@@ -25,11 +31,23 @@ if (!fs.existsSync(DAEMON)) {
   process.exit(0);
 }
 
+// archgramd's CPU time so far (user + system, ms), from /proc: the op's cost apart from what
+// else the machine runs (the wall times above depend on the load of a shared machine).
+function daemonCpuMs() {
+  try {
+    const f = fs.readFileSync(`/proc/${d.proc.pid}/stat`, 'utf8').split(') ')[1].split(' ');
+    return (Number(f[11]) + Number(f[12])) * 10; // fields 14 and 15, at 100 ticks/s
+  } catch {
+    return NaN;
+  }
+}
+
 // Committed resize ops on a model: the root alternately 1.25x wider and back (global), then a
 // window alternately 0.2 m taller and back (global: every window of its rule follows).
 async function committedOps(model, A, B, version, what) {
   const toAck = [];
   const toPeer = [];
+  let cpu = 0;
   for (let i = 0; i < OPS; i++) {
     const cid = `edit-${model.id}-${i}`;
     const t = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`, { timeout: 60000 })).json;
@@ -46,12 +64,14 @@ async function committedOps(model, A, B, version, what) {
     }
     const ack = A.next((m) => (m.type === 'ack' || m.type === 'nack') && m.cid === cid, 60000);
     const seen = B.next((m) => m.type === 'op' && m.cid === cid, 60000);
+    const c0 = daemonCpuMs();
     const ts = performance.now();
     A.send({ type: 'op', base: version, cid, op: { kind: 'resize', node, box, mode: 'global' } });
     const [a] = await Promise.all([
       ack.then((m) => { toAck.push(performance.now() - ts); return m; }),
       seen.then(() => { toPeer.push(performance.now() - ts); }),
     ]);
+    cpu += daemonCpuMs() - c0;
     if (a.type !== 'ack') throw new Error(`op ${i} on ${what} refused: ${JSON.stringify(a)}`);
     version = a.version;
     A.all.length = 0;
@@ -59,6 +79,8 @@ async function committedOps(model, A, B, version, what) {
   }
   console.log(`edit ws ${what}: op→ack ${summary(toAck)}`);
   console.log(`edit ws ${what}: op→broadcast ${summary(toPeer)}   (target ≤ 50 ms at 200k)`);
+  console.log(`edit ws ${what}: archgramd CPU per op ${(cpu / OPS).toFixed(1)} ms (user + system, ` +
+    `all threads, from op sent to ack and broadcast received; load average ${os.loadavg()[0].toFixed(2)})`);
 }
 
 const d = await startDaemon({ args: ['--demo'] });
@@ -67,43 +89,45 @@ let B;
 try {
   // the demo's first building, once its proceduralize job has run
   let model;
-  for (const t0 = Date.now(); Date.now() - t0 < 60000; await sleep(100)) {
-    model = (await http(d, 'GET', '/api/v1/models/1')).json;
-    if (model && model.proceduralized) break;
+  if (DEMO) {
+    for (const t0 = Date.now(); Date.now() - t0 < 60000; await sleep(100)) {
+      model = (await http(d, 'GET', '/api/v1/models/1')).json;
+      if (model && model.proceduralized) break;
+    }
+    if (!model || !model.proceduralized) throw new Error('the demo building was not proceduralized');
+    const tree = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`)).json;
+    console.log(`edit ws: model "${model.name}", ${tree.nodes.length} tree nodes, ${model.stats.triangles} triangles`);
+
+    A = await WsClient.open(d.wsUrl);
+    B = await WsClient.open(d.wsUrl);
+    let version = (await A.request({ type: 'hello', model: model.id, user: 'a' }, 'welcome')).version;
+    await B.request({ type: 'hello', model: model.id, user: 'b' }, 'welcome');
+    await A.next('join');
+
+    // drag previews: root stretched by a varying amount, one at a time (the server keeps 30/s
+    // per connection, so they are spaced 34 ms apart)
+    const box0 = tree.nodes.find((n) => n.id === tree.root).box;
+    const toRoom = [];
+    for (let i = 0; i < PREVIEWS; i++) {
+      const box = [...box0];
+      box[3] = box0[0] + (box0[3] - box0[0]) * (1 + 0.3 * ((i % 20) / 20));
+      const seen = B.next((m) => m.type === 'preview', 10000);
+      const ts = performance.now();
+      A.send({ type: 'preview', model: model.id, base: version, op: { kind: 'resize', node: 'root', box, mode: 'global' } });
+      await seen;
+      toRoom.push(performance.now() - ts);
+      B.all.length = 0;
+      await sleep(34);
+    }
+    A.send({ type: 'preview.end' });
+
+    console.log(`edit ws preview→room:   ${summary(toRoom)}`);
+    await committedOps(model, A, B, version, 'demo building');
   }
-  if (!model || !model.proceduralized) throw new Error('the demo building was not proceduralized');
-  const tree = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`)).json;
-  console.log(`edit ws: model "${model.name}", ${tree.nodes.length} tree nodes, ${model.stats.triangles} triangles`);
-
-  A = await WsClient.open(d.wsUrl);
-  B = await WsClient.open(d.wsUrl);
-  let version = (await A.request({ type: 'hello', model: model.id, user: 'a' }, 'welcome')).version;
-  await B.request({ type: 'hello', model: model.id, user: 'b' }, 'welcome');
-  await A.next('join');
-
-  // drag previews: root stretched by a varying amount, one at a time (the server keeps 30/s
-  // per connection, so they are spaced 34 ms apart)
-  const box0 = tree.nodes.find((n) => n.id === tree.root).box;
-  const toRoom = [];
-  for (let i = 0; i < PREVIEWS; i++) {
-    const box = [...box0];
-    box[3] = box0[0] + (box0[3] - box0[0]) * (1 + 0.3 * ((i % 20) / 20));
-    const seen = B.next((m) => m.type === 'preview', 10000);
-    const ts = performance.now();
-    A.send({ type: 'preview', model: model.id, base: version, op: { kind: 'resize', node: 'root', box, mode: 'global' } });
-    await seen;
-    toRoom.push(performance.now() - ts);
-    B.all.length = 0;
-    await sleep(34);
-  }
-  A.send({ type: 'preview.end' });
-
-  console.log(`edit ws preview→room:   ${summary(toRoom)}`);
-  await committedOps(model, A, B, version, 'demo building');
 
   // the generated buildings, uploaded z-up and proceduralized
   const bench = path.join(path.dirname(DAEMON), 'bench', 'edit');
-  for (const size of ['20k', '200k']) {
+  for (const size of SIZES) {
     if (!fs.existsSync(bench)) {
       console.log(`edit ws: ${bench} is missing (make build/bench/edit); generated buildings skipped`);
       break;

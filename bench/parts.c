@@ -17,6 +17,8 @@
 #include <unistd.h>
 
 #include "app/compose_ops.h"
+#include "app/dbpool.h"
+#include "app/heap.h"
 #include "app/edit_session.h"
 #include "app/events.h"
 #include "app/modelops.h"
@@ -118,6 +120,7 @@ static void die(const char *what, const ag_error *err)
 
 typedef struct {
     char path[64];
+    ag_dbpool *pool; /* as archgramd keeps its connections (checkpoints off the commits) */
     ag_db *db;
     ag_events *bus;
     ag_store_env env;
@@ -135,7 +138,7 @@ static void service_open(service *sv, const ag_mesh *m)
     }
     close(fd);
     unlink(sv->path);
-    if (ag_db_open(sv->path, NULL, &sv->db, &err))
+    if (ag_dbpool_create(sv->path, &sv->pool, &err) || !(sv->db = ag_dbpool_get(sv->pool, &err)))
         die("database", &err);
     sv->bus = ag_events_create();
     sv->env = (ag_store_env){.db = sv->db, .seq = ag_sequencer_create(sv->bus),
@@ -172,7 +175,7 @@ static void service_close(service *sv)
     ag_edit_sessions_free(sv->env.sessions);
     ag_sequencer_free(sv->env.seq);
     ag_events_free(sv->bus);
-    ag_db_close(sv->db);
+    ag_dbpool_free(sv->pool);
     char side[96];
     unlink(sv->path);
     snprintf(side, sizeof side, "%s-wal", sv->path);
@@ -388,6 +391,7 @@ static void bench_compose(const ag_proceduralize_result *r, const ag_part *p, in
 
 int main(void)
 {
+    ag_heap_keep_large_blocks(); /* as archgramd runs */
     /* every box its own component: 1720 windows of 9 boxes on three facades, a blank back */
     ag_gen_facade_options go = {.cols = 34, .rows = 20, .side_cols = 26, .left = 1, .bars = 3,
                                 .no_groups = 1, .annex = 1};

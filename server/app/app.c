@@ -14,6 +14,7 @@
 #include "auth.h"
 #include "demo.h"
 #include "extrude_job.h"
+#include "heap.h"
 #include "import_job.h"
 #include "jobqueue.h"
 #include "proceduralize_job.h"
@@ -101,6 +102,7 @@ static ag_status cancel_leftovers(ag_db *db, ag_error *err)
 
 ag_status ag_app_create(const ag_app_options *opt, ag_app **out, ag_error *err)
 {
+    ag_heap_keep_large_blocks();
     *out = NULL;
     ag_app *app = calloc(1, sizeof *app);
     if (!app)

@@ -1,7 +1,12 @@
 /* One SQLite connection per thread for one database file. A thread's first call opens its
  * connection (the schema as it is: only the first opener, ag_dbpool_create, migrates it);
  * later calls on that thread return the same one. Connections are closed by ag_dbpool_free:
- * threads are few and long-lived (request threads, workers), so keeping them costs little. */
+ * threads are few and long-lived (request threads, workers), so keeping them costs little.
+ *
+ * A commit on a pool connection does not checkpoint (store/db.h no_autocheckpoint): the
+ * pool's own thread copies the write-ahead log into the database file a few times a second,
+ * so a writer's change is acknowledged as soon as it is in the log (durable: SQLite replays
+ * the log after a crash). */
 #ifndef AG_DBPOOL_H
 #define AG_DBPOOL_H
 

@@ -58,9 +58,7 @@ ag_status ag_grammar_edit_apply(const ag_store_env *env, int64_t model, int64_t 
         /* the states before and after are kept: the author's undo restores the old text */
         s = ag_states_keep(t.db, model, t.version - 1, err);
         if (s == AG_OK)
-            s = ag__store_ws_put_state(t.db, model, t.version, &st, summary_text, err);
-        if (s == AG_OK)
-            s = ag_states_keep(t.db, model, t.version, err);
+            s = ag__store_ws_put_state(t.db, model, t.version, &st, summary_text, 1, err);
         int64_t v = t.version;
         if (s == AG_OK) {
             if ((s = ag_sequencer_commit(&t, author, cid, op, err)) == AG_OK) {

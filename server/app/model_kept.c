@@ -30,7 +30,8 @@ typedef struct {
 
 static void put_bytes(packer *k, const void *v, size_t n)
 {
-    if (k->fail || (k->fail = AG_ARRAY_RESERVE_MORE(k->p, k->cap, k->n, n) != AG_OK))
+    if (k->fail || (k->n + n > k->cap &&
+                    (k->fail = AG_ARRAY_RESERVE_MORE(k->p, k->cap, k->n, n) != AG_OK)))
         return;
     memcpy(k->p + k->n, v, n);
     k->n += n;
@@ -55,11 +56,42 @@ static void put_f64(packer *k, double v)
     put_u32(k, (uint32_t)(u >> 32));
 }
 
+/* Standard base64 with padding, as sodium_bin2base64's VARIANT_ORIGINAL writes it (and
+ * sodium_base642bin reads it back). Written here because libsodium's encoder is constant-time,
+ * made for secrets, and takes a quarter of an edit's tree writing on a large building; the
+ * libraries that have a plain one are not this layer's. out holds 4 * ceil(n / 3) + 1. */
+static void base64_encode(char *out, const uint8_t *in, size_t n)
+{
+    static const char digit[64] =
+        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    size_t i = 0;
+    for (; i + 3 <= n; i += 3) {
+        uint32_t v = (uint32_t)in[i] << 16 | (uint32_t)in[i + 1] << 8 | in[i + 2];
+        *out++ = digit[v >> 18];
+        *out++ = digit[(v >> 12) & 63];
+        *out++ = digit[(v >> 6) & 63];
+        *out++ = digit[v & 63];
+    }
+    if (i < n) {
+        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0);
+        *out++ = digit[v >> 18];
+        *out++ = digit[(v >> 12) & 63];
+        *out++ = i + 1 < n ? digit[(v >> 6) & 63] : '=';
+        *out++ = '=';
+    }
+    *out = '\0';
+}
+
 static char *kept_text(const ag_edit_model *em)
 {
     const ag_splittree *t = em->proc->tree;
     const ag_labels *L = em->proc->labels;
     packer k = {0};
+    /* all of it at once: grown piece by piece, a large tree's data is copied many times */
+    size_t total = t->nnodes * NODE_BYTES + t->npatterns * PATTERN_BYTES +
+                   t->nrules * RULE_BYTES + L->ncomponents * COMPONENT_BYTES +
+                   L->nvariants * VARIANT_BYTES;
+    k.fail = AG_ARRAY_RESERVE_MORE(k.p, k.cap, k.n, total ? total : 1) != AG_OK;
     for (size_t n = 0; n < t->nnodes; n++) {
         const ag_tnode *x = &t->nodes[n];
         const int32_t ints[NODE_INTS] = {x->kind,      x->parent,    x->first_child, x->last_child,
@@ -122,8 +154,7 @@ static char *kept_text(const ag_edit_model *em)
                           L->share, L->exact_copies ? 1 : 0);
         if (hn > 0 && (size_t)hn < sizeof head && (out = malloc((size_t)hn + blen + 4))) {
             memcpy(out, head, (size_t)hn);
-            sodium_bin2base64(out + hn, blen, k.p ? k.p : (const uint8_t *)"", k.n,
-                              sodium_base64_VARIANT_ORIGINAL);
+            base64_encode(out + hn, k.p ? k.p : (const uint8_t *)"", k.n);
             strcat(out + hn, "\"}");
         }
     }

@@ -104,41 +104,37 @@ static ag_status derive_text(const char *text, size_t len, ag_terminal_lookup lo
     return s;
 }
 
-/* A copy of m whose components are grouped by the labels of r, named "L<n>" as the grammar
- * export names them. */
-static ag_status regroup(const ag_proceduralize_result *r, ag_mesh **out, ag_error *err)
+/* r's mesh with its components grouped by the labels of r, named "L<n>" as the grammar export
+ * names them (in place: the vertices and triangles stay as they are). */
+static ag_status regroup(ag_proceduralize_result *r, ag_error *err)
 {
-    const ag_mesh *m = r->mesh;
+    ag_mesh *m = r->mesh;
     const ag_labels *L = r->labels;
-    ag_mesh *o = ag_mesh_create();
     int32_t *group = L->nlabels ? malloc(L->nlabels * sizeof *group) : NULL;
-    ag_status s = o && (group || !L->nlabels) ? ag_mesh_reserve(o, m->nverts, m->ntris)
-                                              : AG_ERR_NOMEM;
+    ag_status s = group || !L->nlabels ? AG_OK : AG_ERR_NOMEM;
     for (size_t l = 0; s == AG_OK && l < L->nlabels; l++)
         group[l] = -1;
+    if (s == AG_OK) {
+        for (size_t g = 0; g < m->ngroups; g++)
+            free(m->group_names[g]);
+        m->ngroups = 0;
+    }
     for (size_t c = 0; s == AG_OK && c < m->ncomponents; c++) {
         int32_t l = c < L->ncomponents ? L->label[c] : -1;
-        if (l >= 0 && (size_t)l < L->nlabels && group[l] < 0) {
+        int valid = l >= 0 && (size_t)l < L->nlabels;
+        if (valid && group[l] < 0) {
             char name[32];
             size_t g;
             snprintf(name, sizeof name, "L%d", l + 1);
-            if ((s = ag_mesh_add_group(o, name, &g)) == AG_OK)
+            if ((s = ag_mesh_add_group(m, name, &g)) == AG_OK)
                 group[l] = (int32_t)g;
         }
         if (s == AG_OK)
-            s = ag_mesh_add_component(o, l >= 0 && (size_t)l < L->nlabels ? group[l] : -1, NULL);
+            m->component_group[c] = valid ? group[l] : -1;
     }
-    for (size_t v = 0; s == AG_OK && v < m->nverts; v++)
-        s = ag_mesh_add_vertex(o, m->pos[3 * v], m->pos[3 * v + 1], m->pos[3 * v + 2]);
-    for (size_t t = 0; s == AG_OK && t < m->ntris; t++)
-        s = ag_mesh_add_triangle(o, m->tri[3 * t], m->tri[3 * t + 1], m->tri[3 * t + 2],
-                                 m->tri_component[t]);
     free(group);
-    if (s != AG_OK) {
-        ag_mesh_free(o);
+    if (s != AG_OK)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory naming the labels");
-    }
-    *out = o;
     return AG_OK;
 }
 
@@ -163,14 +159,9 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
     ag_grammar_free(back);
     if (s == AG_OK && (flags & AG_MODEL_READ_BACK)) {
         s = ag_model_state_reload(out->derived, &out->em, err);
-    } else if (s == AG_OK) {
-        ag_mesh *named = NULL;
-        if ((s = regroup(m->proc, &named, err)) == AG_OK) {
-            ag_mesh_free(m->proc->mesh);
-            m->proc->mesh = named;
-            out->em = m;
-            *made = NULL;
-        }
+    } else if (s == AG_OK && (s = regroup(m->proc, err)) == AG_OK) {
+        out->em = m;
+        *made = NULL;
     }
     if (s != AG_OK)
         ag_model_state_clear(out);

@@ -231,7 +231,7 @@ typedef struct {
 
 static void out_reserve(text_out *o, size_t more)
 {
-    if (!o->fail)
+    if (!o->fail && o->n + more + 1 > o->cap)
         o->fail = AG_ARRAY_RESERVE_MORE(o->p, o->cap, o->n, more + 1) != AG_OK;
 }
 

@@ -1,5 +1,6 @@
 #include "store_ws.h"
 
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -108,15 +109,11 @@ static ag_status encode_mesh(const ag_mesh *mesh, uint8_t **blob, size_t *len, c
     return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory summarising the mesh");
 }
 
-ag_status ag__store_ws_put_grammar(ag_db *db, int64_t model, int64_t version, const void *mesh,
-                                   size_t mesh_len, const char *stats, const char *text,
-                                   size_t text_len, const char *tree_json, const char *summary_json,
-                                   ag_error *err)
+/* The grammar row of `version`, naming its mesh file. */
+static ag_status put_grammar_row(ag_db *db, int64_t model, int64_t version, int64_t mesh_blob,
+                                 const char *text, size_t text_len, const char *tree_json,
+                                 const char *summary_json, ag_error *err)
 {
-    int64_t mesh_blob = 0;
-    ag_status s = ag_models_set_mesh(db, model, mesh, mesh_len, stats, &mesh_blob, err);
-    if (s != AG_OK)
-        return s;
     ag_grammar_new g = {.model = model,
                         .version = version,
                         .mesh_blob = mesh_blob,
@@ -128,25 +125,94 @@ ag_status ag__store_ws_put_grammar(ag_db *db, int64_t model, int64_t version, co
     return ag_grammars_put(db, &g, err);
 }
 
-ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
-                                 const ag_model_state *st, const char *summary_json,
-                                 ag_error *err)
+ag_status ag__store_ws_put_grammar(ag_db *db, int64_t model, int64_t version, const void *mesh,
+                                   size_t mesh_len, const char *stats, const char *text,
+                                   size_t text_len, const char *tree_json, const char *summary_json,
+                                   ag_error *err)
 {
-    uint8_t *blob = NULL;
-    size_t blob_len = 0;
-    char *stats = NULL;
-    ag_status s = encode_mesh(st->em->proc->mesh, &blob, &blob_len, &stats, err);
+    int64_t mesh_blob = 0;
+    ag_status s = ag_models_set_mesh(db, model, mesh, mesh_len, stats, &mesh_blob, err);
     if (s != AG_OK)
         return s;
-    char *tree = ag_model_kept_tree_text(st->em); /* a reload gives this model back */
-    if (!tree)
+    return put_grammar_row(db, model, version, mesh_blob, text, text_len, tree_json,
+                           summary_json, err);
+}
+
+/* A state's largest parts as the store keeps them, made outside the transaction where they
+ * can be: the mesh encoded, and the stored tree text printed on a thread of its own meanwhile
+ * (and while the mesh is written); the two need nothing of each other. */
+typedef struct {
+    const ag_edit_model *em;
+    char *tree;
+    pthread_t printer;
+    int threaded;
+    uint8_t *blob;
+    size_t blob_len;
+    char *stats;
+    ag_status mesh_status;
+} encoded_state;
+
+static void *print_tree(void *arg)
+{
+    encoded_state *e = arg;
+    e->tree = ag_model_kept_tree_text(e->em); /* a reload gives this model back */
+    return NULL;
+}
+
+static void encode_state(const ag_model_state *st, encoded_state *e, ag_error *err)
+{
+    memset(e, 0, sizeof *e);
+    e->em = st->em;
+    e->threaded = pthread_create(&e->printer, NULL, print_tree, e) == 0;
+    if (!e->threaded)
+        print_tree(e);
+    e->mesh_status = encode_mesh(st->em->proc->mesh, &e->blob, &e->blob_len, &e->stats, err);
+}
+
+/* The tree text, once printed. */
+static char *encoded_tree(encoded_state *e)
+{
+    if (e->threaded) {
+        pthread_join(e->printer, NULL);
+        e->threaded = 0;
+    }
+    return e->tree;
+}
+
+static void encoded_clear(encoded_state *e)
+{
+    free(encoded_tree(e));
+    free(e->stats);
+    free(e->blob);
+    memset(e, 0, sizeof *e);
+}
+
+static ag_status write_state(ag_db *db, int64_t model, int64_t version, const ag_model_state *st,
+                             encoded_state *e, const char *summary_json, int keep, ag_error *err)
+{
+    int64_t mesh_blob = 0;
+    ag_status s = e->mesh_status;
+    if (s == AG_OK) /* the tree goes on printing meanwhile */
+        s = ag_models_set_mesh(db, model, e->blob, e->blob_len, e->stats, &mesh_blob, err);
+    char *tree = encoded_tree(e);
+    if (s == AG_OK && !tree)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory describing the model");
     if (s == AG_OK)
-        s = ag__store_ws_put_grammar(db, model, version, blob, blob_len, stats, st->text,
-                                     st->text_len, tree, summary_json, err);
-    free(tree);
-    free(stats);
-    free(blob);
+        s = put_grammar_row(db, model, version, mesh_blob, st->text, st->text_len,
+                            keep ? "" : tree, summary_json, err);
+    if (s == AG_OK && keep)
+        s = ag_states_keep_with_tree(db, model, version, tree, err);
+    return s;
+}
+
+ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
+                                 const ag_model_state *st, const char *summary_json, int keep,
+                                 ag_error *err)
+{
+    encoded_state e;
+    encode_state(st, &e, err);
+    ag_status s = write_state(db, model, version, st, &e, summary_json, keep, err);
+    encoded_clear(&e);
     return s;
 }
 
@@ -306,7 +372,7 @@ static ag_status save_proc(ag_store_ws *w, ag_model_state *st, const ag_proc_out
         json_decref(op);
         return s;
     }
-    s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, err);
+    s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, 0, err);
     if (s == AG_OK)
         s = ag_grammars_clear_terminals(t.db, w->o.model, err);
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
@@ -325,19 +391,28 @@ static ag_status save_proc(ag_store_ws *w, ag_model_state *st, const ag_proc_out
 static ag_status commit_change(ag_store_ws *w, ag_model_state *st, json_t *body,
                                const char *summary, ag_error *err)
 {
+    /* encoded before the sequencer's lock is taken: it serializes every model's changes */
+    encoded_state e;
+    encode_state(st, &e, err);
+    if (e.mesh_status != AG_OK) {
+        ag_status s = e.mesh_status;
+        encoded_clear(&e);
+        return s;
+    }
     ag_seq_txn t;
     int dup = 0;
     ag_status s = ag__store_ws_begin(w, "edited", 1, &t, &dup, err);
-    if (s != AG_OK || dup)
+    if (s != AG_OK || dup) {
+        encoded_clear(&e);
         return s;
+    }
     s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
     if (s == AG_OK)
-        s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, err);
+        s = write_state(t.db, w->o.model, t.version, st, &e, summary, 1, err);
+    encoded_clear(&e);
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
         s = ag_grammars_put_terminal(t.db, w->o.model, st->terms.path[i], st->terms.obj[i],
                                      st->terms.len[i], err);
-    if (s == AG_OK)
-        s = ag_states_keep(t.db, w->o.model, t.version, err);
     int64_t v = t.version;
     if (s == AG_OK)
         s = ag_sequencer_commit(&t, w->o.author, w->o.cid, body, err);

@@ -72,9 +72,10 @@ ag_status ag__store_ws_put_grammar(ag_db *db, int64_t model, int64_t version, co
                                    ag_error *err);
 /* For the store's other writers of model states (a grammar text edit): writes st's mesh (its
  * edit model's mesh, with its stats), grammar text, served tree and summary for `version`
- * inside the caller's transaction. */
+ * inside the caller's transaction. keep: also kept as the state of `version` (undo, restore),
+ * the tree written once, in that state row (store/grammars.h). */
 ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
-                                 const ag_model_state *st, const char *summary_json,
+                                 const ag_model_state *st, const char *summary_json, int keep,
                                  ag_error *err);
 /* The point cloud operations of the store workspace (app/store_ws_cloud.c): a cloud upload
  * is a new model of kind "pointcloud" (its points in the point cloud tables, its file kept

@@ -48,11 +48,27 @@ ag_status ag_db_open(const char *path, const ag_db_options *opt, ag_db **out, ag
     }
     sqlite3_extended_result_codes(db->handle, 1);
     sqlite3_busy_timeout(db->handle, opt && opt->busy_timeout_ms ? opt->busy_timeout_ms : 10000);
-    ag_status s = exec(db, "PRAGMA journal_mode = WAL", err);
+    /* A new database gets 64 KiB pages: a version's mesh file is megabytes, and a commit
+     * writes the log page by page, sixteen times the calls with SQLite's 4 KiB. A database
+     * capped below 64 MiB keeps 4 KiB pages so that a small cap still holds its schema. An
+     * existing database keeps the size it was made with (the pragma does nothing then). */
+    ag_status s = exec(db,
+                       opt && opt->max_bytes && opt->max_bytes < ((size_t)64 << 20)
+                           ? "PRAGMA page_size = 4096"
+                           : "PRAGMA page_size = 65536",
+                       err);
+    if (s == AG_OK)
+        s = exec(db, "PRAGMA journal_mode = WAL", err);
     if (s == AG_OK)
         s = exec(db, "PRAGMA foreign_keys = ON", err);
     if (s == AG_OK)
         s = exec(db, "PRAGMA synchronous = NORMAL", err);
+    if (s == AG_OK && opt && opt->no_autocheckpoint)
+        s = exec(db, "PRAGMA wal_autocheckpoint = 0", err);
+    /* the WAL is cut back to this size when it is reset, so one large write does not keep
+     * its file large */
+    if (s == AG_OK)
+        s = exec(db, "PRAGMA journal_size_limit = 67108864", err);
     if (s == AG_OK && opt && opt->max_bytes) {
         sqlite3_stmt *st = NULL;
         long long page = 4096;
@@ -94,6 +110,17 @@ void ag_db_close(ag_db *db)
     sqlite3_close(db->handle);
     free(db->path);
     free(db);
+}
+
+ag_status ag_db_checkpoint(ag_db *db, int *pending, ag_error *err)
+{
+    int log = 0, done = 0;
+    int rc = sqlite3_wal_checkpoint_v2(db->handle, NULL, SQLITE_CHECKPOINT_PASSIVE, &log, &done);
+    if (pending)
+        *pending = log > done ? log - done : 0;
+    if (rc == SQLITE_OK || rc == SQLITE_BUSY || rc == SQLITE_LOCKED)
+        return AG_OK; /* busy: another checkpoint is under way */
+    return ag_db_fail(db, err, "copying the write-ahead log into the database");
 }
 
 sqlite3 *ag_db_handle(ag_db *db) { return db->handle; }

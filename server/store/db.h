@@ -18,7 +18,15 @@ typedef struct {
     int no_migrate;      /* 1: open an existing schema as it is (still refuses a newer one) */
     size_t max_bytes;    /* the file may grow to about this size (PRAGMA max_page_count);
                             0: no limit. Writes past it fail with AG_ERR_STORAGE_FULL */
+    int no_autocheckpoint; /* 1: a commit never copies the WAL into the database file itself
+                              (SQLite's auto-checkpoint, tens of milliseconds after a large
+                              write, would be paid by the writer before its change is
+                              acknowledged); the opener calls ag_db_checkpoint instead */
 } ag_db_options;
+
+/* Copies what the WAL holds into the database file as far as readers allow, without waiting
+ * for anyone (a passive checkpoint); *pending (may be NULL) is set to the frames left. */
+ag_status ag_db_checkpoint(ag_db *db, int *pending, ag_error *err);
 
 ag_status ag_db_open(const char *path, const ag_db_options *opt, ag_db **out, ag_error *err);
 void ag_db_close(ag_db *db);

@@ -64,7 +64,8 @@ ag_status ag_grammars_current(ag_db *db, int64_t model, int with_tree, ag_gramma
     ag_status s = ag_db_prepared(
         db, &st,
         "SELECT m.version, g.version, g.mesh_blob, g.text, g.summary, "
-        "CASE WHEN ? THEN g.tree END, g.tree_numbering "
+        "CASE WHEN ? THEN coalesce(nullif(g.tree, ''), (SELECT k.tree FROM model_states k "
+        "WHERE k.model_id = g.model_id AND k.version = g.version)) END, g.tree_numbering "
         "FROM models m LEFT JOIN grammars g ON g.model_id = m.id AND g.mesh_blob = m.mesh_blob "
         "WHERE m.id = ? ORDER BY g.version DESC LIMIT 1",
         err);

@@ -5,7 +5,11 @@
  * A grammar describes its model while the model's mesh is still the one it was stored with
  * (models.mesh_blob): ops that leave the geometry alone (rename, note) keep it current; a new
  * mesh without a grammar would end it. Only a model's newest grammar row is kept. Every write
- * runs inside the caller's transaction (ag_db_begin). */
+ * runs inside the caller's transaction (ag_db_begin).
+ *
+ * A grammar row whose tree is '' (schema 11) has its tree in the model_states row of its
+ * version (ag_states_keep_with_tree): an edit writes its large tree once, not once here and
+ * once more as the version's kept state. Reads give the tree either way. */
 #ifndef AG_GRAMMARS_H
 #define AG_GRAMMARS_H
 

@@ -21,13 +21,29 @@ void ag_states_row_clear(ag_state_row *row)
 ag_status ag_states_keep(ag_db *db, int64_t model, int64_t version, ag_error *err)
 {
     sqlite3_stmt *st;
-    /* grammars keeps one row per model; it describes the model only while the mesh is its */
+    /* kept already (an edit keeps its version): asked by key alone, so that the large row
+     * the statement below would copy is not read */
     ag_status s = ag_db_prepared(
+        db, &st, "SELECT EXISTS (SELECT 1 FROM model_states WHERE model_id = ? AND version = ?)",
+        err);
+    if (s != AG_OK)
+        return s;
+    sqlite3_bind_int64(st, 1, model);
+    sqlite3_bind_int64(st, 2, version);
+    int rc = sqlite3_step(st), kept = rc == SQLITE_ROW && sqlite3_column_int(st, 0);
+    sqlite3_reset(st);
+    if (rc != SQLITE_ROW)
+        return ag_db_fail(db, err, "reading a model version's state");
+    if (kept)
+        return ag_pointclouds_states_keep(db, model, version, err);
+    /* grammars keeps one row per model; it describes the model only while the mesh is its */
+    s = ag_db_prepared(
         db, &st,
         "INSERT OR IGNORE INTO model_states "
         "(model_id, version, mesh_blob, stats, grammar, tree, summary, tree_numbering) "
-        "SELECT m.id, ?, m.mesh_blob, m.stats, g.text, g.tree, g.summary, "
-        "coalesce(g.tree_numbering, 1) FROM models m "
+        "SELECT m.id, ?, m.mesh_blob, m.stats, g.text, coalesce(nullif(g.tree, ''), "
+        "(SELECT s.tree FROM model_states s WHERE s.model_id = m.id AND s.version = g.version)), "
+        "g.summary, coalesce(g.tree_numbering, 1) FROM models m "
         "LEFT JOIN grammars g ON g.model_id = m.id AND g.mesh_blob = m.mesh_blob "
         "WHERE m.id = ? AND NOT EXISTS (SELECT 1 FROM model_states k " /* kept: not read again */
         "WHERE k.model_id = m.id AND k.version = ?1)",
@@ -39,6 +55,32 @@ ag_status ag_states_keep(ag_db *db, int64_t model, int64_t version, ag_error *er
     s = ag_db_step_done(db, st, "keeping a model version's state", err);
     /* a point cloud's segmentation is part of its state */
     return s == AG_OK ? ag_pointclouds_states_keep(db, model, version, err) : s;
+}
+
+ag_status ag_states_keep_with_tree(ag_db *db, int64_t model, int64_t version,
+                                   const char *tree_json, ag_error *err)
+{
+    sqlite3_stmt *st;
+    ag_status s = ag_db_prepared(
+        db, &st,
+        "INSERT INTO model_states "
+        "(model_id, version, mesh_blob, stats, grammar, tree, summary, tree_numbering) "
+        "SELECT m.id, ?, m.mesh_blob, m.stats, g.text, ?, g.summary, g.tree_numbering "
+        "FROM models m JOIN grammars g ON g.model_id = m.id AND g.mesh_blob = m.mesh_blob "
+        "AND g.version = ?1 WHERE m.id = ?",
+        err);
+    if (s != AG_OK)
+        return s;
+    sqlite3_bind_int64(st, 1, version);
+    sqlite3_bind_text(st, 2, tree_json, -1, SQLITE_STATIC);
+    sqlite3_bind_int64(st, 3, model);
+    if ((s = ag_db_step_done(db, st, "keeping a model version's state", err)) != AG_OK)
+        return s;
+    if (sqlite3_changes(ag_db_handle(db)) != 1)
+        return ag_error_set(err, AG_ERR_INTERNAL, 0,
+                            "model %lld has no grammar of version %lld to keep with its tree",
+                            (long long)model, (long long)version);
+    return ag_pointclouds_states_keep(db, model, version, err);
 }
 
 /* The first op after `from` up to `to` that changes geometry: its version, or 0. */

@@ -31,6 +31,12 @@ void ag_states_row_clear(ag_state_row *row);
  * was this one. A version already kept is left as it is. */
 ag_status ag_states_keep(ag_db *db, int64_t model, int64_t version, ag_error *err);
 
+/* Keeps the model's current state with tree_json as the state of `version`, the version
+ * being written, whose grammar row (ag_grammars_put just before, tree_json "") names this
+ * row for its tree: the tree is written once. */
+ag_status ag_states_keep_with_tree(ag_db *db, int64_t model, int64_t version,
+                                   const char *tree_json, ag_error *err);
+
 /* The state of `version`: the newest kept state at or before it, when only ops that leave
  * the geometry alone (rename, note) came between. AG_ERR_NOT_FOUND (message says why) when
  * the version does not exist or its state was not kept. */
