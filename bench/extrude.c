@@ -17,6 +17,7 @@
 #include "core/extrude/style.h"
 #include "io/footprints.h"
 #include "io/plan_write.h"
+#include "../tests/unit/extrude_grid_profiles.h"
 
 static double now(void)
 {
@@ -557,27 +558,6 @@ static size_t star_shape(double cell, double *xy)
     }
     return (size_t)n;
 }
-
-static void grid_profiles(ag_plan *p, double h)
-{
-    ag_profile_point hip[] = {{0, 0}, {0, h}, {1, h + 1}};
-    ag_profile_point steep[] = {{0, 0}, {0, h}, {0.5, h + 1}};
-    ag_profile_point wall[] = {{0, 0}, {0, h + 1}};
-    ag_profile_point r2[] = {{0, 0}, {0, h}, {2, h + 1}};
-    ag_profile_point over[] = {{0, 0}, {0, h}, {-1, h + 1}, {1, h + 2}};
-    ag_profile_point soffit[] = {{0, 0}, {0, h}, {-1, h}, {1, h + 2}};
-    ag_profile_point r45[] = {{0, 0}, {1, 1}};
-    ag_profile_point terrace[] = {{0, 0}, {0, h}, {1, h}, {1, h + 1}, {2, h + 2}};
-    ag_plan_add_profile(p, "hip", hip, 3, NULL, NULL, NULL);
-    ag_plan_add_profile(p, "steep", steep, 3, NULL, NULL, NULL);
-    ag_plan_add_profile(p, "wall", wall, 2, NULL, NULL, NULL);
-    ag_plan_add_profile(p, "r2", r2, 3, NULL, NULL, NULL);
-    ag_plan_add_profile(p, "over", over, 4, NULL, NULL, NULL);
-    ag_plan_add_profile(p, "soffit", soffit, 4, NULL, NULL, NULL);
-    ag_plan_add_profile(p, "r45", r45, 2, NULL, NULL, NULL);
-    ag_plan_add_profile(p, "terrace", terrace, 5, NULL, NULL, NULL);
-}
-
 
 /* --grid-dump N: the description of stress plan N (before validation) goes to this file */
 static long dump_index = -1;
