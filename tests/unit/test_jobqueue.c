@@ -401,11 +401,11 @@ static void until_exhausted(void *user, ag_task_budget *b)
     while (!ag_task_budget_exhausted(b) && now_s() - t0 < 5.0)
         usleep(1000);
     budget_elapsed = now_s() - t0;
-    atomic_store(&why_seen, b->why);
     ag_error err;
     ag_error_clear(&err);
     ag_status s = ag_task_budget_explain(b, AG_ERR_CANCELLED, "the test task", &err);
     atomic_fetch_add(&ran, s == b->why && strstr(err.text, "the test task") ? 1 : 0);
+    atomic_store(&why_seen, b->why); /* last: the test reads ran once it sees this */
 }
 
 static void a_task_budget_runs_out_at_its_deadline_and_at_a_stop(void **state)
