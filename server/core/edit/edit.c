@@ -8,6 +8,7 @@
 #include "../base/clock.h"
 #include "rebuild.h"
 #include "resize.h"
+#include "treeedit.h"
 
 struct ag_edit_cache {
     ag_edit_resize_solver *solver;
@@ -240,17 +241,89 @@ ag_status ag_edit_apply(ag_edit_model *m, const ag_edit_op *op, ag_edit_model **
     return ag_edit_apply_ex(m, op, AG_EDIT_READ_BACK, out, rep, err);
 }
 
-/* A resize knows its result: the edited tree rebuilt into the new model (rebuild.h), node ids
- * kept; read back through its grammar when asked. */
-static ag_status apply_resize(ag_edit_model *m, const ag_edit_op *op, unsigned flags,
-                              ag_edit_model **out, ag_edit_report *rep, ag_error *err)
+/* The edited tree of op (resize.h, treeedit.h) over *base; AG_ERR_UNSUPPORTED (nothing set in
+ * err) for an edit only the mesh path makes. */
+static ag_status edited_tree(const ag_proceduralize_result *in, const ag_edit_op *op,
+                             ag_treeedit_base *base, ag_splittree **tree, int32_t **source,
+                             ag_edit_report *rep, ag_error *err)
+{
+    switch (op->kind) {
+    case AG_EDIT_RESIZE:
+        memset(base, 0, sizeof *base);
+        base->view = *in;
+        return ag_edit_resize_tree(in, op, tree, source, rep, err);
+    case AG_EDIT_SPLIT:
+        return ag_treeedit_split(in, op, base, tree, source, rep, err);
+    case AG_EDIT_JOIN:
+        return ag_treeedit_join(in, op, base, tree, source, rep, err);
+    case AG_EDIT_REMOVE:
+        return ag_treeedit_remove(in, op, base, tree, source, rep, err);
+    case AG_EDIT_PASTE: {
+        ag_error e = {0};
+        ag_status st = ag_treeedit_paste(in, op, base, tree, source, rep, &e);
+        if (st && st != AG_ERR_UNSUPPORTED && err)
+            *err = e;
+        return st;
+    }
+    default:
+        return ag_error_set(err, AG_ERR_INVALID, 0, "kind: unknown edit kind %d", op->kind);
+    }
+}
+
+/* What the edited tree places, against the budget, before anything is made of it. */
+static ag_status check_tree(const ag_edit_budget *b, const ag_proceduralize_result *base,
+                            const ag_splittree *t, const int32_t *source, ag_error *err)
+{
+    if (!b || (!b->max_triangles && !b->max_components))
+        return AG_OK;
+    const ag_labels *L = base->labels;
+    size_t tris = 0, comps = 0;
+    for (size_t v = 0; v < t->nnodes; v++) {
+        if (t->nodes[v].kind != AG_NODE_COMPONENT)
+            continue;
+        int32_t c = base->tree->nodes[source[v]].component;
+        if (c >= 0 && (size_t)c < L->ncomponents) {
+            tris += L->tri_start[c + 1] - L->tri_start[c];
+            comps++;
+        }
+    }
+    if (b->max_triangles && tris > b->max_triangles)
+        return ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, 0,
+                            "the edit would make %zu triangles; this server takes at most %zu",
+                            tris, b->max_triangles);
+    if (b->max_components && comps > b->max_components)
+        return ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, 0,
+                            "the edit would place %zu terminals; this server takes at most %zu",
+                            comps, b->max_components);
+    return AG_OK;
+}
+
+/* An edit that knows its result: the edited tree rebuilt into the new model (rebuild.h), node
+ * ids kept; read back through its grammar when asked. *done = 0 when the edit takes the mesh
+ * path instead. */
+static ag_status apply_tree(ag_edit_model *m, const ag_edit_op *op, unsigned flags,
+                            ag_edit_model **out, ag_edit_report *rep, int *done, ag_error *err)
 {
     ag_splittree *tree = NULL;
     int32_t *source = NULL;
     ag_proceduralize_result *r = NULL;
-    ag_status st = ag_edit_resize_tree(m->proc, op, &tree, &source, rep, err);
-    if (!st)
-        st = ag_rebuild(m->proc, tree, source, &m->opt.patterns, &r, err);
+    ag_treeedit_base base = {0};
+    *done = 1;
+    ag_status st = edited_tree(m->proc, op, &base, &tree, &source, rep, err);
+    if (st == AG_ERR_UNSUPPORTED) {
+        ag_treeedit_base_free(&base);
+        *done = 0;
+        return AG_OK;
+    }
+    if (!st && op->kind != AG_EDIT_RESIZE) /* a resize counted its emission itself */
+        st = check_tree(op->budget, &base.view, tree, source, err);
+    if (st) {
+        ag_splittree_free(tree);
+        free(source);
+    } else {
+        st = ag_rebuild(&base.view, tree, source, &m->opt.patterns, &r, err);
+    }
+    ag_treeedit_base_free(&base);
     if (st)
         return st;
     if (ag_edit_budget_cancelled(op->budget)) {
@@ -286,12 +359,19 @@ ag_status ag_edit_apply_ex(ag_edit_model *m, const ag_edit_op *op, unsigned flag
         ag_edit_report_clear(rep);
     ag_mesh *mesh = NULL;
     ag_status st;
-    if (op->kind == AG_EDIT_RESIZE) {
-        st = apply_resize(m, op, flags, out, rep, err);
-        ag_edit_report_clear(&local); /* the caller asked for no report */
-        return st;
+    if (!(flags & AG_EDIT_MESH_PATH)) {
+        int done;
+        st = apply_tree(m, op, flags, out, rep, &done, err);
+        if (done) {
+            ag_edit_report_clear(&local); /* the caller asked for no report */
+            return st;
+        }
     }
+    /* the mesh path: the operation's mesh proceduralized again */
     switch (op->kind) {
+    case AG_EDIT_RESIZE:
+        st = ag_edit_resize(m->proc, op, &mesh, rep, err);
+        break;
     case AG_EDIT_SPLIT:
         st = ag_edit_split(m->proc, op, &mesh, rep, err);
         break;

@@ -2,10 +2,12 @@
  *
  * An edit model is a proceduralization result (segmented mesh, labels, split tree, rules,
  * patterns, grammar) plus cached solver state. Every operation is a pure function of the
- * result and an op that returns a new mesh — one component per placed terminal, grouped by
- * label name — and a report; ag_edit_apply then proceduralizes that mesh again, so the new
- * tree and grammar are always valid and rules and patterns are found afresh (a wall stretched
- * past its repeat size becomes more walls, a pattern with a larger count).
+ * result and an op. ag_edit_apply makes the edited split tree (resize.h, treeedit.h: every
+ * node the edit does not remove keeps its index, new nodes are appended, removed ones are
+ * dead) and rebuilds the model from it (rebuild.h: rules and patterns found afresh) without
+ * proceduralizing again. The mesh-returning functions below make the operation's mesh — one
+ * component per placed terminal, grouped by label name — which a paste from another model or a
+ * turned paste (and point clouds, points/pointedit.h) proceduralize again.
  *
  * Nodes are named by their index in the model's split tree (model->proc->tree); node 0 is
  * the root. A visible node's geometry is kept relative to its box: when the box changes, the
@@ -155,7 +157,8 @@ ag_status ag_edit_model_wrap(ag_proceduralize_result *r, const ag_proceduralize_
                              ag_edit_model **out, ag_error *err);
 void ag_edit_model_free(ag_edit_model *m);
 
-/* Applies op: runs the operation, proceduralizes its mesh, derives the grammar found and
+/* Applies op: the edited tree rebuilt into the new model (a paste from another model or a
+ * turned one: the operation's mesh proceduralized), then derives its grammar and
  * proceduralizes that again (so the new model's ids are those a reload of its grammar gives,
  * see ag_edit_model_from_grammar), returns the new model and fills rep (instances per label
  * counted on the new model's tree, named as its grammar's labels). The input model is
@@ -169,6 +172,10 @@ typedef enum {
      * (the CLI). A caller that keeps the returned model and maps ids itself (the service)
      * leaves it out and saves the second run. */
     AG_EDIT_READ_BACK = 1,
+    /* make the operation's mesh and proceduralize it again (every node renumbered) instead of
+     * rebuilding the edited tree: what a paste from another model or a turned paste always
+     * does; for comparisons and benchmarks */
+    AG_EDIT_MESH_PATH = 2,
 } ag_edit_apply_flags;
 
 /* ag_edit_apply is ag_edit_apply_ex(..., AG_EDIT_READ_BACK, ...). */

@@ -338,3 +338,109 @@ ag_status ag_place_finish(ag_place_builder *b, ag_mesh **out, ag_error *err)
     ag_place_builder_free(b);
     return AG_OK;
 }
+
+/* ---- paste plans -------------------------------------------------------------------------- */
+
+#define PASTE_MAX_TRIANGLES 50000000.0
+
+ag_status ag_place_paste_plan_make(const ag_proceduralize_result *in, const ag_edit_op *op,
+                                   uint8_t *smark, ag_place_paste_plan *p, ag_error *err)
+{
+    memset(p, 0, sizeof *p);
+    const ag_proceduralize_result *src = op->source ? op->source : in;
+    int cross = src != in;
+    if (op->nnodes == 0 || !op->nodes)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "paste needs a source selection (nodes is empty)");
+    ag_status st = ag_place_check_node(in, op->node, "paste destination node", err);
+    if (st)
+        return st;
+    char what[64];
+    for (size_t i = 0; i < op->nnodes; i++) {
+        snprintf(what, sizeof what, "paste source nodes[%zu]%s", i,
+                 cross ? " (source model)" : "");
+        if ((st = ag_place_check_node(src, op->nodes[i], what, err)))
+            return st;
+    }
+    if (op->placement != AG_EDIT_INSERT && op->placement != AG_EDIT_REPLACE)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "paste placement must be insert (0) or replace (1), not %d",
+                            op->placement);
+    if (op->fit != AG_EDIT_FILL && op->fit != AG_EDIT_DERIVE)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "paste fit must be fill (0) or derive (1), not %d", op->fit);
+    const ag_splittree *ts = src->tree, *td = in->tree;
+    /* the joined source */
+    ag_box Bs = ts->nodes[op->nodes[0]].box;
+    size_t ns = 0, stris = 0;
+    for (size_t i = 0; i < op->nnodes; i++) {
+        ag_box_extend_box(&Bs, &ts->nodes[op->nodes[i]].box);
+        ns += ag_place_mark_subtree(ts, op->nodes[i], smark);
+    }
+    if (ns == 0)
+        return ag_error_set(err, AG_ERR_INVALID, op->nodes[0],
+                            "the source selection has no geometry");
+    for (size_t c = 0; c < ts->ncomponents; c++)
+        if (smark[c])
+            stris += src->labels->ntris[c];
+    const ag_box Bd = td->nodes[op->node].box;
+    int fs = ag_place_facing(&Bs, &ts->nodes[AG_EDIT_ROOT].box);
+    int fd = ag_place_facing(&Bd, &td->nodes[AG_EDIT_ROOT].box);
+    int k = (fd - fs) & 3;
+    double S[3];
+    ag_box_extents(&Bs, S);
+    if (k & 1) {
+        double x = S[0];
+        S[0] = S[1];
+        S[1] = x;
+    }
+    p->source_box = Bs;
+    p->turns = k;
+    p->ncomponents = ns;
+    p->counts[0] = p->counts[1] = p->counts[2] = 1;
+    p->cell0 = Bd;
+    if (op->fit == AG_EDIT_FILL) {
+        if (ag_place_fill_grid(&Bd, S, fd, p->counts, p->step, &p->cell0))
+            return ag_error_set(err, AG_ERR_TOO_LARGE, op->node,
+                                "the source is too small to fill node %d", (int)op->node);
+        double total = (double)p->counts[0] * p->counts[1] * p->counts[2];
+        double limit = op->budget && op->budget->max_triangles &&
+                               (double)op->budget->max_triangles < PASTE_MAX_TRIANGLES
+                           ? (double)op->budget->max_triangles
+                           : PASTE_MAX_TRIANGLES;
+        if (total * (double)stris > limit)
+            return ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, op->node,
+                                "filling node %d needs %.0f copies of %zu triangles (limit %.0f "
+                                "triangles)",
+                                (int)op->node, total, stris, limit);
+        if (op->budget && op->budget->max_components &&
+            total * (double)op->nnodes > (double)op->budget->max_components)
+            return ag_error_set(err, AG_ERR_RESULT_TOO_LARGE, op->node,
+                                "filling node %d needs %.0f copies of %zu nodes (limit %zu "
+                                "terminals)",
+                                (int)op->node, total, op->nnodes, op->budget->max_components);
+    }
+    p->copies = (size_t)p->counts[0] * p->counts[1] * p->counts[2];
+    return AG_OK;
+}
+
+ag_box ag_place_paste_cell(const ag_place_paste_plan *p, unsigned x, unsigned y, unsigned z)
+{
+    ag_box cell = p->cell0;
+    unsigned ix[3] = {x, y, z};
+    for (int a = 0; a < 3; a++) {
+        cell.min[a] += ix[a] * p->step[a];
+        cell.max[a] += ix[a] * p->step[a];
+    }
+    return cell;
+}
+
+void ag_place_paste_message(ag_edit_report *rep, const ag_place_paste_plan *p,
+                            const ag_edit_op *op)
+{
+    snprintf(rep->message, sizeof rep->message,
+             "pasted %zu cop%s (%u x %u x %u) of %zu components into node %d, turned by %d "
+             "quarter turn%s",
+             p->copies, p->copies == 1 ? "y" : "ies", p->counts[0], p->counts[1], p->counts[2],
+             p->ncomponents, (int)op->node, p->turns, p->turns == 1 ? "" : "s");
+}

@@ -14,6 +14,7 @@
 #include "../mesh.h"
 #include "../proc/proceduralize.h"
 #include "../status.h"
+#include "edit.h"
 
 typedef struct {
     double M[3][3];
@@ -75,5 +76,29 @@ size_t ag_place_triangles(const ag_place_builder *b);
 /* Hands over the mesh; AG_ERR_INVALID when it has no triangle (the edit would leave nothing).
  * The builder is freed either way. */
 ag_status ag_place_finish(ag_place_builder *b, ag_mesh **out, ag_error *err);
+
+/* What a paste places (paste.c): the source selection joined into one box, the quarter turns
+ * from the way it faces to the way the destination faces, and the destination's cells that
+ * receive one copy each (fill: a grid, derive: the destination box). */
+typedef struct {
+    ag_box source_box;
+    int turns;
+    unsigned counts[3];
+    double step[3];
+    ag_box cell0;
+    size_t ncomponents; /* source components, each placed once per cell */
+    size_t copies;      /* cells */
+} ag_place_paste_plan;
+
+/* Checks the paste op (nodes of both models, placement, fit) and makes its plan; smark
+ * (op->source's, or in's, tree->ncomponents entries, zeroed) gets the source components. A fill
+ * past the op's budget or the paste's own ceiling is refused with AG_ERR_RESULT_TOO_LARGE. */
+ag_status ag_place_paste_plan_make(const ag_proceduralize_result *in, const ag_edit_op *op,
+                                   uint8_t *smark, ag_place_paste_plan *p, ag_error *err);
+/* The cell (x, y, z) of the plan's grid. */
+ag_box ag_place_paste_cell(const ag_place_paste_plan *p, unsigned x, unsigned y, unsigned z);
+/* The report message of a paste. */
+void ag_place_paste_message(ag_edit_report *rep, const ag_place_paste_plan *p,
+                            const ag_edit_op *op);
 
 #endif

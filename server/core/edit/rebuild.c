@@ -18,7 +18,7 @@ static ag_status nomem(ag_error *err)
 /* ---- the mesh ---------------------------------------------------------------------------- */
 
 /* The visible nodes of t in component order: the input's components whose node stays, in
- * their order, then the nodes added (copies), in index order. */
+ * their order, then the nodes that place another's component (copies), in index order. */
 static int32_t *component_order(const ag_proceduralize_result *in, const ag_splittree *t,
                                 const int32_t *source, size_t *n)
 {
@@ -33,8 +33,9 @@ static int32_t *component_order(const ag_proceduralize_result *in, const ag_spli
             source[v] == v)
             order[k++] = v;
     }
-    for (size_t v = ot->nnodes; v < t->nnodes; v++)
-        if (t->nodes[v].kind == AG_NODE_COMPONENT)
+    /* then the nodes that place another node's component (a join's node keeps its index) */
+    for (size_t v = 0; v < t->nnodes; v++)
+        if (t->nodes[v].kind == AG_NODE_COMPONENT && (v >= ot->nnodes || source[v] != (int32_t)v))
             order[k++] = (int32_t)v;
     *n = k;
     return order;

@@ -31,6 +31,7 @@
 #include "../base/array.h"
 #include "../base/tolerance.h"
 #include "resize_internal.h"
+#include "treeedit.h"
 
 /* Work limits: a pattern count doubles at most up to this; the count search stops after this
  * many halvings or doublings; the layout recurses at most this deep; a huge stretch splits
@@ -894,40 +895,6 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
 
 /* ---- the whole layout -------------------------------------------------------------------- */
 
-/* Boxes of the invisible nodes from what they hold: a pattern (and the root) spans its
- * children's chain ends; an intermediate split node spans its child. Post-order. */
-static ag_status span_invisible(ag_splittree *t)
-{
-    size_t nn = t->nnodes;
-    int32_t *stack = malloc((nn + 1) * sizeof *stack), *order = malloc((nn + 1) * sizeof *order);
-    if (!stack || !order) {
-        free(stack);
-        free(order);
-        return AG_ERR_NOMEM;
-    }
-    size_t sp = 0, no = 0;
-    stack[sp++] = 0;
-    while (sp && no < nn) {
-        int32_t v = stack[--sp];
-        order[no++] = v;
-        for (int32_t c = t->nodes[v].first_child; c >= 0; c = t->nodes[c].next_sibling)
-            stack[sp++] = c;
-    }
-    for (size_t i = no; i-- > 0;) {
-        ag_tnode *x = &t->nodes[order[i]];
-        if (x->kind == AG_NODE_COMPONENT || x->first_child < 0)
-            continue;
-        ag_box u = ag_box_empty();
-        for (int32_t c = x->first_child; c >= 0; c = t->nodes[c].next_sibling)
-            ag_box_extend_box(&u, &t->nodes[c].box);
-        if (!ag_box_is_empty(&u))
-            x->box = u;
-    }
-    free(stack);
-    free(order);
-    return AG_OK;
-}
-
 ag_status ag__resize_layout(const ag_edit_resize_solver *s, const ag_box *unit_boxes,
                             const ag_box *frame_box, int structural, ag_box *boxes,
                             ag_splittree **out, int32_t **source, ag_edit_report *rep,
@@ -954,7 +921,7 @@ ag_status ag__resize_layout(const ag_edit_resize_solver *s, const ag_box *unit_b
         L.nt->nodes[0].box = *frame_box;
     layout_units(&L, s->level, s->nunits, unit_boxes, 0);
     free(L.walk);
-    if (!L.st && span_invisible(L.nt))
+    if (!L.st && ag_treeedit_span_invisible(L.nt))
         fail_nomem(&L);
     if (L.st) {
         ag_splittree_free(L.nt);

@@ -1,0 +1,748 @@
+/* The edited trees of split, join, paste and remove (treeedit.h). */
+#include "treeedit.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../base/array.h"
+#include "../base/tolerance.h"
+#include "place.h"
+
+/* The tree being edited: a copy of the input's, with a source per node. */
+typedef struct {
+    const ag_splittree *ot; /* the input tree (what copies are made from) */
+    ag_splittree *t;
+    int32_t *src;
+    size_t cap_src;
+    ag_status st;
+} edited;
+
+static ag_status nomem(ag_error *err)
+{
+    return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while editing the split tree");
+}
+
+static ag_status edited_begin(edited *E, const ag_splittree *ot)
+{
+    memset(E, 0, sizeof *E);
+    E->ot = ot;
+    E->t = ag_splittree_copy(ot);
+    if (!E->t || AG_ARRAY_RESERVE(E->src, E->cap_src, ot->nnodes + 1)) {
+        ag_splittree_free(E->t);
+        free(E->src);
+        return AG_ERR_NOMEM;
+    }
+    for (size_t n = 0; n < ot->nnodes; n++)
+        E->src[n] = (int32_t)n;
+    return AG_OK;
+}
+
+static void edited_drop(edited *E)
+{
+    ag_splittree_free(E->t);
+    free(E->src);
+    E->t = NULL;
+    E->src = NULL;
+}
+
+/* The box b scaled per axis by s about nothing (x -> s x + d): a map without turns. */
+typedef struct {
+    double s[3], d[3];
+} axis_map;
+
+static axis_map axis_map_of(const ag_box *from, const ag_box *to)
+{
+    ag_place_map m;
+    ag_place_boxes(&m, from, to, 0);
+    axis_map a;
+    for (int i = 0; i < 3; i++) {
+        a.s[i] = m.M[i][i];
+        a.d[i] = m.t[i];
+    }
+    return a;
+}
+
+static ag_box map_box(const axis_map *m, const ag_box *b)
+{
+    ag_box o;
+    for (int a = 0; a < 3; a++) {
+        double x = m->s[a] * b->min[a] + m->d[a], y = m->s[a] * b->max[a] + m->d[a];
+        o.min[a] = fmin(x, y);
+        o.max[a] = fmax(x, y);
+    }
+    return o;
+}
+
+static void map_pattern(const axis_map *m, ag_pattern *p)
+{
+    for (int a = 0; a < 3; a++) {
+        p->step[a] *= m->s[a];
+        for (int k = 0; k < 3; k++)
+            p->vec[k][a] *= m->s[a];
+    }
+}
+
+/* Every box (and pattern lattice) of x's subtree in E's tree mapped by m. */
+static void map_subtree(edited *E, int32_t x, const axis_map *m)
+{
+    ag_splittree *t = E->t;
+    int32_t *stack = malloc((t->nnodes + 1) * sizeof *stack);
+    if (!stack) {
+        E->st = AG_ERR_NOMEM;
+        return;
+    }
+    size_t sp = 0;
+    stack[sp++] = x;
+    while (sp) {
+        int32_t v = stack[--sp];
+        ag_tnode *n = &t->nodes[v];
+        n->box = map_box(m, &n->box);
+        if (n->kind == AG_NODE_PATTERN && n->pattern >= 0 && (size_t)n->pattern < t->npatterns)
+            map_pattern(m, &t->patterns[n->pattern]);
+        for (int32_t c = n->first_child; c >= 0; c = t->nodes[c].next_sibling)
+            stack[sp++] = c;
+    }
+    free(stack);
+}
+
+/* A new node copying node y of the input tree (its box mapped by m), linked to nothing. */
+static int32_t copy_node(edited *E, int32_t y, const axis_map *m)
+{
+    if (E->st)
+        return -1;
+    ag_splittree *t = E->t;
+    int32_t c = ag_splittree_add_node(t, AG_NODE_DEAD);
+    if (c < 0 || AG_ARRAY_RESERVE(E->src, E->cap_src, (size_t)c + 1)) {
+        E->st = AG_ERR_NOMEM;
+        return -1;
+    }
+    ag_tnode *n = &t->nodes[c];
+    *n = E->ot->nodes[y];
+    n->parent = n->first_child = n->last_child = n->next_sibling = -1;
+    n->box = map_box(m, &n->box);
+    E->src[c] = y;
+    if (n->kind == AG_NODE_PATTERN && n->pattern >= 0 && (size_t)n->pattern < E->ot->npatterns) {
+        if (AG_ARRAY_RESERVE(t->patterns, t->cap_patterns, t->npatterns + 1)) {
+            E->st = AG_ERR_NOMEM;
+            return -1;
+        }
+        ag_pattern p = E->ot->patterns[n->pattern];
+        map_pattern(m, &p);
+        p.node = c;
+        t->patterns[t->npatterns] = p;
+        t->nodes[c].pattern = (int32_t)t->npatterns++;
+    }
+    return c;
+}
+
+/* A copy of the input's subtree of y, boxes mapped by m, hung in parent's list after `after`
+ * (-1: at the end). Returns the copy of y. */
+static int32_t copy_subtree(edited *E, int32_t y, const axis_map *m, int32_t parent, int32_t after)
+{
+    const ag_splittree *ot = E->ot;
+    int32_t top = copy_node(E, y, m);
+    if (top < 0)
+        return -1;
+    ag_splittree_attach_after(E->t, parent, after, top);
+    /* (input node, its copy) pairs whose children are still to copy */
+    int32_t *stack = malloc(2 * (ot->nnodes + 1) * sizeof *stack);
+    if (!stack) {
+        E->st = AG_ERR_NOMEM;
+        return -1;
+    }
+    size_t sp = 0;
+    stack[sp++] = y;
+    stack[sp++] = top;
+    while (sp && !E->st) {
+        int32_t into = stack[--sp], from = stack[--sp];
+        for (int32_t k = ot->nodes[from].first_child; k >= 0 && !E->st;
+             k = ot->nodes[k].next_sibling) {
+            int32_t c = copy_node(E, k, m);
+            if (c < 0)
+                break;
+            ag_splittree_attach(E->t, into, c);
+            stack[sp++] = k;
+            stack[sp++] = c;
+        }
+    }
+    free(stack);
+    return E->st ? -1 : top;
+}
+
+/* x and its subtree are dead, with the intermediate split node x hangs by. */
+static void kill_subtree(edited *E, int32_t x)
+{
+    ag_splittree *t = E->t;
+    int32_t p = t->nodes[x].parent;
+    if (p >= 0 && t->nodes[p].kind == AG_NODE_SPLIT)
+        x = p;
+    ag_splittree_detach(t, x);
+    int32_t *stack = malloc((t->nnodes + 1) * sizeof *stack);
+    if (!stack) {
+        E->st = AG_ERR_NOMEM;
+        return;
+    }
+    size_t sp = 0;
+    stack[sp++] = x;
+    while (sp) {
+        int32_t v = stack[--sp];
+        for (int32_t c = t->nodes[v].first_child; c >= 0; c = t->nodes[c].next_sibling)
+            stack[sp++] = c;
+        ag_tnode *n = &t->nodes[v];
+        n->kind = AG_NODE_DEAD;
+        n->parent = n->first_child = n->last_child = n->next_sibling = -1;
+    }
+    free(stack);
+}
+
+/* Takes x (a chain end) out of the split chain it hangs by: the chain's intermediate node is
+ * dead. */
+static void unhang(edited *E, int32_t x)
+{
+    ag_splittree *t = E->t;
+    int32_t p = t->nodes[x].parent;
+    ag_splittree_detach(t, x);
+    if (p >= 0 && t->nodes[p].kind == AG_NODE_SPLIT) {
+        ag_splittree_detach(t, p);
+        ag_tnode *n = &t->nodes[p];
+        n->kind = AG_NODE_DEAD;
+        n->parent = n->first_child = n->last_child = n->next_sibling = -1;
+    }
+}
+
+/* The node whose child list holds x's split chain, and the chain's head in it (*slot). */
+static int32_t chain_parent(const ag_splittree *t, int32_t x, int32_t *slot)
+{
+    int32_t p = t->nodes[x].parent;
+    *slot = x;
+    if (p >= 0 && t->nodes[p].kind == AG_NODE_SPLIT) {
+        *slot = p;
+        p = t->nodes[p].parent;
+    }
+    return p;
+}
+
+/* The nearest node at or above x that holds components as children (visible, or the root). */
+static int32_t holder_at_or_above(const ag_splittree *t, int32_t x)
+{
+    while (x > 0 && t->nodes[x].kind != AG_NODE_COMPONENT && t->nodes[x].kind != AG_NODE_ROOT)
+        x = t->nodes[x].parent;
+    return x < 0 ? 0 : x;
+}
+
+ag_status ag_treeedit_span_invisible(ag_splittree *t)
+{
+    size_t nn = t->nnodes;
+    int32_t *stack = malloc((nn + 1) * sizeof *stack), *order = malloc((nn + 1) * sizeof *order);
+    if (!stack || !order) {
+        free(stack);
+        free(order);
+        return AG_ERR_NOMEM;
+    }
+    size_t sp = 0, no = 0;
+    stack[sp++] = 0;
+    while (sp && no < nn) {
+        int32_t v = stack[--sp];
+        order[no++] = v;
+        for (int32_t c = t->nodes[v].first_child; c >= 0; c = t->nodes[c].next_sibling)
+            stack[sp++] = c;
+    }
+    for (size_t i = no; i-- > 0;) {
+        ag_tnode *x = &t->nodes[order[i]];
+        if (x->kind == AG_NODE_COMPONENT || x->first_child < 0)
+            continue;
+        ag_box u = ag_box_empty();
+        for (int32_t c = x->first_child; c >= 0; c = t->nodes[c].next_sibling)
+            ag_box_extend_box(&u, &t->nodes[c].box);
+        if (!ag_box_is_empty(&u))
+            x->box = u;
+    }
+    free(stack);
+    free(order);
+    return AG_OK;
+}
+
+static ag_status edited_finish(edited *E, ag_splittree **tree, int32_t **source, ag_error *err)
+{
+    if (!E->st && ag_treeedit_span_invisible(E->t))
+        E->st = AG_ERR_NOMEM;
+    if (E->st) {
+        edited_drop(E);
+        return nomem(err);
+    }
+    *tree = E->t;
+    *source = E->src;
+    return AG_OK;
+}
+
+void ag_treeedit_base_free(ag_treeedit_base *b)
+{
+    if (!b)
+        return;
+    if (b->owns) {
+        free(b->labels.label);
+        free(b->labels.rot);
+        free(b->labels.variant);
+        free(b->labels.vrot);
+        free(b->labels.mirror);
+        free(b->labels.turn);
+        free(b->labels.tri_start);
+        free(b->labels.tris);
+        free(b->labels.variant_label);
+        free(b->labels.variant_deviation);
+        free(b->tree.nodes);
+    }
+    memset(b, 0, sizeof *b);
+}
+
+static void base_of(ag_treeedit_base *b, const ag_proceduralize_result *in)
+{
+    memset(b, 0, sizeof *b);
+    b->view = *in;
+}
+
+/* ---- split -------------------------------------------------------------------------------- */
+
+ag_status ag_treeedit_split(const ag_proceduralize_result *in, const ag_edit_op *op,
+                            ag_treeedit_base *base, ag_splittree **tree, int32_t **source,
+                            ag_edit_report *rep, ag_error *err)
+{
+    *tree = NULL;
+    *source = NULL;
+    base_of(base, in);
+    ag_status st = ag_place_check_node(in, op->node, "split node", err);
+    if (st)
+        return st;
+    if (op->axis < 0 || op->axis > 2)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "split axis must be 0, 1 or 2 (x, y or z), not %d", op->axis);
+    const ag_splittree *ot = in->tree;
+    const ag_box B = ot->nodes[op->node].box;
+    int a = op->axis;
+    double eps = ot->eps > 0 ? AG_EDIT_SPLIT_MARGIN * ot->eps : AG_EDIT_COINCIDENT;
+    if (!isfinite(op->at) || op->at <= B.min[a] + eps || op->at >= B.max[a] - eps)
+        return ag_error_set(err, AG_ERR_INVALID, op->node,
+                            "split plane %c = %g is not inside node %d's box (%g .. %g)",
+                            "xyz"[a], op->at, (int)op->node, B.min[a], B.max[a]);
+    uint8_t *mark = calloc(ot->ncomponents + 1, 1);
+    if (!mark)
+        return nomem(err);
+    size_t n = ag_place_mark_subtree(ot, op->node, mark);
+    free(mark);
+    if (n == 0)
+        return ag_error_set(err, AG_ERR_INVALID, op->node, "node %d has no geometry to split",
+                            (int)op->node);
+    ag_box half[2] = {B, B};
+    half[0].max[a] = op->at;
+    half[1].min[a] = op->at;
+    axis_map lo = axis_map_of(&B, &half[0]), hi = axis_map_of(&B, &half[1]);
+    edited E;
+    if (edited_begin(&E, ot))
+        return nomem(err);
+    if (op->node == AG_EDIT_ROOT) {
+        /* the root stays one: each of its subtrees is halved */
+        for (int32_t c = ot->nodes[0].first_child; c >= 0 && !E.st;
+             c = ot->nodes[c].next_sibling) {
+            copy_subtree(&E, c, &hi, 0, -1);
+            if (!E.st)
+                map_subtree(&E, c, &lo);
+        }
+    } else {
+        int32_t slot, p = chain_parent(E.t, op->node, &slot);
+        copy_subtree(&E, op->node, &hi, p, slot);
+        if (!E.st)
+            map_subtree(&E, op->node, &lo);
+    }
+    if ((st = edited_finish(&E, tree, source, err)))
+        return st;
+    if (rep) {
+        rep->splits++;
+        snprintf(rep->message, sizeof rep->message,
+                 "split node %d at %c = %g: %zu components duplicated into both halves (node %d "
+                 "keeps the lower half)",
+                 (int)op->node, "xyz"[a], op->at, n, (int)op->node);
+    }
+    return AG_OK;
+}
+
+/* ---- remove ------------------------------------------------------------------------------- */
+
+/* Triangles the visible nodes of t place (their sources' components in base). */
+static size_t placed_triangles(const ag_proceduralize_result *base, const ag_splittree *t,
+                               const int32_t *source)
+{
+    const ag_labels *L = base->labels;
+    size_t n = 0;
+    for (size_t v = 0; v < t->nnodes; v++) {
+        if (t->nodes[v].kind != AG_NODE_COMPONENT)
+            continue;
+        int32_t c = base->tree->nodes[source[v]].component;
+        if (c >= 0 && (size_t)c < L->ncomponents)
+            n += L->tri_start[c + 1] - L->tri_start[c];
+    }
+    return n;
+}
+
+ag_status ag_treeedit_remove(const ag_proceduralize_result *in, const ag_edit_op *op,
+                             ag_treeedit_base *base, ag_splittree **tree, int32_t **source,
+                             ag_edit_report *rep, ag_error *err)
+{
+    *tree = NULL;
+    *source = NULL;
+    base_of(base, in);
+    if (op->nnodes == 0 || !op->nodes)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "remove needs at least one node (nodes is empty)");
+    char what[48];
+    for (size_t i = 0; i < op->nnodes; i++) {
+        snprintf(what, sizeof what, "remove nodes[%zu]", i);
+        ag_status st = ag_place_check_node(in, op->nodes[i], what, err);
+        if (st)
+            return st;
+        if (op->nodes[i] == AG_EDIT_ROOT)
+            return ag_error_set(err, AG_ERR_INVALID, 0,
+                                "remove nodes[%zu]: the root cannot be removed", i);
+    }
+    const ag_splittree *ot = in->tree;
+    uint8_t *mark = calloc(ot->ncomponents + 1, 1);
+    if (!mark)
+        return nomem(err);
+    size_t n = 0;
+    for (size_t i = 0; i < op->nnodes; i++)
+        n += ag_place_mark_subtree(ot, op->nodes[i], mark);
+    free(mark);
+    edited E;
+    if (edited_begin(&E, ot))
+        return nomem(err);
+    /* a node below another selected one is already gone with it */
+    for (size_t i = 0; i < op->nnodes && !E.st; i++)
+        if (E.t->nodes[op->nodes[i]].kind != AG_NODE_DEAD)
+            kill_subtree(&E, op->nodes[i]);
+    if (!E.st && placed_triangles(in, E.t, E.src) == 0) {
+        edited_drop(&E);
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "removing the selection would leave no geometry");
+    }
+    ag_status st = edited_finish(&E, tree, source, err);
+    if (!st && rep)
+        snprintf(rep->message, sizeof rep->message, "removed %zu components", n);
+    return st;
+}
+
+/* ---- paste -------------------------------------------------------------------------------- */
+
+/* Is a an ancestor of b (a != b)? */
+static int above(const ag_splittree *t, int32_t a, int32_t b)
+{
+    for (int32_t x = t->nodes[b].parent; x >= 0; x = t->nodes[x].parent)
+        if (x == a)
+            return 1;
+    return 0;
+}
+
+ag_status ag_treeedit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
+                            ag_treeedit_base *base, ag_splittree **tree, int32_t **source,
+                            ag_edit_report *rep, ag_error *err)
+{
+    *tree = NULL;
+    *source = NULL;
+    base_of(base, in);
+    const ag_splittree *ot = in->tree;
+    if (op->source && op->source != in)
+        return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
+                            "a paste from another model places terminals this model has no "
+                            "label for");
+    uint8_t *smark = calloc(ot->ncomponents + 1, 1);
+    if (!smark)
+        return nomem(err);
+    ag_place_paste_plan pl;
+    ag_status st = ag_place_paste_plan_make(in, op, smark, &pl, err);
+    free(smark);
+    if (st)
+        return st;
+    if (pl.turns)
+        return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
+                            "a turned paste places terminals turned from their boxes");
+    edited E;
+    if (edited_begin(&E, ot))
+        return nomem(err);
+    int32_t d = op->node, holder;
+    if (op->placement == AG_EDIT_REPLACE && d != AG_EDIT_ROOT) {
+        holder = holder_at_or_above(E.t, E.t->nodes[d].parent);
+        kill_subtree(&E, d);
+    } else if (op->placement == AG_EDIT_REPLACE) {
+        holder = 0;
+        while (E.t->nodes[0].first_child >= 0 && !E.st)
+            kill_subtree(&E, E.t->nodes[0].first_child);
+    } else {
+        holder = ag_splittree_chain_end(E.t, d);
+        holder = holder_at_or_above(E.t, holder >= 0 ? holder : d);
+    }
+    for (size_t z = 0; z < pl.counts[2] && !E.st; z++)
+        for (size_t y = 0; y < pl.counts[1] && !E.st; y++)
+            for (size_t x = 0; x < pl.counts[0] && !E.st; x++) {
+                ag_box cell = ag_place_paste_cell(&pl, (unsigned)x, (unsigned)y, (unsigned)z);
+                axis_map m = axis_map_of(&pl.source_box, &cell);
+                for (size_t i = 0; i < op->nnodes && !E.st; i++) {
+                    int32_t s = op->nodes[i], dup = 0;
+                    for (size_t j = 0; j < op->nnodes && !dup; j++)
+                        dup = j != i && (op->nodes[j] == s ? j < i : above(ot, op->nodes[j], s));
+                    if (dup)
+                        continue;
+                    if (s == AG_EDIT_ROOT) /* the whole model: what the root holds */
+                        for (int32_t c = ot->nodes[0].first_child; c >= 0 && !E.st;
+                             c = ot->nodes[c].next_sibling)
+                            copy_subtree(&E, c, &m, holder, -1);
+                    else
+                        copy_subtree(&E, s, &m, holder, -1);
+                }
+            }
+    if ((st = edited_finish(&E, tree, source, err)))
+        return st;
+    if (rep)
+        ag_place_paste_message(rep, &pl, op);
+    return AG_OK;
+}
+
+/* ---- join --------------------------------------------------------------------------------- */
+
+/* Adds the visible nodes at or directly below v (through invisible nodes only) to list. */
+static void top_visible(const ag_splittree *t, int32_t v, uint8_t *seen, int32_t *list,
+                        size_t *n)
+{
+    const ag_tnode *x = &t->nodes[v];
+    if (x->kind == AG_NODE_COMPONENT) {
+        if (x->component >= 0 && !seen[v]) {
+            seen[v] = 1;
+            list[(*n)++] = v;
+        }
+        return;
+    }
+    for (int32_t s = x->first_child; s >= 0; s = t->nodes[s].next_sibling)
+        top_visible(t, s, seen, list, n);
+}
+
+static int cmp_i32(const void *a, const void *b)
+{
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The view of in with one more component (the members' triangles together, a label and a
+ * variant of its own) held by one more node (box u): returns that node's index. */
+static int32_t base_join(ag_treeedit_base *b, const ag_proceduralize_result *in,
+                         const int32_t *members, size_t nm, const ag_box *u)
+{
+    const ag_labels *OL = in->labels;
+    const ag_splittree *ot = in->tree;
+    size_t nc = OL->ncomponents, nl = OL->nlabels, nv = OL->nvariants;
+    size_t ntris = OL->tri_start[nc], extra = 0;
+    for (size_t i = 0; i < nm; i++) {
+        int32_t c = ot->nodes[members[i]].component;
+        extra += OL->tri_start[c + 1] - OL->tri_start[c];
+    }
+    ag_labels *L = &b->labels;
+    *L = *OL;
+    b->tree = *ot;
+    b->owns = 1;
+    L->label = malloc((nc + 1) * sizeof *L->label);
+    L->variant = malloc((nc + 1) * sizeof *L->variant);
+    L->rot = malloc(nc + 1);
+    L->vrot = malloc(nc + 1);
+    L->mirror = calloc(nc + 1, 1);
+    L->turn = calloc(nc + 1, sizeof *L->turn);
+    L->tri_start = malloc((nc + 2) * sizeof *L->tri_start);
+    L->tris = malloc((ntris + extra + 1) * sizeof *L->tris);
+    L->variant_label = malloc((nv + 1) * sizeof *L->variant_label);
+    L->variant_deviation = calloc(nv + 1, sizeof *L->variant_deviation);
+    b->tree.nodes = malloc((ot->nnodes + 1) * sizeof *b->tree.nodes);
+    if (!L->label || !L->variant || !L->rot || !L->vrot || !L->mirror || !L->turn ||
+        !L->tri_start || !L->tris || !L->variant_label || !L->variant_deviation ||
+        !b->tree.nodes)
+        return -1;
+    memcpy(L->label, OL->label, nc * sizeof *L->label);
+    memcpy(L->variant, OL->variant, nc * sizeof *L->variant);
+    memcpy(L->rot, OL->rot, nc);
+    memcpy(L->vrot, OL->vrot, nc);
+    if (OL->mirror)
+        memcpy(L->mirror, OL->mirror, nc);
+    if (OL->turn)
+        memcpy(L->turn, OL->turn, nc * sizeof *L->turn);
+    memcpy(L->tri_start, OL->tri_start, (nc + 1) * sizeof *L->tri_start);
+    memcpy(L->tris, OL->tris, ntris * sizeof *L->tris);
+    memcpy(L->variant_label, OL->variant_label, nv * sizeof *L->variant_label);
+    if (OL->variant_deviation)
+        memcpy(L->variant_deviation, OL->variant_deviation, nv * sizeof *L->variant_deviation);
+    size_t k = ntris;
+    for (size_t i = 0; i < nm; i++) {
+        int32_t c = ot->nodes[members[i]].component;
+        for (uint32_t s = OL->tri_start[c]; s < OL->tri_start[c + 1]; s++)
+            L->tris[k++] = OL->tris[s];
+    }
+    L->tri_start[nc + 1] = (uint32_t)k;
+    L->label[nc] = (int32_t)nl;
+    L->variant[nc] = (int32_t)nv;
+    L->rot[nc] = L->vrot[nc] = 0;
+    L->variant_label[nv] = (int32_t)nl;
+    L->ncomponents = nc + 1;
+    L->nlabels = nl + 1;
+    L->nvariants = nv + 1;
+    memcpy(b->tree.nodes, ot->nodes, ot->nnodes * sizeof *b->tree.nodes);
+    int32_t j = (int32_t)ot->nnodes;
+    ag_tnode *x = &b->tree.nodes[j];
+    memset(x, 0, sizeof *x);
+    x->box = *u;
+    x->parent = x->first_child = x->last_child = x->next_sibling = -1;
+    x->component = (int32_t)nc;
+    x->label = (int32_t)nl;
+    x->variant = (int32_t)nv;
+    x->kind = AG_NODE_COMPONENT;
+    x->rule = x->pattern = -1;
+    b->tree.nnodes = ot->nnodes + 1;
+    b->tree.cap = b->tree.nnodes;
+    b->view.labels = L;
+    b->view.tree = &b->tree;
+    return j;
+}
+
+ag_status ag_treeedit_join(const ag_proceduralize_result *in, const ag_edit_op *op,
+                           ag_treeedit_base *base, ag_splittree **tree, int32_t **source,
+                           ag_edit_report *rep, ag_error *err)
+{
+    *tree = NULL;
+    *source = NULL;
+    base_of(base, in);
+    if (op->nnodes == 0 || !op->nodes)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "join needs a selection of at least two nodes (nodes is empty)");
+    char what[48];
+    for (size_t i = 0; i < op->nnodes; i++) {
+        snprintf(what, sizeof what, "join nodes[%zu]", i);
+        ag_status st = ag_place_check_node(in, op->nodes[i], what, err);
+        if (st)
+            return st;
+        if (op->nodes[i] == AG_EDIT_ROOT)
+            return ag_error_set(err, AG_ERR_INVALID, 0,
+                                "join nodes[%zu]: the root cannot be joined", i);
+    }
+    const ag_splittree *ot = in->tree;
+    uint8_t *seen = calloc(ot->nnodes + 1, 1);
+    int32_t *members = malloc((ot->nnodes + 1) * sizeof *members);
+    if (!seen || !members) {
+        free(seen);
+        free(members);
+        return nomem(err);
+    }
+    size_t nm = 0;
+    for (size_t i = 0; i < op->nnodes; i++)
+        top_visible(ot, op->nodes[i], seen, members, &nm);
+    if (nm < 2) {
+        free(seen);
+        free(members);
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "join needs at least two distinct visible nodes; the selection of "
+                            "%zu node(s) names %zu",
+                            op->nnodes, nm);
+    }
+    /* the joined geometry in component order, as the mesh of a join holds it */
+    /* the kept node is the one nearest the root (then the smallest id), so no other member
+     * lies above it */
+    qsort(members, nm, sizeof *members, cmp_i32);
+    size_t best = 0, best_depth = SIZE_MAX;
+    for (size_t i = 0; i < nm; i++) {
+        size_t depth = 0;
+        for (int32_t x = ot->nodes[members[i]].parent; x >= 0; x = ot->nodes[x].parent)
+            depth++;
+        if (depth < best_depth) {
+            best_depth = depth;
+            best = i;
+        }
+    }
+    int32_t keep = members[best];
+    members[best] = members[0];
+    members[0] = keep;
+    ag_box u = ag_box_empty();
+    for (size_t i = 0; i < nm; i++)
+        ag_box_extend_box(&u, &ot->nodes[members[i]].box);
+    int32_t *bycomp = malloc((nm + 1) * sizeof *bycomp);
+    if (!bycomp) {
+        free(seen);
+        free(members);
+        return nomem(err);
+    }
+    for (size_t i = 0; i < nm; i++)
+        bycomp[i] = ot->nodes[members[i]].component;
+    qsort(bycomp, nm, sizeof *bycomp, cmp_i32);
+    for (size_t i = 0; i < nm; i++)
+        bycomp[i] = ot->comp_node[bycomp[i]];
+    int32_t joined = base_join(base, in, bycomp, nm, &u);
+    free(bycomp);
+    edited E;
+    if (joined < 0 || edited_begin(&E, ot)) {
+        free(seen);
+        free(members);
+        ag_treeedit_base_free(base);
+        base_of(base, in);
+        return nomem(err);
+    }
+    /* where it hangs: the nearest ancestor of the kept node that is no member, holds
+     * components and holds the union */
+    double eps = ot->eps > 0 ? ot->eps : AG_EDIT_COINCIDENT;
+    int32_t P = E.t->nodes[keep].parent;
+    for (; P > 0; P = E.t->nodes[P].parent) {
+        const ag_tnode *x = &E.t->nodes[P];
+        if (x->kind != AG_NODE_COMPONENT || seen[P])
+            continue;
+        int holds = 1;
+        for (int a = 0; a < 3 && holds; a++)
+            holds = x->box.min[a] <= u.min[a] + eps && x->box.max[a] >= u.max[a] - eps;
+        if (holds)
+            break;
+    }
+    if (P < 0)
+        P = 0;
+    /* the kept node leaves its chain; the other members' children hang under it; the
+     * members go */
+    unhang(&E, keep);
+    for (size_t i = 1; i < nm && !E.st; i++) {
+        int32_t c = E.t->nodes[members[i]].first_child;
+        while (c >= 0) {
+            int32_t next = E.t->nodes[c].next_sibling;
+            int32_t end = ag_splittree_chain_end(E.t, c);
+            if (end >= 0) {
+                unhang(&E, end);
+                ag_splittree_attach(E.t, keep, end);
+            }
+            c = next;
+        }
+    }
+    for (size_t i = 1; i < nm && !E.st; i++)
+        kill_subtree(&E, members[i]);
+    ag_splittree_attach(E.t, P, keep);
+    ag_tnode *k = &E.t->nodes[keep];
+    k->box = u;
+    k->label = base->labels.label[ot->ncomponents];
+    k->variant = base->labels.variant[ot->ncomponents];
+    k->rot = 0;
+    k->rule = -1;
+    k->rule_rot = 0;
+    E.src[keep] = joined;
+    free(seen);
+    free(members);
+    /* the sources index the view, whose first nodes are the input's */
+    ag_status st = edited_finish(&E, tree, source, err);
+    if (st) {
+        ag_treeedit_base_free(base);
+        base_of(base, in);
+        return st;
+    }
+    if (rep) {
+        rep->joins++;
+        snprintf(rep->message, sizeof rep->message,
+                 "joined %zu nodes into node %d (label L%zu)", nm, (int)keep,
+                 base->labels.nlabels);
+    }
+    return AG_OK;
+}
