@@ -227,6 +227,49 @@ static ag_status labels_complete(ag_labels *L, const ag_mesh *m, const ag_splitt
     return AG_OK;
 }
 
+/* An edit that removes a label's or a variant's exemplar makes another component its first,
+ * and the terminal is then taken from that one: the turns of the others (and of their nodes)
+ * count from it. */
+static void rebase_turns(ag_labels *L, ag_splittree *t)
+{
+    for (size_t c = 0; c < L->ncomponents; c++) {
+        int32_t v = L->variant[c], l = L->label[c];
+        int32_t n = c < t->ncomponents ? t->comp_node[c] : -1;
+        if (v >= 0 && (size_t)v < L->nvariants) {
+            uint32_t e = L->variant_exemplar[v];
+            if (e != c && L->vrot[e]) {
+                L->vrot[c] = (uint8_t)((L->vrot[c] - L->vrot[e]) & 3);
+                if (n >= 0)
+                    t->nodes[n].rot = (uint8_t)((t->nodes[n].rot - L->vrot[e]) & 3);
+            }
+        }
+        if (l >= 0 && (size_t)l < L->nlabels) {
+            uint32_t e = L->exemplar[l];
+            if (e != c && (L->rot[e] || L->turn[e] != 0)) {
+                L->rot[c] = (uint8_t)((L->rot[c] - L->rot[e]) & 3);
+                L->turn[c] -= L->turn[e];
+            }
+        }
+    }
+    /* the exemplars last: the others were counted from their old turns */
+    for (size_t v = 0; v < L->nvariants; v++) {
+        uint32_t e = L->variant_exemplar[v];
+        if (e < L->ncomponents && L->vrot[e]) {
+            int32_t n = e < t->ncomponents ? t->comp_node[e] : -1;
+            if (n >= 0)
+                t->nodes[n].rot = (uint8_t)((t->nodes[n].rot - L->vrot[e]) & 3);
+            L->vrot[e] = 0;
+        }
+    }
+    for (size_t l = 0; l < L->nlabels; l++) {
+        uint32_t e = L->exemplar[l];
+        if (e < L->ncomponents) {
+            L->rot[e] = 0;
+            L->turn[e] = 0;
+        }
+    }
+}
+
 /* ---- the tree ---------------------------------------------------------------------------- */
 
 /* Component map of a tree whose visible nodes carry their component. */
@@ -375,8 +418,16 @@ static ag_status finish(ag_mesh *mesh, ag_labels *L, ag_splittree *t, int with_r
         st = nomem(err);
         goto fail;
     }
+    if (with_rules)
+        rebase_turns(L, t);
     if (with_rules && (st = rules_and_patterns(t, popt, err)))
         goto fail;
+    /* a dead node names nothing (its old rule, pattern or component may be out of range now) */
+    for (size_t n = 0; with_rules && n < t->nnodes; n++)
+        if (t->nodes[n].kind == AG_NODE_DEAD) {
+            t->nodes[n].rule = t->nodes[n].pattern = t->nodes[n].component = -1;
+            t->nodes[n].label = t->nodes[n].variant = -1;
+        }
     if (with_rules && (st = tree_components(t, mesh->ncomponents))) {
         st = nomem(err);
         goto fail;

@@ -1,0 +1,634 @@
+/* Split, join, paste and remove keep node ids: on generated box buildings
+ * (edit_building_fixture.h: windows recessed, flush and proud, a turned building with a roof
+ * overhang, UTM coordinates, jitter) each op is applied through ag_edit_apply_ex and checked
+ * against what the test knows independently:
+ *  (a) every visible node of the input the op did not touch has the same id, kind, label and
+ *      box; what it touched is where the op puts it (a split's node on the lower half, its
+ *      copies appended with the upper half's boxes; removed and joined-away nodes dead; the
+ *      joined node with the union box; pasted copies appended, one set per cell);
+ *  (b) the new model's mesh is the operation's own mesh (ag_edit_split etc., what the mesh path
+ *      proceduralizes): the same number of triangles, the same welded vertex set and the same
+ *      areas per group (as a multiset: a join's label is numbered differently), and the mesh its
+ *      grammar derives has the same vertex set and area;
+ *  (c) the grammar prints, re-parses and prints again byte for byte;
+ *  (d) the input model is untouched (undo gives it back as it was) and the edited model reloads
+ *      from what the store keeps node for node.
+ * A turned paste (a front window onto the side facade) still works through the mesh path. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "app/model_kept.h"
+#include "app/model_state.h"
+#include "app/model_tree.h"
+#include "core/edit/edit.h"
+#include "core/proc/proceduralize.h"
+#include "edit_building_fixture.h"
+#include "io/grammar_text.h"
+#include "io/meshblob.h"
+
+/* ---- what the test measures itself -------------------------------------------------------- */
+
+static const char *label_of(const ag_edit_model *em, int32_t n)
+{
+    const ag_tnode *x = &em->proc->tree->nodes[n];
+    const ag_mesh *m = em->proc->mesh;
+    if (x->kind != AG_NODE_COMPONENT || x->component < 0 ||
+        (size_t)x->component >= m->ncomponents || m->component_group[x->component] < 0)
+        return "";
+    return m->group_names[m->component_group[x->component]];
+}
+
+static int same_box(const ag_box *a, const ag_box *b, double tol)
+{
+    for (int k = 0; k < 3; k++)
+        if (fabs(a->min[k] - b->min[k]) > tol || fabs(a->max[k] - b->max[k]) > tol)
+            return 0;
+    return 1;
+}
+
+/* Is n in the subtree of r (parent links of t)? */
+static int in_subtree(const ag_splittree *t, int32_t n, int32_t r)
+{
+    for (int32_t x = n; x >= 0; x = t->nodes[x].parent)
+        if (x == r)
+            return 1;
+    return 0;
+}
+
+static double tri_area(const ag_mesh *m, size_t t)
+{
+    const double *a = &m->pos[3 * m->tri[3 * t]], *b = &m->pos[3 * m->tri[3 * t + 1]],
+                 *c = &m->pos[3 * m->tri[3 * t + 2]];
+    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    double w[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    return 0.5 * sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Areas of the groups that hold triangles, sorted; *n gets their count. */
+static double *group_areas(const ag_mesh *m, size_t *n)
+{
+    double *a = calloc(m->ngroups + 1, sizeof *a);
+    for (size_t t = 0; t < m->ntris; t++) {
+        int32_t g = m->component_group[m->tri_component[t]];
+        if (g >= 0)
+            a[g] += tri_area(m, t);
+    }
+    size_t k = 0;
+    for (size_t g = 0; g < m->ngroups; g++)
+        if (a[g] > 0)
+            a[k++] = a[g];
+    qsort(a, k, sizeof *a, cmp_double);
+    *n = k;
+    return a;
+}
+
+static double total_area(const ag_mesh *m)
+{
+    double s = 0;
+    for (size_t t = 0; t < m->ntris; t++)
+        s += tri_area(m, t);
+    return s;
+}
+
+/* The vertices of the triangles, welded on a grid of cell tol (sorted cell keys, one each). */
+typedef struct {
+    int64_t k[3];
+} cell;
+
+static int cmp_cell(const void *a, const void *b)
+{
+    const cell *x = a, *y = b;
+    for (int i = 0; i < 3; i++)
+        if (x->k[i] != y->k[i])
+            return x->k[i] < y->k[i] ? -1 : 1;
+    return 0;
+}
+
+static cell *welded(const ag_mesh *m, const double *origin, double tol, size_t *n)
+{
+    cell *c = malloc((3 * m->ntris + 1) * sizeof *c);
+    size_t k = 0;
+    for (size_t t = 0; t < 3 * m->ntris; t++) {
+        const double *p = &m->pos[3 * m->tri[t]];
+        for (int i = 0; i < 3; i++)
+            c[k].k[i] = (int64_t)floor((p[i] - origin[i]) / tol + 0.5);
+        k++;
+    }
+    qsort(c, k, sizeof *c, cmp_cell);
+    size_t u = 0;
+    for (size_t i = 0; i < k; i++)
+        if (!u || cmp_cell(&c[i], &c[u - 1]))
+            c[u++] = c[i];
+    *n = u;
+    return c;
+}
+
+/* Every cell of a has a cell of b within one step (rounding puts a point near a cell border
+ * into either neighbour). */
+static size_t unmatched(const cell *a, size_t na, const cell *b, size_t nb)
+{
+    size_t miss = 0;
+    for (size_t i = 0; i < na; i++) {
+        int found = 0;
+        for (int d = 0; d < 27 && !found; d++) {
+            cell q = {{a[i].k[0] + d % 3 - 1, a[i].k[1] + (d / 3) % 3 - 1, a[i].k[2] + d / 9 - 1}};
+            found = bsearch(&q, b, nb, sizeof *b, cmp_cell) != NULL;
+        }
+        miss += !found;
+    }
+    return miss;
+}
+
+/* The same vertex set (both ways) at tolerance tol, and the same total area. */
+static void assert_same_surface(const ag_mesh *a, const ag_mesh *b, double tol, const char *what)
+{
+    double origin[3] = {a->pos[0], a->pos[1], a->pos[2]};
+    size_t na, nb;
+    cell *ca = welded(a, origin, tol, &na), *cb = welded(b, origin, tol, &nb);
+    size_t ab = unmatched(ca, na, cb, nb), ba = unmatched(cb, nb, ca, na);
+    free(ca);
+    free(cb);
+    if (ab || ba)
+        fail_msg("%s: %zu of %zu vertices have no counterpart, %zu of %zu the other way", what, ab,
+                 na, ba, nb);
+    double sa = total_area(a), sb = total_area(b);
+    if (fabs(sa - sb) > 1e-6 * fmax(1, sa))
+        fail_msg("%s: area %.9g vs %.9g", what, sa, sb);
+}
+
+static char *grammar_text(const ag_grammar *g)
+{
+    char *text = NULL;
+    size_t len = 0;
+    ag_error err = {0};
+    if (ag_grammar_text_print(g, &text, &len, &err))
+        fail_msg("print: %s", err.text);
+    return text;
+}
+
+/* The model as the store keeps it (mesh blob and stored tree) and reloaded: its served tree. */
+static char *served_after_store(const ag_edit_model *em)
+{
+    uint8_t *blob = NULL;
+    size_t len = 0;
+    assert_int_equal(ag_meshblob_encode(em->proc->mesh, &blob, &len), AG_OK);
+    char *stored = ag_model_kept_tree_text(em);
+    assert_non_null(stored);
+    ag_mesh *back = NULL;
+    ag_error err = {0};
+    assert_int_equal(ag_meshblob_decode(blob, len, &back, &err), AG_OK);
+    ag_edit_model *re = NULL;
+    if (ag_model_state_reload_kept(back, stored, &re, &err))
+        fail_msg("reload: %s", err.text);
+    char *text = ag_model_tree_served_text(re);
+    ag_edit_model_free(re);
+    ag_mesh_free(back);
+    free(stored);
+    free(blob);
+    return text;
+}
+
+/* ---- the ops ------------------------------------------------------------------------------ */
+
+typedef struct {
+    const char *what;
+    ag_edit_op op;
+    uint8_t *touched;  /* per old node: the op moves or removes it */
+    int removes;       /* touched nodes are dead afterwards (1), stay (0) or either (2) */
+    size_t appended;   /* visible nodes the op appends */
+} case_t;
+
+/* Visible nodes of t in r's subtree. */
+static size_t visible_below(const ag_splittree *t, int32_t r, uint8_t *mark)
+{
+    size_t n = 0;
+    for (size_t v = 0; v < t->nnodes; v++)
+        if (t->nodes[v].kind != AG_NODE_DEAD && in_subtree(t, (int32_t)v, r)) {
+            if (mark)
+                mark[v] = 1;
+            n += t->nodes[v].kind == AG_NODE_COMPONENT;
+        }
+    return n;
+}
+
+/* Runs one case on em and checks (a) to (d). */
+static void check_case(ag_edit_model *em, case_t *c, const bb_options *o)
+{
+    const ag_splittree *t0 = em->proc->tree;
+    double diag = ag_box_diagonal(&t0->nodes[0].box);
+    double btol = 1e-9 * fmax(1, fabs(t0->nodes[0].box.max[0]) + fabs(t0->nodes[0].box.max[1]));
+    char *served_before = ag_model_tree_served_text(em);
+    char what[160];
+    snprintf(what, sizeof what, "%s: %s", o->name, c->what);
+
+    ag_edit_model *out = NULL;
+    ag_edit_report rep = {0};
+    ag_error err = {0};
+    if (ag_edit_apply_ex(em, &c->op, 0, &out, &rep, &err))
+        fail_msg("%s: %s", what, err.text);
+    const ag_splittree *t1 = out->proc->tree;
+    assert_true(t1->nnodes >= t0->nnodes);
+
+    /* (a) ids */
+    for (size_t n = 0; n < t0->nnodes; n++) {
+        const ag_tnode *a = &t0->nodes[n], *b = &t1->nodes[n];
+        if (a->kind != AG_NODE_COMPONENT)
+            continue;
+        if (c->touched[n] && c->removes == 2)
+            continue; /* checked by the case */
+        if (c->touched[n] && c->removes) {
+            if (b->kind != AG_NODE_DEAD)
+                fail_msg("%s: node %zu should be removed", what, n);
+            continue;
+        }
+        if (b->kind != AG_NODE_COMPONENT)
+            fail_msg("%s: visible node %zu lost its id (kind %d now)", what, n, b->kind);
+        if (c->touched[n])
+            continue; /* checked by the case */
+        if (strcmp(label_of(em, (int32_t)n), label_of(out, (int32_t)n)))
+            fail_msg("%s: node %zu changed label %s -> %s", what, n, label_of(em, (int32_t)n),
+                     label_of(out, (int32_t)n));
+        if (!same_box(&a->box, &b->box, btol))
+            fail_msg("%s: node %zu moved", what, n);
+    }
+    size_t appended = 0;
+    for (size_t n = t0->nnodes; n < t1->nnodes; n++)
+        appended += t1->nodes[n].kind == AG_NODE_COMPONENT;
+    if (appended != c->appended)
+        fail_msg("%s: %zu visible nodes appended, expected %zu", what, appended, c->appended);
+
+    /* (b) the operation's own mesh */
+    ag_mesh *oracle = NULL;
+    ag_status s = AG_OK;
+    switch (c->op.kind) {
+    case AG_EDIT_SPLIT:
+        s = ag_edit_split(em->proc, &c->op, &oracle, NULL, &err);
+        break;
+    case AG_EDIT_JOIN:
+        s = ag_edit_join(em->proc, &c->op, &oracle, NULL, &err);
+        break;
+    case AG_EDIT_PASTE:
+        s = ag_edit_paste(em->proc, &c->op, &oracle, NULL, &err);
+        break;
+    case AG_EDIT_REMOVE:
+        s = ag_edit_remove(em->proc, &c->op, &oracle, NULL, &err);
+        break;
+    }
+    if (s)
+        fail_msg("%s: the mesh path: %s", what, err.text);
+    const ag_mesh *mine = out->proc->mesh;
+    if (mine->ntris != oracle->ntris)
+        fail_msg("%s: %zu triangles, the mesh path %zu", what, mine->ntris, oracle->ntris);
+    char part[200];
+    snprintf(part, sizeof part, "%s (the new mesh)", what);
+    assert_same_surface(mine, oracle, 1e-6 * fmax(1, diag), part);
+    size_t ga, gb;
+    double *aa = group_areas(mine, &ga), *ab = group_areas(oracle, &gb);
+    if (ga != gb)
+        fail_msg("%s: %zu groups with triangles, the mesh path %zu", what, ga, gb);
+    for (size_t i = 0; i < ga; i++)
+        if (fabs(aa[i] - ab[i]) > 1e-6 * fmax(1, ab[i]))
+            fail_msg("%s: group areas differ (%.9g vs %.9g)", what, aa[i], ab[i]);
+    free(aa);
+    free(ab);
+    ag_mesh *derived = NULL;
+    if (ag_grammar_derive(out->proc->grammar, NULL, &derived, &err))
+        fail_msg("%s: derive: %s", what, err.text);
+    snprintf(part, sizeof part, "%s (the derived mesh)", what);
+    assert_same_surface(derived, oracle, 1e-4 * fmax(1, diag), part);
+    ag_mesh_free(derived);
+    ag_mesh_free(oracle);
+
+    /* (c) the grammar prints, re-parses and prints the same */
+    char *text = grammar_text(out->proc->grammar);
+    ag_grammar *g2 = NULL;
+    if (ag_grammar_text_parse(text, strlen(text), &g2, &err, NULL))
+        fail_msg("%s: re-parse: line %ld: %s", what, err.element, err.text);
+    char *text2 = grammar_text(g2);
+    if (strcmp(text, text2))
+        fail_msg("%s: the grammar does not print the same after a re-parse", what);
+    free(text);
+    free(text2);
+    ag_grammar_free(g2);
+
+    /* (d) the input is as it was (undo), the edited model reloads node for node */
+    char *served_now = ag_model_tree_served_text(em);
+    if (strcmp(served_before, served_now))
+        fail_msg("%s: the edit changed the input model", what);
+    char *out_served = ag_model_tree_served_text(out), *out_stored = served_after_store(out);
+    if (strcmp(out_served, out_stored))
+        fail_msg("%s: the edited model does not reload node for node", what);
+    char *back = served_after_store(em);
+    if (strcmp(back, served_before))
+        fail_msg("%s: the previous state does not reload as it was", what);
+    free(back);
+    free(out_served);
+    free(out_stored);
+    free(served_now);
+    free(served_before);
+    ag_edit_report_clear(&rep);
+    ag_edit_model_free(out);
+}
+
+/* Checks a split's moved nodes: the node's subtree squeezed onto the lower half, the appended
+ * copies' boxes those of the upper half (as a multiset of boxes). */
+static void check_split_boxes(ag_edit_model *em, const ag_edit_op *op, const bb_options *o)
+{
+    ag_edit_model *out = NULL;
+    ag_error err = {0};
+    assert_int_equal(ag_edit_apply_ex(em, op, 0, &out, NULL, &err), AG_OK);
+    const ag_splittree *t0 = em->proc->tree, *t1 = out->proc->tree;
+    const ag_box B = t0->nodes[op->node].box;
+    int a = op->axis;
+    double f = (op->at - B.min[a]) / (B.max[a] - B.min[a]);
+    double tol = 1e-9 * fmax(1, fabs(B.max[0]) + fabs(B.max[1]) + fabs(B.max[2]));
+    size_t found = 0, want = 0;
+    for (size_t n = 0; n < t0->nnodes; n++) {
+        if (t0->nodes[n].kind != AG_NODE_COMPONENT || !in_subtree(t0, (int32_t)n, op->node))
+            continue;
+        want++;
+        ag_box lo = t0->nodes[n].box, hi = lo;
+        lo.min[a] = B.min[a] + (lo.min[a] - B.min[a]) * f;
+        lo.max[a] = B.min[a] + (lo.max[a] - B.min[a]) * f;
+        hi.min[a] = op->at + (hi.min[a] - B.min[a]) * (1 - f);
+        hi.max[a] = op->at + (hi.max[a] - B.min[a]) * (1 - f);
+        if (!same_box(&t1->nodes[n].box, &lo, tol))
+            fail_msg("%s: split: node %zu is not on the lower half", o->name, n);
+        for (size_t k = t0->nnodes; k < t1->nnodes; k++)
+            if (t1->nodes[k].kind == AG_NODE_COMPONENT && same_box(&t1->nodes[k].box, &hi, tol) &&
+                !strcmp(label_of(out, (int32_t)k), label_of(em, (int32_t)n))) {
+                found++;
+                break;
+            }
+    }
+    if (found != want)
+        fail_msg("%s: split: %zu of %zu nodes have their copy on the upper half", o->name, found,
+                 want);
+    ag_edit_model_free(out);
+}
+
+/* ---- the buildings ------------------------------------------------------------------------ */
+
+static const bb_options variants[] = {
+    {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0},
+    {"flush", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0},
+    {"proud", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0},
+    {"proud, overhang, turned a quarter", 6, 3, 3, 2, BB_PROUD, 0.3, 1, 0, 0, 0, 0},
+    {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0},
+    {"flush, jittered", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7},
+};
+
+/* The visible node with the largest box volume (a wall). */
+static int32_t largest(const ag_splittree *t)
+{
+    int32_t best = -1;
+    for (size_t n = 0; n < t->nnodes; n++)
+        if (t->nodes[n].kind == AG_NODE_COMPONENT &&
+            (best < 0 || ag_box_volume(&t->nodes[n].box) > ag_box_volume(&t->nodes[best].box)))
+            best = (int32_t)n;
+    return best;
+}
+
+/* Do two boxes lie on one facade: the same thin horizontal axis, the same side of the
+ * building's centre along it? */
+static int same_facade(const ag_splittree *t, int32_t a, int32_t b)
+{
+    const ag_box *r = &t->nodes[0].box, *p = &t->nodes[a].box, *q = &t->nodes[b].box;
+    int ax = ag_box_extent(p, 0) < ag_box_extent(p, 1) ? 0 : 1;
+    int bx = ag_box_extent(q, 0) < ag_box_extent(q, 1) ? 0 : 1;
+    double cp = ag_box_centre_axis(p, ax) - ag_box_centre_axis(r, ax);
+    double cq = ag_box_centre_axis(q, ax) - ag_box_centre_axis(r, ax);
+    return ax == bx && cp * cq > 0;
+}
+
+/* The first two visible leaves of the label with the most instances that face the way `like`
+ * faces (the same thin horizontal axis, same side of the building): windows of one facade. */
+static void two_windows(const ag_edit_model *em, int32_t *a, int32_t *b)
+{
+    const ag_splittree *t = em->proc->tree;
+    size_t nl = em->proc->labels->nlabels;
+    size_t *count = calloc(nl + 1, sizeof *count);
+    for (size_t n = 0; n < t->nnodes; n++)
+        if (t->nodes[n].kind == AG_NODE_COMPONENT && t->nodes[n].first_child < 0 &&
+            t->nodes[n].label >= 0)
+            count[t->nodes[n].label]++;
+    int32_t lab = 0;
+    for (size_t l = 0; l < nl; l++)
+        if (count[l] > count[lab])
+            lab = (int32_t)l;
+    free(count);
+    *a = *b = -1;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        if (x->kind != AG_NODE_COMPONENT || x->first_child >= 0 || x->label != lab)
+            continue;
+        if (*a < 0) {
+            *a = (int32_t)n;
+            continue;
+        }
+        if (same_facade(t, *a, (int32_t)n)) {
+            *b = (int32_t)n;
+            return;
+        }
+    }
+}
+
+static int32_t *list(int32_t a, int32_t b)
+{
+    int32_t *l = malloc(2 * sizeof *l);
+    l[0] = a;
+    l[1] = b;
+    return l;
+}
+
+static void run_variant(const bb_options *o)
+{
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    ag_edit_model *em = bb_service_model(o, &m, &err);
+    if (!em)
+        fail_msg("%s: %s", o->name, err.text);
+    const ag_splittree *t = em->proc->tree;
+    size_t nn = t->nnodes;
+    int32_t wall = largest(t), wa, wb;
+    two_windows(em, &wa, &wb);
+    assert_true(wall > 0 && wa > 0 && wb > 0);
+    uint8_t *touched = calloc(nn, 1);
+
+    /* split the wall across its length, then a window */
+    const ag_box *W = &t->nodes[wall].box;
+    int axis = ag_box_extent(W, 0) >= ag_box_extent(W, 1) ? 0 : 1;
+    ag_edit_op split = {.kind = AG_EDIT_SPLIT, .node = wall, .axis = axis,
+                        .at = W->min[axis] + 0.37 * ag_box_extent(W, axis)};
+    memset(touched, 0, nn);
+    size_t below = visible_below(t, wall, touched);
+    case_t c1 = {"split the wall", split, touched, 0, below};
+    check_case(em, &c1, o);
+    check_split_boxes(em, &split, o);
+    const ag_box *A = &t->nodes[wa].box;
+    int wax = ag_box_extent(A, 0) >= ag_box_extent(A, 1) ? 0 : 1;
+    ag_edit_op split_w = {.kind = AG_EDIT_SPLIT, .node = wa, .axis = wax,
+                          .at = 0.5 * (A->min[wax] + A->max[wax])};
+    memset(touched, 0, nn);
+    below = visible_below(t, wa, touched);
+    case_t c2 = {"split a window", split_w, touched, 0, below};
+    check_case(em, &c2, o);
+    check_split_boxes(em, &split_w, o);
+    ag_edit_op split_z = {.kind = AG_EDIT_SPLIT, .node = AG_EDIT_ROOT, .axis = 2,
+                          .at = t->nodes[0].box.min[2] + 0.5 * ag_box_extent(&t->nodes[0].box, 2)};
+    memset(touched, 0, nn);
+    below = visible_below(t, 0, touched);
+    case_t c3 = {"split the whole building", split_z, touched, 0, below};
+    check_case(em, &c3, o);
+
+    /* remove a window, then the wall (its subtree with it) */
+    ag_edit_op rm = {.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = list(wa, wa)};
+    memset(touched, 0, nn);
+    visible_below(t, wa, touched);
+    case_t c4 = {"remove a window", rm, touched, 1, 0};
+    check_case(em, &c4, o);
+    rm.nodes[0] = wall;
+    memset(touched, 0, nn);
+    visible_below(t, wall, touched);
+    case_t c5 = {"remove the wall", rm, touched, 1, 0};
+    check_case(em, &c5, o);
+    free(rm.nodes);
+
+    /* join two windows of one facade */
+    ag_edit_op join = {.kind = AG_EDIT_JOIN, .nnodes = 2, .nodes = list(wa, wb)};
+    memset(touched, 0, nn);
+    touched[wa] = touched[wb] = 1;
+    case_t c6 = {"join two windows", join, touched, 2, 0};
+    check_case(em, &c6, o);
+    {
+        /* one of them is the joined node (the union box), the other is dead */
+        ag_edit_model *out = NULL;
+        assert_int_equal(ag_edit_apply_ex(em, &join, 0, &out, NULL, &err), AG_OK);
+        const ag_splittree *t1 = out->proc->tree;
+        int32_t kept = t1->nodes[wa].kind == AG_NODE_COMPONENT ? wa : wb;
+        int32_t gone = kept == wa ? wb : wa;
+        ag_box u = t->nodes[wa].box;
+        ag_box_extend_box(&u, &t->nodes[wb].box);
+        assert_int_equal(t1->nodes[gone].kind, AG_NODE_DEAD);
+        assert_true(same_box(&t1->nodes[kept].box, &u, 1e-9 * fmax(1, ag_box_diagonal(&u) + fabs(u.max[1]))));
+        assert_string_not_equal(label_of(out, kept), label_of(em, kept));
+        ag_edit_model_free(out);
+    }
+    free(join.nodes);
+
+    /* paste a window onto another (replace, derive), and into itself (insert, derive) */
+    ag_edit_op paste = {.kind = AG_EDIT_PASTE, .node = wb, .nnodes = 1, .nodes = list(wa, wa),
+                        .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_DERIVE};
+    memset(touched, 0, nn);
+    visible_below(t, wb, touched);
+    case_t c7 = {"paste a window onto another", paste, touched, 1, visible_below(t, wa, NULL)};
+    check_case(em, &c7, o);
+    paste.node = wa;
+    paste.nodes[0] = wb;
+    paste.placement = AG_EDIT_INSERT;
+    memset(touched, 0, nn);
+    case_t c8 = {"paste a window into another", paste, touched, 0, visible_below(t, wb, NULL)};
+    check_case(em, &c8, o);
+    /* fill the window's wall with it (a grid of copies): the largest node of its facade */
+    int32_t front = -1;
+    for (size_t n = 0; n < nn; n++)
+        if (t->nodes[n].kind == AG_NODE_COMPONENT && (int32_t)n != wa && same_facade(t, wa, (int32_t)n) &&
+            (front < 0 || ag_box_volume(&t->nodes[n].box) > ag_box_volume(&t->nodes[front].box)))
+            front = (int32_t)n;
+    assert_true(front > 0);
+    paste.node = front;
+    paste.nodes[0] = wa;
+    paste.fit = AG_EDIT_FILL;
+    {
+        ag_edit_model *out = NULL;
+        ag_edit_report rep = {0};
+        assert_int_equal(ag_edit_apply_ex(em, &paste, 0, &out, &rep, &err), AG_OK);
+        unsigned cx = 0, cy = 0, cz = 0;
+        assert_int_equal(sscanf(strchr(rep.message, '(') + 1, "%u x %u x %u", &cx, &cy, &cz), 3);
+        memset(touched, 0, nn);
+        case_t c9 = {"fill the wall with a window", paste, touched, 0,
+                     (size_t)cx * cy * cz * visible_below(t, wa, NULL)};
+        assert_true(c9.appended > 4);
+        check_case(em, &c9, o);
+        ag_edit_report_clear(&rep);
+        ag_edit_model_free(out);
+    }
+    free(paste.nodes);
+    free(touched);
+    ag_edit_model_free(em);
+    ag_mesh_free(m);
+}
+
+static void ids_survive_split_join_paste_remove(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < sizeof variants / sizeof *variants; i++)
+        run_variant(&variants[i]);
+}
+
+/* A paste that turns its source (a front window onto a window of the side facade) is made by
+ * the mesh path: the result has the pasted window turned, as the operation's mesh has it. */
+static void a_turned_paste_still_works(void **state)
+{
+    (void)state;
+    const bb_options *o = &variants[2];
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    ag_edit_model *em = bb_service_model(o, &m, &err);
+    assert_non_null(em);
+    const ag_splittree *t = em->proc->tree;
+    /* a front window (thin along y) and a side window (thin along x), of one label */
+    int32_t front = -1, side = -1;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        if (x->kind != AG_NODE_COMPONENT || x->first_child >= 0 || ag_box_extent(&x->box, 2) > 3)
+            continue;
+        int thin_y = ag_box_extent(&x->box, 1) < ag_box_extent(&x->box, 0);
+        if (thin_y && front < 0 && ag_box_extent(&x->box, 0) < 3)
+            front = (int32_t)n;
+        if (!thin_y && side < 0 && ag_box_extent(&x->box, 1) < 3)
+            side = (int32_t)n;
+    }
+    assert_true(front > 0 && side > 0);
+    int32_t src[1] = {front};
+    ag_edit_op paste = {.kind = AG_EDIT_PASTE, .node = side, .nnodes = 1, .nodes = src,
+                        .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_DERIVE};
+    ag_edit_model *out = NULL;
+    ag_edit_report rep = {0};
+    if (ag_edit_apply_ex(em, &paste, 0, &out, &rep, &err))
+        fail_msg("turned paste: %s", err.text);
+    assert_non_null(strstr(rep.message, "turned by 1 quarter turn") ? rep.message
+                                                                      : strstr(rep.message, "turned by 3"));
+    ag_mesh *oracle = NULL;
+    assert_int_equal(ag_edit_paste(em->proc, &paste, &oracle, NULL, &err), AG_OK);
+    assert_same_surface(out->proc->mesh, oracle, 1e-6 * ag_box_diagonal(&t->nodes[0].box),
+                        "turned paste");
+    ag_mesh_free(oracle);
+    ag_edit_report_clear(&rep);
+    ag_edit_model_free(out);
+    ag_edit_model_free(em);
+    ag_mesh_free(m);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(ids_survive_split_join_paste_remove),
+        cmocka_unit_test(a_turned_paste_still_works),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
