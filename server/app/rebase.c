@@ -92,6 +92,17 @@ int64_t ag_rebase_map_node(const json_t *tree_a, const json_t *tree_b, int64_t i
                             (root[4] - root[1]) * (root[4] - root[1]) +
                             (root[5] - root[2]) * (root[5] - root[2])));
     double eps = 1e-6 * diag;
+    /* edits keep the ids of the nodes they leave alone: the node with its id, when unchanged */
+    const json_t *same = node_at(tree_b, id);
+    const char *same_kind = json_string_value(json_object_get(same, "kind"));
+    double sb[6];
+    if (same && same_kind && strcmp(same_kind, kind) == 0 && read_box(same, sb)) {
+        int unchanged = 1;
+        for (int c = 0; c < 6 && unchanged; c++)
+            unchanged = fabs(sb[c] - box[c]) <= eps;
+        if (unchanged)
+            return id;
+    }
     const json_t *nodes = json_object_get(tree_b, "nodes");
     int64_t found = -1;
     size_t count = 0;
@@ -114,6 +125,14 @@ int64_t ag_rebase_map_node(const json_t *tree_a, const json_t *tree_b, int64_t i
     if (count == 1)
         return found;
     return count > 1 && same_id ? id : -1; /* twins: only keeping its id is certain */
+}
+
+/* Is node id dead in tree b (an edit removed it)? */
+static int removed(const json_t *tree_b, int64_t id)
+{
+    const json_t *b = node_at(tree_b, id);
+    const char *kind = json_string_value(json_object_get(b, "kind"));
+    return b && kind && strcmp(kind, "dead") == 0;
 }
 
 /* --- the op's node ids ---------------------------------------------------------------------- */
@@ -250,7 +269,8 @@ ag_status ag_rebase_op(const ag_store_env *env, const ag_op_request *rq, const a
                 if (s == AG_OK && !tb)
                     s = conflict(g, rq->base, current, "changed the geometry", err);
                 else if (s == AG_OK && !map_op(copy, rq->model, ta, tb, &lost)) {
-                    snprintf(what, sizeof what, "changed node %lld", (long long)lost);
+                    snprintf(what, sizeof what, "%s node %lld",
+                             removed(tb, lost) ? "removed" : "changed", (long long)lost);
                     s = conflict(g, rq->base, current, what, err);
                 }
                 json_decref(ta);

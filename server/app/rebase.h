@@ -11,8 +11,10 @@
  *   AG_REBASE_NODES         structural edits: ops that leave the geometry alone, and
  *                           geometry ops after which every node the op names is still there,
  *                           unchanged: each is found in the tree after each later geometry op
- *                           by its kind and box (within 1e-6 of the model's size) and the op
- *                           is rewritten with the ids it has now
+ *                           by its id (edits keep the ids of the nodes they leave alone), else
+ *                           by its kind and box (within 1e-6 of the model's size), and the op
+ *                           is rewritten with the ids it has now; a node an edit removed is a
+ *                           conflict naming it removed
  *
  * A true conflict is AG_ERR_STALE naming the op that conflicts (its kind, version and author)
  * with the current version in err->element, like a plain stale op. */
