@@ -163,7 +163,10 @@ static void run(const char *name, const ag_mesh *m)
 /* A committed resize on a generated building, phase by phase, as the service makes it: one
  * window 0.2 m taller in global mode (every window of its rule follows), then the front wall
  * 1.5x wider in global mode. */
-static void run_generated(const char *name, const ag_gen_facade_options *go, int repeat)
+static void run_structural(const char *name, const ag_model_state *st, int mesh_path);
+
+static void run_generated(const char *name, const ag_gen_facade_options *go, int repeat,
+                          int structural)
 {
     ag_mesh *m = NULL;
     ag_error err = {0};
@@ -243,8 +246,90 @@ static void run_generated(const char *name, const ag_gen_facade_options *go, int
         ag_model_state_clear(&next);
         ag_edit_report_clear(&rep);
     }
+    if (structural)
+        run_structural(name, &st, m->ntris < 1000000);
     ag_model_state_clear(&st);
     ag_mesh_free(m);
+}
+
+/* Split, remove, paste and join on a generated building as the service makes them: the edited
+ * tree rebuilt (node ids kept) against the mesh path they took before (the operation's mesh
+ * proceduralized again, every node renumbered; not run at 2M triangles, where one takes
+ * minutes). Per op: edit ms (new model), state ms (grammar printed and read back), and the
+ * mesh path's edit ms. */
+static void run_structural(const char *name, const ag_model_state *st, int mesh_path)
+{
+    const ag_splittree *t = st->em->proc->tree;
+    int32_t wall = -1, w[2] = {-1, -1};
+    double wall_area = 0;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_box *b = &t->nodes[n].box;
+        if (t->nodes[n].kind != AG_NODE_COMPONENT)
+            continue;
+        double dx = b->max[0] - b->min[0], dz = b->max[2] - b->min[2];
+        if (dx < 2 && dz < 3 && dx > 0.5 && b->max[1] - b->min[1] < 1) {
+            if (w[0] < 0)
+                w[0] = (int32_t)n;
+            else if (w[1] < 0 && t->nodes[n].label == t->nodes[w[0]].label &&
+                     fabs(b->min[1] - t->nodes[w[0]].box.min[1]) < 1e-6)
+                w[1] = (int32_t)n;
+        }
+        if (dx * dz > wall_area && b->max[1] - b->min[1] < 1) {
+            wall_area = dx * dz;
+            wall = (int32_t)n;
+        }
+    }
+    if (wall < 0 || w[0] < 0 || w[1] < 0) {
+        printf("%-28s no wall or windows to edit\n", name);
+        return;
+    }
+    const ag_box *W = &t->nodes[wall].box;
+    ag_edit_op ops[4] = {
+        {.kind = AG_EDIT_SPLIT, .node = wall, .axis = 0, .at = 0.5 * (W->min[0] + W->max[0])},
+        {.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = &w[0]},
+        {.kind = AG_EDIT_PASTE, .node = w[1], .nnodes = 1, .nodes = &w[0],
+         .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_DERIVE},
+        {.kind = AG_EDIT_JOIN, .nnodes = 2, .nodes = w},
+    };
+    static const char *const what[4] = {"split wall", "remove window", "paste window",
+                                        "join 2 windows"};
+    ag_edit_model *em = st->em;
+    for (int k = 0; k < 4; k++) {
+        ag_error err = {0};
+        ag_edit_model *out = NULL;
+        double a = now_ms();
+        ag_status s = ag_edit_apply_ex(em, &ops[k], 0, &out, NULL, &err);
+        double t_edit = now_ms() - a;
+        ag_model_state next;
+        a = now_ms();
+        if (!s)
+            s = ag_model_state_make(&out, 0, &next, &err);
+        double t_state = now_ms() - a;
+        if (s) {
+            printf("%-28s %s failed: %s\n", name, what[k], err.text);
+            ag_edit_model_free(out);
+            continue;
+        }
+        size_t after = next.em->proc->mesh->ntris, kept = 0, old = 0;
+        for (size_t n = 0; n < t->nnodes; n++)
+            if (t->nodes[n].kind == AG_NODE_COMPONENT) {
+                old++;
+                kept += n < next.em->proc->tree->nnodes &&
+                        next.em->proc->tree->nodes[n].kind == AG_NODE_COMPONENT;
+            }
+        ag_model_state_clear(&next);
+        double t_mesh = -1;
+        if (mesh_path) {
+            a = now_ms();
+            s = ag_edit_apply_ex(em, &ops[k], AG_EDIT_MESH_PATH, &out, NULL, &err);
+            t_mesh = now_ms() - a;
+            ag_edit_model_free(out);
+            if (s)
+                printf("%-28s %s (mesh path) failed: %s\n", name, what[k], err.text);
+        }
+        printf("%-28s %8zu %8zu %-15s | %7.1f %7.1f | %9.1f | %6zu of %6zu ids kept\n", name,
+               st->em->proc->mesh->ntris, after, what[k], t_edit, t_state, t_mesh, kept, old);
+    }
 }
 
 static void run_file(const char *path, ag_up_axis up)
@@ -300,7 +385,7 @@ int main(int argc, char **argv)
     if ((argc == 3 || argc == 4) && !strcmp(argv[1], "--generated")) {
         for (size_t i = 0; i < sizeof gens / sizeof *gens; i++)
             if (!strcmp(argv[2], gens[i].key)) {
-                run_generated(gens[i].name, &gens[i].go, argc == 4 ? atoi(argv[3]) : 1);
+                run_generated(gens[i].name, &gens[i].go, argc == 4 ? atoi(argv[3]) : 1, 1);
                 return 0;
             }
         fprintf(stderr, "edit: --generated takes 20k, 200k or 2M\n");
@@ -330,6 +415,14 @@ int main(int argc, char **argv)
            "tris", "after", "edit", "proc ms", "solve", "edit", "state", "tree", "blob", "total",
            "treeKB", "blobKB", "MiB");
     for (size_t i = 0; i < sizeof gens / sizeof *gens; i++)
-        run_generated(gens[i].name, &gens[i].go, 1);
+        run_generated(gens[i].name, &gens[i].go, 1, 0);
+
+    printf("\nsplit, remove, paste, join as the service makes them (ms): edit = edited tree + "
+           "new model (ids kept); state = grammar printed and read back; mesh path = the "
+           "operation's mesh proceduralized again, as before (not at 2M)\n");
+    printf("%-28s %8s %8s %-15s | %7s %7s | %9s |\n", "building", "tris", "after", "edit",
+           "edit", "state", "mesh path");
+    for (size_t i = 0; i < sizeof gens / sizeof *gens; i++)
+        run_generated(gens[i].name, &gens[i].go, 0, 1);
     return 0;
 }
