@@ -21,6 +21,7 @@
 #include "app/model_state.h"
 #include "app/model_tree.h"
 #include "edit_building_fixture.h"
+#include "edit_kept_fixture.h"
 #include "core/edit/edit.h"
 #include "core/proc/proceduralize.h"
 #include "io/meshblob.h"
@@ -92,28 +93,6 @@ static size_t count_with_height(const ag_mesh *m, const bb_options *o, const cha
     }
     free(p);
     return ok;
-}
-
-/* The model as the store keeps it (mesh blob and stored tree) and reloaded: its served tree. */
-static char *served_after_store(const ag_edit_model *em)
-{
-    uint8_t *blob = NULL;
-    size_t len = 0;
-    assert_int_equal(ag_meshblob_encode(em->proc->mesh, &blob, &len), AG_OK);
-    char *stored = ag_model_kept_tree_text(em);
-    assert_non_null(stored);
-    ag_mesh *back = NULL;
-    ag_error err = {0};
-    assert_int_equal(ag_meshblob_decode(blob, len, &back, &err), AG_OK);
-    ag_edit_model *re = NULL;
-    if (ag_model_state_reload_kept(back, stored, &re, &err))
-        fail_msg("reload: %s", err.text);
-    char *text = ag_model_tree_served_text(re);
-    ag_edit_model_free(re);
-    ag_mesh_free(back);
-    free(stored);
-    free(blob);
-    return text;
 }
 
 static const bb_options variants[] = {
@@ -202,7 +181,7 @@ static void run_variant(const bb_options *o)
     if (ag_model_state_make(&made, 0, &st, &err))
         fail_msg("%s: state: %s", o->name, err.text);
     char *served = ag_model_tree_served_text(st.em);
-    char *again = served_after_store(st.em);
+    char *again = ek_served_after_store(st.em);
     if (strcmp(served, again))
         fail_msg("%s: the reloaded tree differs from the edited one", o->name);
     free(served);

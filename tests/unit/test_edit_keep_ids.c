@@ -31,6 +31,7 @@
 #include "core/edit/edit.h"
 #include "core/proc/proceduralize.h"
 #include "edit_building_fixture.h"
+#include "edit_kept_fixture.h"
 #include "io/grammar_text.h"
 #include "io/meshblob.h"
 
@@ -180,28 +181,6 @@ static char *grammar_text(const ag_grammar *g)
     return text;
 }
 
-/* The model as the store keeps it (mesh blob and stored tree) and reloaded: its served tree. */
-static char *served_after_store(const ag_edit_model *em)
-{
-    uint8_t *blob = NULL;
-    size_t len = 0;
-    assert_int_equal(ag_meshblob_encode(em->proc->mesh, &blob, &len), AG_OK);
-    char *stored = ag_model_kept_tree_text(em);
-    assert_non_null(stored);
-    ag_mesh *back = NULL;
-    ag_error err = {0};
-    assert_int_equal(ag_meshblob_decode(blob, len, &back, &err), AG_OK);
-    ag_edit_model *re = NULL;
-    if (ag_model_state_reload_kept(back, stored, &re, &err))
-        fail_msg("reload: %s", err.text);
-    char *text = ag_model_tree_served_text(re);
-    ag_edit_model_free(re);
-    ag_mesh_free(back);
-    free(stored);
-    free(blob);
-    return text;
-}
-
 /* ---- the ops ------------------------------------------------------------------------------ */
 
 typedef struct {
@@ -329,10 +308,10 @@ static void check_case(ag_edit_model *em, case_t *c, const bb_options *o)
     char *served_now = ag_model_tree_served_text(em);
     if (strcmp(served_before, served_now))
         fail_msg("%s: the edit changed the input model", what);
-    char *out_served = ag_model_tree_served_text(out), *out_stored = served_after_store(out);
+    char *out_served = ag_model_tree_served_text(out), *out_stored = ek_served_after_store(out);
     if (strcmp(out_served, out_stored))
         fail_msg("%s: the edited model does not reload node for node", what);
-    char *back = served_after_store(em);
+    char *back = ek_served_after_store(em);
     if (strcmp(back, served_before))
         fail_msg("%s: the previous state does not reload as it was", what);
     free(back);

@@ -70,19 +70,10 @@ ag_status ag_edit_join(const ag_proceduralize_result *in, const ag_edit_op *op, 
                        ag_edit_report *rep, ag_error *err)
 {
     *out = NULL;
-    if (op->nnodes == 0 || !op->nodes)
-        return ag_error_set(err, AG_ERR_INVALID, 0,
-                            "join needs a selection of at least two nodes (nodes is empty)");
-    char what[48];
-    for (size_t i = 0; i < op->nnodes; i++) {
-        snprintf(what, sizeof what, "join nodes[%zu]", i);
-        ag_status st = ag_place_check_node(in, op->nodes[i], what, err);
-        if (st)
-            return st;
-        if (op->nodes[i] == AG_EDIT_ROOT)
-            return ag_error_set(err, AG_ERR_INVALID, 0,
-                                "join nodes[%zu]: the root cannot be joined", i);
-    }
+    ag_status st = ag_place_check_selection(in, op, "join", "a selection of at least two nodes",
+                                            "joined", err);
+    if (st)
+        return st;
     const ag_splittree *t = in->tree;
     uint8_t *mark = calloc(t->ncomponents + 1, 1);
     int32_t *labels = malloc((t->ncomponents + 1) * sizeof *labels);
@@ -96,7 +87,6 @@ ag_status ag_edit_join(const ag_proceduralize_result *in, const ag_edit_op *op, 
     size_t n = 0;
     for (size_t i = 0; i < op->nnodes; i++)
         n += mark_top_visible(t, op->nodes[i], mark);
-    ag_status st = AG_OK;
     if (n < 2) {
         st = ag_error_set(err, AG_ERR_INVALID, 0,
                           "join needs at least two distinct visible nodes; the selection of "

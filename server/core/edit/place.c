@@ -76,6 +76,56 @@ ag_status ag_place_check_node(const ag_proceduralize_result *r, int32_t node, co
     return AG_OK;
 }
 
+ag_status ag_place_check_selection(const ag_proceduralize_result *in, const ag_edit_op *op,
+                                   const char *verb, const char *need, const char *done,
+                                   ag_error *err)
+{
+    if (op->nnodes == 0 || !op->nodes)
+        return ag_error_set(err, AG_ERR_INVALID, 0, "%s needs %s (nodes is empty)", verb, need);
+    char what[48];
+    for (size_t i = 0; i < op->nnodes; i++) {
+        snprintf(what, sizeof what, "%s nodes[%zu]", verb, i);
+        ag_status st = ag_place_check_node(in, op->nodes[i], what, err);
+        if (st)
+            return st;
+        if (op->nodes[i] == AG_EDIT_ROOT)
+            return ag_error_set(err, AG_ERR_INVALID, 0, "%s nodes[%zu]: the root cannot be %s",
+                                verb, i, done);
+    }
+    return AG_OK;
+}
+
+ag_status ag_place_check_split(const ag_proceduralize_result *in, const ag_edit_op *op,
+                               size_t *ncomponents, ag_error *err)
+{
+    *ncomponents = 0;
+    ag_status st = ag_place_check_node(in, op->node, "split node", err);
+    if (st)
+        return st;
+    if (op->axis < 0 || op->axis > 2)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "split axis must be 0, 1 or 2 (x, y or z), not %d", op->axis);
+    const ag_splittree *t = in->tree;
+    const ag_box B = t->nodes[op->node].box;
+    int a = op->axis;
+    /* both halves must keep a size the tree can tell from a face coincidence (a tree without
+     * one: as if its diagonal were 1 m) */
+    double eps = t->eps > 0 ? AG_EDIT_SPLIT_MARGIN * t->eps : AG_EDIT_COINCIDENT;
+    if (!isfinite(op->at) || op->at <= B.min[a] + eps || op->at >= B.max[a] - eps)
+        return ag_error_set(err, AG_ERR_INVALID, op->node,
+                            "split plane %c = %g is not inside node %d's box (%g .. %g)",
+                            "xyz"[a], op->at, (int)op->node, B.min[a], B.max[a]);
+    uint8_t *mark = calloc(t->ncomponents + 1, 1);
+    if (!mark)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    *ncomponents = ag_place_mark_subtree(t, op->node, mark);
+    free(mark);
+    if (*ncomponents == 0)
+        return ag_error_set(err, AG_ERR_INVALID, op->node, "node %d has no geometry to split",
+                            (int)op->node);
+    return AG_OK;
+}
+
 size_t ag_place_mark_subtree(const ag_splittree *t, int32_t node, uint8_t *mark)
 {
     /* iterative preorder walk over first_child / next_sibling, bounded by the subtree root */

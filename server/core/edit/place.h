@@ -33,6 +33,18 @@ ag_box ag_place_apply_box(const ag_place_map *m, const ag_box *b);
 ag_status ag_place_check_node(const ag_proceduralize_result *r, int32_t node, const char *what,
                               ag_error *err);
 
+/* Checks a join's or a remove's selection: not empty ("<verb> needs <need> (nodes is empty)"),
+ * every node live ("<verb> nodes[i]"), none the root ("the root cannot be <done>"). */
+ag_status ag_place_check_selection(const ag_proceduralize_result *in, const ag_edit_op *op,
+                                   const char *verb, const char *need, const char *done,
+                                   ag_error *err);
+
+/* Checks a split: its node, its axis and its plane strictly inside the node's box (by more than
+ * a face coincidence); *ncomponents gets the components of the node's subtree (none:
+ * AG_ERR_INVALID). */
+ag_status ag_place_check_split(const ag_proceduralize_result *in, const ag_edit_op *op,
+                               size_t *ncomponents, ag_error *err);
+
 /* Sets mark[c] = 1 for every component of node's subtree (node included); mark holds
  * r->tree->ncomponents entries. Returns the number of components newly marked. */
 size_t ag_place_mark_subtree(const ag_splittree *t, int32_t node, uint8_t *mark);

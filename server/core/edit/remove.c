@@ -10,18 +10,9 @@ ag_status ag_edit_remove(const ag_proceduralize_result *in, const ag_edit_op *op
                          ag_edit_report *rep, ag_error *err)
 {
     *out = NULL;
-    if (op->nnodes == 0 || !op->nodes)
-        return ag_error_set(err, AG_ERR_INVALID, 0, "remove needs at least one node (nodes is empty)");
-    char what[48];
-    for (size_t i = 0; i < op->nnodes; i++) {
-        snprintf(what, sizeof what, "remove nodes[%zu]", i);
-        ag_status st = ag_place_check_node(in, op->nodes[i], what, err);
-        if (st)
-            return st;
-        if (op->nodes[i] == AG_EDIT_ROOT)
-            return ag_error_set(err, AG_ERR_INVALID, 0,
-                                "remove nodes[%zu]: the root cannot be removed", i);
-    }
+    ag_status st = ag_place_check_selection(in, op, "remove", "at least one node", "removed", err);
+    if (st)
+        return st;
     const ag_splittree *t = in->tree;
     uint8_t *mark = calloc(t->ncomponents + 1, 1);
     ag_place_builder *b = ag_place_builder_create();
@@ -33,7 +24,7 @@ ag_status ag_edit_remove(const ag_proceduralize_result *in, const ag_edit_op *op
     size_t n = 0;
     for (size_t i = 0; i < op->nnodes; i++)
         n += ag_place_mark_subtree(t, op->nodes[i], mark);
-    ag_status st = ag_place_copy_unmarked(b, in, mark);
+    st = ag_place_copy_unmarked(b, in, mark);
     free(mark);
     if (st) {
         ag_place_builder_free(b);

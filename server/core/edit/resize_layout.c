@@ -155,24 +155,9 @@ static int32_t copy_subtree(lay *L, int32_t y, int32_t parent, int depth)
 /* x and its subtree are removed (dead, linked to nothing), with the split chain x hangs by. */
 static void kill_subtree(lay *L, int32_t x)
 {
-    ag_splittree *t = L->nt;
-    int32_t p = t->nodes[x].parent;
-    if (p >= 0 && t->nodes[p].kind == AG_NODE_SPLIT)
-        x = p;
-    ag_splittree_detach(t, x);
-    int32_t *stack = walk_stack(L, t->nnodes + 1);
-    if (!stack)
-        return;
-    size_t sp = 0;
-    stack[sp++] = x;
-    while (sp) {
-        int32_t v = stack[--sp];
-        for (int32_t c = t->nodes[v].first_child; c >= 0; c = t->nodes[c].next_sibling)
-            stack[sp++] = c;
-        ag_tnode *n = &t->nodes[v];
-        n->kind = AG_NODE_DEAD;
-        n->parent = n->first_child = n->last_child = n->next_sibling = -1;
-    }
+    int32_t *stack = walk_stack(L, L->nt->nnodes + 1);
+    if (stack)
+        ag_treeedit_kill_subtree(L->nt, x, stack);
 }
 
 /* Everything below x moves by d. */

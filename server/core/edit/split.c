@@ -13,23 +13,13 @@ ag_status ag_edit_split(const ag_proceduralize_result *in, const ag_edit_op *op,
                         ag_edit_report *rep, ag_error *err)
 {
     *out = NULL;
-    ag_status st = ag_place_check_node(in, op->node, "split node", err);
+    size_t n;
+    ag_status st = ag_place_check_split(in, op, &n, err);
     if (st)
         return st;
-    if (op->axis < 0 || op->axis > 2)
-        return ag_error_set(err, AG_ERR_INVALID, 0,
-                            "split axis must be 0, 1 or 2 (x, y or z), not %d", op->axis);
     const ag_splittree *t = in->tree;
     const ag_box B = t->nodes[op->node].box;
     int a = op->axis;
-    /* both halves must keep a size the tree can tell from a face coincidence (a tree without
-     * one: as if its diagonal were 1 m) */
-    double eps = t->eps > 0 ? AG_EDIT_SPLIT_MARGIN * t->eps : AG_EDIT_COINCIDENT;
-    if (!isfinite(op->at) || op->at <= B.min[a] + eps || op->at >= B.max[a] - eps)
-        return ag_error_set(err, AG_ERR_INVALID, op->node,
-                            "split plane %c = %g is not inside node %d's box (%g .. %g)",
-                            "xyz"[a], op->at, (int)op->node, B.min[a], B.max[a]);
-
     uint8_t *mark = calloc(t->ncomponents + 1, 1);
     ag_place_builder *b = ag_place_builder_create();
     if (!mark || !b) {
@@ -37,13 +27,7 @@ ag_status ag_edit_split(const ag_proceduralize_result *in, const ag_edit_op *op,
         ag_place_builder_free(b);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
-    size_t n = ag_place_mark_subtree(t, op->node, mark);
-    if (n == 0) {
-        free(mark);
-        ag_place_builder_free(b);
-        return ag_error_set(err, AG_ERR_INVALID, op->node,
-                            "node %d has no geometry to split", (int)op->node);
-    }
+    ag_place_mark_subtree(t, op->node, mark);
     ag_box half[2] = {B, B};
     half[0].max[a] = op->at;
     half[1].min[a] = op->at;

@@ -171,19 +171,12 @@ static int32_t copy_subtree(edited *E, int32_t y, const axis_map *m, int32_t par
     return E->st ? -1 : top;
 }
 
-/* x and its subtree are dead, with the intermediate split node x hangs by. */
-static void kill_subtree(edited *E, int32_t x)
+void ag_treeedit_kill_subtree(ag_splittree *t, int32_t x, int32_t *stack)
 {
-    ag_splittree *t = E->t;
     int32_t p = t->nodes[x].parent;
     if (p >= 0 && t->nodes[p].kind == AG_NODE_SPLIT)
         x = p;
     ag_splittree_detach(t, x);
-    int32_t *stack = malloc((t->nnodes + 1) * sizeof *stack);
-    if (!stack) {
-        E->st = AG_ERR_NOMEM;
-        return;
-    }
     size_t sp = 0;
     stack[sp++] = x;
     while (sp) {
@@ -194,6 +187,16 @@ static void kill_subtree(edited *E, int32_t x)
         n->kind = AG_NODE_DEAD;
         n->parent = n->first_child = n->last_child = n->next_sibling = -1;
     }
+}
+
+static void kill_subtree(edited *E, int32_t x)
+{
+    int32_t *stack = malloc((E->t->nnodes + 1) * sizeof *stack);
+    if (!stack) {
+        E->st = AG_ERR_NOMEM;
+        return;
+    }
+    ag_treeedit_kill_subtree(E->t, x, stack);
     free(stack);
 }
 
@@ -312,28 +315,13 @@ ag_status ag_treeedit_split(const ag_proceduralize_result *in, const ag_edit_op 
     *tree = NULL;
     *source = NULL;
     base_of(base, in);
-    ag_status st = ag_place_check_node(in, op->node, "split node", err);
+    size_t n;
+    ag_status st = ag_place_check_split(in, op, &n, err);
     if (st)
         return st;
-    if (op->axis < 0 || op->axis > 2)
-        return ag_error_set(err, AG_ERR_INVALID, 0,
-                            "split axis must be 0, 1 or 2 (x, y or z), not %d", op->axis);
     const ag_splittree *ot = in->tree;
     const ag_box B = ot->nodes[op->node].box;
     int a = op->axis;
-    double eps = ot->eps > 0 ? AG_EDIT_SPLIT_MARGIN * ot->eps : AG_EDIT_COINCIDENT;
-    if (!isfinite(op->at) || op->at <= B.min[a] + eps || op->at >= B.max[a] - eps)
-        return ag_error_set(err, AG_ERR_INVALID, op->node,
-                            "split plane %c = %g is not inside node %d's box (%g .. %g)",
-                            "xyz"[a], op->at, (int)op->node, B.min[a], B.max[a]);
-    uint8_t *mark = calloc(ot->ncomponents + 1, 1);
-    if (!mark)
-        return nomem(err);
-    size_t n = ag_place_mark_subtree(ot, op->node, mark);
-    free(mark);
-    if (n == 0)
-        return ag_error_set(err, AG_ERR_INVALID, op->node, "node %d has no geometry to split",
-                            (int)op->node);
     ag_box half[2] = {B, B};
     half[0].max[a] = op->at;
     half[1].min[a] = op->at;
@@ -392,19 +380,9 @@ ag_status ag_treeedit_remove(const ag_proceduralize_result *in, const ag_edit_op
     *tree = NULL;
     *source = NULL;
     base_of(base, in);
-    if (op->nnodes == 0 || !op->nodes)
-        return ag_error_set(err, AG_ERR_INVALID, 0,
-                            "remove needs at least one node (nodes is empty)");
-    char what[48];
-    for (size_t i = 0; i < op->nnodes; i++) {
-        snprintf(what, sizeof what, "remove nodes[%zu]", i);
-        ag_status st = ag_place_check_node(in, op->nodes[i], what, err);
-        if (st)
-            return st;
-        if (op->nodes[i] == AG_EDIT_ROOT)
-            return ag_error_set(err, AG_ERR_INVALID, 0,
-                                "remove nodes[%zu]: the root cannot be removed", i);
-    }
+    ag_status st = ag_place_check_selection(in, op, "remove", "at least one node", "removed", err);
+    if (st)
+        return st;
     const ag_splittree *ot = in->tree;
     uint8_t *mark = calloc(ot->ncomponents + 1, 1);
     if (!mark)
@@ -425,7 +403,7 @@ ag_status ag_treeedit_remove(const ag_proceduralize_result *in, const ag_edit_op
         return ag_error_set(err, AG_ERR_INVALID, 0,
                             "removing the selection would leave no geometry");
     }
-    ag_status st = edited_finish(&E, tree, source, err);
+    st = edited_finish(&E, tree, source, err);
     if (!st && rep)
         snprintf(rep->message, sizeof rep->message, "removed %zu components", n);
     return st;
@@ -614,19 +592,10 @@ ag_status ag_treeedit_join(const ag_proceduralize_result *in, const ag_edit_op *
     *tree = NULL;
     *source = NULL;
     base_of(base, in);
-    if (op->nnodes == 0 || !op->nodes)
-        return ag_error_set(err, AG_ERR_INVALID, 0,
-                            "join needs a selection of at least two nodes (nodes is empty)");
-    char what[48];
-    for (size_t i = 0; i < op->nnodes; i++) {
-        snprintf(what, sizeof what, "join nodes[%zu]", i);
-        ag_status st = ag_place_check_node(in, op->nodes[i], what, err);
-        if (st)
-            return st;
-        if (op->nodes[i] == AG_EDIT_ROOT)
-            return ag_error_set(err, AG_ERR_INVALID, 0,
-                                "join nodes[%zu]: the root cannot be joined", i);
-    }
+    ag_status st = ag_place_check_selection(in, op, "join", "a selection of at least two nodes",
+                                            "joined", err);
+    if (st)
+        return st;
     const ag_splittree *ot = in->tree;
     uint8_t *seen = calloc(ot->nnodes + 1, 1);
     int32_t *members = malloc((ot->nnodes + 1) * sizeof *members);
@@ -732,7 +701,7 @@ ag_status ag_treeedit_join(const ag_proceduralize_result *in, const ag_edit_op *
     free(seen);
     free(members);
     /* the sources index the view, whose first nodes are the input's */
-    ag_status st = edited_finish(&E, tree, source, err);
+    st = edited_finish(&E, tree, source, err);
     if (st) {
         ag_treeedit_base_free(base);
         base_of(base, in);

@@ -56,6 +56,10 @@ ag_status ag_treeedit_remove(const ag_proceduralize_result *in, const ag_edit_op
                              ag_treeedit_base *base, ag_splittree **tree, int32_t **source,
                              ag_edit_report *rep, ag_error *err);
 
+/* x and its subtree are dead (linked to nothing), with the intermediate split node x hangs by;
+ * stack holds t->nnodes entries (the walk's). */
+void ag_treeedit_kill_subtree(ag_splittree *t, int32_t x, int32_t *stack);
+
 /* Boxes of the invisible nodes from what they hold: a pattern and the root span their
  * children, an intermediate split node its child (post-order; a node holding nothing keeps
  * its box). */
