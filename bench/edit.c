@@ -9,7 +9,9 @@
  * phase: the edited tree (solve and layout), the new model (rebuild.h: no
  * re-proceduralization), the model state (grammar printed and read back), the stored tree
  * (served tree and kept model) and the mesh blob; the database writes and the broadcast are
- * measured through the service by bench/edit_ws.js. Not a test. */
+ * measured through the service by bench/edit_ws.js. Last, split, remove, paste and join on the
+ * same buildings: the edited tree rebuilt (ids kept) against the mesh path they took before.
+ * Not a test. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
