@@ -13,7 +13,8 @@
  *  (c) the grammar prints, re-parses and prints again byte for byte;
  *  (d) the input model is untouched (undo gives it back as it was) and the edited model reloads
  *      from what the store keeps node for node.
- * A turned paste (a front window onto the side facade) still works through the mesh path. */
+ * The same for a paste that turns its source (a front window onto the side facade) and one from
+ * another building. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -559,55 +560,86 @@ static void ids_survive_split_join_paste_remove(void **state)
         run_variant(&variants[i]);
 }
 
-/* A paste that turns its source (a front window onto a window of the side facade) is made by
- * the mesh path: the result has the pasted window turned, as the operation's mesh has it. */
-static void a_turned_paste_still_works(void **state)
+/* The front window and the side window of a building (thin along y, thin along x). */
+static void front_and_side(const ag_splittree *t, int32_t *front, int32_t *side)
 {
-    (void)state;
-    const bb_options *o = &variants[2];
-    ag_mesh *m = NULL;
-    ag_error err = {0};
-    ag_edit_model *em = bb_service_model(o, &m, &err);
-    assert_non_null(em);
-    const ag_splittree *t = em->proc->tree;
-    /* a front window (thin along y) and a side window (thin along x), of one label */
-    int32_t front = -1, side = -1;
+    *front = *side = -1;
     for (size_t n = 0; n < t->nnodes; n++) {
         const ag_tnode *x = &t->nodes[n];
         if (x->kind != AG_NODE_COMPONENT || x->first_child >= 0 || ag_box_extent(&x->box, 2) > 3)
             continue;
         int thin_y = ag_box_extent(&x->box, 1) < ag_box_extent(&x->box, 0);
-        if (thin_y && front < 0 && ag_box_extent(&x->box, 0) < 3)
-            front = (int32_t)n;
-        if (!thin_y && side < 0 && ag_box_extent(&x->box, 1) < 3)
-            side = (int32_t)n;
+        if (thin_y && *front < 0 && ag_box_extent(&x->box, 0) < 3)
+            *front = (int32_t)n;
+        if (!thin_y && *side < 0 && ag_box_extent(&x->box, 1) < 3)
+            *side = (int32_t)n;
     }
-    assert_true(front > 0 && side > 0);
-    int32_t src[1] = {front};
-    ag_edit_op paste = {.kind = AG_EDIT_PASTE, .node = side, .nnodes = 1, .nodes = src,
-                        .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_DERIVE};
-    ag_edit_model *out = NULL;
-    ag_edit_report rep = {0};
-    if (ag_edit_apply_ex(em, &paste, 0, &out, &rep, &err))
-        fail_msg("turned paste: %s", err.text);
-    assert_non_null(strstr(rep.message, "turned by 1 quarter turn") ? rep.message
-                                                                      : strstr(rep.message, "turned by 3"));
-    ag_mesh *oracle = NULL;
-    assert_int_equal(ag_edit_paste(em->proc, &paste, &oracle, NULL, &err), AG_OK);
-    assert_same_surface(out->proc->mesh, oracle, 1e-6 * ag_box_diagonal(&t->nodes[0].box),
-                        "turned paste");
-    ag_mesh_free(oracle);
-    ag_edit_report_clear(&rep);
-    ag_edit_model_free(out);
-    ag_edit_model_free(em);
-    ag_mesh_free(m);
+}
+
+/* A paste that turns its source (a front window onto a window of the side facade), and one from
+ * another building, keep ids too: the turned copy is the operation's mesh's. */
+static void turned_and_cross_model_pastes_keep_ids(void **state)
+{
+    (void)state;
+    for (size_t v = 0; v < sizeof variants / sizeof *variants; v++) {
+        const bb_options *o = &variants[v];
+        ag_mesh *m = NULL;
+        ag_error err = {0};
+        ag_edit_model *em = bb_service_model(o, &m, &err);
+        assert_non_null(em);
+        const ag_splittree *t = em->proc->tree;
+        int32_t front, side;
+        front_and_side(t, &front, &side);
+        assert_true(front > 0 && side > 0);
+        int32_t src[1] = {front};
+        ag_edit_op paste = {.kind = AG_EDIT_PASTE, .node = side, .nnodes = 1, .nodes = src,
+                            .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_DERIVE};
+        ag_edit_report rep = {0};
+        ag_edit_model *out = NULL;
+        if (ag_edit_apply_ex(em, &paste, 0, &out, &rep, &err))
+            fail_msg("turned paste: %s", err.text);
+        if (!strstr(rep.message, "turned by 1 quarter turn") && !strstr(rep.message, "turned by 3"))
+            fail_msg("%s: not a turned paste: %s", o->name, rep.message);
+        ag_edit_report_clear(&rep);
+        ag_edit_model_free(out);
+        uint8_t *touched = calloc(t->nnodes, 1);
+        visible_below(t, side, touched);
+        case_t c = {"paste a front window onto a side window", paste, touched, 1,
+                    visible_below(t, front, NULL)};
+        check_case(em, &c, o);
+        /* from another building (the flush one): its labels are new ones here */
+        ag_mesh *m2 = NULL;
+        ag_edit_model *other = bb_service_model(&variants[1], &m2, &err);
+        assert_non_null(other);
+        int32_t f2, s2;
+        front_and_side(other->proc->tree, &f2, &s2);
+        src[0] = f2;
+        paste.source = other->proc;
+        paste.node = front;
+        memset(touched, 0, t->nnodes);
+        visible_below(t, front, touched);
+        case_t c2 = {"paste another building's window", paste, touched, 1,
+                     visible_below(other->proc->tree, f2, NULL)};
+        check_case(em, &c2, o);
+        paste.node = side; /* and turned */
+        memset(touched, 0, t->nnodes);
+        visible_below(t, side, touched);
+        case_t c3 = {"paste another building's window turned", paste, touched, 1,
+                     visible_below(other->proc->tree, f2, NULL)};
+        check_case(em, &c3, o);
+        free(touched);
+        ag_edit_model_free(other);
+        ag_mesh_free(m2);
+        ag_edit_model_free(em);
+        ag_mesh_free(m);
+    }
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(ids_survive_split_join_paste_remove),
-        cmocka_unit_test(a_turned_paste_still_works),
+        cmocka_unit_test(turned_and_cross_model_pastes_keep_ids),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -24,19 +24,26 @@ static int32_t *component_order(const ag_proceduralize_result *in, const ag_spli
 {
     const ag_splittree *ot = in->tree;
     int32_t *order = malloc((t->nnodes + 1) * sizeof *order);
-    if (!order)
+    uint8_t *taken = calloc(t->nnodes + 1, 1);
+    if (!order || !taken) {
+        free(order);
+        free(taken);
         return NULL;
+    }
     size_t k = 0;
     for (size_t c = 0; c < ot->ncomponents; c++) {
         int32_t v = ot->comp_node[c];
         if (v >= 0 && (size_t)v < t->nnodes && t->nodes[v].kind == AG_NODE_COMPONENT &&
-            source[v] == v)
+            source[v] == v) {
             order[k++] = v;
+            taken[v] = 1;
+        }
     }
-    /* then the nodes that place another node's component (a join's node keeps its index) */
+    /* then the nodes that place another node's component (copies, a join's node) */
     for (size_t v = 0; v < t->nnodes; v++)
-        if (t->nodes[v].kind == AG_NODE_COMPONENT && (v >= ot->nnodes || source[v] != (int32_t)v))
+        if (t->nodes[v].kind == AG_NODE_COMPONENT && !taken[v])
             order[k++] = (int32_t)v;
+    free(taken);
     *n = k;
     return order;
 }

@@ -47,45 +47,46 @@ static void edited_drop(edited *E)
     E->src = NULL;
 }
 
-/* The box b scaled per axis by s about nothing (x -> s x + d): a map without turns. */
+/* What copies are made of when they are not the input's own nodes unturned (a paste turned or
+ * from another model): per component of the tree copied from, the view's node that places
+ * it, turned, with its view label and variant; NULL for plain copies. */
 typedef struct {
-    double s[3], d[3];
-} axis_map;
+    const ag_splittree *from; /* the tree copied from */
+    const int32_t *view_node; /* per component of `from` (-1: not copied) */
+    const int32_t *view_comp; /* per component of `from`: the view's component */
+    const ag_labels *labels;  /* the view's */
+    int turns;
+} copy_source;
 
-static axis_map axis_map_of(const ag_box *from, const ag_box *to)
+static ag_box map_box(const ag_place_map *m, const ag_box *b)
 {
-    ag_place_map m;
-    ag_place_boxes(&m, from, to, 0);
-    axis_map a;
-    for (int i = 0; i < 3; i++) {
-        a.s[i] = m.M[i][i];
-        a.d[i] = m.t[i];
-    }
-    return a;
+    return ag_place_apply_box(m, b);
 }
 
-static ag_box map_box(const axis_map *m, const ag_box *b)
+/* A pattern's lattice moved by m (a turned axis grid whose cells no longer follow its axes is
+ * dissolved by the rebuild). */
+static void map_pattern(const ag_place_map *m, ag_pattern *p, int turns)
 {
-    ag_box o;
-    for (int a = 0; a < 3; a++) {
-        double x = m->s[a] * b->min[a] + m->d[a], y = m->s[a] * b->max[a] + m->d[a];
-        o.min[a] = fmin(x, y);
-        o.max[a] = fmax(x, y);
+    double step[3];
+    for (int a = 0; a < 3; a++)
+        step[a] = m->M[a][0] * p->step[0] + m->M[a][1] * p->step[1] + m->M[a][2] * p->step[2];
+    memcpy(p->step, step, sizeof step);
+    for (int k = 0; k < 3; k++) {
+        double v[3];
+        for (int a = 0; a < 3; a++)
+            v[a] = m->M[a][0] * p->vec[k][0] + m->M[a][1] * p->vec[k][1] + m->M[a][2] * p->vec[k][2];
+        memcpy(p->vec[k], v, sizeof v);
     }
-    return o;
+    if (turns & 1 && !p->nvec) {
+        uint32_t c = p->counts[0];
+        p->counts[0] = p->counts[1];
+        p->counts[1] = c;
+    }
+    p->rot = (uint8_t)((p->rot + turns) & 3);
 }
 
-static void map_pattern(const axis_map *m, ag_pattern *p)
-{
-    for (int a = 0; a < 3; a++) {
-        p->step[a] *= m->s[a];
-        for (int k = 0; k < 3; k++)
-            p->vec[k][a] *= m->s[a];
-    }
-}
-
-/* Every box (and pattern lattice) of x's subtree in E's tree mapped by m. */
-static void map_subtree(edited *E, int32_t x, const axis_map *m)
+/* Every box (and pattern lattice) of x's subtree in E's tree mapped by m (no turn). */
+static void map_subtree(edited *E, int32_t x, const ag_place_map *m)
 {
     ag_splittree *t = E->t;
     int32_t *stack = malloc((t->nnodes + 1) * sizeof *stack);
@@ -100,18 +101,20 @@ static void map_subtree(edited *E, int32_t x, const axis_map *m)
         ag_tnode *n = &t->nodes[v];
         n->box = map_box(m, &n->box);
         if (n->kind == AG_NODE_PATTERN && n->pattern >= 0 && (size_t)n->pattern < t->npatterns)
-            map_pattern(m, &t->patterns[n->pattern]);
+            map_pattern(m, &t->patterns[n->pattern], 0);
         for (int32_t c = n->first_child; c >= 0; c = t->nodes[c].next_sibling)
             stack[sp++] = c;
     }
     free(stack);
 }
 
-/* A new node copying node y of the input tree (its box mapped by m), linked to nothing. */
-static int32_t copy_node(edited *E, int32_t y, const axis_map *m)
+/* A new node copying node y of the tree copied from (the input's, or cs's), its box mapped by m,
+ * linked to nothing. */
+static int32_t copy_node(edited *E, const copy_source *cs, int32_t y, const ag_place_map *m)
 {
     if (E->st)
         return -1;
+    const ag_splittree *from = cs ? cs->from : E->ot;
     ag_splittree *t = E->t;
     int32_t c = ag_splittree_add_node(t, AG_NODE_DEAD);
     if (c < 0 || AG_ARRAY_RESERVE(E->src, E->cap_src, (size_t)c + 1)) {
@@ -119,17 +122,33 @@ static int32_t copy_node(edited *E, int32_t y, const axis_map *m)
         return -1;
     }
     ag_tnode *n = &t->nodes[c];
-    *n = E->ot->nodes[y];
+    *n = from->nodes[y];
     n->parent = n->first_child = n->last_child = n->next_sibling = -1;
     n->box = map_box(m, &n->box);
     E->src[c] = y;
-    if (n->kind == AG_NODE_PATTERN && n->pattern >= 0 && (size_t)n->pattern < E->ot->npatterns) {
+    if (cs) {
+        /* invisible nodes place nothing: any source will do */
+        E->src[c] = 0;
+        if (n->kind == AG_NODE_COMPONENT) {
+            int32_t vn = n->component >= 0 ? cs->view_node[n->component] : -1;
+            if (vn < 0) {
+                E->st = AG_ERR_INTERNAL;
+                return -1;
+            }
+            E->src[c] = vn;
+            int32_t vc = cs->view_comp[n->component];
+            n->label = cs->labels->label[vc];
+            n->variant = cs->labels->variant[vc];
+            n->rot = (uint8_t)((n->rot + cs->turns) & 3);
+        }
+    }
+    if (n->kind == AG_NODE_PATTERN && n->pattern >= 0 && (size_t)n->pattern < from->npatterns) {
         if (AG_ARRAY_RESERVE(t->patterns, t->cap_patterns, t->npatterns + 1)) {
             E->st = AG_ERR_NOMEM;
             return -1;
         }
-        ag_pattern p = E->ot->patterns[n->pattern];
-        map_pattern(m, &p);
+        ag_pattern p = from->patterns[n->pattern];
+        map_pattern(m, &p, cs ? cs->turns : 0);
         p.node = c;
         t->patterns[t->npatterns] = p;
         t->nodes[c].pattern = (int32_t)t->npatterns++;
@@ -137,17 +156,18 @@ static int32_t copy_node(edited *E, int32_t y, const axis_map *m)
     return c;
 }
 
-/* A copy of the input's subtree of y, boxes mapped by m, hung in parent's list after `after`
- * (-1: at the end). Returns the copy of y. */
-static int32_t copy_subtree(edited *E, int32_t y, const axis_map *m, int32_t parent, int32_t after)
+/* A copy of the subtree of y (of the input, or of cs's tree), boxes mapped by m, hung in
+ * parent's list after `after` (-1: at the end). Returns the copy of y. */
+static int32_t copy_subtree(edited *E, const copy_source *cs, int32_t y, const ag_place_map *m,
+                            int32_t parent, int32_t after)
 {
-    const ag_splittree *ot = E->ot;
-    int32_t top = copy_node(E, y, m);
+    const ag_splittree *from = cs ? cs->from : E->ot;
+    int32_t top = copy_node(E, cs, y, m);
     if (top < 0)
         return -1;
     ag_splittree_attach_after(E->t, parent, after, top);
-    /* (input node, its copy) pairs whose children are still to copy */
-    int32_t *stack = malloc(2 * (ot->nnodes + 1) * sizeof *stack);
+    /* (node copied from, its copy) pairs whose children are still to copy */
+    int32_t *stack = malloc(2 * (from->nnodes + 1) * sizeof *stack);
     if (!stack) {
         E->st = AG_ERR_NOMEM;
         return -1;
@@ -156,10 +176,10 @@ static int32_t copy_subtree(edited *E, int32_t y, const axis_map *m, int32_t par
     stack[sp++] = y;
     stack[sp++] = top;
     while (sp && !E->st) {
-        int32_t into = stack[--sp], from = stack[--sp];
-        for (int32_t k = ot->nodes[from].first_child; k >= 0 && !E->st;
-             k = ot->nodes[k].next_sibling) {
-            int32_t c = copy_node(E, k, m);
+        int32_t into = stack[--sp], at = stack[--sp];
+        for (int32_t k = from->nodes[at].first_child; k >= 0 && !E->st;
+             k = from->nodes[k].next_sibling) {
+            int32_t c = copy_node(E, cs, k, m);
             if (c < 0)
                 break;
             ag_splittree_attach(E->t, into, c);
@@ -297,6 +317,10 @@ void ag_treeedit_base_free(ag_treeedit_base *b)
         free(b->labels.variant_deviation);
         free(b->tree.nodes);
     }
+    if (b->owns_mesh) {
+        free(b->mesh.pos);
+        free(b->mesh.tri);
+    }
     memset(b, 0, sizeof *b);
 }
 
@@ -325,7 +349,9 @@ ag_status ag_treeedit_split(const ag_proceduralize_result *in, const ag_edit_op 
     ag_box half[2] = {B, B};
     half[0].max[a] = op->at;
     half[1].min[a] = op->at;
-    axis_map lo = axis_map_of(&B, &half[0]), hi = axis_map_of(&B, &half[1]);
+    ag_place_map lo, hi;
+    ag_place_boxes(&lo, &B, &half[0], 0);
+    ag_place_boxes(&hi, &B, &half[1], 0);
     edited E;
     if (edited_begin(&E, ot))
         return nomem(err);
@@ -333,13 +359,13 @@ ag_status ag_treeedit_split(const ag_proceduralize_result *in, const ag_edit_op 
         /* the root stays one: each of its subtrees is halved */
         for (int32_t c = ot->nodes[0].first_child; c >= 0 && !E.st;
              c = ot->nodes[c].next_sibling) {
-            copy_subtree(&E, c, &hi, 0, -1);
+            copy_subtree(&E, NULL, c, &hi, 0, -1);
             if (!E.st)
                 map_subtree(&E, c, &lo);
         }
     } else {
         int32_t slot, p = chain_parent(E.t, op->node, &slot);
-        copy_subtree(&E, op->node, &hi, p, slot);
+        copy_subtree(&E, NULL, op->node, &hi, p, slot);
         if (!E.st)
             map_subtree(&E, op->node, &lo);
     }
@@ -420,6 +446,157 @@ static int above(const ag_splittree *t, int32_t a, int32_t b)
     return 0;
 }
 
+/* The view of in with the marked components of src appended, each turned by k quarter turns
+ * in place (about its box's centre), held by one more node each: view_node and view_comp (per
+ * component of src) get them. Another model's labels and variants become new ones. */
+static ag_status base_paste(ag_treeedit_base *b, const ag_proceduralize_result *in,
+                            const ag_proceduralize_result *src, const uint8_t *smark, int k,
+                            int32_t *view_node, int32_t *view_comp)
+{
+    const ag_labels *IL = in->labels, *SL = src->labels;
+    const ag_splittree *it = in->tree, *st = src->tree;
+    const ag_mesh *im = in->mesh, *sm = src->mesh;
+    int cross = src != in;
+    size_t nc = IL->ncomponents, nl = IL->nlabels, nv = IL->nvariants;
+    size_t extra = 0, xtris = 0;
+    for (size_t c = 0; c < st->ncomponents && c < SL->ncomponents; c++)
+        if (smark[c] && st->comp_node[c] >= 0) {
+            extra++;
+            xtris += SL->tri_start[c + 1] - SL->tri_start[c];
+        }
+    int32_t *lmap = malloc((SL->nlabels + 1) * sizeof *lmap);
+    int32_t *vmap = malloc((SL->nvariants + 1) * sizeof *vmap);
+    uint32_t *vtx = malloc((sm->nverts + 1) * sizeof *vtx);
+    uint32_t *stamp = calloc(sm->nverts + 1, sizeof *stamp);
+    ag_labels *L = &b->labels;
+    *L = *IL;
+    b->tree = *it;
+    b->mesh = *im;
+    b->owns = b->owns_mesh = 1;
+    size_t nall = nc + extra, ntris = IL->tri_start[nc];
+    L->label = malloc((nall + 1) * sizeof *L->label);
+    L->variant = malloc((nall + 1) * sizeof *L->variant);
+    L->rot = malloc(nall + 1);
+    L->vrot = malloc(nall + 1);
+    L->mirror = calloc(nall + 1, 1);
+    L->turn = calloc(nall + 1, sizeof *L->turn);
+    L->tri_start = malloc((nall + 1) * sizeof *L->tri_start);
+    L->tris = malloc((ntris + xtris + 1) * sizeof *L->tris);
+    L->variant_label = malloc((nv + SL->nvariants + 1) * sizeof *L->variant_label);
+    L->variant_deviation = calloc(nv + SL->nvariants + 1, sizeof *L->variant_deviation);
+    b->tree.nodes = malloc((it->nnodes + extra + 1) * sizeof *b->tree.nodes);
+    b->mesh.pos = malloc(3 * (im->nverts + 3 * xtris + 1) * sizeof *b->mesh.pos);
+    b->mesh.tri = malloc(3 * (im->ntris + xtris + 1) * sizeof *b->mesh.tri);
+    ag_status status = AG_OK;
+    if (!lmap || !vmap || !vtx || !stamp || !L->label || !L->variant || !L->rot || !L->vrot ||
+        !L->mirror || !L->turn || !L->tri_start || !L->tris || !L->variant_label ||
+        !L->variant_deviation || !b->tree.nodes || !b->mesh.pos || !b->mesh.tri) {
+        status = AG_ERR_NOMEM;
+        goto done;
+    }
+    memcpy(L->label, IL->label, nc * sizeof *L->label);
+    memcpy(L->variant, IL->variant, nc * sizeof *L->variant);
+    memcpy(L->rot, IL->rot, nc);
+    memcpy(L->vrot, IL->vrot, nc);
+    if (IL->mirror)
+        memcpy(L->mirror, IL->mirror, nc);
+    if (IL->turn)
+        memcpy(L->turn, IL->turn, nc * sizeof *L->turn);
+    memcpy(L->tri_start, IL->tri_start, (nc + 1) * sizeof *L->tri_start);
+    memcpy(L->tris, IL->tris, ntris * sizeof *L->tris);
+    memcpy(L->variant_label, IL->variant_label, nv * sizeof *L->variant_label);
+    if (IL->variant_deviation)
+        memcpy(L->variant_deviation, IL->variant_deviation, nv * sizeof *L->variant_deviation);
+    memcpy(b->tree.nodes, it->nodes, it->nnodes * sizeof *b->tree.nodes);
+    memcpy(b->mesh.pos, im->pos, 3 * im->nverts * sizeof *b->mesh.pos);
+    memcpy(b->mesh.tri, im->tri, 3 * im->ntris * sizeof *b->mesh.tri);
+    /* another model's labels and variants: new numbers after this model's */
+    size_t nl2 = nl, nv2 = nv;
+    for (size_t l = 0; l < SL->nlabels; l++)
+        lmap[l] = cross ? -1 : (int32_t)l;
+    for (size_t v = 0; v < SL->nvariants; v++)
+        vmap[v] = cross ? -1 : (int32_t)v;
+    size_t nvtx = im->nverts, ntri = im->ntris, ti = ntris, e = 0;
+    for (size_t c = 0; c < st->ncomponents && c < SL->ncomponents; c++) {
+        if (!smark[c] || st->comp_node[c] < 0)
+            continue;
+        int32_t l = SL->label[c], v = SL->variant[c];
+        if (l >= 0 && lmap[l] < 0)
+            lmap[l] = (int32_t)nl2++;
+        if (v >= 0 && vmap[v] < 0) {
+            vmap[v] = (int32_t)nv2++;
+            int32_t vl = SL->variant_label[v];
+            L->variant_label[vmap[v]] = vl >= 0 && lmap[vl] >= 0 ? lmap[vl] : lmap[l];
+            L->variant_deviation[vmap[v]] = SL->variant_deviation ? SL->variant_deviation[v] : 0;
+        }
+        const ag_tnode *sn = &st->nodes[st->comp_node[c]];
+        ag_box turned = sn->box;
+        if (k & 1) {
+            double cx = ag_box_centre_axis(&sn->box, 0), cy = ag_box_centre_axis(&sn->box, 1);
+            double hx = 0.5 * ag_box_extent(&sn->box, 1), hy = 0.5 * ag_box_extent(&sn->box, 0);
+            turned.min[0] = cx - hx;
+            turned.max[0] = cx + hx;
+            turned.min[1] = cy - hy;
+            turned.max[1] = cy + hy;
+        }
+        ag_place_map R;
+        ag_place_boxes(&R, &sn->box, &turned, k);
+        size_t comp = nc + e;
+        uint32_t emission = (uint32_t)e + 1;
+        L->tri_start[comp] = (uint32_t)ti;
+        for (uint32_t q = SL->tri_start[c]; q < SL->tri_start[c + 1]; q++) {
+            uint32_t tr = SL->tris[q];
+            for (int j = 0; j < 3; j++) {
+                uint32_t sv = sm->tri[3 * (size_t)tr + j];
+                if (stamp[sv] != emission) {
+                    stamp[sv] = emission;
+                    vtx[sv] = (uint32_t)nvtx;
+                    ag_place_apply(&R, &sm->pos[3 * (size_t)sv], &b->mesh.pos[3 * nvtx]);
+                    nvtx++;
+                }
+                b->mesh.tri[3 * ntri + j] = vtx[sv];
+            }
+            L->tris[ti++] = (uint32_t)ntri++;
+        }
+        L->label[comp] = l >= 0 ? lmap[l] : -1;
+        L->variant[comp] = v >= 0 ? vmap[v] : -1;
+        L->rot[comp] = (uint8_t)((SL->rot[c] + k) & 3);
+        L->vrot[comp] = (uint8_t)((SL->vrot[c] + k) & 3);
+        L->mirror[comp] = SL->mirror ? SL->mirror[c] : 0;
+        L->turn[comp] = (SL->turn ? SL->turn[c] : SL->rot[c] * 1.5707963267948966) +
+                        k * 1.5707963267948966;
+        int32_t vn = (int32_t)(it->nnodes + e);
+        ag_tnode *x = &b->tree.nodes[vn];
+        *x = *sn;
+        x->box = turned;
+        x->parent = x->first_child = x->last_child = x->next_sibling = -1;
+        x->component = (int32_t)comp;
+        x->label = L->label[comp];
+        x->variant = L->variant[comp];
+        x->rot = (uint8_t)((sn->rot + k) & 3);
+        x->rule = x->pattern = -1;
+        view_node[c] = vn;
+        view_comp[c] = (int32_t)comp;
+        e++;
+    }
+    L->tri_start[nall] = (uint32_t)ti;
+    L->ncomponents = nall;
+    L->nlabels = nl2;
+    L->nvariants = nv2;
+    b->tree.nnodes = b->tree.cap = it->nnodes + extra;
+    b->mesh.nverts = nvtx;
+    b->mesh.ntris = ntri;
+    b->view.labels = L;
+    b->view.tree = &b->tree;
+    b->view.mesh = &b->mesh;
+done:
+    free(lmap);
+    free(vmap);
+    free(vtx);
+    free(stamp);
+    return status;
+}
+
 ag_status ag_treeedit_paste(const ag_proceduralize_result *in, const ag_edit_op *op,
                             ag_treeedit_base *base, ag_splittree **tree, int32_t **source,
                             ag_edit_report *rep, ag_error *err)
@@ -427,25 +604,53 @@ ag_status ag_treeedit_paste(const ag_proceduralize_result *in, const ag_edit_op 
     *tree = NULL;
     *source = NULL;
     base_of(base, in);
-    const ag_splittree *ot = in->tree;
-    if (op->source && op->source != in)
-        return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
-                            "a paste from another model places terminals this model has no "
-                            "label for");
-    uint8_t *smark = calloc(ot->ncomponents + 1, 1);
+    const ag_proceduralize_result *src = op->source ? op->source : in;
+    const ag_splittree *ot = in->tree, *ts = src->tree;
+    uint8_t *smark = calloc(ts->ncomponents + 1, 1);
     if (!smark)
         return nomem(err);
     ag_place_paste_plan pl;
     ag_status st = ag_place_paste_plan_make(in, op, smark, &pl, err);
-    free(smark);
-    if (st)
+    if (st) {
+        free(smark);
         return st;
-    if (pl.turns)
-        return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
-                            "a turned paste places terminals turned from their boxes");
+    }
+    /* copies of the input's own nodes unturned are plain copies; the others place the view's
+     * components */
+    copy_source cs = {.from = ts, .turns = pl.turns}, *csp = NULL;
+    int32_t *view_node = NULL, *view_comp = NULL;
+    if (src != in || pl.turns) {
+        for (size_t c = 0; pl.turns && src->labels->mirror && c < ts->ncomponents; c++)
+            if (smark[c] && src->labels->mirror[c]) {
+                free(smark);
+                return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
+                                    "a turned paste of mirrored terminals");
+            }
+        view_node = malloc((ts->ncomponents + 1) * sizeof *view_node);
+        view_comp = malloc((ts->ncomponents + 1) * sizeof *view_comp);
+        for (size_t c = 0; view_node && view_comp && c < ts->ncomponents; c++)
+            view_node[c] = view_comp[c] = -1;
+        if (!view_node || !view_comp ||
+            base_paste(base, in, src, smark, pl.turns, view_node, view_comp)) {
+            free(smark);
+            free(view_node);
+            free(view_comp);
+            ag_treeedit_base_free(base);
+            base_of(base, in);
+            return nomem(err);
+        }
+        cs.view_node = view_node;
+        cs.view_comp = view_comp;
+        cs.labels = &base->labels;
+        csp = &cs;
+    }
+    free(smark);
     edited E;
-    if (edited_begin(&E, ot))
+    if (edited_begin(&E, ot)) {
+        free(view_node);
+        free(view_comp);
         return nomem(err);
+    }
     int32_t d = op->node, holder;
     if (op->placement == AG_EDIT_REPLACE && d != AG_EDIT_ROOT) {
         holder = holder_at_or_above(E.t, E.t->nodes[d].parent);
@@ -462,23 +667,29 @@ ag_status ag_treeedit_paste(const ag_proceduralize_result *in, const ag_edit_op 
         for (size_t y = 0; y < pl.counts[1] && !E.st; y++)
             for (size_t x = 0; x < pl.counts[0] && !E.st; x++) {
                 ag_box cell = ag_place_paste_cell(&pl, (unsigned)x, (unsigned)y, (unsigned)z);
-                axis_map m = axis_map_of(&pl.source_box, &cell);
+                ag_place_map m;
+                ag_place_boxes(&m, &pl.source_box, &cell, pl.turns);
                 for (size_t i = 0; i < op->nnodes && !E.st; i++) {
                     int32_t s = op->nodes[i], dup = 0;
                     for (size_t j = 0; j < op->nnodes && !dup; j++)
-                        dup = j != i && (op->nodes[j] == s ? j < i : above(ot, op->nodes[j], s));
+                        dup = j != i && (op->nodes[j] == s ? j < i : above(ts, op->nodes[j], s));
                     if (dup)
                         continue;
                     if (s == AG_EDIT_ROOT) /* the whole model: what the root holds */
-                        for (int32_t c = ot->nodes[0].first_child; c >= 0 && !E.st;
-                             c = ot->nodes[c].next_sibling)
-                            copy_subtree(&E, c, &m, holder, -1);
+                        for (int32_t c = ts->nodes[0].first_child; c >= 0 && !E.st;
+                             c = ts->nodes[c].next_sibling)
+                            copy_subtree(&E, csp, c, &m, holder, -1);
                     else
-                        copy_subtree(&E, s, &m, holder, -1);
+                        copy_subtree(&E, csp, s, &m, holder, -1);
                 }
             }
-    if ((st = edited_finish(&E, tree, source, err)))
+    free(view_node);
+    free(view_comp);
+    if ((st = edited_finish(&E, tree, source, err))) {
+        ag_treeedit_base_free(base);
+        base_of(base, in);
         return st;
+    }
     if (rep)
         ag_place_paste_message(rep, &pl, op);
     return AG_OK;

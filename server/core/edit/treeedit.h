@@ -16,11 +16,13 @@
  *           under its nearest visible ancestor with the destination's subtree dead
  *   remove  the selection's subtrees (and the split chains they hang by) are dead
  *
- * A join's terminal is geometry the input has no component for: *base is then a view of the
- * input with that component appended (ag_treeedit_base_free frees what the view owns), else
- * the input itself. A paste from another model, or one that turns its source (a window of a
- * side facade pasted on the front), is not expressible so: ag_treeedit_paste returns
- * AG_ERR_UNSUPPORTED and the caller takes the mesh path (edit.h). */
+ * A join's terminal, and the source of a paste that turns it (a window of a side facade pasted
+ * on the front) or comes from another model, are geometry the input has no component for:
+ * *base is then a view of the input with those components appended (a turned source turned
+ * in place, about its box's centre, with its quarter turns counted on; another model's labels
+ * and variants as new ones), and ag_treeedit_base_free frees what the view owns; else *base is
+ * the input itself. A turned paste of mirrored terminals is not made so: ag_treeedit_paste
+ * returns AG_ERR_UNSUPPORTED and the caller takes the mesh path (edit.h). */
 #ifndef AG_EDIT_TREEEDIT_H
 #define AG_EDIT_TREEEDIT_H
 
@@ -35,7 +37,9 @@ typedef struct {
     ag_proceduralize_result view; /* what ag_rebuild is given */
     ag_labels labels;             /* the view's labels when it adds a component */
     ag_splittree tree;            /* the view's tree when it adds a node */
+    ag_mesh mesh;                 /* the view's mesh when it adds geometry (positions, triangles) */
     int owns;                     /* labels' and tree's added arrays are owned */
+    int owns_mesh;                /* mesh's positions and triangles are owned */
 } ag_treeedit_base;
 
 void ag_treeedit_base_free(ag_treeedit_base *b);
