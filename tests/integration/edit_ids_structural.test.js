@@ -152,4 +152,35 @@ describe('split, remove and paste keep node ids', () => {
     assert.equal(undo.type, 'ack', JSON.stringify(undo));
     assert.equal(nodesText(await tree()), nodesText(t5), 'undo of the paste does not give the tree before it back');
   });
+
+  it('over REST: a window split, then resized by its old id; a join keeps the node nearest the root', async () => {
+    const post = (op, version) => http(d, 'POST', `/api/v1/models/${model.id}/ops`, {
+      body: { op }, headers: { 'If-Match': `"${version}"`, 'X-Archgram-User': 'cy' }, timeout: 60000,
+    });
+    const t0 = await tree();
+    const w = windowsOf(t0)[7];
+    const at = w.box[0] + 0.5 * size(w.box, 0);
+    let r = await post({ kind: 'split', node: w.id, axis: 'x', at }, t0.version);
+    assert.equal(r.status, 200, r.text);
+    const t1 = await tree();
+    keptAlone(t0, t1, below(t0, w.id), 'REST split');
+    assert.ok(near(t1.nodes[w.id].box[3], at), JSON.stringify(t1.nodes[w.id]));
+    const b = [...t1.nodes[w.id].box];
+    b[5] += 0.3;
+    r = await post({ kind: 'resize', node: w.id, box: b, mode: 'local' }, t1.version);
+    assert.equal(r.status, 200, r.text);
+    const t2 = await tree();
+    assert.ok(near(t2.nodes[w.id].box[5], b[5]), JSON.stringify(t2.nodes[w.id]));
+    assert.equal(t2.nodes[w.id].label, w.label);
+    // join two other windows: one keeps its id with the union box, the other is dead
+    const [j1, j2] = [windowsOf(t2)[10], windowsOf(t2)[11]];
+    r = await post({ kind: 'join', nodes: [j1.id, j2.id] }, t2.version);
+    assert.equal(r.status, 200, r.text);
+    const t3 = await tree();
+    keptAlone(t2, t3, new Set([j1.id, j2.id]), 'REST join');
+    const [kept, gone] = t3.nodes[j1.id].kind === 'dead' ? [j2, j1] : [j1, j2];
+    assert.equal(t3.nodes[gone.id].kind, 'dead');
+    const u = [0, 1, 2].map((a) => Math.min(j1.box[a], j2.box[a])).concat([0, 1, 2].map((a) => Math.max(j1.box[a + 3], j2.box[a + 3])));
+    assert.ok(sameBox(t3.nodes[kept.id].box, u), JSON.stringify([t3.nodes[kept.id].box, u]));
+  });
 });
