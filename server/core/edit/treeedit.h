@@ -9,8 +9,9 @@
  *           root's subtrees so)
  *   join    the visible nodes at or directly below the selection become one visible node whose
  *           box is the union of theirs and whose terminal is their geometry together (a label
- *           of its own); it keeps the smallest id of them, the others are dead and their
- *           children hang under it; it hangs under the nearest visible ancestor that holds it
+ *           of its own); it keeps the id of the one nearest the root (the smallest of those as
+ *           near), the others are dead and their children hang under it; it hangs under the
+ *           nearest visible ancestor that holds it
  *   paste   the copies of the source selection are appended: inserted under the destination
  *           (its nearest visible ancestor when it is invisible), or, when they replace it,
  *           under its nearest visible ancestor with the destination's subtree dead
