@@ -635,11 +635,71 @@ static void turned_and_cross_model_pastes_keep_ids(void **state)
     }
 }
 
+/* Bad ops get the same precise error from the tree path as from the mesh path, and no model. */
+static void bad_ops_are_refused_as_before(void **state)
+{
+    (void)state;
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    ag_edit_model *em = bb_service_model(&variants[0], &m, &err);
+    assert_non_null(em);
+    const ag_splittree *t = em->proc->tree;
+    int32_t wall = largest(t), wa, wb;
+    two_windows(em, &wa, &wb);
+    const ag_box *W = &t->nodes[wall].box;
+    int32_t one[1] = {wa}, root[2] = {wa, AG_EDIT_ROOT}, far[1] = {(int32_t)t->nnodes + 5};
+    const struct {
+        ag_edit_op op;
+        const char *says;
+    } bad[] = {
+        {{.kind = AG_EDIT_SPLIT, .node = wall, .axis = 0, .at = W->max[0] + 1}, "not inside"},
+        {{.kind = AG_EDIT_SPLIT, .node = wall, .axis = 3, .at = 0}, "axis"},
+        {{.kind = AG_EDIT_SPLIT, .node = (int32_t)t->nnodes, .axis = 0, .at = 0}, "not in the split tree"},
+        {{.kind = AG_EDIT_REMOVE}, "nodes is empty"},
+        {{.kind = AG_EDIT_REMOVE, .nnodes = 2, .nodes = root}, "the root cannot be removed"},
+        {{.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = far}, "not in the split tree"},
+        {{.kind = AG_EDIT_JOIN, .nnodes = 1, .nodes = one}, "at least two distinct visible nodes"},
+        {{.kind = AG_EDIT_JOIN, .nnodes = 2, .nodes = root}, "the root cannot be joined"},
+        {{.kind = AG_EDIT_PASTE, .node = wb}, "source selection"},
+        {{.kind = AG_EDIT_PASTE, .node = wb, .nnodes = 1, .nodes = one, .placement = 7}, "placement"},
+        {{.kind = AG_EDIT_PASTE, .node = wb, .nnodes = 1, .nodes = far}, "not in the split tree"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        ag_edit_model *out = NULL;
+        ag_error e1 = {0}, e2 = {0};
+        ag_status s1 = ag_edit_apply_ex(em, &bad[i].op, 0, &out, NULL, &e1);
+        assert_null(out);
+        ag_status s2 = ag_edit_apply_ex(em, &bad[i].op, AG_EDIT_MESH_PATH, &out, NULL, &e2);
+        assert_null(out);
+        if (!s1 || s1 != s2 || strcmp(e1.text, e2.text) || !strstr(e1.text, bad[i].says))
+            fail_msg("bad op %zu: %d \"%s\" vs the mesh path %d \"%s\"", i, s1, e1.text, s2,
+                     e2.text);
+    }
+    /* removing everything leaves nothing: refused, as before */
+    int32_t all[1] = {0};
+    ag_edit_op rm = {.kind = AG_EDIT_REMOVE, .nnodes = 0, .nodes = all};
+    size_t k = 0;
+    int32_t *tops = malloc((t->nnodes + 1) * sizeof *tops);
+    for (int32_t c = t->nodes[0].first_child; c >= 0; c = t->nodes[c].next_sibling)
+        tops[k++] = c;
+    rm.nodes = tops;
+    rm.nnodes = k;
+    ag_edit_model *out = NULL;
+    ag_error e1 = {0};
+    assert_int_not_equal(ag_edit_apply_ex(em, &rm, 0, &out, NULL, &e1), AG_OK);
+    assert_null(out);
+    assert_non_null(strstr(e1.text, "no geometry"));
+    free(tops);
+    ag_edit_model_free(em);
+    ag_mesh_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(ids_survive_split_join_paste_remove),
         cmocka_unit_test(turned_and_cross_model_pastes_keep_ids),
+        cmocka_unit_test(bad_ops_are_refused_as_before),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
