@@ -548,6 +548,33 @@ static void run_variant(const bb_options *o)
         ag_edit_model_free(out);
     }
     free(paste.nodes);
+
+    /* a pattern: split (its cells squeezed, a copy of it appended), removed, its cells joined */
+    int32_t pat = -1;
+    for (size_t n = 0; n < nn && pat < 0; n++)
+        if (t->nodes[n].kind == AG_NODE_PATTERN)
+            pat = (int32_t)n;
+    if (pat < 0)
+        fail_msg("%s: the building has no pattern", o->name);
+    const ag_box *P = &t->nodes[pat].box;
+    ag_edit_op split_p = {.kind = AG_EDIT_SPLIT, .node = pat, .axis = 2,
+                          .at = P->min[2] + 0.5 * ag_box_extent(P, 2)};
+    memset(touched, 0, nn);
+    below = visible_below(t, pat, touched);
+    case_t c10 = {"split a pattern", split_p, touched, 0, below};
+    check_case(em, &c10, o);
+    check_split_boxes(em, &split_p, o);
+    ag_edit_op rm_p = {.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = list(pat, pat)};
+    memset(touched, 0, nn);
+    visible_below(t, pat, touched);
+    case_t c11 = {"remove a pattern", rm_p, touched, 1, 0};
+    check_case(em, &c11, o);
+    rm_p.kind = AG_EDIT_JOIN; /* a pattern stands for its cells */
+    memset(touched, 0, nn);
+    visible_below(t, pat, touched);
+    case_t c12 = {"join a pattern's cells", rm_p, touched, 2, 0};
+    check_case(em, &c12, o);
+    free(rm_p.nodes);
     free(touched);
     ag_edit_model_free(em);
     ag_mesh_free(m);
