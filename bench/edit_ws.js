@@ -3,7 +3,8 @@
 // drag previews (solved with the kept factorization, never stored); prints op→ack,
 // op→broadcast (to B) and preview→room (to B) times. Then the same committed ops on the
 // generated 20k- and 200k-triangle buildings of bench/edit (written by `build/bench/edit
-// --write-obj`). Target: an op reaches the other clients ≤ 50 ms after it is sent at 200k.
+// --write-obj`), and split, remove, paste and join there. Target: an op reaches
+// the other clients ≤ 50 ms after it is sent at 200k.
 // Prints figures; not a test.
 import fs from 'node:fs';
 import os from 'node:os';
@@ -83,6 +84,48 @@ async function committedOps(model, A, B, version, what) {
     `all threads, from op sent to ack and broadcast received; load average ${os.loadavg()[0].toFixed(2)})`);
 }
 
+// Committed split, remove, paste and join ops on a model, each on other windows of the tree
+// read once before them all (they keep node ids, so those ids stay valid): op→ack and
+// op→broadcast per kind.
+const STRUCTURAL = 10;
+async function structuralOps(model, A, B, version, what) {
+  const t = (await http(d, 'GET', `/api/v1/models/${model.id}/tree`, { timeout: 60000 })).json;
+  const wins = t.nodes.filter((n) => n.visible && n.children.length === 0 && n.box[3] - n.box[0] < 2 &&
+    n.box[5] - n.box[2] < 3 && n.box[3] - n.box[0] > 0.3 && n.box[4] - n.box[1] < 1);
+  if (wins.length < 6 * STRUCTURAL) { console.log(`edit ws ${what}: ${wins.length} windows; structural ops skipped`); return version; }
+  const kinds = {
+    split: (i) => { const w = wins[i]; return { kind: 'split', node: w.id, axis: 'x', at: 0.5 * (w.box[0] + w.box[3]) }; },
+    remove: (i) => ({ kind: 'remove', nodes: [wins[STRUCTURAL + i].id] }),
+    paste: (i) => ({ kind: 'paste', source: [wins[2 * STRUCTURAL + i].id], target: wins[3 * STRUCTURAL + i].id, placement: 'replace', fit: 'derive' }),
+    join: (i) => ({ kind: 'join', nodes: [wins[4 * STRUCTURAL + 2 * i].id, wins[4 * STRUCTURAL + 2 * i + 1].id] }),
+  };
+  for (const [name, make] of Object.entries(kinds)) {
+    const toAck = [];
+    const toPeer = [];
+    let cpu = 0;
+    for (let i = 0; i < STRUCTURAL; i++) {
+      const cid = `${name}-${model.id}-${i}`;
+      const ack = A.next((m) => (m.type === 'ack' || m.type === 'nack') && m.cid === cid, 60000);
+      const seen = B.next((m) => m.type === 'op' && m.cid === cid, 60000);
+      const c0 = daemonCpuMs();
+      const ts = performance.now();
+      A.send({ type: 'op', base: version, cid, op: make(i) });
+      const [a] = await Promise.all([
+        ack.then((m) => { toAck.push(performance.now() - ts); return m; }),
+        seen.then(() => { toPeer.push(performance.now() - ts); }),
+      ]);
+      cpu += daemonCpuMs() - c0;
+      if (a.type !== 'ack') throw new Error(`${name} ${i} on ${what} refused: ${JSON.stringify(a)}`);
+      version = a.version;
+      A.all.length = 0;
+      B.all.length = 0;
+    }
+    console.log(`edit ws ${what}: ${name} op→ack ${summary(toAck)}; op→broadcast ${summary(toPeer)}; ` +
+      `archgramd CPU per op ${(cpu / STRUCTURAL).toFixed(1)} ms`);
+  }
+  return version;
+}
+
 const d = await startDaemon({ args: ['--demo'] });
 let A;
 let B;
@@ -145,6 +188,8 @@ try {
       const v = (await GA.request({ type: 'hello', model: g.id, user: 'a' }, 'welcome')).version;
       await GB.request({ type: 'hello', model: g.id, user: 'b' }, 'welcome');
       await committedOps(g, GA, GB, v, `generated ${size} (${g.stats.triangles} triangles)`);
+      const now = (await http(d, 'GET', `/api/v1/models/${g.id}`)).json.version;
+      await structuralOps(g, GA, GB, now, `generated ${size}`);
     } finally {
       await GA.close();
       await GB.close();
