@@ -361,6 +361,40 @@ static void check_split_boxes(ag_edit_model *em, const ag_edit_op *op, const bb_
     ag_edit_model_free(out);
 }
 
+/* Checks a paste derive of one unturned source node: every visible node of its subtree has an
+ * appended copy of its label whose box is its box mapped from the source's box onto the
+ * target's. */
+static void check_paste_boxes(ag_edit_model *em, const ag_edit_op *op, const bb_options *o)
+{
+    ag_edit_model *out = NULL;
+    ag_error err = {0};
+    assert_int_equal(ag_edit_apply_ex(em, op, 0, &out, NULL, &err), AG_OK);
+    const ag_splittree *t0 = em->proc->tree, *t1 = out->proc->tree;
+    const ag_box S = t0->nodes[op->nodes[0]].box, D = t0->nodes[op->node].box;
+    double tol = 1e-9 * fmax(1, fabs(D.max[0]) + fabs(D.max[1]) + fabs(D.max[2]));
+    size_t found = 0, want = 0;
+    for (size_t n = 0; n < t0->nnodes; n++) {
+        if (t0->nodes[n].kind != AG_NODE_COMPONENT || !in_subtree(t0, (int32_t)n, op->nodes[0]))
+            continue;
+        want++;
+        ag_box b = t0->nodes[n].box, m;
+        for (int a = 0; a < 3; a++) {
+            double f = ag_box_extent(&S, a) > 0 ? ag_box_extent(&D, a) / ag_box_extent(&S, a) : 1;
+            m.min[a] = D.min[a] + (b.min[a] - S.min[a]) * f;
+            m.max[a] = D.min[a] + (b.max[a] - S.min[a]) * f;
+        }
+        for (size_t k = t0->nnodes; k < t1->nnodes; k++)
+            if (t1->nodes[k].kind == AG_NODE_COMPONENT && same_box(&t1->nodes[k].box, &m, tol) &&
+                !strcmp(label_of(out, (int32_t)k), label_of(em, (int32_t)n))) {
+                found++;
+                break;
+            }
+    }
+    if (found != want)
+        fail_msg("%s: paste: %zu of %zu nodes have their copy in the target", o->name, found, want);
+    ag_edit_model_free(out);
+}
+
 /* ---- the buildings ------------------------------------------------------------------------ */
 
 static const bb_options variants[] = {
@@ -517,12 +551,14 @@ static void run_variant(const bb_options *o)
     visible_below(t, wb, touched);
     case_t c7 = {"paste a window onto another", paste, touched, 1, visible_below(t, wa, NULL)};
     check_case(em, &c7, o);
+    check_paste_boxes(em, &paste, o);
     paste.node = wa;
     paste.nodes[0] = wb;
     paste.placement = AG_EDIT_INSERT;
     memset(touched, 0, nn);
     case_t c8 = {"paste a window into another", paste, touched, 0, visible_below(t, wb, NULL)};
     check_case(em, &c8, o);
+    check_paste_boxes(em, &paste, o);
     /* fill the window's wall with it (a grid of copies): the largest node of its facade */
     int32_t front = -1;
     for (size_t n = 0; n < nn; n++)
