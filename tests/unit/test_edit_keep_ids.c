@@ -542,6 +542,13 @@ static void run_variant(const bb_options *o)
         assert_string_not_equal(label_of(out, kept), label_of(em, kept));
         ag_edit_model_free(out);
     }
+    /* the wall and a window (in it, when recessed): one node of both */
+    join.nodes[0] = wall;
+    join.nodes[1] = wa;
+    memset(touched, 0, nn);
+    touched[wall] = touched[wa] = 1;
+    case_t c6b = {"join the wall and a window", join, touched, 2, 0};
+    check_case(em, &c6b, o);
     free(join.nodes);
 
     /* paste a window onto another (replace, derive), and into itself (insert, derive) */
