@@ -222,6 +222,23 @@ static inline ag_mesh *bb_generate(const bb_options *o)
     return g.m;
 }
 
+/* The buildings the id tests (test_edit_ids.c, test_edit_keep_ids.c) run on: windows recessed,
+ * flush and proud, a turned building with a roof overhang, UTM coordinates, jitter. *n gets
+ * their count. */
+static inline const bb_options *bb_id_variants(size_t *n)
+{
+    static const bb_options v[] = {
+        {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0},
+        {"flush", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0},
+        {"proud", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0},
+        {"proud, overhang, turned a quarter", 6, 3, 3, 2, BB_PROUD, 0.3, 1, 0, 0, 0, 0},
+        {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0},
+        {"flush, jittered", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7},
+    };
+    *n = sizeof v / sizeof *v;
+    return v;
+}
+
 /* ---- measuring a mesh --------------------------------------------------------------------- */
 
 /* A component's bounding box in the building frame (turn and offset undone). */

@@ -95,14 +95,6 @@ static size_t count_with_height(const ag_mesh *m, const bb_options *o, const cha
     return ok;
 }
 
-static const bb_options variants[] = {
-    {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0},
-    {"flush", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0},
-    {"proud", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0},
-    {"proud, overhang, turned a quarter", 6, 3, 3, 2, BB_PROUD, 0.3, 1, 0, 0, 0, 0},
-    {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0},
-    {"flush, jittered", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7},
-};
 
 static void run_variant(const bb_options *o)
 {
@@ -195,7 +187,9 @@ static void run_variant(const bb_options *o)
 static void ids_survive_a_facade_stretch(void **state)
 {
     (void)state;
-    for (size_t i = 0; i < sizeof variants / sizeof *variants; i++)
+    size_t nv;
+    const bb_options *variants = bb_id_variants(&nv);
+    for (size_t i = 0; i < nv; i++)
         run_variant(&variants[i]);
 }
 
@@ -203,7 +197,8 @@ static void ids_survive_a_facade_stretch(void **state)
 static void a_broken_kept_model_is_refused(void **state)
 {
     (void)state;
-    const bb_options *o = &variants[2];
+    size_t nv;
+    const bb_options *o = &bb_id_variants(&nv)[2];
     ag_mesh *m = bb_generate(o);
     ag_edit_model *em = NULL;
     ag_error err = {0};

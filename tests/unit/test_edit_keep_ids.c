@@ -397,14 +397,6 @@ static void check_paste_boxes(ag_edit_model *em, const ag_edit_op *op, const bb_
 
 /* ---- the buildings ------------------------------------------------------------------------ */
 
-static const bb_options variants[] = {
-    {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0},
-    {"flush", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0},
-    {"proud", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0},
-    {"proud, overhang, turned a quarter", 6, 3, 3, 2, BB_PROUD, 0.3, 1, 0, 0, 0, 0},
-    {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0},
-    {"flush, jittered", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7},
-};
 
 /* The visible node with the largest box volume (a wall). */
 static int32_t largest(const ag_splittree *t)
@@ -626,7 +618,9 @@ static void run_variant(const bb_options *o)
 static void ids_survive_split_join_paste_remove(void **state)
 {
     (void)state;
-    for (size_t i = 0; i < sizeof variants / sizeof *variants; i++)
+    size_t nv;
+    const bb_options *variants = bb_id_variants(&nv);
+    for (size_t i = 0; i < nv; i++)
         run_variant(&variants[i]);
 }
 
@@ -651,7 +645,9 @@ static void front_and_side(const ag_splittree *t, int32_t *front, int32_t *side)
 static void turned_and_cross_model_pastes_keep_ids(void **state)
 {
     (void)state;
-    for (size_t v = 0; v < sizeof variants / sizeof *variants; v++) {
+    size_t nv;
+    const bb_options *variants = bb_id_variants(&nv);
+    for (size_t v = 0; v < nv; v++) {
         const bb_options *o = &variants[v];
         ag_mesh *m = NULL;
         ag_error err = {0};
@@ -711,7 +707,8 @@ static void bad_ops_are_refused_as_before(void **state)
     (void)state;
     ag_mesh *m = NULL;
     ag_error err = {0};
-    ag_edit_model *em = bb_service_model(&variants[0], &m, &err);
+    size_t nv;
+    ag_edit_model *em = bb_service_model(&bb_id_variants(&nv)[0], &m, &err);
     assert_non_null(em);
     const ag_splittree *t = em->proc->tree;
     int32_t wall = largest(t), wa, wb;
