@@ -292,8 +292,10 @@ static ag_status edited_finish(edited *E, ag_splittree **tree, int32_t **source,
     if (!E->st && ag_treeedit_span_invisible(E->t))
         E->st = AG_ERR_NOMEM;
     if (E->st) {
+        ag_status st = E->st;
         edited_drop(E);
-        return nomem(err);
+        return st == AG_ERR_NOMEM ? nomem(err)
+                                  : ag_error_set(err, st, 0, "the edited split tree is inconsistent");
     }
     *tree = E->t;
     *source = E->src;
