@@ -8,6 +8,7 @@
 
 #include "../base/array.h"
 #include "../base/search.h"
+#include "flats.h"
 #include "keysort.h"
 #include "weld_points.h"
 #include "predicates.h"
@@ -196,13 +197,17 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
         free(map);
         return st;
     }
-    size_t ns = s->nsegs;
-    uint32_t *g = s->segs;
-    for (size_t i = 0; i < ns; i++) {
-        g[3 * i + 1] = map[g[3 * i + 1]];
-        g[3 * i + 2] = map[g[3 * i + 2]];
+    for (size_t i = 0; i < s->nsegs; i++) {
+        s->segs[3 * i + 1] = map[s->segs[3 * i + 1]];
+        s->segs[3 * i + 2] = map[s->segs[3 * i + 2]];
     }
     free(map);
+    /* terrace and soffit faces at one height: the difference of the plans (flats.h) */
+    st = ag_flats_rebuild(s, weld_tol);
+    if (st != AG_OK)
+        return st;
+    size_t ns = s->nsegs;
+    uint32_t *g = s->segs;
     /* sort segments by face, then cancel zero-length and in-face opposite pairs */
     uint32_t *ord = malloc((ns ? ns : 1) * sizeof *ord);
     uint8_t *dead = calloc(ns ? ns : 1, 1);
