@@ -261,6 +261,95 @@ static inline double xc_top(const ag_mesh *m, long component)
     return top;
 }
 
+/* --- volume and winding from the triangles alone --------------------------------------- */
+
+/* The corners of triangle t of m about the point o (UTM-sized coordinates keep their
+ * digits). */
+static inline void xc_corners_about(const ag_mesh *m, size_t t, const double *o, double p[3][3])
+{
+    for (int k = 0; k < 3; k++)
+        for (int d = 0; d < 3; d++)
+            p[k][d] = m->pos[3 * m->tri[3 * t + k] + d] - o[d];
+}
+
+/* Volume of the triangles, computed here from the mesh alone. */
+static inline double xc_mesh_volume(const ag_mesh *m)
+{
+    if (!m->ntris)
+        return 0;
+    const double *o = &m->pos[3 * m->tri[0]];
+    double v = 0;
+    for (size_t t = 0; t < m->ntris; t++) {
+        double p[3][3];
+        xc_corners_about(m, t, o, p);
+        v += p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) -
+             p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
+             p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0]);
+    }
+    return v / 6;
+}
+
+/* Solid angle of triangle (a, b, c) seen from the origin (van Oosterom and Strackee). */
+static inline double xc_solid_angle(const double a[3], const double b[3], const double c[3])
+{
+    double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    double lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                 a[2] * (b[0] * c[1] - b[1] * c[0]);
+    double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
+    double ca = c[0] * a[0] + c[1] * a[1] + c[2] * a[2];
+    return 2 * atan2(det, la * lb * lc + ab * lc + bc * la + ca * lb);
+}
+
+/* The winding number of the triangles about a point just inside each of them (a hair
+ * behind a point near its centre) that is furthest from 1: 1 everywhere for a shell that bounds its
+ * solid once; 2 or more where a face of the shell lies inside another part of it (a shell
+ * overlapping itself), 0 behind a face with no solid behind it (a fin of two faces back to
+ * back, a double-sided sliver): neither shows in welding and counting faces per edge. */
+static inline long xc_max_winding(const ag_mesh *m)
+{
+    if (!m->ntris)
+        return 0;
+    const double *o = &m->pos[3 * m->tri[0]];
+    long worst = 1;
+    for (size_t s = 0; s < m->ntris; s++) {
+        double p[3][3];
+        xc_corners_about(m, s, o, p);
+        double u[3], v[3], n[3];
+        for (int d = 0; d < 3; d++)
+            u[d] = p[1][d] - p[0][d], v[d] = p[2][d] - p[0][d];
+        n[0] = u[1] * v[2] - u[2] * v[1];
+        n[1] = u[2] * v[0] - u[0] * v[2];
+        n[2] = u[0] * v[1] - u[1] * v[0];
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        double per = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) +
+                     sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) +
+                     sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
+                          (u[2] - v[2]) * (u[2] - v[2]));
+        /* a hair behind a point near the centre (off the thirds where grid-aligned walls
+         * pass), well inside the face's inscribed circle (radius len / per); a sliver too
+         * thin for that has no inside to probe */
+        double eps = fmin(1e-6, 0.01 * len / (per > 0 ? per : 1));
+        if (!(eps > 1e-9))
+            continue;
+        double q[3];
+        for (int d = 0; d < 3; d++)
+            q[d] = 0.3137 * p[0][d] + 0.3311 * p[1][d] + 0.3552 * p[2][d] - eps * n[d] / len;
+        double omega = 0;
+        for (size_t t = 0; t < m->ntris; t++) {
+            double a[3][3], oq[3] = {o[0] + q[0], o[1] + q[1], o[2] + q[2]};
+            xc_corners_about(m, t, oq, a);
+            omega += xc_solid_angle(a[0], a[1], a[2]);
+        }
+        long w = lround(omega / (4 * M_PI));
+        if (labs(w - 1) > labs(worst - 1))
+            worst = w;
+    }
+    return worst;
+}
+
 /* --- the CGAL oracle (../shared/tools/cgal_skeleton, built into build/oracle) --------------- */
 
 /* The oracle binary, or NULL (with a line saying why, so the caller can skip). */

@@ -37,8 +37,6 @@ static double rnd(void)
 
 #define MAXC 1024
 
-static long max_winding(const ag_mesh *m);
-
 /* A comb: `teeth` teeth of width w and gaps g (integers), base height b, tooth length t. */
 static size_t comb(int teeth, int w, int g, int b, int t, double *xy)
 {
@@ -253,7 +251,7 @@ static void run_plan(const double *xy, size_t n, const ag_profile_point *const *
         const double *loops[1] = {xy};
         size_t sizes[1] = {n};
         double out = xc_outside(m, -1, loops, sizes, 1, 0);
-        long wind = manifold ? max_winding(m) : 1;
+        long wind = manifold ? xc_max_winding(m) : 1;
         int ok_indep = manifold && out <= 1e-5 && wind == 1;
         if (manifold && wind != 1)
             snprintf(why, sizeof why, "the shell winds %ld times about a point just inside a "
@@ -429,7 +427,7 @@ static ag_built build_checked(const double *xy, size_t n, const int32_t *prof, d
         if (!xc_closed_manifold(m, -1, 1e-7, why, sizeof why))
             fail_msg("%s (repair %s): built %s but %s", what, repair ? "on" : "off",
                      ag_built_name(r.built), why);
-        long w = max_winding(m);
+        long w = xc_max_winding(m);
         if (w != 1)
             fail_msg("%s (repair %s): built %s but the shell winds %ld times just inside a face",
                      what, repair ? "on" : "off", ag_built_name(r.built), w);
@@ -523,92 +521,6 @@ static void test_grid_plans_fall_back_honestly(void **state)
 
 /* --- plans whose chains cross after the inter-chain stage --------------------------------- */
 
-/* The corners of triangle t of m about the point o (UTM-sized coordinates keep their
- * digits). */
-static void corners_about(const ag_mesh *m, size_t t, const double *o, double p[3][3])
-{
-    for (int k = 0; k < 3; k++)
-        for (int d = 0; d < 3; d++)
-            p[k][d] = m->pos[3 * m->tri[3 * t + k] + d] - o[d];
-}
-
-/* Volume of the triangles, computed here from the mesh alone. */
-static double mesh_volume(const ag_mesh *m)
-{
-    if (!m->ntris)
-        return 0;
-    const double *o = &m->pos[3 * m->tri[0]];
-    double v = 0;
-    for (size_t t = 0; t < m->ntris; t++) {
-        double p[3][3];
-        corners_about(m, t, o, p);
-        v += p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) -
-             p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
-             p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0]);
-    }
-    return v / 6;
-}
-
-/* Solid angle of triangle (a, b, c) seen from the origin (van Oosterom and Strackee). */
-static double solid_angle(const double a[3], const double b[3], const double c[3])
-{
-    double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
-    double lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-                 a[2] * (b[0] * c[1] - b[1] * c[0]);
-    double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
-    double ca = c[0] * a[0] + c[1] * a[1] + c[2] * a[2];
-    return 2 * atan2(det, la * lb * lc + ab * lc + bc * la + ca * lb);
-}
-
-/* The winding number of the triangles about a point just inside each of them (a hair
- * behind a point near its centre) that is furthest from 1: 1 everywhere for a shell that bounds its
- * solid once; 2 or more where a face of the shell lies inside another part of it (a shell
- * overlapping itself), 0 behind a face with no solid behind it (a fin of two faces back to
- * back, a double-sided sliver): neither shows in welding and counting faces per edge. */
-static long max_winding(const ag_mesh *m)
-{
-    if (!m->ntris)
-        return 0;
-    const double *o = &m->pos[3 * m->tri[0]];
-    long worst = 1;
-    for (size_t s = 0; s < m->ntris; s++) {
-        double p[3][3];
-        corners_about(m, s, o, p);
-        double u[3], v[3], n[3];
-        for (int d = 0; d < 3; d++)
-            u[d] = p[1][d] - p[0][d], v[d] = p[2][d] - p[0][d];
-        n[0] = u[1] * v[2] - u[2] * v[1];
-        n[1] = u[2] * v[0] - u[0] * v[2];
-        n[2] = u[0] * v[1] - u[1] * v[0];
-        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        double per = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) +
-                     sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) +
-                     sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
-                          (u[2] - v[2]) * (u[2] - v[2]));
-        /* a hair behind a point near the centre (off the thirds where grid-aligned walls
-         * pass), well inside the face's inscribed circle (radius len / per); a sliver too
-         * thin for that has no inside to probe */
-        double eps = fmin(1e-6, 0.01 * len / (per > 0 ? per : 1));
-        if (!(eps > 1e-9))
-            continue;
-        double q[3];
-        for (int d = 0; d < 3; d++)
-            q[d] = 0.3137 * p[0][d] + 0.3311 * p[1][d] + 0.3552 * p[2][d] - eps * n[d] / len;
-        double omega = 0;
-        for (size_t t = 0; t < m->ntris; t++) {
-            double a[3][3], oq[3] = {o[0] + q[0], o[1] + q[1], o[2] + q[2]};
-            corners_about(m, t, oq, a);
-            omega += solid_angle(a[0], a[1], a[2]);
-        }
-        long w = lround(omega / (4 * M_PI));
-        if (labs(w - 1) > labs(worst - 1))
-            worst = w;
-    }
-    return worst;
-}
 
 /* Shells reported good that overlap themselves, without and with the repair. */
 static size_t overlap_claimed[2];
@@ -618,7 +530,7 @@ typedef struct {
     int good_self;       /* ag_extrude_result_ok */
     int good_indep;      /* closed 2-manifold after welding, within reach of the footprint */
     double out, volume;
-    long winding; /* max_winding */
+    long winding; /* xc_max_winding */
     size_t invalid, repairs, refused, dropped;
     char why[160];
 } xoutcome;
@@ -651,8 +563,8 @@ static xoutcome extrude_grid(const double *xy, size_t n, const int32_t *prof, do
     size_t sizes[1] = {n};
     o.out = xc_outside(m, -1, loops, sizes, 1, 0);
     o.good_self = ag_extrude_result_ok(&r);
-    o.volume = mesh_volume(m);
-    o.winding = manifold ? max_winding(m) : 0;
+    o.volume = xc_mesh_volume(m);
+    o.winding = manifold ? xc_max_winding(m) : 0;
     o.good_indep = manifold && o.out <= 2.5 + 1e-6 && o.winding == 1;
     if (manifold && o.winding != 1)
         snprintf(o.why, sizeof o.why, "the shell winds %ld times about a point just inside a face",

@@ -1,0 +1,195 @@
+/* Terrace and soffit steps at one height: edges whose profiles step inwards (a terrace) and
+ * edges whose profiles step outwards (a soffit) at the same height h, then rise as walls to
+ * H. Swept, the two kinds of horizontal face fold over each other around every corner
+ * between them; built as the difference of the plans below and above they must make a
+ * closed 2-manifold. Generated plans: rectangles, regular polygons and L shapes, plain,
+ * turned, jittered and at UTM-sized coordinates, started at every corner. Each building is
+ * judged independently of the extrusion's verdict: welded triangles with every directed edge
+ * once and its reverse once, the winding number 1 just inside every face, nothing further
+ * outside the footprint than the widest soffit's mitre, and the signed volume of the
+ * triangles equal to the analytic one, area(plan) h + area(plan above) (H - h), the plan
+ * above made of the edges' lines moved by their steps (small steps: no edge vanishes). */
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <setjmp.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/extrude/building.h"
+#include "core/extrude/extrude.h"
+#include "extrude_check.h"
+
+#define MAXN 16
+#define H_STEP 3.0
+#define H_TOP 5.0
+
+static uint64_t rng = 0x8F3A6C1D2B4E5F70ULL;
+static double rnd(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (double)(rng >> 11) / 9007199254740992.0;
+}
+
+/* Twice the signed area of a polygon, about its first corner. */
+static double area2(const double *xy, size_t n)
+{
+    double a = 0;
+    for (size_t i = 1; i + 1 < n; i++)
+        a += (xy[2 * i] - xy[0]) * (xy[2 * i + 3] - xy[1]) -
+             (xy[2 * i + 2] - xy[0]) * (xy[2 * i + 1] - xy[1]);
+    return a;
+}
+
+/* The plan above: each edge's line moved inwards by step[i] (negative: outwards), corners
+ * where consecutive lines meet; coordinates about the first corner of xy. */
+static void moved_plan(const double *xy, size_t n, const double *step, double *out)
+{
+    double ox = xy[0], oy = xy[1];
+    for (size_t j = 0; j < n; j++) {
+        size_t i = (j + n - 1) % n; /* edge i ends at corner j, edge j starts there */
+        double l[2][3];
+        for (int k = 0; k < 2; k++) {
+            size_t e = k ? j : i, f = (e + 1) % n;
+            double ax = xy[2 * e] - ox, ay = xy[2 * e + 1] - oy;
+            double dx = xy[2 * f] - xy[2 * e], dy = xy[2 * f + 1] - xy[2 * e + 1];
+            double len = hypot(dx, dy), nx = -dy / len, ny = dx / len;
+            l[k][0] = nx, l[k][1] = ny, l[k][2] = nx * ax + ny * ay + step[e];
+        }
+        double det = l[0][0] * l[1][1] - l[0][1] * l[1][0];
+        out[2 * j] = (l[0][2] * l[1][1] - l[0][1] * l[1][2]) / det;
+        out[2 * j + 1] = (l[0][0] * l[1][2] - l[0][2] * l[1][0]) / det;
+    }
+}
+
+/* The base shapes, counter-clockwise. */
+static size_t shape(int kind, double *xy)
+{
+    size_t n = 0;
+    if (kind == 0) { /* a rectangle */
+        double w = 6 + 4 * rnd(), d = 4 + 3 * rnd();
+        double c[] = {0, 0, w, 0, w, d, 0, d};
+        memcpy(xy, c, sizeof c);
+        n = 4;
+    } else if (kind == 1 || kind == 2) { /* a regular pentagon or hexagon */
+        n = kind == 1 ? 5 : 6;
+        double r = 4 + 2 * rnd();
+        for (size_t i = 0; i < n; i++) {
+            xy[2 * i] = r * cos(2 * M_PI * (double)i / (double)n);
+            xy[2 * i + 1] = r * sin(2 * M_PI * (double)i / (double)n);
+        }
+    } else { /* an L: reflex corners between the two kinds too */
+        double c[] = {0, 0, 8, 0, 8, 3, 3, 3, 3, 7, 0, 7};
+        memcpy(xy, c, sizeof c);
+        n = 6;
+    }
+    return n;
+}
+
+/* variant: bit 0 turned, bit 1 jittered, bit 2 at UTM-sized coordinates */
+static void transform(double *xy, size_t n, int variant)
+{
+    double a = (variant & 1) ? 0.4 + rnd() : 0;
+    double ox = (variant & 4) ? 512345.678 : 0, oy = (variant & 4) ? 5801234.321 : 0;
+    for (size_t i = 0; i < n; i++) {
+        double x = xy[2 * i], y = xy[2 * i + 1];
+        if (variant & 2) {
+            x += (rnd() - 0.5) * 0.2;
+            y += (rnd() - 0.5) * 0.2;
+        }
+        xy[2 * i] = ox + x * cos(a) - y * sin(a);
+        xy[2 * i + 1] = oy + x * sin(a) + y * cos(a);
+    }
+}
+
+/* Extrudes the plan (edge i steps in by step[i] at H_STEP, negative: out) and checks it. */
+static void check_plan(const double *xy, size_t n, const double *step, const char *what)
+{
+    ag_plan *p = ag_plan_create();
+    int32_t prof[MAXN];
+    for (size_t i = 0; i < n; i++) {
+        char name[16];
+        snprintf(name, sizeof name, "e%zu", i);
+        ag_profile_point pts[] = {{0, 0}, {0, H_STEP}, {step[i], H_STEP}, {step[i], H_TOP}};
+        ag_plan_add_profile(p, name, pts, 4, NULL, NULL, NULL);
+        prof[i] = (int32_t)i;
+    }
+    ag_plan_add_loop(p, xy, n, prof, NULL);
+    ag_mesh *m = ag_mesh_create();
+    ag_building_result r;
+    ag_extrude_options eo = {0};
+    ag_error err = {0};
+    assert_int_equal(ag_building_extrude_plan(p, &eo, m, -1, &r, &err), AG_OK);
+    ag_plan_free(p);
+    if (r.built != AG_BUILT_STYLED)
+        fail_msg("%s: built %s: %s", what, ag_built_name(r.built), r.reason);
+    char why[160] = "";
+    if (!xc_closed_manifold(m, -1, 1e-7, why, sizeof why))
+        fail_msg("%s: %s", what, why);
+    long w = xc_max_winding(m);
+    if (w != 1)
+        fail_msg("%s: the shell winds %ld times just inside a face", what, w);
+    double widest = 0;
+    for (size_t i = 0; i < n; i++)
+        widest = fmax(widest, -step[i]);
+    const double *loops[1] = {xy};
+    size_t sizes[1] = {n};
+    double out = xc_outside(m, -1, loops, sizes, 1, 0);
+    if (out > 2.5 * widest + 1e-6)
+        fail_msg("%s: reaches %.3g m outside the footprint (widest soffit %.3g m)", what, out,
+                 widest);
+    double above[2 * MAXN];
+    moved_plan(xy, n, step, above);
+    double expect = area2(xy, n) / 2 * H_STEP + area2(above, n) / 2 * (H_TOP - H_STEP);
+    double got = xc_mesh_volume(m);
+    if (fabs(got - expect) > 1e-7 * fabs(expect) + 1e-6)
+        fail_msg("%s: volume %.9f, analytic %.9f", what, got, expect);
+    ag_mesh_free(m);
+}
+
+/* Terraces and soffits alternating (and in runs) around each shape, every variant, every
+ * starting corner. */
+static void test_terrace_and_soffit_at_one_height(void **state)
+{
+    (void)state;
+    size_t plans = 0;
+    for (int kind = 0; kind < 4; kind++)
+        for (int variant = 0; variant < 8; variant++)
+            for (int pattern = 0; pattern < 3; pattern++) {
+                double base[2 * MAXN], xy[2 * MAXN], step[MAXN], rot_step[MAXN];
+                size_t n = shape(kind, base);
+                transform(base, n, variant);
+                for (size_t i = 0; i < n; i++) {
+                    int terrace = pattern == 0 ? (int)(i % 2) : pattern == 1 ? (i % 3 != 0)
+                                                                             : rnd() < 0.5;
+                    step[i] = terrace ? 0.3 + 0.4 * rnd() : -(0.3 + 0.4 * rnd());
+                }
+                for (size_t s = 0; s < n; s++) {
+                    for (size_t i = 0; i < n; i++) {
+                        xy[2 * i] = base[2 * ((i + s) % n)];
+                        xy[2 * i + 1] = base[2 * ((i + s) % n) + 1];
+                        rot_step[i] = step[(i + s) % n];
+                    }
+                    char what[96];
+                    snprintf(what, sizeof what, "shape %d variant %d pattern %d start %zu", kind,
+                             variant, pattern, s);
+                    check_plan(xy, n, rot_step, what);
+                    plans++;
+                }
+            }
+    printf("terrace and soffit at one height: %zu plans closed, volumes as computed\n", plans);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_terrace_and_soffit_at_one_height),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
