@@ -578,7 +578,7 @@ static void grid_stress_with(size_t count, int repair)
     size_t w_invalid = 0, w_repairs = 0, w_refused = 0, w_dropped = 0, w_good = 0;
     size_t failed = 0, leaky = 0, rejected = 0, leaky_nested = 0, good_nested = 0;
     size_t kinds[2] = {0, 0}, leaky_kind[2] = {0, 0};
-    size_t cause[4][2] = {{0}}; /* overlap / open / shared edge / other, elsewhere or at h */
+    size_t cause[5][2] = {{0}}; /* overlap / open / shared edge / fold / other, elsewhere or at h */
     static double xy[2 * 1200];
     size_t starts[300];
     static int32_t prof[1200];
@@ -638,7 +638,7 @@ static void grid_stress_with(size_t count, int repair)
              * horizontal profile segments (every flat step of a stress plan is at h) */
             const char *why = not_good(&r);
             int kind_i = strstr(why, "overlaps itself") ? 0 : strstr(why, "is open") ? 1
-                         : strstr(why, "more than two") ? 2 : 3;
+                         : strstr(why, "more than two") ? 2 : strstr(why, "folded") ? 3 : 4;
             const char *zs = strchr(why, '(');
             double wx, wy, wz;
             int at_h = zs && sscanf(zs, "(%lf, %lf, %lf)", &wx, &wy, &wz) == 3 &&
@@ -682,9 +682,10 @@ static void grid_stress_with(size_t count, int repair)
            "intersections (as are %zu good ones)\n", leaky_kind[0], kinds[0], leaky_kind[1],
            kinds[1], leaky_nested, good_nested);
     printf("    by cause (at the flat steps' height / elsewhere): winding other than once %zu / "
-           "%zu, open %zu / %zu, an edge of more than two faces %zu / %zu, other %zu / %zu\n",
+           "%zu, open %zu / %zu, an edge of more than two faces %zu / %zu, a horizontal face "
+           "folded %zu / %zu, other %zu / %zu\n",
            cause[0][1], cause[0][0], cause[1][1], cause[1][0], cause[2][1], cause[2][0],
-           cause[3][1], cause[3][0]);
+           cause[3][1], cause[3][0], cause[4][1], cause[4][0]);
     if (repair)
         printf("    winding rule: %zu levels with crossing chains, %zu rebuilt (%zu pieces removed), "
                "%zu refused; %zu plans with a rebuild are good\n", w_invalid, w_repairs, w_dropped,

