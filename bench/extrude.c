@@ -576,6 +576,7 @@ static void grid_stress_with(size_t count, int repair)
 {
     srng = 0x9E3779B97F4A7C15ULL;
     size_t w_invalid = 0, w_repairs = 0, w_refused = 0, w_dropped = 0, w_good = 0;
+    size_t f_levels = 0, f_rebuilt = 0, f_left = 0;
     size_t failed = 0, leaky = 0, rejected = 0, leaky_nested = 0, good_nested = 0;
     size_t kinds[2] = {0, 0}, leaky_kind[2] = {0, 0};
     size_t cause[5][2] = {{0}}; /* overlap / open / shared edge / fold / other, elsewhere or at h */
@@ -620,6 +621,9 @@ static void grid_stress_with(size_t count, int repair)
         if (st == AG_OK) {
             w_invalid += r.stats.winding_invalid;
             w_repairs += r.stats.winding_repairs;
+            f_levels += r.stats.flat_levels;
+            f_rebuilt += r.stats.flat_rebuilt;
+            f_left += r.stats.flat_left;
             w_refused += r.stats.winding_refused;
             w_dropped += r.stats.winding_pieces_dropped;
             w_good += r.stats.winding_repairs && !not_good(&r);
@@ -661,9 +665,10 @@ static void grid_stress_with(size_t count, int repair)
                         strcat(used, pname[b]);
                     }
                 printf("    not good grid%zu (%s, %zu nested intersections, %zu winding repairs, "
-                       "%zu refused; h %g, profiles %s): %s\n", i, kind ? "star" : "grid",
-                       r.stats.irregular, r.stats.winding_repairs, r.stats.winding_refused, h,
-                       used, not_good(&r));
+                       "%zu refused, %zu of %zu flat heights left; h %g, profiles %s): %s\n", i,
+                       kind ? "star" : "grid", r.stats.irregular, r.stats.winding_repairs,
+                       r.stats.winding_refused, r.stats.flat_left, r.stats.flat_levels, h, used,
+                       not_good(&r));
             }
         } else {
             good_nested += r.stats.irregular > 0;
@@ -690,6 +695,8 @@ static void grid_stress_with(size_t count, int repair)
         printf("    winding rule: %zu levels with crossing chains, %zu rebuilt (%zu pieces removed), "
                "%zu refused; %zu plans with a rebuild are good\n", w_invalid, w_repairs, w_dropped,
                w_refused, w_good);
+    printf("    flat heights with upward and downward faces: %zu, rebuilt as the plans' difference "
+           "%zu, left %zu\n", f_levels, f_rebuilt, f_left);
 }
 
 int main(int argc, char **argv)
