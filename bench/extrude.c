@@ -695,7 +695,7 @@ static void grid_stress_with(size_t count, int repair)
         printf("    winding rule: %zu levels with crossing chains, %zu rebuilt (%zu pieces removed), "
                "%zu refused; %zu plans with a rebuild are good\n", w_invalid, w_repairs, w_dropped,
                w_refused, w_good);
-    printf("    flat heights with upward and downward faces: %zu, rebuilt as the plans' difference "
+    printf("    heights with two flat faces or more: %zu, rebuilt as the plans' difference "
            "%zu, left %zu\n", f_levels, f_rebuilt, f_left);
 }
 

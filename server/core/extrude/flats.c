@@ -159,7 +159,7 @@ static ag_status push_cut(level_buf *L, double t, uint32_t p)
  * *done: 1 when rebuilt, 0 when left as it was. */
 static ag_status rebuild_level(ag_shell *s, double tol, double z, const uint32_t *list, size_t n,
                                const uint8_t *soup_face, uint32_t up, uint32_t down,
-                               level_buf *L, int *done)
+                               int merge, level_buf *L, int *done)
 {
     *done = 0;
     L->npts = L->nsegs = L->ncuts = L->nnet = L->npieces = L->nout = 0;
@@ -196,8 +196,8 @@ static ag_status rebuild_level(ag_shell *s, double tol, double z, const uint32_t
     for (size_t i = 0; i < L->nsegs; i++)
         for (size_t j = i + 1; j < L->nsegs; j++) {
             const lseg *u = &L->segs[i], *w = &L->segs[j];
-            if (!u->soup && !w->soup)
-                continue;
+            if (!merge || (!u->soup && !w->soup))
+                continue; /* faces of one kind that cross overlap: nothing to rebuild */
             const lpt *A = &L->pts[u->a], *B = &L->pts[u->b], *C = &L->pts[w->a], *D = &L->pts[w->b];
             if (fmax(A->x, B->x) < fmin(C->x, D->x) - tol || fmax(C->x, D->x) < fmin(A->x, B->x) - tol ||
                 fmax(A->y, B->y) < fmin(C->y, D->y) - tol || fmax(C->y, D->y) < fmin(A->y, B->y) - tol)
@@ -256,7 +256,7 @@ static ag_status rebuild_level(ag_shell *s, double tol, double z, const uint32_t
     }
     L->cut_start[L->nsegs] = (uint32_t)L->ncuts;
     /* the horizontal faces' pieces, netted: u -> v cancels v -> u */
-    for (size_t i = 0; i < L->nsegs; i++) {
+    for (size_t i = 0; i < L->nsegs && merge; i++) {
         if (!L->segs[i].soup)
             continue;
         for (uint32_t k = L->cut_start[i]; k + 1 < L->cut_start[i + 1]; k++) {
@@ -301,9 +301,9 @@ static ag_status rebuild_level(ag_shell *s, double tol, double z, const uint32_t
             L->out[L->nout++] = (lout){side == 0 ? up : down, L->pieces[i].a, L->pieces[i].b};
         }
     }
-    /* the other faces' edges, cut */
+    /* the other faces' edges (and without a merge every edge), cut */
     for (size_t i = 0; i < L->nsegs; i++) {
-        if (L->segs[i].soup || L->cut_start[i + 1] - L->cut_start[i] == 2)
+        if ((merge && L->segs[i].soup) || L->cut_start[i + 1] - L->cut_start[i] == 2)
             continue;
         for (uint32_t k = L->cut_start[i]; k + 1 < L->cut_start[i + 1]; k++) {
             uint32_t p = L->cuts[k].p, q = L->cuts[k + 1].p;
@@ -319,7 +319,7 @@ static ag_status rebuild_level(ag_shell *s, double tol, double z, const uint32_t
         if (ag_shell_add_vertex(s, L->pts[k].x + ox, L->pts[k].y + oy, z, &L->pts[k].v) != AG_OK)
             return AG_ERR_NOMEM;
     for (size_t i = 0; i < L->nsegs; i++)
-        if (L->segs[i].soup || L->cut_start[i + 1] - L->cut_start[i] > 2) {
+        if ((merge && L->segs[i].soup) || L->cut_start[i + 1] - L->cut_start[i] > 2) {
             uint32_t *g = &s->segs[3 * L->segs[i].seg];
             g[2] = g[1];
         }
@@ -359,7 +359,7 @@ ag_status ag_flats_rebuild(ag_shell *s, double tol)
     uint32_t *first = malloc(nf * sizeof *first);
     double *lz = NULL;
     uint32_t *lup = NULL, *ldown = NULL, *lcount = NULL, *lstart = NULL, *list = NULL;
-    uint8_t *soup = NULL;
+    uint8_t *soup = NULL, *both = NULL;
     level_buf L;
     memset(&L, 0, sizeof L);
     if (!hor || !fz || !area || !first) {
@@ -418,16 +418,39 @@ ag_status ag_flats_rebuild(ag_shell *s, double tol)
     for (size_t l = 0; l < nl; l++)
         lup[l] = ldown[l] = NONE;
     for (size_t f = 0; f < nf; f++)
-        if (hor[f] == 1 && area[f] != 0) {
+        if (hor[f] == 1) {
             size_t l = level_of(lz, nl, fz[f], tol);
             if (area[f] > 0 && lup[l] == NONE)
                 lup[l] = (uint32_t)f;
             if (area[f] < 0 && ldown[l] == NONE)
                 ldown[l] = (uint32_t)f;
+            lcount[l]++;
+        }
+    /* a height with two horizontal faces or more is rebuilt (faces of one kind only may
+     * leave corners of one on the other's edges); the upward or downward pieces go to a
+     * face of the other kind or without area when it has none of its own */
+    both = calloc(nl, 1);
+    if (!both) {
+        st = AG_ERR_NOMEM;
+        goto out;
+    }
+    for (size_t l = 0; l < nl; l++)
+        both[l] = lup[l] != NONE && ldown[l] != NONE;
+    for (size_t f = 0; f < nf; f++)
+        if (hor[f] == 1) {
+            size_t l = level_of(lz, nl, fz[f], tol);
+            if (lup[l] == NONE && f != ldown[l])
+                lup[l] = (uint32_t)f;
+            else if (ldown[l] == NONE && f != lup[l])
+                ldown[l] = (uint32_t)f;
         }
     size_t active = 0;
-    for (size_t l = 0; l < nl; l++)
+    for (size_t l = 0; l < nl; l++) {
+        if (lcount[l] < 2)
+            lup[l] = ldown[l] = NONE;
         active += lup[l] != NONE && ldown[l] != NONE;
+        lcount[l] = 0;
+    }
     s->flat_levels = active;
     if (!active)
         goto out;
@@ -468,7 +491,7 @@ ag_status ag_flats_rebuild(ag_shell *s, double tol)
             continue;
         int done = 0;
         st = rebuild_level(s, tol, lz[l], list + lcount[l], lcount[l + 1] - lcount[l], soup,
-                           lup[l], ldown[l], &L, &done);
+                           lup[l], ldown[l], both[l], &L, &done);
         if (done)
             s->flat_rebuilt++;
         else
@@ -487,5 +510,6 @@ out:
     free(lstart);
     free(list);
     free(soup);
+    free(both);
     return st;
 }

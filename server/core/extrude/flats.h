@@ -14,6 +14,10 @@
  * (winding -1 on their right). The other faces' edges at that height (the walls' tops and
  * bottoms) are cut at the same points so that they meet the new faces edge to edge.
  *
+ * A height with faces of one kind only (terraces meeting, soffits meeting) keeps its faces:
+ * there every edge at that height is only cut at the corners lying on it (a corner of one
+ * face on another's edge left the shell open there).
+ *
  * Levels whose winding is not within -1..1, or is not consistent across a piece (rounding
  * at a degenerate contact), are left as they were: the shell check then reports them. */
 #ifndef AG_EXTRUDE_FLATS_H
