@@ -570,8 +570,21 @@ static int flat_corners(const ag_mesh *m, uint32_t t, const double *o, double c[
 static int no_flat_fold(const ag_mesh *m, size_t t0, size_t t1, double min_area, char *why,
                         size_t nwhy)
 {
+    /* most buildings have no upward and downward horizontal triangles at all */
+    size_t nup = 0, ndown = 0;
+    for (size_t t = t0; t < t1; t++) {
+        const double *a = &m->pos[3 * m->tri[3 * t]], *b = &m->pos[3 * m->tri[3 * t + 1]],
+                     *c = &m->pos[3 * m->tri[3 * t + 2]];
+        if (a[2] != b[2] || b[2] != c[2])
+            continue;
+        double area = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+        nup += area > 0;
+        ndown += area < 0;
+    }
+    if (!nup || !ndown)
+        return 1;
     size_t n = 0;
-    flat_tri *F = malloc((t1 > t0 ? t1 - t0 : 1) * sizeof *F);
+    flat_tri *F = malloc((nup + ndown) * sizeof *F);
     if (!F) {
         snprintf(why, nwhy, "out of memory checking the building");
         return 0;
