@@ -252,10 +252,13 @@ static void run_plan(const double *xy, size_t n, const ag_profile_point *const *
         size_t sizes[1] = {n};
         double out = xc_outside(m, -1, loops, sizes, 1, 0);
         long wind = manifold ? xc_max_winding(m) : 1;
-        int ok_indep = manifold && out <= 1e-5 && wind == 1;
+        size_t folds = manifold ? xc_flat_folds(m, 1e-9) : 0;
+        int ok_indep = manifold && out <= 1e-5 && wind == 1 && !folds;
         if (manifold && wind != 1)
             snprintf(why, sizeof why, "the shell winds %ld times about a point just inside a "
                      "face", wind);
+        else if (folds)
+            snprintf(why, sizeof why, "%zu upward and downward triangles overlap", folds);
         int ok_self = ag_extrude_result_ok(&r);
         if (ok_self && !ok_indep)
             fail_msg("%s (repair %s): reported good but %s (%.3g m outside)", what,
@@ -431,6 +434,10 @@ static ag_built build_checked(const double *xy, size_t n, const int32_t *prof, d
         if (w != 1)
             fail_msg("%s (repair %s): built %s but the shell winds %ld times just inside a face",
                      what, repair ? "on" : "off", ag_built_name(r.built), w);
+        size_t folds = xc_flat_folds(m, 1e-9);
+        if (folds)
+            fail_msg("%s (repair %s): built %s but %zu upward and downward triangles overlap",
+                     what, repair ? "on" : "off", ag_built_name(r.built), folds);
         const double *loops[1] = {xy};
         size_t sizes[1] = {n};
         double out = xc_outside(m, -1, loops, sizes, 1, 0);
@@ -565,10 +572,13 @@ static xoutcome extrude_grid(const double *xy, size_t n, const int32_t *prof, do
     o.good_self = ag_extrude_result_ok(&r);
     o.volume = xc_mesh_volume(m);
     o.winding = manifold ? xc_max_winding(m) : 0;
-    o.good_indep = manifold && o.out <= 2.5 + 1e-6 && o.winding == 1;
+    size_t folds = manifold ? xc_flat_folds(m, 1e-9) : 0;
+    o.good_indep = manifold && o.out <= 2.5 + 1e-6 && o.winding == 1 && !folds;
     if (manifold && o.winding != 1)
         snprintf(o.why, sizeof o.why, "the shell winds %ld times about a point just inside a face",
                  o.winding);
+    else if (folds)
+        snprintf(o.why, sizeof o.why, "%zu upward and downward triangles overlap", folds);
     /* the batch's own check sees no overlap of a shell with itself (only the winding
      * number does): without the repair such shells are counted by the callers, with it
      * none may be reported good */
