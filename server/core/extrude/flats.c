@@ -15,7 +15,7 @@
 #define NONE UINT32_MAX
 /* A height with more boundary segments than this is left as it was (and judged by the
  * shell check): the cutting compares every pair. */
-#define LEVEL_MAX_SEGMENTS 6000
+#define LEVEL_MAX_SEGMENTS 4000
 
 typedef struct {
     double x, y; /* relative to the level's origin */
