@@ -420,6 +420,89 @@ static inline size_t xc_flat_folds(const ag_mesh *m, double min_area)
     return folds;
 }
 
+/* --- generated plans ------------------------------------------------------------------- */
+
+/* A polyomino of cells on a G x G grid (its outer boundary only, counter-clockwise: the
+ * cells are grown from the centre and holes are filled), at most max / 2 corners written to
+ * xy; rnd gives numbers in [0, 1). Returns its corners. */
+static inline size_t xc_polyomino(int G, double cell, double *xy, size_t max,
+                                  double (*rnd)(void))
+{
+    unsigned char in[18][18] = {{0}};
+    int cnt = 2 + (int)(rnd() * G * G * 0.5);
+    in[G / 2 + 1][G / 2 + 1] = 1;
+    for (int k = 1; k < cnt; k++)
+        for (int tries = 0; tries < 200; tries++) {
+            int x = 1 + (int)(rnd() * G), y = 1 + (int)(rnd() * G);
+            if (in[x][y])
+                continue;
+            /* edge neighbours only, and no cell touching another only at a corner */
+            int nb = in[x - 1][y] || in[x + 1][y] || in[x][y - 1] || in[x][y + 1];
+            int pinch = (in[x - 1][y - 1] && !in[x - 1][y] && !in[x][y - 1]) ||
+                        (in[x + 1][y - 1] && !in[x + 1][y] && !in[x][y - 1]) ||
+                        (in[x - 1][y + 1] && !in[x - 1][y] && !in[x][y + 1]) ||
+                        (in[x + 1][y + 1] && !in[x + 1][y] && !in[x][y + 1]);
+            if (nb && !pinch) {
+                in[x][y] = 1;
+                break;
+            }
+        }
+    /* walk the outer boundary with the inside on the left, from the lowest-left cell */
+    int sx = -1, sy = -1;
+    for (int y = 0; y < 18 && sx < 0; y++)
+        for (int x = 0; x < 18; x++)
+            if (in[x][y]) {
+                sx = x, sy = y;
+                break;
+            }
+    int x = sx, y = sy, d = 0; /* at corner (x, y), heading +x along the bottom */
+    int dx[4] = {1, 0, -1, 0}, dy[4] = {0, 1, 0, -1};
+    size_t n = 0;
+    do {
+        /* the cells ahead-left and ahead-right of the edge from (x, y) in direction d */
+        int nx = x + dx[d], ny = y + dy[d];
+        xy[2 * n] = x * cell, xy[2 * n + 1] = y * cell;
+        int left, right;
+        /* the edge (x,y)->(nx,ny): left cell and right cell */
+        switch (d) {
+        case 0: left = in[x][y], right = y > 0 ? in[x][y - 1] : 0; break;
+        case 1: left = in[x - 1][y], right = in[x][y]; break;
+        case 2: left = in[x - 1][y - 1], right = in[x - 1][y]; break;
+        default: left = in[x][y - 1], right = in[x - 1][y - 1]; break;
+        }
+        (void)left;
+        (void)right;
+        x = nx, y = ny;
+        /* next direction: prefer a left turn, then straight, then right */
+        int cells[4]; /* the four cells around corner (x, y): ll, lr, ul, ur */
+        cells[0] = in[x - 1][y - 1];
+        cells[1] = in[x][y - 1];
+        cells[2] = in[x - 1][y];
+        cells[3] = in[x][y];
+        int nd = -1;
+        for (int turn = 1; turn >= -1 && nd < 0; turn--) {
+            int c = (d + turn + 4) % 4;
+            int l, r;
+            switch (c) {
+            case 0: l = cells[3], r = cells[1]; break;
+            case 1: l = cells[2], r = cells[3]; break;
+            case 2: l = cells[0], r = cells[2]; break;
+            default: l = cells[1], r = cells[0]; break;
+            }
+            if (l && !r)
+                nd = c;
+        }
+        if (nd < 0)
+            return 0;
+        if (nd != d)
+            n++;
+        else
+            continue;
+        d = nd;
+    } while (!(x == sx && y == sy) && n < max / 2);
+    return n;
+}
+
 /* --- the CGAL oracle (../shared/tools/cgal_skeleton, built into build/oracle) --------------- */
 
 /* The oracle binary, or NULL (with a line saying why, so the caller can skip). */

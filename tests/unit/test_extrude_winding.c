@@ -116,85 +116,6 @@ static size_t spiral(int turns, int w, int s, double *xy)
     return n;
 }
 
-/* A polyomino of cells on a G x G grid (its outer boundary only, counter-clockwise: the
- * cells are grown from the centre and holes are filled). Returns its corners. */
-static size_t polyomino(int G, double cell, double *xy)
-{
-    unsigned char in[18][18] = {{0}};
-    int cnt = 2 + (int)(rnd() * G * G * 0.5);
-    in[G / 2 + 1][G / 2 + 1] = 1;
-    for (int k = 1; k < cnt; k++)
-        for (int tries = 0; tries < 200; tries++) {
-            int x = 1 + (int)(rnd() * G), y = 1 + (int)(rnd() * G);
-            if (in[x][y])
-                continue;
-            /* edge neighbours only, and no cell touching another only at a corner */
-            int nb = in[x - 1][y] || in[x + 1][y] || in[x][y - 1] || in[x][y + 1];
-            int pinch = (in[x - 1][y - 1] && !in[x - 1][y] && !in[x][y - 1]) ||
-                        (in[x + 1][y - 1] && !in[x + 1][y] && !in[x][y - 1]) ||
-                        (in[x - 1][y + 1] && !in[x - 1][y] && !in[x][y + 1]) ||
-                        (in[x + 1][y + 1] && !in[x + 1][y] && !in[x][y + 1]);
-            if (nb && !pinch) {
-                in[x][y] = 1;
-                break;
-            }
-        }
-    /* walk the outer boundary with the inside on the left, from the lowest-left cell */
-    int sx = -1, sy = -1;
-    for (int y = 0; y < 18 && sx < 0; y++)
-        for (int x = 0; x < 18; x++)
-            if (in[x][y]) {
-                sx = x, sy = y;
-                break;
-            }
-    int x = sx, y = sy, d = 0; /* at corner (x, y), heading +x along the bottom */
-    int dx[4] = {1, 0, -1, 0}, dy[4] = {0, 1, 0, -1};
-    size_t n = 0;
-    do {
-        /* the cells ahead-left and ahead-right of the edge from (x, y) in direction d */
-        int nx = x + dx[d], ny = y + dy[d];
-        xy[2 * n] = x * cell, xy[2 * n + 1] = y * cell;
-        int left, right;
-        /* the edge (x,y)->(nx,ny): left cell and right cell */
-        switch (d) {
-        case 0: left = in[x][y], right = y > 0 ? in[x][y - 1] : 0; break;
-        case 1: left = in[x - 1][y], right = in[x][y]; break;
-        case 2: left = in[x - 1][y - 1], right = in[x - 1][y]; break;
-        default: left = in[x][y - 1], right = in[x - 1][y - 1]; break;
-        }
-        (void)left;
-        (void)right;
-        x = nx, y = ny;
-        /* next direction: prefer a left turn, then straight, then right */
-        int cells[4]; /* the four cells around corner (x, y): ll, lr, ul, ur */
-        cells[0] = in[x - 1][y - 1];
-        cells[1] = in[x][y - 1];
-        cells[2] = in[x - 1][y];
-        cells[3] = in[x][y];
-        int nd = -1;
-        for (int turn = 1; turn >= -1 && nd < 0; turn--) {
-            int c = (d + turn + 4) % 4;
-            int l, r;
-            switch (c) {
-            case 0: l = cells[3], r = cells[1]; break;
-            case 1: l = cells[2], r = cells[3]; break;
-            case 2: l = cells[0], r = cells[2]; break;
-            default: l = cells[1], r = cells[0]; break;
-            }
-            if (l && !r)
-                nd = c;
-        }
-        if (nd < 0)
-            return 0;
-        if (nd != d)
-            n++;
-        else
-            continue;
-        d = nd;
-    } while (!(x == sx && y == sy) && n < MAXC / 2);
-    return n;
-}
-
 typedef struct {
     size_t plans, reported_good[2], independently_good[2];
     size_t invalid, repairs, refused;
@@ -334,7 +255,7 @@ static void test_generated_shapes(void **state)
             run_plan(tx, n, mixed, nmixed, 6, 1, what, &all, NULL);
         }
         for (int k = 0; k < 40; k++) {
-            size_t n = polyomino(4 + (int)(rnd() * 8), 1 + (int)(rnd() * 3), xy);
+            size_t n = xc_polyomino(4 + (int)(rnd() * 8), 1 + (int)(rnd() * 3), xy, MAXC, rnd);
             if (n < 4)
                 continue;
             transform(xy, n, variant, tx);
@@ -503,7 +424,7 @@ static void test_grid_plans_fall_back_honestly(void **state)
     rng = 0xD1B54A32D192ED03ULL;
     char what[64];
     for (int k = 0; k < 600; k++) {
-        size_t n = polyomino(3 + (int)(rnd() * 6), 1 + (int)(rnd() * 2), xy);
+        size_t n = xc_polyomino(3 + (int)(rnd() * 6), 1 + (int)(rnd() * 2), xy, MAXC, rnd);
         if (n < 4)
             continue;
         double h = 1 + (int)(rnd() * 3);
