@@ -24,6 +24,7 @@
 
 #include "core/extrude/building.h"
 #include "core/extrude/extrude.h"
+#include "core/extrude/shell.h"
 #include "core/extrude/verify.h"
 #include "extrude_check.h"
 
@@ -306,12 +307,105 @@ static void test_grid_terrace_and_soffit(void **state)
     assert_true(styled * 10 >= plans * 9);
 }
 
+/* Signed area (seen from above) of face f's loops in a finished shell. */
+static double face_area(const ag_shell *s, size_t f)
+{
+    double a = 0;
+    uint32_t nl = s->faces[f].nloops & 0x7fffffffu;
+    if (!nl)
+        return 0;
+    /* about the face's first corner: a UTM-sized origin would drown the area */
+    const double *o = &s->pos[3 * s->idx[s->loop_start[s->faces[f].first_loop]]];
+    for (uint32_t l = s->faces[f].first_loop; l < s->faces[f].first_loop + nl; l++)
+        for (uint32_t i = s->loop_start[l]; i < s->loop_start[l + 1]; i++) {
+            uint32_t j = i + 1 < s->loop_start[l + 1] ? i + 1 : s->loop_start[l];
+            const double *p = &s->pos[3 * s->idx[i]], *q = &s->pos[3 * s->idx[j]];
+            a += (p[0] - o[0]) * (q[1] - o[1]) - (q[0] - o[0]) * (p[1] - o[1]);
+        }
+    return a / 2;
+}
+
+/* A rectangle [x0, x1] x [y0, y1] at height z as a face of s, upward (counter-clockwise
+ * seen from above) or downward. */
+static uint32_t add_rect(ag_shell *s, double x0, double y0, double x1, double y1, double z,
+                         int up)
+{
+    ag_shell_face f = {AG_SHELL_FACE_SIDE, 0, 0, 0, 0, 0, 0};
+    uint32_t id = 0, v[4];
+    assert_int_equal(ag_shell_add_face(s, &f, &id), AG_OK);
+    const double c[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+    for (int k = 0; k < 4; k++)
+        assert_int_equal(ag_shell_add_vertex(s, c[k][0], c[k][1], z, &v[k]), AG_OK);
+    for (int k = 0; k < 4; k++) {
+        int a = up ? k : 3 - k, b = up ? (k + 1) % 4 : (3 - k + 3) % 4;
+        assert_int_equal(ag_shell_add_segment(s, id, v[a], v[b]), AG_OK);
+    }
+    return id;
+}
+
+/* The rebuild on shells made by hand: an upward and a downward rectangle overlapping become
+ * the two differences (the overlap, in neither plan, is gone), at UTM-sized coordinates too;
+ * a height where two upward faces overlap (winding 2) is left as it was and counted so. */
+static void test_rebuild_by_hand(void **state)
+{
+    (void)state;
+    for (int far = 0; far < 2; far++) {
+        double ox = far ? 512345.5 : 0, oy = far ? 5801234.25 : 0;
+        ag_shell *s = ag_shell_create();
+        uint32_t up = add_rect(s, ox, oy, ox + 2, oy + 2, 1, 1);
+        uint32_t down = add_rect(s, ox + 1, oy, ox + 3, oy + 2, 1, 0);
+        assert_int_equal(ag_shell_finish(s, 1e-9), AG_OK);
+        assert_int_equal(s->flat_levels, 1);
+        assert_int_equal(s->flat_rebuilt, 1);
+        assert_int_equal(s->flat_left, 0);
+        double a_up = 0, a_down = 0;
+        for (size_t f = 0; f < s->nfaces; f++) {
+            double a = face_area(s, f);
+            if (f == up)
+                a_up = a;
+            else if (f == down)
+                a_down = a;
+            else
+                assert_true(fabs(a) < 1e-6);
+        }
+        assert_true(fabs(a_up - 2) < 1e-9);
+        assert_true(fabs(a_down + 2) < 1e-9);
+        /* every corner of the upward face lies in [0, 1] x [0, 2], of the downward one in
+         * [2, 3] x [0, 2] */
+        for (int which = 0; which < 2; which++) {
+            uint32_t f = which ? down : up;
+            uint32_t nl = s->faces[f].nloops & 0x7fffffffu;
+            assert_int_equal(nl, 1);
+            for (uint32_t i = s->loop_start[s->faces[f].first_loop];
+                 i < s->loop_start[s->faces[f].first_loop + 1]; i++) {
+                double x = s->pos[3 * s->idx[i]] - ox;
+                assert_true(which ? x > 2 - 1e-9 : x < 1 + 1e-9);
+            }
+        }
+        ag_shell_free(s);
+    }
+    /* winding 2: left alone */
+    ag_shell *s = ag_shell_create();
+    add_rect(s, 0, 0, 2, 2, 1, 1);
+    add_rect(s, 1, 0, 3, 2, 1, 1);
+    add_rect(s, 5, 0, 6, 1, 1, 0);
+    assert_int_equal(ag_shell_finish(s, 1e-9), AG_OK);
+    assert_int_equal(s->flat_levels, 1);
+    assert_int_equal(s->flat_rebuilt, 0);
+    assert_int_equal(s->flat_left, 1);
+    assert_true(fabs(face_area(s, 0) - 4) < 1e-9);
+    assert_true(fabs(face_area(s, 1) - 4) < 1e-9);
+    assert_true(fabs(face_area(s, 2) + 1) < 1e-9);
+    ag_shell_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_terrace_and_soffit_at_one_height),
         cmocka_unit_test(test_verify_reports_a_fold),
         cmocka_unit_test(test_grid_terrace_and_soffit),
+        cmocka_unit_test(test_rebuild_by_hand),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
