@@ -1,0 +1,249 @@
+// A point cloud proceduralized and edited in the web client against a real archgramd in
+// Debian's chromium: a generated building with 10 known windows is uploaded through the page,
+// a template box is dragged around one window, Proceduralize runs from the panel (the job by
+// the point pipeline's stages), the derived points are drawn (derived.ply within the budget);
+// the front facade is picked in the tree panel, its x+ handle dragged to twice its width with
+// a live preview a second person sees, the committed version drawn on both pages; undo brings
+// the point count back; a click on a derived point selects its node; a refused op is told.
+// The window counts are the test's own (points_building.js on derived.ply fetched here), never
+// archgram's report.
+import assert from 'node:assert/strict';
+import { test } from 'node:test';
+import { parsePly } from '../integration/clouds.js';
+import { buildingPly, countWindows, ORIGIN, WIN } from '../integration/points_building.js';
+import { daemonAndBrowser, openPage } from './browser.js';
+import { uploadAndOpen, versionOf, WAIT, waitVersion } from './page.js';
+
+const POINTS = 60000;
+const LONG = { timeout: 120000 };
+
+const env = daemonAndBrowser();
+const api = async (p, init) => fetch(`${env.daemon.url}api/v1${p}`, init);
+
+// The viewport shows version v's derived points.
+const waitDerived = (page, v) =>
+  page.locator(`#viewport[data-version="${v}"][data-points-of="derived"][data-points]`).waitFor({ state: 'attached', ...LONG });
+const drawn = (page) => page.evaluate(() => Number(document.getElementById('viewport').dataset.points ?? -1));
+
+// derived.ply with absolute coordinates (its offset comment added).
+async function derived(id) {
+  const res = await api(`/models/${id}/derived.ply`);
+  assert.equal(res.status, 200, await res.clone().text());
+  const c = parsePly(Buffer.from(await res.arrayBuffer()));
+  const line = c.comments.find((x) => x.startsWith('offset'));
+  const o = line ? line.split(' ').slice(1).map(Number) : [0, 0, 0];
+  const n = c.props.x.length;
+  for (let i = 0; i < n; i++) { c.props.x[i] += o[0]; c.props.y[i] += o[1]; c.props.z[i] += o[2]; }
+  return { n, props: c.props };
+}
+
+const treeOf = async (id) => (await api(`/models/${id}/tree`)).json();
+// The front wall: the node spanning the building's width in the plane y = 0.
+const frontOf = (t) => t.nodes.find((nd) => nd.kind === 'component' && nd.box[3] - nd.box[0] > 14 &&
+  nd.box[4] - nd.box[1] < 0.6 && Math.abs(nd.box[1] - ORIGIN[1]) < 0.2 && nd.box[5] - nd.box[2] > 6);
+
+// The canvas rectangle (page pixels) that the 8 corners of a box (archgram axes, in the
+// coordinates of what is drawn) project to.
+async function screenRect(page, box) {
+  const r = await page.evaluate((b) => {
+    const vp = window.archgramTools.viewport;
+    const xs = [], ys = [];
+    for (const x of [b[0], b[3]]) for (const y of [b[1], b[4]]) for (const z of [b[2], b[5]]) {
+      const s = vp.toScreen(vp.camera.position.clone().set(x, z, -y));
+      xs.push(s.x);
+      ys.push(s.y);
+    }
+    return { x0: Math.min(...xs), x1: Math.max(...xs), y0: Math.min(...ys), y1: Math.max(...ys) };
+  }, box);
+  const c = await page.locator('#viewport canvas').boundingBox();
+  return { x0: c.x + r.x0, x1: c.x + r.x1, y0: c.y + r.y0, y1: c.y + r.y1 };
+}
+
+async function dragPage(page, a, b, steps = 10, pause = 0) {
+  await page.mouse.move(a.x, a.y);
+  await page.mouse.down();
+  for (let i = 1; i <= steps; i++) {
+    await page.mouse.move(a.x + ((b.x - a.x) * i) / steps, a.y + ((b.y - a.y) * i) / steps);
+    if (pause) await page.waitForTimeout(pause);
+  }
+}
+
+test('a point cloud proceduralized from the panel, its derived points drawn, picked, resized live to twice its front, undone', async (t) => {
+  const pia = await openPage(env.browser, { user: 'pia' });
+  await pia.goto(env.daemon.url);
+  const input = buildingPly(POINTS);
+  const id = await uploadAndOpen(pia, 'upload-input', { name: 'house.ply', mimeType: 'application/octet-stream', buffer: Buffer.from(input.bytes) });
+  const model = await (await api(`/models/${id}`)).json();
+  assert.equal(model.kind, 'pointcloud');
+  const offset = model.stats.offset;
+  await pia.locator('#viewport[data-points-of="input"][data-points]').waitFor({ state: 'attached', ...LONG });
+  assert.equal(await drawn(pia), POINTS);
+
+  // a template box around window 2, dragged over the uploaded points (drawn local to the
+  // offset): the rectangle the window's opening in the front wall, 10 cm around, is drawn in
+  const [wx, wz] = WIN[2];
+  const local = [wx - 0.1, 0, wz - 0.1, wx + 1.3, 0, wz + 1.6].map((v, k) => v + ORIGIN[k % 3] - offset[k % 3]);
+  // the person turns the view to face the front (the orbit's end, set directly) and zooms in
+  await pia.evaluate((c) => {
+    const vp = window.archgramTools.viewport;
+    const target = vp.camera.position.clone().set(c[0], c[2], -c[1]);
+    vp.look(target, target.clone().set(0, 0.15, 1), 14, { near: 0.1, far: 500 });
+  }, [wx + 0.6 + ORIGIN[0] - offset[0], ORIGIN[1] - offset[1], wz + 0.75 + ORIGIN[2] - offset[2]]);
+  await pia.getByTestId('cloud-proc-template').click();
+  await pia.locator('#viewport[data-cloud-tool="procTemplate"]').waitFor({ state: 'attached', ...WAIT });
+  const r = await screenRect(pia, local);
+  await dragPage(pia, { x: r.x0, y: r.y0 }, { x: r.x1, y: r.y1 });
+  await pia.mouse.up();
+  await pia.locator('[data-testid="cloud-proc-templates"][data-count="1"]').waitFor({ state: 'attached', ...WAIT });
+  const tb = await pia.evaluate(() => window.archgram.cloud.procTemplates[0]);
+  const dbg = await pia.evaluate(() => ({ info: window.archgram.cloud.info, rect: document.querySelector('[data-testid=cloud-drag]').style.cssText }));
+  // the box holds the window, and neither the back wall nor much wall around it
+  const win = [wx, 0, wz, wx + 1.2, 0.25, wz + 1.5].map((v, k) => v + ORIGIN[k % 3]);
+  for (let k = 0; k < 3; k++) {
+    assert.ok(tb[k] <= win[k] + 0.05 && tb[k + 3] >= win[k + 3] - 0.05, `the template box ${JSON.stringify(tb)} does not hold the window ${JSON.stringify(win)}`);
+    assert.ok(tb[k] >= win[k] - 0.4 && tb[k + 3] <= win[k + 3] + 0.4, `the template box ${JSON.stringify(tb)} reaches far past the window`);
+  }
+
+  // Proceduralize from the panel: the job's stages are the point pipeline's; the derived points
+  // are drawn, coloured by placement, within the budget
+  const v0 = await versionOf(pia);
+  await pia.getByTestId('proceduralize').click();
+  await pia.locator('[data-testid="proc-job"][data-status="succeeded"]').waitFor(LONG);
+  const stages = await pia.locator('[data-testid="proc-job"] li.stage').evaluateAll((ls) => ls.map((l) => `${l.dataset.stage}:${l.className}`));
+  assert.deepEqual(stages.map((s) => s.split(':')[0]), ['segment', 'repeat', 'absorb', 'consensus', 'tree', 'grammar', 'verify']);
+  assert.ok(stages.every((s) => /done/.test(s)), JSON.stringify(stages));
+  const v1 = v0 + 1;
+  await waitVersion(pia, v1);
+  await waitDerived(pia, v1);
+  const log = (await (await api(`/models/${id}/ops`)).json()).items.at(-1);
+  assert.equal(log.op.kind, 'proceduralize');
+  const tree0 = await treeOf(id);
+  assert.equal(tree0.summary.repetition.templates.length, 1, JSON.stringify(tree0.summary.repetition));
+  const c0 = await derived(id);
+  assert.equal(countWindows(c0), 10);
+  assert.equal(await drawn(pia), c0.n, 'every derived point is drawn (the budget is larger)');
+  await pia.getByTestId('cloud-shown').filter({ hasText: `${c0.n.toLocaleString('en')} of ${c0.n.toLocaleString('en')} derived points drawn` }).waitFor(WAIT);
+  // the derived points drawn where derived.ply has them (the view is in the tree's coordinates)
+  const far = await pia.evaluate(() => {
+    const pts = window.archgramTools.viewport.layers.model.points;
+    let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    const v = pts[0].position.clone();
+    for (const p of pts) {
+      p.updateWorldMatrix(true, false);
+      const pos = p.geometry.getAttribute('position');
+      for (let i = 0; i < pos.count; i++) {
+        v.fromBufferAttribute(pos, i).applyMatrix4(p.matrixWorld);
+        const m = [v.x, -v.z, v.y];
+        lo = lo.map((x, k) => Math.min(x, m[k]));
+        hi = hi.map((x, k) => Math.max(x, m[k]));
+      }
+    }
+    return [...lo, ...hi];
+  });
+  const root0 = tree0.nodes[tree0.root].box;
+  assert.ok(far.every((x, k) => Math.abs(x - root0[k]) < 0.05), `drawn ${JSON.stringify(far)}, tree root ${JSON.stringify(root0)}`);
+
+  // a smaller budget draws fewer of them
+  await pia.getByTestId('cloud-budget').fill('20000');
+  await pia.getByTestId('cloud-budget').press('Tab');
+  await pia.waitForFunction(() => { const n = Number(document.getElementById('viewport').dataset.points); return n > 0 && n <= 20000; }, null, WAIT);
+  await pia.getByTestId('cloud-budget').fill('1000000');
+  await pia.getByTestId('cloud-budget').press('Tab');
+  await pia.waitForFunction((n) => document.getElementById('viewport').dataset.points === String(n), c0.n, WAIT);
+
+  // a second person in the room
+  const bo = await openPage(env.browser, { user: 'bo' });
+  await bo.goto(`${env.daemon.url}#model=${id}`);
+  await waitDerived(bo, v1);
+  await bo.getByTestId('peers').filter({ hasText: 'pia' }).waitFor(WAIT);
+
+  // the front facade picked in the tree panel lights its points; its x+ handle dragged to 2x
+  const front = frontOf(tree0);
+  assert.ok(front, 'a front wall node');
+  await pia.locator(`[data-testid="tree-node"][data-node="${front.id}"]`).click();
+  await pia.locator('#viewport[data-lit-placements]').waitFor({ state: 'attached', ...WAIT });
+  assert.ok(Number(await pia.locator('#viewport').getAttribute('data-lit-placements')) >= 1);
+  const handle = await pia.evaluate(() => window.archgramTools.handles.screen('x+'));
+  assert.ok(handle, 'no x+ handle on the front facade');
+  const b = front.box;
+  const goal = b[0] + 2 * (b[3] - b[0]);
+  const cb = await pia.locator('#viewport canvas').boundingBox();
+  const to = await pia.evaluate(({ x, y, z }) => {
+    const vp = window.archgramTools.viewport;
+    return vp.toScreen(vp.camera.position.clone().set(x, z, -y));
+  }, { x: goal, y: (b[1] + b[4]) / 2, z: (b[2] + b[5]) / 2 });
+  await dragPage(pia, { x: cb.x + handle.x, y: cb.y + handle.y }, { x: cb.x + to.x, y: cb.y + to.y }, 12, 40);
+  assert.equal(await pia.locator('#viewport').getAttribute('data-dragging'), 'x+');
+  // bo sees pia's preview while she holds the handle, and no new version
+  await bo.locator('#viewport[data-preview]').waitFor({ state: 'attached', ...LONG });
+  assert.equal(await bo.locator('#viewport').getAttribute('data-preview-by'), 'pia');
+  assert.equal(await versionOf(bo), v1, 'a preview made a version');
+  const received = await bo.evaluate(() => window.archgramTools.preview.received);
+  assert.ok(received >= 1);
+  await pia.mouse.up();
+  const v2 = v1 + 1;
+  for (const page of [pia, bo]) {
+    await waitVersion(page, v2);
+    await waitDerived(page, v2);
+  }
+  const resize = (await (await api(`/models/${id}/ops`)).json()).items.at(-1);
+  assert.equal(resize.op.kind, 'resize');
+  assert.equal(resize.author, 'pia');
+  const width = resize.op.box[3] - resize.op.box[0];
+  assert.ok(Math.abs(width / (b[3] - b[0]) - 2) < 0.02, `the drag made the front ${(width / (b[3] - b[0])).toFixed(3)}x as wide`);
+  const c1 = await derived(id);
+  const windows1 = countWindows(c1);
+  assert.equal(windows1, 2 * countWindows(c0), `${windows1} windows after doubling the front`);
+  assert.equal(await drawn(pia), c1.n);
+  assert.equal(await drawn(bo), c1.n);
+  assert.equal(await bo.locator('#viewport').getAttribute('data-preview'), null, 'bo still shows the preview');
+  t.diagnostic(`doubled front: ${countWindows(c0)} → ${windows1} windows, ${c0.n} → ${c1.n} derived points; bo received ${received} previews`);
+
+  // undo: the derived points as before, on both pages
+  await pia.getByTestId('undo').click();
+  const v3 = v2 + 1;
+  for (const page of [pia, bo]) {
+    await waitVersion(page, v3);
+    await waitDerived(page, v3);
+  }
+  const c2 = await derived(id);
+  assert.equal(c2.n, c0.n);
+  assert.equal(countWindows(c2), 10);
+  assert.equal(await drawn(pia), c0.n);
+  assert.equal(await drawn(bo), c0.n);
+
+  // a click on a derived point of the front wall selects the front wall's node
+  const tree1 = await treeOf(id);
+  const front1 = frontOf(tree1);
+  assert.ok(front1);
+  // the drawn point of the front wall nearest its middle, between the rows of windows
+  const middle = [ORIGIN[0] + 8, ORIGIN[1], ORIGIN[2] + 3.45];
+  const at = await pia.evaluate(({ component, m }) => {
+    const vp = window.archgramTools.viewport;
+    const pts = vp.layers.model.points.find((p) => p.userData.component === component);
+    if (!pts) return null;
+    const pos = pts.geometry.getAttribute('position');
+    const v = pts.position.clone();
+    const goal = v.clone().set(m[0], m[2], -m[1]);
+    let best = null;
+    for (let i = 0; i < pos.count; i++) {
+      v.fromBufferAttribute(pos, i).applyMatrix4(pts.matrixWorld);
+      const d = v.distanceTo(goal);
+      if (!best || d < best.d) best = { d, s: vp.toScreen(v) };
+    }
+    return best.s;
+  }, { component: front1.component, m: middle });
+  assert.ok(at, 'no drawn points of the front wall');
+  await pia.locator('#viewport canvas').click({ position: { x: Math.round(at.x), y: Math.round(at.y) } });
+  await pia.waitForFunction((n) => window.archgram.selected.single() === n, front1.id, WAIT);
+
+  // a refused op is told, and makes no version: the root cannot be removed
+  await pia.locator(`[data-testid="tree-node"][data-node="${tree1.root}"]`).click();
+  await pia.getByTestId('remove').click();
+  await pia.getByTestId('error').filter({ hasText: /root/ }).waitFor({ state: 'visible', ...WAIT });
+  assert.equal(await versionOf(pia), v3);
+  assert.equal((await (await api(`/models/${id}`)).json()).version, v3);
+
+  assert.deepEqual(pia.problems.filter((p) => !/root/.test(p)), [], 'the page reported errors');
+  assert.deepEqual(bo.problems, [], 'the second page reported errors');
+});
