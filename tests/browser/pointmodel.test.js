@@ -10,7 +10,7 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 import { parsePly } from '../integration/clouds.js';
-import { buildingPly, countWindows, ORIGIN, WIN } from '../integration/points_building.js';
+import { buildingPly, countWindows, frontsOf, glassOf, ORIGIN, WIN } from '../integration/points_building.js';
 import { daemonAndBrowser, openPage } from './browser.js';
 import { uploadAndOpen, versionOf, WAIT, waitVersion } from './page.js';
 
@@ -37,10 +37,43 @@ async function derived(id) {
   return { n, props: c.props };
 }
 
+// The share of a's points within r of one of b's (a grid of r-sized cells).
+function covered(a, b, r) {
+  const key = (x, y, z) => `${Math.floor(x / r)},${Math.floor(y / r)},${Math.floor(z / r)}`;
+  const cells = new Map();
+  for (let i = 0; i < b.n; i++) {
+    const k = key(b.props.x[i], b.props.y[i], b.props.z[i]);
+    if (!cells.has(k)) cells.set(k, []);
+    cells.get(k).push(i);
+  }
+  let hit = 0;
+  for (let i = 0; i < a.n; i++) {
+    const x = a.props.x[i], y = a.props.y[i], z = a.props.z[i];
+    const cx = Math.floor(x / r), cy = Math.floor(y / r), cz = Math.floor(z / r);
+    let found = false;
+    for (let dx = -1; dx <= 1 && !found; dx++) for (let dy = -1; dy <= 1 && !found; dy++) for (let dz = -1; dz <= 1 && !found; dz++) {
+      for (const j of cells.get(`${cx + dx},${cy + dy},${cz + dz}`) || []) {
+        if (Math.hypot(b.props.x[j] - x, b.props.y[j] - y, b.props.z[j] - z) <= r) { found = true; break; }
+      }
+    }
+    hit += found;
+  }
+  return hit / a.n;
+}
+
+// Opens the tree panel down to node id (its ancestors' toggles) and clicks its row.
+async function clickRow(page, tree, id, modifiers = []) {
+  const chain = [];
+  for (let n = tree.nodes.find((x) => x.id === id); n && n.parent !== null && n.parent !== undefined; n = tree.nodes.find((x) => x.id === n.parent)) chain.unshift(n.parent);
+  for (const a of chain) {
+    const row = page.locator(`[data-testid="tree-node"][data-node="${a}"]`);
+    if ((await row.getAttribute('aria-expanded')) === 'false') await row.locator('button.toggle').click();
+  }
+  await page.locator(`[data-testid="tree-node"][data-node="${id}"]`).click({ modifiers });
+}
+
 const treeOf = async (id) => (await api(`/models/${id}/tree`)).json();
-// The front wall: the node spanning the building's width in the plane y = 0.
-const frontOf = (t) => t.nodes.find((nd) => nd.kind === 'component' && nd.box[3] - nd.box[0] > 14 &&
-  nd.box[4] - nd.box[1] < 0.6 && Math.abs(nd.box[1] - ORIGIN[1]) < 0.2 && nd.box[5] - nd.box[2] > 6);
+const frontOf = (t) => frontsOf(t)[0];
 
 // The canvas rectangle (page pixels) that the 8 corners of a box (archgram axes, in the
 // coordinates of what is drawn) project to.
@@ -68,7 +101,7 @@ async function dragPage(page, a, b, steps = 10, pause = 0) {
   }
 }
 
-test('a point cloud proceduralized from the panel, its derived points drawn, picked, resized live to twice its front, undone', async (t) => {
+test('a point cloud proceduralized from the panel, its derived points drawn and picked, edited as a mesh model: live resize to twice its front, undo, redo, split, join, paste, remove', async (t) => {
   const pia = await openPage(env.browser, { user: 'pia' });
   await pia.goto(env.daemon.url);
   const input = buildingPly(POINTS);
@@ -236,13 +269,92 @@ test('a point cloud proceduralized from the panel, its derived points drawn, pic
   assert.ok(at, 'no drawn points of the front wall');
   await pia.locator('#viewport canvas').click({ position: { x: Math.round(at.x), y: Math.round(at.y) } });
   await pia.waitForFunction((n) => window.archgram.selected.single() === n, front1.id, WAIT);
+  // bo sees what pia selected in her colour
+  await bo.locator('#viewport[data-peer-placements]').waitFor({ state: 'attached', ...WAIT });
+
+  // redo brings the wide front back; undo again
+  let v = v3;
+  const step = async (what) => {
+    v += 1;
+    for (const page of [pia, bo]) {
+      await waitVersion(page, v);
+      await waitDerived(page, v);
+    }
+    const e = (await (await api(`/models/${id}/ops`)).json()).items.at(-1);
+    assert.equal(e.version, v, `${what}: ${JSON.stringify(e)}`);
+    return { entry: e, cloud: await derived(id), tree: await treeOf(id) };
+  };
+  await pia.getByTestId('redo').click();
+  assert.equal(countWindows((await step('redo')).cloud), 20);
+  await pia.getByTestId('undo').click();
+  let now = await step('undo');
+  assert.equal(now.cloud.n, c0.n);
+
+  // the split-plane tool on window 2, along x at its middle: more nodes, the same points
+  const nodes0 = now.tree.nodes.length;
+  const before = now.cloud;
+  await clickRow(pia, now.tree, glassOf(now.tree, 2).id);
+  await pia.getByTestId('split-tool').click();
+  await pia.getByTestId('split-axis').selectOption('x');
+  await pia.getByTestId('split').click();
+  now = await step('split');
+  assert.equal(now.entry.op.kind, 'split');
+  assert.ok(now.tree.nodes.length > nodes0, `split: ${nodes0} → ${now.tree.nodes.length} nodes`);
+  // the derivation is the same cloud (each within 3 cm of the other's points), cut in two
+  const cover = [covered(now.cloud, before, 0.03), covered(before, now.cloud, 0.03)];
+  assert.ok(cover.every((c) => c > 0.97), `the split moved points: ${cover.join(', ')} covered`);
+  assert.equal(countWindows(now.cloud), 10);
+  const pieces = now.tree.nodes.filter((nd) => nd.kind === 'component' && nd.box && !glassOf({ nodes: [nd] }, 2) &&
+    nd.box[0] > WIN[2][0] + ORIGIN[0] - 0.3 && nd.box[3] < WIN[2][0] + ORIGIN[0] + 1.5 &&
+    nd.box[2] > WIN[2][1] + ORIGIN[2] - 0.3 && nd.box[5] < WIN[2][1] + ORIGIN[2] + 1.8 && nd.box[4] - ORIGIN[1] < 0.6 &&
+    nd.box[3] - nd.box[0] > 0.3 && nd.box[5] - nd.box[2] > 1);
+  t.diagnostic(`split: ${nodes0} → ${now.tree.nodes.length} nodes, ${cover.map((c) => c.toFixed(4)).join(' / ')} of the points within 3 cm; window 2 in ${pieces.length} pieces (${now.entry.op.report.message})`);
+  assert.equal(glassOf(now.tree, 2), undefined, 'window 2 is whole after its split');
+  await pia.getByTestId('split-tool').click(); // the tool closes
+
+  // join the two pieces (Shift+click in the tree): window 2 whole again, the same points
+  assert.equal(pieces.length, 2, JSON.stringify(pieces.map((p) => p.box)));
+  await clickRow(pia, now.tree, pieces[0].id);
+  await clickRow(pia, now.tree, pieces[1].id, ['Shift']);
+  assert.deepEqual(await pia.evaluate(() => window.archgram.selected.nodeIds()), [pieces[0].id, pieces[1].id]);
+  await pia.getByTestId('join').click();
+  const split = now.cloud;
+  now = await step('join');
+  assert.equal(now.entry.op.kind, 'join');
+  assert.match(now.entry.op.report.message, /joined 2 nodes into one/);
+  // one node holds window 2 again (the tree may find the joined window's two halves a pattern)
+  assert.ok(glassOf({ nodes: now.tree.nodes.map((nd) => ({ ...nd, kind: 'component' })) }, 2), 'no node holds window 2');
+  assert.ok(covered(now.cloud, split, 0.03) > 0.97 && covered(split, now.cloud, 0.03) > 0.97, 'the join moved points');
+  assert.equal(countWindows(now.cloud), 10);
+
+  // copy window 0, paste it over window 1: still 10 windows, at the input's place
+  const w0 = glassOf(now.tree, 0), w1 = glassOf(now.tree, 1);
+  assert.ok(w0 && w1, 'window nodes');
+  await clickRow(pia, now.tree, w0.id);
+  await pia.getByTestId('copy').click();
+  await clickRow(pia, now.tree, w1.id);
+  await pia.getByTestId('paste-placement').selectOption('replace');
+  await pia.getByTestId('paste').click();
+  now = await step('paste');
+  assert.equal(now.entry.op.kind, 'paste');
+  assert.equal(countWindows(now.cloud), 10);
+
+  // remove window 3: one window fewer
+  const w3 = glassOf(now.tree, 3);
+  assert.ok(w3, 'window 3');
+  await clickRow(pia, now.tree, w3.id);
+  await pia.getByTestId('remove').click();
+  now = await step('remove');
+  assert.equal(now.entry.op.kind, 'remove');
+  assert.equal(countWindows(now.cloud), 9);
+  const tree1b = now.tree;
 
   // a refused op is told, and makes no version: the root cannot be removed
-  await pia.locator(`[data-testid="tree-node"][data-node="${tree1.root}"]`).click();
+  await pia.locator(`[data-testid="tree-node"][data-node="${tree1b.root}"]`).click();
   await pia.getByTestId('remove').click();
   await pia.getByTestId('error').filter({ hasText: /root/ }).waitFor({ state: 'visible', ...WAIT });
-  assert.equal(await versionOf(pia), v3);
-  assert.equal((await (await api(`/models/${id}`)).json()).version, v3);
+  assert.equal(await versionOf(pia), v);
+  assert.equal((await (await api(`/models/${id}`)).json()).version, v);
 
   assert.deepEqual(pia.problems.filter((p) => !/root/.test(p)), [], 'the page reported errors');
   assert.deepEqual(bo.problems, [], 'the second page reported errors');

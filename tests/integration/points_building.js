@@ -94,3 +94,16 @@ export function writeBuilding(file, n = 60000) {
   fs.writeFileSync(file, bytes);
   return b;
 }
+
+// The tree node (GET …/tree, boxes in the cloud's coordinates) of window w's glass: its box
+// centred on the window, at most a little larger.
+export const glassOf = (tree, w) => tree.nodes.find((nd) => nd.kind === 'component' && nd.box &&
+  Math.abs((nd.box[0] + nd.box[3]) / 2 - (WIN[w][0] + 0.6 + ORIGIN[0])) < 0.2 &&
+  Math.abs((nd.box[2] + nd.box[5]) / 2 - (WIN[w][1] + 0.75 + ORIGIN[2])) < 0.2 &&
+  nd.box[3] - nd.box[0] < 2 && nd.box[5] - nd.box[2] < 2.2 && nd.box[4] - ORIGIN[1] < 0.6);
+
+// The front wall's nodes: those in the plane y = 0 at least `minWidth` m wide and 6 m tall.
+export const frontsOf = (tree, minWidth = 14) => tree.nodes.filter((nd) => nd.kind === 'component' && nd.box &&
+  nd.box[3] - nd.box[0] > minWidth && nd.box[4] - nd.box[1] < 0.6 && Math.abs(nd.box[1] - ORIGIN[1]) < 0.2 &&
+  nd.box[5] - nd.box[2] > 6);
+

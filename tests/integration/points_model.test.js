@@ -9,7 +9,7 @@ import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
 import { assertProblem, http, importModel, PROBLEM, removeDir, sql, startDaemon, waitJob, WsClient, facadeObj } from './harness.js';
 import { parsePly } from './clouds.js';
-import { buildingPly, countWindows, ORIGIN, WIN, windowBox } from './points_building.js';
+import { buildingPly, countWindows, frontsOf, glassOf, ORIGIN, windowBox } from './points_building.js';
 
 // A PLY answer with absolute coordinates (its offset comment added).
 function absolute(buf) {
@@ -35,11 +35,6 @@ function densities(c, width, windows) {
   return { wall: wall / wallArea, glass: glass / (windows * 1.2 * 1.5) };
 }
 
-// The tree node of window w (its box centred on the window, at most a little larger).
-const glassOf = (tree, w) => tree.nodes.find((nd) => nd.kind === 'component' && nd.box &&
-  Math.abs((nd.box[0] + nd.box[3]) / 2 - (WIN[w][0] + 0.6 + ORIGIN[0])) < 0.2 &&
-  Math.abs((nd.box[2] + nd.box[5]) / 2 - (WIN[w][1] + 0.75 + ORIGIN[2])) < 0.2 &&
-  nd.box[3] - nd.box[0] < 2 && nd.box[5] - nd.box[2] < 2.2 && nd.box[4] - ORIGIN[1] < 0.6);
 const near = (a, b, eps = 1e-6) => a.every((v, i) => Math.abs(v - b[i]) <= eps);
 
 const within = (a, b, rel, what) => assert.ok(Math.abs(a / b - 1) <= rel, `${what}: ${a.toFixed(1)} against ${b.toFixed(1)} per m²`);
@@ -202,8 +197,7 @@ describe('point models in the service', () => {
 
   it('a resize doubling the front doubles its windows at the input density; undo and redo over the websocket', async () => {
     const t = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
-    const front = t.nodes.find((nd) => nd.kind === 'component' && nd.box[3] - nd.box[0] > 14 &&
-      nd.box[4] - nd.box[1] < 0.6 && Math.abs(nd.box[1] - ORIGIN[1]) < 0.2 && nd.box[5] - nd.box[2] > 6);
+    const front = frontsOf(t)[0];
     assert.ok(front, 'a front wall node');
     const box = [...front.box];
     box[3] = box[0] + 2 * (box[3] - box[0]);

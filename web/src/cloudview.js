@@ -12,6 +12,7 @@
 // segment's), padded a little: the shown points are float32 copies of the stored ones.
 import * as THREE from 'three';
 import { isCloud } from './cloud.js';
+import { colourOf } from './peers.js';
 
 const HIGHLIGHT = new THREE.Color(0xffc820); // as the viewport's picked component
 const NONE = new THREE.Color(0x8d96a0);      // points in no segment
@@ -46,9 +47,11 @@ export class CloudView {
     c.segmentChanged.add(() => this.colourize());
     c.toolChanged.add((tool) => this.toolChanged(tool));
     editor.signals.modelOpened.add(() => this.clearBox());
-    editor.signals.selectionChanged.add(() => {
+    const recolour = () => {
       if (this.derived) this.colourize();
-    });
+    };
+    editor.signals.selectionChanged.add(recolour);
+    editor.signals.peersChanged.add(recolour); // what the others have selected, in their colours
 
     const el = viewport.canvas;
     el.addEventListener('pointerdown', (e) => this.dragStart(e));
@@ -100,6 +103,7 @@ export class CloudView {
     const picked = derived ? null : this.cloud.segment;
     // a derived cloud's placements are the components the selected nodes cover
     const lit = derived ? new Set(this.editor.selected.components()) : null;
+    const theirs = derived ? this.peerSelections() : null;
     const c = new THREE.Color();
     for (const p of this.points) {
       const g = p.geometry;
@@ -113,6 +117,7 @@ export class CloudView {
       const span = Math.max(max.y - min.y, 1e-6);
       for (let i = 0; i < n; i++) {
         if (seg && ((picked !== null && seg.getX(i) === picked) || lit?.has(seg.getX(i)))) c.copy(HIGHLIGHT);
+        else if (seg && theirs?.has(seg.getX(i))) c.copy(theirs.get(seg.getX(i)));
         else if (ids) {
           const id = ids.getX(i);
           if (id < 0) c.copy(NONE);
@@ -129,6 +134,19 @@ export class CloudView {
     this.viewport.mark('segment', picked);
     this.viewport.mark('litPlacements', lit ? lit.size : null);
     this.viewport.requestRender();
+  }
+
+  // Placement -> the colour of the first other person who has it selected.
+  peerSelections() {
+    const out = new Map();
+    for (const p of this.editor.peers.values()) {
+      const sel = p.state?.selection;
+      if (!Array.isArray(sel)) continue;
+      const colour = new THREE.Color(colourOf(p.state?.name || p.user || p.peer));
+      for (const component of sel) if (!out.has(component)) out.set(component, colour);
+    }
+    this.viewport.mark('peerPlacements', out.size || null);
+    return out;
   }
 
   // A click on a point picks its segment; a click beside the points drops the pick.
