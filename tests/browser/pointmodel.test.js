@@ -4,7 +4,10 @@
 // the point pipeline's stages), the derived points are drawn (derived.ply within the budget);
 // the front facade is picked in the tree panel, its x+ handle dragged to twice its width with
 // a live preview a second person sees, the committed version drawn on both pages; undo brings
-// the point count back; a click on a derived point selects its node; a refused op is told.
+// the point count back, redo the wide front; a click on a derived point selects its node (the
+// other page sees it in the picker's colour); a window split by the split plane and its pieces
+// joined (Shift+click in the tree) keep the points where they were; a window copied and pasted
+// over another, and one removed (one window fewer); a refused op is told.
 // The window counts are the test's own (points_building.js on derived.ply fetched here), never
 // archgram's report.
 import assert from 'node:assert/strict';
