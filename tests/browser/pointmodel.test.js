@@ -12,8 +12,7 @@
 // archgram's report.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
-import { parsePly } from '../integration/clouds.js';
-import { buildingPly, countWindows, frontsOf, glassOf, ORIGIN, WIN } from '../integration/points_building.js';
+import { absolutePly, buildingPly, countWindows, frontsOf, glassOf, ORIGIN, WIN } from '../integration/points_building.js';
 import { daemonAndBrowser, openPage } from './browser.js';
 import { uploadAndOpen, versionOf, WAIT, waitVersion } from './page.js';
 
@@ -28,16 +27,11 @@ const waitDerived = (page, v) =>
   page.locator(`#viewport[data-version="${v}"][data-points-of="derived"][data-points]`).waitFor({ state: 'attached', ...LONG });
 const drawn = (page) => page.evaluate(() => Number(document.getElementById('viewport').dataset.points ?? -1));
 
-// derived.ply with absolute coordinates (its offset comment added).
+// derived.ply with absolute coordinates.
 async function derived(id) {
   const res = await api(`/models/${id}/derived.ply`);
   assert.equal(res.status, 200, await res.clone().text());
-  const c = parsePly(Buffer.from(await res.arrayBuffer()));
-  const line = c.comments.find((x) => x.startsWith('offset'));
-  const o = line ? line.split(' ').slice(1).map(Number) : [0, 0, 0];
-  const n = c.props.x.length;
-  for (let i = 0; i < n; i++) { c.props.x[i] += o[0]; c.props.y[i] += o[1]; c.props.z[i] += o[2]; }
-  return { n, props: c.props };
+  return absolutePly(Buffer.from(await res.arrayBuffer()));
 }
 
 // The share of a's points within r of one of b's (a grid of r-sized cells).

@@ -8,18 +8,9 @@
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
 import { assertProblem, http, importModel, PROBLEM, removeDir, sql, startDaemon, waitJob, WsClient, facadeObj } from './harness.js';
-import { parsePly } from './clouds.js';
-import { buildingPly, countWindows, frontsOf, glassOf, ORIGIN, windowBox } from './points_building.js';
+import { absolutePly, buildingPly, countWindows, frontsOf, glassOf, ORIGIN, windowBox } from './points_building.js';
 
-// A PLY answer with absolute coordinates (its offset comment added).
-function absolute(buf) {
-  const c = parsePly(buf);
-  const line = c.comments.find((x) => x.startsWith('offset'));
-  const o = line ? line.split(' ').slice(1).map(Number) : [0, 0, 0];
-  const n = c.props.x.length;
-  for (let i = 0; i < n; i++) { c.props.x[i] += o[0]; c.props.y[i] += o[1]; c.props.z[i] += o[2]; }
-  return { n, props: c.props };
-}
+const absolute = absolutePly;
 
 // Points per m² of the front wall (the plane y = 0 between the windows) and of the windows'
 // glass (0.25 m behind it), measured on a cloud of a front `width` m wide with `windows` windows.

@@ -12,7 +12,7 @@
 // segment's), padded a little: the shown points are float32 copies of the stored ones.
 import * as THREE from 'three';
 import { isCloud } from './cloud.js';
-import { colourOf } from './peers.js';
+import { peerSelections } from './peers.js';
 
 const HIGHLIGHT = new THREE.Color(0xffc820); // as the viewport's picked component
 const NONE = new THREE.Color(0x8d96a0);      // points in no segment
@@ -138,13 +138,7 @@ export class CloudView {
 
   // Placement -> the colour of the first other person who has it selected.
   peerSelections() {
-    const out = new Map();
-    for (const p of this.editor.peers.values()) {
-      const sel = p.state?.selection;
-      if (!Array.isArray(sel)) continue;
-      const colour = new THREE.Color(colourOf(p.state?.name || p.user || p.peer));
-      for (const component of sel) if (!out.has(component)) out.set(component, colour);
-    }
+    const out = new Map([...peerSelections(this.editor.peers)].map(([c, hex]) => [c, new THREE.Color(hex)]));
     this.viewport.mark('peerPlacements', out.size || null);
     return out;
   }

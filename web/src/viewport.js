@@ -11,7 +11,7 @@ import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { isCloud } from './cloud.js';
 import { derivedScene } from './derivedpoints.js';
 import { Layer, ModelLayer } from './layers.js';
-import { colourOf } from './peers.js';
+import { peerSelections } from './peers.js';
 import { Signal } from './signal.js';
 
 // Flat, light background; model colours are mid-tones kept well away from it so the model
@@ -366,13 +366,7 @@ export class Viewport {
   // Our selection in yellow; what others have selected in their colours.
   highlight() {
     const on = new Set(this.editor.selected.components());
-    const theirs = new Map();
-    for (const p of this.editor.peers.values()) {
-      const sel = p.state?.selection;
-      if (!Array.isArray(sel)) continue;
-      const colour = new THREE.Color(colourOf(p.state?.name || p.user || p.peer));
-      for (const c of sel) if (!theirs.has(c)) theirs.set(c, colour);
-    }
+    const theirs = new Map([...peerSelections(this.editor.peers)].map(([c, hex]) => [c, new THREE.Color(hex)]));
     for (const [component, meshes] of this.layers.model.components()) {
       const lit = on.has(component);
       const peer = lit ? null : theirs.get(component);
