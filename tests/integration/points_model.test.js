@@ -155,6 +155,16 @@ describe('point models in the service', () => {
     // an ETag that names the state
     const again = await http(d, 'GET', `/api/v1/models/${id}/derived.ply`, { headers: { 'If-None-Match': (await http(d, 'GET', `/api/v1/models/${id}/derived.ply`)).headers.get('etag') } });
     assert.equal(again.status, 304);
+    // a budget: every k-th point of the derivation, k the least that keeps within it
+    const some = await http(d, 'GET', `/api/v1/models/${id}/derived.ply?budget=1000`, { timeout: 60000 });
+    assert.equal(some.status, 200, some.text.slice(0, 300));
+    const s = absolute(some.body), k = Math.ceil(c.n / 1000);
+    assert.equal(s.n, Math.ceil(c.n / k));
+    assert.ok(s.n <= 1000);
+    for (let i = 0; i < s.n; i++) assert.ok(s.props.x[i] === c.props.x[i * k] && s.props.segment[i] === c.props.segment[i * k], `point ${i}`);
+    assert.notEqual(some.headers.get('etag'), again.headers.get('etag'));
+    assert.equal((await http(d, 'GET', `/api/v1/models/${id}/derived.ply?budget=0`, { timeout: 60000 })).body.length, (await http(d, 'GET', `/api/v1/models/${id}/derived.ply`, { timeout: 60000 })).body.length);
+    assertProblem(await http(d, 'GET', `/api/v1/models/${id}/derived.ply?budget=-1`), 400, 'invalid', 'a negative budget');
   });
 
   it('PUT grammar of a point model re-derives it; bad text is refused and nothing changes', async () => {

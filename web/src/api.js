@@ -175,9 +175,10 @@ export class Api {
     return res.arrayBuffer();
   }
 
-  // The points a proceduralized cloud's grammar derives, as binary PLY (derivedpoints.js).
-  async derivedBuffer(model) {
-    const res = await this.request('GET', `/models/${model.id}/derived.ply`, { raw: true, headers: { Accept: 'application/x-ply' } });
+  // At most `budget` of the points a proceduralized cloud's grammar derives, as binary PLY
+  // (derivedpoints.js).
+  async derivedBuffer(model, budget) {
+    const res = await this.request('GET', `/models/${model.id}/derived.ply?budget=${budget}`, { raw: true, headers: { Accept: 'application/x-ply' } });
     return res.arrayBuffer();
   }
 

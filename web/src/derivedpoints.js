@@ -10,8 +10,9 @@
 // the tree's boxes) while the GPU sees small numbers. glTF's axes as everywhere in the view:
 // archgram's (x, y, z) is (x, z, -y) of the scene.
 //
-// The budget: at most `budget` points are drawn, every k-th point of the derivation (which is
-// placement by placement, so each keeps its share).
+// The budget: the server sends at most `budget` points (derived.ply?budget=N, every k-th of
+// the derivation, placement by placement so each keeps its share); a larger file is thinned
+// here the same way.
 import * as THREE from 'three';
 import { PLYLoader } from 'three/examples/jsm/loaders/PLYLoader.js';
 

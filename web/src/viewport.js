@@ -165,7 +165,7 @@ export class Viewport {
     try {
       let scene;
       if (derived) {
-        const buffer = await this.api.derivedBuffer(model);
+        const buffer = await this.api.derivedBuffer(model, budget);
         if (token !== this.loadToken) return;
         scene = derivedScene(buffer, budget, model.id);
       } else {
