@@ -264,6 +264,9 @@ test('a point cloud proceduralized from the panel, its derived points drawn and 
     return best.s;
   }, { component: front1.component, m: middle });
   assert.ok(at, 'no drawn points of the front wall');
+  // hovering tells which node the point is of; a click selects it
+  await pia.locator('#viewport canvas').hover({ position: { x: Math.round(at.x), y: Math.round(at.y) } });
+  await pia.locator(`#viewport[data-hover-node="${front1.id}"]`).waitFor({ state: 'attached', ...WAIT });
   await pia.locator('#viewport canvas').click({ position: { x: Math.round(at.x), y: Math.round(at.y) } });
   await pia.waitForFunction((n) => window.archgram.selected.single() === n, front1.id, WAIT);
   // bo sees what pia selected in her colour
