@@ -15,6 +15,7 @@ import { test } from 'node:test';
 import { absolutePly, buildingPly, countWindows, frontsOf, glassOf, ORIGIN, WIN } from '../integration/points_building.js';
 import { daemonAndBrowser, openPage } from './browser.js';
 import { uploadAndOpen, versionOf, WAIT, waitVersion } from './page.js';
+import { countChanged, readCanvas } from './pixels.js';
 
 const POINTS = 60000;
 const LONG = { timeout: 120000 };
@@ -172,6 +173,20 @@ test('a point cloud proceduralized from the panel, its derived points drawn and 
   });
   const root0 = tree0.nodes[tree0.root].box;
   assert.ok(far.every((x, k) => Math.abs(x - root0[k]) < 0.05), `drawn ${JSON.stringify(far)}, tree root ${JSON.stringify(root0)}`);
+
+  // they show on the canvas; coloured by terminal ("label") they look otherwise
+  const byPlacement = await readCanvas(pia);
+  assert.ok(byPlacement.fraction > 0.003, `the derived points cover ${byPlacement.fraction} of the view`);
+  await pia.getByTestId('cloud-colour').selectOption('label');
+  await pia.locator('#viewport[data-colour-by="label"]').waitFor({ state: 'attached', ...WAIT });
+  const byTerminal = await readCanvas(pia);
+  assert.ok(countChanged(byPlacement, byTerminal) > 100, 'terminal colours look like placement colours');
+  await pia.getByTestId('cloud-colour').selectOption('segment');
+  // the uploaded points, and back
+  await pia.getByTestId('cloud-view').selectOption('input');
+  await pia.locator(`#viewport[data-points-of="input"][data-points="${POINTS}"]`).waitFor({ state: 'attached', ...WAIT });
+  await pia.getByTestId('cloud-view').selectOption('derived');
+  await waitDerived(pia, v1);
 
   // a smaller budget draws fewer of them
   await pia.getByTestId('cloud-budget').fill('20000');
