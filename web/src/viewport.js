@@ -183,6 +183,12 @@ export class Viewport {
     } catch (err) {
       if (token !== this.loadToken) return;
       this.loading = null;
+      if (derived && err.status === 409) {
+        // restored to before its proceduralization: its figures say so, and its uploaded
+        // points are drawn (editor.updateModel)
+        this.api.getModel(model.id).then((m) => this.editor.updateModel(m), (e) => this.editor.fail(e));
+        return;
+      }
       this.setStatus(cloud ? 'The points could not be shown' : 'The mesh could not be shown');
       this.editor.fail(err.problem || { title: 'Cannot show the mesh', detail: err.message });
     }
