@@ -83,7 +83,7 @@ static ag_status make_grafted(void *user, const ag_mesh *derived, ag_edit_model 
         if ((s = ag_edit_model_wrap(r, &gm->model->opt, em, err)) != AG_OK)
             ag_proceduralize_result_free(r);
         else
-            gm->out->grafted = 1;
+            gm->out->report.grafted = 1;
         return s;
     }
     if (s != AG_ERR_NOT_AVAILABLE) {
@@ -91,7 +91,7 @@ static ag_status make_grafted(void *user, const ag_mesh *derived, ag_edit_model 
             *err = e;
         return s;
     }
-    snprintf(gm->out->fallback, sizeof gm->out->fallback, "%s", e.text);
+    snprintf(gm->out->report.fallback, sizeof gm->out->report.fallback, "%.150s", e.text);
     return ag_model_state_reload(derived, em, err);
 }
 
@@ -153,7 +153,7 @@ ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_para
 json_t *ag_usecase_compose_report_json(const ag_compose_outcome *o)
 {
     const ag_compose_report *r = &o->report;
-    return json_pack(
+    json_t *j = json_pack(
         "{s:{s:s,s:I,s:s},s:s,s:s,s:I,s:[I,I,I],s:i,s:[f,f,f],"
         "s:{s:I,s:I,s:I,s:I,s:I,s:I,s:I},s:{s:I,s:I,s:I,s:I},s:s}",
         "part", "name", o->part->name, "version", (json_int_t)o->part->version, "root",
@@ -167,4 +167,12 @@ json_t *ag_usecase_compose_report_json(const ag_compose_outcome *o)
         "elements", (json_int_t)r->fit.elements, "equations", (json_int_t)r->fit.equations,
         "rigid", (json_int_t)r->fit.rigid, "rigid_relaxed", (json_int_t)r->fit.rigid_relaxed,
         "message", r->message);
+    /* how the new model was made: grafted, or (with the reason) proceduralized */
+    if (j && (json_object_set_new(j, "state", json_string(r->grafted ? "grafted"
+                                                                      : "proceduralized")) ||
+              (r->fallback[0] && json_object_set_new(j, "fallback", json_string(r->fallback))))) {
+        json_decref(j);
+        j = NULL;
+    }
+    return j;
 }

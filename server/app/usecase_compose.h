@@ -35,10 +35,10 @@ typedef struct {
     double load_ms;          /* reading the model and the part */
     double compose_ms;       /* rewriting the grammar (core/parts/compose.h) */
     double state_ms;         /* the new state (a preview: derived) */
-    int grafted;             /* the state's tree is the model's with the part grafted in
-                                (core/parts/graft.h); 0: its derivation was proceduralized */
-    char fallback[256];      /* why the graft did not apply ("" when it did or was not tried) */
-    ag_graft_report graft;
+    ag_graft_report graft;   /* report.grafted: the state's tree is the model's with the part
+                                grafted in (core/parts/graft.h); else its derivation was
+                                proceduralized (report.fallback: why the graft did not apply,
+                                "" when it was not tried) */
 } ag_usecase_compose_result;
 
 /* Problems naming the target or the mode are AG_ERR_INVALID or AG_ERR_NOT_FOUND ("target:

@@ -180,33 +180,59 @@ static int same_shape(const shape *a, const shape *b)
 
 /* ---- the tree ------------------------------------------------------------------------------ */
 
-/* Takes the subtree of n (with the split chain above it, when n ends one) out of the tree and
- * marks it dead; counts the visible nodes removed. */
-static int remove_subtree(ag_splittree *t, int32_t n, size_t *visible)
+/* Marks the subtree of n (with the split chain above it, when n ends one) dead, its links
+ * left for unlink_dead; counts the visible nodes removed. stack: room for every node. */
+static void remove_subtree(ag_splittree *t, int32_t n, int32_t *stack, size_t *visible)
 {
     int32_t top = n;
     while (t->nodes[top].parent >= 0 && t->nodes[t->nodes[top].parent].kind == AG_NODE_SPLIT &&
            t->nodes[t->nodes[top].parent].first_child == top &&
            t->nodes[t->nodes[top].parent].last_child == top)
         top = t->nodes[top].parent;
-    if (t->nodes[top].parent >= 0)
-        ag_splittree_detach(t, top);
-    int32_t *stack = malloc((t->nnodes + 1) * sizeof *stack);
-    if (!stack)
-        return -1;
     size_t ns = 0;
     stack[ns++] = top;
     while (ns) {
         int32_t x = stack[--ns];
+        if (t->nodes[x].kind == AG_NODE_DEAD)
+            continue;
         for (int32_t c = t->nodes[x].first_child; c >= 0; c = t->nodes[c].next_sibling)
             stack[ns++] = c;
-        ag_tnode *k = &t->nodes[x];
-        *visible += k->kind == AG_NODE_COMPONENT;
-        k->kind = AG_NODE_DEAD;
-        k->parent = k->first_child = k->last_child = k->next_sibling = -1;
+        *visible += t->nodes[x].kind == AG_NODE_COMPONENT;
+        t->nodes[x].kind = AG_NODE_DEAD;
     }
-    free(stack);
-    return 0;
+}
+
+/* Takes the dead nodes out of their parents' lists (one pass: a detach per node would walk
+ * long sibling lists once per site) and unlinks them. */
+static void unlink_dead(ag_splittree *t)
+{
+    for (size_t p = 0; p < t->nnodes; p++) {
+        ag_tnode *x = &t->nodes[p];
+        if (x->kind == AG_NODE_DEAD)
+            continue;
+        int32_t last = -1;
+        for (int32_t c = x->first_child; c >= 0;) {
+            int32_t next = t->nodes[c].next_sibling;
+            if (t->nodes[c].kind != AG_NODE_DEAD) {
+                if (last < 0)
+                    x->first_child = c;
+                else
+                    t->nodes[last].next_sibling = c;
+                last = c;
+            }
+            c = next;
+        }
+        if (last < 0)
+            x->first_child = -1;
+        else
+            t->nodes[last].next_sibling = -1;
+        x->last_child = last;
+    }
+    for (size_t p = 0; p < t->nnodes; p++) {
+        ag_tnode *x = &t->nodes[p];
+        if (x->kind == AG_NODE_DEAD)
+            x->parent = x->first_child = x->last_child = x->next_sibling = -1;
+    }
 }
 
 /* The nearest visible ancestor of n (or the root) whose box holds b. */
@@ -253,6 +279,16 @@ static void graft_free(graft *g)
     free(g->variant_exemplar);
 }
 
+/* k for a group named "L<k>" (k >= 1), else 0. */
+static size_t label_number(const char *name)
+{
+    if (!name || name[0] != 'L' || name[1] < '1' || name[1] > '9')
+        return 0;
+    char *end;
+    unsigned long k = strtoul(name + 1, &end, 10);
+    return *end || k > (1ul << 24) ? 0 : (size_t)k;
+}
+
 /* Pairs the derivation's components with the kept ones by box; the others are new. */
 static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t *gone,
                                  ag_graft_report *rep, ag_error *err)
@@ -284,6 +320,14 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
     rep->kept = nk;
     const ag_mesh *D = g->D;
     size_t matched = 0;
+    /* per group of the derivation: the label "L<k>" names (k - 1), else -1 */
+    int32_t *group_label = malloc((D->ngroups + 1) * sizeof *group_label);
+    if (!group_label) {
+        st = nomem(err);
+        goto done;
+    }
+    for (size_t k = 0; k < D->ngroups; k++)
+        group_label[k] = (int32_t)label_number(D->group_names[k]) - 1;
     for (size_t c = 0; c < g->d.nc; c++) {
         if (!dcomp_ntris(&g->d, c))
             continue;
@@ -296,7 +340,7 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
         /* the best candidate: the same triangle count, then the same label group */
         int32_t best = -1, best_score = -1;
         int32_t grp = D->component_group ? D->component_group[c] : -1;
-        const char *gname = grp >= 0 && (size_t)grp < D->ngroups ? D->group_names[grp] : NULL;
+        int32_t glab = grp >= 0 && (size_t)grp < D->ngroups ? group_label[grp] : -1;
         for (int64_t x = lo[0]; x <= hi[0]; x++)
             for (int64_t y = lo[1]; y <= hi[1]; y++)
                 for (int64_t z = lo[2]; z <= hi[2]; z++)
@@ -307,9 +351,7 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
                             continue;
                         int score = (L->tri_start[kc + 1] - L->tri_start[kc]) ==
                                     dcomp_ntris(&g->d, c);
-                        char want[32];
-                        snprintf(want, sizeof want, "L%d", L->label[kc] + 1);
-                        score += gname && !strcmp(gname, want) ? 2 : 0;
+                        score += glab >= 0 && glab == L->label[kc] ? 2 : 0;
                         if (score > best_score) {
                             best_score = score;
                             best = kc;
@@ -321,6 +363,7 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
             matched++;
         }
     }
+    free(group_label);
     if (matched != nk) {
         for (size_t i = 0; i < nk; i++)
             if (!used[kept[i]]) {
@@ -430,16 +473,6 @@ static ag_status assign_sites(graft *g, const ag_splittree *T, ag_error *err)
     free(ent_site);
     cellhash_free(&h);
     return st;
-}
-
-/* k for a group named "L<k>" (k >= 1), else 0. */
-static size_t label_number(const char *name)
-{
-    if (!name || name[0] != 'L' || name[1] < '1' || name[1] > '9')
-        return 0;
-    char *end;
-    unsigned long k = strtoul(name + 1, &end, 10);
-    return *end || k > (1ul << 24) ? 0 : (size_t)k;
 }
 
 /* Labels (by group) and variants (by exact shape) of the new components. */
@@ -717,6 +750,7 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
     graft g = {.in = in, .D = derived};
     ag_splittree *X = NULL;
     uint8_t *gone = NULL;
+    int32_t *stack = NULL;
     ag_proceduralize_result comb = {0};
     ag_status st = AG_OK;
     if (dcomps_make(derived, &g.d)) {
@@ -746,7 +780,8 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
     rep->sites = g.nsites;
     /* removals */
     if (!(X = ag_splittree_copy(T)) || !(gone = calloc(T->nnodes + 1, 1)) ||
-        !(g.hang = malloc((g.nsites + 1) * sizeof *g.hang))) {
+        !(g.hang = malloc((g.nsites + 1) * sizeof *g.hang)) ||
+        !(stack = malloc((T->nnodes + 1) * sizeof *stack))) {
         st = nomem(err);
         goto done;
     }
@@ -762,24 +797,23 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
             while (p > 0 && X->nodes[p].kind != AG_NODE_COMPONENT)
                 p = X->nodes[p].parent;
             g.hang[s] = p < 0 ? 0 : p;
-            if (remove_subtree(X, n, &rep->removed)) {
-                st = nomem(err);
-                goto done;
-            }
+            remove_subtree(X, n, stack, &rep->removed);
         } else {
             g.hang[s] = n;
             if (op->mode != AG_COMPOSE_INSERT)
-                while (X->nodes[n].first_child >= 0)
-                    if (remove_subtree(X, X->nodes[n].first_child, &rep->removed)) {
-                        st = nomem(err);
-                        goto done;
-                    }
+                for (int32_t c = X->nodes[n].first_child; c >= 0; c = X->nodes[c].next_sibling)
+                    remove_subtree(X, c, stack, &rep->removed);
         }
     }
+    unlink_dead(X);
     for (size_t n = 0; n < T->nnodes; n++)
         gone[n] = X->nodes[n].kind == AG_NODE_DEAD;
-    if ((st = pair_components(&g, X, gone, rep, err)) || (st = assign_sites(&g, T, err)) ||
-        (st = classify(&g, err)) || (st = insert_new(&g, X, err)))
+    if ((st = pair_components(&g, X, gone, rep, err)))
+        goto done;
+    if ((st = assign_sites(&g, T, err)) ||
+        (st = classify(&g, err)))
+        goto done;
+    if ((st = insert_new(&g, X, err)))
         goto done;
     rep->added = g.nnew;
     if ((st = combined_input(&g, X, &comb, err)))
@@ -801,6 +835,7 @@ done:
     ag_splittree_free(comb.tree);
     ag_splittree_free(X);
     free(gone);
+    free(stack);
     graft_free(&g);
     return st;
 }
