@@ -1,6 +1,7 @@
 #include "part_library.h"
 
 #include <jansson.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,12 +50,42 @@ static char *stats_of(const ag_part *p, const ag_mesh *m)
     return s;
 }
 
+/* The thumbnail and the stats: the part derived and pictured (a thread of its own while the
+ * entry is encoded; both only read the part). */
+typedef struct {
+    const ag_part *p;
+    uint8_t *png;
+    size_t png_len;
+    char *stats;
+    ag_status s;
+    ag_error err;
+} pictured;
+
+static void *picture(void *arg)
+{
+    pictured *x = arg;
+    ag_mesh *m = NULL;
+    ag_error_clear(&x->err);
+    x->s = ag_part_media_mesh(x->p, &m, &x->err);
+    if (x->s == AG_OK)
+        x->s = ag_part_media_picture(m, x->p->facing, AG_PART_THUMBNAIL_SIDE, &x->png,
+                                     &x->png_len, &x->err);
+    if (x->s == AG_OK && !(x->stats = stats_of(x->p, m)))
+        x->s = ag_error_set(&x->err, AG_ERR_NOMEM, 0, "out of memory");
+    ag_mesh_free(m);
+    return NULL;
+}
+
 static ag_status prepare(const ag_part *p, stored *out, ag_error *err)
 {
     memset(out, 0, sizeof *out);
     json_t *entry = NULL;
-    ag_mesh *m = NULL;
     ag_status s = ag_part_validate(p, err);
+    if (s != AG_OK)
+        return s;
+    pictured pic = {.p = p};
+    pthread_t th;
+    int threaded = pthread_create(&th, NULL, picture, &pic) == 0;
     if (s == AG_OK && !(out->terminals = json_object()))
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     if (s == AG_OK)
@@ -79,12 +110,18 @@ static ag_status prepare(const ag_part *p, stored *out, ag_error *err)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     for (size_t i = 0; s == AG_OK && i < p->ntags; i++)
         out->tags[i] = p->tags[i];
-    if (s == AG_OK && (s = ag_part_media_mesh(p, &m, err)) == AG_OK)
-        s = ag_part_media_picture(m, p->facing, AG_PART_THUMBNAIL_SIDE, &out->png, &out->png_len,
-                                  err);
-    if (s == AG_OK && !(out->stats = stats_of(p, m)))
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    ag_mesh_free(m);
+    if (threaded)
+        pthread_join(th, NULL);
+    else
+        picture(&pic);
+    out->png = pic.png;
+    out->png_len = pic.png_len;
+    out->stats = pic.stats;
+    if (s == AG_OK && pic.s != AG_OK) {
+        s = pic.s;
+        if (err)
+            *err = pic.err;
+    }
     if (s != AG_OK)
         stored_clear(out);
     return s;
