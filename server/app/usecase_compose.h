@@ -3,8 +3,9 @@
  * (core/parts/compose.h) → the new model state: the composed grammar as it was made, its
  * terminals, what it derives, and its tree: the model's tree with the part's components
  * grafted in (core/parts/graft.h: the nodes outside the target keep their ids, nothing is
- * proceduralized again), or, where the graft does not apply, the derivation proceduralized
- * (app/model_state.h) → saved. The target is an id
+ * proceduralized again) in a workspace that keeps the tree (the store), or the derivation
+ * proceduralized (app/model_state.h) where the graft does not apply and in one that keeps
+ * only the grammar (a folder, whose reload numbers the tree so) → saved. The target is an id
  * of the workspace's tree (app/model_tree.h), checked before anything is computed. `archgram
  * part compose` runs it between folders, the "compose" op (app/compose_ops.h) on the store.
  * A preview (the service's, before the op is sent) runs the same steps without the save. */
