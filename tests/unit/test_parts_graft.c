@@ -18,6 +18,7 @@
 #include <cmocka.h>
 
 #include "core/edit/edit.h"
+#include "core/gen_facade.h"
 #include "core/parts/compose.h"
 #include "core/parts/graft.h"
 #include "core/parts/part.h"
@@ -521,6 +522,80 @@ static void test_pattern_target(void **state)
     ag_part_free(p);
 }
 
+static size_t visible_under(const ag_splittree *t, int32_t n)
+{
+    size_t k = t->nodes[n].kind == AG_NODE_COMPONENT;
+    for (int32_t c = t->nodes[n].first_child; c >= 0; c = t->nodes[c].next_sibling)
+        k += visible_under(t, c);
+    return k;
+}
+
+/* The bench's building (bench/parts.c) at a small size: every box its own component, windows
+ * of several pieces on three facades in patterns, a blank back, an annex. As the bench picks:
+ * the most repeated visible node, the one with the largest subtree (a facade), the largest
+ * leaf (the blank wall). Each case is composed into the previous case's grafted model, as the
+ * service's ops follow one another. */
+static void test_generated_facade(void **state)
+{
+    (void)state;
+    for (int bars = 0; bars <= 3; bars += 3) {
+        ag_gen_facade_options go = {.cols = 6, .rows = 4, .side_cols = 4, .left = 1, .bars = (unsigned)bars,
+                                    .no_groups = 1, .annex = 1};
+        ag_mesh *m = NULL;
+        assert_int_equal(ag_gen_facade(&go, &m, NULL), AG_OK);
+        ag_edit_model *em = model_of(m);
+        const ag_splittree *t = em->proc->tree;
+        int32_t rep = -1, big = -1;
+        size_t best_rep = 0, best_sub = 0;
+        for (size_t i = 1; i < t->nnodes; i++) {
+            const ag_tnode *n = &t->nodes[i];
+            if (n->kind != AG_NODE_COMPONENT)
+                continue;
+            if (n->rule >= 0 && t->rule_count[n->rule] > best_rep) {
+                best_rep = t->rule_count[n->rule];
+                rep = (int32_t)i;
+            }
+            size_t sub = visible_under(t, (int32_t)i);
+            if (sub > best_sub) {
+                best_sub = sub;
+                big = (int32_t)i;
+            }
+        }
+        assert_true(rep > 0 && big > 0 && best_sub > 10);
+        ag_part *piece = save_node(em->proc, rep, "window piece");
+        ag_part *facade = save_node(em->proc, big, "facade");
+        ag_edit_model *a = compare(em, piece, rep, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE, "piece into its rule");
+        /* the same node id names the same place in the grafted model */
+        assert_true(pf_same_box(&a->proc->tree->nodes[big].box, &t->nodes[big].box, TOL));
+        ag_edit_model *b = compare(a, piece, big, AG_COMPOSE_INSERT, AG_COMPOSE_NODE, "piece under a facade");
+        /* the largest leaf of the grafted model: a blank wall */
+        const ag_splittree *tb = b->proc->tree;
+        int32_t leaf = -1;
+        double best_area = 0;
+        for (size_t i = 1; i < tb->nnodes; i++) {
+            const ag_tnode *n = &tb->nodes[i];
+            if (n->kind != AG_NODE_COMPONENT || n->first_child >= 0)
+                continue;
+            double area = fmax(n->box.max[0] - n->box.min[0], n->box.max[1] - n->box.min[1]) *
+                          (n->box.max[2] - n->box.min[2]);
+            if (area > best_area) {
+                best_area = area;
+                leaf = (int32_t)i;
+            }
+        }
+        assert_true(leaf > 0);
+        ag_edit_model *c = compare(b, facade, leaf, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, "facade onto the blank wall");
+        resize_works(c);
+        ag_edit_model_free(c);
+        ag_edit_model_free(b);
+        ag_edit_model_free(a);
+        ag_part_free(piece);
+        ag_part_free(facade);
+        ag_edit_model_free(em);
+        ag_mesh_free(m);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -534,6 +609,7 @@ int main(void)
         cmocka_unit_test(test_insert_balcony),
         cmocka_unit_test(test_rule_scope_terminal),
         cmocka_unit_test(test_pattern_target),
+        cmocka_unit_test(test_generated_facade),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
