@@ -522,6 +522,69 @@ static void test_pattern_target(void **state)
     ag_part_free(p);
 }
 
+/* The graft refuses (AG_ERR_NOT_AVAILABLE, so a service proceduralizes instead) a derivation
+ * that does not pair with the model: a kept component moved, or other geometry in its box. */
+static void test_refuses_what_does_not_pair(void **state)
+{
+    (void)state;
+    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    ag_part *p = save_window(&oa, 0);
+    ag_box *slots;
+    size_t ns;
+    ag_mesh *m = pf_building(&ob, &slots, &ns);
+    ag_edit_model *em = model_of(m);
+    int32_t target = pf_node_with_box(em->proc, &slots[13], TOL);
+    ag_compose_op op = {.target = target, .mode = AG_COMPOSE_REPLACE, .scope = AG_COMPOSE_NODE};
+    ag_grammar *g = NULL;
+    ag_error err = {0};
+    assert_int_equal(ag_compose(em->proc, p, &op, &g, NULL, &err), AG_OK);
+    for (int how = 0; how < 2; how++) {
+        ag_mesh *d = NULL;
+        assert_int_equal(ag_grammar_derive(g, NULL, &d, &err), AG_OK);
+        /* the largest component (a wall, away from the target) */
+        ag_box *cb = pf_component_boxes(d);
+        size_t wall = 0;
+        for (size_t c = 1; c < d->ncomponents; c++)
+            if (ag_box_volume(&cb[c]) > ag_box_volume(&cb[wall]))
+                wall = c;
+        uint8_t *mine = calloc(d->nverts, 1);
+        for (size_t t = 0; t < d->ntris; t++)
+            if (d->tri_component[t] == wall)
+                for (int j = 0; j < 3; j++)
+                    mine[d->tri[3 * t + j]] = 1;
+        for (size_t v = 0; v < d->nverts; v++) {
+            if (!mine[v])
+                continue;
+            double *x = &d->pos[3 * v];
+            if (how == 0) /* moved by 1 m */
+                x[0] += 1.0;
+            else if (x[0] == cb[wall].max[0] && x[1] == cb[wall].min[1] && x[2] == cb[wall].max[2])
+                x[1] = cb[wall].max[1]; /* one corner pulled through: the same box, another surface */
+        }
+        ag_box after = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+        for (size_t v = 0; v < d->nverts; v++)
+            if (mine[v])
+                ag_box_extend_point(&after, &d->pos[3 * v]);
+        if (how == 1)
+            assert_true(pf_same_box(&after, &cb[wall], 1e-12));
+        ag_proceduralize_result *r = NULL;
+        ag_error e = {0};
+        assert_int_equal(ag_graft_compose(em->proc, &op, d, &em->opt.patterns, &r, NULL, &e),
+                         AG_ERR_NOT_AVAILABLE);
+        assert_null(r);
+        print_message("refused: %s\n", e.text);
+        assert_non_null(strstr(e.text, "node"));
+        free(mine);
+        free(cb);
+        ag_mesh_free(d);
+    }
+    ag_grammar_free(g);
+    ag_edit_model_free(em);
+    free(slots);
+    ag_mesh_free(m);
+    ag_part_free(p);
+}
+
 static size_t visible_under(const ag_splittree *t, int32_t n)
 {
     size_t k = t->nodes[n].kind == AG_NODE_COMPONENT;
@@ -610,6 +673,7 @@ int main(void)
         cmocka_unit_test(test_rule_scope_terminal),
         cmocka_unit_test(test_pattern_target),
         cmocka_unit_test(test_generated_facade),
+        cmocka_unit_test(test_refuses_what_does_not_pair),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

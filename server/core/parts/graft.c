@@ -76,6 +76,7 @@ typedef struct {
     size_t nc;
     uint32_t *tri_start, *tris; /* triangles per component */
     ag_box *box;
+    double *sig; /* per component: its surface area and its area centroid (4 values) */
 } dcomps;
 
 static void dcomps_free(dcomps *d)
@@ -83,6 +84,29 @@ static void dcomps_free(dcomps *d)
     free(d->tri_start);
     free(d->tris);
     free(d->box);
+    free(d->sig);
+}
+
+/* Area and area centroid of the triangles tris[0..n) of m: what a component covers, whatever
+ * its triangulation (sig: 4 values). */
+static void signature(const ag_mesh *m, const uint32_t *tris, size_t n, double sig[4])
+{
+    double a = 0, c[3] = {0, 0, 0};
+    for (size_t k = 0; k < n; k++) {
+        const double *p = &m->pos[3 * m->tri[3 * tris[k]]], *q = &m->pos[3 * m->tri[3 * tris[k] + 1]],
+                     *r = &m->pos[3 * m->tri[3 * tris[k] + 2]];
+        double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, v[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+        double x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2], z = u[0] * v[1] - u[1] * v[0];
+        double w = 0.5 * sqrt(x * x + y * y + z * z);
+        a += w;
+        /* about the first corner: the centroid stays exact at UTM-sized coordinates */
+        for (int j = 0; j < 3; j++)
+            c[j] += w * (u[j] + v[j]) / 3;
+    }
+    const double *o = n ? &m->pos[3 * m->tri[3 * tris[0]]] : c;
+    sig[0] = a;
+    for (int j = 0; j < 3; j++)
+        sig[1 + j] = n ? o[j] + (a > 0 ? c[j] / a : 0) : 0;
 }
 
 static int dcomps_make(const ag_mesh *m, dcomps *d)
@@ -92,8 +116,9 @@ static int dcomps_make(const ag_mesh *m, dcomps *d)
     d->tri_start = calloc(nc + 2, sizeof *d->tri_start);
     d->tris = malloc((m->ntris + 1) * sizeof *d->tris);
     d->box = malloc((nc + 1) * sizeof *d->box);
+    d->sig = malloc((4 * nc + 1) * sizeof *d->sig);
     uint32_t *fill = malloc((nc + 1) * sizeof *fill);
-    if (!d->tri_start || !d->tris || !d->box || !fill) {
+    if (!d->tri_start || !d->tris || !d->box || !d->sig || !fill) {
         free(fill);
         return -1;
     }
@@ -110,6 +135,8 @@ static int dcomps_make(const ag_mesh *m, dcomps *d)
         for (uint32_t k = d->tri_start[c]; k < d->tri_start[c + 1]; k++)
             for (int j = 0; j < 3; j++)
                 ag_box_extend_point(&d->box[c], &m->pos[3 * m->tri[3 * d->tris[k] + j]]);
+        signature(m, d->tris + d->tri_start[c], d->tri_start[c + 1] - d->tri_start[c],
+                  d->sig + 4 * c);
     }
     return 0;
 }
@@ -358,6 +385,23 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
                         }
                     }
         if (best >= 0) {
+            /* the same surface as the kept component: a composition that put other geometry
+             * into the same box would otherwise keep the old one */
+            double ks[4], *ds = g->d.sig + 4 * c, dg = ag_box_diagonal(b);
+            signature(g->in->mesh, L->tris + L->tri_start[best],
+                      L->tri_start[best + 1] - L->tri_start[best], ks);
+            double tol = fmax(g->q, fmax(L->tol, L->share));
+            int same = fabs(ks[0] - ds[0]) <= 1e-3 * fmax(ks[0], ds[0]) + tol * dg;
+            for (int a = 1; a < 4 && same; a++)
+                same = fabs(ks[a] - ds[a]) <= tol + 1e-3 * dg;
+            if (!same) {
+                free(group_label);
+                st = ag_error_set(err, AG_ERR_NOT_AVAILABLE, T->comp_node[best],
+                                  "the composed grammar places other geometry on the box of "
+                                  "node %d, which stays",
+                                  (int)T->comp_node[best]);
+                goto done;
+            }
             used[best] = 1;
             paired[c] = 1;
             matched++;
