@@ -17,6 +17,7 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "app/model_kept.h"
 #include "core/edit/edit.h"
 #include "core/gen_facade.h"
 #include "core/parts/compose.h"
@@ -330,6 +331,19 @@ static ag_edit_model *compare(ag_edit_model *em, const ag_part *part, int32_t ta
     ag_edit_model *out = NULL;
     if (ag_edit_model_wrap(fast, &em->opt, &out, &err))
         fail_msg("wrap: %s", err.text);
+    /* as the store keeps it (the mesh and the tree text) it reloads node for node */
+    char *kept_text = ag_model_kept_tree_text(out);
+    assert_non_null(kept_text);
+    ag_edit_model *back = NULL;
+    if (ag_model_kept_reload(out->proc->mesh, kept_text, &back, &err))
+        fail_msg("%s: the kept model does not reload: %s", what, err.text);
+    assert_int_equal(back->proc->tree->nnodes, out->proc->tree->nnodes);
+    for (size_t n = 0; n < out->proc->tree->nnodes; n++) {
+        assert_int_equal(back->proc->tree->nodes[n].kind, out->proc->tree->nodes[n].kind);
+        assert_true(pf_same_box(&back->proc->tree->nodes[n].box, &out->proc->tree->nodes[n].box, TOL));
+    }
+    ag_edit_model_free(back);
+    free(kept_text);
     ag_mesh_free(fd);
     ag_edit_model_free(slow);
     ag_mesh_free(d);

@@ -257,8 +257,11 @@ static void unlink_dead(ag_splittree *t)
     }
     for (size_t p = 0; p < t->nnodes; p++) {
         ag_tnode *x = &t->nodes[p];
-        if (x->kind == AG_NODE_DEAD)
+        if (x->kind == AG_NODE_DEAD) {
+            /* a dead node names nothing: the kept tree checks every index it holds */
             x->parent = x->first_child = x->last_child = x->next_sibling = -1;
+            x->component = x->label = x->variant = x->rule = x->pattern = -1;
+        }
     }
 }
 
