@@ -228,4 +228,30 @@ static inline int pf_same_box(const ag_box *x, const ag_box *y, double tol)
     return pf_inside(x, y, tol) && pf_inside(y, x, tol);
 }
 
+static inline char *pf_print(const ag_grammar *g)
+{
+    char *text = NULL;
+    size_t len = 0;
+    ag_error err = {0};
+    if (ag_grammar_text_print(g, &text, &len, &err))
+        fail_msg("print: %s", err.text);
+    return text;
+}
+
+/* fmt round trip: prints, parses and prints back to the same bytes. */
+static inline void pf_check_roundtrip(const ag_grammar *g)
+{
+    char *a = pf_print(g);
+    ag_grammar *back = NULL;
+    ag_error err = {0};
+    long col = 0;
+    if (ag_grammar_text_parse(a, strlen(a), &back, &err, &col))
+        fail_msg("the grammar does not parse: %ld:%ld: %s\n%s", err.element, col, err.text, a);
+    char *b = pf_print(back);
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    ag_grammar_free(back);
+}
+
 #endif

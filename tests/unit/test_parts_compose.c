@@ -72,32 +72,6 @@ static ag_part *save_window(const pf_options *o, int which)
     return p;
 }
 
-static char *print(const ag_grammar *g)
-{
-    char *text = NULL;
-    size_t len = 0;
-    ag_error err = {0};
-    if (ag_grammar_text_print(g, &text, &len, &err))
-        fail_msg("print: %s", err.text);
-    return text;
-}
-
-/* fmt round trip: prints, parses and prints back to the same bytes. */
-static void check_roundtrip(const ag_grammar *g)
-{
-    char *a = print(g);
-    ag_grammar *back = NULL;
-    ag_error err = {0};
-    long col = 0;
-    if (ag_grammar_text_parse(a, strlen(a), &back, &err, &col))
-        fail_msg("composed grammar does not parse: %ld:%ld: %s\n%s", err.element, col, err.text, a);
-    char *b = print(back);
-    assert_string_equal(a, b);
-    free(a);
-    free(b);
-    ag_grammar_free(back);
-}
-
 /* The along (horizontal, longer) axis of a window slot. */
 static int along_axis(const ag_box *s)
 {
@@ -162,7 +136,7 @@ static ag_grammar *compose(const ag_proceduralize_result *r, const ag_part *p, i
     if (ag_compose(r, p, &op, &g, rep, &err))
         fail_msg("compose: %s", err.text);
     print_message("%s\n", rep->message);
-    check_roundtrip(g);
+    pf_check_roundtrip(g);
     return g;
 }
 

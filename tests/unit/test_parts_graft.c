@@ -238,31 +238,6 @@ static void components_closed(const ag_mesh *m, const char *what)
     free(tris);
 }
 
-static char *print(const ag_grammar *g)
-{
-    char *text = NULL;
-    size_t len = 0;
-    ag_error err = {0};
-    if (ag_grammar_text_print(g, &text, &len, &err))
-        fail_msg("print: %s", err.text);
-    return text;
-}
-
-static void check_roundtrip(const ag_grammar *g)
-{
-    char *a = print(g);
-    ag_grammar *back = NULL;
-    ag_error err = {0};
-    long col = 0;
-    if (ag_grammar_text_parse(a, strlen(a), &back, &err, &col))
-        fail_msg("grafted grammar does not parse: %ld:%ld: %s", err.element, col, err.text);
-    char *b = print(back);
-    assert_string_equal(a, b);
-    free(a);
-    free(b);
-    ag_grammar_free(back);
-}
-
 static int under(const ag_splittree *t, int32_t n, int32_t anc)
 {
     for (int32_t p = n; p >= 0; p = t->nodes[p].parent)
@@ -305,7 +280,7 @@ static ag_edit_model *compare(ag_edit_model *em, const ag_part *part, int32_t ta
     assert_int_equal(fd->ncomponents, d->ncomponents);
     same_welded(fd, d, what);
     same_label_areas(fd, d, what);
-    check_roundtrip(fast->grammar);
+    pf_check_roundtrip(fast->grammar);
     /* visible nodes away from the sites keep their ids and boxes */
     const ag_splittree *T = em->proc->tree, *F = fast->tree;
     size_t kept = 0;

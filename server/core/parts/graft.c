@@ -309,16 +309,6 @@ static void graft_free(graft *g)
     free(g->variant_exemplar);
 }
 
-/* k for a group named "L<k>" (k >= 1), else 0. */
-static size_t label_number(const char *name)
-{
-    if (!name || name[0] != 'L' || name[1] < '1' || name[1] > '9')
-        return 0;
-    char *end;
-    unsigned long k = strtoul(name + 1, &end, 10);
-    return *end || k > (1ul << 24) ? 0 : (size_t)k;
-}
-
 /* Pairs the derivation's components with the kept ones by box; the others are new. */
 static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t *gone,
                                  ag_graft_report *rep, ag_error *err)
@@ -357,7 +347,7 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
         goto done;
     }
     for (size_t k = 0; k < D->ngroups; k++)
-        group_label[k] = (int32_t)label_number(D->group_names[k]) - 1;
+        group_label[k] = (int32_t)ag__rebuild_label_number(D->group_names[k]) - 1;
     for (size_t c = 0; c < g->d.nc; c++) {
         if (!dcomp_ntris(&g->d, c))
             continue;
@@ -543,7 +533,7 @@ static ag_status classify(graft *g, ag_error *err)
         goto done;
     }
     for (size_t k = 0; k < D->ngroups; k++) {
-        size_t n = label_number(D->group_names[k]);
+        size_t n = ag__rebuild_label_number(D->group_names[k]);
         group_label[k] = n >= 1 && n <= nl0 ? (int32_t)(n - 1) : -1;
     }
     uint32_t mark = 0;
