@@ -76,6 +76,31 @@ static ag_part *save_window(const pf_options *o, int which)
     return p;
 }
 
+/* A window of design oa (window `which`) as a part and a building of design ob, proceduralized
+ * as the service keeps it. */
+typedef struct {
+    ag_part *part;
+    ag_mesh *m;
+    ag_box *slots;
+    size_t ns;
+    ag_edit_model *em;
+} scene;
+
+static void scene_open(scene *sc, const pf_options *oa, int which, const pf_options *ob)
+{
+    sc->part = save_window(oa, which);
+    sc->m = pf_building(ob, &sc->slots, &sc->ns);
+    sc->em = model_of(sc->m);
+}
+
+static void scene_close(scene *sc)
+{
+    ag_edit_model_free(sc->em);
+    free(sc->slots);
+    ag_mesh_free(sc->m);
+    ag_part_free(sc->part);
+}
+
 /* ---- independent measures -------------------------------------------------------------------- */
 
 typedef struct {
@@ -346,20 +371,17 @@ static void rule_replace(int depth, int turn_a, int turn_b, double ox, double oy
     pf_options oa = design_a(depth, turn_a, ox, oy), ob = design_b(depth, turn_b, -ox, oy);
     oa.flip = flip;
     ob.jitter = jitter;
-    ag_part *p = save_window(&oa, 1);
-    ag_box *slots;
-    size_t ns;
-    ag_mesh *m = pf_building(&ob, &slots, &ns);
-    ag_edit_model *em = model_of(m);
+    scene sc;
+    scene_open(&sc, &oa, 1, &ob);
+    ag_part *p = sc.part;
+    ag_box *slots = sc.slots;
+    ag_edit_model *em = sc.em;
     int32_t target = pf_node_with_box(em->proc, &slots[5], TOL);
     assert_true(target > 0);
     ag_edit_model *g = compare(em, p, target, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE, "rule replace");
     resize_works(g);
     ag_edit_model_free(g);
-    ag_edit_model_free(em);
-    free(slots);
-    ag_mesh_free(m);
-    ag_part_free(p);
+    scene_close(&sc);
 }
 
 static void test_rule_replace_recessed(void **state) { (void)state; rule_replace(PF_RECESSED, 0, 0, 0, 0, 0, 0); }
@@ -383,11 +405,11 @@ static void test_node_replace(void **state)
     (void)state;
     for (int turn = 0; turn < 4; turn += 3) {
         pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, turn, 0, 0);
-        ag_part *p = save_window(&oa, 0);
-        ag_box *slots;
-        size_t ns;
-        ag_mesh *m = pf_building(&ob, &slots, &ns);
-        ag_edit_model *em = model_of(m);
+        scene sc;
+        scene_open(&sc, &oa, 0, &ob);
+        ag_part *p = sc.part;
+        ag_box *slots = sc.slots;
+        ag_edit_model *em = sc.em;
         int32_t target = pf_node_with_box(em->proc, &slots[13], TOL);
         assert_true(target > 0);
         ag_edit_model *g = compare(em, p, target, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, "node replace");
@@ -398,10 +420,7 @@ static void test_node_replace(void **state)
         resize_works(g2);
         ag_edit_model_free(g2);
         ag_edit_model_free(g);
-        ag_edit_model_free(em);
-        free(slots);
-        ag_mesh_free(m);
-        ag_part_free(p);
+        scene_close(&sc);
     }
 }
 
@@ -411,12 +430,11 @@ static void test_fill_blank_wall(void **state)
     (void)state;
     for (int depth = PF_FLUSH; depth <= PF_PROUD; depth++) {
         pf_options oa = design_a(depth, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
-        ag_part *p = save_window(&oa, 2);
-        ag_box *slots;
-        size_t ns;
-        ag_mesh *m = pf_building(&ob, &slots, &ns);
-        ag_edit_model *em = model_of(m);
-        ag_box bounds = ag_mesh_bounds(m);
+        scene sc;
+        scene_open(&sc, &oa, 2, &ob);
+        ag_part *p = sc.part;
+        ag_edit_model *em = sc.em;
+        ag_box bounds = ag_mesh_bounds(sc.m);
         double Dp = bounds.max[1] - 0.2;
         ag_box back = {{0, Dp - 0.3, 0}, {11.2, Dp, 10.6}};
         int32_t target = pf_node_with_box(em->proc, &back, TOL);
@@ -424,10 +442,7 @@ static void test_fill_blank_wall(void **state)
         ag_edit_model *g = compare(em, p, target, AG_COMPOSE_FILL, AG_COMPOSE_NODE, "fill");
         resize_works(g);
         ag_edit_model_free(g);
-        ag_edit_model_free(em);
-        free(slots);
-        ag_mesh_free(m);
-        ag_part_free(p);
+        scene_close(&sc);
     }
 }
 
@@ -470,11 +485,11 @@ static void test_rule_scope_terminal(void **state)
 {
     (void)state;
     pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
-    ag_part *p = save_window(&oa, 0);
-    ag_box *slots;
-    size_t ns;
-    ag_mesh *m = pf_building(&ob, &slots, &ns);
-    ag_edit_model *em = model_of(m);
+    scene sc;
+    scene_open(&sc, &oa, 0, &ob);
+    ag_part *p = sc.part;
+    ag_box *slots = sc.slots;
+    ag_edit_model *em = sc.em;
     const ag_box *w0 = &slots[0];
     ag_box glass = {{w0->min[0] + 0.12, w0->min[1] + 0.07, w0->min[2] + 0.12},
                     {w0->max[0] - 0.12, w0->min[1] + 0.08, w0->max[2] - 0.12}};
@@ -482,10 +497,7 @@ static void test_rule_scope_terminal(void **state)
     assert_true(target > 0);
     ag_edit_model *g = compare(em, p, target, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE, "rule terminal");
     ag_edit_model_free(g);
-    ag_edit_model_free(em);
-    free(slots);
-    ag_mesh_free(m);
-    ag_part_free(p);
+    scene_close(&sc);
 }
 
 /* A pattern node (the front window grid) replaced by one part, scope node. */
@@ -493,11 +505,11 @@ static void test_pattern_target(void **state)
 {
     (void)state;
     pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
-    ag_part *p = save_window(&oa, 0);
-    ag_box *slots;
-    size_t ns;
-    ag_mesh *m = pf_building(&ob, &slots, &ns);
-    ag_edit_model *em = model_of(m);
+    scene sc;
+    scene_open(&sc, &oa, 0, &ob);
+    ag_part *p = sc.part;
+    ag_box *slots = sc.slots;
+    ag_edit_model *em = sc.em;
     const ag_splittree *t = em->proc->tree;
     int32_t pat = t->nodes[pf_node_with_box(em->proc, &slots[0], TOL)].parent;
     while (pat >= 0 && t->nodes[pat].kind == AG_NODE_SPLIT)
@@ -505,10 +517,7 @@ static void test_pattern_target(void **state)
     assert_int_equal(t->nodes[pat].kind, AG_NODE_PATTERN);
     ag_edit_model *g = compare(em, p, pat, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, "pattern node");
     ag_edit_model_free(g);
-    ag_edit_model_free(em);
-    free(slots);
-    ag_mesh_free(m);
-    ag_part_free(p);
+    scene_close(&sc);
 }
 
 /* The graft refuses (AG_ERR_NOT_AVAILABLE, so a service proceduralizes instead) a derivation
@@ -517,11 +526,11 @@ static void test_refuses_what_does_not_pair(void **state)
 {
     (void)state;
     pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
-    ag_part *p = save_window(&oa, 0);
-    ag_box *slots;
-    size_t ns;
-    ag_mesh *m = pf_building(&ob, &slots, &ns);
-    ag_edit_model *em = model_of(m);
+    scene sc;
+    scene_open(&sc, &oa, 0, &ob);
+    ag_part *p = sc.part;
+    ag_box *slots = sc.slots;
+    ag_edit_model *em = sc.em;
     int32_t target = pf_node_with_box(em->proc, &slots[13], TOL);
     ag_compose_op op = {.target = target, .mode = AG_COMPOSE_REPLACE, .scope = AG_COMPOSE_NODE};
     ag_grammar *g = NULL;
@@ -568,10 +577,7 @@ static void test_refuses_what_does_not_pair(void **state)
         ag_mesh_free(d);
     }
     ag_grammar_free(g);
-    ag_edit_model_free(em);
-    free(slots);
-    ag_mesh_free(m);
-    ag_part_free(p);
+    scene_close(&sc);
 }
 
 static size_t visible_under(const ag_splittree *t, int32_t n)
