@@ -228,6 +228,21 @@ static inline int pf_same_box(const ag_box *x, const ag_box *y, double tol)
     return pf_inside(x, y, tol) && pf_inside(y, x, tol);
 }
 
+/* Window design A (the part): 1.2 x 1.8, frame 0.08, one mullion. Design B (the target's):
+ * 1.6 x 2.0, frame 0.12, two mullions. */
+static inline pf_options pf_design_a(int depth, int turn, double ox, double oy)
+{
+    return (pf_options){.cols = 3, .rows = 2, .ww = 1.2, .wh = 1.8, .frame = 0.08, .mullions = 1,
+                        .depth = depth, .turn = turn, .ox = ox, .oy = oy};
+}
+
+static inline pf_options pf_design_b(int depth, int turn, double ox, double oy)
+{
+    return (pf_options){.cols = 4, .rows = 3, .side_cols = 2, .ww = 1.6, .wh = 2.0,
+                        .frame = 0.12, .mullions = 2, .depth = depth, .turn = turn, .ox = ox,
+                        .oy = oy};
+}
+
 static inline char *pf_print(const ag_grammar *g)
 {
     char *text = NULL;

@@ -19,21 +19,6 @@
 
 #define TOL 1e-6
 
-/* Window design A (the part): 1.2 x 1.8, frame 0.08, one mullion. Design B (the target's):
- * 1.6 x 2.0, frame 0.12, two mullions. */
-static pf_options design_a(int depth, int turn, double ox, double oy)
-{
-    return (pf_options){.cols = 3, .rows = 2, .ww = 1.2, .wh = 1.8, .frame = 0.08, .mullions = 1,
-                        .depth = depth, .turn = turn, .ox = ox, .oy = oy};
-}
-
-static pf_options design_b(int depth, int turn, double ox, double oy)
-{
-    return (pf_options){.cols = 4, .rows = 3, .side_cols = 2, .ww = 1.6, .wh = 2.0,
-                        .frame = 0.12, .mullions = 2, .depth = depth, .turn = turn, .ox = ox,
-                        .oy = oy};
-}
-
 static ag_part *save_window(const pf_options *o, int which)
 {
     ag_box *slots;
@@ -211,7 +196,7 @@ static size_t part_components(const scene *sc, const ag_box *boxes, size_t nb, s
 static void rule_scope_replace_ex(int depth, int turn_a, int turn_b, double ox, double oy,
                                   double jitter, int flip)
 {
-    pf_options oa = design_a(depth, turn_a, ox, oy), ob = design_b(depth, turn_b, -ox, oy);
+    pf_options oa = pf_design_a(depth, turn_a, ox, oy), ob = pf_design_b(depth, turn_b, -ox, oy);
     oa.flip = flip;
     ob.jitter = jitter;
     scene sc;
@@ -266,7 +251,7 @@ static void test_node_replace(void **state)
 {
     (void)state;
     for (int turn = 0; turn < 4; turn += 3) {
-        pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, turn, 0, 0);
+        pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, turn, 0, 0);
         scene sc;
         scene_open(&sc, &oa, 0, &ob);
         size_t which = 13; /* on the right facade */
@@ -290,7 +275,7 @@ static void test_node_replace(void **state)
 static void test_fill_blank_wall(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_FLUSH, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_FLUSH, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     scene sc;
     scene_open(&sc, &oa, 2, &ob);
     /* the back wall: 11.2 x 0.3 x 10.6 at y in [D - 0.3, D] */
@@ -322,7 +307,7 @@ static void test_fill_blank_wall(void **state)
 static void test_insert_balcony(void **state)
 {
     (void)state;
-    pf_options oc = design_a(PF_FLUSH, 0, 0, 0);
+    pf_options oc = pf_design_a(PF_FLUSH, 0, 0, 0);
     oc.balcony = 1;
     ag_mesh *mc;
     ag_box *sc;
@@ -336,7 +321,7 @@ static void test_insert_balcony(void **state)
     ag_error err = {0};
     if (ag_part_extract(rc, bn, &meta, &p, &err))
         fail_msg("extract: %s", err.text);
-    pf_options ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     ag_mesh *m;
     ag_box *slots;
     size_t ns;
@@ -396,7 +381,7 @@ static void test_insert_balcony(void **state)
 static void test_names_clash_and_share(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     ag_part *p = save_window(&oa, 0);
     ag_mesh *m;
     ag_box *slots;
@@ -456,7 +441,7 @@ static void test_names_clash_and_share(void **state)
 static void test_rule_scope_terminal(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     scene sc;
     scene_open(&sc, &oa, 0, &ob);
     /* the glass of the first window: inset by the frame, 0.07 behind the casing's face */
@@ -491,7 +476,7 @@ static void test_rule_scope_terminal(void **state)
 static void test_pattern_target(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     scene sc;
     scene_open(&sc, &oa, 0, &ob);
     const ag_splittree *t = sc.r->tree;
@@ -521,7 +506,7 @@ static void test_pattern_target(void **state)
 static void test_bad_ops(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     ag_part *p = save_window(&oa, 0);
     ag_mesh *m;
     ag_box *slots;

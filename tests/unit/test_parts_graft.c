@@ -28,19 +28,6 @@
 
 #define TOL 1e-6
 
-static pf_options design_a(int depth, int turn, double ox, double oy)
-{
-    return (pf_options){.cols = 3, .rows = 2, .ww = 1.2, .wh = 1.8, .frame = 0.08, .mullions = 1,
-                        .depth = depth, .turn = turn, .ox = ox, .oy = oy};
-}
-
-static pf_options design_b(int depth, int turn, double ox, double oy)
-{
-    return (pf_options){.cols = 4, .rows = 3, .side_cols = 2, .ww = 1.6, .wh = 2.0,
-                        .frame = 0.12, .mullions = 2, .depth = depth, .turn = turn, .ox = ox,
-                        .oy = oy};
-}
-
 static ag_edit_model *model_of(const ag_mesh *m)
 {
     ag_edit_model *em = NULL;
@@ -368,7 +355,7 @@ static void resize_works(ag_edit_model *m)
 static void rule_replace(int depth, int turn_a, int turn_b, double ox, double oy, double jitter,
                          int flip)
 {
-    pf_options oa = design_a(depth, turn_a, ox, oy), ob = design_b(depth, turn_b, -ox, oy);
+    pf_options oa = pf_design_a(depth, turn_a, ox, oy), ob = pf_design_b(depth, turn_b, -ox, oy);
     oa.flip = flip;
     ob.jitter = jitter;
     scene sc;
@@ -404,7 +391,7 @@ static void test_node_replace(void **state)
 {
     (void)state;
     for (int turn = 0; turn < 4; turn += 3) {
-        pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, turn, 0, 0);
+        pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, turn, 0, 0);
         scene sc;
         scene_open(&sc, &oa, 0, &ob);
         ag_part *p = sc.part;
@@ -429,7 +416,7 @@ static void test_fill_blank_wall(void **state)
 {
     (void)state;
     for (int depth = PF_FLUSH; depth <= PF_PROUD; depth++) {
-        pf_options oa = design_a(depth, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+        pf_options oa = pf_design_a(depth, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
         scene sc;
         scene_open(&sc, &oa, 2, &ob);
         ag_part *p = sc.part;
@@ -450,7 +437,7 @@ static void test_fill_blank_wall(void **state)
 static void test_insert_balcony(void **state)
 {
     (void)state;
-    pf_options oc = design_a(PF_FLUSH, 0, 0, 0);
+    pf_options oc = pf_design_a(PF_FLUSH, 0, 0, 0);
     oc.balcony = 1;
     ag_box *sc;
     size_t nsc;
@@ -460,7 +447,7 @@ static void test_insert_balcony(void **state)
     int32_t bn = pf_node_with_box(ec->proc, &bal, TOL);
     assert_true(bn > 0);
     ag_part *p = save_node(ec->proc, bn, "balcony");
-    pf_options ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     ag_box *slots;
     size_t ns;
     ag_mesh *m = pf_building(&ob, &slots, &ns);
@@ -484,7 +471,7 @@ static void test_insert_balcony(void **state)
 static void test_rule_scope_terminal(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     scene sc;
     scene_open(&sc, &oa, 0, &ob);
     ag_part *p = sc.part;
@@ -504,7 +491,7 @@ static void test_rule_scope_terminal(void **state)
 static void test_pattern_target(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     scene sc;
     scene_open(&sc, &oa, 0, &ob);
     ag_part *p = sc.part;
@@ -525,7 +512,7 @@ static void test_pattern_target(void **state)
 static void test_refuses_what_does_not_pair(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     scene sc;
     scene_open(&sc, &oa, 0, &ob);
     ag_part *p = sc.part;
