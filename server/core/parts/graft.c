@@ -151,6 +151,7 @@ static uint32_t dcomp_ntris(const dcomps *d, size_t c)
 /* A component's geometry relative to its box: vertices in first use, triangles on them. */
 typedef struct {
     size_t nv, nt;
+    double ext[3]; /* the box's extents */
     double *pos;   /* 3 * nv, in [0, 1] per axis (0 on flat axes) */
     uint32_t *tri; /* 3 * nt local indices */
 } shape;
@@ -162,22 +163,21 @@ static void shape_free(shape *s)
     memset(s, 0, sizeof *s);
 }
 
-/* stamp/local: per mesh vertex scratch (stamp of the last component that met it). */
-static int shape_of(const ag_mesh *m, const dcomps *d, size_t c, uint32_t *stamp, uint32_t *local,
-                    uint32_t mark, shape *s)
+/* The shape of triangles tris[0..nt) of m relative to box b. stamp/local: per mesh vertex
+ * scratch (stamp of the last shape that met it). */
+static int shape_of_tris(const ag_mesh *m, const uint32_t *tris, uint32_t nt, const ag_box *b,
+                         uint32_t *stamp, uint32_t *local, uint32_t mark, shape *s)
 {
-    uint32_t nt = dcomp_ntris(d, c);
     s->nt = nt;
     s->nv = 0;
     s->pos = malloc((3 * (size_t)nt + 1) * 3 * sizeof *s->pos);
     s->tri = malloc((3 * (size_t)nt + 1) * sizeof *s->tri);
     if (!s->pos || !s->tri)
         return -1;
-    const ag_box *b = &d->box[c];
-    double ext[3];
+    double *ext = s->ext;
     ag_box_extents(b, ext);
     for (uint32_t k = 0; k < nt; k++) {
-        uint32_t tr = d->tris[d->tri_start[c] + k];
+        uint32_t tr = tris[k];
         for (int j = 0; j < 3; j++) {
             uint32_t v = m->tri[3 * tr + j];
             if (stamp[v] != mark) {
@@ -194,14 +194,31 @@ static int shape_of(const ag_mesh *m, const dcomps *d, size_t c, uint32_t *stamp
     return 0;
 }
 
-static int same_shape(const shape *a, const shape *b)
+static int shape_of(const ag_mesh *m, const dcomps *d, size_t c, uint32_t *stamp, uint32_t *local,
+                    uint32_t mark, shape *s)
+{
+    return shape_of_tris(m, d->tris + d->tri_start[c], dcomp_ntris(d, c), &d->box[c], stamp,
+                         local, mark, s);
+}
+
+/* Is b the shape a turned by r quarter turns counter-clockwise about z (within its box:
+ * (x, y) -> (1 - y, x) per turn)? */
+static int same_shape(const shape *a, const shape *b, int r)
 {
     if (a->nv != b->nv || a->nt != b->nt ||
         memcmp(a->tri, b->tri, 3 * a->nt * sizeof *a->tri) != 0)
         return 0;
-    for (size_t i = 0; i < 3 * a->nv; i++)
-        if (fabs(a->pos[i] - b->pos[i]) > 1e-9)
+    for (size_t i = 0; i < a->nv; i++) {
+        double x = a->pos[3 * i], y = a->pos[3 * i + 1];
+        for (int k = 0; k < r; k++) {
+            double t = x;
+            x = 1 - y;
+            y = t;
+        }
+        if (fabs(x - b->pos[3 * i]) > 1e-9 || fabs(y - b->pos[3 * i + 1]) > 1e-9 ||
+            fabs(a->pos[3 * i + 2] - b->pos[3 * i + 2]) > 1e-9)
             return 0;
+    }
     return 1;
 }
 
@@ -293,6 +310,7 @@ typedef struct {
     size_t nnew;
     uint32_t *nd;
     int32_t *nsite, *nlabel, *nvariant;
+    uint8_t *nrot; /* quarter turns from the variant's exemplar */
     size_t new_labels, new_variants;
     int32_t *variant_exemplar; /* per new variant: index into nd */
 } graft;
@@ -306,6 +324,7 @@ static void graft_free(graft *g)
     free(g->nsite);
     free(g->nlabel);
     free(g->nvariant);
+    free(g->nrot);
     free(g->variant_exemplar);
 }
 
@@ -512,6 +531,89 @@ static ag_status assign_sites(graft *g, const ag_splittree *T, ag_error *err)
     return st;
 }
 
+/* A new variant that is one of the model's variants of its label (the exemplar's shape and
+ * size, turned or not: a terminal the part shares with the target) becomes that variant, as
+ * labeling the derivation would find it; the other new variants are numbered after
+ * the model's. g->nvariant then holds final variant numbers. */
+static ag_status reuse_variants(graft *g, shape *vshape, ag_error *err)
+{
+    const ag_labels *L = g->in->labels;
+    const ag_mesh *M = g->in->mesh;
+    int32_t *final = malloc((g->new_variants + 1) * sizeof *final);
+    uint8_t *turn = calloc(g->new_variants + 1, 1);
+    uint32_t *stamp = calloc(M->nverts + 1, sizeof *stamp);
+    uint32_t *local = malloc((M->nverts + 1) * sizeof *local);
+    shape *old = calloc(L->nvariants + 1, sizeof *old);
+    uint8_t *made = calloc(L->nvariants + 1, 1);
+    ag_status st = AG_OK;
+    if (!final || !turn || !stamp || !local || !old || !made) {
+        st = nomem(err);
+        goto done;
+    }
+    size_t next = L->nvariants;
+    uint32_t mark = 0;
+    double tol = fmax(g->q, L->exact);
+    for (size_t k = 0; k < g->new_variants && !st; k++) {
+        final[k] = -1;
+        for (size_t v = 0; v < L->nvariants && final[k] < 0; v++) {
+            uint32_t e = L->variant_exemplar ? L->variant_exemplar[v] : UINT32_MAX;
+            if (e >= L->ncomponents || L->variant[e] != (int32_t)v)
+                continue;
+            uint32_t nt = L->tri_start[e + 1] - L->tri_start[e];
+            /* within its label: the derivation's groups keep labels apart */
+            if (nt != vshape[k].nt || L->variant_label[v] != g->nlabel[g->variant_exemplar[k]])
+                continue;
+            if (!made[v]) {
+                ag_box b = ag_box_empty();
+                for (uint32_t t = L->tri_start[e]; t < L->tri_start[e + 1]; t++)
+                    for (int j = 0; j < 3; j++)
+                        ag_box_extend_point(&b, &M->pos[3 * M->tri[3 * L->tris[t] + j]]);
+                if (shape_of_tris(M, L->tris + L->tri_start[e], nt, &b, stamp, local, ++mark,
+                                  &old[v])) {
+                    st = nomem(err);
+                    break;
+                }
+                made[v] = 1;
+            }
+            /* the same size too (turned): labels tell boxes of other proportions apart */
+            for (int r = 0; r < 4 && final[k] < 0; r++)
+                if (fabs(old[v].ext[r & 1] - vshape[k].ext[0]) <= tol &&
+                    fabs(old[v].ext[1 - (r & 1)] - vshape[k].ext[1]) <= tol &&
+                    fabs(old[v].ext[2] - vshape[k].ext[2]) <= tol &&
+                    same_shape(&old[v], &vshape[k], r)) {
+                    final[k] = (int32_t)v;
+                    turn[k] = (uint8_t)r;
+                }
+        }
+        if (final[k] < 0)
+            final[k] = (int32_t)next++;
+    }
+    if (st)
+        goto done;
+    /* the model's variants taken keep their labels; the rest are the new ones, renumbered */
+    size_t nv = 0;
+    for (size_t k = 0; k < g->new_variants; k++)
+        if ((size_t)final[k] >= L->nvariants)
+            g->variant_exemplar[nv++] = g->variant_exemplar[k];
+    for (size_t i = 0; i < g->nnew; i++) {
+        int32_t k = g->nvariant[i];
+        g->nvariant[i] = final[k];
+        if ((size_t)final[k] < L->nvariants)
+            g->nrot[i] = (uint8_t)((g->nrot[i] + turn[k]) & 3);
+    }
+    g->new_variants = nv;
+done:
+    for (size_t v = 0; old && v < L->nvariants; v++)
+        shape_free(&old[v]);
+    free(old);
+    free(made);
+    free(final);
+    free(turn);
+    free(stamp);
+    free(local);
+    return st;
+}
+
 /* Labels (by group) and variants (by exact shape) of the new components. */
 static ag_status classify(graft *g, ag_error *err)
 {
@@ -520,6 +622,7 @@ static ag_status classify(graft *g, ag_error *err)
     size_t nl0 = L->nlabels;
     g->nlabel = malloc((g->nnew + 1) * sizeof *g->nlabel);
     g->nvariant = malloc((g->nnew + 1) * sizeof *g->nvariant);
+    g->nrot = calloc(g->nnew + 1, 1);
     g->variant_exemplar = malloc((g->nnew + 1) * sizeof *g->variant_exemplar);
     int32_t *group_label = malloc((D->ngroups + 1) * sizeof *group_label);
     uint32_t *stamp = calloc(D->nverts + 1, sizeof *stamp);
@@ -527,7 +630,7 @@ static ag_status classify(graft *g, ag_error *err)
     shape *vshape = calloc(g->nnew + 1, sizeof *vshape);
     int32_t *vlabel = malloc((g->nnew + 1) * sizeof *vlabel);
     ag_status st = AG_OK;
-    if (!g->nlabel || !g->nvariant || !g->variant_exemplar || !group_label || !stamp || !local ||
+    if (!g->nlabel || !g->nvariant || !g->nrot || !g->variant_exemplar || !group_label || !stamp || !local ||
         !vshape || !vlabel) {
         st = nomem(err);
         goto done;
@@ -555,10 +658,15 @@ static ag_status classify(graft *g, ag_error *err)
             st = nomem(err);
             break;
         }
+        /* a copy, or a copy turned by quarter turns (as labeling finds them: a part placed
+         * on facades facing other ways keeps one terminal) */
         int32_t v = -1;
         for (size_t k = 0; k < g->new_variants && v < 0; k++)
-            if (vlabel[k] == lab && same_shape(&vshape[k], &s))
-                v = (int32_t)k;
+            for (int r = 0; r < 4 && v < 0; r++)
+                if (vlabel[k] == lab && same_shape(&vshape[k], &s, r)) {
+                    v = (int32_t)k;
+                    g->nrot[i] = (uint8_t)r;
+                }
         if (v < 0) {
             v = (int32_t)g->new_variants++;
             vshape[v] = s;
@@ -569,6 +677,8 @@ static ag_status classify(graft *g, ag_error *err)
         }
         g->nvariant[i] = v;
     }
+    if (!st)
+        st = reuse_variants(g, vshape, err);
 done:
     for (size_t k = 0; vshape && k < g->new_variants; k++)
         shape_free(&vshape[k]);
@@ -647,7 +757,9 @@ static ag_status combined_input(const graft *g, ag_splittree *X, ag_proceduraliz
             goto nomem_;
         size_t ci = n0 + i;
         L->label[ci] = g->nlabel[i];
-        L->variant[ci] = (int32_t)L0->nvariants + g->nvariant[i];
+        L->variant[ci] = g->nvariant[i];
+        L->rot[ci] = L->vrot[ci] = g->nrot[i];
+        L->turn[ci] = g->nrot[i] * 1.5707963267948966;
         uint32_t mark = (uint32_t)i + 1;
         for (uint32_t k = g->d.tri_start[dc]; k < g->d.tri_start[dc + 1]; k++) {
             uint32_t tr = g->d.tris[k], v[3];
@@ -704,7 +816,7 @@ static ag_status insert_new(graft *g, ag_splittree *X, ag_error *err)
     ml.ntris = malloc(nn * sizeof *ml.ntris);
     ml.label = malloc(nn * sizeof *ml.label);
     ml.variant = malloc(nn * sizeof *ml.variant);
-    ml.vrot = calloc(nn, 1);
+    ml.vrot = malloc(nn);
     ml.diagonal = L0->diagonal;
     ml.exact = L0->exact;
     ag_splittree *mt = NULL;
@@ -719,6 +831,7 @@ static ag_status insert_new(graft *g, ag_splittree *X, ag_error *err)
         ml.ntris[i] = dcomp_ntris(&g->d, g->nd[i]);
         ml.label[i] = g->nlabel[i];
         ml.variant[i] = g->nvariant[i];
+        ml.vrot[i] = g->nrot[i];
     }
     if ((st = ag_splittree_build(g->D, &ml, &mt, err)))
         goto done;
@@ -749,8 +862,8 @@ static ag_status insert_new(graft *g, ag_splittree *X, ag_error *err)
         y->box = b;
         y->component = (int32_t)(n0 + i);
         y->label = g->nlabel[i];
-        y->variant = (int32_t)L0->nvariants + g->nvariant[i];
-        y->rot = 0;
+        y->variant = g->nvariant[i];
+        y->rot = g->nrot[i];
         X->comp_node[n0 + i] = n;
         map[k] = n;
     }
