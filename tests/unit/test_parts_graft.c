@@ -90,55 +90,6 @@ static void scene_close(scene *sc)
 
 /* ---- independent measures -------------------------------------------------------------------- */
 
-typedef struct {
-    int64_t q[3];
-} qpoint;
-
-static int cmp_qpoint(const void *a, const void *b)
-{
-    const qpoint *x = a, *y = b;
-    for (int k = 0; k < 3; k++)
-        if (x->q[k] != y->q[k])
-            return x->q[k] < y->q[k] ? -1 : 1;
-    return 0;
-}
-
-/* The welded vertex set of the triangles' corners: positions rounded to 1e-5 m (relative to
- * the mesh's min corner), sorted, duplicates dropped. */
-static qpoint *welded(const ag_mesh *m, const double origin[3], size_t *n)
-{
-    qpoint *p = malloc((3 * m->ntris + 1) * sizeof *p);
-    size_t k = 0;
-    for (size_t t = 0; t < m->ntris; t++)
-        for (int j = 0; j < 3; j++) {
-            const double *v = &m->pos[3 * m->tri[3 * t + j]];
-            for (int a = 0; a < 3; a++)
-                p[k].q[a] = llround((v[a] - origin[a]) * 1e5);
-            k++;
-        }
-    qsort(p, k, sizeof *p, cmp_qpoint);
-    size_t u = 0;
-    for (size_t i = 0; i < k; i++)
-        if (!u || cmp_qpoint(&p[i], &p[u - 1]))
-            p[u++] = p[i];
-    *n = u;
-    return p;
-}
-
-static void same_welded(const ag_mesh *a, const ag_mesh *b, const char *what)
-{
-    ag_box bb = ag_mesh_bounds(b);
-    size_t na, nb;
-    qpoint *pa = welded(a, bb.min, &na), *pb = welded(b, bb.min, &nb);
-    if (na != nb)
-        fail_msg("%s: %zu welded vertices, the slow path %zu", what, na, nb);
-    for (size_t i = 0; i < na; i++)
-        if (cmp_qpoint(&pa[i], &pb[i]))
-            fail_msg("%s: welded vertex %zu differs", what, i);
-    free(pa);
-    free(pb);
-}
-
 static double tri_area(const ag_mesh *m, size_t t)
 {
     const double *a = &m->pos[3 * m->tri[3 * t]], *b = &m->pos[3 * m->tri[3 * t + 1]],
@@ -210,7 +161,7 @@ static void components_closed(const ag_mesh *m, const char *what)
         size_t nt = start[c + 1] - start[c];
         if (!nt)
             continue;
-        qpoint *p = malloc(3 * nt * sizeof *p);
+        pf_qpoint *p = malloc(3 * nt * sizeof *p);
         for (size_t i = 0; i < nt; i++)
             for (int j = 0; j < 3; j++)
                 for (int a = 0; a < 3; a++)
@@ -221,7 +172,7 @@ static void components_closed(const ag_mesh *m, const char *what)
         for (size_t i = 0; i < 3 * nt; i++) {
             id[i] = (uint32_t)i;
             for (size_t k = 0; k < i; k++)
-                if (!cmp_qpoint(&p[i], &p[k])) {
+                if (!pf_cmp_qpoint(&p[i], &p[k])) {
                     id[i] = id[k];
                     break;
                 }
@@ -326,14 +277,14 @@ static ag_edit_model *compare(ag_edit_model *em, const ag_part *part, int32_t ta
     assert_true(rep.added > 0);
     /* the model's mesh, and what its grammar derives, are the slow path's */
     assert_int_equal(fast->mesh->ncomponents, slow->proc->mesh->ncomponents);
-    same_welded(fast->mesh, slow->proc->mesh, what);
+    pf_same_welded(fast->mesh, slow->proc->mesh, what);
     same_label_areas(fast->mesh, slow->proc->mesh, what);
     components_closed(fast->mesh, what);
     ag_mesh *fd = NULL;
     if (ag_grammar_derive(fast->grammar, NULL, &fd, &err))
         fail_msg("%s: the grafted grammar does not derive: %s", what, err.text);
     assert_int_equal(fd->ncomponents, d->ncomponents);
-    same_welded(fd, d, what);
+    pf_same_welded(fd, d, what);
     same_label_areas(fd, d, what);
     pf_check_roundtrip(fast->grammar);
     same_classes(fast->tree, slow->proc->tree, what);

@@ -402,10 +402,16 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
             double ks[4], *ds = g->d.sig + 4 * c, dg = ag_box_diagonal(b);
             signature(g->in->mesh, L->tris + L->tri_start[best],
                       L->tri_start[best + 1] - L->tri_start[best], ks);
-            double tol = fmax(g->q, fmax(L->tol, L->share));
-            int same = fabs(ks[0] - ds[0]) <= 1e-3 * fmax(ks[0], ds[0]) + tol * dg;
+            /* the derivation places a shared terminal, which differs from the member by up
+             * to what labeling certified (its variant's deviation) */
+            int32_t kv = L->variant[best];
+            double dev = kv >= 0 && (size_t)kv < L->nvariants && L->variant_deviation
+                             ? L->variant_deviation[kv]
+                             : 0;
+            double tol = fmax(g->q, fmax(fmax(L->tol, L->share), dev));
+            int same = fabs(ks[0] - ds[0]) <= 1e-2 * fmax(ks[0], ds[0]) + 4 * tol * dg;
             for (int a = 1; a < 4 && same; a++)
-                same = fabs(ks[a] - ds[a]) <= tol + 1e-3 * dg;
+                same = fabs(ks[a] - ds[a]) <= 2 * tol + 1e-3 * dg;
             if (!same) {
                 free(group_label);
                 st = ag_error_set(err, AG_ERR_NOT_AVAILABLE, T->comp_node[best],
