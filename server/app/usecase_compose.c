@@ -109,7 +109,7 @@ ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_par
     double t0 = now_ms();
     /* a workspace that keeps only the grammar reads it back proceduralized: its tree must be
      * numbered as that reload numbers it, so only one that keeps the tree takes the graft */
-    int graft = !p->proceduralize && !(ws->ops->state_flags & AG_MODEL_READ_BACK);
+    int graft = !(ws->ops->state_flags & AG_MODEL_READ_BACK);
     graft_maker gm = {.model = em, .op = &p->op, .out = out};
     s = over_budget(ag_model_state_from_grammar_ex(g, budget, graft ? make_grafted : NULL,
                                                    &gm, st, err),

@@ -26,8 +26,6 @@ typedef struct {
     const ag_part_ref *part;
     ag_compose_op op;
     size_t max_triangles; /* 0: the budget above */
-    int proceduralize;    /* non-zero: make the new state by proceduralizing its derivation
-                             even where the graft applies (to compare the two) */
 } ag_usecase_compose_params;
 
 typedef struct {
