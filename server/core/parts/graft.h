@@ -11,7 +11,10 @@
  * the site's nearest visible ancestor that holds them), their geometry taken from the
  * derivation. A new component in a group "L<k>" naming one of in's labels keeps that label;
  * the others get one new label per group; variants are exact shapes (the geometry relative to
- * its box). The tree is then rebuilt (rebuild.h: chains, mesh, rules, patterns, grammar), so
+ * its box, turned by quarter turns or not: a part composed onto facades facing other ways
+ * keeps one terminal), one of in's variants of the label where shape and size are its. A kept
+ * component's pair must cover the same surface (area and centroid, within the variant's
+ * certified deviation). The tree is then rebuilt (rebuild.h: chains, mesh, rules, patterns, grammar), so
  * the result is the model the derivation proceduralized would be, with in's node ids kept.
  *
  * When the derivation does not pair that way (a kept component missing or moved, a new one
