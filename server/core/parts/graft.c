@@ -705,18 +705,31 @@ static ag_status combined_input(const graft *g, ag_splittree *X, ag_proceduraliz
     const ag_labels *L0 = in->labels;
     const ag_mesh *D = g->D;
     size_t n0 = L0->ncomponents, nc = n0 + g->nnew;
-    ag_mesh *m = ag_mesh_clone(in->mesh);
+    const ag_mesh *M = in->mesh;
+    ag_mesh *m = ag_mesh_create();
     ag_labels *L = calloc(1, sizeof *L);
     uint32_t *stamp = calloc(D->nverts + 1, sizeof *stamp), *local = malloc((D->nverts + 1) * sizeof *local);
     if (!m || !L || !stamp || !local)
         goto nomem_;
-    size_t ntris = m->ntris, nv = m->nverts;
+    size_t ntris = M->ntris, nv = M->nverts;
     for (size_t i = 0; i < g->nnew; i++) {
         ntris += dcomp_ntris(&g->d, g->nd[i]);
         nv += 3 * dcomp_ntris(&g->d, g->nd[i]);
     }
+    /* the model's mesh copied once into room for the new components (the rebuild reads the
+     * geometry and the components; groups are its own) */
     if (ag_mesh_reserve(m, nv, ntris))
         goto nomem_;
+    memcpy(m->pos, M->pos, 3 * M->nverts * sizeof *m->pos);
+    memcpy(m->tri, M->tri, 3 * M->ntris * sizeof *m->tri);
+    memcpy(m->tri_component, M->tri_component, M->ntris * sizeof *m->tri_component);
+    m->nverts = M->nverts;
+    m->ntris = M->ntris;
+    for (size_t c = 0; c < M->ncomponents; c++) {
+        size_t comp;
+        if (ag_mesh_add_component(m, -1, &comp))
+            goto nomem_;
+    }
     L->ncomponents = nc;
     L->nlabels = L0->nlabels + g->new_labels;
     L->nvariants = L0->nvariants + g->new_variants;
