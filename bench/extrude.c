@@ -559,6 +559,76 @@ static size_t star_shape(double cell, double *xy)
     return (size_t)n;
 }
 
+/* For a building whose edge is shared by more than two faces: 1 when every such edge of its
+ * triangles (corners welded on a 1e-6 m lattice; the stress plans lie on a metre grid) is
+ * used equally often each way, so parts of the solid touch along it (no closed 2-manifold
+ * can have that edge), 0 when some edge is used more often one way than the other (a
+ * defect of the shell). */
+typedef struct {
+    int64_t a[3], b[3];
+} bench_edge;
+static int cmp_bench_edge(const void *x, const void *y)
+{
+    const bench_edge *e = x, *f = y;
+    int64_t u[6] = {e->a[0] >> 1, e->a[1], e->a[2], e->b[0], e->b[1], e->b[2]};
+    int64_t v[6] = {f->a[0] >> 1, f->a[1], f->a[2], f->b[0], f->b[1], f->b[2]};
+    for (int k = 0; k < 6; k++)
+        if (u[k] != v[k])
+            return u[k] < v[k] ? -1 : 1;
+    return (int)(e->a[0] & 1) - (int)(f->a[0] & 1);
+}
+static int only_touching(const ag_mesh *m)
+{
+    bench_edge *E = malloc((3 * m->ntris + 1) * sizeof *E);
+    if (!E)
+        return 0;
+    size_t n = 0;
+    for (size_t t = 0; t < m->ntris; t++)
+        for (int k = 0; k < 3; k++) {
+            const double *p = &m->pos[3 * m->tri[3 * t + k]];
+            const double *q = &m->pos[3 * m->tri[3 * t + (k + 1) % 3]];
+            bench_edge e;
+            memset(&e, 0, sizeof e);
+            int rev = 0;
+            for (int d = 0; d < 3 && !rev; d++) {
+                int64_t pa = llround(p[d] * 1e6), qa = llround(q[d] * 1e6);
+                if (pa != qa) {
+                    rev = pa > qa ? 1 : -1;
+                }
+            }
+            if (!rev)
+                continue;
+            const double *lo = rev < 0 ? p : q, *hi = rev < 0 ? q : p;
+            for (int d = 0; d < 3; d++) {
+                e.a[d] = llround(lo[d] * 1e6);
+                e.b[d] = llround(hi[d] * 1e6);
+            }
+            /* the direction in the lowest bit of the first coordinate pair's slot */
+            e.a[0] = e.a[0] * 2 + (rev > 0);
+            E[n++] = e;
+        }
+    qsort(E, n, sizeof *E, cmp_bench_edge);
+    int ok = 1;
+    for (size_t i = 0; i < n && ok;) {
+        /* the entries of one undirected edge: both directions sit next to each other */
+        size_t j = i, fw = 0, bw = 0;
+        int64_t a0 = E[i].a[0] >> 1;
+        while (j < n && (E[j].a[0] >> 1) == a0 && memcmp(E[j].a + 1, E[i].a + 1, 2 * sizeof(int64_t)) == 0 &&
+               memcmp(E[j].b, E[i].b, sizeof E[i].b) == 0) {
+            if (E[j].a[0] & 1)
+                bw++;
+            else
+                fw++;
+            j++;
+        }
+        if (fw != bw)
+            ok = 0;
+        i = j;
+    }
+    free(E);
+    return ok;
+}
+
 /* --grid-dump N: the description of stress plan N (before validation) goes to this file */
 static long dump_index = -1;
 static const char *dump_path = NULL;
@@ -576,9 +646,10 @@ static void grid_stress_with(size_t count, int repair)
 {
     srng = 0x9E3779B97F4A7C15ULL;
     size_t w_invalid = 0, w_repairs = 0, w_refused = 0, w_dropped = 0, w_good = 0;
+    size_t f_levels = 0, f_rebuilt = 0, f_left = 0, touching = 0;
     size_t failed = 0, leaky = 0, rejected = 0, leaky_nested = 0, good_nested = 0;
     size_t kinds[2] = {0, 0}, leaky_kind[2] = {0, 0};
-    size_t cause[4][2] = {{0}}; /* overlap / open / shared edge / other, elsewhere or at h */
+    size_t cause[5][2] = {{0}}; /* overlap / open / shared edge / fold / other, elsewhere or at h */
     static double xy[2 * 1200];
     size_t starts[300];
     static int32_t prof[1200];
@@ -620,6 +691,9 @@ static void grid_stress_with(size_t count, int repair)
         if (st == AG_OK) {
             w_invalid += r.stats.winding_invalid;
             w_repairs += r.stats.winding_repairs;
+            f_levels += r.stats.flat_levels;
+            f_rebuilt += r.stats.flat_rebuilt;
+            f_left += r.stats.flat_left;
             w_refused += r.stats.winding_refused;
             w_dropped += r.stats.winding_pieces_dropped;
             w_good += r.stats.winding_repairs && !not_good(&r);
@@ -638,12 +712,14 @@ static void grid_stress_with(size_t count, int repair)
              * horizontal profile segments (every flat step of a stress plan is at h) */
             const char *why = not_good(&r);
             int kind_i = strstr(why, "overlaps itself") ? 0 : strstr(why, "is open") ? 1
-                         : strstr(why, "more than two") ? 2 : 3;
+                         : strstr(why, "more than two") ? 2 : strstr(why, "folded") ? 3 : 4;
             const char *zs = strchr(why, '(');
             double wx, wy, wz;
             int at_h = zs && sscanf(zs, "(%lf, %lf, %lf)", &wx, &wy, &wz) == 3 &&
                        fabs(wz - h) < 1e-6;
             cause[kind_i][at_h]++;
+            if (kind_i == 2)
+                touching += only_touching(m);
             leaky_nested += r.stats.irregular > 0;
             leaky_kind[kind]++;
             if (repair) {
@@ -661,9 +737,10 @@ static void grid_stress_with(size_t count, int repair)
                         strcat(used, pname[b]);
                     }
                 printf("    not good grid%zu (%s, %zu nested intersections, %zu winding repairs, "
-                       "%zu refused; h %g, profiles %s): %s\n", i, kind ? "star" : "grid",
-                       r.stats.irregular, r.stats.winding_repairs, r.stats.winding_refused, h,
-                       used, not_good(&r));
+                       "%zu refused, %zu of %zu flat heights left; h %g, profiles %s): %s\n", i,
+                       kind ? "star" : "grid", r.stats.irregular, r.stats.winding_repairs,
+                       r.stats.winding_refused, r.stats.flat_left, r.stats.flat_levels, h, used,
+                       not_good(&r));
             }
         } else {
             good_nested += r.stats.irregular > 0;
@@ -682,13 +759,19 @@ static void grid_stress_with(size_t count, int repair)
            "intersections (as are %zu good ones)\n", leaky_kind[0], kinds[0], leaky_kind[1],
            kinds[1], leaky_nested, good_nested);
     printf("    by cause (at the flat steps' height / elsewhere): winding other than once %zu / "
-           "%zu, open %zu / %zu, an edge of more than two faces %zu / %zu, other %zu / %zu\n",
+           "%zu, open %zu / %zu, an edge of more than two faces %zu / %zu, a horizontal face "
+           "folded %zu / %zu, other %zu / %zu\n",
            cause[0][1], cause[0][0], cause[1][1], cause[1][0], cause[2][1], cause[2][0],
-           cause[3][1], cause[3][0]);
+           cause[3][1], cause[3][0], cause[4][1], cause[4][0]);
+    printf("    of the edges of more than two faces: %zu buildings whose parts only touch along "
+           "edges (as many faces each way: no closed 2-manifold has them), %zu with a defect\n",
+           touching, cause[2][0] + cause[2][1] - touching);
     if (repair)
         printf("    winding rule: %zu levels with crossing chains, %zu rebuilt (%zu pieces removed), "
                "%zu refused; %zu plans with a rebuild are good\n", w_invalid, w_repairs, w_dropped,
                w_refused, w_good);
+    printf("    heights with two flat faces or more: %zu, rebuilt as the plans' difference "
+           "%zu, left %zu\n", f_levels, f_rebuilt, f_left);
 }
 
 int main(int argc, char **argv)

@@ -261,6 +261,248 @@ static inline double xc_top(const ag_mesh *m, long component)
     return top;
 }
 
+/* --- volume and winding from the triangles alone --------------------------------------- */
+
+/* The corners of triangle t of m about the point o (UTM-sized coordinates keep their
+ * digits). */
+static inline void xc_corners_about(const ag_mesh *m, size_t t, const double *o, double p[3][3])
+{
+    for (int k = 0; k < 3; k++)
+        for (int d = 0; d < 3; d++)
+            p[k][d] = m->pos[3 * m->tri[3 * t + k] + d] - o[d];
+}
+
+/* Volume of the triangles, computed here from the mesh alone. */
+static inline double xc_mesh_volume(const ag_mesh *m)
+{
+    if (!m->ntris)
+        return 0;
+    const double *o = &m->pos[3 * m->tri[0]];
+    double v = 0;
+    for (size_t t = 0; t < m->ntris; t++) {
+        double p[3][3];
+        xc_corners_about(m, t, o, p);
+        v += p[0][0] * (p[1][1] * p[2][2] - p[1][2] * p[2][1]) -
+             p[0][1] * (p[1][0] * p[2][2] - p[1][2] * p[2][0]) +
+             p[0][2] * (p[1][0] * p[2][1] - p[1][1] * p[2][0]);
+    }
+    return v / 6;
+}
+
+/* Solid angle of triangle (a, b, c) seen from the origin (van Oosterom and Strackee). */
+static inline double xc_solid_angle(const double a[3], const double b[3], const double c[3])
+{
+    double la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    double lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+    double lc = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    double det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                 a[2] * (b[0] * c[1] - b[1] * c[0]);
+    double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    double bc = b[0] * c[0] + b[1] * c[1] + b[2] * c[2];
+    double ca = c[0] * a[0] + c[1] * a[1] + c[2] * a[2];
+    return 2 * atan2(det, la * lb * lc + ab * lc + bc * la + ca * lb);
+}
+
+/* The winding number of the triangles about a point just inside each of them (a hair
+ * behind a point near its centre) that is furthest from 1: 1 everywhere for a shell that bounds its
+ * solid once; 2 or more where a face of the shell lies inside another part of it (a shell
+ * overlapping itself), 0 behind a face with no solid behind it (a fin of two faces back to
+ * back, a double-sided sliver): neither shows in welding and counting faces per edge. */
+static inline long xc_max_winding(const ag_mesh *m)
+{
+    if (!m->ntris)
+        return 0;
+    const double *o = &m->pos[3 * m->tri[0]];
+    long worst = 1;
+    for (size_t s = 0; s < m->ntris; s++) {
+        double p[3][3];
+        xc_corners_about(m, s, o, p);
+        double u[3], v[3], n[3];
+        for (int d = 0; d < 3; d++)
+            u[d] = p[1][d] - p[0][d], v[d] = p[2][d] - p[0][d];
+        n[0] = u[1] * v[2] - u[2] * v[1];
+        n[1] = u[2] * v[0] - u[0] * v[2];
+        n[2] = u[0] * v[1] - u[1] * v[0];
+        double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        double per = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) +
+                     sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) +
+                     sqrt((u[0] - v[0]) * (u[0] - v[0]) + (u[1] - v[1]) * (u[1] - v[1]) +
+                          (u[2] - v[2]) * (u[2] - v[2]));
+        /* a hair behind a point near the centre (off the thirds where grid-aligned walls
+         * pass), well inside the face's inscribed circle (radius len / per); a sliver too
+         * thin for that has no inside to probe */
+        double eps = fmin(1e-6, 0.01 * len / (per > 0 ? per : 1));
+        if (!(eps > 1e-9))
+            continue;
+        double q[3];
+        for (int d = 0; d < 3; d++)
+            q[d] = 0.3137 * p[0][d] + 0.3311 * p[1][d] + 0.3552 * p[2][d] - eps * n[d] / len;
+        double omega = 0;
+        for (size_t t = 0; t < m->ntris; t++) {
+            double a[3][3], oq[3] = {o[0] + q[0], o[1] + q[1], o[2] + q[2]};
+            xc_corners_about(m, t, oq, a);
+            omega += xc_solid_angle(a[0], a[1], a[2]);
+        }
+        long w = lround(omega / (4 * M_PI));
+        if (labs(w - 1) > labs(worst - 1))
+            worst = w;
+    }
+    return worst;
+}
+
+/* Area of the intersection of two counter-clockwise triangles in the plane (one clipped by
+ * the other's edges). */
+static inline double xc_tri_overlap(const double a[3][2], const double b[3][2])
+{
+    double poly[2][16][2];
+    int n = 3, cur = 0;
+    for (int i = 0; i < 3; i++)
+        poly[0][i][0] = a[i][0], poly[0][i][1] = a[i][1];
+    for (int e = 0; e < 3 && n; e++) {
+        const double *p = b[e], *q = b[(e + 1) % 3];
+        int m = 0;
+        for (int i = 0; i < n; i++) {
+            const double *s = poly[cur][i], *t = poly[cur][(i + 1) % n];
+            double ds = (q[0] - p[0]) * (s[1] - p[1]) - (q[1] - p[1]) * (s[0] - p[0]);
+            double dt = (q[0] - p[0]) * (t[1] - p[1]) - (q[1] - p[1]) * (t[0] - p[0]);
+            if (ds >= 0 && m < 16)
+                poly[1 - cur][m][0] = s[0], poly[1 - cur][m][1] = s[1], m++;
+            if (((ds >= 0) != (dt >= 0)) && m < 16) {
+                double r = ds / (ds - dt);
+                poly[1 - cur][m][0] = s[0] + r * (t[0] - s[0]);
+                poly[1 - cur][m][1] = s[1] + r * (t[1] - s[1]);
+                m++;
+            }
+        }
+        n = m;
+        cur = 1 - cur;
+    }
+    double area = 0;
+    for (int i = 0; i < n; i++)
+        area += poly[cur][i][0] * poly[cur][(i + 1) % n][1] - poly[cur][(i + 1) % n][0] * poly[cur][i][1];
+    return area / 2;
+}
+
+/* Folds of horizontal faces: pairs of an upward and a downward triangle at the same height
+ * whose insides overlap by more than min_area (a double-sided sheet the solid is on neither
+ * side of; it leaves the edges paired and the volume unchanged, so welding, counting faces
+ * per edge and the volume miss it, and probes behind faces see it only where one falls in
+ * it). Returns the number of such pairs. */
+static inline size_t xc_flat_folds(const ag_mesh *m, double min_area)
+{
+    if (!m->ntris)
+        return 0;
+    const double *o = &m->pos[3 * m->tri[0]];
+    size_t folds = 0;
+    for (size_t s = 0; s < m->ntris; s++) {
+        double p[3][3];
+        xc_corners_about(m, s, o, p);
+        if (p[0][2] != p[1][2] || p[1][2] != p[2][2])
+            continue;
+        double a[3][2] = {{p[0][0], p[0][1]}, {p[1][0], p[1][1]}, {p[2][0], p[2][1]}};
+        double sa = (a[1][0] - a[0][0]) * (a[2][1] - a[0][1]) - (a[2][0] - a[0][0]) * (a[1][1] - a[0][1]);
+        if (!(sa > 0))
+            continue; /* s: the upward one */
+        for (size_t t = 0; t < m->ntris; t++) {
+            double q[3][3];
+            xc_corners_about(m, t, o, q);
+            if (q[0][2] != p[0][2] || q[1][2] != p[0][2] || q[2][2] != p[0][2])
+                continue;
+            /* the downward one, reversed to counter-clockwise */
+            double b[3][2] = {{q[0][0], q[0][1]}, {q[2][0], q[2][1]}, {q[1][0], q[1][1]}};
+            double sb = (b[1][0] - b[0][0]) * (b[2][1] - b[0][1]) - (b[2][0] - b[0][0]) * (b[1][1] - b[0][1]);
+            if (!(sb > 0))
+                continue;
+            if (xc_tri_overlap(a, b) > min_area)
+                folds++;
+        }
+    }
+    return folds;
+}
+
+/* --- generated plans ------------------------------------------------------------------- */
+
+/* A polyomino of cells on a G x G grid (its outer boundary only, counter-clockwise: the
+ * cells are grown from the centre and holes are filled), at most max / 2 corners written to
+ * xy; rnd gives numbers in [0, 1). Returns its corners. */
+static inline size_t xc_polyomino(int G, double cell, double *xy, size_t max,
+                                  double (*rnd)(void))
+{
+    unsigned char in[18][18] = {{0}};
+    int cnt = 2 + (int)(rnd() * G * G * 0.5);
+    in[G / 2 + 1][G / 2 + 1] = 1;
+    for (int k = 1; k < cnt; k++)
+        for (int tries = 0; tries < 200; tries++) {
+            int x = 1 + (int)(rnd() * G), y = 1 + (int)(rnd() * G);
+            if (in[x][y])
+                continue;
+            /* edge neighbours only, and no cell touching another only at a corner */
+            int nb = in[x - 1][y] || in[x + 1][y] || in[x][y - 1] || in[x][y + 1];
+            int pinch = (in[x - 1][y - 1] && !in[x - 1][y] && !in[x][y - 1]) ||
+                        (in[x + 1][y - 1] && !in[x + 1][y] && !in[x][y - 1]) ||
+                        (in[x - 1][y + 1] && !in[x - 1][y] && !in[x][y + 1]) ||
+                        (in[x + 1][y + 1] && !in[x + 1][y] && !in[x][y + 1]);
+            if (nb && !pinch) {
+                in[x][y] = 1;
+                break;
+            }
+        }
+    /* walk the outer boundary with the inside on the left, from the lowest-left cell */
+    int sx = -1, sy = -1;
+    for (int y = 0; y < 18 && sx < 0; y++)
+        for (int x = 0; x < 18; x++)
+            if (in[x][y]) {
+                sx = x, sy = y;
+                break;
+            }
+    int x = sx, y = sy, d = 0; /* at corner (x, y), heading +x along the bottom */
+    int dx[4] = {1, 0, -1, 0}, dy[4] = {0, 1, 0, -1};
+    size_t n = 0;
+    do {
+        /* the cells ahead-left and ahead-right of the edge from (x, y) in direction d */
+        int nx = x + dx[d], ny = y + dy[d];
+        xy[2 * n] = x * cell, xy[2 * n + 1] = y * cell;
+        int left, right;
+        /* the edge (x,y)->(nx,ny): left cell and right cell */
+        switch (d) {
+        case 0: left = in[x][y], right = y > 0 ? in[x][y - 1] : 0; break;
+        case 1: left = in[x - 1][y], right = in[x][y]; break;
+        case 2: left = in[x - 1][y - 1], right = in[x - 1][y]; break;
+        default: left = in[x][y - 1], right = in[x - 1][y - 1]; break;
+        }
+        (void)left;
+        (void)right;
+        x = nx, y = ny;
+        /* next direction: prefer a left turn, then straight, then right */
+        int cells[4]; /* the four cells around corner (x, y): ll, lr, ul, ur */
+        cells[0] = in[x - 1][y - 1];
+        cells[1] = in[x][y - 1];
+        cells[2] = in[x - 1][y];
+        cells[3] = in[x][y];
+        int nd = -1;
+        for (int turn = 1; turn >= -1 && nd < 0; turn--) {
+            int c = (d + turn + 4) % 4;
+            int l, r;
+            switch (c) {
+            case 0: l = cells[3], r = cells[1]; break;
+            case 1: l = cells[2], r = cells[3]; break;
+            case 2: l = cells[0], r = cells[2]; break;
+            default: l = cells[1], r = cells[0]; break;
+            }
+            if (l && !r)
+                nd = c;
+        }
+        if (nd < 0)
+            return 0;
+        if (nd != d)
+            n++;
+        else
+            continue;
+        d = nd;
+    } while (!(x == sx && y == sy) && n < max / 2);
+    return n;
+}
+
 /* --- the CGAL oracle (../shared/tools/cgal_skeleton, built into build/oracle) --------------- */
 
 /* The oracle binary, or NULL (with a line saying why, so the caller can skip). */

@@ -8,6 +8,7 @@
 
 #include "../base/array.h"
 #include "../base/search.h"
+#include "flats.h"
 #include "keysort.h"
 #include "weld_points.h"
 #include "predicates.h"
@@ -186,6 +187,54 @@ static void pair_radial(ag_shell *s, const seg_key *hk, size_t lo, size_t n, con
     }
 }
 
+/* Newell normal (not normalised) of a face from its k segments g[3 * ord[i]] (in any order:
+ * the sum goes edge by edge), relative to its first segment's start. */
+static void face_segments_normal(const ag_shell *s, const uint32_t *g, const uint32_t *ord,
+                                 uint32_t k, double *n)
+{
+    n[0] = n[1] = n[2] = 0;
+    if (!k)
+        return;
+    const double *o = &s->pos[3 * g[3 * ord[0] + 1]];
+    for (uint32_t i = 0; i < k; i++) {
+        const double *P = &s->pos[3 * g[3 * ord[i] + 1]], *Q = &s->pos[3 * g[3 * ord[i] + 2]];
+        double p[3] = {P[0] - o[0], P[1] - o[1], P[2] - o[2]};
+        double q[3] = {Q[0] - o[0], Q[1] - o[1], Q[2] - o[2]};
+        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    }
+}
+
+/* Of the unused segments leaving the end of segment cur (keys[lo..] with that from-vertex),
+ * the one turning furthest left about the face normal n. */
+static uint32_t sharpest_left(const ag_shell *s, const uint32_t *g, const seg_key *keys,
+                              uint32_t lo, uint32_t k, const uint8_t *dead, uint32_t cur,
+                              const double *n)
+{
+    const double *A = &s->pos[3 * g[3 * cur + 1]], *B = &s->pos[3 * g[3 * cur + 2]];
+    double din[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
+    uint32_t to = g[3 * cur + 2], best = NONE;
+    double best_ang = -INFINITY;
+    for (uint32_t j = lo; j < k && (keys[j].key >> 32) == to; j++) {
+        uint32_t sg = keys[j].val;
+        if (dead[sg])
+            continue;
+        const double *C = &s->pos[3 * g[3 * sg + 2]];
+        double d[3] = {C[0] - B[0], C[1] - B[1], C[2] - B[2]};
+        double c[3] = {din[1] * d[2] - din[2] * d[1], din[2] * d[0] - din[0] * d[2],
+                       din[0] * d[1] - din[1] * d[0]};
+        double ang = atan2(c[0] * n[0] + c[1] * n[1] + c[2] * n[2],
+                           (din[0] * d[0] + din[1] * d[1] + din[2] * d[2]) *
+                               sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]));
+        if (ang > best_ang) {
+            best_ang = ang;
+            best = sg;
+        }
+    }
+    return best;
+}
+
 ag_status ag_shell_finish(ag_shell *s, double weld_tol)
 {
     uint32_t *map = malloc((s->nverts ? s->nverts : 1) * sizeof *map);
@@ -196,13 +245,17 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
         free(map);
         return st;
     }
-    size_t ns = s->nsegs;
-    uint32_t *g = s->segs;
-    for (size_t i = 0; i < ns; i++) {
-        g[3 * i + 1] = map[g[3 * i + 1]];
-        g[3 * i + 2] = map[g[3 * i + 2]];
+    for (size_t i = 0; i < s->nsegs; i++) {
+        s->segs[3 * i + 1] = map[s->segs[3 * i + 1]];
+        s->segs[3 * i + 2] = map[s->segs[3 * i + 2]];
     }
     free(map);
+    /* terrace and soffit faces at one height: the difference of the plans (flats.h) */
+    st = ag_flats_rebuild(s, weld_tol);
+    if (st != AG_OK)
+        return st;
+    size_t ns = s->nsegs;
+    uint32_t *g = s->segs;
     /* sort segments by face, then cancel zero-length and in-face opposite pairs */
     uint32_t *ord = malloc((ns ? ns : 1) * sizeof *ord);
     uint8_t *dead = calloc(ns ? ns : 1, 1);
@@ -265,6 +318,8 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
                 }
         }
         /* link: keys sorted by from-vertex; walk from each unused segment */
+        double fn1[3];
+        int have_n = 0;
         s->faces[f].first_loop = (uint32_t)s->nloops;
         for (uint32_t i = 0; i < k; i++) {
             uint32_t sg = keys[i].val;
@@ -283,12 +338,23 @@ ag_status ag_shell_finish(ag_shell *s, double weld_tol)
                 }
                 uint64_t want = (uint64_t)to << 32;
                 uint32_t lo = (uint32_t)ag_search_lower_u64(&keys->key, k, sizeof *keys, want);
-                uint32_t next = NONE;
+                uint32_t next = NONE, nfound = 0;
                 for (uint32_t j = lo; j < k && (keys[j].key >> 32) == to; j++)
                     if (!dead[keys[j].val]) {
-                        next = keys[j].val;
-                        break;
+                        if (!nfound++)
+                            next = keys[j].val;
+                        else
+                            break;
                     }
+                if (nfound > 1) {
+                    /* the face touches itself at this corner: the sharpest left turn keeps
+                     * the loops apart (one figure-eight loop triangulates across itself) */
+                    if (!have_n) {
+                        face_segments_normal(s, g, ord + a, k, fn1);
+                        have_n = 1;
+                    }
+                    next = sharpest_left(s, g, keys, lo, k, dead, cur, fn1);
+                }
                 if (next == NONE)
                     break;
                 cur = next;

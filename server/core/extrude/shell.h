@@ -44,6 +44,9 @@ typedef struct {
     size_t nhalf;
     uint32_t *he_twin, *he_next, *he_face;
     size_t open_segments; /* boundary pieces that could not be linked into a loop */
+    /* heights with two horizontal faces or more (see flats.h), how many of them were
+     * rebuilt from their winding and how many were left as they were */
+    size_t flat_levels, flat_rebuilt, flat_left;
 
     /* private build state */
     size_t cap_verts, cap_faces, nsegs, cap_segs;

@@ -391,8 +391,12 @@ ag_status ag_skeleton_build(const ag_plan *plan, double extent, const ag_skeleto
     free(S.deferred.arr);
     free(S.made.arr);
     ag_status st = S.st;
-    if (st == AG_OK)
+    if (st == AG_OK) {
         st = ag_shell_finish(S.shell, S.d1);
+        S.stats.flat_levels = S.shell->flat_levels;
+        S.stats.flat_rebuilt = S.shell->flat_rebuilt;
+        S.stats.flat_left = S.shell->flat_left;
+    }
     ag_eventq_free(&S.q);
     free(S.e);
     free(S.c);

@@ -50,6 +50,9 @@ typedef struct {
      * many of them were rebuilt by the winding rule and how many were left (a degenerate
      * contact the repair does not take), chain pieces the winding rule removed */
     size_t winding_invalid, winding_repairs, winding_refused, winding_pieces_dropped;
+    /* heights with two horizontal faces or more, rebuilt as the difference of the plans
+     * below and above, and left as they were (see flats.h) */
+    size_t flat_levels, flat_rebuilt, flat_left;
     size_t steps, steps_skipped; /* plan edits made / not made (anchor not on the plan) */
     size_t offsets, offset_sides; /* offset events handled, side edges they made */
     size_t offset_gaps;   /* inside boundaries (gaps) opened by offset events */

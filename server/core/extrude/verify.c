@@ -498,6 +498,138 @@ static int winds_once(const ag_mesh *m, size_t t0, size_t t1, double tol, double
     return ok;
 }
 
+/* --- folds of horizontal faces ----------------------------------------------------------- */
+
+typedef struct {
+    double z, x0, x1;
+    uint32_t t;
+    int up;
+} flat_tri;
+
+static int cmp_flat_tri(const void *a, const void *b)
+{
+    const flat_tri *x = a, *y = b;
+    if (x->z != y->z)
+        return x->z < y->z ? -1 : 1;
+    return x->x0 < y->x0 ? -1 : x->x0 > y->x0;
+}
+
+/* Area of the intersection of two counter-clockwise triangles in the plane. */
+static double overlap_area(const double a[3][2], const double b[3][2])
+{
+    double poly[2][12][2];
+    int n = 3, cur = 0;
+    memcpy(poly[0], a, sizeof(double[3][2]));
+    for (int e = 0; e < 3 && n; e++) {
+        const double *p = b[e], *q = b[(e + 1) % 3];
+        int k = 0;
+        for (int i = 0; i < n; i++) {
+            const double *u = poly[cur][i], *v = poly[cur][(i + 1) % n];
+            double du = (q[0] - p[0]) * (u[1] - p[1]) - (q[1] - p[1]) * (u[0] - p[0]);
+            double dv = (q[0] - p[0]) * (v[1] - p[1]) - (q[1] - p[1]) * (v[0] - p[0]);
+            if (du >= 0 && k < 12)
+                poly[1 - cur][k][0] = u[0], poly[1 - cur][k][1] = u[1], k++;
+            if ((du >= 0) != (dv >= 0) && k < 12) {
+                double r = du / (du - dv);
+                poly[1 - cur][k][0] = u[0] + r * (v[0] - u[0]);
+                poly[1 - cur][k][1] = u[1] + r * (v[1] - u[1]);
+                k++;
+            }
+        }
+        n = k;
+        cur = 1 - cur;
+    }
+    double area = 0;
+    for (int i = 0; i < n; i++)
+        area += poly[cur][i][0] * poly[cur][(i + 1) % n][1] - poly[cur][(i + 1) % n][0] * poly[cur][i][1];
+    return area / 2;
+}
+
+/* The corners of triangle t in the plane, about o, counter-clockwise seen from its outside
+ * (an upward triangle as it is, a downward one reversed); 1 when upward. */
+static int flat_corners(const ag_mesh *m, uint32_t t, const double *o, double c[3][2])
+{
+    for (int k = 0; k < 3; k++) {
+        const double *p = &m->pos[3 * m->tri[3 * t + k]];
+        c[k][0] = p[0] - o[0];
+        c[k][1] = p[1] - o[1];
+    }
+    double a = (c[1][0] - c[0][0]) * (c[2][1] - c[0][1]) - (c[2][0] - c[0][0]) * (c[1][1] - c[0][1]);
+    if (a < 0) {
+        double x = c[1][0], y = c[1][1];
+        c[1][0] = c[2][0], c[1][1] = c[2][1];
+        c[2][0] = x, c[2][1] = y;
+    }
+    return a > 0;
+}
+
+/* An upward and a downward horizontal triangle at one height whose insides overlap (more
+ * than a sliver of the point tolerance along the building): a sheet of two faces back to
+ * back with the solid on neither side. Its edges pair and it adds no volume, and the probes
+ * behind faces find it only where one falls into it; here every pair is compared. */
+static int no_flat_fold(const ag_mesh *m, size_t t0, size_t t1, double min_area, char *why,
+                        size_t nwhy)
+{
+    /* most buildings have no upward and downward horizontal triangles at all */
+    size_t nup = 0, ndown = 0;
+    for (size_t t = t0; t < t1; t++) {
+        const double *a = &m->pos[3 * m->tri[3 * t]], *b = &m->pos[3 * m->tri[3 * t + 1]],
+                     *c = &m->pos[3 * m->tri[3 * t + 2]];
+        if (a[2] != b[2] || b[2] != c[2])
+            continue;
+        double area = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+        nup += area > 0;
+        ndown += area < 0;
+    }
+    if (!nup || !ndown)
+        return 1;
+    size_t n = 0;
+    flat_tri *F = malloc((nup + ndown) * sizeof *F);
+    if (!F) {
+        snprintf(why, nwhy, "out of memory checking the building");
+        return 0;
+    }
+    for (size_t t = t0; t < t1; t++) {
+        const double *a = &m->pos[3 * m->tri[3 * t]], *b = &m->pos[3 * m->tri[3 * t + 1]],
+                     *c = &m->pos[3 * m->tri[3 * t + 2]];
+        if (a[2] != b[2] || b[2] != c[2])
+            continue;
+        double area = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+        if (area == 0)
+            continue;
+        F[n++] = (flat_tri){a[2], fmin(a[0], fmin(b[0], c[0])), fmax(a[0], fmax(b[0], c[0])),
+                            (uint32_t)t, area > 0};
+    }
+    qsort(F, n, sizeof *F, cmp_flat_tri);
+    int ok = 1;
+    for (size_t g = 0; ok && g < n;) {
+        size_t e = g, ups = 0;
+        while (e < n && F[e].z == F[g].z)
+            ups += F[e++].up;
+        if (ups && ups < e - g) {
+            const double *o = &m->pos[3 * m->tri[3 * F[g].t]];
+            for (size_t i = g; ok && i < e; i++)
+                for (size_t j = i + 1; ok && j < e && F[j].x0 <= F[i].x1; j++) {
+                    if (F[i].up == F[j].up)
+                        continue;
+                    double A[3][2], B[3][2];
+                    flat_corners(m, F[i].t, o, A);
+                    flat_corners(m, F[j].t, o, B);
+                    if (overlap_area(A, B) > min_area) {
+                        ok = 0;
+                        snprintf(why, nwhy, "an upward and a downward face overlap near (%.3f, "
+                                 "%.3f, %.3f): a horizontal face folded inside out",
+                                 o[0] + (A[0][0] + A[1][0] + A[2][0]) / 3,
+                                 o[1] + (A[0][1] + A[1][1] + A[2][1]) / 3, F[g].z);
+                    }
+                }
+        }
+        g = e;
+    }
+    free(F);
+    return ok;
+}
+
 int ag_verify_building(const ag_mesh *m, size_t t0, size_t t1, const ag_plan *plan, char *why,
                        size_t nwhy)
 {
@@ -557,5 +689,7 @@ int ag_verify_building(const ag_mesh *m, size_t t0, size_t t1, const ag_plan *pl
                  zmin, zmax, top);
         return 0;
     }
+    if (!no_flat_fold(m, t0, t1, tol.point * fmax(tol.size, extent), why, nwhy))
+        return 0;
     return winds_once(m, t0, t1, tol.point, fmax(tol.size, extent), why, nwhy);
 }

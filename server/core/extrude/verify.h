@@ -7,6 +7,9 @@
  *     exactly once (so no edge is shared by more than two triangles), and no two
  *     triangles use the same three vertices (a zero-area, double-sided sliver passes the
  *     edge count but not this);
+ *   - have no fold: no upward and downward horizontal triangles of one height overlap (two
+ *     faces back to back with the solid on neither side; their edges pair and they add no
+ *     volume, and a probe behind a face finds them only where it happens to fall in them);
  *   - bound their solid once: just inside each face (a hair behind its centre) the
  *     shell winds exactly once, counted along rays — not twice (two parts swept through
  *     each other, which the edge counts cannot see) nor zero (a fold or fin turned inside
