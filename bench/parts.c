@@ -4,7 +4,9 @@
  * - service: the same building in a store on a temporary database with the edit models kept
  *   as archgramd keeps them (no HTTP): saving a part (the use case on the store workspace:
  *   extraction, thumbnail, one transaction), previewing a compose op (rewrite and derivation)
- *   and the compose op itself (rewrite, the new state proceduralized, one sequenced commit);
+ *   and the compose op itself (rewrite, the new state: the part grafted into the model's tree,
+ *   core/parts/graft.h, or where that does not apply its derivation proceduralized, counted
+ *   from the op log; one sequenced commit);
  * - search latency over a library of 10,000 parts (FTS5 words, prefixes, tags, deep pages).
  * Target: save and compose <= 50 ms each in the service. */
 #include <math.h>
@@ -31,6 +33,7 @@
 #include "core/parts/compose.h"
 #include "core/parts/part.h"
 #include "core/proc/proceduralize.h"
+#include "store/ops.h"
 #include "store/parts.h"
 
 static double now_ms(void)
@@ -230,10 +233,30 @@ static json_t *compose_op(int64_t part, int32_t target, const char *mode, const 
                      "target", target, "mode", mode, "scope", scope);
 }
 
+/* How the op log says the compose op made its new state (report.state, report.fallback). */
+typedef struct {
+    int grafted;
+    char fallback[200];
+} op_state;
+
+static void read_state(void *user, const ag_op_row *row)
+{
+    op_state *o = user;
+    json_t *b = json_loads(row->body_json, 0, NULL);
+    json_t *r = json_object_get(b, "report");
+    const char *st = json_string_value(json_object_get(r, "state"));
+    const char *fb = json_string_value(json_object_get(r, "fallback"));
+    o->grafted = st && !strcmp(st, "grafted");
+    snprintf(o->fallback, sizeof o->fallback, "%s", fb ? fb : "");
+    json_decref(b);
+}
+
 static void service_compose(service *sv, int64_t part, int which, const char *mode,
                             const char *scope, const char *what)
 {
     double pv[RUNS], op[RUNS];
+    int grafted = 0;
+    char fallback[200] = "";
     json_t *rep = NULL;
     for (int i = 0; i < RUNS; i++) {
         ag_error err = {0};
@@ -263,14 +286,21 @@ static void service_compose(service *sv, int64_t part, int which, const char *mo
         op[i] = now_ms() - t0;
         json_decref(o);
         sv->version = v;
+        op_state os = {0};
+        if (ag_ops_each_since(sv->db, sv->model, v - 1, 1, read_state, &os, &err))
+            die("op log", &err);
+        grafted += os.grafted;
+        if (!os.grafted)
+            snprintf(fallback, sizeof fallback, "%s", os.fallback);
     }
     printf("service compose %-34s %-7s %-4s %6lld instances: preview %8.2f ms, op %8.2f ms "
-           "(in the preview: loading %.1f ms, rewrite %.1f ms, derivation %.1f ms; the op makes "
-           "the new state: its derivation proceduralized)\n",
+           "(in the preview: loading %.1f ms, rewrite %.1f ms, derivation %.1f ms; the op's new "
+           "state grafted in %d of %d runs%s%s)\n",
            what, mode, scope, (long long)json_integer_value(json_object_get(rep, "instances")),
            median(pv, RUNS), median(op, RUNS), json_real_value(json_object_get(rep, "load_ms")),
            json_real_value(json_object_get(rep, "compose_ms")),
-           json_real_value(json_object_get(rep, "state_ms")));
+           json_real_value(json_object_get(rep, "state_ms")), grafted, RUNS,
+           fallback[0] ? ", else proceduralized: " : "", fallback);
     json_decref(rep);
 }
 

@@ -228,7 +228,29 @@ ag_status ag_app_points_glb(ag_app *app, int64_t id, size_t budget,
     return s;
 }
 
-ag_status ag_app_points_derived_ply(ag_app *app, int64_t id,
+/* Every k-th point of *c, k the least that keeps at most budget (0: all), in place. */
+static ag_status thin_to_budget(ag_cloud **c, size_t budget, ag_error *err)
+{
+    size_t n = (*c)->n;
+    if (!budget || n <= budget)
+        return AG_OK;
+    size_t k = (n + budget - 1) / budget, m = (n + k - 1) / k;
+    uint32_t *idx = malloc(m * sizeof *idx);
+    if (!idx)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory for %zu points", m);
+    for (size_t i = 0; i < m; i++)
+        idx[i] = (uint32_t)(i * k);
+    ag_cloud *kept = NULL;
+    ag_status s = ag_cloud_subset(*c, idx, m, &kept, err);
+    free(idx);
+    if (s == AG_OK) {
+        ag_cloud_free(*c);
+        *c = kept;
+    }
+    return s;
+}
+
+ag_status ag_app_points_derived_ply(ag_app *app, int64_t id, size_t budget,
                                     int (*fresh)(void *user, const char *etag), void *user,
                                     ag_app_bytes *out, ag_error *err)
 {
@@ -240,8 +262,8 @@ ag_status ag_app_points_derived_ply(ag_app *app, int64_t id,
     ag_grammar_row g;
     ag_status s = ag_grammars_current(db, id, 0, &g, err);
     if (s == AG_OK) {
-        snprintf(out->etag, sizeof out->etag, "\"derived-%lld-%lld\"", (long long)id,
-                 (long long)g.mesh_blob);
+        snprintf(out->etag, sizeof out->etag, "\"derived-%lld-%lld-%zu\"", (long long)id,
+                 (long long)g.mesh_blob, budget);
         ag_grammars_row_clear(&g);
         if (fresh && fresh(user, out->etag))
             return AG_OK;
@@ -259,10 +281,12 @@ ag_status ag_app_points_derived_ply(ag_app *app, int64_t id,
     }
     ag_pointclouds_read_end(db);
     if (s == AG_OK) {
-        snprintf(out->etag, sizeof out->etag, "\"derived-%lld-%lld\"", (long long)id,
-                 (long long)blob);
+        snprintf(out->etag, sizeof out->etag, "\"derived-%lld-%lld-%zu\"", (long long)id,
+                 (long long)blob, budget);
         s = ag_pointmodel_derive(pm, AG_CLOUD_MAX_POINTS, &c, NULL, err);
     }
+    if (s == AG_OK)
+        s = thin_to_budget(&c, budget, err);
     if (s == AG_OK)
         s = ply_bytes(c, out, err);
     ag_cloud_free(c);

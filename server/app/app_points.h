@@ -18,9 +18,11 @@
  * placement stretches), binary little-endian PLY as points.ply writes it, with normals, every
  * terminal property, int `label` (terminal) and `segment` (placement). AG_ERR_CONFLICT for a
  * model that is not a point cloud, AG_ERR_NOT_PROCEDURALIZED without a grammar. The ETag
- * names the model's grammar state; fresh as for ag_app_query_glb. A derivation past
- * AG_CLOUD_MAX_POINTS (app/cloud_state.h) is refused with AG_ERR_TOO_LARGE. */
-ag_status ag_app_points_derived_ply(ag_app *app, int64_t id,
+ * names the model's grammar state and the budget; fresh as for ag_app_query_glb. A
+ * derivation past AG_CLOUD_MAX_POINTS (app/cloud_state.h) is refused with AG_ERR_TOO_LARGE.
+ * budget > 0 keeps at most that many points, every k-th of the derivation (placement by
+ * placement, so each keeps its share; a viewer's point budget); 0 keeps them all. */
+ag_status ag_app_points_derived_ply(ag_app *app, int64_t id, size_t budget,
                                     int (*fresh)(void *user, const char *etag), void *user,
                                     ag_app_bytes *out, ag_error *err);
 

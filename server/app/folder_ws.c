@@ -184,6 +184,41 @@ ag_status ag__folder_ws_make_out(ag_folder_ws *w, int terminals, ag_error *err)
     return AG_OK;
 }
 
+static json_t *vec3(const double *v);
+
+/* The patterns of a proceduralized model and the bytes of its save, the tail of the mesh
+ * and point model summaries. */
+void ag__folder_ws_model_figures(json_t *j, const ag_proceduralize_result *r, size_t grammar_bytes,
+                                 size_t terminal_bytes)
+{
+    json_t *jp = json_array();
+    for (size_t p = 0; p < r->tree->npatterns; p++) {
+        const ag_pattern *pt = &r->tree->patterns[p];
+        int32_t ri = r->info.rule_of_class ? r->info.rule_of_class[pt->rule] : -1;
+        json_t *po = json_object();
+        json_object_set_new(po, "rule", ri >= 0 ? json_string(r->grammar->rules[ri].name) : json_null());
+        json_t *cnt = json_array();
+        for (int a = 0; a < 3; a++)
+            json_array_append_new(cnt, json_integer(pt->counts[a]));
+        json_object_set_new(po, "counts", cnt);
+        json_object_set_new(po, "step", vec3(pt->step));
+        json_object_set_new(po, "kind", json_string(pt->nvec ? "repeat" : "subdivide"));
+        if (pt->nvec) {
+            json_t *vs = json_array();
+            for (int k = 0; k < pt->nvec; k++)
+                json_array_append_new(vs, vec3(pt->vec[k]));
+            json_object_set_new(po, "vectors", vs);
+        }
+        json_object_set_new(po, "rot", json_integer(90 * pt->rot));
+        json_object_set_new(po, "instances",
+                            json_integer((json_int_t)pt->counts[0] * pt->counts[1] * pt->counts[2]));
+        json_array_append_new(jp, po);
+    }
+    json_object_set_new(j, "patterns", jp);
+    json_object_set_new(j, "grammar_bytes", json_integer((json_int_t)grammar_bytes));
+    json_object_set_new(j, "terminal_bytes", json_integer((json_int_t)terminal_bytes));
+}
+
 json_t *ag__folder_ws_tree_figures(const ag_splittree *t)
 {
     ag_splittree_stats ts = ag_splittree_stats_of(t);
@@ -424,32 +459,7 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
     json_object_set_new(j, "rules", json_integer((json_int_t)r->grammar->nrules));
     json_object_set_new(j, "terminals", json_integer((json_int_t)r->grammar->nterminals));
 
-    json_t *jp = json_array();
-    for (size_t p = 0; p < r->tree->npatterns; p++) {
-        const ag_pattern *pt = &r->tree->patterns[p];
-        int32_t ri = r->info.rule_of_class ? r->info.rule_of_class[pt->rule] : -1;
-        json_t *po = json_object();
-        json_object_set_new(po, "rule", ri >= 0 ? json_string(r->grammar->rules[ri].name) : json_null());
-        json_t *cnt = json_array();
-        for (int a = 0; a < 3; a++)
-            json_array_append_new(cnt, json_integer(pt->counts[a]));
-        json_object_set_new(po, "counts", cnt);
-        json_object_set_new(po, "step", vec3(pt->step));
-        json_object_set_new(po, "kind", json_string(pt->nvec ? "repeat" : "subdivide"));
-        if (pt->nvec) {
-            json_t *vs = json_array();
-            for (int k = 0; k < pt->nvec; k++)
-                json_array_append_new(vs, vec3(pt->vec[k]));
-            json_object_set_new(po, "vectors", vs);
-        }
-        json_object_set_new(po, "rot", json_integer(90 * pt->rot));
-        json_object_set_new(po, "instances",
-                            json_integer((json_int_t)pt->counts[0] * pt->counts[1] * pt->counts[2]));
-        json_array_append_new(jp, po);
-    }
-    json_object_set_new(j, "patterns", jp);
-    json_object_set_new(j, "grammar_bytes", json_integer((json_int_t)st->text_len));
-    json_object_set_new(j, "terminal_bytes", json_integer((json_int_t)st->terms.bytes));
+    ag__folder_ws_model_figures(j, r, st->text_len, st->terms.bytes);
     json_t *jf = json_object();
     json_object_set_new(jf, "max_error", json_real(o->fidelity.max_error));
     json_object_set_new(jf, "relative", json_real(o->fidelity.relative));

@@ -82,6 +82,10 @@ ag_status ag__folder_ws_write_grammar(ag_folder_ws *w, const char *text, size_t 
 /* The split tree's figures summaries give: {"nodes","visible","invisible","depth",
  * "adjacent_pairs"} (a new reference, NULL when out of memory). */
 json_t *ag__folder_ws_tree_figures(const ag_splittree *t);
+/* Sets "patterns" (rule, counts, step, kind, vectors, rot, instances of each), "grammar_bytes"
+ * and "terminal_bytes" on summary j. */
+void ag__folder_ws_model_figures(json_t *j, const ag_proceduralize_result *r, size_t grammar_bytes,
+                                 size_t terminal_bytes);
 /* The point operations of the folder workspace (app/points_folder_ws.c). */
 ag_status ag__folder_ws_input_cloud(ag_workspace *ws, int with_properties, int need_segmentation,
                                     ag_cloud_state *cs, ag_error *err);

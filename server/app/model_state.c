@@ -177,6 +177,13 @@ static int budget_stage(void *budget, ag_stage stage)
 ag_status ag_model_state_from_grammar(ag_grammar *g, size_t max_triangles, ag_model_state *out,
                                       ag_error *err)
 {
+    return ag_model_state_from_grammar_ex(g, max_triangles, NULL, NULL, out, err);
+}
+
+ag_status ag_model_state_from_grammar_ex(ag_grammar *g, size_t max_triangles,
+                                         ag_model_state_maker make, void *user,
+                                         ag_model_state *out, ag_error *err)
+{
     memset(out, 0, sizeof *out);
     ag_grammar *back = NULL;
     long col = 0;
@@ -201,7 +208,8 @@ ag_status ag_model_state_from_grammar(ag_grammar *g, size_t max_triangles, ag_mo
     if (s == AG_OK && !out->derived->ntris)
         s = ag_error_set(err, AG_ERR_EMPTY, 0, "the grammar derives no geometry");
     if (s == AG_OK)
-        s = ag_model_state_reload(out->derived, &out->em, err);
+        s = make ? make(user, out->derived, &out->em, err)
+                 : ag_model_state_reload(out->derived, &out->em, err);
     if (s != AG_OK)
         ag_model_state_clear(out);
     return s;

@@ -52,6 +52,15 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
 ag_status ag_model_state_from_grammar(ag_grammar *g, size_t max_triangles, ag_model_state *out,
                                       ag_error *err);
 
+/* Makes the edit model of what a state's grammar derives (the derivation stays the state's). */
+typedef ag_status (*ag_model_state_maker)(void *user, const ag_mesh *derived, ag_edit_model **em,
+                                          ag_error *err);
+/* ag_model_state_from_grammar with the edit model made by make (NULL: the derivation
+ * proceduralized, ag_model_state_reload). */
+ag_status ag_model_state_from_grammar_ex(ag_grammar *g, size_t max_triangles,
+                                         ag_model_state_maker make, void *user,
+                                         ag_model_state *out, ag_error *err);
+
 /* OBJ text of the terminal kept under path: AG_OK with *obj malloc'd, AG_ERR_NOT_FOUND when
  * there is none. */
 typedef ag_status (*ag_terminal_lookup)(void *user, const char *path, char **obj, size_t *len,

@@ -1,6 +1,7 @@
 #include "part_library.h"
 
 #include <jansson.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -49,12 +50,42 @@ static char *stats_of(const ag_part *p, const ag_mesh *m)
     return s;
 }
 
+/* The thumbnail and the stats: the part derived and pictured (a thread of its own while the
+ * entry is encoded; both only read the part). */
+typedef struct {
+    const ag_part *p;
+    uint8_t *png;
+    size_t png_len;
+    char *stats;
+    ag_status s;
+    ag_error err;
+} pictured;
+
+static void *picture(void *arg)
+{
+    pictured *x = arg;
+    ag_mesh *m = NULL;
+    ag_error_clear(&x->err);
+    x->s = ag_part_media_mesh(x->p, &m, &x->err);
+    if (x->s == AG_OK)
+        x->s = ag_part_media_picture(m, x->p->facing, AG_PART_THUMBNAIL_SIDE, &x->png,
+                                     &x->png_len, &x->err);
+    if (x->s == AG_OK && !(x->stats = stats_of(x->p, m)))
+        x->s = ag_error_set(&x->err, AG_ERR_NOMEM, 0, "out of memory");
+    ag_mesh_free(m);
+    return NULL;
+}
+
 static ag_status prepare(const ag_part *p, stored *out, ag_error *err)
 {
     memset(out, 0, sizeof *out);
     json_t *entry = NULL;
-    ag_mesh *m = NULL;
     ag_status s = ag_part_validate(p, err);
+    if (s != AG_OK)
+        return s;
+    pictured pic = {.p = p};
+    pthread_t th;
+    int threaded = pthread_create(&th, NULL, picture, &pic) == 0;
     if (s == AG_OK && !(out->terminals = json_object()))
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     if (s == AG_OK)
@@ -79,12 +110,18 @@ static ag_status prepare(const ag_part *p, stored *out, ag_error *err)
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     for (size_t i = 0; s == AG_OK && i < p->ntags; i++)
         out->tags[i] = p->tags[i];
-    if (s == AG_OK && (s = ag_part_media_mesh(p, &m, err)) == AG_OK)
-        s = ag_part_media_picture(m, p->facing, AG_PART_THUMBNAIL_SIDE, &out->png, &out->png_len,
-                                  err);
-    if (s == AG_OK && !(out->stats = stats_of(p, m)))
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    ag_mesh_free(m);
+    if (threaded)
+        pthread_join(th, NULL);
+    else
+        picture(&pic);
+    out->png = pic.png;
+    out->png_len = pic.png_len;
+    out->stats = pic.stats;
+    if (s == AG_OK && pic.s != AG_OK) {
+        s = pic.s;
+        if (err)
+            *err = pic.err;
+    }
     if (s != AG_OK)
         stored_clear(out);
     return s;
@@ -161,7 +198,26 @@ static ag_status add_terminal(void *user, const char *sha256, const char *obj, s
     return AG_OK;
 }
 
-/* One version's entry appended to parts, its terminals added to terminals. */
+/* One version's entry (row, read with it) appended to parts, its terminals added to
+ * terminals. */
+static ag_status gather_row(ag_db *db, int64_t id, const ag_part_version_row *row, json_t *parts,
+                            json_t *terminals, ag_error *err)
+{
+    ag_status s = AG_OK;
+    json_error_t je;
+    json_t *entry = json_loads(row->entry_json, 0, &je);
+    if (!entry)
+        s = ag_error_set(err, AG_ERR_INTERNAL, 0, "part %lld version %lld is not stored whole",
+                         (long long)id, (long long)row->version);
+    else if (json_array_append_new(parts, entry))
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    if (s == AG_OK &&
+        (s = ag_parts_each_terminal(db, id, row->version, add_terminal, terminals, err)) ==
+            AG_ERR_NOMEM)
+        ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    return s;
+}
+
 static ag_status gather(ag_db *db, int64_t id, int64_t version, json_t *parts, json_t *terminals,
                         ag_error *err)
 {
@@ -169,30 +225,93 @@ static ag_status gather(ag_db *db, int64_t id, int64_t version, json_t *parts, j
     ag_status s = ag_parts_get_version(db, id, version, 1, &row, err);
     if (s != AG_OK)
         return s;
-    json_error_t je;
-    json_t *entry = json_loads(row.entry_json, 0, &je);
-    if (!entry)
-        s = ag_error_set(err, AG_ERR_INTERNAL, 0, "part %lld version %lld is not stored whole",
-                         (long long)id, (long long)row.version);
-    else if (json_array_append_new(parts, entry))
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    if (s == AG_OK &&
-        (s = ag_parts_each_terminal(db, id, row.version, add_terminal, terminals, err)) ==
-            AG_ERR_NOMEM)
-        ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    s = gather_row(db, id, &row, parts, terminals, err);
     ag_parts_version_row_clear(&row);
     return s;
+}
+
+/* Parts read back, by their stored entry. A part is a pure function of its entry and the
+ * terminals the entry names by content, so an equal entry is the same part (whatever the
+ * database); reading a large part back (the entry parsed, printed as a bundle and read again)
+ * costs more than composing it, and a preview and the op after it read the same part. A few
+ * parts, the least recently used going first, none whose entry is over a limit. */
+#define PART_CACHE_SLOTS 8
+#define PART_CACHE_MAX_ENTRY ((size_t)8 << 20)
+
+typedef struct {
+    char *entry;
+    size_t len;
+    ag_part *part;
+    uint64_t used;
+} cached_part;
+
+static cached_part part_cache[PART_CACHE_SLOTS];
+static uint64_t part_cache_clock;
+static pthread_mutex_t part_cache_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* A copy of the cached part read from entry; AG_ERR_NOT_FOUND when none is. */
+static ag_status cache_get(const char *entry, ag_part **out, ag_error *err)
+{
+    size_t len = strlen(entry);
+    ag_status s = AG_ERR_NOT_FOUND;
+    pthread_mutex_lock(&part_cache_lock);
+    for (size_t i = 0; i < PART_CACHE_SLOTS; i++) {
+        cached_part *c = &part_cache[i];
+        if (c->part && c->len == len && memcmp(c->entry, entry, len) == 0) {
+            c->used = ++part_cache_clock;
+            s = ag_part_copy(c->part, out, err);
+            break;
+        }
+    }
+    pthread_mutex_unlock(&part_cache_lock);
+    return s;
+}
+
+/* Keeps a copy of p, read from entry (nothing when it is too large or memory is short). */
+static void cache_put(const char *entry, const ag_part *p)
+{
+    size_t len = strlen(entry);
+    if (len > PART_CACHE_MAX_ENTRY)
+        return;
+    char *e = malloc(len + 1);
+    ag_part *c = NULL;
+    if (!e || ag_part_copy(p, &c, NULL) != AG_OK) {
+        free(e);
+        return;
+    }
+    memcpy(e, entry, len + 1);
+    pthread_mutex_lock(&part_cache_lock);
+    size_t victim = 0;
+    for (size_t i = 0; i < PART_CACHE_SLOTS; i++)
+        if (!part_cache[i].part || part_cache[i].used < part_cache[victim].used) {
+            victim = i;
+            if (!part_cache[i].part)
+                break;
+        }
+    cached_part old = part_cache[victim];
+    part_cache[victim] = (cached_part){e, len, c, ++part_cache_clock};
+    pthread_mutex_unlock(&part_cache_lock);
+    free(old.entry);
+    ag_part_free(old.part);
 }
 
 ag_status ag_part_library_load(ag_db *db, int64_t id, int64_t version, ag_part **out,
                                ag_error *err)
 {
     *out = NULL;
+    ag_part_version_row row;
+    ag_status s = ag_parts_get_version(db, id, version, 1, &row, err);
+    if (s != AG_OK)
+        return s;
+    if ((s = cache_get(row.entry_json, out, err)) != AG_ERR_NOT_FOUND) {
+        ag_parts_version_row_clear(&row);
+        return s;
+    }
     json_t *parts = json_array(), *terminals = json_object();
     char *text = NULL;
     size_t len = 0;
-    ag_status s = parts && terminals ? gather(db, id, version, parts, terminals, err)
-                                     : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    s = parts && terminals ? gather_row(db, id, &row, parts, terminals, err)
+                           : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     if (s == AG_OK)
         s = ag_part_bundle_print(parts, terminals, &text, &len, err);
     json_decref(parts);
@@ -210,8 +329,10 @@ ag_status ag_part_library_load(ag_db *db, int64_t id, int64_t version, ag_part *
     if (s == AG_OK) {
         *out = list[0];
         list[0] = NULL;
+        cache_put(row.entry_json, *out);
     }
     ag_part_bundle_free(list, n);
+    ag_parts_version_row_clear(&row);
     return s;
 }
 

@@ -47,22 +47,7 @@ static void model_summary(json_t *j, const ag_points_state *st)
     json_object_set_new(j, "terminals", json_integer((json_int_t)pm->nterminals));
     json_object_set_new(j, "placements", json_integer((json_int_t)pm->nplacements));
     json_object_set_new(j, "rules", json_integer((json_int_t)r->grammar->nrules));
-    json_t *jp = json_array();
-    for (size_t p = 0; p < r->tree->npatterns; p++) {
-        const ag_pattern *pt = &r->tree->patterns[p];
-        json_t *po = json_object(), *cnt = json_array();
-        for (int a = 0; a < 3; a++)
-            json_array_append_new(cnt, json_integer(pt->counts[a]));
-        json_object_set_new(po, "counts", cnt);
-        json_object_set_new(po, "kind", json_string(pt->nvec ? "repeat" : "subdivide"));
-        json_object_set_new(po, "step", vec3(pt->step));
-        json_object_set_new(po, "instances",
-                            json_integer((json_int_t)pt->counts[0] * pt->counts[1] * pt->counts[2]));
-        json_array_append_new(jp, po);
-    }
-    json_object_set_new(j, "patterns", jp);
-    json_object_set_new(j, "grammar_bytes", json_integer((json_int_t)st->text_len));
-    json_object_set_new(j, "terminal_bytes", json_integer((json_int_t)st->terms.bytes));
+    ag__folder_ws_model_figures(j, r, st->text_len, st->terms.bytes);
     json_object_set_new(j, "spacing", json_real(pm->spacing));
 }
 

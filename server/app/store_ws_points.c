@@ -4,8 +4,9 @@
  *
  * A point model is kept in the tables meshes use: its grammar text, served tree (boxes in the
  * input's coordinates, numbering AG_MODEL_TREE_NUMBERING) and summary in grammars, its PLY
- * terminals in terminals (paths name their content, so the terminals of every kept state stay
- * readable), and a new empty mesh file per saved state, so that the grammar describes the
+ * terminals in terminals (paths name their content, so a run or edit that makes the same
+ * point set stores it once; the terminals of every kept state stay readable, and those no kept
+ * version names are released with each save), and a new empty mesh file per saved state, so that the grammar describes the
  * model exactly while that state is current (store/grammars.h) and undo, redo and restore
  * bring a version's grammar back with its states (store/states.h). Nothing is cached: a model
  * is read back from its text each time (the ids of its tree are those the text gives). */
@@ -215,6 +216,9 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
             s = put_points_state(t.db, w->o.model, t.version, st, summary, err);
         if (s == AG_OK)
             s = ag_states_keep(t.db, w->o.model, t.version, err);
+        /* what the earlier runs and edits stored and no version names any more goes */
+        if (s == AG_OK)
+            s = ag_pointclouds_release_terminals(t.db, w->o.model, NULL, err);
         s = ag__store_ws_commit(w, &t, s, AG__STORE_WS_LINKS_GRAMMAR, body, err);
     }
     json_decref(body);

@@ -1,5 +1,6 @@
 #include "usecase_compose.h"
 
+#include <stdio.h>
 #include <string.h>
 #include <time.h>
 
@@ -16,7 +17,7 @@ static double now_ms(void)
  * derive. */
 static ag_status compose_grammar(ag_workspace *ws, const ag_usecase_compose_params *p,
                                  ag_grammar **g, size_t *budget, ag_usecase_compose_result *out,
-                                 ag_error *err)
+                                 const ag_edit_model **model, ag_error *err)
 {
     memset(out, 0, sizeof *out);
     *g = NULL;
@@ -38,6 +39,8 @@ static ag_status compose_grammar(ag_workspace *ws, const ag_usecase_compose_para
         return s;
     out->load_ms = now_ms() - t0;
     out->part = part;
+    if (model)
+        *model = em;
     size_t own = 2 * em->proc->mesh->ntris;
     *budget = p->max_triangles                       ? p->max_triangles
               : own > AG_USECASE_COMPOSE_MAX_TRIANGLES ? own
@@ -59,6 +62,39 @@ static ag_status over_budget(ag_status s, size_t budget, ag_error *err)
     return s;
 }
 
+typedef struct {
+    const ag_edit_model *model;
+    const ag_compose_op *op;
+    ag_usecase_compose_result *out;
+} graft_maker;
+
+/* The new state's edit model: the model's tree with the part grafted in; where the graft does
+ * not apply, the derivation proceduralized. */
+static ag_status make_grafted(void *user, const ag_mesh *derived, ag_edit_model **em,
+                              ag_error *err)
+{
+    graft_maker *gm = user;
+    ag_proceduralize_result *r = NULL;
+    ag_error e;
+    ag_error_clear(&e);
+    ag_status s = ag_graft_compose(gm->model->proc, gm->op, derived, &gm->model->opt.patterns,
+                                   &r, &gm->out->graft, &e);
+    if (s == AG_OK) {
+        if ((s = ag_edit_model_wrap(r, &gm->model->opt, em, err)) != AG_OK)
+            ag_proceduralize_result_free(r);
+        else
+            gm->out->report.grafted = 1;
+        return s;
+    }
+    if (s != AG_ERR_NOT_AVAILABLE) {
+        if (err)
+            *err = e;
+        return s;
+    }
+    snprintf(gm->out->report.fallback, sizeof gm->out->report.fallback, "%.150s", e.text);
+    return ag_model_state_reload(derived, em, err);
+}
+
 ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,
                                   ag_model_state *st, ag_usecase_compose_result *out,
                                   ag_error *err)
@@ -66,11 +102,18 @@ ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_par
     memset(st, 0, sizeof *st);
     ag_grammar *g = NULL;
     size_t budget = 0;
-    ag_status s = compose_grammar(ws, p, &g, &budget, out, err);
+    const ag_edit_model *em = NULL;
+    ag_status s = compose_grammar(ws, p, &g, &budget, out, &em, err);
     if (s != AG_OK)
         return s;
     double t0 = now_ms();
-    s = over_budget(ag_model_state_from_grammar(g, budget, st, err), budget, err);
+    /* a workspace that keeps only the grammar reads it back proceduralized: its tree must be
+     * numbered as that reload numbers it, so only one that keeps the tree takes the graft */
+    int graft = !(ws->ops->state_flags & AG_MODEL_READ_BACK);
+    graft_maker gm = {.model = em, .op = &p->op, .out = out};
+    s = over_budget(ag_model_state_from_grammar_ex(g, budget, graft ? make_grafted : NULL,
+                                                   &gm, st, err),
+                    budget, err);
     ag_grammar_free(g);
     out->state_ms = now_ms() - t0;
     return s;
@@ -83,7 +126,7 @@ ag_status ag_usecase_compose_preview(ag_workspace *ws, const ag_usecase_compose_
     *mesh = NULL;
     ag_grammar *g = NULL;
     size_t budget = 0;
-    ag_status s = compose_grammar(ws, p, &g, &budget, out, err);
+    ag_status s = compose_grammar(ws, p, &g, &budget, out, NULL, err);
     if (s != AG_OK)
         return s;
     double t0 = now_ms();
@@ -113,7 +156,7 @@ ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_para
 json_t *ag_usecase_compose_report_json(const ag_compose_outcome *o)
 {
     const ag_compose_report *r = &o->report;
-    return json_pack(
+    json_t *j = json_pack(
         "{s:{s:s,s:I,s:s},s:s,s:s,s:I,s:[I,I,I],s:i,s:[f,f,f],"
         "s:{s:I,s:I,s:I,s:I,s:I,s:I,s:I},s:{s:I,s:I,s:I,s:I},s:s}",
         "part", "name", o->part->name, "version", (json_int_t)o->part->version, "root",
@@ -127,4 +170,12 @@ json_t *ag_usecase_compose_report_json(const ag_compose_outcome *o)
         "elements", (json_int_t)r->fit.elements, "equations", (json_int_t)r->fit.equations,
         "rigid", (json_int_t)r->fit.rigid, "rigid_relaxed", (json_int_t)r->fit.rigid_relaxed,
         "message", r->message);
+    /* how the new model was made: grafted, or (with the reason) proceduralized */
+    if (j && (json_object_set_new(j, "state", json_string(r->grafted ? "grafted"
+                                                                      : "proceduralized")) ||
+              (r->fallback[0] && json_object_set_new(j, "fallback", json_string(r->fallback))))) {
+        json_decref(j);
+        j = NULL;
+    }
+    return j;
 }

@@ -1,7 +1,11 @@
 /* Composing a part into a building (paper section 4.2), over any workspace (app/workspace.h):
  * the workspace's model and the part it names → the target's grammar rewritten
  * (core/parts/compose.h) → the new model state: the composed grammar as it was made, its
- * terminals, and the tree of what it derives (app/model_state.h) → saved. The target is an id
+ * terminals, what it derives, and its tree: the model's tree with the part's components
+ * grafted in (core/parts/graft.h: the nodes outside the target keep their ids, nothing is
+ * proceduralized again) in a workspace that keeps the tree (the store), or the derivation
+ * proceduralized (app/model_state.h) where the graft does not apply and in one that keeps
+ * only the grammar (a folder, whose reload numbers the tree so) → saved. The target is an id
  * of the workspace's tree (app/model_tree.h), checked before anything is computed. `archgram
  * part compose` runs it between folders, the "compose" op (app/compose_ops.h) on the store.
  * A preview (the service's, before the op is sent) runs the same steps without the save. */
@@ -10,6 +14,7 @@
 
 #include <jansson.h>
 
+#include "../core/parts/graft.h"
 #include "workspace.h"
 
 /* The budget of one composition: what it derives (the whole model afterwards) is proceduralized
@@ -28,7 +33,11 @@ typedef struct {
     const ag_part *part;     /* the part composed (the workspace's until it closes) */
     double load_ms;          /* reading the model and the part */
     double compose_ms;       /* rewriting the grammar (core/parts/compose.h) */
-    double state_ms;         /* the new state: its derivation proceduralized (a preview: derived) */
+    double state_ms;         /* the new state (a preview: derived) */
+    ag_graft_report graft;   /* report.grafted: the state's tree is the model's with the part
+                                grafted in (core/parts/graft.h); else its derivation was
+                                proceduralized (report.fallback: why the graft did not apply,
+                                "" when it was not tried) */
 } ag_usecase_compose_result;
 
 /* Problems naming the target or the mode are AG_ERR_INVALID or AG_ERR_NOT_FOUND ("target:

@@ -1,5 +1,5 @@
 /* Point cloud models over REST: POST …/segment (a job), GET …/points.ply,
- * …/points.glb?budget=N and, once proceduralized, …/derived.ply. Uploads are POST /api/v1/models (api_models.c); ROI refinement and
+ * …/points.glb?budget=N and, once proceduralized, …/derived.ply[?budget=N]. Uploads are POST /api/v1/models (api_models.c); ROI refinement and
  * template marking are ops (POST …/ops). */
 #include <stdlib.h>
 
@@ -56,8 +56,12 @@ enum MHD_Result ag_api_model_points_ply(ag_request *r)
 enum MHD_Result ag_api_model_derived_ply(ag_request *r)
 {
     ag_error err;
-    ag_app_bytes b;
-    ag_status s = ag_app_points_derived_ply(r->cfg->app, r->ids[0], client_has, r, &b, &err);
+    ag_app_bytes b = {0};
+    long long budget = 0; /* 0: every point */
+    ag_status s = ag_request_query_int(r, "budget", 0, BUDGET_MAX, 0, &budget, &err);
+    if (s == AG_OK)
+        s = ag_app_points_derived_ply(r->cfg->app, r->ids[0], (size_t)budget, client_has, r,
+                                      &b, &err);
     return reply(r, s, &b, "application/x-ply", &err);
 }
 

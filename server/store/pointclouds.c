@@ -632,3 +632,28 @@ void ag_pointclouds_read_end(ag_db *db)
 {
     sqlite3_exec(ag_db_handle(db), "COMMIT", NULL, NULL, NULL);
 }
+
+ag_status ag_pointclouds_release_terminals(ag_db *db, int64_t model, size_t *released,
+                                           ag_error *err)
+{
+    if (released)
+        *released = 0;
+    sqlite3_stmt *st;
+    /* a path is named as a quoted string ("terminals/<hex>.ply") in a grammar text */
+    ag_status s = ag_db_prepared(
+        db, &st,
+        "DELETE FROM terminals WHERE model_id = ?1"
+        " AND NOT EXISTS (SELECT 1 FROM grammars g WHERE g.model_id = ?1"
+        "                 AND instr(g.text, '\"' || terminals.path || '\"') > 0)"
+        " AND NOT EXISTS (SELECT 1 FROM model_states k WHERE k.model_id = ?1"
+        "                 AND k.grammar IS NOT NULL"
+        "                 AND instr(k.grammar, '\"' || terminals.path || '\"') > 0)",
+        err);
+    if (s != AG_OK)
+        return s;
+    sqlite3_bind_int64(st, 1, model);
+    s = ag_db_step_done(db, st, "releasing terminals no version names", err);
+    if (s == AG_OK && released)
+        *released = (size_t)sqlite3_changes(ag_db_handle(db));
+    return s;
+}

@@ -96,6 +96,17 @@ ag_status ag_pointclouds_states_keep(ag_db *db, int64_t model, int64_t version, 
 ag_status ag_pointclouds_states_restore(ag_db *db, int64_t model, int64_t kept_version,
                                         ag_error *err);
 
+/* Releases the PLY terminals of a proceduralized cloud that no kept version names: neither
+ * the model's grammar nor the grammar of any of its kept states (store/states.h) holds the
+ * terminal's quoted path. Terminal paths name their content, so a terminal of an earlier
+ * proceduralization or edit stays exactly while a version that undo or restore can come back
+ * to needs it. Inside the caller's transaction (the save that wrote the new version).
+ * *released (optional): how many went. The work is bounded by the model's terminals times
+ * the bytes of its kept grammars; a terminal the current grammar names is kept at the first
+ * test, so only the ones it dropped are looked for in the states. */
+ag_status ag_pointclouds_release_terminals(ag_db *db, int64_t model, size_t *released,
+                                           ag_error *err);
+
 /* A read of points and segmentation that sees one version: BEGIN (deferred) / COMMIT. */
 ag_status ag_pointclouds_read_begin(ag_db *db, ag_error *err);
 void ag_pointclouds_read_end(ag_db *db);

@@ -319,6 +319,7 @@ describe('parts library', () => {
       r = await http(d, 'POST', `/api/v1/models/${b.id}/compose-preview`, { body: { op: compose }, headers: { 'If-Match': `"${v0 + 3}"` } });
       assertProblem(r, 412, 'stale', 'a preview on another version');
 
+      const t0 = await tree(b.id);
       r = await op(b.id, v0, compose);
       assert.equal(r.status, 200, r.text);
       const v1 = r.json.version;
@@ -327,6 +328,7 @@ describe('parts library', () => {
       assert.equal(seen.op.kind, 'compose');
       assert.equal(seen.op.version, 1);
       assert.equal(seen.op.report.instances, b.slots.length);
+      assert.equal(seen.op.report.state, 'grafted'); // the part grafted into b's tree
       assert.equal(seen.author, 'ana');
       await ana.next((m) => m.type === 'op' && m.version === v1, 10000, 'the compose op (author)');
 
@@ -338,6 +340,16 @@ describe('parts library', () => {
         const p = pieces(t1, s);
         assert.equal(p.length, 7, `slot ${s}`);
         assert.equal(p.filter((n) => Math.abs(n.box[3] - n.box[0] - 0.08) < 1e-6).length, 2, `jambs in ${s}`);
+      }
+      // the nodes outside the windows keep their ids and boxes
+      const inAnySlot = (n) => b.slots.some((sl) => n.box.every((x, i) => (i < 3 ? x >= sl[i] - 1e-6 : x <= sl[i] + 1e-6)));
+      const kept = t0.nodes.filter((n) => n.visible && !inAnySlot(n));
+      assert.ok(kept.length > 0);
+      const byId = new Map(t1.nodes.map((n) => [n.id, n]));
+      for (const n of kept) {
+        const m = byId.get(n.id);
+        assert.ok(m && m.visible, `node ${n.id} stays`);
+        assert.ok(m.box.every((x, i) => Math.abs(x - n.box[i]) < 1e-6), `node ${n.id} keeps its box`);
       }
       // the grammar is the composition as made: it keeps b's rules and holds the part's root
       const g1 = await grammar(b.id);
@@ -367,15 +379,20 @@ describe('parts library', () => {
       assert.equal(nack2.problem.status, 400);
       assert.match(nack2.problem.detail, /mode/);
       assert.equal(await version(b.id), v2);
+      // the composed model edits like any other: a resize of the whole building
+      r = await op(b.id, v2, { kind: 'resize', node: 'root', scale: [1.2, 1, 1] });
+      assert.equal(r.status, 200, r.text);
 
-      // undo both: the grammar before the first composition, byte for byte
-      r = await op(b.id, v2, { kind: 'undo' });
+      // undo all three: the grammar before the first composition, byte for byte
+      r = await op(b.id, r.json.version, { kind: 'undo' });
+      assert.equal(r.status, 200, r.text);
+      r = await op(b.id, r.json.version, { kind: 'undo' });
       assert.equal(r.status, 200, r.text);
       r = await op(b.id, r.json.version, { kind: 'undo' });
       assert.equal(r.status, 200, r.text);
       assert.equal(await grammar(b.id), g0);
       const ops = (await http(d, 'GET', `/api/v1/models/${b.id}/ops?since=${v0}`)).json.items;
-      assert.deepEqual(ops.map((o) => o.op.kind), ['compose', 'compose', 'restore', 'restore']);
+      assert.deepEqual(ops.map((o) => o.op.kind), ['compose', 'compose', 'resize', 'restore', 'restore', 'restore']);
       b.version = await version(b.id);
     } finally {
       await ana.close();

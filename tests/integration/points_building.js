@@ -2,7 +2,7 @@
 // point models: a 16 x 8 x 7 m block with 5 x 2 recessed windows in its front at RD New-like
 // coordinates, and the windows of a cloud counted geometrically (not by archgram's labels).
 import fs from 'node:fs';
-import { plyBytes, rng } from './clouds.js';
+import { parsePly, plyBytes, rng } from './clouds.js';
 
 // A 16 x 8 x 7 m block with a flat roof and 5 x 2 recessed windows (1.2 x 1.5 m, glass 0.25 m
 // behind the wall) in its front (y = 0), at RD New-like coordinates, as double x y z plus the
@@ -93,4 +93,27 @@ export function writeBuilding(file, n = 60000) {
   const { b, bytes } = buildingPly(n);
   fs.writeFileSync(file, bytes);
   return b;
+}
+
+// The tree node (GET …/tree, boxes in the cloud's coordinates) of window w's glass: its box
+// centred on the window, at most a little larger.
+export const glassOf = (tree, w) => tree.nodes.find((nd) => nd.kind === 'component' && nd.box &&
+  Math.abs((nd.box[0] + nd.box[3]) / 2 - (WIN[w][0] + 0.6 + ORIGIN[0])) < 0.2 &&
+  Math.abs((nd.box[2] + nd.box[5]) / 2 - (WIN[w][1] + 0.75 + ORIGIN[2])) < 0.2 &&
+  nd.box[3] - nd.box[0] < 2 && nd.box[5] - nd.box[2] < 2.2 && nd.box[4] - ORIGIN[1] < 0.6);
+
+// The front wall's nodes: those in the plane y = 0 at least `minWidth` m wide and 6 m tall.
+export const frontsOf = (tree, minWidth = 14) => tree.nodes.filter((nd) => nd.kind === 'component' && nd.box &&
+  nd.box[3] - nd.box[0] > minWidth && nd.box[4] - nd.box[1] < 0.6 && Math.abs(nd.box[1] - ORIGIN[1]) < 0.2 &&
+  nd.box[5] - nd.box[2] > 6);
+
+// A PLY (a file, or a derived.ply answer) with absolute coordinates (its offset comment added),
+// as {n, props}.
+export function absolutePly(buf) {
+  const c = parsePly(buf);
+  const line = c.comments.find((x) => x.startsWith('offset'));
+  const o = line ? line.split(' ').slice(1).map(Number) : [0, 0, 0];
+  const n = c.props.x.length;
+  for (let i = 0; i < n; i++) { c.props.x[i] += o[0]; c.props.y[i] += o[1]; c.props.z[i] += o[2]; }
+  return { n, props: c.props };
 }

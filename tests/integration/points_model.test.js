@@ -8,18 +8,9 @@
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
 import { assertProblem, http, importModel, PROBLEM, removeDir, sql, startDaemon, waitJob, WsClient, facadeObj } from './harness.js';
-import { parsePly } from './clouds.js';
-import { buildingPly, countWindows, ORIGIN, WIN, windowBox } from './points_building.js';
+import { absolutePly, buildingPly, countWindows, frontsOf, glassOf, ORIGIN, windowBox } from './points_building.js';
 
-// A PLY answer with absolute coordinates (its offset comment added).
-function absolute(buf) {
-  const c = parsePly(buf);
-  const line = c.comments.find((x) => x.startsWith('offset'));
-  const o = line ? line.split(' ').slice(1).map(Number) : [0, 0, 0];
-  const n = c.props.x.length;
-  for (let i = 0; i < n; i++) { c.props.x[i] += o[0]; c.props.y[i] += o[1]; c.props.z[i] += o[2]; }
-  return { n, props: c.props };
-}
+const absolute = absolutePly;
 
 // Points per m² of the front wall (the plane y = 0 between the windows) and of the windows'
 // glass (0.25 m behind it), measured on a cloud of a front `width` m wide with `windows` windows.
@@ -35,11 +26,6 @@ function densities(c, width, windows) {
   return { wall: wall / wallArea, glass: glass / (windows * 1.2 * 1.5) };
 }
 
-// The tree node of window w (its box centred on the window, at most a little larger).
-const glassOf = (tree, w) => tree.nodes.find((nd) => nd.kind === 'component' && nd.box &&
-  Math.abs((nd.box[0] + nd.box[3]) / 2 - (WIN[w][0] + 0.6 + ORIGIN[0])) < 0.2 &&
-  Math.abs((nd.box[2] + nd.box[5]) / 2 - (WIN[w][1] + 0.75 + ORIGIN[2])) < 0.2 &&
-  nd.box[3] - nd.box[0] < 2 && nd.box[5] - nd.box[2] < 2.2 && nd.box[4] - ORIGIN[1] < 0.6);
 const near = (a, b, eps = 1e-6) => a.every((v, i) => Math.abs(v - b[i]) <= eps);
 
 const within = (a, b, rel, what) => assert.ok(Math.abs(a / b - 1) <= rel, `${what}: ${a.toFixed(1)} against ${b.toFixed(1)} per m²`);
@@ -169,6 +155,16 @@ describe('point models in the service', () => {
     // an ETag that names the state
     const again = await http(d, 'GET', `/api/v1/models/${id}/derived.ply`, { headers: { 'If-None-Match': (await http(d, 'GET', `/api/v1/models/${id}/derived.ply`)).headers.get('etag') } });
     assert.equal(again.status, 304);
+    // a budget: every k-th point of the derivation, k the least that keeps within it
+    const some = await http(d, 'GET', `/api/v1/models/${id}/derived.ply?budget=1000`, { timeout: 60000 });
+    assert.equal(some.status, 200, some.text.slice(0, 300));
+    const s = absolute(some.body), k = Math.ceil(c.n / 1000);
+    assert.equal(s.n, Math.ceil(c.n / k));
+    assert.ok(s.n <= 1000);
+    for (let i = 0; i < s.n; i++) assert.ok(s.props.x[i] === c.props.x[i * k] && s.props.segment[i] === c.props.segment[i * k], `point ${i}`);
+    assert.notEqual(some.headers.get('etag'), again.headers.get('etag'));
+    assert.equal((await http(d, 'GET', `/api/v1/models/${id}/derived.ply?budget=0`, { timeout: 60000 })).body.length, (await http(d, 'GET', `/api/v1/models/${id}/derived.ply`, { timeout: 60000 })).body.length);
+    assertProblem(await http(d, 'GET', `/api/v1/models/${id}/derived.ply?budget=-1`), 400, 'invalid', 'a negative budget');
   });
 
   it('PUT grammar of a point model re-derives it; bad text is refused and nothing changes', async () => {
@@ -202,8 +198,7 @@ describe('point models in the service', () => {
 
   it('a resize doubling the front doubles its windows at the input density; undo and redo over the websocket', async () => {
     const t = (await http(d, 'GET', `/api/v1/models/${id}/tree`)).json;
-    const front = t.nodes.find((nd) => nd.kind === 'component' && nd.box[3] - nd.box[0] > 14 &&
-      nd.box[4] - nd.box[1] < 0.6 && Math.abs(nd.box[1] - ORIGIN[1]) < 0.2 && nd.box[5] - nd.box[2] > 6);
+    const front = frontsOf(t)[0];
     assert.ok(front, 'a front wall node');
     const box = [...front.box];
     box[3] = box[0] + 2 * (box[3] - box[0]);

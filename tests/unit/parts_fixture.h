@@ -228,4 +228,94 @@ static inline int pf_same_box(const ag_box *x, const ag_box *y, double tol)
     return pf_inside(x, y, tol) && pf_inside(y, x, tol);
 }
 
+/* Window design A (the part): 1.2 x 1.8, frame 0.08, one mullion. Design B (the target's):
+ * 1.6 x 2.0, frame 0.12, two mullions. */
+static inline pf_options pf_design_a(int depth, int turn, double ox, double oy)
+{
+    return (pf_options){.cols = 3, .rows = 2, .ww = 1.2, .wh = 1.8, .frame = 0.08, .mullions = 1,
+                        .depth = depth, .turn = turn, .ox = ox, .oy = oy};
+}
+
+static inline pf_options pf_design_b(int depth, int turn, double ox, double oy)
+{
+    return (pf_options){.cols = 4, .rows = 3, .side_cols = 2, .ww = 1.6, .wh = 2.0,
+                        .frame = 0.12, .mullions = 2, .depth = depth, .turn = turn, .ox = ox,
+                        .oy = oy};
+}
+
+typedef struct {
+    int64_t q[3];
+} pf_qpoint;
+
+static inline int pf_cmp_qpoint(const void *a, const void *b)
+{
+    const pf_qpoint *x = a, *y = b;
+    for (int k = 0; k < 3; k++)
+        if (x->q[k] != y->q[k])
+            return x->q[k] < y->q[k] ? -1 : 1;
+    return 0;
+}
+
+/* The welded vertex set of the triangles' corners: positions rounded to 1e-5 m (relative to
+ * the mesh's min corner), sorted, duplicates dropped. */
+static inline pf_qpoint *pf_welded(const ag_mesh *m, const double origin[3], size_t *n)
+{
+    pf_qpoint *p = malloc((3 * m->ntris + 1) * sizeof *p);
+    size_t k = 0;
+    for (size_t t = 0; t < m->ntris; t++)
+        for (int j = 0; j < 3; j++) {
+            const double *v = &m->pos[3 * m->tri[3 * t + j]];
+            for (int a = 0; a < 3; a++)
+                p[k].q[a] = llround((v[a] - origin[a]) * 1e5);
+            k++;
+        }
+    qsort(p, k, sizeof *p, pf_cmp_qpoint);
+    size_t u = 0;
+    for (size_t i = 0; i < k; i++)
+        if (!u || pf_cmp_qpoint(&p[i], &p[u - 1]))
+            p[u++] = p[i];
+    *n = u;
+    return p;
+}
+
+static inline void pf_same_welded(const ag_mesh *a, const ag_mesh *b, const char *what)
+{
+    ag_box bb = ag_mesh_bounds(b);
+    size_t na, nb;
+    pf_qpoint *pa = pf_welded(a, bb.min, &na), *pb = pf_welded(b, bb.min, &nb);
+    if (na != nb)
+        fail_msg("%s: %zu welded vertices, the other %zu", what, na, nb);
+    for (size_t i = 0; i < na; i++)
+        if (pf_cmp_qpoint(&pa[i], &pb[i]))
+            fail_msg("%s: welded vertex %zu differs", what, i);
+    free(pa);
+    free(pb);
+}
+
+static inline char *pf_print(const ag_grammar *g)
+{
+    char *text = NULL;
+    size_t len = 0;
+    ag_error err = {0};
+    if (ag_grammar_text_print(g, &text, &len, &err))
+        fail_msg("print: %s", err.text);
+    return text;
+}
+
+/* fmt round trip: prints, parses and prints back to the same bytes. */
+static inline void pf_check_roundtrip(const ag_grammar *g)
+{
+    char *a = pf_print(g);
+    ag_grammar *back = NULL;
+    ag_error err = {0};
+    long col = 0;
+    if (ag_grammar_text_parse(a, strlen(a), &back, &err, &col))
+        fail_msg("the grammar does not parse: %ld:%ld: %s\n%s", err.element, col, err.text, a);
+    char *b = pf_print(back);
+    assert_string_equal(a, b);
+    free(a);
+    free(b);
+    ag_grammar_free(back);
+}
+
 #endif

@@ -352,10 +352,35 @@ static void the_library_exports_what_it_imported_and_refuses_bad_bundles(void **
     ag_db_close(other);
     free(text);
 
+    /* a part read twice (the second from the library's cache of parts read back) is the same
+     * part: the same bundle bytes; the two parts stay apart */
+    ag_part *r1 = NULL, *r2 = NULL, *r3 = NULL;
+    assert_int_equal(ag_part_library_load(f->db, p0, 1, &r1, &err), AG_OK);
+    assert_int_equal(ag_part_library_load(f->db, p0, 0, &r2, &err), AG_OK);
+    assert_int_equal(ag_part_library_load(f->db, p1, 1, &r3, &err), AG_OK);
+    char *b1, *b2, *b3;
+    size_t l1, l2, l3;
+    assert_int_equal(ag_part_bundle_write((const ag_part *const[]){r1}, 1, &b1, &l1, &err), AG_OK);
+    assert_int_equal(ag_part_bundle_write((const ag_part *const[]){r2}, 1, &b2, &l2, &err), AG_OK);
+    assert_int_equal(ag_part_bundle_write((const ag_part *const[]){r3}, 1, &b3, &l3, &err), AG_OK);
+    assert_int_equal(l1, l2);
+    assert_memory_equal(b1, b2, l1);
+    assert_string_equal(r3->name, "another window");
+    assert_string_equal(r2->name, "window");
+    assert_true(r1 != r2 && r1->grammar != r2->grammar); /* each caller its own copy */
+    free(b1);
+    free(b2);
+    free(b3);
+    ag_part_free(r1);
+    ag_part_free(r2);
+    ag_part_free(r3);
+
     /* deleting a part keeps the terminals the other uses; deleting both frees them */
     assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
     assert_int_equal(ag_parts_delete(f->db, p0, 1, &err), AG_OK);
     assert_int_equal(ag_db_commit(f->db, &err), AG_OK);
+    /* a deleted part does not come back from the cache */
+    assert_int_equal(ag_part_library_load(f->db, p0, 1, &r1, &err), AG_ERR_NOT_FOUND);
     assert_int_equal(count(f->db, "SELECT count(*) FROM part_terminals"), texts);
     assert_int_equal(ag_db_begin(f->db, &err), AG_OK);
     assert_int_equal(ag_parts_delete(f->db, p1, 1, &err), AG_OK);

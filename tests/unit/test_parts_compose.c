@@ -19,21 +19,6 @@
 
 #define TOL 1e-6
 
-/* Window design A (the part): 1.2 x 1.8, frame 0.08, one mullion. Design B (the target's):
- * 1.6 x 2.0, frame 0.12, two mullions. */
-static pf_options design_a(int depth, int turn, double ox, double oy)
-{
-    return (pf_options){.cols = 3, .rows = 2, .ww = 1.2, .wh = 1.8, .frame = 0.08, .mullions = 1,
-                        .depth = depth, .turn = turn, .ox = ox, .oy = oy};
-}
-
-static pf_options design_b(int depth, int turn, double ox, double oy)
-{
-    return (pf_options){.cols = 4, .rows = 3, .side_cols = 2, .ww = 1.6, .wh = 2.0,
-                        .frame = 0.12, .mullions = 2, .depth = depth, .turn = turn, .ox = ox,
-                        .oy = oy};
-}
-
 static ag_part *save_window(const pf_options *o, int which)
 {
     ag_box *slots;
@@ -70,32 +55,6 @@ static ag_part *save_window(const pf_options *o, int which)
     ag_proceduralize_result_free(r);
     ag_mesh_free(m);
     return p;
-}
-
-static char *print(const ag_grammar *g)
-{
-    char *text = NULL;
-    size_t len = 0;
-    ag_error err = {0};
-    if (ag_grammar_text_print(g, &text, &len, &err))
-        fail_msg("print: %s", err.text);
-    return text;
-}
-
-/* fmt round trip: prints, parses and prints back to the same bytes. */
-static void check_roundtrip(const ag_grammar *g)
-{
-    char *a = print(g);
-    ag_grammar *back = NULL;
-    ag_error err = {0};
-    long col = 0;
-    if (ag_grammar_text_parse(a, strlen(a), &back, &err, &col))
-        fail_msg("composed grammar does not parse: %ld:%ld: %s\n%s", err.element, col, err.text, a);
-    char *b = print(back);
-    assert_string_equal(a, b);
-    free(a);
-    free(b);
-    ag_grammar_free(back);
 }
 
 /* The along (horizontal, longer) axis of a window slot. */
@@ -162,7 +121,7 @@ static ag_grammar *compose(const ag_proceduralize_result *r, const ag_part *p, i
     if (ag_compose(r, p, &op, &g, rep, &err))
         fail_msg("compose: %s", err.text);
     print_message("%s\n", rep->message);
-    check_roundtrip(g);
+    pf_check_roundtrip(g);
     return g;
 }
 
@@ -237,7 +196,7 @@ static size_t part_components(const scene *sc, const ag_box *boxes, size_t nb, s
 static void rule_scope_replace_ex(int depth, int turn_a, int turn_b, double ox, double oy,
                                   double jitter, int flip)
 {
-    pf_options oa = design_a(depth, turn_a, ox, oy), ob = design_b(depth, turn_b, -ox, oy);
+    pf_options oa = pf_design_a(depth, turn_a, ox, oy), ob = pf_design_b(depth, turn_b, -ox, oy);
     oa.flip = flip;
     ob.jitter = jitter;
     scene sc;
@@ -292,7 +251,7 @@ static void test_node_replace(void **state)
 {
     (void)state;
     for (int turn = 0; turn < 4; turn += 3) {
-        pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, turn, 0, 0);
+        pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, turn, 0, 0);
         scene sc;
         scene_open(&sc, &oa, 0, &ob);
         size_t which = 13; /* on the right facade */
@@ -316,7 +275,7 @@ static void test_node_replace(void **state)
 static void test_fill_blank_wall(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_FLUSH, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_FLUSH, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     scene sc;
     scene_open(&sc, &oa, 2, &ob);
     /* the back wall: 11.2 x 0.3 x 10.6 at y in [D - 0.3, D] */
@@ -348,7 +307,7 @@ static void test_fill_blank_wall(void **state)
 static void test_insert_balcony(void **state)
 {
     (void)state;
-    pf_options oc = design_a(PF_FLUSH, 0, 0, 0);
+    pf_options oc = pf_design_a(PF_FLUSH, 0, 0, 0);
     oc.balcony = 1;
     ag_mesh *mc;
     ag_box *sc;
@@ -362,7 +321,7 @@ static void test_insert_balcony(void **state)
     ag_error err = {0};
     if (ag_part_extract(rc, bn, &meta, &p, &err))
         fail_msg("extract: %s", err.text);
-    pf_options ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     ag_mesh *m;
     ag_box *slots;
     size_t ns;
@@ -422,7 +381,7 @@ static void test_insert_balcony(void **state)
 static void test_names_clash_and_share(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     ag_part *p = save_window(&oa, 0);
     ag_mesh *m;
     ag_box *slots;
@@ -482,7 +441,7 @@ static void test_names_clash_and_share(void **state)
 static void test_rule_scope_terminal(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     scene sc;
     scene_open(&sc, &oa, 0, &ob);
     /* the glass of the first window: inset by the frame, 0.07 behind the casing's face */
@@ -517,7 +476,7 @@ static void test_rule_scope_terminal(void **state)
 static void test_pattern_target(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     scene sc;
     scene_open(&sc, &oa, 0, &ob);
     const ag_splittree *t = sc.r->tree;
@@ -547,7 +506,7 @@ static void test_pattern_target(void **state)
 static void test_bad_ops(void **state)
 {
     (void)state;
-    pf_options oa = design_a(PF_RECESSED, 0, 0, 0), ob = design_b(PF_RECESSED, 0, 0, 0);
+    pf_options oa = pf_design_a(PF_RECESSED, 0, 0, 0), ob = pf_design_b(PF_RECESSED, 0, 0, 0);
     ag_part *p = save_window(&oa, 0);
     ag_mesh *m;
     ag_box *slots;

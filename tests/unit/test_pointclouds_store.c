@@ -14,6 +14,8 @@
 
 #include "core/points/lod.h"
 #include "random_fixture.h"
+#include "store/grammars.h"
+#include "store/models.h"
 #include "store/pointclouds.h"
 #include "store/states.h"
 #include "store_fixture.h"
@@ -289,12 +291,97 @@ static void a_segmentation_of_another_cloud_is_refused(void **state)
     close_temp_db(db, path);
 }
 
+/* A point grammar saved as a new version, with the terminals it brings, and its state kept. */
+static int64_t save_points(ag_db *db, int64_t model, int64_t base, const char *text,
+                           const char *const *paths)
+{
+    ag_error err;
+    int64_t version = 0, blob = 0;
+    assert_int_equal(ag_db_begin(db, &err), AG_OK);
+    assert_int_equal(ag_models_bump_version(db, model, base, &version, &err), AG_OK);
+    assert_int_equal(ag_models_set_mesh(db, model, "", 0, "{}", &blob, &err), AG_OK);
+    ag_grammar_new g = {.model = model, .version = version, .mesh_blob = blob, .text = text,
+                        .text_len = strlen(text), .tree_json = "{\"root\":0}",
+                        .summary_json = "{}"};
+    assert_int_equal(ag_grammars_put(db, &g, &err), AG_OK);
+    for (size_t i = 0; paths[i]; i++)
+        assert_int_equal(ag_grammars_put_terminal(db, model, paths[i], "ply\n", 4, &err), AG_OK);
+    assert_int_equal(ag_states_keep(db, model, version, &err), AG_OK);
+    assert_int_equal(ag_db_commit(db, &err), AG_OK);
+    return version;
+}
+
+static size_t release(ag_db *db, int64_t model)
+{
+    ag_error err;
+    size_t n = 99;
+    assert_int_equal(ag_db_begin(db, &err), AG_OK);
+    assert_int_equal(ag_pointclouds_release_terminals(db, model, &n, &err), AG_OK);
+    assert_int_equal(ag_db_commit(db, &err), AG_OK);
+    return n;
+}
+
+static int has_terminal(ag_db *db, int64_t model, const char *path)
+{
+    char *data = NULL;
+    size_t len = 0;
+    ag_error err;
+    ag_status s = ag_grammars_get_terminal(db, model, path, &data, &len, &err);
+    free(data);
+    assert_true(s == AG_OK || s == AG_ERR_NOT_FOUND);
+    return s == AG_OK;
+}
+
+/* Terminals stay while the current grammar or a kept state names them (as a whole quoted
+ * path: a path inside a longer one is not a name), and go once none does. */
+static void terminals_go_when_no_version_names_them(void **state)
+{
+    (void)state;
+    char *path;
+    ag_db *db = open_temp_db(&path);
+    int64_t model = a_model(db, "pointcloud"), other = a_model(db, "pointcloud");
+    static const char *const first[] = {"terminals/00aa.ply", "terminals/00bb.ply", NULL};
+    static const char *const second[] = {"terminals/00cc.ply", "terminals/00a.ply", NULL};
+    int64_t v2 = save_points(db, model, 1,
+                             "axiom A\nA -> I(\"terminals/00aa.ply\") I(\"terminals/00bb.ply\")\n",
+                             first);
+    /* the other model's terminal of the same path is its own */
+    save_points(db, other, 1, "axiom A\nA -> I(\"terminals/00cc.ply\")\n", second);
+    /* the second version drops 00aa, brings 00cc and a terminal it does not name (00a) */
+    int64_t v3 = save_points(db, model, v2,
+                             "axiom A\nA -> I(\"terminals/00bb.ply\") I(\"terminals/00cc.ply\")\n",
+                             second);
+    assert_int_equal(ag_grammars_count_terminals(db, model), 4);
+    assert_int_equal(release(db, model), 1);
+    assert_false(has_terminal(db, model, "terminals/00a.ply"));
+    /* 00aa: version 2's kept state names it (a restore brings it back) */
+    assert_true(has_terminal(db, model, "terminals/00aa.ply"));
+    assert_true(has_terminal(db, model, "terminals/00bb.ply"));
+    assert_true(has_terminal(db, model, "terminals/00cc.ply"));
+    assert_int_equal(release(db, model), 0);
+    /* without version 2's state nothing names 00aa any more */
+    char sql[128];
+    snprintf(sql, sizeof sql, "DELETE FROM model_states WHERE model_id = %lld AND version = %lld",
+             (long long)model, (long long)v2);
+    assert_int_equal(sqlite3_exec(ag_db_handle(db), sql, NULL, NULL, NULL), SQLITE_OK);
+    assert_int_equal(release(db, model), 1);
+    assert_false(has_terminal(db, model, "terminals/00aa.ply"));
+    assert_int_equal(ag_grammars_count_terminals(db, model), 2);
+    assert_true(v3 > v2);
+    /* the other model is untouched: both of its terminals stay until it is saved itself */
+    assert_int_equal(ag_grammars_count_terminals(db, other), 2);
+    assert_int_equal(release(db, other), 1);
+    assert_true(has_terminal(db, other, "terminals/00cc.ply"));
+    close_temp_db(db, path);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(clouds_come_back_in_every_chunking),
         cmocka_unit_test(segmentations_follow_the_states),
         cmocka_unit_test(a_segmentation_of_another_cloud_is_refused),
+        cmocka_unit_test(terminals_go_when_no_version_names_them),
     };
     return cmocka_run_group_tests_name("pointclouds_store", tests, NULL, NULL);
 }

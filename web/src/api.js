@@ -175,6 +175,13 @@ export class Api {
     return res.arrayBuffer();
   }
 
+  // At most `budget` of the points a proceduralized cloud's grammar derives, as binary PLY
+  // (derivedpoints.js).
+  async derivedBuffer(model, budget) {
+    const res = await this.request('GET', `/models/${model.id}/derived.ply?budget=${budget}`, { raw: true, headers: { Accept: 'application/x-ply' } });
+    return res.arrayBuffer();
+  }
+
   // Starts the segment job against the version the person sees (412 if the model moved on).
   segment(id, version, params = {}) {
     const headers = version != null ? { 'If-Match': `"${version}"` } : {};
@@ -192,9 +199,9 @@ export class Api {
 
   // --- proceduralization ----------------------------------------------------------------------
   // Starts the job against the version the person sees (412 if the model moved on).
-  proceduralize(id, version) {
+  proceduralize(id, version, options = {}) {
     const headers = version != null ? { 'If-Match': `"${version}"` } : {};
-    return this.request('POST', `/models/${id}/proceduralize`, { body: {}, headers });
+    return this.request('POST', `/models/${id}/proceduralize`, { body: options, headers });
   }
 
   getTree(id) {

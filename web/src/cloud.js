@@ -1,7 +1,9 @@
 // The open point cloud model, as the editor's sub-editor: how its points are coloured (by
 // segment or by label), how many of them to show (the budget of GET …/points.glb), the
 // segment picked, the tool a box drag in the view makes (an ROI to segment again, a template
-// on the picked segment), and what the last points.glb said of itself (its node's extras).
+// on the picked segment), which points are drawn once the cloud is proceduralized (the ones its
+// grammar derives, edited like a mesh model, or the uploaded ones, refined by boxes), and what
+// the points on screen said of themselves (points.glb's node extras, or derivedpoints.js).
 // Ops go through editor.execute like every other; the segment job through Api.segment.
 import { OP } from './opkinds.js';
 import { Signal } from './signal.js';
@@ -9,7 +11,10 @@ import { Signal } from './signal.js';
 export const COLOUR_MODES = ['segment', 'label'];
 export const DEFAULT_BUDGET = 1000000;
 export const MAX_BUDGET = 100000000; // what the server takes (api_points.c)
-export const TOOLS = ['roi', 'template'];
+// 'procTemplate': a box the next proceduralize takes as a template (§3.2), kept in the client
+export const TOOLS = ['roi', 'template', 'procTemplate'];
+const MAX_PROC_TEMPLATES = 64; // what POST …/proceduralize takes
+export const VIEWS = ['derived', 'input'];
 
 export const isCloud = (model) => model?.kind === 'pointcloud';
 
@@ -22,11 +27,15 @@ export class CloudEditor {
       segmentChanged: new Signal(), // segment id (or null)
       toolChanged: new Signal(),    // tool (or null)
       infoChanged: new Signal(),    // info (or null)
+      viewChanged: new Signal(),    // view
+      procTemplatesChanged: new Signal(), // the template boxes for the next proceduralize
     };
     this.colourBy = 'segment';
     this.budget = DEFAULT_BUDGET;
     this.segment = null;
     this.tool = null;
+    this.view = 'derived'; // of a proceduralized cloud; an unproceduralized one has only its input
+    this.procTemplates = []; // boxes in the cloud's coordinates (the offset added)
     // {model, points, shown, budget, offset, segmented, segments, labels} of what is on screen
     this.info = null;
     editor.signals.modelOpened.add(() => this.reset());
@@ -42,6 +51,46 @@ export class CloudEditor {
     this.setSegment(null);
     this.setTool(null);
     this.setInfo(null);
+    this.view = 'derived';
+    this.clearProcTemplates();
+  }
+
+  // A template box for the next proceduralize, in model coordinates (those of the uploaded
+  // points drawn, local to the cloud's offset); kept in the cloud's coordinates, as the
+  // proceduralize job takes them.
+  addProcTemplate(box) {
+    const o = this.info?.offset ?? [0, 0, 0];
+    if (this.procTemplates.length >= MAX_PROC_TEMPLATES) {
+      this.editor.fail({ title: 'Too many template boxes', detail: `proceduralize takes at most ${MAX_PROC_TEMPLATES}` });
+      return;
+    }
+    this.procTemplates.push(box.map((v, k) => v + o[k % 3]));
+    this.signals.procTemplatesChanged.dispatch(this.procTemplates);
+  }
+
+  clearProcTemplates() {
+    if (!this.procTemplates.length) return;
+    this.procTemplates = [];
+    this.signals.procTemplatesChanged.dispatch(this.procTemplates);
+  }
+
+  // The options of POST …/proceduralize for the open cloud: its template boxes, when marked
+  // (then only their copies are repetitions: no automatic search beside them).
+  procOptions() {
+    return this.procTemplates.length ? { templates: this.procTemplates.map((b) => b.slice()), auto: false } : {};
+  }
+
+  // Whether `model` is drawn as the points its grammar derives (a proceduralized cloud, unless
+  // the person asked for the uploaded points).
+  showsDerived(model = this.editor.model) {
+    return isCloud(model) && !!model.proceduralized && this.view === 'derived';
+  }
+
+  setView(view) {
+    if (!VIEWS.includes(view) || view === this.view) return;
+    this.view = view;
+    this.setTool(null); // ROI and template boxes refine the uploaded points only
+    this.signals.viewChanged.dispatch(view);
   }
 
   setColourBy(mode) {

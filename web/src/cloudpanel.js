@@ -1,7 +1,9 @@
 // The point cloud panel, shown while a point cloud model is open: how many points are drawn
 // of how many, colour by segment or label, the point budget, the segment job, the picked
-// segment, and the ROI and template box tools (editors only).
-import { COLOUR_MODES, isCloud } from './cloud.js';
+// segment, and the ROI and template box tools (editors only). Once the cloud is proceduralized
+// it chooses between the points its grammar derives (edited with the edit panel's tools) and
+// the uploaded ones (refined with the boxes).
+import { COLOUR_MODES, VIEWS, isCloud } from './cloud.js';
 import { el } from './dom.js';
 import { finished, followJob } from './jobs.js';
 
@@ -24,6 +26,13 @@ export class CloudPanel {
       ...COLOUR_MODES.map((m) => el('option', { value: m }, `colour: ${m}`)),
     );
     this.colour.addEventListener('change', () => this.cloud.setColourBy(this.colour.value));
+    const viewText = { derived: 'show: derived points', input: 'show: uploaded points' };
+    this.view = el(
+      'select',
+      { 'data-testid': 'cloud-view', title: 'Which points to draw: those the grammar derives, or those uploaded', 'aria-label': 'Points shown' },
+      ...VIEWS.map((v) => el('option', { value: v }, viewText[v])),
+    );
+    this.view.addEventListener('change', () => this.cloud.setView(this.view.value));
     this.budget = el('input.num', {
       type: 'number', min: 1, step: 1, 'data-testid': 'cloud-budget', title: 'Point budget: how many points to draw',
       'aria-label': 'Point budget', list: 'cloud-budgets',
@@ -36,6 +45,11 @@ export class CloudPanel {
     this.roiBtn.addEventListener('click', () => this.cloud.setTool(this.cloud.tool === 'roi' ? null : 'roi'));
     this.templateBtn = el('button', { type: 'button', 'data-testid': 'cloud-template', title: 'Drag a box on the picked segment: a template, its copies labelled with it' }, 'Template box');
     this.templateBtn.addEventListener('click', () => this.cloud.setTool(this.cloud.tool === 'template' ? null : 'template'));
+    this.procTemplateBtn = el('button', { type: 'button', 'data-testid': 'cloud-proc-template', title: 'Drag a box around one window (or other repeated element): Proceduralize finds its copies' }, 'Template for Proceduralize');
+    this.procTemplateBtn.addEventListener('click', () => this.cloud.setTool(this.cloud.tool === 'procTemplate' ? null : 'procTemplate'));
+    this.procTemplates = el('span.cloud-proc-templates', { 'data-testid': 'cloud-proc-templates' });
+    this.clearTemplatesBtn = el('button', { type: 'button', 'data-testid': 'cloud-proc-templates-clear', title: 'Forget the template boxes' }, 'Clear');
+    this.clearTemplatesBtn.addEventListener('click', () => this.cloud.clearProcTemplates());
     this.picked = el('div.picked', { 'data-testid': 'cloud-picked' });
     this.jobText = el('div.job-text', { 'data-testid': 'cloud-job' });
 
@@ -44,7 +58,9 @@ export class CloudPanel {
       this.shown,
       this.figures,
       el('div.proc-actions', {}, this.colour, this.budget, presets),
+      el('div.proc-actions', {}, this.view),
       el('div.proc-actions', {}, this.segmentBtn, this.roiBtn, this.templateBtn),
+      el('div.proc-actions', {}, this.procTemplateBtn, this.procTemplates, this.clearTemplatesBtn),
       this.picked,
       this.jobText,
     );
@@ -59,7 +75,7 @@ export class CloudPanel {
     s.roleChanged.add(() => this.render());
     s.pointsChanged.add(() => this.refreshFigures());
     const c = this.cloud.signals;
-    for (const sig of [c.colourChanged, c.budgetChanged, c.segmentChanged, c.toolChanged, c.infoChanged]) sig.add(() => this.render());
+    for (const sig of [c.colourChanged, c.budgetChanged, c.segmentChanged, c.toolChanged, c.infoChanged, c.viewChanged, c.procTemplatesChanged]) sig.add(() => this.render());
     this.render();
   }
 
@@ -71,12 +87,18 @@ export class CloudPanel {
     const info = cloud.info;
     const fmt = (n) => (typeof n === 'number' ? n.toLocaleString('en') : '–');
     const total = info?.points ?? ed.model.stats?.points;
-    this.shown.textContent = info ? `${fmt(info.drawn)} of ${fmt(total)} points drawn` : 'Loading points…';
+    const derived = !!info?.derived;
+    this.shown.textContent = info ? `${fmt(info.drawn)} of ${fmt(total)} ${derived ? 'derived ' : ''}points drawn` : 'Loading points…';
+    this.shown.dataset.of = derived ? 'derived' : 'input';
     this.shown.dataset.drawn = String(info?.drawn ?? 0);
-    const segmented = !!(info?.segmented ?? ed.model.stats?.segmented);
-    this.figures.textContent = segmented
-      ? `${fmt(info?.segments ?? ed.model.stats?.segments)} segments · ${fmt(info?.labels ?? ed.model.stats?.labels)} labels`
-      : 'not segmented';
+    const segmented = !!(derived ? ed.model.stats?.segmented : info?.segmented ?? ed.model.stats?.segmented);
+    this.figures.textContent = derived
+      ? `${fmt(info.segments)} placements · ${fmt(info.labels)} terminals`
+      : segmented
+        ? `${fmt(info?.segments ?? ed.model.stats?.segments)} segments · ${fmt(info?.labels ?? ed.model.stats?.labels)} labels`
+        : 'not segmented';
+    this.view.hidden = !ed.model.proceduralized;
+    this.view.value = cloud.view;
     this.colour.value = cloud.colourBy;
     if (document.activeElement !== this.budget) this.budget.value = String(cloud.budget);
     const edit = ed.canEdit;
@@ -85,13 +107,23 @@ export class CloudPanel {
     this.roiBtn.hidden = !edit;
     this.templateBtn.hidden = !edit;
     this.segmentBtn.disabled = running;
-    this.roiBtn.disabled = !segmented;
-    this.templateBtn.disabled = !segmented || cloud.segment === null;
+    // the boxes refine the uploaded points' segmentation
+    this.roiBtn.disabled = !segmented || derived;
+    this.templateBtn.disabled = !segmented || derived || cloud.segment === null;
+    this.procTemplateBtn.hidden = !edit;
+    this.procTemplateBtn.disabled = derived || !info;
+    this.procTemplateBtn.classList.toggle('on', cloud.tool === 'procTemplate');
+    const nt = cloud.procTemplates.length;
+    this.procTemplates.textContent = nt ? `${nt} template box${nt === 1 ? '' : 'es'} for Proceduralize` : '';
+    this.procTemplates.dataset.count = String(nt);
+    this.clearTemplatesBtn.hidden = !edit || !nt;
     this.roiBtn.classList.toggle('on', cloud.tool === 'roi');
     this.templateBtn.classList.toggle('on', cloud.tool === 'template');
-    this.picked.textContent = cloud.segment === null
-      ? (segmented ? 'Click a point to pick its segment' : '')
-      : `segment ${cloud.segment}`;
+    this.picked.textContent = derived
+      ? 'Click a point to select its node (Shift+click: several)'
+      : cloud.segment === null
+        ? (segmented ? 'Click a point to pick its segment' : '')
+        : `segment ${cloud.segment}`;
     this.picked.classList.toggle('none', cloud.segment === null);
     const j = this.job;
     this.jobText.textContent = j ? `segment: ${j.status}${j.stage ? ` · ${j.stage}` : ''}${finished(j) ? '' : ` ${Math.round((j.progress ?? 0) * 100)} %`}` : '';

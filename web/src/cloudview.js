@@ -1,13 +1,18 @@
 // A point cloud model in the view: colours its points by segment or by label (cloud.js), the
 // picked segment in the highlight colour, turns a click on a point into that point's segment,
 // and a box dragged over the view (with the ROI or template tool on) into a segment_roi or
-// mark_template op. It draws only through the viewport's layers and listens to signals.
+// mark_template op. The derived points of a proceduralized cloud (derivedpoints.js) are
+// coloured by placement ("segment") or terminal ("label"), the selected nodes' in the highlight
+// colour, and a click on one selects its placement's node (Shift+click: one more node), as a
+// click on a mesh model's component does. It draws only through the viewport's layers and
+// listens to signals.
 //
 // Box drags: the box sent is the model-coordinate bounding box of the drawn points whose
 // screen position falls inside the dragged rectangle (for a template, only the picked
 // segment's), padded a little: the shown points are float32 copies of the stored ones.
 import * as THREE from 'three';
 import { isCloud } from './cloud.js';
+import { peerSelections } from './peers.js';
 
 const HIGHLIGHT = new THREE.Color(0xffc820); // as the viewport's picked component
 const NONE = new THREE.Color(0x8d96a0);      // points in no segment
@@ -42,6 +47,11 @@ export class CloudView {
     c.segmentChanged.add(() => this.colourize());
     c.toolChanged.add((tool) => this.toolChanged(tool));
     editor.signals.modelOpened.add(() => this.clearBox());
+    const recolour = () => {
+      if (this.derived) this.colourize();
+    };
+    editor.signals.selectionChanged.add(recolour);
+    editor.signals.peersChanged.add(recolour); // what the others have selected, in their colours
 
     const el = viewport.canvas;
     el.addEventListener('pointerdown', (e) => this.dragStart(e));
@@ -54,10 +64,16 @@ export class CloudView {
     return this.viewport.layers.model.points;
   }
 
+  // The points on screen are a proceduralized cloud's derivation.
+  get derived() {
+    return !!this.cloud.info?.derived && isCloud(this.editor.model);
+  }
+
   // A points.glb is on screen: our material, its extras as the cloud's info, our colours.
   shown() {
     if (!isCloud(this.editor.model)) {
       this.viewport.mark('points', null);
+      this.viewport.mark('pointsOf', null);
       return;
     }
     this.clearBox();
@@ -75,6 +91,7 @@ export class CloudView {
     }
     this.cloud.setInfo(info ? { ...info, drawn } : { drawn });
     this.viewport.mark('points', drawn); // how many points are drawn
+    this.viewport.mark('pointsOf', info?.derived ? 'derived' : 'input'); // and which
     this.colourize();
   }
 
@@ -82,7 +99,11 @@ export class CloudView {
   colourize() {
     if (!isCloud(this.editor.model)) return;
     const mode = this.cloud.colourBy;
-    const picked = this.cloud.segment;
+    const derived = this.derived;
+    const picked = derived ? null : this.cloud.segment;
+    // a derived cloud's placements are the components the selected nodes cover
+    const lit = derived ? new Set(this.editor.selected.components()) : null;
+    const theirs = derived ? this.peerSelections() : null;
     const c = new THREE.Color();
     for (const p of this.points) {
       const g = p.geometry;
@@ -95,7 +116,8 @@ export class CloudView {
       const { min, max } = g.boundingBox;
       const span = Math.max(max.y - min.y, 1e-6);
       for (let i = 0; i < n; i++) {
-        if (seg && picked !== null && seg.getX(i) === picked) c.copy(HIGHLIGHT);
+        if (seg && ((picked !== null && seg.getX(i) === picked) || lit?.has(seg.getX(i)))) c.copy(HIGHLIGHT);
+        else if (seg && theirs?.has(seg.getX(i))) c.copy(theirs.get(seg.getX(i)));
         else if (ids) {
           const id = ids.getX(i);
           if (id < 0) c.copy(NONE);
@@ -110,15 +132,40 @@ export class CloudView {
     }
     this.viewport.mark('colourBy', mode);
     this.viewport.mark('segment', picked);
+    this.viewport.mark('litPlacements', lit ? lit.size : null);
     this.viewport.requestRender();
+  }
+
+  // Placement -> the colour of the first other person who has it selected.
+  peerSelections() {
+    const out = new Map([...peerSelections(this.editor.peers)].map(([c, hex]) => [c, new THREE.Color(hex)]));
+    this.viewport.mark('peerPlacements', out.size || null);
+    return out;
   }
 
   // A click on a point picks its segment; a click beside the points drops the pick.
   picked(hit) {
+    if (this.derived) {
+      this.pickedDerived(hit);
+      return;
+    }
     const seg = hit?.points.geometry.getAttribute('_segment');
     if (hit && !seg) this.editor.notify('The cloud is not segmented yet: segment it to pick segments');
     const id = seg ? seg.getX(hit.index) : -1;
     this.cloud.setSegment(id >= 0 ? id : null);
+  }
+
+  // A derived point stands for its placement: its node is selected (Shift: added or taken out).
+  pickedDerived(hit) {
+    const selected = this.editor.selected;
+    const component = hit?.points.userData.component;
+    if (typeof component !== 'number') {
+      if (!hit?.extend) selected.clear();
+      return;
+    }
+    const node = this.editor.tree?.nodeOfComponent(component) ?? null;
+    if (hit.extend && node !== null) selected.toggle(node);
+    else selected.set({ component, group: null });
   }
 
   // --- box drags ------------------------------------------------------------------------------
@@ -174,7 +221,9 @@ export class CloudView {
       this.editor.fail({ title: 'No segment picked', detail: 'click a point of the segment the template is in first' });
       return;
     }
-    const box = this.boxUnder(from, to, only);
+    // a template for proceduralize is what the person sees in the rectangle: the points
+    // behind it (the far wall through a window) stay out
+    const box = this.boxUnder(from, to, only, tool === 'procTemplate');
     if (!box) {
       this.editor.fail({ title: 'No points in the box', detail: only === null ? 'drag over the points' : `drag over points of segment ${only}` });
       return;
@@ -182,19 +231,20 @@ export class CloudView {
     this.cloud.setTool(null);
     this.showBox(box);
     if (tool === 'roi') await this.cloud.segmentRoi(box);
+    else if (tool === 'procTemplate') this.cloud.addProcTemplate(box);
     else await this.cloud.markTemplate(box);
   }
 
   // The padded model-coordinate box of the drawn points inside the screen rectangle (of
-  // segment `only` when given), or null when none is.
-  boxUnder(a, b, only) {
+  // segment `only` when given; with `front`, only those within the rectangle's size behind the
+  // nearest of them), or null when none is.
+  boxUnder(a, b, only, front = false) {
     const vp = this.viewport;
     const w = vp.canvas.clientWidth, h = vp.canvas.clientHeight;
     const x0 = Math.min(a.x, b.x), x1 = Math.max(a.x, b.x), y0 = Math.min(a.y, b.y), y1 = Math.max(a.y, b.y);
     vp.camera.updateMatrixWorld();
-    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
     const v = new THREE.Vector3(), s = new THREE.Vector3();
-    let found = 0;
+    const inside = []; // [x, y, z, distance to the camera] per point in the rectangle
     for (const p of this.points) {
       p.updateWorldMatrix(true, false);
       const pos = p.geometry.getAttribute('position');
@@ -208,15 +258,25 @@ export class CloudView {
         const sx = ((s.x + 1) / 2) * w, sy = ((1 - s.y) / 2) * h;
         if (sx < x0 || sx > x1 || sy < y0 || sy > y1) continue;
         // glTF is y-up: archgram's (x, y, z) is (x, -z, y) of the scene
-        const m = [v.x, -v.z, v.y];
-        for (let k = 0; k < 3; k++) {
-          lo[k] = Math.min(lo[k], m[k]);
-          hi[k] = Math.max(hi[k], m[k]);
-        }
-        found++;
+        inside.push([v.x, -v.z, v.y, front ? v.distanceTo(vp.camera.position) : 0]);
       }
     }
-    if (!found) return null;
+    if (!inside.length) return null;
+    let reach = Infinity;
+    if (front) {
+      let near = Infinity;
+      for (const q of inside) near = Math.min(near, q[3]);
+      const px = Math.max(x1 - x0, y1 - y0);
+      reach = near + px * (2 * near * Math.tan(THREE.MathUtils.degToRad(vp.camera.fov) / 2)) / (h || 1);
+    }
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (const q of inside) {
+      if (q[3] > reach) continue;
+      for (let k = 0; k < 3; k++) {
+        lo[k] = Math.min(lo[k], q[k]);
+        hi[k] = Math.max(hi[k], q[k]);
+      }
+    }
     return [...lo.map((x) => x - BOX_PAD), ...hi.map((x) => x + BOX_PAD)];
   }
 

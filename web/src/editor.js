@@ -7,12 +7,14 @@
 import { CloudEditor, isCloud } from './cloud.js';
 import { ExtrusionEditor } from './extrusioneditor.js';
 import { PartsLibrary } from './library.js';
-import { OP, REMESHING, RESEGMENTING, isSendable } from './opkinds.js';
+import { OP, REMESHING, RESEGMENTING, STRUCTURAL, isSendable, kinds } from './opkinds.js';
 import { Selection } from './selection.js';
 import { Signal } from './signal.js';
 
 // Roles on a model that may change it (the server checks again; this only spares refusals).
 const EDITING_ROLES = new Set(['editor', 'owner']);
+// Ops only a proceduralized cloud has (undo, redo and restore may go either way).
+const PROCEDURAL_CLOUD = kinds('proceduralize', 'grammar', ...STRUCTURAL);
 
 export class Editor {
   constructor() {
@@ -165,16 +167,19 @@ export class Editor {
     this.model.version = entry.version;
     const op = entry.op || {};
     if (op.kind === OP.rename && typeof op.name === 'string') this.model.name = op.name;
-    // a point cloud has no mesh to replace: its segmentation is what those ops change
+    // a point cloud's segmentation is what the segment ops change; once proceduralized its
+    // derived points, tree and grammar change as a mesh model's do
     const cloud = isCloud(this.model);
     const resegmented = cloud && RESEGMENTING.has(op.kind);
-    const remeshed = !cloud && REMESHING.has(op.kind);
-    if (remeshed) this.model.proceduralized = true;
+    const remeshed = REMESHING.has(op.kind);
+    // an undo may take a cloud back before its proceduralization: the model's figures tell
+    const madeProcedural = remeshed && (!cloud || PROCEDURAL_CLOUD.has(op.kind));
+    if (madeProcedural) this.model.proceduralized = true;
     const listed = this.models.find((m) => m.id === this.model.id);
     if (listed) {
       listed.name = this.model.name;
       listed.version = entry.version;
-      if (remeshed) listed.proceduralized = true;
+      if (madeProcedural) listed.proceduralized = true;
       this.signals.modelsChanged.dispatch(this.models);
     }
     this.signals.modelChanged.dispatch(this.model);
@@ -189,8 +194,11 @@ export class Editor {
   // Fresh figures of the open model (e.g. re-read after its mesh changed).
   updateModel(model) {
     if (!this.model || model.id !== this.model.id || model.version < this.model.version) return;
+    const was = !!this.model.proceduralized;
     this.model = { ...this.model, stats: model.stats, proceduralized: model.proceduralized };
     this.signals.modelChanged.dispatch(this.model);
+    // a cloud proceduralized (or no longer) is drawn from other points
+    if (isCloud(this.model) && was !== !!model.proceduralized) this.signals.pointsChanged.dispatch(this.model);
   }
 
   // The server told us the current version (welcome) without ops to carry us there.

@@ -85,6 +85,7 @@ export class EditTools {
     s.selectionChanged.add(() => this.render());
     s.treeChanged.add(() => this.render());
     s.modelOpened.add(() => this.render());
+    editor.cloud.signals.viewChanged.add(() => this.render());
     window.addEventListener('keydown', (e) => this.key(e));
     this.render();
   }
@@ -201,11 +202,9 @@ export class EditTools {
 
   render() {
     const ed = this.editor;
-    // a point model is edited through the API for now (its tree is in the cloud's coordinates)
-    const cloud = isCloud(ed.model);
-    const ready = !!(ed.model && ed.tree) && !cloud;
-    this.empty.textContent = cloud && ed.tree
-      ? 'Point models are edited through the API (POST …/ops) for now.'
+    const ready = !!(ed.model && ed.tree) && editsShown(ed);
+    this.empty.textContent = ed.tree
+      ? 'Show the derived points to edit the point model.'
       : 'Proceduralize the model to edit it.';
     // viewers get no edit tools at all (and no undo: they have no edits)
     if (ed.model && !ed.canEdit && this.splitting) this.splitting = false;
@@ -259,6 +258,12 @@ export class EditTools {
     this.plane.userData.tool = 'split-plane';
     layer.add(this.plane);
   }
+}
+
+// Whether what is on screen is what the edit tools change: a mesh model, or a point model's
+// derived points (its uploaded points are refined by boxes instead, cloud.js).
+export function editsShown(editor) {
+  return !isCloud(editor.model) || editor.cloud.showsDerived();
 }
 
 function button(text, testid, onclick, title) {

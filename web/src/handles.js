@@ -3,7 +3,7 @@
 // 30 a second); the server's re-solved boxes for the whole area of effect reach everyone in the
 // room. Releasing sends one resize op — one undo step.
 import * as THREE from 'three';
-import { isCloud } from './cloud.js';
+import { editsShown } from './edittools.js';
 import { worldBox } from './previewlayer.js';
 
 const PREVIEW_INTERVAL_MS = 1000 / 30;
@@ -61,6 +61,7 @@ export class Handles {
     s.treeChanged.add(() => this.sync());
     s.modelOpened.add(() => this.sync());
     s.roleChanged.add(() => this.sync()); // viewers get no drag handles
+    editor.cloud.signals.viewChanged.add(() => this.sync());
     s.cameraChanged.add(() => this.scale());
   }
 
@@ -69,9 +70,9 @@ export class Handles {
     if (this.drag) this.cancel();
     const tree = this.editor.tree;
     const id = this.editor.selected.single();
-    // a point model's tree is in the cloud's coordinates, its points on screen in their local
-    // ones: it is edited through the API (POST …/ops) for now, not by handles
-    const editable = tree && this.editor.canEdit && !isCloud(this.editor.model);
+    // a point model is edited on the points its grammar derives (drawn in the coordinates of
+    // its tree's boxes), not on the uploaded ones
+    const editable = tree && this.editor.canEdit && editsShown(this.editor);
     const n = id !== null && editable ? tree.node(id) : null;
     if (!n || !Array.isArray(n.box) || n.box.length !== 6) {
       this.node = null;

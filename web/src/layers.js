@@ -1,7 +1,7 @@
 // The viewport's layers: each a group in the scene that one part of the client draws into, so
 // no module reaches into the scene or another module's objects.
 //   model    the loaded model, its meshes by component (picking, colours, drag previews), or
-//            the points of a point cloud model
+//            the points of a point cloud model (a derived cloud's by placement, its components)
 //   preview  stand-ins drawn in place of model components (an extrusion's live preview)
 //   handles  tools drawn over the model (resize handles, the split plane)
 import * as THREE from 'three';
@@ -50,7 +50,7 @@ export class ModelLayer extends Layer {
   constructor(viewport) {
     super(viewport, 'model');
     this.root = null;
-    this.byComponent = new Map(); // component -> meshes
+    this.byComponent = new Map(); // component -> meshes (and the Points of a derived cloud)
     this.points = [];             // THREE.Points of a point cloud model
     this.tint = null;             // (mesh) => THREE.Color | null: a colouring that overrides labels
   }
@@ -61,7 +61,7 @@ export class ModelLayer extends Layer {
     this.root = root;
     root.traverse((o) => {
       if (o.isPoints) this.points.push(o);
-      if (!o.isMesh) return;
+      if (!o.isMesh && !o.isPoints) return;
       const owner = componentOwner(o);
       const component = owner ? owner.userData.component : -1;
       o.userData.componentId = component;

@@ -7,6 +7,7 @@
 // stored), then commit it as one compose op (editor.execute). State lives in editor.library.
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { isCloud } from './cloud.js';
 import { el, timeAgo } from './dom.js';
 import { MODES, SCOPES } from './library.js';
 import { describeNode } from './treewalk.js';
@@ -253,9 +254,14 @@ export class LibraryPanel {
   renderSelection() {
     const ed = this.editor;
     const tree = ed.tree;
-    const ready = !!(ed.model && tree);
+    // parts are saved from and composed into meshes (the service refuses point models)
+    const cloud = isCloud(ed.model);
+    const ready = !!(ed.model && tree) && !cloud;
     this.saveBox.hidden = !ready;
     this.empty.hidden = ready;
+    this.empty.textContent = cloud
+      ? 'Parts are saved from and composed into mesh models.'
+      : 'Proceduralize a model to save parts of it or compose parts into it.';
     const ids = ed.selected.nodeIds();
     this.saveBtn.disabled = !ready || !ids.length;
     this.selText.replaceChildren(

@@ -3,6 +3,8 @@
 import { describeNode, walkParent } from './treewalk.js';
 
 const INTERVAL_MS = 80; // at most this often a ray is cast while the pointer moves
+// a ray against points tests every one of them: past this many drawn, no tooltip on hover
+const HOVER_POINTS_MAX = 300000;
 
 export class NodeInfo {
   constructor(editor, viewport) {
@@ -21,8 +23,18 @@ export class NodeInfo {
 
   show(x, y) {
     const tree = this.editor.tree;
-    const owner = tree ? this.viewport.layers.model.hit(this.viewport.ray(x, y)) : null;
-    this.set(owner ? tree.nodeOfComponent(owner.userData.component) : null);
+    const vp = this.viewport;
+    if (!tree) {
+      this.set(null);
+      return;
+    }
+    // a derived cloud's points stand for their placements (derivedpoints.js)
+    const points = vp.layers.model.points;
+    let owner = null;
+    if (!points.length) owner = vp.layers.model.hit(vp.ray(x, y));
+    else if (typeof points[0].userData.component === 'number' && drawnPoints(points) <= HOVER_POINTS_MAX) owner = vp.hitPoint(x, y)?.points;
+    const component = owner?.userData.component;
+    this.set(typeof component === 'number' ? tree.nodeOfComponent(component) : null);
   }
 
   set(id) {
@@ -42,4 +54,10 @@ export class NodeInfo {
     this.viewport.canvas.title = `${describeNode(n)}${within}`;
     this.viewport.mark('hoverNode', id);
   }
+}
+
+function drawnPoints(points) {
+  let n = 0;
+  for (const p of points) n += p.geometry.getAttribute('position').count;
+  return n;
 }

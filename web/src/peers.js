@@ -10,6 +10,19 @@ export function colourOf(name) {
   return COLOURS[h % COLOURS.length];
 }
 
+// What the others in the room have selected: component -> the colour (a '#rrggbb' string) of
+// the first of them who has it.
+export function peerSelections(peers) {
+  const out = new Map();
+  for (const p of peers.values()) {
+    const sel = p.state?.selection;
+    if (!Array.isArray(sel)) continue;
+    const colour = colourOf(p.state?.name || p.user || p.peer);
+    for (const c of sel) if (!out.has(c)) out.set(c, colour);
+  }
+  return out;
+}
+
 export class PeersPanel {
   constructor(editor, container) {
     this.editor = editor;

@@ -1,6 +1,7 @@
 // The open model's procedural side: runs the proceduralize job, keeps the split tree and the
 // grammar current (after opening, and whenever a proceduralize or grammar op arrives, from
 // anyone), and applies grammar edits.
+import { isCloud } from './cloud.js';
 import { SplitTree } from './splittree.js';
 import { finished, followJob } from './jobs.js';
 
@@ -55,7 +56,8 @@ export class Procedural {
     ed.setProcJob({ kind: 'proceduralize', status: 'queued', progress: 0, stage: null, model: id, name });
     let job;
     try {
-      job = await this.api.proceduralize(id, version);
+      // a point cloud's template boxes, when the person marked some (cloud.js)
+      job = await this.api.proceduralize(id, version, isCloud(ed.model) ? ed.cloud.procOptions() : {});
     } catch (err) {
       ed.setProcJob({ kind: 'proceduralize', status: 'failed', progress: 0, stage: null, model: id, name });
       ed.fail(err);
@@ -69,6 +71,7 @@ export class Procedural {
     if (!mine()) return;
     ed.setProcJob({ ...done, progress: done.status === 'succeeded' ? 1 : ed.procJob?.progress ?? 0, model: id, name });
     if (done.status === 'succeeded') {
+      if (isCloud(ed.model)) ed.cloud.clearProcTemplates(); // they made this version
       await this.catchUp(id);
     } else if (done.status === 'failed') {
       ed.fail(done.error || { title: 'Proceduralization failed', detail: name });

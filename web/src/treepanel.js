@@ -1,10 +1,13 @@
 // The split-tree panel: the Proceduralize button and its job's stages, the label legend, the
 // expandable tree of nodes and the selected node's details. Selecting a node selects its
 // geometry; a component picked in the viewport is revealed here (both through the editor).
+import { isCloud } from './cloud.js';
 import { el } from './dom.js';
 import { boxSize, nodeTitle } from './splittree.js';
 
 const STAGES = ['segment', 'label', 'tree', 'rules', 'patterns', 'export', 'verify'];
+// a point cloud's pipeline (server/app/cloud_pipeline.c)
+const CLOUD_STAGES = ['segment', 'repeat', 'absorb', 'consensus', 'tree', 'grammar', 'verify'];
 const OPEN_DEPTH = 2; // levels shown expanded when a tree arrives
 const MAX_CHILDREN = 500; // children listed under one node; the rest are summarised
 
@@ -81,9 +84,10 @@ export class SplitTreePanel {
     this.job.className = `job ${job.status}`;
     this.job.dataset.status = job.status;
     this.job.dataset.stage = job.stage ?? '';
-    const at = STAGES.indexOf(job.stage);
+    const stages = isCloud(this.editor.model) ? CLOUD_STAGES : STAGES;
+    const at = stages.indexOf(job.stage);
     this.stages.replaceChildren(
-      ...STAGES.map((name, i) => {
+      ...stages.map((name, i) => {
         let state = 'pending'; // a stage not reached yet
         if (job.status === 'succeeded' || i < at) state = 'done';
         else if (i === at) state = done ? job.status : 'now';

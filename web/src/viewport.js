@@ -1,15 +1,17 @@
 // The 3D view: loads a model's GLB, frames it, renders on demand and turns clicks into
 // component selections. It only reacts to editor signals and reports picks/camera moves back.
 // Once the model is proceduralized its components are coloured by label (the tree's colours).
-// A point cloud model is its points.glb at the cloud's budget (cloud.js); cloudview.js
-// colours its points and turns a picked point into a segment.
+// A point cloud model is its points.glb at the cloud's budget (cloud.js), or once
+// proceduralized the points its grammar derives (derivedpoints.js); cloudview.js colours the
+// points and turns a picked point into a segment or a node.
 // Other modules draw through its layers (layers.js) and its camera helpers, never its scene.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { isCloud } from './cloud.js';
+import { derivedScene } from './derivedpoints.js';
 import { Layer, ModelLayer } from './layers.js';
-import { colourOf } from './peers.js';
+import { peerSelections } from './peers.js';
 import { Signal } from './signal.js';
 
 // Flat, light background; model colours are mid-tones kept well away from it so the model
@@ -31,7 +33,7 @@ export class Viewport {
     this.container = container;
     this.signals = {
       shown: new Signal(), // {model, version}: that model's mesh is on screen now
-      pointPicked: new Signal(), // {points, index} of a click on a point cloud (null: none)
+      pointPicked: new Signal(), // {points, index, extend} of a click on a point cloud (null: none)
     };
 
     this.renderer = new THREE.WebGLRenderer({ antialias: true });
@@ -56,6 +58,8 @@ export class Viewport {
       handles: new Layer(this, 'handles'),
     };
     this.loadToken = 0;
+    this.loading = null; // loadKey of what is loading or on screen
+    this.frameOf = null; // 'mesh' | 'input' | 'derived': the coordinates the camera was framed in
     this.shown = null; // {model, version} on screen
 
     this.camera = new THREE.PerspectiveCamera(45, 1, 0.1, 1000);
@@ -93,9 +97,11 @@ export class Viewport {
     s.modelOpened.add((model) => this.load(model));
     s.meshChanged.add((model) => this.load(model, { keepCamera: true }));
     s.pointsChanged.add((model) => this.load(model, { keepCamera: true }));
-    editor.cloud.signals.budgetChanged.add(() => {
+    const reloadCloud = () => {
       if (isCloud(editor.model)) this.load(editor.model, { keepCamera: true });
-    });
+    };
+    editor.cloud.signals.budgetChanged.add(reloadCloud);
+    editor.cloud.signals.viewChanged.add(reloadCloud);
     s.treeChanged.add(() => this.colourize());
     s.selectionChanged.add(() => this.highlight());
     s.peersChanged.add(() => this.highlight());
@@ -132,9 +138,17 @@ export class Viewport {
   // --- loading ------------------------------------------------------------------------------
   // keepCamera: the same model with a new mesh (it stays where the person was looking).
   async load(model, { keepCamera = false } = {}) {
+    // one change may announce itself twice (a cloud's restore: its points and its derivation)
+    const key = model ? this.loadKey(model) : null;
+    if (keepCamera && key !== null && key === this.loading) return;
+    this.loading = key;
     const token = ++this.loadToken;
     const layer = this.layers.model;
-    const reframe = !(keepCamera && layer.root);
+    // a cloud's uploaded points are local to its offset, its derived ones in the tree's
+    // coordinates: switching between them frames the view again
+    const frame = !model ? null : !isCloud(model) ? 'mesh' : this.editor.cloud.showsDerived(model) ? 'derived' : 'input';
+    const reframe = !(keepCamera && layer.root && frame === this.frameOf);
+    this.frameOf = frame;
     this.shown = null;
     this.mark('model', null);
     this.mark('version', null);
@@ -145,15 +159,22 @@ export class Viewport {
     }
     const version = model.version;
     const cloud = isCloud(model);
+    const derived = this.editor.cloud.showsDerived(model);
+    const budget = this.editor.cloud.budget;
     if (reframe) this.setStatus(cloud ? 'Loading points…' : 'Loading mesh…');
     try {
-      const buffer = cloud
-        ? await this.api.pointsBuffer(model, this.editor.cloud.budget)
-        : await this.api.meshBuffer(model);
+      let scene;
+      if (derived) {
+        const buffer = await this.api.derivedBuffer(model, budget);
+        if (token !== this.loadToken) return;
+        scene = derivedScene(buffer, budget, model.id);
+      } else {
+        const buffer = cloud ? await this.api.pointsBuffer(model, budget) : await this.api.meshBuffer(model);
+        if (token !== this.loadToken) return;
+        scene = (await new GLTFLoader().parseAsync(buffer, '')).scene;
+      }
       if (token !== this.loadToken) return;
-      const gltf = await new GLTFLoader().parseAsync(buffer, '');
-      if (token !== this.loadToken) return;
-      this.show(gltf.scene, reframe);
+      this.show(scene, reframe);
       this.setStatus('');
       this.shown = { model: model.id, version };
       this.mark('model', model.id); // which model is on screen
@@ -161,9 +182,22 @@ export class Viewport {
       this.signals.shown.dispatch(this.shown);
     } catch (err) {
       if (token !== this.loadToken) return;
+      this.loading = null;
+      if (derived && err.status === 409) {
+        // restored to before its proceduralization: its figures say so, and its uploaded
+        // points are drawn (editor.updateModel)
+        this.api.getModel(model.id).then((m) => this.editor.updateModel(m), (e) => this.editor.fail(e));
+        return;
+      }
       this.setStatus(cloud ? 'The points could not be shown' : 'The mesh could not be shown');
       this.editor.fail(err.problem || { title: 'Cannot show the mesh', detail: err.message });
     }
+  }
+
+  // What a load shows: the model's version, and for a cloud which points within which budget.
+  loadKey(model) {
+    const cloud = this.editor.cloud;
+    return `${model.id}:${model.version}:${isCloud(model) ? `${cloud.showsDerived(model) ? 'derived' : 'input'}:${cloud.budget}` : ''}`;
   }
 
   show(root, reframe = true) {
@@ -171,6 +205,7 @@ export class Viewport {
     layer.set(root);
     for (const meshes of layer.byComponent.values()) {
       for (const o of meshes) {
+        if (!o.isMesh) continue; // points are coloured by cloudview.js
         // Own material per mesh so a highlight touches only the picked component.
         for (const m of [].concat(o.material)) m.dispose();
         o.material = new THREE.MeshStandardMaterial({
@@ -197,6 +232,7 @@ export class Viewport {
     const groupColour = new Map();
     for (const meshes of layer.byComponent.values()) {
       for (const o of meshes) {
+        if (!o.isMesh) continue;
         const byLabel = tree && o.userData.label !== null ? tree.colourOf(o.userData.label) : null;
         let colour;
         if (byLabel) {
@@ -306,7 +342,8 @@ export class Viewport {
     const layer = this.layers.model;
     if (!layer.root) return;
     if (layer.points.length) {
-      this.signals.pointPicked.dispatch(this.hitPoint(clientX, clientY));
+      const hit = this.hitPoint(clientX, clientY);
+      this.signals.pointPicked.dispatch(hit && { ...hit, extend });
       return;
     }
     const owner = layer.hit(this.ray(clientX, clientY));
@@ -335,17 +372,12 @@ export class Viewport {
   // Our selection in yellow; what others have selected in their colours.
   highlight() {
     const on = new Set(this.editor.selected.components());
-    const theirs = new Map();
-    for (const p of this.editor.peers.values()) {
-      const sel = p.state?.selection;
-      if (!Array.isArray(sel)) continue;
-      const colour = new THREE.Color(colourOf(p.state?.name || p.user || p.peer));
-      for (const c of sel) if (!theirs.has(c)) theirs.set(c, colour);
-    }
+    const theirs = new Map([...peerSelections(this.editor.peers)].map(([c, hex]) => [c, new THREE.Color(hex)]));
     for (const [component, meshes] of this.layers.model.components()) {
       const lit = on.has(component);
       const peer = lit ? null : theirs.get(component);
       for (const mesh of meshes) {
+        if (!mesh.isMesh) continue; // cloudview.js lights picked points
         mesh.material.color.copy(lit ? HIGHLIGHT : peer || mesh.userData.baseColour);
         mesh.material.emissive.copy(lit ? HIGHLIGHT_GLOW : peer ? peer.clone().multiplyScalar(0.25) : BLACK);
       }

@@ -656,3 +656,8 @@ ag_status ag_rebuild_name_labels(ag_proceduralize_result *r, ag_error *err)
     ag_grammar_export_info_free(&r->info);
     return ag_grammar_export(r->mesh, r->labels, r->tree, &r->grammar, &r->info, err);
 }
+
+size_t ag__rebuild_label_number(const char *name)
+{
+    return label_number(name);
+}

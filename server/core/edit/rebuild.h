@@ -61,4 +61,7 @@ ag_status ag_rebuild_finish(ag_mesh *mesh, ag_splittree *tree, const ag_rebuild_
  * names would change under every edit. Unused numbers stay as labels without components. */
 ag_status ag_rebuild_name_labels(ag_proceduralize_result *r, ag_error *err);
 
+/* k for a mesh group named "L<k>" (k >= 1, a label's name), else 0 (for core/parts/graft). */
+size_t ag__rebuild_label_number(const char *name);
+
 #endif

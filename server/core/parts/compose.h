@@ -65,6 +65,11 @@ typedef struct {
     double fitted[3];       /* the size the part was fitted to (its own axes) */
     ag_fit_report fit;
     char message[256];
+    /* how a service made the new model from the composed grammar (app/usecase_compose.h;
+     * ag_compose leaves them 0): 1 when the part was grafted into the model's tree
+     * (graft.h), else its derivation was proceduralized, for the reason in fallback */
+    int grafted;
+    char fallback[160];
 } ag_compose_report;
 
 ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,

@@ -79,6 +79,41 @@ ag_status ag_part_set_meta(ag_part *p, const ag_part_meta *meta)
     return bad ? AG_ERR_NOMEM : AG_OK;
 }
 
+ag_status ag_part_copy(const ag_part *p, ag_part **out, ag_error *err)
+{
+    *out = NULL;
+    ag_part *c = calloc(1, sizeof *c);
+    if (!c)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    ag_part_meta meta = {.name = p->name, .description = p->description,
+                         .tags = (const char *const *)p->tags, .ntags = p->ntags,
+                         .source = p->source, .source_version = p->source_version};
+    int bad = ag_part_set_meta(c, &meta) != AG_OK;
+    for (size_t i = 0; i < p->nattrs && !bad; i++)
+        bad = ag_part_add_attr(c, p->attrs[i].key, p->attrs[i].value) != AG_OK;
+    c->version = p->version;
+    c->source_node = p->source_node;
+    c->box = p->box;
+    c->facing = p->facing;
+    c->root = bad ? NULL : dup_or_null(p->root, &bad);
+    if (!bad && p->nnodes) {
+        if ((c->nodes = malloc(p->nnodes * sizeof *c->nodes))) {
+            memcpy(c->nodes, p->nodes, p->nnodes * sizeof *c->nodes);
+            c->nnodes = p->nnodes;
+        } else {
+            bad = 1;
+        }
+    }
+    ag_status st = bad ? ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory")
+                       : ag_gcopy_grammar(p->grammar, &c->grammar, err);
+    if (st) {
+        ag_part_free(c);
+        return st;
+    }
+    *out = c;
+    return AG_OK;
+}
+
 ag_status ag_part_add_attr(ag_part *p, const char *key, const char *value)
 {
     ag_part_attr *a = realloc(p->attrs, (p->nattrs + 1) * sizeof *a);

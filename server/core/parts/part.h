@@ -70,6 +70,8 @@ typedef struct {
 ag_status ag_part_extract(const ag_proceduralize_result *r, int32_t node, const ag_part_meta *meta,
                           ag_part **out, ag_error *err);
 void ag_part_free(ag_part *p);
+/* A deep copy (its grammar resolved again). */
+ag_status ag_part_copy(const ag_part *p, ag_part **out, ag_error *err);
 
 /* Checks the metadata limits (name length, tags, text); element = 0. */
 ag_status ag_part_check_meta(const ag_part_meta *meta, ag_error *err);
