@@ -21,6 +21,7 @@
 #include "core/mesh.h"
 #include "core/proc/proceduralize.h"
 #include "edit_fixture.h"
+#include "mesh_measure_fixture.h"
 
 enum { PF_RECESSED = 0, PF_FLUSH = 1, PF_PROUD = 2 };
 
@@ -243,50 +244,22 @@ static inline pf_options pf_design_b(int depth, int turn, double ox, double oy)
                         .oy = oy};
 }
 
-typedef struct {
-    int64_t q[3];
-} pf_qpoint;
-
-static inline int pf_cmp_qpoint(const void *a, const void *b)
-{
-    const pf_qpoint *x = a, *y = b;
-    for (int k = 0; k < 3; k++)
-        if (x->q[k] != y->q[k])
-            return x->q[k] < y->q[k] ? -1 : 1;
-    return 0;
-}
-
 /* The welded vertex set of the triangles' corners: positions rounded to 1e-5 m (relative to
- * the mesh's min corner), sorted, duplicates dropped. */
-static inline pf_qpoint *pf_welded(const ag_mesh *m, const double origin[3], size_t *n)
+ * origin), sorted, duplicates dropped. */
+static inline mm_cell *pf_welded(const ag_mesh *m, const double origin[3], size_t *n)
 {
-    pf_qpoint *p = malloc((3 * m->ntris + 1) * sizeof *p);
-    size_t k = 0;
-    for (size_t t = 0; t < m->ntris; t++)
-        for (int j = 0; j < 3; j++) {
-            const double *v = &m->pos[3 * m->tri[3 * t + j]];
-            for (int a = 0; a < 3; a++)
-                p[k].q[a] = llround((v[a] - origin[a]) * 1e5);
-            k++;
-        }
-    qsort(p, k, sizeof *p, pf_cmp_qpoint);
-    size_t u = 0;
-    for (size_t i = 0; i < k; i++)
-        if (!u || pf_cmp_qpoint(&p[i], &p[u - 1]))
-            p[u++] = p[i];
-    *n = u;
-    return p;
+    return mm_welded(m, origin, 1e-5, n);
 }
 
 static inline void pf_same_welded(const ag_mesh *a, const ag_mesh *b, const char *what)
 {
     ag_box bb = ag_mesh_bounds(b);
     size_t na, nb;
-    pf_qpoint *pa = pf_welded(a, bb.min, &na), *pb = pf_welded(b, bb.min, &nb);
+    mm_cell *pa = pf_welded(a, bb.min, &na), *pb = pf_welded(b, bb.min, &nb);
     if (na != nb)
         fail_msg("%s: %zu welded vertices, the other %zu", what, na, nb);
     for (size_t i = 0; i < na; i++)
-        if (pf_cmp_qpoint(&pa[i], &pb[i]))
+        if (mm_cmp_cell(&pa[i], &pb[i]))
             fail_msg("%s: welded vertex %zu differs", what, i);
     free(pa);
     free(pb);

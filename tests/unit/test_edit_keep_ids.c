@@ -35,6 +35,7 @@
 #include "edit_kept_fixture.h"
 #include "io/grammar_text.h"
 #include "io/meshblob.h"
+#include "mesh_measure_fixture.h"
 
 /* ---- what the test measures itself -------------------------------------------------------- */
 
@@ -65,109 +66,19 @@ static int in_subtree(const ag_splittree *t, int32_t n, int32_t r)
     return 0;
 }
 
-static double tri_area(const ag_mesh *m, size_t t)
-{
-    const double *a = &m->pos[3 * m->tri[3 * t]], *b = &m->pos[3 * m->tri[3 * t + 1]],
-                 *c = &m->pos[3 * m->tri[3 * t + 2]];
-    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    double w[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    return 0.5 * sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* Areas of the groups that hold triangles, sorted; *n gets their count. */
-static double *group_areas(const ag_mesh *m, size_t *n)
-{
-    double *a = calloc(m->ngroups + 1, sizeof *a);
-    for (size_t t = 0; t < m->ntris; t++) {
-        int32_t g = m->component_group[m->tri_component[t]];
-        if (g >= 0)
-            a[g] += tri_area(m, t);
-    }
-    size_t k = 0;
-    for (size_t g = 0; g < m->ngroups; g++)
-        if (a[g] > 0)
-            a[k++] = a[g];
-    qsort(a, k, sizeof *a, cmp_double);
-    *n = k;
-    return a;
-}
-
-static double total_area(const ag_mesh *m)
-{
-    double s = 0;
-    for (size_t t = 0; t < m->ntris; t++)
-        s += tri_area(m, t);
-    return s;
-}
-
-/* The vertices of the triangles, welded on a grid of cell tol (sorted cell keys, one each). */
-typedef struct {
-    int64_t k[3];
-} cell;
-
-static int cmp_cell(const void *a, const void *b)
-{
-    const cell *x = a, *y = b;
-    for (int i = 0; i < 3; i++)
-        if (x->k[i] != y->k[i])
-            return x->k[i] < y->k[i] ? -1 : 1;
-    return 0;
-}
-
-static cell *welded(const ag_mesh *m, const double *origin, double tol, size_t *n)
-{
-    cell *c = malloc((3 * m->ntris + 1) * sizeof *c);
-    size_t k = 0;
-    for (size_t t = 0; t < 3 * m->ntris; t++) {
-        const double *p = &m->pos[3 * m->tri[t]];
-        for (int i = 0; i < 3; i++)
-            c[k].k[i] = (int64_t)floor((p[i] - origin[i]) / tol + 0.5);
-        k++;
-    }
-    qsort(c, k, sizeof *c, cmp_cell);
-    size_t u = 0;
-    for (size_t i = 0; i < k; i++)
-        if (!u || cmp_cell(&c[i], &c[u - 1]))
-            c[u++] = c[i];
-    *n = u;
-    return c;
-}
-
-/* Every cell of a has a cell of b within one step (rounding puts a point near a cell border
- * into either neighbour). */
-static size_t unmatched(const cell *a, size_t na, const cell *b, size_t nb)
-{
-    size_t miss = 0;
-    for (size_t i = 0; i < na; i++) {
-        int found = 0;
-        for (int d = 0; d < 27 && !found; d++) {
-            cell q = {{a[i].k[0] + d % 3 - 1, a[i].k[1] + (d / 3) % 3 - 1, a[i].k[2] + d / 9 - 1}};
-            found = bsearch(&q, b, nb, sizeof *b, cmp_cell) != NULL;
-        }
-        miss += !found;
-    }
-    return miss;
-}
-
 /* The same vertex set (both ways) at tolerance tol, and the same total area. */
 static void assert_same_surface(const ag_mesh *a, const ag_mesh *b, double tol, const char *what)
 {
     double origin[3] = {a->pos[0], a->pos[1], a->pos[2]};
     size_t na, nb;
-    cell *ca = welded(a, origin, tol, &na), *cb = welded(b, origin, tol, &nb);
-    size_t ab = unmatched(ca, na, cb, nb), ba = unmatched(cb, nb, ca, na);
+    mm_cell *ca = mm_welded(a, origin, tol, &na), *cb = mm_welded(b, origin, tol, &nb);
+    size_t ab = mm_unmatched(ca, na, cb, nb), ba = mm_unmatched(cb, nb, ca, na);
     free(ca);
     free(cb);
     if (ab || ba)
         fail_msg("%s: %zu of %zu vertices have no counterpart, %zu of %zu the other way", what, ab,
                  na, ba, nb);
-    double sa = total_area(a), sb = total_area(b);
+    double sa = mm_total_area(a), sb = mm_total_area(b);
     if (fabs(sa - sb) > 1e-6 * fmax(1, sa))
         fail_msg("%s: area %.9g vs %.9g", what, sa, sb);
 }
@@ -277,7 +188,7 @@ static void check_case(ag_edit_model *em, case_t *c, const bb_options *o)
     snprintf(part, sizeof part, "%s (the new mesh)", what);
     assert_same_surface(mine, oracle, 1e-6 * fmax(1, diag), part);
     size_t ga, gb;
-    double *aa = group_areas(mine, &ga), *ab = group_areas(oracle, &gb);
+    double *aa = mm_group_areas(mine, &ga), *ab = mm_group_areas(oracle, &gb);
     if (ga != gb)
         fail_msg("%s: %zu groups with triangles, the mesh path %zu", what, ga, gb);
     for (size_t i = 0; i < ga; i++)

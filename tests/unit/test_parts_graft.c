@@ -90,44 +90,10 @@ static void scene_close(scene *sc)
 
 /* ---- independent measures -------------------------------------------------------------------- */
 
-static double tri_area(const ag_mesh *m, size_t t)
-{
-    const double *a = &m->pos[3 * m->tri[3 * t]], *b = &m->pos[3 * m->tri[3 * t + 1]],
-                 *c = &m->pos[3 * m->tri[3 * t + 2]];
-    double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    double x = u[1] * v[2] - u[2] * v[1], y = u[2] * v[0] - u[0] * v[2], z = u[0] * v[1] - u[1] * v[0];
-    return 0.5 * sqrt(x * x + y * y + z * z);
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* Areas per component group (label), sorted: labels are compared by what they cover, not by
- * their numbers. */
-static double *label_areas(const ag_mesh *m, size_t *n)
-{
-    double *a = calloc(m->ngroups + 1, sizeof *a);
-    for (size_t t = 0; t < m->ntris; t++) {
-        int32_t g = m->component_group[m->tri_component[t]];
-        if (g >= 0)
-            a[g] += tri_area(m, t);
-    }
-    size_t k = 0;
-    for (size_t g = 0; g < m->ngroups; g++)
-        if (a[g] > 0)
-            a[k++] = a[g];
-    qsort(a, k, sizeof *a, cmp_double);
-    *n = k;
-    return a;
-}
-
 static void same_label_areas(const ag_mesh *a, const ag_mesh *b, const char *what)
 {
     size_t na, nb;
-    double *x = label_areas(a, &na), *y = label_areas(b, &nb);
+    double *x = mm_group_areas(a, &na), *y = mm_group_areas(b, &nb);
     if (na != nb)
         fail_msg("%s: %zu labels with geometry, the slow path %zu", what, na, nb);
     for (size_t i = 0; i < na; i++)
@@ -161,18 +127,18 @@ static void components_closed(const ag_mesh *m, const char *what)
         size_t nt = start[c + 1] - start[c];
         if (!nt)
             continue;
-        pf_qpoint *p = malloc(3 * nt * sizeof *p);
+        mm_cell *p = malloc(3 * nt * sizeof *p);
         for (size_t i = 0; i < nt; i++)
             for (int j = 0; j < 3; j++)
                 for (int a = 0; a < 3; a++)
-                    p[3 * i + j].q[a] =
+                    p[3 * i + j].k[a] =
                         llround((m->pos[3 * m->tri[3 * tris[start[c] + i] + j] + a] - bb.min[a]) * 1e5);
         /* weld: a vertex's id is the index of its first equal point */
         uint32_t *id = malloc(3 * nt * sizeof *id);
         for (size_t i = 0; i < 3 * nt; i++) {
             id[i] = (uint32_t)i;
             for (size_t k = 0; k < i; k++)
-                if (!pf_cmp_qpoint(&p[i], &p[k])) {
+                if (!mm_cmp_cell(&p[i], &p[k])) {
                     id[i] = id[k];
                     break;
                 }
