@@ -269,7 +269,8 @@ static ag_status rebuild_level(ag_shell *s, double tol, double z, const uint32_t
                                       : (lnet){(uint64_t)q << 32 | p, -1};
         }
     }
-    qsort(L->net, L->nnet, sizeof *L->net, cmp_net);
+    if (L->nnet) /* qsort must not be given a null array, even of no items */
+        qsort(L->net, L->nnet, sizeof *L->net, cmp_net);
     for (size_t i = 0; i < L->nnet;) {
         size_t j = i;
         int c = 0;

@@ -636,6 +636,7 @@ static ag_status classify(graft *g, ag_error *err)
     shape *vshape = calloc(g->nnew + 1, sizeof *vshape);
     int32_t *vlabel = malloc((g->nnew + 1) * sizeof *vlabel);
     ag_status st = AG_OK;
+    size_t made = 0; /* shapes made into vshape */
     if (!g->nlabel || !g->nvariant || !g->nrot || !g->variant_exemplar || !group_label || !stamp || !local ||
         !vshape || !vlabel) {
         st = nomem(err);
@@ -683,10 +684,12 @@ static ag_status classify(graft *g, ag_error *err)
         }
         g->nvariant[i] = v;
     }
+    /* the reuse renumbers the variants and lowers their count: every shape made is freed */
+    made = g->new_variants;
     if (!st)
         st = reuse_variants(g, vshape, err);
 done:
-    for (size_t k = 0; vshape && k < g->new_variants; k++)
+    for (size_t k = 0; vshape && k < made; k++)
         shape_free(&vshape[k]);
     free(vshape);
     free(vlabel);
