@@ -16,10 +16,10 @@ static const struct {
     int (*run)(int argc, char **argv);
     const char *usage;
 } commands[] = {
-    {"info", ag_cli_info, "info FILE [--up y|z] [--json]   counts, groups and bounds of a mesh"},
-    {"convert", ag_cli_convert, "convert IN OUT [--up y|z]       convert a mesh (OUT: .obj or .glb)"},
+    {"info", ag_cli_info, "info FILE [--up y|z|auto] [--json]  counts, groups and bounds of a mesh"},
+    {"convert", ag_cli_convert, "convert IN OUT [--up y|z|auto]  convert a mesh (OUT: .obj or .glb)"},
     {"proceduralize", ag_cli_proceduralize,
-     "proceduralize IN --out DIR [--up y|z]  split grammar + terminals + summary.json"},
+     "proceduralize IN --out DIR [--up y|z|auto]  split grammar + terminals + summary.json"},
     {"derive", ag_cli_derive, "derive GRAMMAR --out FILE.obj|FILE.glb  derive a grammar into a mesh"},
     {"edit", ag_cli_edit, "edit DIR --op OP.json --out DIR2     apply one edit op to a proceduralized model"},
     {"part", ag_cli_part, "part save|compose|info ...          the parts library (archgram part --help)"},
@@ -38,8 +38,9 @@ static void usage(FILE *f)
           f);
     for (size_t i = 0; i < NCOMMANDS; i++)
         fprintf(f, "  %s\n", commands[i].usage);
-    fputs("\n--up names the input's up axis (default y, OBJ's convention); archgram works "
-          "z-up.\n",
+    fputs("\n--up names the input's up axis; without it (or with auto) the file says it where "
+          "its format can,\nelse its content decides (reported as `up axis ...`); archgram "
+          "works z-up.\n",
           f);
 }
 
