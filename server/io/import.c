@@ -1,6 +1,7 @@
 #include "import.h"
 
 #include "assimp_import.h"
+#include "ply_mesh_positions.h"
 
 #include <string.h>
 #include <strings.h>
@@ -157,7 +158,10 @@ static ag_status read_raw(const uint8_t *data, size_t len, ag_format fmt,
                                  .allow_external_files = raw.allow_external_files};
         return ag_obj_read_buffer((const char *)data, len, &o, out, err);
     }
-    return ag_assimp_import_buffer(data, len, fmt, &raw, out, NULL, err);
+    ag_status st = ag_assimp_import_buffer(data, len, fmt, &raw, out, NULL, err);
+    if (st == AG_OK && fmt == AG_FORMAT_PLY)
+        ag_ply_mesh_restore_positions(*out, data, len); /* assimp's floats, the file's doubles */
+    return st;
 }
 
 ag_status ag_import_buffer(const uint8_t *data, size_t len, ag_format fmt,

@@ -233,10 +233,10 @@ export function meshVariants() {
   add('obj-1e7', 'obj', objText(offset(B, [1e7, 1e7, 0]), { num: 'fixed' }), B);
   add('obj-yup', 'obj', objText(yUp(B)), B);
   add('obj-yup-utm', 'obj', objText(yUp(offset(B, [678088, 5403784, 413])), { num: 'fixed' }), B);
-  for (const deg of [17, 30, 45, 133]) add(`obj-rot${deg}`, 'obj', objText(rotZ(B, deg)), B);
+  for (const deg of [17, 30, 45, 133]) add(`obj-rot${deg}`, 'obj', objText(rotZ(B, deg)), rotZ(B, deg));
   add('obj-mm', 'obj', objText(scale(B, 1000)), B, { scale: 1000 });
   add('obj-feet', 'obj', objText(scale(B, 1 / 0.3048)), B, { scale: 1 / 0.3048 });
-  add('obj-yup-mm-rot30', 'obj', objText(yUp(scale(rotZ(B, 30), 1000))), B, { scale: 1000 });
+  add('obj-yup-mm-rot30', 'obj', objText(yUp(scale(rotZ(B, 30), 1000))), rotZ(B, 30), { scale: 1000 });
   const r = rng(5);
   add('obj-faces-shuffled', 'obj', objText({ v: B.v, f: shuffle(T.f, r) }), B);
   add('obj-winding-reversed', 'obj', objText({ v: B.v, f: B.f.map((p) => p.slice().reverse()) }), B);
@@ -280,10 +280,10 @@ export function meshVariants() {
   add('stl-binary', 'stl', stlBinary(B, false), B);
   add('stl-binary-solid-header', 'stl', stlBinary(B, true), B);
   add('stl-ascii-mm', 'stl', stlAscii(scale(B, 1000)), B, { scale: 1000 });
-  add('stl-binary-rot30-rd', 'stl', stlBinary(offset(rotZ(B, 30), [85000, 445000, 0]), false), B);
+  add('stl-binary-rot30-rd', 'stl', stlBinary(offset(rotZ(B, 30), [85000, 445000, 0]), false), rotZ(B, 30));
   add('gltf-embedded', 'gltf', gltf(B), B);
   add('glb', 'glb', gltf(B, { binary: true }), B);
-  add('glb-node-transform', 'glb', gltf(B, { binary: true, node: { translation: [5, 0, 3], rotation: [0, Math.sin(Math.PI / 12), 0, Math.cos(Math.PI / 12)] } }), B);
+  add('glb-node-transform', 'glb', gltf(B, { binary: true, node: { translation: [5, 0, 3], rotation: [0, Math.sin(Math.PI / 12), 0, Math.cos(Math.PI / 12)] } }), rotZ(B, 30));
 
   // shared meshes, transformed
   const pick = [['lod3_ingolstadt/obj/4018148.obj', 'ingolstadt148'], ['lod3_ingolstadt/obj/4018194.obj', 'ingolstadt194'], ['meshes_0ad/rome_workshop.obj', '0ad-workshop']];
@@ -296,10 +296,10 @@ export function meshVariants() {
     const MT = { v: M.v, f: tri(M.f) };
     const rr = rng(11);
     add(`${name}-as-is`, 'obj', objText(M), M);
-    add(`${name}-rot37-utm-shuffled`, 'obj', objText({ v: rotZ(offset(M, [0, 0, 0]), 37).v.map(([x, y, z]) => [x + 678088, y + 5403784, z + 413]), f: shuffle(MT.f, rr) }, { num: 'fixed' }), M);
+    add(`${name}-rot37-utm-shuffled`, 'obj', objText({ v: rotZ(offset(M, [0, 0, 0]), 37).v.map(([x, y, z]) => [x + 678088, y + 5403784, z + 413]), f: shuffle(MT.f, rr) }, { num: 'fixed' }), rotZ(M, 37));
     add(`${name}-reversed-mm`, 'obj', objText({ v: scale(M, 1000).v, f: M.f.map((p) => p.slice().reverse()) }), M, { scale: 1000 });
-    add(`${name}-yup-rot200`, 'obj', objText(yUp(rotZ(M, 200))), M);
-    add(`${name}-ply-be`, 'ply', plyText(rotZ(M, 73), { format: 'binary_big_endian' }), M);
+    add(`${name}-yup-rot200`, 'obj', objText(yUp(rotZ(M, 200))), rotZ(M, 200));
+    add(`${name}-ply-be`, 'ply', plyText(rotZ(M, 73), { format: 'binary_big_endian' }), rotZ(M, 73));
     add(`${name}-stl`, 'stl', stlBinary(offset(M, [85000, 445000, 0]), true), M);
   }
   return out;
