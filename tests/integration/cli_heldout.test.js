@@ -9,7 +9,7 @@ import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { REPO, tempDir, removeDir } from './harness.js';
-import { building, measure, offset, rotZ, plyText, stlBinary, gltf, objText } from '../heldout/generate.js';
+import { building, measure, offset, rotZ, plyText, stlBinary, gltf, objText, cloudPoints, las } from '../heldout/generate.js';
 
 const CLI = process.env.ARCHGRAM ? path.resolve(process.env.ARCHGRAM) : path.join(REPO, 'build', 'archgram');
 const run = (...args) => spawnSync(CLI, args, { encoding: 'utf8', timeout: 60000 });
@@ -107,6 +107,28 @@ test('OBJ: comments after the data are comments; the model is the one without th
     assert.equal(b.status, 0, b.stderr);
     assert.equal(fs.readFileSync(path.join(dir, 'a', 'grammar.txt'), 'utf8'), fs.readFileSync(path.join(dir, 'b', 'grammar.txt'), 'utf8'));
     assert.match(b.stdout, /^\S+: 162 triangles/);
+  } finally {
+    removeDir(dir);
+  }
+});
+
+test('cut: a tile in a local site frame (coordinates near 0, 0) is refused as degrees, and cut with --metres', () => {
+  const dir = tempDir();
+  try {
+    const P = cloudPoints(); // a building on [0, 20] x [0, 10] (class 6) and ground (class 2)
+    const tile = path.join(dir, 'site.las'), fp = path.join(dir, 'fp.geojson');
+    fs.writeFileSync(tile, las(P, { minor: 4, format: 6 }));
+    const ring = [[-0.5, -0.5], [20.5, -0.5], [20.5, 10.5], [-0.5, 10.5], [-0.5, -0.5]];
+    fs.writeFileSync(fp, JSON.stringify({ type: 'FeatureCollection', features: [{ type: 'Feature', properties: { id: 'b1' }, geometry: { type: 'Polygon', coordinates: [ring] } }] }));
+    let r = run('cut', tile, '--footprints', fp, '--out', path.join(dir, 'a'));
+    assert.equal(r.status, 1);
+    assert.match(r.stderr, /site\.las: the tile looks like longitude\/latitude; .*--metres for a local frame/);
+    r = run('cut', tile, '--footprints', fp, '--out', path.join(dir, 'b'), '--metres');
+    assert.equal(r.status, 0, r.stderr);
+    // the building's points, counted here: every class 6 point, no ground point (class 2)
+    const building = P.filter((p) => p[3] === 6).length;
+    const head = fs.readFileSync(path.join(dir, 'b', 'b1.ply')).subarray(0, 2000).toString('latin1');
+    assert.equal(Number(head.match(/element vertex (\d+)/)[1]), building);
   } finally {
     removeDir(dir);
   }
