@@ -86,6 +86,23 @@ static int looks_like_obj(const uint8_t *data, size_t len)
     return seen > 0;
 }
 
+/* Binary STL: an 80-byte header (which may well begin with "solid"), a triangle count and
+ * exactly 50 bytes per triangle; ASCII STL: "solid" then a facet. */
+static int looks_like_stl(const uint8_t *data, size_t len)
+{
+    if (len >= 84) {
+        uint64_t n = (uint64_t)data[80] | (uint64_t)data[81] << 8 | (uint64_t)data[82] << 16 |
+                     (uint64_t)data[83] << 24;
+        if (n > 0 && 84 + 50 * n == len)
+            return 1;
+    }
+    size_t i = 0;
+    while (i < len && (data[i] == ' ' || data[i] == '\t' || data[i] == '\r' || data[i] == '\n'))
+        i++;
+    return len - i >= 5 && !memcmp(data + i, "solid", 5) &&
+           memmem(data, len < 4096 ? len : 4096, "facet", 5);
+}
+
 ag_format ag_format_sniff(const uint8_t *data, size_t len, const char *filename)
 {
     if (data && len) {
@@ -110,6 +127,8 @@ ag_format ag_format_sniff(const uint8_t *data, size_t len, const char *filename)
             return AG_FORMAT_GLTF;
         if (memmem(data, len < 4096 ? len : 4096, "<COLLADA", 8))
             return AG_FORMAT_DAE;
+        if (looks_like_stl(data, len))
+            return AG_FORMAT_STL;
     }
     return AG_FORMAT_UNKNOWN;
 }
