@@ -26,14 +26,19 @@ static int usage(void)
 
 /* The label tolerance the grammar was made with (summary.json next to it, `labeling`), in
  * metres: members of a label share a terminal within it, so the comparison allows it. 0
- * when there is no summary (then the comparison's own default, 1e-5 of the diagonal). */
+ * (the comparison's own default, 1e-5 of the diagonal) when there is no summary or the
+ * grammar shares terminals between exact copies only (--exact: it derives the input as it
+ * was). */
 static double grammar_tolerance(const char *dir)
 {
     char path[4096];
     if (snprintf(path, sizeof path, "%s/summary.json", dir) >= (int)sizeof path)
         return 0;
     json_t *root = json_load_file(path, 0, NULL);
-    double tol = json_number_value(json_object_get(json_object_get(root, "labeling"), "tolerance"));
+    json_t *lab = json_object_get(root, "labeling");
+    double tol = json_is_true(json_object_get(lab, "exact_copies"))
+                     ? 0
+                     : json_number_value(json_object_get(lab, "tolerance"));
     json_decref(root);
     return isfinite(tol) && tol > 0 ? tol : 0;
 }

@@ -79,6 +79,15 @@ test('derive --compare: default models of float inputs (GLB turned by a node, ST
       assert.equal(r.status, 0, r.stdout + r.stderr);
       assert.match(r.stdout, /unmatched within 0\.02 m/);
     }
+    // an --exact grammar derives the input as it was: compared at 1e-5 of the diagonal
+    const rd = path.join(dir, 'rd.stl'), ex = path.join(dir, 'exact');
+    let e = run('proceduralize', rd, '--out', ex, '--exact');
+    assert.equal(e.status, 0, e.stderr);
+    e = run('derive', path.join(ex, 'grammar.txt'), '--out', path.join(dir, 'ex.obj'), '--compare', rd);
+    assert.equal(e.status, 0, e.stdout + e.stderr);
+    const diag = Math.hypot(...measure(rotZ(B, 30).v, B.f).extent);
+    const within = Number(e.stdout.match(/unmatched within (\S+) m/)[1]);
+    assert.ok(Math.abs(within - 1e-5 * diag) < 5e-3 * within, `${within} vs ${1e-5 * diag}`);
     // the same grammar against the building moved by half a metre: unmatched, exit 1
     const moved = path.join(dir, 'moved.stl');
     fs.writeFileSync(moved, stlBinary(offset(rotZ(B, 30), [85000.5, 445000, 0]), false));
