@@ -22,7 +22,8 @@ static int usage(FILE *f)
           "                    [--ground auto|class|plane|none] [--id-property NAME] [--double]\n"
           "                    [--metres]\n"
           "  --buffer M          points this close to a footprint belong to it (0.5)\n"
-          "  --ground G          auto: classification 2 when the tile has it, else a plane\n"
+          "  --ground G          auto: classification 2 when the tile has it, else a plane;\n"
+          "                      class: refused when no point has classification 2\n"
           "  --id-property NAME  name the files by this feature property (default: the feature\n"
           "                      id, properties.id, else the feature's index)\n"
           "  --double            absolute double coordinates instead of float + offset\n"
@@ -168,6 +169,15 @@ int ag_cli_cut(int argc, char **argv)
     if (degrees) {
         fprintf(stderr, "archgram cut: %s: the tile looks like longitude/latitude; cut needs "
                         "projected metres (e.g. UTM or RD New), or --metres for a local frame\n",
+                in);
+        ag_cloud_free(c);
+        return 1;
+    }
+    if (o.ground == AG_CUT_GROUND_CLASS &&
+        ag_cut_ground_method(c, AG_CUT_GROUND_AUTO) != AG_CUT_GROUND_CLASS) {
+        /* asked for, but nothing to remove: say so rather than keep the ground silently */
+        fprintf(stderr, "archgram cut: %s: --ground class, but no point has classification 2 "
+                        "(ground); --ground plane fits one\n",
                 in);
         ag_cloud_free(c);
         return 1;

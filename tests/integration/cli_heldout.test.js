@@ -138,6 +138,14 @@ test('cut: a tile in a local site frame (coordinates near 0, 0) is refused as de
     const building = P.filter((p) => p[3] === 6).length;
     const head = fs.readFileSync(path.join(dir, 'b', 'b1.ply')).subarray(0, 2000).toString('latin1');
     assert.equal(Number(head.match(/element vertex (\d+)/)[1]), building);
+    // a tile never classified: --ground class has nothing to remove and says so; plane works
+    const plain = path.join(dir, 'plain.las');
+    fs.writeFileSync(plain, las(P.map(([x, y, z]) => [x, y, z, 1]), { minor: 2, format: 1 }));
+    r = run('cut', plain, '--footprints', fp, '--out', path.join(dir, 'c'), '--metres', '--ground', 'class');
+    assert.equal(r.status, 1);
+    assert.match(r.stderr, /plain\.las: --ground class, but no point has classification 2/);
+    r = run('cut', plain, '--footprints', fp, '--out', path.join(dir, 'd'), '--metres', '--ground', 'plane');
+    assert.equal(r.status, 0, r.stderr);
   } finally {
     removeDir(dir);
   }
