@@ -25,13 +25,15 @@
 #define SANDBOX_CAP 1
 #endif
 
-/* What the child writes first: the outcome, then blob_len bytes of meshblob. */
+/* What the child writes first: the outcome and the up axis it decided (the parent reports
+ * it), then blob_len bytes of meshblob. */
 typedef struct {
     uint32_t magic;
     int32_t status;
     int64_t element;
     uint64_t blob_len;
     char text[AG_ERROR_TEXT];
+    ag_up_decision up;
 } reply_head;
 
 #define REPLY_MAGIC 0x61677362u /* "agsb" */
@@ -94,11 +96,12 @@ static void child(int fd, const uint8_t *data, size_t len, ag_format fmt, ag_up_
         struct rlimit rl = {cap, cap};
         setrlimit(RLIMIT_AS, &rl);
     }
-    ag_import_options o = {.up = up}; /* no progress (it writes the parent's store), no files */
+    reply_head h = {.magic = REPLY_MAGIC};
+    /* no progress (it writes the parent's store), no files */
+    ag_import_options o = {.up = up, .up_decision = &h.up};
     ag_mesh *m = NULL;
     ag_error err;
     ag_error_clear(&err);
-    reply_head h = {.magic = REPLY_MAGIC};
     uint8_t *blob = NULL;
     size_t blob_len = 0;
     ag_status s = ag_import_buffer(data, len, fmt, &o, &m, &err);
@@ -213,6 +216,8 @@ ag_status ag_import_sandbox_read(const uint8_t *data, size_t len, ag_format fmt,
             s = ag_error_set(err, (ag_status)h.status, (long)h.element, "%s", h.text);
         } else {
             s = ag_meshblob_decode(blob, h.blob_len, out, err);
+            if (s == AG_OK && opt && opt->up_decision)
+                *opt->up_decision = h.up;
         }
     }
     free(blob);

@@ -20,11 +20,15 @@ static int usage(FILE *f)
 {
     fputs("usage: archgram cut TILE --footprints F.geojson --out DIR [--buffer METRES]\n"
           "                    [--ground auto|class|plane|none] [--id-property NAME] [--double]\n"
+          "                    [--metres]\n"
           "  --buffer M          points this close to a footprint belong to it (0.5)\n"
-          "  --ground G          auto: classification 2 when the tile has it, else a plane\n"
+          "  --ground G          auto: classification 2 when the tile has it, else a plane;\n"
+          "                      class: refused when no point has classification 2\n"
           "  --id-property NAME  name the files by this feature property (default: the feature\n"
           "                      id, properties.id, else the feature's index)\n"
-          "  --double            absolute double coordinates instead of float + offset\n",
+          "  --double            absolute double coordinates instead of float + offset\n"
+          "  --metres            the tile is in metres even where its coordinates could be\n"
+          "                      degrees (a local site frame near 0, 0)\n",
           f);
     return f == stdout ? 0 : 2;
 }
@@ -102,7 +106,7 @@ int ag_cli_cut(int argc, char **argv)
 {
     const char *in = NULL, *fp_path = NULL, *dir = NULL, *id_prop = NULL;
     ag_cut_options o = {0};
-    int dbl = 0;
+    int dbl = 0, metres = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         int more = i + 1 < argc;
@@ -139,6 +143,8 @@ int ag_cli_cut(int argc, char **argv)
             id_prop = argv[++i];
         } else if (!strcmp(a, "--double")) {
             dbl = 1;
+        } else if (!strcmp(a, "--metres")) {
+            metres = 1;
         } else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "archgram cut: unknown or incomplete option %s\n", a);
             return usage(stderr);
@@ -158,11 +164,20 @@ int ag_cli_cut(int argc, char **argv)
     /* the tile is in projected metres when its coordinates cannot be degrees */
     double mn[3], mx[3];
     ag_cloud_bounds(c, mn, mx);
-    int degrees = c->n && fabs(mn[0] + c->offset[0]) <= 180 && fabs(mx[0] + c->offset[0]) <= 180 &&
+    int degrees = !metres && c->n && fabs(mn[0] + c->offset[0]) <= 180 && fabs(mx[0] + c->offset[0]) <= 180 &&
                   fabs(mn[1] + c->offset[1]) <= 90 && fabs(mx[1] + c->offset[1]) <= 90;
     if (degrees) {
         fprintf(stderr, "archgram cut: %s: the tile looks like longitude/latitude; cut needs "
-                        "projected metres (e.g. UTM or RD New)\n",
+                        "projected metres (e.g. UTM or RD New), or --metres for a local frame\n",
+                in);
+        ag_cloud_free(c);
+        return 1;
+    }
+    if (o.ground == AG_CUT_GROUND_CLASS &&
+        ag_cut_ground_method(c, AG_CUT_GROUND_AUTO) != AG_CUT_GROUND_CLASS) {
+        /* asked for, but nothing to remove: say so rather than keep the ground silently */
+        fprintf(stderr, "archgram cut: %s: --ground class, but no point has classification 2 "
+                        "(ground); --ground plane fits one\n",
                 in);
         ag_cloud_free(c);
         return 1;

@@ -1,21 +1,46 @@
-/* archgram derive GRAMMAR --out FILE.obj|FILE.glb [--compare MESH [--up y|z]] */
+/* archgram derive GRAMMAR --out FILE.obj|FILE.glb [--compare MESH [--up y|z] [--tolerance M]] */
 #include <errno.h>
+#include <jansson.h>
 #include <libgen.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/base/tolerance.h"
 #include "../core/proc/proceduralize.h"
 #include "../io/glb.h"
 #include "../io/grammar_text.h"
 #include "../io/terminals.h"
 #include "commands.h"
 
+#define USAGE                                                                                 \
+    "usage: archgram derive GRAMMAR --out FILE.obj|FILE.glb [--compare MESH [--up y|z] "       \
+    "[--tolerance METRES]]\n"
+
 static int usage(void)
 {
-    fputs("usage: archgram derive GRAMMAR --out FILE.obj|FILE.glb [--compare MESH [--up y|z]]\n",
-          stderr);
+    fputs(USAGE, stderr);
     return 2;
+}
+
+/* The label tolerance the grammar was made with (summary.json next to it, `labeling`), in
+ * metres: members of a label share a terminal within it, so the comparison allows it. 0
+ * (the comparison's own default, 1e-5 of the diagonal) when there is no summary or the
+ * grammar shares terminals between exact copies only (--exact: it derives the input as it
+ * was). */
+static double grammar_tolerance(const char *dir)
+{
+    char path[4096];
+    if (snprintf(path, sizeof path, "%s/summary.json", dir) >= (int)sizeof path)
+        return 0;
+    json_t *root = json_load_file(path, 0, NULL);
+    json_t *lab = json_object_get(root, "labeling");
+    double tol = json_is_true(json_object_get(lab, "exact_copies"))
+                     ? 0
+                     : json_number_value(json_object_get(lab, "tolerance"));
+    json_decref(root);
+    return isfinite(tol) && tol > 0 ? tol : 0;
 }
 
 static int ends_with(const char *s, const char *suf)
@@ -96,6 +121,7 @@ int ag_cli_derive(int argc, char **argv)
         return ag_cli_points_derive(argc, argv);
     const char *gpath = NULL, *out = NULL, *cmp = NULL;
     ag_up_axis up = AG_UP_DEFAULT;
+    double tol = -1;
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--out")) {
             if (++i >= argc)
@@ -105,12 +131,25 @@ int ag_cli_derive(int argc, char **argv)
             if (++i >= argc)
                 return usage();
             cmp = argv[i];
+        } else if (!strcmp(argv[i], "--tolerance")) {
+            char *end;
+            if (++i >= argc)
+                return usage();
+            tol = strtod(argv[i], &end);
+            if (end == argv[i] || *end || !isfinite(tol) || tol <= 0) {
+                fprintf(stderr, "archgram: derive: --tolerance must be a positive number of "
+                                "metres, not '%s'\n",
+                        argv[i]);
+                return 2;
+            }
         } else if (!strcmp(argv[i], "--up")) {
             if (++i >= argc || ag_cli_parse_up(argv[i], &up))
                 return usage();
         } else if (!strcmp(argv[i], "--help")) {
-            fputs("usage: archgram derive GRAMMAR --out FILE.obj|FILE.glb "
-                  "[--compare MESH [--up y|z]]\n",
+            fputs(USAGE "  --tolerance M  how far the derivation may lie from MESH (default: the "
+                        "label tolerance\n"
+                        "                 in summary.json next to GRAMMAR, else 1e-5 of the "
+                        "diagonal)\n",
                   stdout);
             return 0;
         } else if (argv[i][0] == '-' && argv[i][1]) {
@@ -163,14 +202,31 @@ int ag_cli_derive(int argc, char **argv)
             goto done;
         }
         ag_fidelity f;
-        if (ag_grammar_fidelity(input, m, 0, &f, &err)) {
+        if (tol < 0) {
+            char *dcopy2 = strdup(gpath);
+            tol = dcopy2 ? grammar_tolerance(dirname(dcopy2)) : 0;
+            free(dcopy2);
+        }
+        /* the input cut into components as proceduralize cuts it, so that its components
+         * pair with the placed terminals */
+        ag_mesh *seg = NULL;
+        if (ag_segment_run(input, NULL, &seg, NULL, &err)) {
             ag_cli_report(cmp, &err);
             rc = 1;
             goto done;
         }
+        ag_mesh_free(input);
+        input = seg;
+        if (ag_grammar_fidelity(input, m, tol, &f, &err)) {
+            ag_cli_report(cmp, &err);
+            rc = 1;
+            goto done;
+        }
+        ag_box b = ag_mesh_bounds(input);
         printf("compared with %s: max error %.3g (%.3g of the diagonal), %zu of %zu input "
-               "triangles unmatched\n",
-               cmp, f.max_error, f.relative, f.unmatched, f.input_triangles);
+               "triangles unmatched within %.3g m\n",
+               cmp, f.max_error, f.relative, f.unmatched, f.input_triangles,
+               tol > 0 ? tol : AG_PROC_FIDELITY * ag_box_diagonal(&b));
         rc = f.unmatched ? 1 : 0;
     }
 done:

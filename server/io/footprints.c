@@ -1,5 +1,6 @@
 #include "footprints.h"
 
+#include <ctype.h>
 #include <jansson.h>
 #include <math.h>
 #include <stdarg.h>
@@ -433,13 +434,41 @@ static int crs_is_lonlat(const ag_jsondoc *d, uint32_t root)
     return strstr(s, "CRS84") || strstr(s, "4326") ? 1 : 0;
 }
 
-/* A number member of props as the height, when it is one. */
-static int height_of(const ag_jsondoc *d, uint32_t props, const char *key, double *h)
+/* The height member key of props: 1 when it gives a height (a number, or a string holding
+ * one, as files converted from tables have), 0 when it is absent or null, -1 when it holds
+ * something else (a word, a negative or non-finite number, true): noted on fp, so that the
+ * report says the style's height stood in for it. */
+static int height_of(const ag_jsondoc *d, uint32_t props, const char *key, ag_footprint *fp)
 {
     uint32_t v = ag_jsondoc_get(d, props, key);
-    if (ag_jsondoc_type(d, v) != AG_JSON_NUMBER)
+    ag_json_type t = ag_jsondoc_type(d, v);
+    double h = NAN;
+    if (v == AG_JSONDOC_NONE || t == AG_JSON_NULL)
         return 0;
-    *h = ag_jsondoc_number(d, v);
+    if (t == AG_JSON_NUMBER) {
+        h = ag_jsondoc_number(d, v);
+    } else if (t == AG_JSON_STRING) {
+        const char *text = ag_jsondoc_string(d, v);
+        char *end;
+        h = strtod(text, &end);
+        while (end != text && isspace((unsigned char)*end))
+            end++;
+        if (end == text || *end)
+            h = NAN;
+        else if (isfinite(h) && h >= 0)
+            note(fp, "%s read from the text \"%.20s\"", key, text);
+    }
+    if (!isfinite(h) || h < 0) {
+        if (t == AG_JSON_STRING)
+            note(fp, "%s \"%.20s\" is not a height in metres: the style's height used", key,
+                 ag_jsondoc_string(d, v));
+        else if (t == AG_JSON_NUMBER)
+            note(fp, "%s %g is not a height in metres: the style's height used", key, h);
+        else
+            note(fp, "%s is not a number: the style's height used", key);
+        return -1;
+    }
+    fp->height = h;
     return 1;
 }
 
@@ -470,7 +499,12 @@ ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footp
         first = root; /* a lone Feature: the root is the only one (it has no sibling) */
         nf = 1;
     } else {
+        int cityjson = type && !strcmp(type, "CityJSON");
         ag_jsondoc_free(doc);
+        if (cityjson)
+            return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
+                                "a CityJSON file, not GeoJSON: extrude reads footprints as a "
+                                "GeoJSON FeatureCollection of Polygon or MultiPolygon features");
         return ag_error_set(err, AG_ERR_PARSE, 0,
                             "GeoJSON: expected a FeatureCollection or a Feature");
     }
@@ -505,14 +539,12 @@ ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footp
             fp->id = dupstr(buf);
         }
         if (opt && opt->height_property) {
-            height_of(doc, props, opt->height_property, &fp->height);
+            height_of(doc, props, opt->height_property, fp);
         } else {
             for (int k = 0; hp[k]; k++)
-                if (height_of(doc, props, hp[k], &fp->height))
+                if (height_of(doc, props, hp[k], fp))
                     break;
         }
-        if (!isfinite(fp->height) || fp->height < 0)
-            fp->height = 0;
         if (strcmp(gt, "Polygon") == 0) {
             st = add_polygon(fp, doc, coords, fi, -1, err);
         } else if (ag_jsondoc_type(doc, coords) != AG_JSON_ARRAY) {

@@ -1,6 +1,7 @@
 #include "import.h"
 
 #include "assimp_import.h"
+#include "ply_mesh_positions.h"
 
 #include <string.h>
 #include <strings.h>
@@ -85,6 +86,23 @@ static int looks_like_obj(const uint8_t *data, size_t len)
     return seen > 0;
 }
 
+/* Binary STL: an 80-byte header (which may well begin with "solid"), a triangle count and
+ * exactly 50 bytes per triangle; ASCII STL: "solid" then a facet. */
+static int looks_like_stl(const uint8_t *data, size_t len)
+{
+    if (len >= 84) {
+        uint64_t n = (uint64_t)data[80] | (uint64_t)data[81] << 8 | (uint64_t)data[82] << 16 |
+                     (uint64_t)data[83] << 24;
+        if (n > 0 && 84 + 50 * n == len)
+            return 1;
+    }
+    size_t i = 0;
+    while (i < len && (data[i] == ' ' || data[i] == '\t' || data[i] == '\r' || data[i] == '\n'))
+        i++;
+    return len - i >= 5 && !memcmp(data + i, "solid", 5) &&
+           memmem(data, len < 4096 ? len : 4096, "facet", 5);
+}
+
 ag_format ag_format_sniff(const uint8_t *data, size_t len, const char *filename)
 {
     if (data && len) {
@@ -109,6 +127,8 @@ ag_format ag_format_sniff(const uint8_t *data, size_t len, const char *filename)
             return AG_FORMAT_GLTF;
         if (memmem(data, len < 4096 ? len : 4096, "<COLLADA", 8))
             return AG_FORMAT_DAE;
+        if (looks_like_stl(data, len))
+            return AG_FORMAT_STL;
     }
     return AG_FORMAT_UNKNOWN;
 }
@@ -157,7 +177,10 @@ static ag_status read_raw(const uint8_t *data, size_t len, ag_format fmt,
                                  .allow_external_files = raw.allow_external_files};
         return ag_obj_read_buffer((const char *)data, len, &o, out, err);
     }
-    return ag_assimp_import_buffer(data, len, fmt, &raw, out, NULL, err);
+    ag_status st = ag_assimp_import_buffer(data, len, fmt, &raw, out, NULL, err);
+    if (st == AG_OK && fmt == AG_FORMAT_PLY)
+        ag_ply_mesh_restore_positions(*out, data, len); /* assimp's floats, the file's doubles */
+    return st;
 }
 
 ag_status ag_import_buffer(const uint8_t *data, size_t len, ag_format fmt,

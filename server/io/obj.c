@@ -456,6 +456,13 @@ static ag_status read_line(reader *r, const char *p, const char *e)
         p++;
     if (p >= e || *p == '#')
         return AG_OK;
+    /* a comment after the data (`f 1 2 3 # roof`, as some exporters write): a '#' after
+     * white space ends the line; one inside a name (`g wall#3`) does not */
+    for (const char *c = p + 1; c < e; c++)
+        if (*c == '#' && is_space(c[-1])) {
+            e = c;
+            break;
+        }
     const char *k = p;
     while (p < e && !is_space(*p))
         p++;

@@ -168,15 +168,35 @@ ag_status ag_xyz_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag
     return AG_OK;
 }
 
+/* The decimals that write a coordinate of resolution `scale` (a LAS scale: 0.001 gives 3)
+ * exactly, or -1 when there is no such resolution or it needs more than 9 (then %.17g):
+ * 84916.949, not the 84916.949000000008 that the local origin's sum prints as. */
+static int decimals_of(double scale)
+{
+    if (!(scale > 0) || !isfinite(scale))
+        return -1;
+    double t = scale;
+    for (int d = 0; d <= 9; d++, t *= 10)
+        if (round(t) >= 1 && fabs(t - round(t)) < 1e-9 * t)
+            return d;
+    return -1;
+}
+
 ag_status ag_xyz_write(const ag_cloud *c, FILE *f, ag_error *err)
 {
     const ag_cloud_property *rgb[3] = {ag_cloud_find(c, "red"), ag_cloud_find(c, "green"),
                                        ag_cloud_find(c, "blue")};
     int colour = rgb[0] && rgb[1] && rgb[2];
+    int dec[3] = {decimals_of(c->scale[0]), decimals_of(c->scale[1]), decimals_of(c->scale[2])};
     for (size_t i = 0; i < c->n; i++) {
         const double *p = c->xyz + 3 * i;
-        fprintf(f, "%.17g %.17g %.17g", p[0] + c->offset[0], p[1] + c->offset[1],
-                p[2] + c->offset[2]);
+        for (int k = 0; k < 3; k++) {
+            double v = p[k] + c->offset[k];
+            if (dec[k] >= 0)
+                fprintf(f, k ? " %.*f" : "%.*f", dec[k], v);
+            else
+                fprintf(f, k ? " %.17g" : "%.17g", v);
+        }
         if (c->normals)
             fprintf(f, " %.9g %.9g %.9g", c->normals[3 * i], c->normals[3 * i + 1],
                     c->normals[3 * i + 2]);

@@ -64,6 +64,82 @@ static void test_stl_and_ply(void **state)
     ag_mesh_free(m);
 }
 
+/* STL sniffed from its content (an upload without ?format=): ASCII, and binary whose header
+ * begins with "solid" as many exporters write it; a text that only begins with "solid" is
+ * not taken for one. */
+static void test_stl_sniffed(void **state)
+{
+    (void)state;
+    const char *ascii = "solid x\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n"
+                        "   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\nendsolid x\n";
+    assert_int_equal(ag_format_sniff((const uint8_t *)ascii, strlen(ascii), NULL), AG_FORMAT_STL);
+    uint8_t bin[84 + 50] = {0};
+    memcpy(bin, "solid but binary", 16);
+    bin[80] = 1;
+    float v[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+    memcpy(bin + 84, v, sizeof v);
+    assert_int_equal(ag_format_sniff(bin, sizeof bin, NULL), AG_FORMAT_STL);
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    assert_int_equal(ag_import_buffer(bin, sizeof bin, AG_FORMAT_UNKNOWN, NULL, &m, &err), AG_OK);
+    assert_int_equal(m->ntris, 1);
+    ag_mesh_free(m);
+    /* one byte more or less is no binary STL */
+    assert_int_equal(ag_format_sniff(bin, sizeof bin - 1, NULL), AG_FORMAT_UNKNOWN);
+    const char *words = "solid ground is what a building needs\n";
+    assert_int_equal(ag_format_sniff((const uint8_t *)words, strlen(words), NULL),
+                     AG_FORMAT_UNKNOWN);
+}
+
+/* A PLY mesh in double at UTM coordinates keeps the file's values (assimp holds floats: 0.5 m
+ * steps at a northing of 5.4e6), in ASCII and binary. */
+static void test_ply_double_positions(void **state)
+{
+    (void)state;
+    const double X = 678088.123456, Y = 5403784.654321, Z = 413.017;
+    const double p[4][3] = {{X, Y, Z}, {X + 1.001, Y, Z}, {X + 1.001, Y + 0.3337, Z}, {X, Y + 0.3337, Z + 2.25}};
+    char text[1024];
+    int n = snprintf(text, sizeof text,
+                     "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+                     "property double z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                     "end_header\n");
+    for (int i = 0; i < 4; i++)
+        n += snprintf(text + n, sizeof text - (size_t)n, "%.6f %.6f %.6f\n", p[i][0], p[i][1], p[i][2]);
+    n += snprintf(text + n, sizeof text - (size_t)n, "4 0 1 2 3\n");
+    uint8_t bin[512];
+    const char *head = "ply\nformat binary_big_endian 1.0\nelement vertex 4\nproperty double x\n"
+                       "property double y\nproperty double z\nelement face 1\n"
+                       "property list uchar int vertex_indices\nend_header\n";
+    size_t bn = strlen(head);
+    memcpy(bin, head, bn);
+    for (int i = 0; i < 4; i++)
+        for (int k = 0; k < 3; k++) {
+            uint64_t u;
+            memcpy(&u, &p[i][k], 8);
+            for (int b = 7; b >= 0; b--)
+                bin[bn++] = (uint8_t)(u >> (8 * b));
+        }
+    const uint8_t face[17] = {4, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 3};
+    memcpy(bin + bn, face, sizeof face);
+    bn += sizeof face;
+    const uint8_t *files[2] = {(const uint8_t *)text, bin};
+    size_t lens[2] = {(size_t)n, bn};
+    for (int f = 0; f < 2; f++) {
+        ag_import_options o = {.up = AG_UP_Z};
+        ag_mesh *m = NULL;
+        ag_error err = {0};
+        assert_int_equal(ag_import_buffer(files[f], lens[f], AG_FORMAT_PLY, &o, &m, &err), AG_OK);
+        assert_int_equal(m->nverts, 4);
+        assert_int_equal(m->ntris, 2);
+        for (int i = 0; i < 4; i++)
+            for (int k = 0; k < 3; k++)
+                if (fabs(m->pos[3 * i + k] - p[i][k]) > 1e-6)
+                    fail_msg("file %d vertex %d axis %d: %.6f, not %.6f", f, i, k, m->pos[3 * i + k],
+                             p[i][k]);
+        ag_mesh_free(m);
+    }
+}
+
 static void test_gltf_node_becomes_a_group(void **state)
 {
     (void)state;
@@ -143,6 +219,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_stl_and_ply),
+        cmocka_unit_test(test_stl_sniffed),
+        cmocka_unit_test(test_ply_double_positions),
         cmocka_unit_test(test_gltf_node_becomes_a_group),
         cmocka_unit_test(test_collada_z_up),
         cmocka_unit_test(test_garbage_is_an_error),

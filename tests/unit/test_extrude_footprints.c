@@ -181,6 +181,69 @@ static void test_orientation_and_refusals(void **state)
     ag_footprints_free(f);
 }
 
+/* Heights as third-party files give them: a number, a number in a string (tables turned
+ * into GeoJSON), and values that are no height (a word, a negative number, true), which
+ * take the style's height and are reported, not silently dropped. The walls are measured
+ * on the flat-roofed result. */
+static void test_heights_from_properties(void **state)
+{
+    (void)state;
+    static const char *const props[] = {"{\"height\": 12}", "{\"height\": \"9.5\"}",
+                                        "{\"height\": \" 7 \"}", "{\"height\": \"tall\"}",
+                                        "{\"height\": -4}", "{\"height\": true}",
+                                        "{\"height\": null}", "{}"};
+    const double want[] = {12, 9.5, 7, 0, 0, 0, 0, 0};
+    const char *noted[] = {NULL, "read from the text", "read from the text",
+                           "\"tall\" is not a height", "-4 is not a height", "not a number",
+                           NULL, NULL};
+    char features[4096] = "";
+    for (int i = 0; i < 8; i++) {
+        char one[400];
+        snprintf(one, sizeof one,
+                 "%s{\"type\": \"Feature\", \"id\": \"b%d\", \"properties\": %s,"
+                 " \"geometry\": {\"type\": \"Polygon\", \"coordinates\": [[[%d,446000],"
+                 "[%d,446000],[%d,446010],[%d,446010],[%d,446000]]]}}",
+                 i ? "," : "", i, props[i], 85000 + 20 * i, 85010 + 20 * i, 85010 + 20 * i,
+                 85000 + 20 * i, 85000 + 20 * i);
+        strcat(features, one);
+    }
+    ag_footprints *f = read_doc(features);
+    assert_int_equal(f->n, 8);
+    ag_style st;
+    ag_style_builtin("flat", &st, NULL);
+    ag_mesh *m = ag_mesh_create();
+    ag_footprints_report r;
+    ag_error err = {0};
+    assert_int_equal(ag_footprints_extrude(f, &st, m, &r, &err), AG_OK);
+    assert_int_equal(r.succeeded, 8);
+    for (int i = 0; i < 8; i++) {
+        assert_true(f->items[i].height == want[i]);
+        double top = xc_top(m, i);
+        if (fabs(top - (want[i] > 0 ? want[i] : st.height)) > 1e-9)
+            fail_msg("b%d: top at %g", i, top);
+        const ag_footprint_issue *x = issue_of(r.fixed, r.nfixed, f->items[i].id);
+        if (noted[i] ? !x || !strstr(x->reason, noted[i]) : x != NULL)
+            fail_msg("b%d: fixes '%s'", i, x ? x->reason : "none");
+    }
+    ag_footprints_report_free(&r);
+    ag_mesh_free(m);
+    ag_footprints_free(f);
+}
+
+/* A CityJSON file is named as such, not as a malformed GeoJSON. */
+static void test_cityjson_named(void **state)
+{
+    (void)state;
+    const char *doc = "{\"type\": \"CityJSON\", \"version\": \"1.1\", \"CityObjects\": {},"
+                      " \"vertices\": []}";
+    ag_footprints *f = NULL;
+    ag_error err = {0};
+    assert_int_equal(ag_footprints_read_buffer(doc, strlen(doc), NULL, &f, &err),
+                     AG_ERR_UNSUPPORTED);
+    assert_null(f);
+    assert_non_null(strstr(err.text, "CityJSON"));
+}
+
 /* The threaded batch is the serial one: the same triangles in the same order, the same
  * report, whatever the number of threads. */
 static void test_threaded_batch_is_serial(void **state)
@@ -246,6 +309,8 @@ int main(void)
         cmocka_unit_test(test_ogc_valid_accepted),
         cmocka_unit_test(test_shared_edges_dissolved),
         cmocka_unit_test(test_orientation_and_refusals),
+        cmocka_unit_test(test_heights_from_properties),
+        cmocka_unit_test(test_cityjson_named),
         cmocka_unit_test(test_threaded_batch_is_serial),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

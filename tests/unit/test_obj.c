@@ -222,6 +222,23 @@ static void test_continued_group_name(void **state)
     ag_mesh_free(m);
 }
 
+/* Comments after the data, as some exporters write them: the line's data before the '#'
+ * counts; a '#' inside a name is part of it. */
+static void test_trailing_comments(void **state)
+{
+    ag_mesh *m = parse_ok("v 0 0 0 # origin\nv 1 0 0\t# x\nv 0 1 0 #\nv 5 5 5 #v 9 9 9\n"
+                          "g wall#3 # the west wall\nf 1 2 3 # f 1 2 4\nf 1 3 4 #f 9 9 9\n",
+                          AG_UP_Z);
+    assert_int_equal(m->nverts, 4);
+    assert_true(m->pos[9] == 5 && m->pos[10] == 5 && m->pos[11] == 5);
+    assert_int_equal(m->ngroups, 1);
+    assert_string_equal(m->group_names[0], "wall#3");
+    assert_int_equal(m->ntris, 2);
+    ag_mesh_free(m);
+    /* no space before the '#': 3#x is a bad vertex, as before */
+    expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3#x\n", AG_ERR_PARSE, 4, "bad face vertex");
+}
+
 static void test_repeated_index_dropped_flat_kept(void **state)
 {
     ag_mesh *m = parse_ok("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\n"
@@ -662,6 +679,7 @@ int main(void)
         cmocka_unit_test(test_lone_object_splits_connected),
         cmocka_unit_test(test_lexical_variety),
         cmocka_unit_test(test_continued_group_name),
+        cmocka_unit_test(test_trailing_comments),
         cmocka_unit_test(test_repeated_index_dropped_flat_kept),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_limits),

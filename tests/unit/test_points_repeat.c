@@ -171,6 +171,38 @@ static void test_template_refusals(void **state)
     ag_cloud_free(c);
 }
 
+/* Automatic mode on clouds with nothing that repeats (a lone plane; planes in one piece each,
+ * whatever their normals say): no element, no failure (an empty unit list reached qsort as a
+ * null array before, which UBSan reports). */
+static void test_auto_nothing_to_repeat(void **state)
+{
+    (void)state;
+    for (int kind = 0; kind < 2; kind++) {
+        ag_cloud *c = ag_cloud_create();
+        ag_error e;
+        size_t n = 0, side = 60;
+        assert_int_equal(ag_cloud_resize(c, kind ? 2 * side * side : side * side, &e), AG_OK);
+        for (size_t i = 0; i < side; i++)
+            for (size_t j = 0; j < side; j++, n++) {
+                double *p = c->xyz + 3 * n;
+                p[0] = 0.1 * (double)i, p[1] = 0.1 * (double)j, p[2] = 0;
+                if (kind) { /* and a wall beside it */
+                    p = c->xyz + 3 * (n + side * side);
+                    p[0] = 0.1 * (double)i, p[1] = 8, p[2] = 0.1 + 0.1 * (double)j;
+                }
+            }
+        ag_segment_cloud_result *r = segment(c);
+        ag_repeat_report rep = {0};
+        if (ag_repeat_auto(c, r, NULL, &rep, &e) != AG_OK)
+            fail_msg("kind %d: %s", kind, e.text);
+        for (size_t s = 0; s < r->nsegments; s++)
+            assert_int_not_equal(r->segments[s].kind, AG_SEGMENT_CLOUD_ELEMENT);
+        ag_repeat_report_clear(&rep);
+        ag_segment_cloud_free(r);
+        ag_cloud_free(c);
+    }
+}
+
 /* Automatic mode: the windows become elements, those of one size share a label. */
 static void test_auto_elements(void **state)
 {
@@ -387,6 +419,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_template_finds_the_facade_windows),
         cmocka_unit_test(test_template_refusals),
+        cmocka_unit_test(test_auto_nothing_to_repeat),
         cmocka_unit_test(test_auto_elements),
         cmocka_unit_test(test_consensus_completes_occluded_windows),
     };

@@ -109,12 +109,59 @@ static void test_large_coordinates(void **state)
     ag_cloud_free(c);
 }
 
+/* A cloud with a source resolution (a LAS scale) is written to that resolution: the
+ * numbers LAS holds, not their sum with the local origin printed to 17 digits; a resolution
+ * that needs many decimals, or none, keeps the round-trip form. */
+static void test_written_at_the_source_resolution(void **state)
+{
+    (void)state;
+    ag_cloud *c = ag_cloud_create();
+    ag_error e;
+    assert_int_equal(ag_cloud_resize(c, 2, &e), AG_OK);
+    const double abs[2][3] = {{84916.949, 447413.3, 5.977}, {84808.3, 447412.8, -0.568}};
+    c->offset[0] = 84808, c->offset[1] = 447412, c->offset[2] = 0;
+    for (int i = 0; i < 2; i++)
+        for (int k = 0; k < 3; k++)
+            c->xyz[3 * i + k] = abs[i][k] - c->offset[k];
+    const struct {
+        double scale[3];
+        const char *want;
+    } cases[] = {
+        {{0.001, 0.001, 0.001}, "84916.949 447413.300 5.977\n84808.300 447412.800 -0.568\n"},
+        {{0.25, 0.1, 1}, "84916.95 447413.3 6\n84808.30 447412.8 -1\n"},
+        {{0, 0, 0}, NULL}, /* no resolution: round trip */
+        {{1e-12, 0.3 / 7, 0}, NULL},
+    };
+    for (size_t t = 0; t < sizeof cases / sizeof *cases; t++) {
+        memcpy(c->scale, cases[t].scale, sizeof c->scale);
+        char *buf = NULL;
+        size_t len;
+        FILE *f = open_memstream(&buf, &len);
+        assert_int_equal(ag_xyz_write(c, f, &e), AG_OK);
+        fclose(f);
+        if (cases[t].want) {
+            assert_string_equal(buf, cases[t].want);
+        } else {
+            ag_cloud *back;
+            assert_int_equal(ag_xyz_read_buffer((uint8_t *)buf, len, &back, &e), AG_OK);
+            for (int i = 0; i < 2; i++)
+                for (int k = 0; k < 3; k++)
+                    assert_true(fabs(back->xyz[3 * i + k] + back->offset[k] -
+                                     c->xyz[3 * i + k] - c->offset[k]) < 1e-9);
+            ag_cloud_free(back);
+        }
+        free(buf);
+    }
+    ag_cloud_free(c);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_columns),
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_large_coordinates),
+        cmocka_unit_test(test_written_at_the_source_resolution),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -935,7 +935,8 @@ ag_status ag_repeat_auto(const ag_cloud *c, ag_segment_cloud_result *r,
         if (st != AG_OK)
             goto done;
     }
-    qsort(units, nunits, sizeof *units, cmp_unit);
+    if (nunits > 1) /* qsort takes no null array, even empty */
+        qsort(units, nunits, sizeof *units, cmp_unit);
     if ((st = grid_build(&grid, c, 8 * spacing, err)) != AG_OK)
         goto done;
     int32_t group;
