@@ -533,6 +533,9 @@ static void ids_survive_split_join_paste_remove(void **state)
     const bb_options *variants = bb_id_variants(&nv);
     for (size_t i = 0; i < nv; i++)
         run_variant(&variants[i]);
+    variants = bb_handed_variants(&nv);
+    for (size_t i = 0; i < nv; i++)
+        run_variant(&variants[i]);
 }
 
 /* The front window and the side window of a building (thin along y, thin along x). */
@@ -612,6 +615,95 @@ static void turned_and_cross_model_pastes_keep_ids(void **state)
     }
 }
 
+/* The nearest visible ancestor of n (a wall holding a recessed window), or -1. */
+static int32_t holder_wall(const ag_splittree *t, int32_t n)
+{
+    for (int32_t x = t->nodes[n].parent; x > 0; x = t->nodes[x].parent)
+        if (t->nodes[x].kind == AG_NODE_COMPONENT)
+            return x;
+    return -1;
+}
+
+/* A turned paste of mirrored terminals keeps ids too: on buildings whose windows are mirror
+ * images of each other (handles left and right), a front window that is a mirror image of its
+ * label's exemplar pasted onto a side window (a quarter turn), checked as every case is
+ * (against the operation's own mesh); and the copy is still marked as a mirror image. */
+static void turned_paste_of_mirrored_terminals_keeps_ids(void **state)
+{
+    (void)state;
+    size_t nh;
+    const bb_options *handed = bb_handed_variants(&nh);
+    for (size_t v = 0; v < nh; v++) {
+        const bb_options *o = &handed[v];
+        ag_mesh *m = NULL;
+        ag_error err = {0};
+        ag_edit_model *em = bb_service_model(o, &m, &err);
+        if (!em)
+            fail_msg("%s: %s", o->name, err.text);
+        const ag_splittree *t = em->proc->tree;
+        const ag_labels *L = em->proc->labels;
+        /* a mirrored window of one facade and a window of a facade at a quarter turn to it */
+        int32_t src = -1, dst = -1;
+        for (size_t n = 0; n < t->nnodes && src < 0; n++) {
+            const ag_tnode *x = &t->nodes[n];
+            if (x->kind == AG_NODE_COMPONENT && x->first_child < 0 && x->component >= 0 &&
+                L->mirror[x->component] && ag_box_extent(&x->box, 2) < 3)
+                src = (int32_t)n;
+        }
+        if (src < 0)
+            fail_msg("%s: no window is a mirror image of another", o->name);
+        const ag_box *S = &t->nodes[src].box;
+        int sthin = ag_box_extent(S, 0) < ag_box_extent(S, 1) ? 0 : 1;
+        for (size_t n = 0; n < t->nnodes && dst < 0; n++) {
+            const ag_tnode *x = &t->nodes[n];
+            int thin = ag_box_extent(&x->box, 0) < ag_box_extent(&x->box, 1) ? 0 : 1;
+            if (x->kind == AG_NODE_COMPONENT && x->first_child < 0 && thin != sthin &&
+                ag_box_extent(&x->box, 2) < 3 && ag_box_extent(&x->box, 2) > 1 &&
+                ag_box_extent(&x->box, 1 - thin) < 3)
+                dst = (int32_t)n;
+        }
+        assert_true(dst > 0);
+        int32_t nodes[1] = {src};
+        ag_edit_op paste = {.kind = AG_EDIT_PASTE, .node = dst, .nnodes = 1, .nodes = nodes,
+                            .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_DERIVE};
+        ag_edit_report rep = {0};
+        ag_edit_model *out = NULL;
+        if (ag_edit_apply_ex(em, &paste, 0, &out, &rep, &err))
+            fail_msg("%s: turned paste: %s", o->name, err.text);
+        if (!strstr(rep.message, "turned by 1 quarter turn") && !strstr(rep.message, "turned by 3"))
+            fail_msg("%s: not a turned paste: %s", o->name, rep.message);
+        /* the copy: appended, a mirror image of its label's exemplar, of the source's label */
+        const ag_splittree *t1 = out->proc->tree;
+        size_t copies = 0;
+        for (size_t n = t->nnodes; n < t1->nnodes; n++) {
+            const ag_tnode *x = &t1->nodes[n];
+            if (x->kind != AG_NODE_COMPONENT)
+                continue;
+            copies++;
+            assert_string_equal(label_of(out, (int32_t)n), label_of(em, src));
+        }
+        assert_int_equal(copies, 1);
+        ag_edit_report_clear(&rep);
+        ag_edit_model_free(out);
+        uint8_t *touched = calloc(t->nnodes, 1);
+        visible_below(t, dst, touched);
+        case_t c = {"paste a mirrored window turned", paste, touched, 1, 1};
+        check_case(em, &c, o);
+        /* and inserted into a wall of the other facade (kept beside what is there) */
+        int32_t wall = holder_wall(t, dst);
+        if (wall > 0) {
+            paste.node = wall;
+            paste.placement = AG_EDIT_INSERT;
+            memset(touched, 0, t->nnodes);
+            case_t c2 = {"insert a mirrored window turned", paste, touched, 0, 1};
+            check_case(em, &c2, o);
+        }
+        free(touched);
+        ag_edit_model_free(em);
+        ag_mesh_free(m);
+    }
+}
+
 /* Bad ops get the same precise error from the tree path as from the mesh path, and no model. */
 static void bad_ops_are_refused_as_before(void **state)
 {
@@ -677,6 +769,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(ids_survive_split_join_paste_remove),
         cmocka_unit_test(turned_and_cross_model_pastes_keep_ids),
+        cmocka_unit_test(turned_paste_of_mirrored_terminals_keeps_ids),
         cmocka_unit_test(bad_ops_are_refused_as_before),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
