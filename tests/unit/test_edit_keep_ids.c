@@ -30,6 +30,7 @@
 #include "app/model_state.h"
 #include "app/model_tree.h"
 #include "core/edit/edit.h"
+#include "core/edit/idmatch.h"
 #include "core/proc/proceduralize.h"
 #include "edit_building_fixture.h"
 #include "edit_kept_fixture.h"
@@ -704,6 +705,159 @@ static void turned_paste_of_mirrored_terminals_keeps_ids(void **state)
     }
 }
 
+/* ---- ids matched after proceduralizing again ---------------------------------------------- */
+
+/* op's mesh proceduralized again (the mesh path: every node renumbered), then matched to the
+ * input (core/edit/idmatch.h) with `changed` (what the op names as replaced; NULL: nothing
+ * named): every visible node of the input outside `touched` has its id, label and box again;
+ * the touched ones are dead when the op removes or moves them; `appended` visible nodes get new
+ * ids; the renumbered model's mesh is the mesh path's (vertex set, areas), its grammar derives
+ * it, and it reloads from what the store keeps node for node. Returns how many of the kept
+ * nodes the mesh path alone had numbered as before. */
+static size_t check_matched(ag_edit_model *em, const ag_edit_op *op, const uint8_t *touched,
+                            const uint8_t *changed, int removes, size_t appended,
+                            const char *what, const bb_options *o)
+{
+    ag_edit_model *mp = NULL, *out = NULL;
+    ag_proceduralize_result *r = NULL;
+    ag_idmatch_report rep = {0};
+    ag_error err = {0};
+    if (ag_edit_apply_ex(em, op, AG_EDIT_MESH_PATH, &mp, NULL, &err))
+        fail_msg("%s: %s: the mesh path: %s", o->name, what, err.text);
+    if (ag_idmatch_renumber(em->proc, mp->proc, changed, &em->opt.patterns, &r, &rep, &err))
+        fail_msg("%s: %s: match: %s", o->name, what, err.text);
+    assert_int_equal(ag_edit_model_wrap(r, &em->opt, &out, &err), AG_OK);
+    const ag_splittree *t0 = em->proc->tree, *t1 = out->proc->tree, *tm = mp->proc->tree;
+    double btol = 1e-9 * fmax(1, fabs(t0->nodes[0].box.max[0]) + fabs(t0->nodes[0].box.max[1]));
+    assert_true(t1->nnodes >= t0->nnodes);
+    size_t by_chance = 0, kept = 0;
+    for (size_t n = 0; n < t0->nnodes; n++) {
+        const ag_tnode *a = &t0->nodes[n], *b = &t1->nodes[n];
+        if (a->kind != AG_NODE_COMPONENT)
+            continue;
+        if (touched[n]) {
+            if (removes && b->kind != AG_NODE_DEAD)
+                fail_msg("%s: %s: node %zu should be dead, it is %s", o->name, what, n,
+                         label_of(out, (int32_t)n));
+            continue;
+        }
+        if (b->kind != AG_NODE_COMPONENT)
+            fail_msg("%s: %s: visible node %zu (%s) lost its id", o->name, what, n,
+                     label_of(em, (int32_t)n));
+        if (strcmp(label_of(em, (int32_t)n), label_of(out, (int32_t)n)))
+            fail_msg("%s: %s: node %zu changed label %s -> %s", o->name, what, n,
+                     label_of(em, (int32_t)n), label_of(out, (int32_t)n));
+        if (!same_box(&a->box, &b->box, btol))
+            fail_msg("%s: %s: node %zu moved", o->name, what, n);
+        kept++;
+        by_chance += n < tm->nnodes && tm->nodes[n].kind == AG_NODE_COMPONENT &&
+                     same_box(&tm->nodes[n].box, &a->box, btol) &&
+                     !strcmp(label_of(mp, (int32_t)n), label_of(em, (int32_t)n));
+    }
+    size_t added = 0, visible = 0;
+    for (size_t n = 0; n < t1->nnodes; n++) {
+        visible += t1->nodes[n].kind == AG_NODE_COMPONENT;
+        added += n >= t0->nnodes && t1->nodes[n].kind == AG_NODE_COMPONENT;
+    }
+    if (added != appended)
+        fail_msg("%s: %s: %zu visible nodes appended, expected %zu", o->name, what, added,
+                 appended);
+    assert_int_equal(rep.kept, kept);
+    assert_int_equal(rep.kept + rep.appended, visible);
+    double diag = ag_box_diagonal(&t0->nodes[0].box);
+    char part[200];
+    snprintf(part, sizeof part, "%s: %s (matched mesh)", o->name, what);
+    assert_same_surface(out->proc->mesh, mp->proc->mesh, 1e-6 * fmax(1, diag), part);
+    ag_mesh *derived = NULL;
+    if (ag_grammar_derive(out->proc->grammar, NULL, &derived, &err))
+        fail_msg("%s: %s: derive: %s", o->name, what, err.text);
+    snprintf(part, sizeof part, "%s: %s (matched grammar)", o->name, what);
+    assert_same_surface(derived, mp->proc->mesh, 1e-4 * fmax(1, diag), part);
+    ag_mesh_free(derived);
+    char *served = ag_model_tree_served_text(out), *stored = ek_served_after_store(out);
+    if (strcmp(served, stored))
+        fail_msg("%s: %s: the matched model does not reload node for node", o->name, what);
+    free(served);
+    free(stored);
+    ag_edit_model_free(out);
+    ag_edit_model_free(mp);
+    return by_chance;
+}
+
+static void match_variant(const bb_options *o, size_t *chance, size_t *total)
+{
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    ag_edit_model *em = bb_service_model(o, &m, &err);
+    if (!em)
+        fail_msg("%s: %s", o->name, err.text);
+    const ag_splittree *t = em->proc->tree;
+    size_t nn = t->nnodes, vis = visible_below(t, 0, NULL);
+    int32_t wall = largest(t), wa, wb;
+    two_windows(em, &wa, &wb);
+    assert_true(wall > 0 && wa > 0 && wb > 0);
+    uint8_t *touched = calloc(nn, 1);
+    int32_t pair[2] = {wa, wb};
+#define MATCHED(op, changed, removes, appended, what)                                          \
+    do {                                                                                      \
+        *chance += check_matched(em, &(op), touched, changed, removes, appended, what, o);    \
+        *total += vis;                                                                        \
+    } while (0)
+    /* a window removed, the wall removed (with what it holds) */
+    ag_edit_op rm = {.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = pair};
+    visible_below(t, wa, touched);
+    MATCHED(rm, NULL, 1, 0, "remove a window");
+    memset(touched, 0, nn);
+    int32_t w1[1] = {wall};
+    rm.nodes = w1;
+    visible_below(t, wall, touched);
+    MATCHED(rm, NULL, 1, 0, "remove the wall");
+    /* two windows joined: one node of a new label */
+    ag_edit_op join = {.kind = AG_EDIT_JOIN, .nnodes = 2, .nodes = pair};
+    memset(touched, 0, nn);
+    touched[wa] = touched[wb] = 1;
+    MATCHED(join, NULL, 1, 1, "join two windows");
+    /* a window pasted onto another (what it replaces named), and into another */
+    int32_t src[1] = {wa};
+    ag_edit_op paste = {.kind = AG_EDIT_PASTE, .node = wb, .nnodes = 1, .nodes = src,
+                        .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_DERIVE};
+    memset(touched, 0, nn);
+    visible_below(t, wb, touched);
+    MATCHED(paste, touched, 1, visible_below(t, wa, NULL), "paste a window onto another");
+    paste.placement = AG_EDIT_INSERT;
+    memset(touched, 0, nn);
+    MATCHED(paste, NULL, 0, visible_below(t, wa, NULL), "paste a window into another");
+    /* the wall split: both halves (and what it holds) are new boxes */
+    const ag_box *W = &t->nodes[wall].box;
+    int axis = ag_box_extent(W, 0) >= ag_box_extent(W, 1) ? 0 : 1;
+    ag_edit_op split = {.kind = AG_EDIT_SPLIT, .node = wall, .axis = axis,
+                        .at = W->min[axis] + 0.37 * ag_box_extent(W, axis)};
+    memset(touched, 0, nn);
+    size_t below = visible_below(t, wall, touched);
+    MATCHED(split, NULL, 1, 2 * below, "split the wall");
+#undef MATCHED
+    free(touched);
+    ag_edit_model_free(em);
+    ag_mesh_free(m);
+}
+
+/* A model proceduralized again gets the ids of the model it replaces (core/edit/idmatch.h):
+ * on every generated building, for ops made by their mesh and proceduralized again. */
+static void ids_matched_after_proceduralizing_again(void **state)
+{
+    (void)state;
+    size_t chance = 0, total = 0;
+    for (int set = 0; set < 2; set++) {
+        size_t nv;
+        const bb_options *v = set ? bb_handed_variants(&nv) : bb_id_variants(&nv);
+        for (size_t i = 0; i < nv; i++)
+            match_variant(&v[i], &chance, &total);
+    }
+    /* what the matching is for: without it most ids name other nodes */
+    print_message("ids the mesh path alone kept: %zu of %zu\n", chance, total);
+    assert_true(chance < total / 2);
+}
+
 /* Bad ops get the same precise error from the tree path as from the mesh path, and no model. */
 static void bad_ops_are_refused_as_before(void **state)
 {
@@ -770,6 +924,7 @@ int main(void)
         cmocka_unit_test(ids_survive_split_join_paste_remove),
         cmocka_unit_test(turned_and_cross_model_pastes_keep_ids),
         cmocka_unit_test(turned_paste_of_mirrored_terminals_keeps_ids),
+        cmocka_unit_test(ids_matched_after_proceduralizing_again),
         cmocka_unit_test(bad_ops_are_refused_as_before),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

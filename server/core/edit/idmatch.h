@@ -5,9 +5,11 @@
  * node afresh. ag_idmatch_renumber gives such a model the ids of the model it replaces: walking
  * down from the root, a node of the new tree takes the id of the node of the old tree that has
  * the same kind, the same label name (its component's group, as the grammar names labels), the
- * same box within the models' tolerances and the old id of its own parent (the nearest
- * ancestor that is not a split chain's intermediate node); an intermediate split node follows
- * the chain end it leads to. Old nodes marked `changed` (what the change removed or replaced)
+ * same box within the models' tolerances and whose holder (the nearest visible ancestor, or
+ * the root) has the old id of its own holder; an intermediate split node follows the chain end
+ * it leads to. A node nothing matched so (nested now in a node the change made, a joined one)
+ * then takes the old node of the same kind and label name on the same box anywhere, the
+ * nearest. Old nodes marked `changed` (what the change removed or replaced)
  * are never matched. New nodes nothing matched are appended after every old id, old nodes
  * nothing matched are dead, so an id never names another node than it did. The renumbered
  * tree is rebuilt from the new model (rebuild.h): the same components, labels and geometry,
