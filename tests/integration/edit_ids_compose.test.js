@@ -1,9 +1,10 @@
-// A selection another person holds names the same nodes after a resize, a paste and a
-// composition the graft cannot pair (the composed model is its derivation proceduralized
-// again, and the nodes it left alone get their ids back): bo selects windows and the wall,
-// ana edits over REST and the websocket, and after each op bo's ids name nodes of the same
-// label on the same boxes; an op bo made before the composition, naming a window by its id,
-// is rebased onto it and resizes that window.
+// A selection another person holds names the same nodes after a resize, a paste, a
+// composition the graft cannot pair and grammar text edits (the model is then its derivation
+// proceduralized again, and the nodes it left alone get their ids back): bo selects windows
+// and the wall, ana edits over REST and the websocket, and after each op bo's ids name nodes
+// of the same label on the same boxes; an op bo made before the composition, naming a window
+// by its id, is rebased onto it and resizes that window; the model reloads node for node
+// after a restart.
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
 import { http, importModel, removeDir, startDaemon, tempDir, waitJob, windowWallObj, WsClient } from './harness.js';
@@ -12,7 +13,7 @@ const near = (a, b, eps = 1e-6) => Math.abs(a - b) <= eps;
 const sameBox = (a, b, eps = 1e-6) => a.every((v, k) => near(v, b[k], eps));
 const size = (b, a) => b[3 + a] - b[a];
 
-describe('ids held by another client survive resize, paste and a proceduralized composition', () => {
+describe('ids held by another client survive resize, paste, a proceduralized composition and grammar edits', () => {
   const dir = tempDir();
   let d;
   const clients = [];
@@ -87,10 +88,10 @@ describe('ids held by another client survive resize, paste and a proceduralized 
     const seenPresence = A.next((m) => m.type === 'presence' && m.user === 'bo', 10000, 'bo\'s presence');
     B.send({ type: 'presence', state: { selection: held } });
     assert.deepEqual((await seenPresence).state.selection, held);
-    // bo's selection names what it named in t0: same labels, same boxes
-    const stillHeld = (t, what) => {
+    // bo's selection names what it named in ref: same labels, same boxes
+    const stillHeld = (t, what, ref = t0) => {
       for (const id of held) {
-        const x = t0.nodes[id], y = t.nodes[id];
+        const x = ref.nodes[id], y = t.nodes[id];
         assert.ok(y && y.visible, `${what}: bo's node ${id} is gone`);
         assert.equal(y.label, x.label, `${what}: bo's node ${id} changed label`);
         assert.ok(sameBox(y.box, x.box), `${what}: bo's node ${id} moved`);
@@ -141,6 +142,30 @@ describe('ids held by another client survive resize, paste and a proceduralized 
     const t4 = await tree(b.id);
     assert.ok(near(t4.nodes[w1.id].box[5], w1.box[5] + 0.1), JSON.stringify(t4.nodes[w1.id]));
     assert.equal(t4.nodes[w1.id].label, w1.label);
+
+    // grammar text edits re-derive and proceduralize the model: the text as it is keeps every
+    // id; one more terminal placed in a corner of the axiom keeps them too and adds one node
+    const put = (text, version) => http(d, 'PUT', `/api/v1/models/${b.id}/grammar`, {
+      body: text, headers: { 'If-Match': `"${version}"`, 'Content-Type': 'text/plain', 'X-Archgram-User': 'ana' }, timeout: 60000,
+    });
+    const text = (await http(d, 'GET', `/api/v1/models/${b.id}/grammar`)).text;
+    r = await put(text, t4.version);
+    assert.equal(r.status, 200, r.text);
+    const t5 = await tree(b.id);
+    assert.equal(keptAlone(t4, t5, new Set(), 'grammar text as it is'), t4.nodes.filter((n) => n.visible).length);
+    assert.equal(t5.nodes.filter((n) => n.visible).length, t4.nodes.filter((n) => n.visible).length);
+    stillHeld(t5, 'grammar text as it is', t4);
+    const terminal = text.match(/^terminal (\S+) /m)[1];
+    const axiomEnd = text.lastIndexOf('}');
+    const more = `${text.slice(0, axiomEnd)}  added_corner = split(p, 0.05, 0.05, 0.05, 1)\n  ${terminal}(added_corner)\n${text.slice(axiomEnd)}`;
+    r = await put(more, t5.version);
+    assert.equal(r.status, 200, r.text);
+    const t6 = await tree(b.id);
+    keptAlone(t5, t6, new Set(), 'grammar text with one more terminal');
+    const grown6 = t6.nodes.filter((n) => n.visible && !(t5.nodes[n.id]?.visible));
+    assert.equal(grown6.length, 1, JSON.stringify(grown6));
+    assert.ok(grown6[0].id >= t5.nodes.length);
+    stillHeld(t6, 'grammar text with one more terminal', t4);
 
     // the composed version reloads node for node after a restart
     const before = JSON.stringify((await tree(b.id)).nodes);
