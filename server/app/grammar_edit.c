@@ -26,6 +26,8 @@ static ag_status keep_ids(const ag_store_env *env, int64_t model, ag_model_state
     ag_status s = ag_idmatch_renumber(cur->em->proc, st->em->proc, NULL, &st->em->opt.patterns,
                                       &r, NULL, err);
     ag_edit_session_release(env->sessions, cur);
+    if (s == AG_OK && !r) /* numbered as before */
+        return AG_OK;
     if (s == AG_OK && (s = ag_edit_model_wrap(r, &st->em->opt, &em, err)) != AG_OK)
         ag_proceduralize_result_free(r);
     if (s == AG_OK) {

@@ -133,9 +133,13 @@ static ag_status make_grafted(void *user, const ag_mesh *derived, ag_edit_model 
                                    &r, &ids, err)
              : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     free(away);
-    ag_edit_model_free(fresh);
-    if (s == AG_OK && (s = ag_edit_model_wrap(r, &gm->model->opt, em, err)) != AG_OK)
+    if (s == AG_OK && !r) { /* numbered as before */
+        *em = fresh;
+        fresh = NULL;
+    } else if (s == AG_OK && (s = ag_edit_model_wrap(r, &gm->model->opt, em, err)) != AG_OK) {
         ag_proceduralize_result_free(r);
+    }
+    ag_edit_model_free(fresh);
     if (s == AG_OK)
         gm->out->graft = (ag_graft_report){.kept = ids.kept, .removed = ids.dead,
                                            .added = ids.appended};

@@ -726,6 +726,7 @@ static size_t check_matched(ag_edit_model *em, const ag_edit_op *op, const uint8
         fail_msg("%s: %s: the mesh path: %s", o->name, what, err.text);
     if (ag_idmatch_renumber(em->proc, mp->proc, changed, &em->opt.patterns, &r, &rep, &err))
         fail_msg("%s: %s: match: %s", o->name, what, err.text);
+    assert_non_null(r); /* the mesh path numbers otherwise */
     assert_int_equal(ag_edit_model_wrap(r, &em->opt, &out, &err), AG_OK);
     const ag_splittree *t0 = em->proc->tree, *t1 = out->proc->tree, *tm = mp->proc->tree;
     double btol = 1e-9 * fmax(1, fabs(t0->nodes[0].box.max[0]) + fabs(t0->nodes[0].box.max[1]));
@@ -852,6 +853,29 @@ static void ids_matched_after_proceduralizing_again(void **state)
         const bb_options *v = set ? bb_handed_variants(&nv) : bb_id_variants(&nv);
         for (size_t i = 0; i < nv; i++)
             match_variant(&v[i], &chance, &total);
+    }
+    /* a model matched to itself read back through its grammar: every visible node kept, none
+     * new, none dead */
+    for (int set = 0; set < 2; set++) {
+        size_t nv;
+        const bb_options *v = set ? bb_handed_variants(&nv) : bb_id_variants(&nv);
+        for (size_t i = 0; i < nv; i++) {
+            ag_mesh *m = NULL;
+            ag_error err = {0};
+            ag_edit_model *em = bb_service_model(&v[i], &m, &err), *again = NULL;
+            assert_non_null(em);
+            assert_int_equal(ag_edit_model_from_grammar(em->proc->grammar, &em->opt, &again, &err), AG_OK);
+            ag_proceduralize_result *r = NULL;
+            ag_idmatch_report rep = {0};
+            assert_int_equal(ag_idmatch_renumber(em->proc, again->proc, NULL, &em->opt.patterns, &r, &rep, &err), AG_OK);
+            ag_proceduralize_result_free(r); /* NULL when numbered as before */
+            assert_int_equal(rep.appended, 0);
+            assert_int_equal(rep.dead, 0);
+            assert_int_equal(rep.kept, visible_below(em->proc->tree, 0, NULL));
+            ag_edit_model_free(again);
+            ag_edit_model_free(em);
+            ag_mesh_free(m);
+        }
     }
     /* what the matching is for: without it most ids name other nodes */
     print_message("ids the mesh path alone kept: %zu of %zu\n", chance, total);

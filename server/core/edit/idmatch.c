@@ -222,10 +222,10 @@ static int32_t remap(const int32_t *id, int32_t n)
     return n >= 0 ? id[n] : -1;
 }
 
-/* fresh's tree with node f at id[f], the other slots dead; *source per node: the fresh node it
- * is. */
-static ag_splittree *renumbered(const ag_splittree *F, const int32_t *id, size_t nnodes,
-                                int32_t **source)
+/* fresh's tree with node f at id[f], the other slots dead (an old id keeps its old node's
+ * box and pivot, as a dead node does); *source per node: the fresh node it is. */
+static ag_splittree *renumbered(const ag_splittree *O, const ag_splittree *F, const int32_t *id,
+                                size_t nnodes, int32_t **source)
 {
     ag_splittree *T = calloc(1, sizeof *T);
     int32_t *src = malloc((nnodes + 1) * sizeof *src);
@@ -245,7 +245,10 @@ static ag_splittree *renumbered(const ag_splittree *F, const int32_t *id, size_t
     T->eps = F->eps;
     for (size_t n = 0; n < nnodes; n++) {
         ag_tnode *x = &T->nodes[n];
-        memset(x, 0, sizeof *x);
+        if (n < O->nnodes)
+            *x = O->nodes[n];
+        else
+            memset(x, 0, sizeof *x);
         x->kind = AG_NODE_DEAD;
         x->parent = x->first_child = x->last_child = x->next_sibling = -1;
         x->component = x->label = x->variant = x->rule = x->pattern = -1;
@@ -399,12 +402,27 @@ ag_status ag_idmatch_renumber(const ag_proceduralize_result *old,
                 r.appended++;
         }
     }
-    for (size_t n = 0; n < O->nnodes; n++)
+    int same = next == O->nnodes && F->nnodes == O->nnodes;
+    for (size_t n = 0; n < O->nnodes; n++) {
         r.dead += O->nodes[n].kind == AG_NODE_COMPONENT && !alive[n];
+        same = same && (O->nodes[n].kind == AG_NODE_DEAD ? F->nodes[n].kind == AG_NODE_DEAD
+                                                         : f2o[n] == (int32_t)n);
+    }
+    for (size_t c = 0; same && c < FL->ncomponents; c++)
+        same = label[c] == FL->label[c];
     free(alive);
+    if (same) { /* fresh numbers every node as old did: nothing to rebuild */
+        free(f2o);
+        free(id);
+        free(label);
+        free(vlabel);
+        if (rep)
+            *rep = r;
+        return AG_OK;
+    }
     free(f2o);
     int32_t *source = NULL;
-    ag_splittree *T = renumbered(F, id, next, &source);
+    ag_splittree *T = renumbered(O, F, id, next, &source);
     free(id);
     if (!T) {
         free(label);

@@ -29,8 +29,10 @@ typedef struct {
     size_t dead;     /* visible nodes of the old model no new node matched */
 } ag_idmatch_report;
 
-/* fresh renumbered after old into *out (fresh is not changed). changed: per old node, non-zero
- * for nodes that may not be matched (NULL: none). rep may be NULL. */
+/* fresh renumbered after old into *out (fresh is not changed); *out = NULL when fresh already
+ * numbers every node as old does (a text re-derived as it was: fresh is the result, exactly).
+ * changed: per old node, non-zero for nodes that may not be matched (NULL: none). rep may be
+ * NULL. */
 ag_status ag_idmatch_renumber(const ag_proceduralize_result *old,
                               const ag_proceduralize_result *fresh, const uint8_t *changed,
                               const ag_patterns_options *popt, ag_proceduralize_result **out,
