@@ -4,16 +4,17 @@
  * grammar text edit) the new model is its derivation proceduralized, and that numbers every
  * node afresh. ag_idmatch_renumber gives such a model the ids of the model it replaces: walking
  * down from the root, a node of the new tree takes the id of the node of the old tree that has
- * the same kind, the same label name (its component's group, as the grammar names labels), the
- * same box within the models' tolerances and whose holder (the nearest visible ancestor, or
- * the root) has the old id of its own holder; an intermediate split node follows the chain end
- * it leads to. A node nothing matched so (nested now in a node the change made, a joined one)
+ * the same kind, the same label name (its component's group, as the grammar names labels) and
+ * the same box within the models' tolerances, under the old node its own holder (the nearest
+ * visible ancestor, or the root) matched; an intermediate split node follows the chain end it
+ * leads to. A node nothing matched so (nested now in a node the change made, a joined one)
  * then takes the old node of the same kind and label name on the same box anywhere, the
- * nearest. Old nodes marked `changed` (what the change removed or replaced)
- * are never matched. New nodes nothing matched are appended after every old id, old nodes
+ * nearest. Old nodes marked `changed` (what the change removed or replaced) are never
+ * matched. New nodes nothing matched are appended after every old id, old nodes
  * nothing matched are dead, so an id never names another node than it did. The renumbered
  * tree is rebuilt from the new model (rebuild.h): the same components, labels and geometry,
- * rules and patterns found again on the same boxes. */
+ * rules and patterns found again on the same boxes, labels named as the kept nodes' old labels
+ * were where that is one name per variant. */
 #ifndef AG_EDIT_IDMATCH_H
 #define AG_EDIT_IDMATCH_H
 
