@@ -3,10 +3,39 @@
 #include <jansson.h>
 #include <stdlib.h>
 
+#include "../core/edit/idmatch.h"
 #include "../store/grammars.h"
 #include "../store/states.h"
 #include "cloud_pipeline.h"
+#include "edit_session.h"
 #include "store_ws.h"
+
+/* The re-derived model given the ids of the model as it is (core/edit/idmatch.h): a node the
+ * text left where it was, with its label, keeps its id. A model with no state to match (none
+ * loads) keeps the numbering of its derivation. */
+static ag_status keep_ids(const ag_store_env *env, int64_t model, ag_model_state *st,
+                          ag_error *err)
+{
+    ag_edit_state *cur = NULL;
+    ag_error e;
+    ag_error_clear(&e);
+    if (ag_edit_session_acquire(env->sessions, env->db, model, &cur, &e) != AG_OK)
+        return AG_OK;
+    ag_proceduralize_result *r = NULL;
+    ag_edit_model *em = NULL;
+    ag_status s = ag_idmatch_renumber(cur->em->proc, st->em->proc, NULL, &st->em->opt.patterns,
+                                      &r, NULL, err);
+    ag_edit_session_release(env->sessions, cur);
+    if (s == AG_OK && !r) /* numbered as before */
+        return AG_OK;
+    if (s == AG_OK && (s = ag_edit_model_wrap(r, &st->em->opt, &em, err)) != AG_OK)
+        ag_proceduralize_result_free(r);
+    if (s == AG_OK) {
+        ag_edit_model_free(st->em);
+        st->em = em;
+    }
+    return s;
+}
 
 ag_status ag_grammar_edit_apply(const ag_store_env *env, int64_t model, int64_t base,
                                 const char *author, const char *cid, const char *text,
@@ -41,6 +70,10 @@ ag_status ag_grammar_edit_apply(const ag_store_env *env, int64_t model, int64_t 
     if ((s = ag_model_state_from_text(text, len, ag__store_ws_terminal_lookup, &ctx, &eb, &st, err, col)) !=
         AG_OK)
         return ag_task_budget_explain(budget, s, "the grammar edit", err);
+    if ((s = keep_ids(env, model, &st, err)) != AG_OK) {
+        ag_model_state_clear(&st);
+        return s;
+    }
     const ag_grammar *g = st.em->proc->grammar;
     json_t *summary = json_pack(
         "{s:s, s:I, s:I, s:I, s:I, s:I, s:I}", "source", "edit", "rules", (json_int_t)g->nrules,

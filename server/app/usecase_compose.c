@@ -1,9 +1,11 @@
 #include "usecase_compose.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "../core/edit/idmatch.h"
 #include "model_tree.h"
 
 static double now_ms(void)
@@ -68,8 +70,37 @@ typedef struct {
     ag_usecase_compose_result *out;
 } graft_maker;
 
+/* Per node of t: what the composition replaces (a replace's sites with their subtrees, what
+ * lies below a fill's sites; an insert replaces nothing), which keeps no id. NULL when out of
+ * memory. */
+static uint8_t *composed_away(const ag_splittree *t, const ag_compose_op *op)
+{
+    uint8_t *site = calloc(t->nnodes + 1, 1), *away = calloc(t->nnodes + 1, 1);
+    if (!site || !away) {
+        free(site);
+        free(away);
+        return NULL;
+    }
+    int32_t rule = t->nodes[op->target].rule;
+    for (size_t n = 0; n < t->nnodes; n++)
+        site[n] = op->scope == AG_COMPOSE_RULE
+                      ? t->nodes[n].kind == AG_NODE_COMPONENT && rule >= 0 &&
+                            t->nodes[n].rule == rule
+                      : n == (size_t)op->target;
+    for (size_t n = 0; op->mode != AG_COMPOSE_INSERT && n < t->nnodes; n++) {
+        if (t->nodes[n].kind == AG_NODE_DEAD)
+            continue;
+        /* below a site, or the site itself when it is replaced */
+        int32_t x = op->mode == AG_COMPOSE_REPLACE ? (int32_t)n : t->nodes[n].parent;
+        for (; x >= 0 && !away[n]; x = t->nodes[x].parent)
+            away[n] = site[x];
+    }
+    free(site);
+    return away;
+}
+
 /* The new state's edit model: the model's tree with the part grafted in; where the graft does
- * not apply, the derivation proceduralized. */
+ * not apply, the derivation proceduralized and given the model's ids (core/edit/idmatch.h). */
 static ag_status make_grafted(void *user, const ag_mesh *derived, ag_edit_model **em,
                               ag_error *err)
 {
@@ -92,7 +123,27 @@ static ag_status make_grafted(void *user, const ag_mesh *derived, ag_edit_model 
         return s;
     }
     snprintf(gm->out->report.fallback, sizeof gm->out->report.fallback, "%.150s", e.text);
-    return ag_model_state_reload(derived, em, err);
+    ag_edit_model *fresh = NULL;
+    if ((s = ag_model_state_reload(derived, &fresh, err)) != AG_OK)
+        return s;
+    const ag_splittree *t = gm->model->proc->tree;
+    uint8_t *away = composed_away(t, gm->op);
+    ag_idmatch_report ids = {0};
+    s = away ? ag_idmatch_renumber(gm->model->proc, fresh->proc, away, &gm->model->opt.patterns,
+                                   &r, &ids, err)
+             : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    free(away);
+    if (s == AG_OK && !r) { /* numbered as before */
+        *em = fresh;
+        fresh = NULL;
+    } else if (s == AG_OK && (s = ag_edit_model_wrap(r, &gm->model->opt, em, err)) != AG_OK) {
+        ag_proceduralize_result_free(r);
+    }
+    ag_edit_model_free(fresh);
+    if (s == AG_OK)
+        gm->out->graft = (ag_graft_report){.kept = ids.kept, .removed = ids.dead,
+                                           .added = ids.appended};
+    return s;
 }
 
 ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,

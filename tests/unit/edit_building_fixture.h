@@ -34,6 +34,8 @@ typedef struct {
     int turn;             /* quarter turns of the whole building about z */
     double dx, dy, dz;    /* offset after the turn */
     double jitter;        /* amplitude of a deterministic per-vertex jitter, metres */
+    int handed;           /* windows with a handle, on the left in even columns and on the
+                             right in odd ones: mirror images of each other */
 } bb_options;
 
 /* Dimensions (metres) in the building's frame: the front faces -y along x from 0 to
@@ -66,6 +68,7 @@ typedef struct {
     double ox, oy; /* facade frame: world = origin + R_k(u, v) */
     int k;
     size_t comp;
+    int hand; /* the next window's handle: 0 none, 1 left, 2 right */
     int fail;
 } bb_gen;
 
@@ -168,6 +171,10 @@ static inline void bb_window(bb_gen *g, double u, double w)
     bb_box(g, u, u + BB_WIN_W, fr[0], fr[1], w, w + BB_WIN_H);
     bb_box(g, u + 0.1, u + BB_WIN_W - 0.1, gl[0], gl[1], w + 0.1, w + BB_WIN_H - 0.1);
     bb_box(g, u - 0.05, u + BB_WIN_W + 0.05, si[0], si[1], w - 0.08, w);
+    if (g->hand) { /* in front of the glass, off the window's centre */
+        double h0 = g->hand == 1 ? u + 0.15 : u + BB_WIN_W - 0.3;
+        bb_box(g, h0, h0 + 0.15, gl[0] - 0.04, gl[0], w + 0.6, w + 0.75);
+    }
 }
 
 static inline void bb_door(bb_gen *g, double u)
@@ -185,6 +192,7 @@ static inline void bb_grid(bb_gen *g, const char *side, unsigned cols, unsigned 
             char name[64];
             snprintf(name, sizeof name, "window_%s_%u_%u", side, i, j);
             bb_begin(g, name);
+            g->hand = g->o->handed ? 1 + (int)(i & 1) : 0;
             bb_window(g, BB_MARGIN + i * BB_PERIOD, BB_ROW0 + j * BB_FLOOR);
         }
 }
@@ -228,12 +236,25 @@ static inline ag_mesh *bb_generate(const bb_options *o)
 static inline const bb_options *bb_id_variants(size_t *n)
 {
     static const bb_options v[] = {
-        {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0},
-        {"flush", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0},
-        {"proud", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0},
-        {"proud, overhang, turned a quarter", 6, 3, 3, 2, BB_PROUD, 0.3, 1, 0, 0, 0, 0},
-        {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0},
-        {"flush, jittered", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7},
+        {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0, 0},
+        {"flush", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0, 0},
+        {"proud", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0, 0},
+        {"proud, overhang, turned a quarter", 6, 3, 3, 2, BB_PROUD, 0.3, 1, 0, 0, 0, 0, 0},
+        {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0, 0},
+        {"flush, jittered", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7, 0},
+    };
+    *n = sizeof v / sizeof *v;
+    return v;
+}
+
+/* Buildings whose windows are mirror images of each other (handles left and right): for the
+ * tests of edits that copy or turn terminals. *n gets their count. */
+static inline const bb_options *bb_handed_variants(size_t *n)
+{
+    static const bb_options v[] = {
+        {"proud, handed", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0, 1},
+        {"recessed, handed, turned a quarter", 4, 2, 3, 2, BB_RECESSED, 0.3, 1, 0, 0, 0, 0, 1},
+        {"flush, handed, UTM", 5, 2, 3, 0, BB_FLUSH, 0, 0, 512345.0, 5812345.0, 31.0, 0, 1},
     };
     *n = sizeof v / sizeof *v;
     return v;

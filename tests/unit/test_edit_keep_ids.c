@@ -30,6 +30,7 @@
 #include "app/model_state.h"
 #include "app/model_tree.h"
 #include "core/edit/edit.h"
+#include "core/edit/idmatch.h"
 #include "core/proc/proceduralize.h"
 #include "edit_building_fixture.h"
 #include "edit_kept_fixture.h"
@@ -533,6 +534,9 @@ static void ids_survive_split_join_paste_remove(void **state)
     const bb_options *variants = bb_id_variants(&nv);
     for (size_t i = 0; i < nv; i++)
         run_variant(&variants[i]);
+    variants = bb_handed_variants(&nv);
+    for (size_t i = 0; i < nv; i++)
+        run_variant(&variants[i]);
 }
 
 /* The front window and the side window of a building (thin along y, thin along x). */
@@ -612,6 +616,272 @@ static void turned_and_cross_model_pastes_keep_ids(void **state)
     }
 }
 
+/* The nearest visible ancestor of n (a wall holding a recessed window), or -1. */
+static int32_t holder_wall(const ag_splittree *t, int32_t n)
+{
+    for (int32_t x = t->nodes[n].parent; x > 0; x = t->nodes[x].parent)
+        if (t->nodes[x].kind == AG_NODE_COMPONENT)
+            return x;
+    return -1;
+}
+
+/* A turned paste of mirrored terminals keeps ids too: on buildings whose windows are mirror
+ * images of each other (handles left and right), a front window that is a mirror image of its
+ * label's exemplar pasted onto a side window (a quarter turn), checked as every case is
+ * (against the operation's own mesh); and the copy is still marked as a mirror image. */
+static void turned_paste_of_mirrored_terminals_keeps_ids(void **state)
+{
+    (void)state;
+    size_t nh;
+    const bb_options *handed = bb_handed_variants(&nh);
+    for (size_t v = 0; v < nh; v++) {
+        const bb_options *o = &handed[v];
+        ag_mesh *m = NULL;
+        ag_error err = {0};
+        ag_edit_model *em = bb_service_model(o, &m, &err);
+        if (!em)
+            fail_msg("%s: %s", o->name, err.text);
+        const ag_splittree *t = em->proc->tree;
+        const ag_labels *L = em->proc->labels;
+        /* a mirrored window of one facade and a window of a facade at a quarter turn to it */
+        int32_t src = -1, dst = -1;
+        for (size_t n = 0; n < t->nnodes && src < 0; n++) {
+            const ag_tnode *x = &t->nodes[n];
+            if (x->kind == AG_NODE_COMPONENT && x->first_child < 0 && x->component >= 0 &&
+                L->mirror[x->component] && ag_box_extent(&x->box, 2) < 3)
+                src = (int32_t)n;
+        }
+        if (src < 0)
+            fail_msg("%s: no window is a mirror image of another", o->name);
+        const ag_box *S = &t->nodes[src].box;
+        int sthin = ag_box_extent(S, 0) < ag_box_extent(S, 1) ? 0 : 1;
+        for (size_t n = 0; n < t->nnodes && dst < 0; n++) {
+            const ag_tnode *x = &t->nodes[n];
+            int thin = ag_box_extent(&x->box, 0) < ag_box_extent(&x->box, 1) ? 0 : 1;
+            if (x->kind == AG_NODE_COMPONENT && x->first_child < 0 && thin != sthin &&
+                ag_box_extent(&x->box, 2) < 3 && ag_box_extent(&x->box, 2) > 1 &&
+                ag_box_extent(&x->box, 1 - thin) < 3)
+                dst = (int32_t)n;
+        }
+        assert_true(dst > 0);
+        int32_t nodes[1] = {src};
+        ag_edit_op paste = {.kind = AG_EDIT_PASTE, .node = dst, .nnodes = 1, .nodes = nodes,
+                            .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_DERIVE};
+        ag_edit_report rep = {0};
+        ag_edit_model *out = NULL;
+        if (ag_edit_apply_ex(em, &paste, 0, &out, &rep, &err))
+            fail_msg("%s: turned paste: %s", o->name, err.text);
+        if (!strstr(rep.message, "turned by 1 quarter turn") && !strstr(rep.message, "turned by 3"))
+            fail_msg("%s: not a turned paste: %s", o->name, rep.message);
+        /* the copy: appended, a mirror image of its label's exemplar, of the source's label */
+        const ag_splittree *t1 = out->proc->tree;
+        size_t copies = 0;
+        for (size_t n = t->nnodes; n < t1->nnodes; n++) {
+            const ag_tnode *x = &t1->nodes[n];
+            if (x->kind != AG_NODE_COMPONENT)
+                continue;
+            copies++;
+            assert_string_equal(label_of(out, (int32_t)n), label_of(em, src));
+        }
+        assert_int_equal(copies, 1);
+        ag_edit_report_clear(&rep);
+        ag_edit_model_free(out);
+        uint8_t *touched = calloc(t->nnodes, 1);
+        visible_below(t, dst, touched);
+        case_t c = {"paste a mirrored window turned", paste, touched, 1, 1};
+        check_case(em, &c, o);
+        /* and inserted into a wall of the other facade (kept beside what is there) */
+        int32_t wall = holder_wall(t, dst);
+        if (wall > 0) {
+            paste.node = wall;
+            paste.placement = AG_EDIT_INSERT;
+            memset(touched, 0, t->nnodes);
+            case_t c2 = {"insert a mirrored window turned", paste, touched, 0, 1};
+            check_case(em, &c2, o);
+        }
+        free(touched);
+        ag_edit_model_free(em);
+        ag_mesh_free(m);
+    }
+}
+
+/* ---- ids matched after proceduralizing again ---------------------------------------------- */
+
+/* op's mesh proceduralized again (the mesh path: every node renumbered), then matched to the
+ * input (core/edit/idmatch.h) with `changed` (what the op names as replaced; NULL: nothing
+ * named): every visible node of the input outside `touched` has its id, label and box again;
+ * the touched ones are dead when the op removes or moves them; `appended` visible nodes get new
+ * ids; the renumbered model's mesh is the mesh path's (vertex set, areas), its grammar derives
+ * it, and it reloads from what the store keeps node for node. Returns how many of the kept
+ * nodes the mesh path alone had numbered as before. */
+static size_t check_matched(ag_edit_model *em, const ag_edit_op *op, const uint8_t *touched,
+                            const uint8_t *changed, int removes, size_t appended,
+                            const char *what, const bb_options *o)
+{
+    ag_edit_model *mp = NULL, *out = NULL;
+    ag_proceduralize_result *r = NULL;
+    ag_idmatch_report rep = {0};
+    ag_error err = {0};
+    if (ag_edit_apply_ex(em, op, AG_EDIT_MESH_PATH, &mp, NULL, &err))
+        fail_msg("%s: %s: the mesh path: %s", o->name, what, err.text);
+    if (ag_idmatch_renumber(em->proc, mp->proc, changed, &em->opt.patterns, &r, &rep, &err))
+        fail_msg("%s: %s: match: %s", o->name, what, err.text);
+    assert_non_null(r); /* the mesh path numbers otherwise */
+    assert_int_equal(ag_edit_model_wrap(r, &em->opt, &out, &err), AG_OK);
+    const ag_splittree *t0 = em->proc->tree, *t1 = out->proc->tree, *tm = mp->proc->tree;
+    double btol = 1e-9 * fmax(1, fabs(t0->nodes[0].box.max[0]) + fabs(t0->nodes[0].box.max[1]));
+    assert_true(t1->nnodes >= t0->nnodes);
+    size_t by_chance = 0, kept = 0;
+    for (size_t n = 0; n < t0->nnodes; n++) {
+        const ag_tnode *a = &t0->nodes[n], *b = &t1->nodes[n];
+        if (a->kind != AG_NODE_COMPONENT)
+            continue;
+        if (touched[n]) {
+            if (removes && b->kind != AG_NODE_DEAD)
+                fail_msg("%s: %s: node %zu should be dead, it is %s", o->name, what, n,
+                         label_of(out, (int32_t)n));
+            continue;
+        }
+        if (b->kind != AG_NODE_COMPONENT)
+            fail_msg("%s: %s: visible node %zu (%s) lost its id", o->name, what, n,
+                     label_of(em, (int32_t)n));
+        if (strcmp(label_of(em, (int32_t)n), label_of(out, (int32_t)n)))
+            fail_msg("%s: %s: node %zu changed label %s -> %s", o->name, what, n,
+                     label_of(em, (int32_t)n), label_of(out, (int32_t)n));
+        if (!same_box(&a->box, &b->box, btol))
+            fail_msg("%s: %s: node %zu moved", o->name, what, n);
+        kept++;
+        by_chance += n < tm->nnodes && tm->nodes[n].kind == AG_NODE_COMPONENT &&
+                     same_box(&tm->nodes[n].box, &a->box, btol) &&
+                     !strcmp(label_of(mp, (int32_t)n), label_of(em, (int32_t)n));
+    }
+    size_t added = 0, visible = 0;
+    for (size_t n = 0; n < t1->nnodes; n++) {
+        visible += t1->nodes[n].kind == AG_NODE_COMPONENT;
+        added += n >= t0->nnodes && t1->nodes[n].kind == AG_NODE_COMPONENT;
+    }
+    if (added != appended)
+        fail_msg("%s: %s: %zu visible nodes appended, expected %zu", o->name, what, added,
+                 appended);
+    assert_int_equal(rep.kept, kept);
+    assert_int_equal(rep.kept + rep.appended, visible);
+    double diag = ag_box_diagonal(&t0->nodes[0].box);
+    char part[200];
+    snprintf(part, sizeof part, "%s: %s (matched mesh)", o->name, what);
+    assert_same_surface(out->proc->mesh, mp->proc->mesh, 1e-6 * fmax(1, diag), part);
+    ag_mesh *derived = NULL;
+    if (ag_grammar_derive(out->proc->grammar, NULL, &derived, &err))
+        fail_msg("%s: %s: derive: %s", o->name, what, err.text);
+    snprintf(part, sizeof part, "%s: %s (matched grammar)", o->name, what);
+    assert_same_surface(derived, mp->proc->mesh, 1e-4 * fmax(1, diag), part);
+    ag_mesh_free(derived);
+    char *served = ag_model_tree_served_text(out), *stored = ek_served_after_store(out);
+    if (strcmp(served, stored))
+        fail_msg("%s: %s: the matched model does not reload node for node", o->name, what);
+    free(served);
+    free(stored);
+    ag_edit_model_free(out);
+    ag_edit_model_free(mp);
+    return by_chance;
+}
+
+static void match_variant(const bb_options *o, size_t *chance, size_t *total)
+{
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    ag_edit_model *em = bb_service_model(o, &m, &err);
+    if (!em)
+        fail_msg("%s: %s", o->name, err.text);
+    const ag_splittree *t = em->proc->tree;
+    size_t nn = t->nnodes, vis = visible_below(t, 0, NULL);
+    int32_t wall = largest(t), wa, wb;
+    two_windows(em, &wa, &wb);
+    assert_true(wall > 0 && wa > 0 && wb > 0);
+    uint8_t *touched = calloc(nn, 1);
+    int32_t pair[2] = {wa, wb};
+#define MATCHED(op, changed, removes, appended, what)                                          \
+    do {                                                                                      \
+        *chance += check_matched(em, &(op), touched, changed, removes, appended, what, o);    \
+        *total += vis;                                                                        \
+    } while (0)
+    /* a window removed, the wall removed (with what it holds) */
+    ag_edit_op rm = {.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = pair};
+    visible_below(t, wa, touched);
+    MATCHED(rm, NULL, 1, 0, "remove a window");
+    memset(touched, 0, nn);
+    int32_t w1[1] = {wall};
+    rm.nodes = w1;
+    visible_below(t, wall, touched);
+    MATCHED(rm, NULL, 1, 0, "remove the wall");
+    /* two windows joined: one node of a new label */
+    ag_edit_op join = {.kind = AG_EDIT_JOIN, .nnodes = 2, .nodes = pair};
+    memset(touched, 0, nn);
+    touched[wa] = touched[wb] = 1;
+    MATCHED(join, NULL, 1, 1, "join two windows");
+    /* a window pasted onto another (what it replaces named), and into another */
+    int32_t src[1] = {wa};
+    ag_edit_op paste = {.kind = AG_EDIT_PASTE, .node = wb, .nnodes = 1, .nodes = src,
+                        .placement = AG_EDIT_REPLACE, .fit = AG_EDIT_DERIVE};
+    memset(touched, 0, nn);
+    visible_below(t, wb, touched);
+    MATCHED(paste, touched, 1, visible_below(t, wa, NULL), "paste a window onto another");
+    paste.placement = AG_EDIT_INSERT;
+    memset(touched, 0, nn);
+    MATCHED(paste, NULL, 0, visible_below(t, wa, NULL), "paste a window into another");
+    /* the wall split: both halves (and what it holds) are new boxes */
+    const ag_box *W = &t->nodes[wall].box;
+    int axis = ag_box_extent(W, 0) >= ag_box_extent(W, 1) ? 0 : 1;
+    ag_edit_op split = {.kind = AG_EDIT_SPLIT, .node = wall, .axis = axis,
+                        .at = W->min[axis] + 0.37 * ag_box_extent(W, axis)};
+    memset(touched, 0, nn);
+    size_t below = visible_below(t, wall, touched);
+    MATCHED(split, NULL, 1, 2 * below, "split the wall");
+#undef MATCHED
+    free(touched);
+    ag_edit_model_free(em);
+    ag_mesh_free(m);
+}
+
+/* A model proceduralized again gets the ids of the model it replaces (core/edit/idmatch.h):
+ * on every generated building, for ops made by their mesh and proceduralized again. */
+static void ids_matched_after_proceduralizing_again(void **state)
+{
+    (void)state;
+    size_t chance = 0, total = 0;
+    for (int set = 0; set < 2; set++) {
+        size_t nv;
+        const bb_options *v = set ? bb_handed_variants(&nv) : bb_id_variants(&nv);
+        for (size_t i = 0; i < nv; i++)
+            match_variant(&v[i], &chance, &total);
+    }
+    /* a model matched to itself read back through its grammar: every visible node kept, none
+     * new, none dead */
+    for (int set = 0; set < 2; set++) {
+        size_t nv;
+        const bb_options *v = set ? bb_handed_variants(&nv) : bb_id_variants(&nv);
+        for (size_t i = 0; i < nv; i++) {
+            ag_mesh *m = NULL;
+            ag_error err = {0};
+            ag_edit_model *em = bb_service_model(&v[i], &m, &err), *again = NULL;
+            assert_non_null(em);
+            assert_int_equal(ag_edit_model_from_grammar(em->proc->grammar, &em->opt, &again, &err), AG_OK);
+            ag_proceduralize_result *r = NULL;
+            ag_idmatch_report rep = {0};
+            assert_int_equal(ag_idmatch_renumber(em->proc, again->proc, NULL, &em->opt.patterns, &r, &rep, &err), AG_OK);
+            ag_proceduralize_result_free(r); /* NULL when numbered as before */
+            assert_int_equal(rep.appended, 0);
+            assert_int_equal(rep.dead, 0);
+            assert_int_equal(rep.kept, visible_below(em->proc->tree, 0, NULL));
+            ag_edit_model_free(again);
+            ag_edit_model_free(em);
+            ag_mesh_free(m);
+        }
+    }
+    /* what the matching is for: without it most ids name other nodes */
+    print_message("ids the mesh path alone kept: %zu of %zu\n", chance, total);
+    assert_true(chance < total / 2);
+}
+
 /* Bad ops get the same precise error from the tree path as from the mesh path, and no model. */
 static void bad_ops_are_refused_as_before(void **state)
 {
@@ -677,6 +947,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(ids_survive_split_join_paste_remove),
         cmocka_unit_test(turned_and_cross_model_pastes_keep_ids),
+        cmocka_unit_test(turned_paste_of_mirrored_terminals_keeps_ids),
+        cmocka_unit_test(ids_matched_after_proceduralizing_again),
         cmocka_unit_test(bad_ops_are_refused_as_before),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

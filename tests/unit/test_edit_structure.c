@@ -290,17 +290,17 @@ static void expect_stretched(const bb_measure *r, const bb_options *o, const cha
 }
 
 static const bb_options variants[] = {
-    {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0},
-    {"flush", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0},
-    {"proud", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0},
-    {"proud, overhang", 6, 3, 3, 0, BB_PROUD, 0.3, 0, 0, 0, 0, 0},
-    {"recessed, overhang, both sides", 6, 3, 3, 2, BB_RECESSED, 0.3, 0, 0, 0, 0, 0},
-    {"flush, turned a quarter", 6, 3, 3, 0, BB_FLUSH, 0, 1, 0, 0, 0, 0},
-    {"proud, turned three quarters", 6, 3, 3, 3, BB_PROUD, 0.2, 3, 0, 0, 0, 0},
-    {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0},
-    {"proud, UTM, turned", 6, 3, 3, 0, BB_PROUD, 0.3, 2, 684321.0, 5403210.0, 412.0, 0},
-    {"flush, jittered", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7},
-    {"proud 5 x 2, jittered", 5, 2, 4, 0, BB_PROUD, 0.3, 0, 0, 0, 0, 2e-7},
+    {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0, 0},
+    {"flush", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0, 0},
+    {"proud", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0, 0},
+    {"proud, overhang", 6, 3, 3, 0, BB_PROUD, 0.3, 0, 0, 0, 0, 0, 0},
+    {"recessed, overhang, both sides", 6, 3, 3, 2, BB_RECESSED, 0.3, 0, 0, 0, 0, 0, 0},
+    {"flush, turned a quarter", 6, 3, 3, 0, BB_FLUSH, 0, 1, 0, 0, 0, 0, 0},
+    {"proud, turned three quarters", 6, 3, 3, 3, BB_PROUD, 0.2, 3, 0, 0, 0, 0, 0},
+    {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0, 0},
+    {"proud, UTM, turned", 6, 3, 3, 0, BB_PROUD, 0.3, 2, 684321.0, 5403210.0, 412.0, 0, 0},
+    {"flush, jittered", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7, 0},
+    {"proud 5 x 2, jittered", 5, 2, 4, 0, BB_PROUD, 0.3, 0, 0, 0, 0, 2e-7, 0},
 };
 
 /* One variant through every edit, each on the service's path (the model kept, no read-back)

@@ -91,11 +91,11 @@ static void test_box_buildings(void **state)
 {
     (void)state;
     const bb_options variants[] = {
-        {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0},
-        {"flush", 6, 3, 3, 2, BB_FLUSH, 0, 0, 0, 0, 0, 0},
-        {"proud, overhang, turned", 6, 3, 3, 0, BB_PROUD, 0.3, 1, 0, 0, 0, 0},
-        {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0},
-        {"flush, jittered", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7},
+        {"recessed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0, 0},
+        {"flush", 6, 3, 3, 2, BB_FLUSH, 0, 0, 0, 0, 0, 0, 0},
+        {"proud, overhang, turned", 6, 3, 3, 0, BB_PROUD, 0.3, 1, 0, 0, 0, 0, 0},
+        {"recessed, UTM", 6, 3, 3, 0, BB_RECESSED, 0, 0, 512345.0, 5812345.0, 31.0, 0, 0},
+        {"flush, jittered", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7, 0},
     };
     for (size_t i = 0; i < sizeof variants / sizeof *variants; i++) {
         ag_mesh *m = NULL;

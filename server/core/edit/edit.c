@@ -241,8 +241,7 @@ ag_status ag_edit_apply(ag_edit_model *m, const ag_edit_op *op, ag_edit_model **
     return ag_edit_apply_ex(m, op, AG_EDIT_READ_BACK, out, rep, err);
 }
 
-/* The edited tree of op (resize.h, treeedit.h) over *base; AG_ERR_UNSUPPORTED (nothing set in
- * err) for an edit only the mesh path makes. */
+/* The edited tree of op (resize.h, treeedit.h) over *base. */
 static ag_status edited_tree(const ag_proceduralize_result *in, const ag_edit_op *op,
                              ag_treeedit_base *base, ag_splittree **tree, int32_t **source,
                              ag_edit_report *rep, ag_error *err)
@@ -258,13 +257,8 @@ static ag_status edited_tree(const ag_proceduralize_result *in, const ag_edit_op
         return ag_treeedit_join(in, op, base, tree, source, rep, err);
     case AG_EDIT_REMOVE:
         return ag_treeedit_remove(in, op, base, tree, source, rep, err);
-    case AG_EDIT_PASTE: {
-        ag_error e = {0};
-        ag_status st = ag_treeedit_paste(in, op, base, tree, source, rep, &e);
-        if (st && st != AG_ERR_UNSUPPORTED && err)
-            *err = e;
-        return st;
-    }
+    case AG_EDIT_PASTE:
+        return ag_treeedit_paste(in, op, base, tree, source, rep, err);
     default:
         return ag_error_set(err, AG_ERR_INVALID, 0, "kind: unknown edit kind %d", op->kind);
     }
@@ -299,22 +293,15 @@ static ag_status check_tree(const ag_edit_budget *b, const ag_proceduralize_resu
 }
 
 /* An edit that knows its result: the edited tree rebuilt into the new model (rebuild.h), node
- * ids kept; read back through its grammar when asked. *done = 0 when the edit takes the mesh
- * path instead. */
+ * ids kept; read back through its grammar when asked. */
 static ag_status apply_tree(ag_edit_model *m, const ag_edit_op *op, unsigned flags,
-                            ag_edit_model **out, ag_edit_report *rep, int *done, ag_error *err)
+                            ag_edit_model **out, ag_edit_report *rep, ag_error *err)
 {
     ag_splittree *tree = NULL;
     int32_t *source = NULL;
     ag_proceduralize_result *r = NULL;
     ag_treeedit_base base = {0};
-    *done = 1;
     ag_status st = edited_tree(m->proc, op, &base, &tree, &source, rep, err);
-    if (st == AG_ERR_UNSUPPORTED) {
-        ag_treeedit_base_free(&base);
-        *done = 0;
-        return AG_OK;
-    }
     if (!st && op->kind != AG_EDIT_RESIZE) /* a resize counted its emission itself */
         st = check_tree(op->budget, &base.view, tree, source, err);
     if (st) {
@@ -360,12 +347,9 @@ ag_status ag_edit_apply_ex(ag_edit_model *m, const ag_edit_op *op, unsigned flag
     ag_mesh *mesh = NULL;
     ag_status st;
     if (!(flags & AG_EDIT_MESH_PATH)) {
-        int done;
-        st = apply_tree(m, op, flags, out, rep, &done, err);
-        if (done) {
-            ag_edit_report_clear(&local); /* the caller asked for no report */
-            return st;
-        }
+        st = apply_tree(m, op, flags, out, rep, err);
+        ag_edit_report_clear(&local); /* the caller asked for no report */
+        return st;
     }
     /* the mesh path: the operation's mesh proceduralized again */
     switch (op->kind) {

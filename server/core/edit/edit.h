@@ -6,8 +6,8 @@
  * node the edit does not remove keeps its index, new nodes are appended, removed ones are
  * dead) and rebuilds the model from it (rebuild.h: rules and patterns found afresh) without
  * proceduralizing again. The mesh-returning functions below make the operation's mesh — one
- * component per placed terminal, grouped by label name — which a turned paste of mirrored
- * terminals (and point clouds, points/pointedit.h) proceduralize again.
+ * component per placed terminal, grouped by label name — which point clouds
+ * (points/pointedit.h) and AG_EDIT_MESH_PATH proceduralize again.
  *
  * Nodes are named by their index in the model's split tree (model->proc->tree); node 0 is
  * the root. A visible node's geometry is kept relative to its box: when the box changes, the
@@ -157,8 +157,7 @@ ag_status ag_edit_model_wrap(ag_proceduralize_result *r, const ag_proceduralize_
                              ag_edit_model **out, ag_error *err);
 void ag_edit_model_free(ag_edit_model *m);
 
-/* Applies op: the edited tree rebuilt into the new model (a turned paste of mirrored
- * terminals: the operation's mesh proceduralized), then derives its grammar and
+/* Applies op: the edited tree rebuilt into the new model, then derives its grammar and
  * proceduralizes that again (so the new model's ids are those a reload of its grammar gives,
  * see ag_edit_model_from_grammar), returns the new model and fills rep (instances per label
  * counted on the new model's tree, named as its grammar's labels). The input model is
@@ -173,8 +172,7 @@ typedef enum {
      * leaves it out and saves the second run. */
     AG_EDIT_READ_BACK = 1,
     /* make the operation's mesh and proceduralize it again (every node renumbered) instead of
-     * rebuilding the edited tree: what a turned paste of mirrored terminals always does; for
-     * comparisons and benchmarks */
+     * rebuilding the edited tree: for comparisons and benchmarks */
     AG_EDIT_MESH_PATH = 2,
 } ag_edit_apply_flags;
 

@@ -622,12 +622,6 @@ ag_status ag_treeedit_paste(const ag_proceduralize_result *in, const ag_edit_op 
     copy_source cs = {.from = ts, .turns = pl.turns}, *csp = NULL;
     int32_t *view_node = NULL, *view_comp = NULL;
     if (src != in || pl.turns) {
-        for (size_t c = 0; pl.turns && src->labels->mirror && c < ts->ncomponents; c++)
-            if (smark[c] && src->labels->mirror[c]) {
-                free(smark);
-                return ag_error_set(err, AG_ERR_UNSUPPORTED, 0,
-                                    "a turned paste of mirrored terminals");
-            }
         view_node = malloc((ts->ncomponents + 1) * sizeof *view_node);
         view_comp = malloc((ts->ncomponents + 1) * sizeof *view_comp);
         for (size_t c = 0; view_node && view_comp && c < ts->ncomponents; c++)

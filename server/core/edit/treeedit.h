@@ -22,8 +22,9 @@
  * *base is then a view of the input with those components appended (a turned source turned
  * in place, about its box's centre, with its quarter turns counted on; another model's labels
  * and variants as new ones), and ag_treeedit_base_free frees what the view owns; else *base is
- * the input itself. A turned paste of mirrored terminals is not made so: ag_treeedit_paste
- * returns AG_ERR_UNSUPPORTED and the caller takes the mesh path (edit.h). */
+ * the input itself. A mirror image turned is still a turn of its variant's terminal (a mirror
+ * image has a variant of its own, label.h), so a turned paste of mirrored terminals is made so
+ * too. */
 #ifndef AG_EDIT_TREEEDIT_H
 #define AG_EDIT_TREEEDIT_H
 

@@ -1,0 +1,449 @@
+/* Ids for a model proceduralized again (idmatch.h). */
+#include "idmatch.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rebuild.h"
+
+static ag_status nomem(ag_error *err)
+{
+    return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while matching node ids");
+}
+
+/* A node's label name: its component's group ("" for invisible nodes). */
+static const char *name_of(const ag_proceduralize_result *r, const ag_tnode *x)
+{
+    const ag_mesh *m = r->mesh;
+    if (x->kind != AG_NODE_COMPONENT || x->component < 0 ||
+        (size_t)x->component >= m->ncomponents)
+        return "";
+    int32_t g = m->component_group[x->component];
+    return g >= 0 && (size_t)g < m->ngroups && m->group_names[g] ? m->group_names[g] : "";
+}
+
+/* The nearest visible ancestor of n, or the root (-1 for the root): patterns come and go
+ * with an edit (a row with a window less is no pattern), what holds a node stays. */
+static int32_t holder(const ag_splittree *t, int32_t n)
+{
+    int32_t p = t->nodes[n].parent;
+    while (p > 0 && t->nodes[p].kind != AG_NODE_COMPONENT)
+        p = t->nodes[p].parent;
+    return p;
+}
+
+/* The largest distance between corresponding faces of two boxes. */
+static double box_distance(const ag_box *a, const ag_box *b)
+{
+    double d = 0;
+    for (int k = 0; k < 3; k++)
+        d = fmax(d, fmax(fabs(a->min[k] - b->min[k]), fabs(a->max[k] - b->max[k])));
+    return d;
+}
+
+/* An old node keyed by its box's lower x, for the search by place. */
+typedef struct {
+    double x;
+    int32_t n;
+} keyed;
+
+static int by_x(const void *a, const void *b)
+{
+    double x = ((const keyed *)a)->x, y = ((const keyed *)b)->x;
+    return x < y ? -1 : x > y;
+}
+
+/* The first of k (sorted by x) at x or above. */
+static size_t first_at_or_above(const keyed *k, size_t n, double x)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (k[mid].x < x)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+static int matchable(const ag_tnode *x)
+{
+    return x->kind == AG_NODE_COMPONENT || x->kind == AG_NODE_PATTERN;
+}
+
+/* Boxes this close are the same: the derivation places shared terminals, which differ from
+ * the instances by up to the labels' tolerances. */
+static double match_tolerance(const ag_proceduralize_result *r)
+{
+    const ag_labels *L = r->labels;
+    double tol = fmax(r->tree->tol, r->tree->eps);
+    if (L)
+        tol = fmax(tol, fmax(L->tol, L->share));
+    return 2 * tol;
+}
+
+/* f2o: per fresh node, the old node it matches (-1). */
+static ag_status match(const ag_proceduralize_result *old, const ag_proceduralize_result *fresh,
+                       const uint8_t *changed, int32_t *f2o)
+{
+    const ag_splittree *O = old->tree, *F = fresh->tree;
+    size_t no = O->nnodes, nf = F->nnodes;
+    double tol = fmax(match_tolerance(old), match_tolerance(fresh));
+    /* old nodes that may be matched, bucketed by their holder */
+    uint32_t *start = calloc(no + 2, sizeof *start);
+    int32_t *list = malloc((no + 1) * sizeof *list);
+    int32_t *queue = malloc((nf + 1) * sizeof *queue);
+    uint8_t *taken = calloc(no + 1, 1);
+    ag_status st = AG_OK;
+    if (!start || !list || !queue || !taken) {
+        st = AG_ERR_NOMEM;
+        goto done;
+    }
+    for (size_t n = 1; n < no; n++) {
+        int32_t h = matchable(&O->nodes[n]) && !(changed && changed[n]) ? holder(O, (int32_t)n)
+                                                                         : -1;
+        if (h >= 0)
+            start[h + 1]++;
+    }
+    for (size_t n = 0; n < no; n++)
+        start[n + 1] += start[n];
+    uint32_t *fill = calloc(no + 1, sizeof *fill);
+    if (!fill) {
+        st = AG_ERR_NOMEM;
+        goto done;
+    }
+    for (size_t n = 1; n < no; n++) {
+        int32_t h = matchable(&O->nodes[n]) && !(changed && changed[n]) ? holder(O, (int32_t)n)
+                                                                         : -1;
+        if (h >= 0)
+            list[start[h] + fill[h]++] = (int32_t)n;
+    }
+    free(fill);
+    for (size_t f = 0; f < nf; f++)
+        f2o[f] = -1;
+    if (!no || !nf || F->nodes[0].kind != AG_NODE_ROOT || O->nodes[0].kind != AG_NODE_ROOT)
+        goto done;
+    f2o[0] = 0;
+    taken[0] = 1;
+    /* top-down, so a node's holder is matched (or not) before it */
+    size_t qh = 0, qt = 0;
+    queue[qt++] = 0;
+    while (qh < qt) {
+        int32_t f = queue[qh++];
+        for (int32_t c = F->nodes[f].first_child; c >= 0 && qt < nf; c = F->nodes[c].next_sibling)
+            queue[qt++] = c;
+        const ag_tnode *x = &F->nodes[f];
+        if (f == 0 || !matchable(x))
+            continue;
+        int32_t h = holder(F, f);
+        if (h < 0 || f2o[h] < 0)
+            continue;
+        const char *name = name_of(fresh, x);
+        int32_t best = -1;
+        double bd = tol;
+        for (uint32_t i = start[f2o[h]]; i < start[f2o[h] + 1]; i++) {
+            int32_t o = list[i];
+            const ag_tnode *y = &O->nodes[o];
+            if (taken[o] || y->kind != x->kind || strcmp(name_of(old, y), name))
+                continue;
+            double d = box_distance(&x->box, &y->box);
+            if (d <= bd) {
+                bd = d;
+                best = o;
+            }
+        }
+        if (best >= 0) {
+            f2o[f] = best;
+            taken[best] = 1;
+        }
+    }
+    /* a node whose holder is new (nested in a node the change made, such as a joined one)
+     * or held otherwise now: the same label on the same box anywhere, nearest first */
+    size_t nl = 0;
+    keyed *k = malloc((no + 1) * sizeof *k);
+    if (!k) {
+        st = AG_ERR_NOMEM;
+        goto done;
+    }
+    for (size_t n = 1; n < no; n++)
+        if (!taken[n] && matchable(&O->nodes[n]) && !(changed && changed[n]))
+            k[nl++] = (keyed){O->nodes[n].box.min[0], (int32_t)n};
+    qsort(k, nl, sizeof *k, by_x);
+    for (size_t q = 0; q < qt; q++) {
+        int32_t f = queue[q];
+        const ag_tnode *x = &F->nodes[f];
+        if (f == 0 || f2o[f] >= 0 || !matchable(x))
+            continue;
+        const char *name = name_of(fresh, x);
+        int32_t best = -1;
+        double bd = tol;
+        for (size_t i = first_at_or_above(k, nl, x->box.min[0] - tol);
+             i < nl && k[i].x <= x->box.min[0] + tol; i++) {
+            int32_t o = k[i].n;
+            const ag_tnode *y = &O->nodes[o];
+            if (taken[o] || y->kind != x->kind || strcmp(name_of(old, y), name))
+                continue;
+            double d = box_distance(&x->box, &y->box);
+            if (d <= bd) {
+                bd = d;
+                best = o;
+            }
+        }
+        if (best >= 0) {
+            f2o[f] = best;
+            taken[best] = 1;
+        }
+    }
+    free(k);
+    /* an intermediate split node follows the chain end below it */
+    for (size_t f = 1; f < nf; f++) {
+        const ag_tnode *x = &F->nodes[f];
+        int32_t c = x->first_child;
+        if (x->kind != AG_NODE_SPLIT || c < 0 || f2o[c] < 0)
+            continue;
+        int32_t p = O->nodes[f2o[c]].parent;
+        if (p > 0 && O->nodes[p].kind == AG_NODE_SPLIT && !taken[p]) {
+            f2o[f] = p;
+            taken[p] = 1;
+        }
+    }
+done:
+    free(start);
+    free(list);
+    free(queue);
+    free(taken);
+    return st;
+}
+
+static int32_t remap(const int32_t *id, int32_t n)
+{
+    return n >= 0 ? id[n] : -1;
+}
+
+/* fresh's tree with node f at id[f], the other slots dead (an old id keeps its old node's
+ * box and pivot, as a dead node does); *source per node: the fresh node it is. */
+static ag_splittree *renumbered(const ag_splittree *O, const ag_splittree *F, const int32_t *id,
+                                size_t nnodes, int32_t **source)
+{
+    ag_splittree *T = calloc(1, sizeof *T);
+    int32_t *src = malloc((nnodes + 1) * sizeof *src);
+    if (T) {
+        T->nodes = malloc((nnodes + 1) * sizeof *T->nodes);
+        T->patterns = malloc((F->npatterns + 1) * sizeof *T->patterns);
+        T->rule_count = malloc((F->nrules + 1) * sizeof *T->rule_count);
+        T->rule_rep = malloc((F->nrules + 1) * sizeof *T->rule_rep);
+    }
+    if (!T || !src || !T->nodes || !T->patterns || !T->rule_count || !T->rule_rep) {
+        ag_splittree_free(T);
+        free(src);
+        return NULL;
+    }
+    T->nnodes = T->cap = nnodes;
+    T->tol = F->tol;
+    T->eps = F->eps;
+    for (size_t n = 0; n < nnodes; n++) {
+        ag_tnode *x = &T->nodes[n];
+        if (n < O->nnodes)
+            *x = O->nodes[n];
+        else
+            memset(x, 0, sizeof *x);
+        x->kind = AG_NODE_DEAD;
+        x->parent = x->first_child = x->last_child = x->next_sibling = -1;
+        x->component = x->label = x->variant = x->rule = x->pattern = -1;
+        src[n] = 0;
+    }
+    for (size_t f = 0; f < F->nnodes; f++) {
+        if (id[f] < 0)
+            continue;
+        ag_tnode *x = &T->nodes[id[f]];
+        *x = F->nodes[f];
+        x->parent = remap(id, x->parent);
+        x->first_child = remap(id, x->first_child);
+        x->last_child = remap(id, x->last_child);
+        x->next_sibling = remap(id, x->next_sibling);
+        src[id[f]] = (int32_t)f;
+    }
+    for (size_t p = 0; p < F->npatterns; p++) {
+        T->patterns[p] = F->patterns[p];
+        T->patterns[p].node = remap(id, F->patterns[p].node);
+    }
+    T->npatterns = T->cap_patterns = F->npatterns;
+    for (size_t r = 0; r < F->nrules; r++) {
+        T->rule_count[r] = F->rule_count[r];
+        T->rule_rep[r] = remap(id, F->rule_rep[r]);
+    }
+    T->nrules = F->nrules;
+    *source = src;
+    return T;
+}
+
+/* Label numbers for fresh's components as the old model named its kept nodes' labels:
+ * proceduralizing again classes by shape, so a kept node's label may come back together with
+ * new geometry of its shape, or split (a stretched window is another shape now). A variant
+ * whose kept members all had one old label ("L<k>") goes to that label; the other variants
+ * keep their label's number unless an old name took it, else follow the largest number.
+ * label (per component) and vlabel (per variant) get the numbers, *nlabels the label count;
+ * -1 when out of memory. */
+static int old_label_names(const ag_proceduralize_result *old,
+                           const ag_proceduralize_result *fresh, const int32_t *f2o,
+                           int32_t *label, int32_t *vlabel, size_t *nlabels)
+{
+    const ag_labels *L = fresh->labels;
+    const ag_splittree *F = fresh->tree, *O = old->tree;
+    size_t nv = L->nvariants, nl = L->nlabels;
+    size_t *claim = calloc(nv + 1, sizeof *claim);
+    uint8_t *mixed = calloc(nv + 1, 1), *used = NULL;
+    int32_t *moved = malloc((nl + 1) * sizeof *moved);
+    size_t top = nl;
+    int st = -1;
+    if (!claim || !mixed || !moved)
+        goto done;
+    for (size_t f = 0; f < F->nnodes; f++) {
+        const ag_tnode *x = &F->nodes[f];
+        if (x->kind != AG_NODE_COMPONENT || f2o[f] < 0 || x->component < 0 ||
+            (size_t)x->component >= L->ncomponents)
+            continue;
+        int32_t v = L->variant[x->component];
+        if (v < 0 || (size_t)v >= nv)
+            continue;
+        size_t k = ag__rebuild_label_number(name_of(old, &O->nodes[f2o[f]]));
+        if (!k || (claim[v] && claim[v] != k))
+            mixed[v] = 1;
+        else
+            claim[v] = k;
+    }
+    for (size_t v = 0; v < nv; v++) {
+        if (mixed[v])
+            claim[v] = 0;
+        if (claim[v] > top)
+            top = claim[v];
+    }
+    used = calloc(top + 1, 1);
+    if (!used)
+        goto done;
+    for (size_t v = 0; v < nv; v++)
+        if (claim[v])
+            used[claim[v] - 1] = 1;
+    for (size_t l = 0; l < nl; l++)
+        moved[l] = -1;
+    size_t next = top;
+    for (size_t v = 0; v < nv; v++) {
+        int32_t l = L->variant_label[v];
+        if (claim[v]) {
+            vlabel[v] = (int32_t)claim[v] - 1;
+        } else if (l < 0 || (size_t)l >= nl) {
+            vlabel[v] = l;
+        } else {
+            if (moved[l] < 0)
+                moved[l] = used[l] ? (int32_t)next++ : l;
+            vlabel[v] = moved[l];
+        }
+    }
+    for (size_t c = 0; c < L->ncomponents; c++) {
+        int32_t v = L->variant[c];
+        label[c] = v >= 0 && (size_t)v < nv ? vlabel[v] : L->label[c];
+    }
+    *nlabels = next > nl ? next : nl;
+    st = 0;
+done:
+    free(claim);
+    free(mixed);
+    free(used);
+    free(moved);
+    return st;
+}
+
+ag_status ag_idmatch_renumber(const ag_proceduralize_result *old,
+                              const ag_proceduralize_result *fresh, const uint8_t *changed,
+                              const ag_patterns_options *popt, ag_proceduralize_result **out,
+                              ag_idmatch_report *rep, ag_error *err)
+{
+    *out = NULL;
+    const ag_splittree *O = old->tree, *F = fresh->tree;
+    const ag_labels *FL = fresh->labels;
+    int32_t *f2o = malloc((F->nnodes + 1) * sizeof *f2o);
+    int32_t *id = malloc((F->nnodes + 1) * sizeof *id);
+    int32_t *label = malloc((FL->ncomponents + 1) * sizeof *label);
+    int32_t *vlabel = malloc((FL->nvariants + 1) * sizeof *vlabel);
+    size_t nlabels = 0;
+    if (!f2o || !id || !label || !vlabel || match(old, fresh, changed, f2o) ||
+        old_label_names(old, fresh, f2o, label, vlabel, &nlabels)) {
+        free(f2o);
+        free(id);
+        free(label);
+        free(vlabel);
+        return nomem(err);
+    }
+    ag_idmatch_report r = {0};
+    size_t next = O->nnodes;
+    uint8_t *alive = calloc(O->nnodes + 1, 1);
+    if (!alive) {
+        free(f2o);
+        free(id);
+        free(label);
+        free(vlabel);
+        return nomem(err);
+    }
+    for (size_t f = 0; f < F->nnodes; f++) {
+        const ag_tnode *x = &F->nodes[f];
+        if (x->kind == AG_NODE_DEAD) {
+            id[f] = -1;
+            continue;
+        }
+        id[f] = f2o[f] >= 0 ? f2o[f] : (int32_t)next++;
+        if (f2o[f] >= 0)
+            alive[f2o[f]] = 1;
+        if (x->kind == AG_NODE_COMPONENT) {
+            if (f2o[f] >= 0)
+                r.kept++;
+            else
+                r.appended++;
+        }
+    }
+    int same = next == O->nnodes && F->nnodes == O->nnodes;
+    for (size_t n = 0; n < O->nnodes; n++) {
+        r.dead += O->nodes[n].kind == AG_NODE_COMPONENT && !alive[n];
+        same = same && (O->nodes[n].kind == AG_NODE_DEAD ? F->nodes[n].kind == AG_NODE_DEAD
+                                                         : f2o[n] == (int32_t)n);
+    }
+    for (size_t c = 0; same && c < FL->ncomponents; c++)
+        same = label[c] == FL->label[c];
+    free(alive);
+    if (same) { /* fresh numbers every node as old did: nothing to rebuild */
+        free(f2o);
+        free(id);
+        free(label);
+        free(vlabel);
+        if (rep)
+            *rep = r;
+        return AG_OK;
+    }
+    free(f2o);
+    int32_t *source = NULL;
+    ag_splittree *T = renumbered(O, F, id, next, &source);
+    free(id);
+    if (!T) {
+        free(label);
+        free(vlabel);
+        return nomem(err);
+    }
+    /* fresh as the rebuild reads it, its labels named after the old ones */
+    ag_proceduralize_result view = *fresh;
+    ag_labels named = *fresh->labels;
+    named.label = label;
+    named.variant_label = vlabel;
+    named.nlabels = nlabels;
+    view.labels = &named;
+    for (size_t n = 0; n < T->nnodes; n++)
+        if (T->nodes[n].kind == AG_NODE_COMPONENT && T->nodes[n].component >= 0 &&
+            (size_t)T->nodes[n].component < named.ncomponents)
+            T->nodes[n].label = label[T->nodes[n].component];
+    ag_status st = ag_rebuild(&view, T, source, popt, out, err);
+    free(label);
+    free(vlabel);
+    if (!st && rep)
+        *rep = r;
+    return st;
+}
