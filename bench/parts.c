@@ -1,4 +1,4 @@
-/* Parts library timings (figures, not pass/fail), median of 5 runs each unless said:
+/* Parts library timings (figures, not pass/fail), median of 11 runs each unless said:
  * - core: save (ag_part_extract) and compose (ag_compose) on a generated ~200k-triangle
  *   building, the operations the service runs on a model in memory;
  * - service: the same building in a store on a temporary database with the edit models kept
@@ -6,7 +6,8 @@
  *   extraction, thumbnail, one transaction), previewing a compose op (rewrite and derivation)
  *   and the compose op itself (rewrite, the new state: the part grafted into the model's tree,
  *   core/parts/graft.h, or where that does not apply its derivation proceduralized, counted
- *   from the op log; one sequenced commit);
+ *   from the op log; one sequenced commit), with its stages as the op log reports them: the
+ *   rewrite, the new state (print, read back, derivation, graft) and the rest (the commit);
  * - search latency over a library of 10,000 parts (FTS5 words, prefixes, tags, deep pages).
  * Target: save and compose <= 50 ms each in the service. */
 #include <math.h>
@@ -49,7 +50,7 @@ static int cmp(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-#define RUNS 5
+#define RUNS 11
 
 static size_t subtree(const ag_splittree *t, int32_t n)
 {
@@ -187,17 +188,27 @@ static void service_close(service *sv)
     unlink(side);
 }
 
-/* The model's nodes at its current version. */
-static picks service_picks(service *sv)
+/* The model's nodes at its current version (nodes and dead: its tree's size, may be NULL). */
+static picks service_picks_sized(service *sv, size_t *nodes, size_t *dead)
 {
     ag_error err = {0};
     ag_edit_state *st;
     if (ag_edit_session_acquire(sv->env.sessions, sv->db, sv->model, &st, &err))
         die("acquire", &err);
-    picks k = pick(st->em->proc->tree);
+    const ag_splittree *t = st->em->proc->tree;
+    picks k = pick(t);
+    if (nodes)
+        *nodes = t->nnodes;
+    for (size_t i = 0; dead && i < t->nnodes; i++)
+        *dead += t->nodes[i].kind == AG_NODE_DEAD;
     sv->version = st->version;
     ag_edit_session_release(sv->env.sessions, st);
     return k;
+}
+
+static picks service_picks(service *sv)
+{
+    return service_picks_sized(sv, NULL, NULL);
 }
 
 static int64_t service_save(service *sv, int32_t node, const char *what)
@@ -237,6 +248,7 @@ static json_t *compose_op(int64_t part, int32_t target, const char *mode, const 
 typedef struct {
     int grafted;
     char fallback[200];
+    double compose_ms, state_ms; /* the rewrite, the new state */
 } op_state;
 
 static void read_state(void *user, const ag_op_row *row)
@@ -247,6 +259,8 @@ static void read_state(void *user, const ag_op_row *row)
     const char *st = json_string_value(json_object_get(r, "state"));
     const char *fb = json_string_value(json_object_get(r, "fallback"));
     o->grafted = st && !strcmp(st, "grafted");
+    o->compose_ms = json_number_value(json_object_get(r, "compose_ms"));
+    o->state_ms = json_number_value(json_object_get(r, "state_ms"));
     snprintf(o->fallback, sizeof o->fallback, "%s", fb ? fb : "");
     json_decref(b);
 }
@@ -254,7 +268,7 @@ static void read_state(void *user, const ag_op_row *row)
 static void service_compose(service *sv, int64_t part, int which, const char *mode,
                             const char *scope, const char *what)
 {
-    double pv[RUNS], op[RUNS];
+    double pv[RUNS], op[RUNS], rw[RUNS], ns[RUNS], rest[RUNS];
     int grafted = 0;
     char fallback[200] = "";
     json_t *rep = NULL;
@@ -290,17 +304,27 @@ static void service_compose(service *sv, int64_t part, int which, const char *mo
         if (ag_ops_each_since(sv->db, sv->model, v - 1, 1, read_state, &os, &err))
             die("op log", &err);
         grafted += os.grafted;
+        rw[i] = os.compose_ms;
+        ns[i] = os.state_ms;
+        rest[i] = op[i] - os.compose_ms - os.state_ms;
         if (!os.grafted)
             snprintf(fallback, sizeof fallback, "%s", os.fallback);
     }
     printf("service compose %-34s %-7s %-4s %6lld instances: preview %8.2f ms, op %8.2f ms "
-           "(in the preview: loading %.1f ms, rewrite %.1f ms, derivation %.1f ms; the op's new "
+           "(in the op: rewrite %.1f ms, new state %.1f ms, commit and the rest %.1f ms; "
+           "in the preview: loading %.1f ms, rewrite %.1f ms, derivation %.1f ms; the op's new "
            "state grafted in %d of %d runs%s%s)\n",
            what, mode, scope, (long long)json_integer_value(json_object_get(rep, "instances")),
-           median(pv, RUNS), median(op, RUNS), json_real_value(json_object_get(rep, "load_ms")),
+           median(pv, RUNS), median(op, RUNS), median(rw, RUNS), median(ns, RUNS),
+           median(rest, RUNS), json_real_value(json_object_get(rep, "load_ms")),
            json_real_value(json_object_get(rep, "compose_ms")),
            json_real_value(json_object_get(rep, "state_ms")), grafted, RUNS,
            fallback[0] ? ", else proceduralized: " : "", fallback);
+    /* removed nodes keep their ids (dead in the tree): what every later op carries */
+    size_t nodes = 0, dead = 0;
+    service_picks_sized(sv, &nodes, &dead);
+    printf("                after: the model's tree has %zu nodes, %zu of them removed ones\n",
+           nodes, dead);
     json_decref(rep);
 }
 

@@ -79,7 +79,6 @@ static void *picture(void *arg)
 static ag_status prepare(const ag_part *p, stored *out, ag_error *err)
 {
     memset(out, 0, sizeof *out);
-    json_t *entry = NULL;
     ag_status s = ag_part_validate(p, err);
     if (s != AG_OK)
         return s;
@@ -88,13 +87,9 @@ static ag_status prepare(const ag_part *p, stored *out, ag_error *err)
     int threaded = pthread_create(&th, NULL, picture, &pic) == 0;
     if (s == AG_OK && !(out->terminals = json_object()))
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    size_t entry_len = 0;
     if (s == AG_OK)
-        s = ag_part_bundle_entry(p, out->terminals, &entry, err);
-    if (s == AG_OK &&
-        !(out->entry = json_dumps(entry, JSON_COMPACT | JSON_PRESERVE_ORDER |
-                                             JSON_REAL_PRECISION(17))))
-        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    json_decref(entry);
+        s = ag_part_bundle_entry_text(p, out->terminals, &out->entry, &entry_len, err);
     size_t nt = s == AG_OK ? json_object_size(out->terminals) : 0;
     if (s == AG_OK && nt && !(out->terms = calloc(nt, sizeof *out->terms)))
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");

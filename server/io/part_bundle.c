@@ -9,8 +9,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "../core/base/array.h"
 #include "../core/parts/gcopy.h"
+#include "../core/utf8.h"
 #include "grammar_text.h"
+#include "numtext.h"
 #include "sha256.h"
 #include "terminals.h"
 
@@ -34,17 +37,117 @@ static int kind_of(const char *s)
                                                                                   : -1;
 }
 
-static json_t *box_json(const double *v)
+/* Compact JSON text written straight into one growing buffer: a large part's entry (thousands
+ * of nodes) cost several times more as a tree of jansson values built, printed and freed. */
+typedef struct {
+    char *p;
+    size_t n, cap;
+    const char *bad; /* the first member that could not be written, or NULL */
+    int nomem;
+} jtext;
+
+static void jt_put(jtext *j, const char *s, size_t n)
 {
-    json_t *a = json_array();
-    for (int i = 0; i < 6; i++)
-        json_array_append_new(a, json_real(v[i]));
-    return a;
+    if (j->nomem || AG_ARRAY_RESERVE_MORE(j->p, j->cap, j->n, n + 1) != AG_OK) {
+        j->nomem = 1;
+        return;
+    }
+    memcpy(j->p + j->n, s, n);
+    j->n += n;
+    j->p[j->n] = '\0';
 }
 
-ag_status ag_part_bundle_entry(const ag_part *p, json_t *terminals, json_t **out, ag_error *err)
+static void jt_lit(jtext *j, const char *s)
+{
+    jt_put(j, s, strlen(s));
+}
+
+/* A JSON string escaped as jansson escapes it (quote, backslash, control characters); what
+ * is not valid UTF-8 is not written and named as bad. */
+static void jt_string(jtext *j, const char *s, size_t n, const char *what)
+{
+    if (ag_utf8_valid_prefix(s, n) != n) {
+        if (!j->bad)
+            j->bad = what;
+        return;
+    }
+    jt_put(j, "\"", 1);
+    size_t run = 0;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c >= 0x20 && c != '"' && c != '\\')
+            continue;
+        jt_put(j, s + run, i - run);
+        run = i + 1;
+        char esc[8];
+        switch (c) {
+        case '"': jt_put(j, "\\\"", 2); break;
+        case '\\': jt_put(j, "\\\\", 2); break;
+        case '\n': jt_put(j, "\\n", 2); break;
+        case '\t': jt_put(j, "\\t", 2); break;
+        case '\r': jt_put(j, "\\r", 2); break;
+        case '\b': jt_put(j, "\\b", 2); break;
+        case '\f': jt_put(j, "\\f", 2); break;
+        default:
+            snprintf(esc, sizeof esc, "\\u%04X", c);
+            jt_put(j, esc, 6);
+        }
+    }
+    jt_put(j, s + run, n - run);
+    jt_put(j, "\"", 1);
+}
+
+/* "key": then a string, or nothing at all when s is NULL (as a jansson member set to NULL). */
+static void jt_member_string(jtext *j, const char *key, const char *s, const char *what)
+{
+    if (!s)
+        return;
+    jt_lit(j, key);
+    jt_string(j, s, strlen(s), what);
+}
+
+static void jt_int(jtext *j, long long v)
+{
+    char b[AG_NUMTEXT_MAX + 1];
+    size_t n = v < 0 ? (b[0] = '-', 1 + ag_numtext_u64(b + 1, 0ull - (unsigned long long)v))
+                     : ag_numtext_u64(b, (unsigned long long)v);
+    jt_put(j, b, n);
+}
+
+/* The shortest decimal that reads back to v, always read as a real (a fraction or an
+ * exponent: "3.0", "-0.0"). */
+static void jt_real(jtext *j, double v, const char *what)
+{
+    if (!isfinite(v)) {
+        if (!j->bad)
+            j->bad = what;
+        return;
+    }
+    char b[AG_NUMTEXT_MAX + 2];
+    size_t n = ag_numtext_double(b, v);
+    if (!memchr(b, '.', n) && !memchr(b, 'e', n)) {
+        memcpy(b + n, ".0", 2);
+        n += 2;
+    }
+    jt_put(j, b, n);
+}
+
+static void jt_box(jtext *j, const double *v, const char *what)
+{
+    jt_put(j, "[", 1);
+    for (int i = 0; i < 6; i++) {
+        if (i)
+            jt_put(j, ",", 1);
+        jt_real(j, v[i], what);
+    }
+    jt_put(j, "]", 1);
+}
+
+ag_status ag_part_bundle_entry_text(const ag_part *p, json_t *terminals, char **out, size_t *len,
+                                    ag_error *err)
 {
     *out = NULL;
+    *len = 0;
     ag_grammar *g = NULL;
     ag_status st = ag_gcopy_grammar(p->grammar, &g, err);
     if (st)
@@ -52,10 +155,10 @@ ag_status ag_part_bundle_entry(const ag_part *p, json_t *terminals, json_t **out
     for (size_t i = 0; i < g->nterminals && !st; i++) {
         ag_gterminal *t = &g->terminals[i];
         char *text = NULL;
-        size_t len = 0;
+        size_t tlen = 0;
         char hex[AG_SHA256_HEX], path[96];
-        if ((st = ag_terminals_format(t, &text, &len, err)) ||
-            (st = ag_sha256_hex(text, len, hex, err))) {
+        if ((st = ag_terminals_format(t, &text, &tlen, err)) ||
+            (st = ag_sha256_hex(text, tlen, hex, err))) {
             free(text);
             break;
         }
@@ -63,57 +166,110 @@ ag_status ag_part_bundle_entry(const ag_part *p, json_t *terminals, json_t **out
         free(t->path);
         t->path = strdup(path);
         if (!json_object_get(terminals, hex))
-            json_object_set_new(terminals, hex, json_stringn(text, len));
+            json_object_set_new(terminals, hex, json_stringn(text, tlen));
         free(text);
         if (!t->path)
             st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
     char *text = NULL;
-    size_t len = 0;
+    size_t tlen = 0;
     if (!st)
-        st = ag_grammar_text_print(g, &text, &len, err);
+        st = ag_grammar_text_print(g, &text, &tlen, err);
     ag_grammar_free(g);
     if (st)
         return st;
-    json_t *o = json_object();
-    json_object_set_new(o, "name", json_string(p->name));
-    json_object_set_new(o, "version", json_integer(p->version));
+    jtext j = {0};
+    /* about 160 bytes a node: reserved at once, not grown node by node */
+    if (AG_ARRAY_RESERVE_MORE(j.p, j.cap, 0, tlen + 160 * p->nnodes + 4096) != AG_OK)
+        j.nomem = 1;
+    jt_put(&j, "{", 1);
+    if (p->name) {
+        jt_lit(&j, "\"name\":");
+        jt_string(&j, p->name, strlen(p->name), "name");
+        jt_put(&j, ",", 1);
+    }
+    jt_lit(&j, "\"version\":");
+    jt_int(&j, (long long)p->version);
     if (p->description)
-        json_object_set_new(o, "description", json_string(p->description));
-    json_t *tags = json_array();
-    for (size_t i = 0; i < p->ntags; i++)
-        json_array_append_new(tags, json_string(p->tags[i]));
-    json_object_set_new(o, "tags", tags);
-    json_t *prov = json_object();
-    if (p->source)
-        json_object_set_new(prov, "source", json_string(p->source));
-    json_object_set_new(prov, "source_version", json_integer(p->source_version));
-    json_object_set_new(prov, "node", json_integer(p->source_node));
-    json_object_set_new(o, "provenance", prov);
-    json_object_set_new(o, "root", json_string(p->root));
+        jt_member_string(&j, ",\"description\":", p->description, "description");
+    jt_lit(&j, ",\"tags\":[");
+    for (size_t i = 0, k = 0; i < p->ntags; i++) {
+        if (!p->tags[i])
+            continue;
+        if (k++)
+            jt_put(&j, ",", 1);
+        jt_string(&j, p->tags[i], strlen(p->tags[i]), "tags");
+    }
+    jt_lit(&j, "],\"provenance\":{");
+    if (p->source) {
+        jt_member_string(&j, "\"source\":", p->source, "provenance.source");
+        jt_put(&j, ",", 1);
+    }
+    jt_lit(&j, "\"source_version\":");
+    jt_int(&j, (long long)p->source_version);
+    jt_lit(&j, ",\"node\":");
+    jt_int(&j, (long long)p->source_node);
+    jt_lit(&j, "}");
+    jt_member_string(&j, ",\"root\":", p->root, "root");
     double b[6] = {p->box.min[0], p->box.min[1], p->box.min[2],
                    p->box.max[0], p->box.max[1], p->box.max[2]};
-    json_object_set_new(o, "box", box_json(b));
-    json_object_set_new(o, "facing", json_integer(p->facing));
-    json_object_set_new(o, "grammar", json_stringn(text, len));
+    jt_lit(&j, ",\"box\":");
+    jt_box(&j, b, "box");
+    jt_lit(&j, ",\"facing\":");
+    jt_int(&j, p->facing);
+    jt_lit(&j, ",\"grammar\":");
+    jt_string(&j, text, tlen, "grammar");
     free(text);
-    json_t *nodes = json_array();
+    jt_lit(&j, ",\"nodes\":[");
     for (size_t i = 0; i < p->nnodes; i++) {
         const ag_part_node *n = &p->nodes[i];
-        json_t *jn = json_object();
-        json_object_set_new(jn, "parent", json_integer(n->parent));
-        json_object_set_new(jn, "kind", json_string(kind_name(n->kind)));
-        json_object_set_new(jn, "label", json_integer(n->label));
-        json_object_set_new(jn, "rule", json_string(n->rule));
-        json_object_set_new(jn, "box", box_json(n->box));
-        json_array_append_new(nodes, jn);
+        jt_lit(&j, i ? ",{\"parent\":" : "{\"parent\":");
+        jt_int(&j, n->parent);
+        jt_lit(&j, ",\"kind\":\"");
+        jt_lit(&j, kind_name(n->kind));
+        jt_put(&j, "\"", 1);
+        jt_lit(&j, ",\"label\":");
+        jt_int(&j, n->label);
+        jt_member_string(&j, ",\"rule\":", n->rule, "nodes.rule");
+        jt_lit(&j, ",\"box\":");
+        jt_box(&j, n->box, "nodes.box");
+        jt_put(&j, "}", 1);
     }
-    json_object_set_new(o, "nodes", nodes);
-    json_t *attrs = json_object();
-    for (size_t i = 0; i < p->nattrs; i++)
-        json_object_set_new(attrs, p->attrs[i].key, json_string(p->attrs[i].value));
-    json_object_set_new(o, "attributes", attrs);
-    *out = o;
+    jt_lit(&j, "],\"attributes\":{");
+    for (size_t i = 0, k = 0; i < p->nattrs; i++) {
+        if (!p->attrs[i].key || !p->attrs[i].value)
+            continue;
+        if (k++)
+            jt_put(&j, ",", 1);
+        jt_string(&j, p->attrs[i].key, strlen(p->attrs[i].key), "attributes");
+        jt_put(&j, ":", 1);
+        jt_string(&j, p->attrs[i].value, strlen(p->attrs[i].value), "attributes");
+    }
+    jt_lit(&j, "}}");
+    if (j.nomem || j.bad) {
+        free(j.p);
+        return j.nomem ? ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory")
+                       : ag_error_set(err, AG_ERR_INVALID, 0,
+                                      "%s: not valid UTF-8 or not a finite number", j.bad);
+    }
+    *out = j.p;
+    *len = j.n;
+    return AG_OK;
+}
+
+ag_status ag_part_bundle_entry(const ag_part *p, json_t *terminals, json_t **out, ag_error *err)
+{
+    *out = NULL;
+    char *text = NULL;
+    size_t len = 0;
+    ag_status st = ag_part_bundle_entry_text(p, terminals, &text, &len, err);
+    if (st)
+        return st;
+    json_error_t je;
+    *out = json_loadb(text, len, 0, &je);
+    free(text);
+    if (!*out)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory reading the entry back");
     return AG_OK;
 }
 

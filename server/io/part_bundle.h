@@ -38,6 +38,12 @@ ag_status ag_part_bundle_write(const ag_part *const *parts, size_t n, char **out
  * of their hashes (so entries kept and put together again give the same bytes). */
 ag_status ag_part_bundle_entry(const ag_part *p, json_t *terminals, json_t **entry,
                                ag_error *err);
+/* The entry as compact JSON text (*out malloc'd, NUL-terminated), as a library stores it:
+ * written directly, every real as the shortest decimal that reads back to it; the same
+ * members and values as ag_part_bundle_entry (which reads this text back). A name or text
+ * that is not valid UTF-8, or a box that is not finite, is AG_ERR_INVALID naming it. */
+ag_status ag_part_bundle_entry_text(const ag_part *p, json_t *terminals, char **out,
+                                    size_t *len, ag_error *err);
 ag_status ag_part_bundle_print(json_t *parts, json_t *terminals, char **out, size_t *len,
                                ag_error *err);
 /* Writes the bundle to path through a temporary file renamed into place: on failure nothing

@@ -499,6 +499,113 @@ static void test_mutations(void **state)
     free(text);
 }
 
+/* The stored entry text is written without jansson: checked here against the part itself,
+ * read back by jansson (an independent parser): every real exactly the part's double and
+ * still a real, names with quotes, backslashes, control characters and UTF-8 unchanged, and
+ * text that is not UTF-8 refused naming the member. */
+static void expect_box(json_t *a, const double *v)
+{
+    assert_true(json_is_array(a));
+    assert_int_equal(json_array_size(a), 6);
+    for (int i = 0; i < 6; i++) {
+        json_t *x = json_array_get(a, i);
+        assert_true(json_is_real(x));
+        double got = json_real_value(x);
+        assert_memory_equal(&got, &v[i], sizeof got); /* bit for bit: -0.0 stays -0.0 */
+    }
+}
+
+static void test_entry_text(void **state)
+{
+    (void)state;
+    for (int w = 0; w < 2; w++) {
+        ag_part *p = P[w];
+        char *oldname = p->name, *olddesc = p->description;
+        double oldbox = p->nodes[0].box[0];
+        char name[] = "a \"quoted\" \\ name\twith\nlines \x01 and \xc3\xa9\xe2\x82\xac";
+        p->name = name;
+        p->description = w ? NULL : "plain";
+        p->nodes[0].box[0] = -0.0;
+        json_t *terms = json_object();
+        char *text = NULL;
+        size_t len = 0;
+        ag_error err = {0};
+        assert_int_equal(ag_part_bundle_entry_text(p, terms, &text, &len, &err), AG_OK);
+        assert_int_equal(strlen(text), len);
+        json_error_t je;
+        json_t *e = json_loadb(text, len, JSON_REJECT_DUPLICATES, &je);
+        if (!e)
+            fail_msg("the entry does not parse: %s (column %d)", je.text, je.column);
+        assert_string_equal(json_string_value(json_object_get(e, "name")), name);
+        if (w)
+            assert_null(json_object_get(e, "description"));
+        else
+            assert_string_equal(json_string_value(json_object_get(e, "description")), "plain");
+        assert_int_equal(json_integer_value(json_object_get(e, "version")), p->version);
+        json_t *tags = json_object_get(e, "tags");
+        assert_int_equal(json_array_size(tags), p->ntags);
+        for (size_t i = 0; i < p->ntags; i++)
+            assert_string_equal(json_string_value(json_array_get(tags, i)), p->tags[i]);
+        json_t *prov = json_object_get(e, "provenance");
+        assert_string_equal(json_string_value(json_object_get(prov, "source")), p->source);
+        assert_int_equal(json_integer_value(json_object_get(prov, "source_version")),
+                         p->source_version);
+        assert_int_equal(json_integer_value(json_object_get(prov, "node")), p->source_node);
+        assert_string_equal(json_string_value(json_object_get(e, "root")), p->root);
+        double b[6] = {p->box.min[0], p->box.min[1], p->box.min[2],
+                       p->box.max[0], p->box.max[1], p->box.max[2]};
+        expect_box(json_object_get(e, "box"), b);
+        assert_int_equal(json_integer_value(json_object_get(e, "facing")), p->facing);
+        /* the grammar as the part's own, with the terminals named by their content */
+        const char *gt = json_string_value(json_object_get(e, "grammar"));
+        assert_non_null(gt);
+        ag_grammar *g = NULL;
+        assert_int_equal(ag_grammar_text_parse(gt, strlen(gt), &g, &err, NULL), AG_OK);
+        assert_int_equal(g->nrules, p->grammar->nrules);
+        assert_int_equal(g->nterminals, p->grammar->nterminals);
+        assert_int_equal(json_object_size(terms), p->grammar->nterminals);
+        for (size_t i = 0; i < g->nterminals; i++) {
+            const char *path = g->terminals[i].path;
+            assert_int_equal(strncmp(path, "terminals/", 10), 0);
+            char hex[AG_SHA256_HEX];
+            snprintf(hex, sizeof hex, "%.64s", path + 10);
+            assert_non_null(json_object_get(terms, hex));
+        }
+        ag_grammar_free(g);
+        json_t *nodes = json_object_get(e, "nodes");
+        assert_int_equal(json_array_size(nodes), p->nnodes);
+        for (size_t i = 0; i < p->nnodes; i++) {
+            json_t *n = json_array_get(nodes, i);
+            assert_int_equal(json_integer_value(json_object_get(n, "parent")), p->nodes[i].parent);
+            assert_int_equal(json_integer_value(json_object_get(n, "label")), p->nodes[i].label);
+            assert_string_equal(json_string_value(json_object_get(n, "rule")), p->nodes[i].rule);
+            expect_box(json_object_get(n, "box"), p->nodes[i].box);
+        }
+        json_t *attrs = json_object_get(e, "attributes");
+        assert_int_equal(json_object_size(attrs), p->nattrs);
+        for (size_t i = 0; i < p->nattrs; i++)
+            assert_string_equal(json_string_value(json_object_get(attrs, p->attrs[i].key)),
+                                p->attrs[i].value);
+        json_decref(e);
+        free(text);
+        /* not UTF-8: refused, naming the member */
+        char bad[] = "broken \xc3(";
+        p->name = bad;
+        text = NULL;
+        assert_int_equal(ag_part_bundle_entry_text(p, terms, &text, &len, &err), AG_ERR_INVALID);
+        assert_null(text);
+        assert_non_null(strstr(err.text, "name"));
+        p->name = name;
+        p->nodes[0].box[0] = NAN;
+        assert_int_equal(ag_part_bundle_entry_text(p, terms, &text, &len, &err), AG_ERR_INVALID);
+        assert_non_null(strstr(err.text, "nodes.box"));
+        json_decref(terms);
+        p->name = oldname;
+        p->description = olddesc;
+        p->nodes[0].box[0] = oldbox;
+    }
+}
+
 static void test_write_file_leaves_nothing(void **state)
 {
     (void)state;
@@ -532,6 +639,7 @@ int main(void)
         cmocka_unit_test(test_absurd_sizes),
         cmocka_unit_test(test_mutations),
         cmocka_unit_test(test_write_file_leaves_nothing),
+        cmocka_unit_test(test_entry_text),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
