@@ -7,7 +7,7 @@
 // after a restart.
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
-import { http, importModel, removeDir, startDaemon, tempDir, waitJob, windowWallObj, WsClient } from './harness.js';
+import { http, importModel, proceduralizedWall, removeDir, startDaemon, tempDir, waitJob, windowWallObj, WsClient } from './harness.js';
 
 const near = (a, b, eps = 1e-6) => Math.abs(a - b) <= eps;
 const sameBox = (a, b, eps = 1e-6) => a.every((v, k) => near(v, b[k], eps));
@@ -18,15 +18,7 @@ describe('ids held by another client survive resize, paste, a proceduralized com
   let d;
   const clients = [];
 
-  const proceduralized = async (opt, name) => {
-    const { obj, slots } = windowWallObj(opt);
-    const m = await importModel(d, Buffer.from(obj), { name, up: 'z' });
-    const r = await http(d, 'POST', `/api/v1/models/${m.id}/proceduralize`, {});
-    assert.equal(r.status, 202, r.text);
-    const job = await waitJob(d, r.json.id, { timeout: 60000 });
-    assert.equal(job.status, 'succeeded', JSON.stringify(job));
-    return { id: m.id, slots };
-  };
+  const proceduralized = (opt, name) => proceduralizedWall(d, opt, name);
   const tree = async (id) => {
     const r = await http(d, 'GET', `/api/v1/models/${id}/tree`);
     assert.equal(r.status, 200, r.text);

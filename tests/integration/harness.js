@@ -696,3 +696,15 @@ export function windowWallObj({ cols, rows, ww, wh, frame, mullions, front = 0.1
   }
   return { obj: out.join('\n') + '\n', slots };
 }
+
+// A windowWallObj wall imported z-up and proceduralized (the job asserted to succeed):
+// { id, slots }.
+export async function proceduralizedWall(d, opt, name) {
+  const { obj, slots } = windowWallObj(opt);
+  const m = await importModel(d, Buffer.from(obj), { name, up: 'z' });
+  const r = await http(d, 'POST', `/api/v1/models/${m.id}/proceduralize`, {});
+  if (r.status !== 202) throw new Error(`proceduralize: ${r.status} ${r.text}`);
+  const job = await waitJob(d, r.json.id, { timeout: 60000 });
+  if (job.status !== 'succeeded') throw new Error(`proceduralize job: ${JSON.stringify(job)}`);
+  return { id: m.id, slots };
+}

@@ -11,7 +11,7 @@ import { after, before, describe, it } from 'node:test';
 import { decodePng } from '../browser/png.js';
 import {
   WsClient, assertProblem, http, importModel, parseGlb, removeDir, startDaemon, waitJob,
-  windowWallObj,
+  proceduralizedWall, windowWallObj,
 } from './harness.js';
 
 const A = { cols: 3, rows: 2, ww: 1.2, wh: 1.8, frame: 0.08, mullions: 1 };
@@ -26,14 +26,9 @@ describe('parts library', () => {
   const dirs = [];
 
   const proceduralized = async (opt, name) => {
-    const { obj, slots } = windowWallObj(opt);
-    const m = await importModel(d, Buffer.from(obj), { name, up: 'z' });
-    const r = await http(d, 'POST', `/api/v1/models/${m.id}/proceduralize`, {});
-    assert.equal(r.status, 202, r.text);
-    const job = await waitJob(d, r.json.id, { timeout: 60000 });
-    assert.equal(job.status, 'succeeded', JSON.stringify(job));
-    const t = await tree(m.id);
-    return { id: m.id, slots, version: t.version, tree: t, nodeOf: (s) => t.nodes.find((n) => n.kind === 'component' && near(n.box, s)).id };
+    const { id, slots } = await proceduralizedWall(d, opt, name);
+    const t = await tree(id);
+    return { id, slots, version: t.version, tree: t, nodeOf: (s) => t.nodes.find((n) => n.kind === 'component' && near(n.box, s)).id };
   };
   const tree = async (id) => {
     const r = await http(d, 'GET', `/api/v1/models/${id}/tree`);

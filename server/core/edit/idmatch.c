@@ -84,6 +84,42 @@ static double match_tolerance(const ag_proceduralize_result *r)
     return 2 * tol;
 }
 
+/* The nearest old node of a fresh node's kind and label within the tolerance, among the
+ * candidates offered to it one by one. */
+typedef struct {
+    const ag_splittree *O;
+    const ag_proceduralize_result *old;
+    const uint8_t *taken;
+    const ag_tnode *x;
+    const char *name;
+    int32_t best;
+    double bd;
+} nearest;
+
+static nearest nearest_start(const ag_proceduralize_result *old, const uint8_t *taken,
+                             const ag_tnode *x, const char *name, double tol)
+{
+    return (nearest){old->tree, old, taken, x, name, -1, tol};
+}
+
+static void nearest_offer(nearest *s, int32_t o)
+{
+    const ag_tnode *y = &s->O->nodes[o];
+    if (s->taken[o] || y->kind != s->x->kind || strcmp(name_of(s->old, y), s->name))
+        return;
+    double d = box_distance(&s->x->box, &y->box);
+    if (d <= s->bd) {
+        s->bd = d;
+        s->best = o;
+    }
+}
+
+/* The holder an old node is bucketed under, or -1 when it may not be matched. */
+static int32_t bucket_of(const ag_splittree *O, const uint8_t *changed, size_t n)
+{
+    return matchable(&O->nodes[n]) && !(changed && changed[n]) ? holder(O, (int32_t)n) : -1;
+}
+
 /* f2o: per fresh node, the old node it matches (-1). */
 static ag_status match(const ag_proceduralize_result *old, const ag_proceduralize_result *fresh,
                        const uint8_t *changed, int32_t *f2o)
@@ -102,8 +138,7 @@ static ag_status match(const ag_proceduralize_result *old, const ag_proceduraliz
         goto done;
     }
     for (size_t n = 1; n < no; n++) {
-        int32_t h = matchable(&O->nodes[n]) && !(changed && changed[n]) ? holder(O, (int32_t)n)
-                                                                         : -1;
+        int32_t h = bucket_of(O, changed, n);
         if (h >= 0)
             start[h + 1]++;
     }
@@ -115,8 +150,7 @@ static ag_status match(const ag_proceduralize_result *old, const ag_proceduraliz
         goto done;
     }
     for (size_t n = 1; n < no; n++) {
-        int32_t h = matchable(&O->nodes[n]) && !(changed && changed[n]) ? holder(O, (int32_t)n)
-                                                                         : -1;
+        int32_t h = bucket_of(O, changed, n);
         if (h >= 0)
             list[start[h] + fill[h]++] = (int32_t)n;
     }
@@ -140,23 +174,12 @@ static ag_status match(const ag_proceduralize_result *old, const ag_proceduraliz
         int32_t h = holder(F, f);
         if (h < 0 || f2o[h] < 0)
             continue;
-        const char *name = name_of(fresh, x);
-        int32_t best = -1;
-        double bd = tol;
-        for (uint32_t i = start[f2o[h]]; i < start[f2o[h] + 1]; i++) {
-            int32_t o = list[i];
-            const ag_tnode *y = &O->nodes[o];
-            if (taken[o] || y->kind != x->kind || strcmp(name_of(old, y), name))
-                continue;
-            double d = box_distance(&x->box, &y->box);
-            if (d <= bd) {
-                bd = d;
-                best = o;
-            }
-        }
-        if (best >= 0) {
-            f2o[f] = best;
-            taken[best] = 1;
+        nearest near = nearest_start(old, taken, x, name_of(fresh, x), tol);
+        for (uint32_t i = start[f2o[h]]; i < start[f2o[h] + 1]; i++)
+            nearest_offer(&near, list[i]);
+        if (near.best >= 0) {
+            f2o[f] = near.best;
+            taken[near.best] = 1;
         }
     }
     /* a node whose holder is new (nested in a node the change made, such as a joined one)
@@ -176,24 +199,13 @@ static ag_status match(const ag_proceduralize_result *old, const ag_proceduraliz
         const ag_tnode *x = &F->nodes[f];
         if (f == 0 || f2o[f] >= 0 || !matchable(x))
             continue;
-        const char *name = name_of(fresh, x);
-        int32_t best = -1;
-        double bd = tol;
+        nearest near = nearest_start(old, taken, x, name_of(fresh, x), tol);
         for (size_t i = first_at_or_above(k, nl, x->box.min[0] - tol);
-             i < nl && k[i].x <= x->box.min[0] + tol; i++) {
-            int32_t o = k[i].n;
-            const ag_tnode *y = &O->nodes[o];
-            if (taken[o] || y->kind != x->kind || strcmp(name_of(old, y), name))
-                continue;
-            double d = box_distance(&x->box, &y->box);
-            if (d <= bd) {
-                bd = d;
-                best = o;
-            }
-        }
-        if (best >= 0) {
-            f2o[f] = best;
-            taken[best] = 1;
+             i < nl && k[i].x <= x->box.min[0] + tol; i++)
+            nearest_offer(&near, k[i].n);
+        if (near.best >= 0) {
+            f2o[f] = near.best;
+            taken[near.best] = 1;
         }
     }
     free(k);
