@@ -447,6 +447,8 @@ static ag_status read_binary(reader *r, ply_element *el, size_t *pos, int store_
                             "the header declares %llu %s rows of at least %zu bytes, but only %zu "
                             "bytes of data follow",
                             (unsigned long long)el->count, el->name, el->row_bytes, remaining);
+    if (!el->nprops)
+        return AG_OK; /* rows of nothing take no bytes, however many the header declares */
     const uint8_t *p = r->data + *pos, *end = r->data + r->len;
     uint8_t value[8];
     for (uint64_t row = 0; row < el->count; row++) {
@@ -490,9 +492,11 @@ static ag_status read_binary(reader *r, ply_element *el, size_t *pos, int store_
 
 static ag_status read_ascii(reader *r, ply_element *el, ascii_cursor *cur, int store_rows)
 {
+    if (!el->nprops)
+        return AG_OK; /* rows of nothing, as in read_binary */
     /* every value takes at least one character and one separator */
     size_t remaining = (size_t)(cur->end - cur->p);
-    size_t per_row = el->nprops ? el->nprops : 1;
+    size_t per_row = el->nprops;
     if (el->count && el->count > (remaining / 2 + 1) / per_row)
         return ag_error_set(r->err, AG_ERR_PARSE, 0,
                             "the header declares %llu %s rows, more than the %zu bytes of data can "

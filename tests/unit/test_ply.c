@@ -319,6 +319,40 @@ static void test_fixtures(void **state)
     ag_cloud_free(c);
 }
 
+/* An element without properties has rows of no bytes: any count the header declares is read
+ * at once (it used to loop once per declared row), and the points after it are all there. */
+static void test_elements_without_properties(void **state)
+{
+    (void)state;
+    const char *counts[] = {"0", "7", "4000000000", "18446744073709551615"};
+    for (int binary = 0; binary < 2; binary++)
+        for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++) {
+            char text[512];
+            int n = snprintf(text, sizeof text,
+                             "ply\nformat %s 1.0\nelement empty %s\nelement vertex 2\n"
+                             "property float x\nproperty float y\nproperty float z\n"
+                             "element trailer %s\nend_header\n",
+                             binary ? "binary_little_endian" : "ascii", counts[i], counts[i]);
+            uint8_t buf[600];
+            memcpy(buf, text, (size_t)n);
+            size_t len = (size_t)n;
+            const float xyz[6] = {1, 2, 3, -4, 5.5f, 6};
+            if (binary) {
+                memcpy(buf + len, xyz, sizeof xyz); /* this machine is little-endian */
+                len += sizeof xyz;
+            } else {
+                len += (size_t)snprintf((char *)buf + len, sizeof buf - len, "1 2 3\n-4 5.5 6\n");
+            }
+            ag_cloud *c = NULL;
+            ag_error e;
+            assert_int_equal(ag_ply_read_buffer(buf, len, &c, &e), AG_OK);
+            assert_int_equal(c->n, 2);
+            for (int k = 0; k < 6; k++)
+                assert_true(c->xyz[k] == (double)xyz[k]);
+            ag_cloud_free(c);
+        }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -328,6 +362,7 @@ int main(void)
         cmocka_unit_test(test_errors),
         cmocka_unit_test(test_truncation_and_corruption),
         cmocka_unit_test(test_fixtures),
+        cmocka_unit_test(test_elements_without_properties),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
