@@ -11,7 +11,10 @@
 #include "../core/edit/rebuild.h"
 #include "model_tree.h"
 
-#define KEPT_FORMAT 3
+#define KEPT_FORMAT 4
+#define KEPT_FORMAT_FULL_DEAD 3 /* dead nodes written whole; still read */
+/* the most node ids a format 4 member may name (runs of dead nodes cost no data per id) */
+#define KEPT_MAX_NODES ((size_t)1 << 24)
 #define NODE_INTS 13
 #define NODE_BYTES (4 * NODE_INTS + 8 * 9)
 #define PATTERN_BYTES (4 * 7 + 8 * 12)
@@ -94,6 +97,16 @@ static char *kept_text(const ag_edit_model *em)
     k.fail = AG_ARRAY_RESERVE_MORE(k.p, k.cap, k.n, total ? total : 1) != AG_OK;
     for (size_t n = 0; n < t->nnodes; n++) {
         const ag_tnode *x = &t->nodes[n];
+        if (x->kind == AG_NODE_DEAD) {
+            /* a dead node only holds its id: a run of them is its kind and its length */
+            size_t run = 1;
+            while (n + run < t->nnodes && t->nodes[n + run].kind == AG_NODE_DEAD)
+                run++;
+            put_i32(&k, AG_NODE_DEAD);
+            put_u32(&k, (uint32_t)run);
+            n += run - 1;
+            continue;
+        }
         const int32_t ints[NODE_INTS] = {x->kind,      x->parent,    x->first_child, x->last_child,
                                          x->next_sibling, x->component, x->label,    x->variant,
                                          x->rot,       x->octant,    x->rule_rot,    x->rule,
@@ -258,6 +271,15 @@ static int finite3(reader *R, const double *v, const char *what)
     return 1;
 }
 
+/* A dead node as it is read: its id and nothing else (no links, classes or box). */
+static void dead_node(ag_tnode *x)
+{
+    memset(x, 0, sizeof *x);
+    x->kind = AG_NODE_DEAD;
+    x->parent = x->first_child = x->last_child = x->next_sibling = -1;
+    x->component = x->label = x->variant = x->rule = x->pattern = -1;
+}
+
 static int read_node(reader *R, const ag_splittree *t, size_t nlabels, size_t nvariants,
                      ag_tnode *x)
 {
@@ -305,6 +327,38 @@ static int read_node(reader *R, const ag_splittree *t, size_t nlabels, size_t nv
     for (int a = 0; a < 3; a++)
         if (x->box.max[a] < x->box.min[a])
             return bad(R, "a node's box is inverted");
+    if (x->kind == AG_NODE_DEAD) /* format 3 wrote a dead node whole: it keeps only its id */
+        dead_node(x);
+    return 1;
+}
+
+/* The nodes of format 4: a live node's record as format 3's, a run of dead ones their kind
+ * and count. The records are not of one length, so each is checked against the data left
+ * (rest: the bytes the sections after the nodes take). */
+static int read_nodes_compact(reader *R, ag_splittree *t, size_t nlabels, size_t nvariants,
+                              size_t rest)
+{
+    size_t n = 0;
+    while (n < t->nnodes) {
+        if (R->n - R->at < rest + 8)
+            return bad(R, "the data ends inside the nodes");
+        size_t at = R->at;
+        if (get_i32(R) == AG_NODE_DEAD) {
+            uint32_t run = get_u32(R);
+            if (!run || run > t->nnodes - n)
+                return bad(R, "a run of dead nodes is empty or passes the last node");
+            for (uint32_t i = 0; i < run; i++)
+                dead_node(&t->nodes[n++]);
+            continue;
+        }
+        R->at = at;
+        if (R->n - R->at < rest + NODE_BYTES)
+            return bad(R, "the data ends inside the nodes");
+        if (!read_node(R, t, nlabels, nvariants, &t->nodes[n++]))
+            return 0;
+    }
+    if (R->n - R->at != rest)
+        return bad(R, "the data's length does not match its counts");
     return 1;
 }
 
@@ -436,9 +490,11 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
     size_t blen = b64 ? strlen(b64) : 0;
     /* every count is bounded by the data's length, so nothing larger than it is allocated */
     int ok = get_count(&R, k, "format", KEPT_FORMAT, &format) &&
-             (format == KEPT_FORMAT || bad(&R, "an unknown format")) &&
+             (format == KEPT_FORMAT || format == KEPT_FORMAT_FULL_DEAD ||
+              bad(&R, "an unknown format")) &&
              (b64 || bad(&R, "no data")) && get_count(&R, k, "ncomponents", blen, &ncomp) &&
-             get_count(&R, k, "nnodes", blen, &nnodes) &&
+             /* runs of dead nodes take a few bytes for many ids: a cap instead of the length */
+             get_count(&R, k, "nnodes", format == KEPT_FORMAT ? KEPT_MAX_NODES : blen, &nnodes) &&
              get_count(&R, k, "npatterns", blen, &npat) &&
              get_count(&R, k, "nrules", blen, &nrules) && get_count(&R, k, "nlabels", INT32_MAX, &nl) &&
              get_count(&R, k, "nvariants", blen, &nv) && get_real(&R, k, "tol", &tol) &&
@@ -454,8 +510,9 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
     if (ok && sodium_base642bin(data, blen + 1, b64, blen, NULL, &dlen, NULL,
                                 sodium_base64_VARIANT_ORIGINAL))
         ok = bad(&R, "the data is not base64");
-    if (ok && dlen != nnodes * NODE_BYTES + npat * PATTERN_BYTES + nrules * RULE_BYTES +
-                          ncomp * COMPONENT_BYTES + nv * VARIANT_BYTES)
+    size_t rest = npat * PATTERN_BYTES + nrules * RULE_BYTES + ncomp * COMPONENT_BYTES +
+                  nv * VARIANT_BYTES; /* after the nodes */
+    if (ok && (format == KEPT_FORMAT ? dlen < rest : dlen != nnodes * NODE_BYTES + rest))
         ok = bad(&R, "the data's length does not match its counts");
     if (ok && !nnodes)
         ok = bad(&R, "no nodes");
@@ -488,7 +545,9 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
             !t->rule_count || !t->rule_rep)
             R.st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory"), ok = 0;
     }
-    for (size_t n = 0; ok && n < nnodes; n++)
+    if (ok && format == KEPT_FORMAT)
+        ok = read_nodes_compact(&R, t, nl, nv, rest);
+    for (size_t n = 0; ok && format == KEPT_FORMAT_FULL_DEAD && n < nnodes; n++)
         ok = read_node(&R, t, nl, nv, &t->nodes[n]);
     for (size_t i = 0; ok && i < npat; i++)
         ok = read_pattern(&R, t, &t->patterns[i]);

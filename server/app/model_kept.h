@@ -8,15 +8,16 @@
  * the rules survive the store round trip, undo, redo and restore.
  *
  * The stored tree text (app/model_tree.h, numbering AG_MODEL_TREE_NUMBERING) is the served
- * tree with one more member, "kept": {"format":3,"tol","eps","ncomponents","nnodes",
+ * tree with one more member, "kept": {"format":4,"tol","eps","ncomponents","nnodes",
  * "npatterns","nrules","nlabels","nvariants","diagonal","label_tol","exact","share",
  * "exact_copies","data"}, data the
  * base64 of little-endian int32s and doubles: per node its kind, parent, first child, last
  * child, next sibling, component, label, variant, rot, octant, rule rot, rule and pattern,
- * then its box (min, max) and pivot; per pattern its rule, rot, lattice size, counts, step,
+ * then its box (min, max) and pivot, except that a run of dead nodes (which keep only their
+ * ids, never reused) is written as the dead kind and the run's length; per pattern its rule, rot, lattice size, counts, step,
  * vectors and node; per rule its count and representative; per component its label,
  * variant, rot, variant rot, mirror flag and turn (radians); per variant its label and
- * deviation. Binary, because the tree is written
+ * deviation. Format 3, which wrote dead nodes whole, is still read. Binary, because the tree is written
  * with every edit: numbers exactly, a 200k-triangle building's in milliseconds. A kept member
  * that does not describe a tree over the mesh is refused (AG_ERR_PARSE naming what is wrong),
  * never trusted. */

@@ -26,6 +26,9 @@ static const char *kind_name(int k)
     }
 }
 
+/* A dead node's box: it keeps only its id (the stored model keeps nothing else of it). */
+static const ag_box no_box;
+
 static json_t *box_json(const ag_box *b)
 {
     json_t *a = json_array();
@@ -140,7 +143,7 @@ static json_t *served(const ag_edit_model *em, int with_nodes)
                                 !dead && x->parent >= 0 ? json_integer(x->parent) : json_null());
             json_object_set_new(o, "children", dead ? json_array() : children_json(t, x));
             json_object_set_new(o, "kind", json_string(kind_name(x->kind)));
-            json_object_set_new(o, "box", box_json(&x->box));
+            json_object_set_new(o, "box", box_json(dead ? &no_box : &x->box));
             json_object_set_new(o, "visible", json_boolean(x->kind == AG_NODE_COMPONENT));
         }
         const ag_pattern *p = dead ? NULL : pattern_of(t, x);
@@ -383,7 +386,7 @@ static void out_node(text_out *o, const ag_proceduralize_result *r, size_t n)
     for (int a = 0; a < 6; a++) {
         if (a)
             OUT_LIT(o, ",");
-        out_real(o, a < 3 ? x->box.min[a] : x->box.max[a - 3]);
+        out_real(o, dead ? 0 : a < 3 ? x->box.min[a] : x->box.max[a - 3]);
     }
     OUT_LIT(o, "],\"visible\":");
     if (x->kind == AG_NODE_COMPONENT)

@@ -208,7 +208,7 @@ static void a_broken_kept_model_is_refused(void **state)
     static const struct {
         const char *from, *to;
     } breaks[] = {
-        {"\"format\":3", "\"format\":7"},
+        {"\"format\":4", "\"format\":7"},
         {"\"ncomponents\":", "\"ncomponents\":1"},
         {"\"nnodes\":", "\"nnodes\":9"},
         {"\"data\":\"", "\"data\":\"AAAA"},

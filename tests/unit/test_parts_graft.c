@@ -288,7 +288,9 @@ static ag_edit_model *compare(ag_edit_model *em, const ag_part *part, int32_t ta
     assert_int_equal(back->proc->tree->nnodes, out->proc->tree->nnodes);
     for (size_t n = 0; n < out->proc->tree->nnodes; n++) {
         assert_int_equal(back->proc->tree->nodes[n].kind, out->proc->tree->nodes[n].kind);
-        assert_true(pf_same_box(&back->proc->tree->nodes[n].box, &out->proc->tree->nodes[n].box, TOL));
+        /* a dead node keeps only its id: no box to compare */
+        if (out->proc->tree->nodes[n].kind != AG_NODE_DEAD)
+            assert_true(pf_same_box(&back->proc->tree->nodes[n].box, &out->proc->tree->nodes[n].box, TOL));
     }
     ag_edit_model_free(back);
     free(kept_text);
