@@ -36,46 +36,66 @@ static size_t visible(const ag_splittree *t)
     return v;
 }
 
+#define REPEAT 5 /* each figure is the fastest of this many runs */
+
 /* The pairs of t recomputed from scratch on a copy: ms, and the count. */
 static double full_ms(const ag_splittree *t, size_t *npairs)
 {
-    ag_splittree *c = ag_splittree_copy(t);
-    if (!c)
-        return -1;
-    double a = now_ms();
-    ag_status s = ag_splittree_adjacency(c);
-    double ms = now_ms() - a;
-    *npairs = c->nadj;
-    ag_splittree_free(c);
-    return s ? -1 : ms;
+    double best = -1;
+    for (int r = 0; r < REPEAT; r++) {
+        ag_splittree *c = ag_splittree_copy(t);
+        if (!c)
+            return -1;
+        double a = now_ms();
+        ag_status s = ag_splittree_adjacency(c);
+        double ms = now_ms() - a;
+        *npairs = c->nadj;
+        ag_splittree_free(c);
+        if (s)
+            return -1;
+        best = best < 0 || ms < best ? ms : best;
+    }
+    return best;
 }
 
 /* The pairs of `after` brought up to date from those of `before` (its adjacency state moved
- * onto a copy of after, as an edited tree carries its input's): ms, and whether they equal
- * the full recomputation's. */
+ * onto a copy of after, as an edited tree carries its input's): ms, whether they equal the
+ * full recomputation's, and whether the update found them from scratch. */
 static double update_ms(const ag_splittree *before, const ag_splittree *after, int *same,
                         int *scratch_out)
 {
-    ag_splittree *c = ag_splittree_copy(after), *b = ag_splittree_copy(before);
     ag_splittree *f = ag_splittree_copy(after);
     *same = 0;
-    if (!c || !b || !f || ag_splittree_adjacency(f)) {
-        ag_splittree_free(c);
-        ag_splittree_free(b);
+    if (!f || ag_splittree_adjacency(f)) {
         ag_splittree_free(f);
         return -1;
     }
-    ag_splittree_adjacency_take(c, b);
-    double a = now_ms();
-    int scratch = 0;
-    ag_status s = ag_splittree_adjacency_update(c, &scratch);
-    double ms = now_ms() - a;
-    *scratch_out = scratch;
-    *same = !s && c->nadj == f->nadj && !memcmp(c->adj, f->adj, 2 * f->nadj * sizeof *f->adj);
-    ag_splittree_free(c);
-    ag_splittree_free(b);
+    double best = -1;
+    for (int r = 0; r < REPEAT; r++) {
+        ag_splittree *c = ag_splittree_copy(after), *b = ag_splittree_copy(before);
+        if (!c || !b) {
+            ag_splittree_free(c);
+            ag_splittree_free(b);
+            best = -1;
+            break;
+        }
+        ag_splittree_adjacency_take(c, b);
+        int scratch = 0;
+        double a = now_ms();
+        ag_status s = ag_splittree_adjacency_update(c, &scratch);
+        double ms = now_ms() - a;
+        *scratch_out = scratch;
+        *same = !s && c->nadj == f->nadj && !memcmp(c->adj, f->adj, 2 * f->nadj * sizeof *f->adj);
+        ag_splittree_free(c);
+        ag_splittree_free(b);
+        if (s || !*same) {
+            best = -1;
+            break;
+        }
+        best = best < 0 || ms < best ? ms : best;
+    }
     ag_splittree_free(f);
-    return s ? -1 : ms;
+    return best;
 }
 
 static void row(const char *what, double op_ms, const ag_splittree *before,
@@ -332,7 +352,8 @@ int main(void)
     ag_heap_keep_large_blocks(); /* as archgramd runs */
     printf("adjacency per op: 'full ms' = the pairs of the result recomputed from scratch (what "
            "every op paid before), 'update ms' = brought up to date from the input's pairs "
-           "(checked equal to the full recomputation)\n");
+           "(checked equal to the full recomputation), each the fastest of %d runs; 'how' = "
+           "whether the update searched the changed nodes or started over\n", REPEAT);
     edit_ops();
     compositions();
     return 0;

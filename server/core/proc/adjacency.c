@@ -226,9 +226,10 @@ done:
 
 /* ---- bringing the pairs up to date ------------------------------------------------------- */
 
-/* Past this share of changed visible nodes (one in ADJ_UPDATE_MAX_SHARE) finding all pairs
- * again costs less than searching the changed ones. */
-#define ADJ_UPDATE_MAX_SHARE 4
+/* From this share of changed visible nodes on (one in ADJ_UPDATE_MAX_SHARE), finding all
+ * pairs again costs less than searching the changed ones (bench/adjacency: a search is 4-10
+ * times cheaper with a fifth changed, about even with most changed). */
+#define ADJ_UPDATE_MAX_SHARE 2
 
 /* The changed nodes' neighbours are searched in a bounding-box hierarchy over every visible
  * box: the boxes in the order of their centres along a Morton curve, a complete binary tree
@@ -343,38 +344,37 @@ static ag_status bvh_query(adj_bvh *h, const ag_splittree *t, uint32_t q)
 }
 
 /* t's pairs without those of a changed node (the others are as they were), merged with the
- * sorted pairs found for the changed nodes (those have a changed node: the two are apart). */
+ * sorted pairs found for the changed nodes (those have a changed node: the two are apart), in
+ * one pass over the old pairs. */
 static ag_status merge_found(ag_splittree *t, const uint8_t *changed, ag_radix_item *found,
                              size_t nfound)
 {
-    size_t nn = t->nnodes, nk = 0, nf = 0;
-    uint32_t *old = t->adj;
-    for (size_t p = 0; p < t->nadj; p++) {
-        uint32_t a = old[2 * p], b = old[2 * p + 1];
-        if (a < nn && b < nn && !changed[a] && !changed[b]) {
-            old[2 * nk] = a;
-            old[2 * nk + 1] = b;
-            nk++;
-        }
-    }
+    size_t nn = t->nnodes, nf = 0;
     for (size_t f = 0; f < nfound; f++) /* a pair of two changed nodes was found from both */
         if (!nf || found[f].key != found[nf - 1].key)
             found[nf++] = found[f];
-    uint32_t *adj = nk + nf ? malloc(2 * (nk + nf) * sizeof *adj) : NULL;
-    if (nk + nf && !adj)
+    size_t cap = t->nadj + nf;
+    uint32_t *adj = cap ? malloc(2 * cap * sizeof *adj) : NULL;
+    if (cap && !adj)
         return AG_ERR_NOMEM;
-    size_t w = 0, k = 0, f = 0;
-    while (k < nk || f < nf) {
-        uint64_t kk = k < nk ? (uint64_t)old[2 * k] << 32 | old[2 * k + 1] : UINT64_MAX;
-        uint64_t fk = f < nf ? found[f].key : UINT64_MAX;
-        uint64_t key = kk < fk ? kk : fk;
-        if (kk < fk)
-            k++;
-        else
-            f++;
-        adj[2 * w] = (uint32_t)(key >> 32);
-        adj[2 * w + 1] = (uint32_t)key;
+    const uint32_t *old = t->adj;
+    size_t w = 0, f = 0;
+    for (size_t p = 0; p < t->nadj; p++) {
+        uint32_t a = old[2 * p], b = old[2 * p + 1];
+        if (a >= nn || b >= nn || changed[a] || changed[b])
+            continue;
+        uint64_t key = (uint64_t)a << 32 | b;
+        for (; f < nf && found[f].key < key; f++, w++) {
+            adj[2 * w] = (uint32_t)(found[f].key >> 32);
+            adj[2 * w + 1] = (uint32_t)found[f].key;
+        }
+        adj[2 * w] = a;
+        adj[2 * w + 1] = b;
         w++;
+    }
+    for (; f < nf; f++, w++) {
+        adj[2 * w] = (uint32_t)(found[f].key >> 32);
+        adj[2 * w + 1] = (uint32_t)found[f].key;
     }
     free(t->adj);
     t->adj = adj;

@@ -19,8 +19,9 @@ ag_status ag_splittree_adjacency(ag_splittree *t);
 /* The pairs brought up to date with t's current boxes, kinds and tolerance: exactly what
  * ag_splittree_adjacency would find. Only the changed nodes' neighbours are searched (in a
  * bounding-box hierarchy over the visible boxes, O(n) to build, about log n per pair found);
- * the pairs of two unchanged nodes are kept as they are. It finds them all from scratch when
- * it knows nothing of them (no adj_seen), when the tolerance changed, or when a quarter of the
+ * the pairs of two unchanged nodes are kept as they are (one O(pairs) copy, no geometry).
+ * It finds them all from scratch when
+ * it knows nothing of them (no adj_seen), when the tolerance changed, or when half of the
  * visible nodes or more changed. *from_scratch (may be NULL) says which it did. AG_ERR_NOMEM
  * (t then has no pairs and knows nothing of them). */
 ag_status ag_splittree_adjacency_update(ag_splittree *t, int *from_scratch);
