@@ -27,6 +27,7 @@ static void adj_cells(const double o[3], double h, const double lo[3], const dou
     }
 }
 
+/* As ag_box_meets, and a box with a NaN meets nothing. */
 static int boxes_meet(const ag_box *a, const ag_box *b, double tol)
 {
     return ag_box_meets_axis(a, b, 0, tol) && ag_box_meets_axis(a, b, 1, tol) &&
@@ -39,7 +40,7 @@ static uint64_t pair_key(uint32_t x, uint32_t y)
     return x < y ? (uint64_t)x << 32 | y : (uint64_t)y << 32 | x;
 }
 
-/* The sorted keys' pairs, each once (a pair found twice is listed twice), as t's pairs. */
+/* The sorted keys as t's pairs, a repeated key (a pair found twice) once. */
 static ag_status set_pairs(ag_splittree *t, const ag_radix_item *pairs, size_t npairs)
 {
     uint32_t *adj = npairs ? malloc(2 * npairs * sizeof *adj) : NULL;
@@ -302,18 +303,14 @@ static ag_status bvh_build(adj_bvh *h, const ag_splittree *t, size_t nv)
             *b = t->nodes[ord[i].val].box;
         } else {
             h->leaf[i] = UINT32_MAX;
-            for (int a = 0; a < 3; a++) {
-                b->min[a] = INFINITY;
-                b->max[a] = -INFINITY;
-            }
+            *b = ag_box_empty();
         }
     }
     free(ord);
-    for (size_t i = h->m; i-- > 1;)
-        for (int a = 0; a < 3; a++) {
-            h->bound[i].min[a] = fmin(h->bound[2 * i].min[a], h->bound[2 * i + 1].min[a]);
-            h->bound[i].max[a] = fmax(h->bound[2 * i].max[a], h->bound[2 * i + 1].max[a]);
-        }
+    for (size_t i = h->m; i-- > 1;) {
+        h->bound[i] = h->bound[2 * i];
+        ag_box_extend_box(&h->bound[i], &h->bound[2 * i + 1]);
+    }
     return AG_OK;
 }
 
