@@ -227,11 +227,12 @@ static int mutate(uint64_t *s, ag_splittree *t)
         return 0;
     case 6: { /* a copy appended under the same parent, shifted by a window */
         ag_box b = x->box;
+        int32_t parent = x->parent; /* x moves when the nodes grow */
         b.min[0] += 0.8;
         b.max[0] += 0.8;
         int32_t k = add_box(t, b.min, b.max);
-        if (x->parent >= 0)
-            ag_splittree_attach(t, x->parent, k);
+        if (parent >= 0)
+            ag_splittree_attach(t, parent, k);
         return 1;
     }
     default: { /* moved far: to another wall's place */
