@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "../base/tolerance.h"
+#include "../proc/adjacency.h"
 #include "resize.h"
 
 static ag_status nomem(ag_error *err)
@@ -420,7 +421,7 @@ static ag_status finish(ag_mesh *mesh, ag_labels *L, ag_splittree *t, int with_r
     if (!st)
         st = labels_complete(L, mesh, t);
     if (!st)
-        st = ag_splittree_adjacency(t);
+        st = ag_splittree_adjacency_update(t, NULL); /* only the changed nodes' pairs found again */
     if (st) {
         st = nomem(err);
         goto fail;
