@@ -174,8 +174,7 @@ static ag_status read_raw(const uint8_t *data, size_t len, ag_format fmt,
     if (fmt == AG_FORMAT_OBJ) {
         ag_obj_read_options o = {.up = AG_UP_Z,
                                  .progress = raw.progress,
-                                 .user = raw.user,
-                                 .allow_external_files = raw.allow_external_files};
+                                 .user = raw.user};
         return ag_obj_read_buffer((const char *)data, len, &o, out, err);
     }
     ag_status st = ag_assimp_import_buffer(data, len, fmt, &raw, out, NULL, err);
