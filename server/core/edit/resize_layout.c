@@ -16,7 +16,8 @@
  *                    count keep their size, cells of the same count their share of the new
  *                    box, except along an axis that is thin for them (they keep their size
  *                    and are spaced out); patterns of one parent whose lattices
- *                    interleave (the pieces of composite windows) share one lattice; new cells
+ *                    interleave (the pieces of composite windows, windows alternating with
+ *                    their mirror images) share one lattice, placed as one; new cells
  *                    copy the cell at their place in the old grid, cells no new cell copies go
  *
  * A node of the copy keeps its index (its id); copies are appended, removed nodes become
@@ -556,11 +557,25 @@ typedef struct {
     int grid;              /* a complete axis-aligned grid: laid out by periods */
     axis_layout ax[3];
     ag__resize_map map;    /* otherwise: its cells follow this map */
+    ag_box nb;             /* its new box */
+    ag_box cont;           /* what holds it (its holder's box, grown to hold nb) */
+    int thin[3];           /* its cells are thin along the axis */
 } pattern_layout;
 
+/* Along one axis, the patterns that share a lattice laid out by the first of them (the
+ * pieces of composite windows, windows and their mirror images alternating): where the
+ * count changes they are placed as one, so that the set stays centred and inside what holds
+ * it (each pattern alone is off-centre by its offset in the set). */
+typedef struct {
+    ag_box nb;     /* the union of their new boxes */
+    ag_box cont;   /* the union of what holds them */
+    double lo, hi; /* the lowest and highest old min of their first cells */
+} lattice_set;
+
 /* Along axis a, the pattern's new count and period from its stretch f, unless a reference
- * pattern ref (interleaved with it, same count, period and stretch) fixes them. */
-static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const ag_box *cont,
+ * pattern ref (interleaved with it, same count, period and stretch) fixes them; set: the
+ * patterns it is the reference of, itself included. */
+static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const lattice_set *set,
                         int a, int thin, const axis_layout *ref)
 {
     uint32_t k = x->n;
@@ -599,16 +614,18 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const ag
         /* k periods span one spacing more than the stretched cells did: the cells stay inside
          * what holds the pattern, one fewer when they would not fit (a facade of 6 windows
          * stretched twice as long with less than half a spacing at its ends holds 11) */
-        double room = ag_box_extent(cont, a) + L->eps;
-        while (k > 1 && (k - 1) * x->pn + x->wn > room)
+        const ag_box *cont = &set->cont;
+        double room = ag_box_extent(cont, a) + L->eps, spread = set->hi - set->lo;
+        while (k > 1 && (k - 1) * x->pn + x->wn + spread > room)
             k--;
         x->k = k;
-        double span = (k - 1) * x->pn + x->wn;
-        x->on = ag_box_centre_axis(nb, a) - 0.5 * span;
-        if (x->on + span > cont->max[a])
-            x->on = cont->max[a] - span;
-        if (x->on < cont->min[a])
-            x->on = cont->min[a];
+        double span = (k - 1) * x->pn + x->wn + spread;
+        double lo = ag_box_centre_axis(&set->nb, a) - 0.5 * span;
+        if (lo + span > cont->max[a])
+            lo = cont->max[a] - span;
+        if (lo < cont->min[a])
+            lo = cont->min[a];
+        x->on = lo + (x->o - set->lo);
     }
 }
 
@@ -809,6 +826,32 @@ static void place_cells(lay *L, const pattern_layout *pl, int depth)
     free(cells);
 }
 
+/* The pattern whose lattice pattern i follows along axis a: the first earlier one
+ * interleaved with it, followed to the one that follows none; i itself when none. */
+static size_t lattice_root(const pattern_layout *pl, size_t i, int a, double tol)
+{
+    for (size_t j = 0; j < i; j++)
+        if (pl[j].grid && pl[j].ax[a].lattice && interleaved(&pl[j].ax[a], &pl[i].ax[a], tol))
+            return lattice_root(pl, j, a, tol);
+    return i;
+}
+
+/* The set of patterns that follow pattern r's lattice along axis a. */
+static lattice_set lattice_set_of(const pattern_layout *pl, size_t n, size_t r, int a,
+                                  double tol)
+{
+    lattice_set set = {pl[r].nb, pl[r].cont, pl[r].ax[a].o, pl[r].ax[a].o};
+    for (size_t j = r + 1; j < n; j++) {
+        if (!pl[j].grid || !pl[j].ax[a].lattice || lattice_root(pl, j, a, tol) != r)
+            continue;
+        ag_box_extend_box(&set.nb, &pl[j].nb);
+        ag_box_extend_box(&set.cont, &pl[j].cont);
+        set.lo = fmin(set.lo, pl[j].ax[a].o);
+        set.hi = fmax(set.hi, pl[j].ax[a].o);
+    }
+    return set;
+}
+
 static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
 {
     ag_splittree *t = L->nt;
@@ -818,12 +861,14 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
         return;
     }
     double tol = t->tol > 0 ? t->tol : L->eps;
+    /* each pattern's old lattice, new box and holder */
     for (size_t i = 0; i < n; i++) {
         int32_t P = pats[i];
         pattern_layout *x = &pl[i];
         x->node = P;
         ag_box ob = oldb(L, P), nb = t->nodes[P].box;
         x->map = ag__resize_map_between(&ob, &nb);
+        x->nb = nb;
         const ag_tnode *pn = &t->nodes[P];
         const ag_pattern *pp = pn->pattern >= 0 && (size_t)pn->pattern < t->npatterns
                                    ? &t->patterns[pn->pattern]
@@ -841,10 +886,8 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
         while (holder > 0 && t->nodes[holder].kind != AG_NODE_COMPONENT)
             holder = t->nodes[holder].parent;
         ag_box cont = holder >= 0 ? t->nodes[holder].box : nb;
-        for (int a = 0; a < 3; a++) { /* a pattern already past its holder keeps its own box */
-            cont.min[a] = fmin(cont.min[a], nb.min[a]);
-            cont.max[a] = fmax(cont.max[a], nb.max[a]);
-        }
+        ag_box_extend_box(&cont, &nb); /* a pattern already past its holder keeps its own box */
+        x->cont = cont;
         ag_box cb = oldb(L, first);
         double e[3], emax = 0;
         ag_box_extents(&cb, e);
@@ -856,21 +899,28 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
             ax->k = ax->n;
             ax->w = e[a];
             ax->o = cb.min[a];
+            x->thin[a] = e[a] < L->s->thin_ratio * emax;
             double span = ag_box_extent(&ob, a);
             ax->lattice = ax->n >= 2 && span > AG_EDIT_FLAT;
             if (!ax->lattice)
                 continue;
             ax->p = (span - ax->w) / (ax->n - 1);
             ax->f = x->map.s[a];
-            if (!(ax->p > AG_EDIT_FLAT) || !(ax->f > AG_EDIT_MIN_RATIO) || !isfinite(ax->f)) {
+            if (!(ax->p > AG_EDIT_FLAT) || !(ax->f > AG_EDIT_MIN_RATIO) || !isfinite(ax->f))
                 ax->lattice = 0;
+        }
+    }
+    /* the new lattices, a shared one from the pattern that leads it */
+    for (size_t i = 0; i < n; i++) {
+        if (!pl[i].grid)
+            continue;
+        for (int a = 0; a < 3; a++) {
+            axis_layout *ax = &pl[i].ax[a];
+            if (!ax->lattice)
                 continue;
-            }
-            const axis_layout *ref = NULL;
-            for (size_t j = 0; j < i && !ref; j++)
-                if (pl[j].grid && interleaved(&pl[j].ax[a], ax, tol))
-                    ref = &pl[j].ax[a];
-            layout_axis(L, ax, &nb, &cont, a, e[a] < L->s->thin_ratio * emax, ref);
+            size_t r = lattice_root(pl, i, a, tol);
+            lattice_set set = lattice_set_of(pl, n, r, a, tol);
+            layout_axis(L, ax, &pl[i].nb, &set, a, pl[i].thin[a], r < i ? &pl[r].ax[a] : NULL);
         }
     }
     for (size_t i = 0; i < n && !L->st; i++)
