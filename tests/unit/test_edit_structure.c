@@ -309,6 +309,10 @@ static const bb_options variants[] = {
     {"flush, handed", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0, 1},
     {"proud, handed", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0, 1},
     {"proud, handed, overhang, turned", 6, 2, 3, 2, BB_PROUD, 0.3, 1, 0, 0, 0, 0, 1},
+    /* an odd count: 3 windows and 2 mirror images taking turns */
+    {"flush, handed 5 x 2", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0, 1},
+    {"recessed, handed 5 x 2", 5, 2, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0, 1},
+    {"proud, handed 5 x 2, overhang, turned", 5, 2, 3, 2, BB_PROUD, 0.3, 3, 0, 0, 0, 0, 1},
 
 };
 

@@ -545,6 +545,7 @@ done:
 /* A grid pattern's layout along one axis. */
 typedef struct {
     uint32_t n, k;   /* old and new count */
+    uint32_t kset;   /* the new count of the set it leads (lattice_set) */
     double p, pn;    /* old and new period */
     double w, wn;    /* old and new cell size */
     double o, on;    /* old and new min of the first cell */
@@ -566,24 +567,46 @@ typedef struct {
  * pieces of composite windows, windows and their mirror images alternating): where the
  * count changes they are placed as one, so that the set stays centred and inside what holds
  * it (each pattern alone is off-centre by its offset in the set). */
+#define LATTICE_SET_MAX 8
 typedef struct {
     ag_box nb;     /* the union of their new boxes */
     ag_box cont;   /* the union of what holds them */
     double lo, hi; /* the lowest and highest old min of their first cells */
+    uint32_t cells; /* of all members along the axis */
+    size_t m, rank; /* members; the rank of the pattern being laid out (by first cell) */
+    /* alternating: members whose cells lie apart and take turns (a window, its mirror
+     * image, the window again: 3 and 2 cells), counted as one sequence of cells; d: the
+     * members' offsets from lo by rank */
+    int alternating;
+    double d[LATTICE_SET_MAX];
 } lattice_set;
 
+/* Cells of the member of rank q when an alternating set holds `cells` cells in all. */
+static uint32_t member_cells(const lattice_set *set, uint32_t cells, size_t q)
+{
+    return (uint32_t)((cells - q + set->m - 1) / set->m);
+}
+
+/* The extent of an alternating set of `cells` cells at period pn, cells w long. */
+static double set_span(const lattice_set *set, uint32_t cells, double pn, double w)
+{
+    return (double)((cells - 1) / set->m) * pn + set->d[(cells - 1) % set->m] + w;
+}
+
 /* Along axis a, the pattern's new count and period from its stretch f, unless a reference
- * pattern ref (interleaved with it, same count, period and stretch) fixes them; set: the
- * patterns it is the reference of, itself included. */
+ * pattern ref (interleaved with it: the same period and stretch) fixes them; set: the
+ * patterns it is the reference of, itself included. An alternating set is counted as one
+ * sequence of cells (kset), which its members take turns in. */
 static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const lattice_set *set,
                         int a, int thin, const axis_layout *ref)
 {
-    uint32_t k = x->n;
+    int alt = set->alternating;
+    uint32_t n = alt ? set->cells : x->n, k = n;
     if (ref) {
-        k = ref->k;
+        k = ref->kset;
     } else if (L->structural && !thin) { /* thin elements are spaced out, never added */
         for (int it = 0; it < PATTERN_MAX_STEPS; it++) {
-            double r = x->f * x->n / k;
+            double r = x->f * n / k;
             if (r > L->s->split_ratio && k < PATTERN_MAX_COUNT)
                 k *= 2;
             else if (r < L->s->join_ratio && k > 1)
@@ -592,8 +615,12 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const la
                 break;
         }
     }
-    x->k = k;
-    if (ref && ref->k != ref->n) { /* cells of a new count keep their size and offset */
+    int changed = k != n;
+    if (alt && k < set->m)
+        k = (uint32_t)set->m; /* every member keeps a cell */
+    x->kset = k;
+    x->k = alt ? member_cells(set, k, set->rank) : k;
+    if (ref && changed) { /* cells of a new count keep their size and offset */
         x->pn = ref->pn;
         x->wn = x->w;
         x->on = ref->on + (x->o - ref->o);
@@ -601,25 +628,32 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const la
         x->pn = ref->pn;
         x->wn = thin ? x->w : x->w * x->pn / x->p;
         x->on = ref->on + (x->o - ref->o) * x->pn / x->p;
-    } else if (k == x->n) {
+    } else if (!changed) {
         /* the count stays: the cells span the pattern's new box (thin ones spaced out) */
         x->wn = thin ? x->w : x->w * x->f;
-        x->pn = (ag_box_extent(nb, a) - x->wn) / (k - 1);
+        x->pn = (ag_box_extent(nb, a) - x->wn) / (x->k - 1);
         x->on = nb->min[a];
     } else {
         /* the pattern's length in periods; the cells keep their size (a facade stretched 2x
          * holds twice the windows at the original size and spacing, 1.9x slightly closer) */
-        x->pn = x->f * x->n * x->p / k;
+        x->pn = x->f * n * x->p / k;
         x->wn = x->w;
         /* k periods span one spacing more than the stretched cells did: the cells stay inside
          * what holds the pattern, one fewer when they would not fit (a facade of 6 windows
          * stretched twice as long with less than half a spacing at its ends holds 11) */
         const ag_box *cont = &set->cont;
-        double room = ag_box_extent(cont, a) + L->eps, spread = set->hi - set->lo;
-        while (k > 1 && (k - 1) * x->pn + x->wn + spread > room)
-            k--;
-        x->k = k;
-        double span = (k - 1) * x->pn + x->wn + spread;
+        double room = ag_box_extent(cont, a) + L->eps, spread = set->hi - set->lo, span;
+        if (alt) {
+            while (k > set->m && set_span(set, k, x->pn, x->wn) > room)
+                k--;
+            span = set_span(set, k, x->pn, x->wn);
+        } else {
+            while (k > 1 && (k - 1) * x->pn + x->wn + spread > room)
+                k--;
+            span = (k - 1) * x->pn + x->wn + spread;
+        }
+        x->kset = k;
+        x->k = alt ? member_cells(set, k, set->rank) : k;
         double lo = ag_box_centre_axis(&set->nb, a) - 0.5 * span;
         if (lo + span > cont->max[a])
             lo = cont->max[a] - span;
@@ -629,11 +663,12 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const la
     }
 }
 
-/* Do two patterns' lattices interleave along an axis (same count, period and stretch, first
- * cells less than a period apart)? */
+/* Do two patterns' lattices interleave along an axis (counts at most one apart, the same
+ * period and stretch, first cells less than a period apart)? */
 static int interleaved(const axis_layout *x, const axis_layout *y, double tol)
 {
-    return x->lattice && y->lattice && x->n == y->n && fabs(x->p - y->p) <= tol &&
+    return x->lattice && y->lattice && x->n + 1 >= y->n && y->n + 1 >= x->n &&
+           fabs(x->p - y->p) <= tol &&
            fabs(x->f - y->f) <= 1e-9 * fmax(1, fabs(x->f)) && fabs(x->o - y->o) < x->p - tol;
 }
 
@@ -836,19 +871,56 @@ static size_t lattice_root(const pattern_layout *pl, size_t i, int a, double tol
     return i;
 }
 
-/* The set of patterns that follow pattern r's lattice along axis a. */
-static lattice_set lattice_set_of(const pattern_layout *pl, size_t n, size_t r, int a,
-                                  double tol)
+static int member_of(const pattern_layout *pl, size_t j, size_t r, int a, double tol)
 {
-    lattice_set set = {pl[r].nb, pl[r].cont, pl[r].ax[a].o, pl[r].ax[a].o};
-    for (size_t j = r + 1; j < n; j++) {
-        if (!pl[j].grid || !pl[j].ax[a].lattice || lattice_root(pl, j, a, tol) != r)
+    return j == r || (pl[j].grid && pl[j].ax[a].lattice && lattice_root(pl, j, a, tol) == r);
+}
+
+/* The set of patterns that follow pattern r's lattice along axis a, as pattern i sees it.
+ * Members whose cells lie apart (each in its own place in the period: windows and their
+ * mirror images) alternate when the member of rank q holds ceil((cells - q) / m) cells; a
+ * set whose counts differ and do not alternate gives *ok = 0 (each pattern goes alone). */
+static lattice_set lattice_set_of(const pattern_layout *pl, size_t n, size_t r, size_t i,
+                                  int a, double tol, int *ok)
+{
+    lattice_set set = {.nb = pl[r].nb, .cont = pl[r].cont, .lo = pl[r].ax[a].o,
+                       .hi = pl[r].ax[a].o};
+    int differ = 0;
+    double w = 0;
+    for (size_t j = r; j < n; j++) {
+        if (!member_of(pl, j, r, a, tol))
             continue;
         ag_box_extend_box(&set.nb, &pl[j].nb);
         ag_box_extend_box(&set.cont, &pl[j].cont);
         set.lo = fmin(set.lo, pl[j].ax[a].o);
         set.hi = fmax(set.hi, pl[j].ax[a].o);
+        set.cells += pl[j].ax[a].n;
+        differ |= pl[j].ax[a].n != pl[r].ax[a].n;
+        w = fmax(w, pl[j].ax[a].w);
+        set.m++;
     }
+    *ok = !differ;
+    if (set.m < 2 || set.m > LATTICE_SET_MAX)
+        return set;
+    int apart = 1, regular = 1;
+    for (size_t j = r; j < n; j++) {
+        if (!member_of(pl, j, r, a, tol))
+            continue;
+        size_t q = 0; /* its rank: the members whose first cell comes before */
+        for (size_t h = r; h < n; h++)
+            q += h != j && member_of(pl, h, r, a, tol) &&
+                 (pl[h].ax[a].o < pl[j].ax[a].o || (pl[h].ax[a].o == pl[j].ax[a].o && h < j));
+        set.d[q] = pl[j].ax[a].o - set.lo;
+        regular = regular && pl[j].ax[a].n == member_cells(&set, set.cells, q);
+        if (j == i)
+            set.rank = q;
+    }
+    for (size_t q = 0; q < set.m; q++) {
+        double next = q + 1 < set.m ? set.d[q + 1] : pl[r].ax[a].p;
+        apart = apart && next - set.d[q] >= w - tol;
+    }
+    set.alternating = apart && regular;
+    *ok = *ok || set.alternating;
     return set;
 }
 
@@ -919,7 +991,12 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
             if (!ax->lattice)
                 continue;
             size_t r = lattice_root(pl, i, a, tol);
-            lattice_set set = lattice_set_of(pl, n, r, a, tol);
+            int ok;
+            lattice_set set = lattice_set_of(pl, n, r, i, a, tol, &ok);
+            if (!ok) { /* counts that differ and do not alternate: alone */
+                r = i;
+                set = (lattice_set){.nb = pl[i].nb, .cont = pl[i].cont, .lo = ax->o, .hi = ax->o};
+            }
             layout_axis(L, ax, &pl[i].nb, &set, a, pl[i].thin[a], r < i ? &pl[r].ax[a] : NULL);
         }
     }
