@@ -1,10 +1,11 @@
 /* Node ids survive edits: on generated box buildings (edit_building_fixture.h; windows recessed,
  * flush and proud, turned, at UTM coordinates, jittered, handed: mirror images alternating) a
- * window picked by its place before the front wall is stretched 2x is named by the same id after it (same label, same size,
- * still the first window of its row); no visible node of the input loses its id or changes
- * its kind or label; an op naming the window by that id (made before the stretch) applies to
- * it and its rule; and the edited model reloads from what the store keeps (mesh and stored
- * tree) node for node. Windows are measured on the output mesh. */
+ * window picked by its place before the front wall is stretched 2x is named by the same id
+ * after it (same label, same size, still the first window of its row); no visible node of the
+ * input loses its id or changes its kind or label; an op naming the window by that id (made
+ * before the stretch) applies to it and its rule (handed: the mirror images are a rule of
+ * their own); and the edited model reloads from what the store keeps (mesh and stored tree)
+ * node for node. Windows are measured on the output mesh. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
