@@ -245,6 +245,23 @@ function sweepFootprints(m, work) {
     else if (o) note += `; rise ${o.rise.toFixed(3)} m as CGAL's`;
   }
   record(m, 'extrude', verdict, note);
+  if (m.polys) sweepMixedStyle(m, work);
+}
+
+// per-edge profiles from a style's rules: vertical walls north, a 0.5 m soffit and 45°
+// south, steep (63°) or the soffit elsewhere; reach: the soffit mitred (2.5x), top: the
+// steep slope over the whole footprint
+const MIXED = { name: 'mixed', height: 9, seed: 7, profiles: { steep: [[0.5, 1]], wall: [[0, 1]], over: [[-0.5, 0], [2.5, 3]] },
+  rules: [{ orientation: 'north', profiles: 'wall' }, { orientation: 'south', profiles: 'over' }, { profiles: { steep: 0.6, over: 0.4 } }] };
+function sweepMixedStyle(m, work) {
+  const style = path.join(work, 'mixed.json'), outObj = path.join(work, 'mixed.obj'), rep = path.join(work, 'mixed-report.json');
+  fs.writeFileSync(style, JSON.stringify(MIXED));
+  const r = run(['extrude', m.file, '--style', style, '--out', outObj, '--report', rep]);
+  if (r.verdict !== 'ok') return record(m, 'extrude-mixed', r.verdict === 'error' ? 'BUG:rejected-valid' : `BUG:${r.verdict}`, r.out);
+  const report = JSON.parse(fs.readFileSync(rep, 'utf8'));
+  const c = checkExtrusion(outObj, m, { reach: 2.5 * 0.5, top: m.height + 2 * (diagonal(m.polys) + 0.5), origin: report.origin || [0, 0] });
+  const fell = report.fallbacks.length || report.failed.length;
+  record(m, 'extrude-mixed', c.fails.length ? 'BUG:wrong-result' : fell ? 'WARN:fallback' : 'ok', c.fails.length ? c.fails.join('; ') : r.out.split('\n').slice(-1)[0]);
 }
 
 // a plan with per-edge profiles, steps and offset events: the shell is checked like a
