@@ -210,6 +210,28 @@ export function readObj(file) {
   return { v, f };
 }
 
+// An extrusion's OBJ as z-up points, triangles per group (component) and each vertex's id
+// welded at 1e-6 m: what sweep.js and the held-out tests check extrusions on.
+export function readExtrusion(file) {
+  const text = fs.readFileSync(file, 'utf8');
+  const yup = /^# archgram:.*y up/m.test(text);
+  const v = [], groups = new Map();
+  let g = '';
+  for (const line of text.split('\n')) {
+    const t = line.trim().split(/\s+/);
+    if (t[0] === 'v') { const [x, y, z] = t.slice(1, 4).map(Number); v.push(yup ? [x, -z, y] : [x, y, z]); }
+    else if (t[0] === 'g' || t[0] === 'o') g = t.slice(1).join(' ');
+    else if (t[0] === 'f') {
+      const p = t.slice(1).map((s) => parseInt(s, 10) - 1);
+      if (!groups.has(g)) groups.set(g, []);
+      for (let k = 1; k + 1 < p.length; k++) groups.get(g).push([p[0], p[k], p[k + 1]]);
+    }
+  }
+  const ids = new Map();
+  const weld = v.map((p) => { const k = p.map((x) => Math.round(x * 1e6)).join(','); if (!ids.has(k)) ids.set(k, ids.size); return ids.get(k); });
+  return { v, weld, groups };
+}
+
 // --- mesh variants ------------------------------------------------------------------------
 export function meshVariants() {
   const out = [];

@@ -8,6 +8,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
+import { readExtrusion } from './generate.js';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const args = process.argv.slice(2);
@@ -123,26 +124,6 @@ function sweepMesh(m, work) {
   record(m, 'part-compose', r.verdict === 'ok' ? 'ok' : r.verdict === 'error' ? 'precise-error' : `BUG:${r.verdict}`, r.out);
 }
 
-// An extrusion's OBJ as z-up triangles per group (component), coordinates welded at 1e-6 m.
-function readExtrusion(file) {
-  const text = fs.readFileSync(file, 'utf8');
-  const yup = /^# archgram:.*y up/m.test(text);
-  const v = [], groups = new Map();
-  let g = '';
-  for (const line of text.split('\n')) {
-    const t = line.trim().split(/\s+/);
-    if (t[0] === 'v') { const [x, y, z] = t.slice(1, 4).map(Number); v.push(yup ? [x, -z, y] : [x, y, z]); }
-    else if (t[0] === 'g' || t[0] === 'o') g = t.slice(1).join(' ');
-    else if (t[0] === 'f') {
-      const p = t.slice(1).map((s) => parseInt(s, 10) - 1);
-      if (!groups.has(g)) groups.set(g, []);
-      for (let k = 1; k + 1 < p.length; k++) groups.get(g).push([p[0], p[k], p[k + 1]]);
-    }
-  }
-  const ids = new Map();
-  const weld = v.map((p) => { const k = p.map((x) => Math.round(x * 1e6)).join(','); if (!ids.has(k)) ids.set(k, ids.size); return ids.get(k); });
-  return { v, weld, groups };
-}
 const ringArea = (r) => r.reduce((a, p, i) => { const q = r[(i + 1) % r.length]; return a + p[0] * q[1] - q[0] * p[1]; }, 0) / 2;
 
 // Independent checks of an extrusion: every group a closed 2-manifold (each welded directed

@@ -9,7 +9,7 @@ import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { REPO, tempDir, removeDir } from './harness.js';
-import { building, measure, offset, rotZ, plyText, stlBinary, gltf, objText, cloudPoints, las } from '../heldout/generate.js';
+import { building, measure, offset, rotZ, plyText, stlBinary, gltf, objText, cloudPoints, las, readExtrusion } from '../heldout/generate.js';
 
 const CLI = process.env.ARCHGRAM ? path.resolve(process.env.ARCHGRAM) : path.join(REPO, 'build', 'archgram');
 const run = (...args) => spawnSync(CLI, args, { encoding: 'utf8', timeout: 60000 });
@@ -151,19 +151,6 @@ test('cut: a tile in a local site frame (coordinates near 0, 0) is refused as de
   }
 });
 
-// An extrusion's OBJ (y up) as z-up points and triangles, welded at 1e-6 m.
-function readExtrusion(file) {
-  const v = [], T = [];
-  for (const line of fs.readFileSync(file, 'utf8').split('\n')) {
-    const t = line.trim().split(/\s+/);
-    if (t[0] === 'v') { const [x, y, z] = t.slice(1, 4).map(Number); v.push([x, -z, y]); }
-    else if (t[0] === 'f') { const p = t.slice(1).map((s) => parseInt(s, 10) - 1); for (let k = 1; k + 1 < p.length; k++) T.push([p[0], p[k], p[k + 1]]); }
-  }
-  const ids = new Map();
-  const weld = v.map((p) => { const k = p.map((x) => Math.round(x * 1e6)).join(','); if (!ids.has(k)) ids.set(k, ids.size); return ids.get(k); });
-  return { v, T, weld };
-}
-
 test('extrude: a footprint with a spike a few micrometres wide builds as styled, closed, with its base area', () => {
   const dir = tempDir();
   try {
@@ -179,7 +166,8 @@ test('extrude: a footprint with a spike a few micrometres wide builds as styled,
       const report = JSON.parse(fs.readFileSync(rep, 'utf8'));
       assert.equal(report.succeeded, 1, `${w}: ${r.stdout}${r.stderr}`);
       assert.deepEqual(report.fallbacks, [], `${w}: ${r.stderr}`);
-      const { v, T, weld } = readExtrusion(out);
+      const { v, weld, groups } = readExtrusion(out);
+      const T = [...groups.values()].flat();
       const use = new Map();
       for (const t of T) for (let k = 0; k < 3; k++) { const key = `${weld[t[k]]},${weld[t[(k + 1) % 3]]}`; use.set(key, (use.get(key) || 0) + 1); }
       for (const [key, n] of use) {
