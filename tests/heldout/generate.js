@@ -471,6 +471,11 @@ export function planVariants() {
     steps: [{ name: 'c', edge: 2, relative: 0.6, height: 7, profile: 'chimney', points: [[-0.4, -0.6], [0.4, -0.6], [0.4, 0.3], [-0.4, 0.3]] }] });
   P('box-offset-event-gables', [box], ['steep', 'wall', 'steep', 'wall'], [0, 0], {
     offsets: [{ height: 6, outside: 0.4, edges: [{ edge: 1, disabled: true }, { edge: 3, disabled: true }] }] });
+  // two parts meeting corner to corner across a 0.5 m gap, both with a 0.5 m soffit: the
+  // soffits run into each other head-on (the MultiPolygon with corner-touching parts under
+  // a style with soffits falls back for the same reason)
+  out.push({ family: 'plan', variant: 'diagonal-parts-soffits-collide', ext: 'json', polys: [[box.map(([x, y]) => [x * 10 / 12, y * 10 / 8])], [[[10.5, 10.5], [20, 10.5], [20, 20], [10.5, 20]]]], origin: [0, 0], rise: 10,
+    data: JSON.stringify({ profiles: { o: [[0, 0], [0, 9], [-0.5, 9], [2.5, 12]] }, default_profile: 'o', loops: [[[0, 0], [10, 0], [10, 10], [0, 10]], [[10.5, 10.5], [20, 10.5], [20, 20], [10.5, 20]]] }) });
   return out;
 }
 
