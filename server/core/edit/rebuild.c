@@ -505,6 +505,7 @@ ag_status ag_rebuild(const ag_proceduralize_result *in, ag_splittree *t, int32_t
         memcpy(L->variant_deviation, OL->variant_deviation,
                OL->nvariants * sizeof *L->variant_deviation);
     L->exact_copies = OL->exact_copies;
+    L->units = OL->units; /* a resize changes sizes, not the unit */
     /* tolerances follow the model's size */
     double od = ag_box_diagonal(&ot->nodes[0].box), nd = ag_box_diagonal(&t->nodes[0].box);
     double scale = od > 0 && nd > 0 ? nd / od : 1;
