@@ -242,6 +242,11 @@
 #define AG_VERIFY_MITRE 2.5
 /* ... plus this fraction of the plan's size (and its point tolerance) of slack. */
 #define AG_VERIFY_REACH_REL 1e-6
+/* How far behind a face the building check probes its winding, relative to the
+ * building's size. Validation removes spikes no wider than this: the probe of a wall
+ * would lie beyond the spike's other wall, and the shell welds the corners of narrower
+ * ones (delta1 apart) into one edge used twice. */
+#define AG_VERIFY_WINDING_PROBE 1e-7
 
 /* A face whose Newell normal (twice its area, m²) is shorter than this has no area and
  * is not triangulated. */
