@@ -394,6 +394,18 @@ static ag_status write_proc_summary(ag_folder_ws *w, const char *path, json_t *j
     return s;
 }
 
+/* The file's length unit and why (core/proc/units.h), as the up axis is reported. */
+static json_t *units_json(const ag_units *u)
+{
+    json_t *j = json_pack("{s:s, s:f, s:s}", "unit", u->name ? u->name : "m", "metres_per_unit",
+                          u->metres_per_unit > 0 ? u->metres_per_unit : 1.0, "decided",
+                          u->given ? "request" : "content");
+    if (j && !u->given)
+        json_object_set_new(j, "evidence", json_pack("{s:f, s:f}", "height", u->height,
+                                                     "median_part", u->median_part));
+    return j;
+}
+
 /* summary.json of `archgram proceduralize`. */
 static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
                             const ag_proc_outcome *o, double write_s)
@@ -416,7 +428,7 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
     snprintf(norm, sizeof norm, "%s; %s",
              zup ? "input taken as z-up, kept" : "y-up input turned to z-up: (x, y, z) -> (x, -z, y)",
              fmt == AG_FORMAT_FBX ? "FBX units (UnitScaleFactor) converted to metres"
-                                  : "units taken as metres");
+                                  : "coordinates kept in the file's unit (labeling.units)");
     json_object_set_new(ji, "format", json_string(ag_format_name(fmt)));
     json_object_set_new(ji, "up", ag_import_up_json(&w->up));
     json_object_set_new(ji, "normalization", json_string(norm));
@@ -448,9 +460,10 @@ static json_t *proc_summary(const ag_folder_ws *w, const ag_model_state *st,
     json_object_set_new(j, "labels", jl);
     /* how labels and shared terminals were decided (README, "Labels and shared terminals") */
     json_object_set_new(j, "labeling",
-                        json_pack("{s:f, s:f, s:b, s:I}", "tolerance", L->tol, "share",
+                        json_pack("{s:f, s:f, s:b, s:I, s:o}", "tolerance", L->tol, "share",
                                   L->share, "exact_copies", L->exact_copies,
-                                  "surface_checks", (json_int_t)L->surface_checks));
+                                  "surface_checks", (json_int_t)L->surface_checks, "units",
+                                  units_json(&L->units)));
 
     /* one object per component: printed directly in save (components_text) */
     json_object_set_new(j, "components", json_string(COMPONENTS_MARK));

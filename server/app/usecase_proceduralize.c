@@ -87,6 +87,7 @@ ag_status ag_usecase_proceduralize_run(ag_workspace *ws, const ag_usecase_proced
     out->terminal_bytes = st.terms.bytes;
     out->fidelity = o.fidelity;
     out->label_tolerance = r->labels->tol;
+    out->units = r->labels->units;
     o.total_s = now() - t_all - o.seconds[AG_STAGE_VERIFY];
     s = ag_workspace_save(ws, &st, &o, NULL, err);
     out->total_s = now() - t_all - o.seconds[AG_STAGE_VERIFY];

@@ -27,7 +27,8 @@ typedef struct {
 typedef struct {
     size_t triangles, components, labels, variants, rules, patterns, terminals;
     size_t grammar_bytes, terminal_bytes;
-    double label_tolerance; /* metres: labels and shared terminals */
+    double label_tolerance; /* file units: labels and shared terminals */
+    ag_units units;         /* the file's length unit, given or decided (core/proc/units.h) */
     ag_fidelity fidelity;
     double total_s; /* up to the save, verify excluded */
 } ag_usecase_proceduralize_result;

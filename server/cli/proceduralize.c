@@ -90,9 +90,10 @@ int ag_cli_proceduralize(int argc, char **argv)
            in, r.triangles, r.components, r.labels, r.variants, r.rules, r.patterns, r.terminals,
            r.grammar_bytes, r.terminal_bytes, w.input_bytes, r.fidelity.max_error,
            r.fidelity.relative, r.fidelity.unmatched, r.total_s);
-    printf("%s: up axis %s (%s, score %.2f); label tolerance %.3g m%s\n", in,
+    printf("%s: up axis %s (%s, score %.2f); label tolerance %.3g %s (units %s, %s)%s\n", in,
            w.up.axis == AG_UP_Z ? "z" : "y", ag_import_up_basis_name(w.up.basis),
-           w.up.evidence.score, r.label_tolerance, p.label.exact_copies ? ", exact copies" : "");
+           w.up.evidence.score, r.label_tolerance, r.units.name, r.units.name,
+           r.units.given ? "request" : "content", p.label.exact_copies ? ", exact copies" : "");
     if (r.fidelity.unmatched) {
         fprintf(stderr, "archgram: %s: the grammar does not reproduce %zu input triangles\n", in,
                 r.fidelity.unmatched);

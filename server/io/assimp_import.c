@@ -1,6 +1,7 @@
 #include "assimp_import.h"
 
 #include "external_ref.h"
+#include "ply.h"
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
@@ -372,11 +373,11 @@ ag_status ag_assimp_import_buffer(const uint8_t *data, size_t len, ag_format fmt
     if (!data || len == 0)
         return ag_error_set(err, AG_ERR_EMPTY, 0, "empty file");
     if (fmt == AG_FORMAT_PLY) {
-        /* assimp 5.2 loops forever on a PLY header without end_header */
-        size_t n = len < 65536 ? len : 65536;
-        if (len < 4 || memcmp(data, "ply", 3) || !memmem(data, n, "end_header", 10))
-            return ag_error_set(err, AG_ERR_PARSE, 1,
-                                "ply: the header is missing or has no end_header");
+        /* assimp 5.2 loops forever on a PLY header without an end_header line (one glued to
+         * the line before it is enough): archgram's own reader checks the header first */
+        ag_status st = ag_ply_check_header(data, len, err);
+        if (st)
+            return st;
     }
     if (len > UINT32_MAX)
         return ag_error_set(err, AG_ERR_TOO_LARGE, 0, "the file is larger than 4 GiB");

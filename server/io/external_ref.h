@@ -1,8 +1,9 @@
 /* The one rule every importer follows for files an input refers to (a glTF buffer or image by
- * URI, an OBJ mtllib, a Collada or FBX texture, ...): an upload is read from its own bytes
- * and inline data only, and a reference to any other file fails with AG_ERR_EXTERNAL_REF
- * (422, problem "external-reference") naming it. Importers call this to refuse one, so the
- * message is the same everywhere. */
+ * URI, a Collada or FBX texture, ...): an upload is read from its own bytes and inline data
+ * only, and a reference to any other file fails with AG_ERR_EXTERNAL_REF (422, problem
+ * "external-reference") naming it. Importers call this to refuse one, so the message is the
+ * same everywhere. (An OBJ's mtllib is not such a reference: materials are ignored and the
+ * OBJ reader opens nothing, so the mesh imports.) */
 #ifndef AG_EXTERNAL_REF_H
 #define AG_EXTERNAL_REF_H
 

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "../core/base/array.h"
+#include "../core/base/search.h"
 #include "../core/extrude/building.h"
 #include "../core/extrude/extrude.h"
 #include "../core/extrude/predicates.h"
@@ -66,8 +67,24 @@ static int ring_ok(const ag_jsondoc *d, uint32_t ring)
     return 1;
 }
 
-static ag_status add_ring(ag_footprint *fp, const ag_jsondoc *d, uint32_t ring, int hole)
+/* Appends a ring; *cap is the capacity of fp->sizes and fp->loops, grown by doubling (one
+ * ring at a time copied both arrays once per ring: quadratic in a polygon's holes). */
+static ag_status add_ring(ag_footprint *fp, size_t *cap, const ag_jsondoc *d, uint32_t ring)
 {
+    if (fp->nloops == *cap) {
+        size_t nc;
+        if (ag_array_capacity(*cap, fp->nloops + 1, sizeof *fp->sizes + sizeof *fp->loops, &nc))
+            return AG_ERR_NOMEM;
+        size_t *ns = realloc(fp->sizes, nc * sizeof *ns);
+        if (ns)
+            fp->sizes = ns;
+        double **nl = realloc(fp->loops, nc * sizeof *nl);
+        if (nl)
+            fp->loops = nl;
+        if (!ns || !nl)
+            return AG_ERR_NOMEM;
+        *cap = nc;
+    }
     size_t n = ag_jsondoc_size(d, ring);
     double *xy = malloc(2 * n * sizeof *xy);
     if (!xy)
@@ -80,17 +97,6 @@ static ag_status add_ring(ag_footprint *fp, const ag_jsondoc *d, uint32_t ring, 
     }
     if (k > 1 && xy[0] == xy[2 * (k - 1)] && xy[1] == xy[2 * (k - 1) + 1])
         k--; /* GeoJSON closes rings by repeating the first position */
-    size_t *ns = realloc(fp->sizes, (fp->nloops + 1) * sizeof *ns);
-    if (ns)
-        fp->sizes = ns;
-    double **nl = realloc(fp->loops, (fp->nloops + 1) * sizeof *nl);
-    if (nl)
-        fp->loops = nl;
-    if (!ns || !nl) {
-        free(xy);
-        return AG_ERR_NOMEM;
-    }
-    (void)hole;
     fp->sizes[fp->nloops] = k;
     fp->loops[fp->nloops] = xy;
     fp->nloops++;
@@ -136,8 +142,8 @@ static void note(ag_footprint *fp, const char *fmt, ...)
 
 /* One polygon (part `part` of the feature, or -1 for a Polygon): rings oriented outer
  * counter-clockwise, holes clockwise, each reversal noted. */
-static ag_status add_polygon(ag_footprint *fp, const ag_jsondoc *d, uint32_t rings, size_t fi,
-                             long part, ag_error *err)
+static ag_status add_polygon(ag_footprint *fp, size_t *cap, const ag_jsondoc *d, uint32_t rings,
+                             size_t fi, long part, ag_error *err)
 {
     if (ag_jsondoc_type(d, rings) != AG_JSON_ARRAY || ag_jsondoc_size(d, rings) == 0)
         return ag_error_set(err, AG_ERR_PARSE, (long)fi + 1,
@@ -150,7 +156,7 @@ static ag_status add_polygon(ag_footprint *fp, const ag_jsondoc *d, uint32_t rin
                                 "feature %zu: ring %zu is not an array of at least 3 finite "
                                 "[x, y] positions", fi, i);
         size_t first = fp->nloops;
-        if (add_ring(fp, d, ring, i > 0) != AG_OK)
+        if (add_ring(fp, cap, d, ring) != AG_OK)
             return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         double a = ring_area(fp->loops[first], fp->sizes[first]);
         if ((i == 0 && a < 0) || (i > 0 && a > 0)) {
@@ -168,6 +174,11 @@ static ag_status add_polygon(ag_footprint *fp, const ag_jsondoc *d, uint32_t rin
 }
 
 /* --- dissolving parts that share edges ---------------------------------------------------- */
+
+/* Corners tested against the edges whose x range holds them, in one footprint's dissolve
+ * (a fraction of a second): a grid of n x n squares of two triangles each takes about
+ * 10 n^3, so 170 x 170 (57 800 triangles) is within it. */
+#define DISSOLVE_MAX_TESTS 50000000ull
 
 typedef struct {
     double x, y;
@@ -223,7 +234,8 @@ static double turn_from(double rx, double ry, double dx, double dy)
  * become the boundary of their union: every edge is split where another corner lies on
  * it, edges used both ways cancel, and what is left is linked into loops, turning at
  * shared corners so that each loop keeps the inside on its left. Parts that only touch
- * are left alone. Returns AG_OK (and *dissolved 0 when no edge was shared). */
+ * are left alone. Returns AG_OK (and *dissolved 0 when no edge was shared), AG_ERR_NOMEM,
+ * or AG_ERR_TOO_LARGE past DISSOLVE_MAX_TESTS (the footprint is left as it was). */
 static ag_status dissolve(ag_footprint *fp, size_t nparts, int *dissolved)
 {
     *dissolved = 0;
@@ -247,6 +259,7 @@ static ag_status dissolve(ag_footprint *fp, size_t nparts, int *dissolved)
     dedge *e = malloc(cap * sizeof *e);
     along *on = malloc((nu + 2) * sizeof *on);
     ag_status st = e && on ? AG_OK : AG_ERR_NOMEM;
+    uint64_t tests = 0; /* corners tested against edges */
     for (size_t L = 0; st == AG_OK && L < fp->nloops; L++) {
         size_t n = fp->sizes[L];
         const double *xy = fp->loops[L];
@@ -255,10 +268,17 @@ static ag_status dissolve(ag_footprint *fp, size_t nparts, int *dissolved)
             size_t non = 0;
             on[non++] = (along){0, pt_index(u, nu, a[0], a[1])};
             double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
-            for (size_t q = 0; q < nu && l2 > 0; q++) {
+            /* the corners sorted by x between the edge's ends: not every corner of the
+             * footprint (quadratic in its parts), and within a budget */
+            double x1 = fmax(a[0], b[0]);
+            for (size_t q = ag_search_lower_double(&u[0].x, nu, sizeof *u, fmin(a[0], b[0]));
+                 q < nu && u[q].x <= x1 && l2 > 0; q++) {
+                if (++tests > DISSOLVE_MAX_TESTS) {
+                    st = AG_ERR_TOO_LARGE;
+                    break;
+                }
                 const double p[2] = {u[q].x, u[q].y};
                 if ((p[0] == a[0] && p[1] == a[1]) || (p[0] == b[0] && p[1] == b[1]) ||
-                    p[0] < fmin(a[0], b[0]) || p[0] > fmax(a[0], b[0]) ||
                     p[1] < fmin(a[1], b[1]) || p[1] > fmax(a[1], b[1]) ||
                     ag_pred_orient2d(a, b, p) != 0)
                     continue;
@@ -545,8 +565,9 @@ ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footp
                 if (height_of(doc, props, hp[k], fp))
                     break;
         }
+        size_t cap = 0; /* of fp->sizes and fp->loops */
         if (strcmp(gt, "Polygon") == 0) {
-            st = add_polygon(fp, doc, coords, fi, -1, err);
+            st = add_polygon(fp, &cap, doc, coords, fi, -1, err);
         } else if (ag_jsondoc_type(doc, coords) != AG_JSON_ARRAY) {
             st = ag_error_set(err, AG_ERR_PARSE, (long)fi + 1,
                               "feature %zu: MultiPolygon coordinates must be an array", fi);
@@ -554,13 +575,19 @@ ag_status ag_footprints_read_buffer(const char *data, size_t len, const ag_footp
             long pi = 0;
             for (uint32_t poly = ag_jsondoc_first(doc, coords); poly != AG_JSONDOC_NONE;
                  poly = ag_jsondoc_next(doc, poly), pi++) {
-                st = add_polygon(fp, doc, poly, fi, pi, err);
+                st = add_polygon(fp, &cap, doc, poly, fi, pi, err);
                 if (st != AG_OK)
                     break;
             }
             int dissolved = 0;
             size_t nparts = ag_jsondoc_size(doc, coords);
-            if (st == AG_OK && nparts > 1 && dissolve(fp, nparts, &dissolved) != AG_OK)
+            ag_status ds = st == AG_OK && nparts > 1 ? dissolve(fp, nparts, &dissolved) : AG_OK;
+            if (ds == AG_ERR_TOO_LARGE)
+                st = ag_error_set(err, ds, (long)fi + 1,
+                                  "feature %zu: its %zu parts share too many corners to "
+                                  "dissolve within %llu tests; split it into several features",
+                                  fi, nparts, DISSOLVE_MAX_TESTS);
+            else if (ds != AG_OK)
                 st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         }
         f->n++; /* counted even on error so that free() releases it */

@@ -146,17 +146,18 @@ const char *ag_import_up_basis_name(ag_up_basis b)
 
 static json_t *cues_json(const ag_upaxis_cues *c)
 {
-    return json_pack("{s:f, s:f, s:f, s:f, s:f}", "base", c->base, "top", c->top, "vertical",
-                     c->vertical, "extent", c->extent, "origin", c->origin);
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:f}", "base", c->base, "top", c->top,
+                     "vertical", c->vertical, "extent", c->extent, "origin", c->origin, "roof",
+                     c->roof);
 }
 
 json_t *ag_import_up_json(const ag_up_decision *d)
 {
     const ag_upaxis_evidence *e = &d->evidence;
-    json_t *ev = json_pack("{s:o, s:f, s:b, s:b, s:[f,f,f], s:o, s:o}", "content",
+    json_t *ev = json_pack("{s:o, s:f, s:b, s:b, s:b, s:[f,f,f], s:o, s:o}", "content",
                            e->axis ? json_string(e->axis == 2 ? "z" : "y") : json_null(),
                            "score", e->score, "georeferenced", e->georeferenced, "storey",
-                           e->storey, "centre",
+                           e->storey, "roof", e->roof, "centre",
                            e->centre[0], e->centre[1], e->centre[2], "y", cues_json(&e->cue[0]),
                            "z", cues_json(&e->cue[1]));
     return json_pack("{s:s, s:s, s:o}", "axis", d->axis == AG_UP_Z ? "z" : "y", "decided",
@@ -173,8 +174,7 @@ static ag_status read_raw(const uint8_t *data, size_t len, ag_format fmt,
     if (fmt == AG_FORMAT_OBJ) {
         ag_obj_read_options o = {.up = AG_UP_Z,
                                  .progress = raw.progress,
-                                 .user = raw.user,
-                                 .allow_external_files = raw.allow_external_files};
+                                 .user = raw.user};
         return ag_obj_read_buffer((const char *)data, len, &o, out, err);
     }
     ag_status st = ag_assimp_import_buffer(data, len, fmt, &raw, out, NULL, err);

@@ -57,8 +57,9 @@ typedef struct {
     ag_up_decision *up_decision;
     int (*progress)(void *user, double fraction); /* non-zero return cancels */
     void *user;
-    /* Whether the input may bring in other files: glTF buffers and images by URI, OBJ
-     * mtllib, Collada/FBX textures. Off (0, the default) for everything from the network:
+    /* Whether the input may bring in other files: glTF buffers and images by URI,
+     * Collada/FBX textures (an OBJ's mtllib is ignored either way: the OBJ reader opens no
+     * file). Off (0, the default) for everything from the network:
      * only the given bytes and inline data: URIs are read, and any other reference fails
      * with AG_ERR_EXTERNAL_REF naming it (external_ref.h). The CLI turns it on for a file on
      * the user's own disk. Every importer follows it. */

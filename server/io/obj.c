@@ -1,6 +1,5 @@
 #include "obj.h"
 
-#include "external_ref.h"
 #include "filemap.h"
 #include "numtext.h"
 
@@ -233,7 +232,6 @@ typedef struct {
     const char *pend;
     size_t pend_len;
     int have_pend;
-    int allow_external; /* mtllib is accepted (and ignored) rather than refused */
     long cur_comp;  /* component that faces go to, or -1 when not resolved yet */
     long nogroup_comp; /* the component of faces before any g/o, or -1 */
     uint32_t *comp_of_group;
@@ -489,21 +487,9 @@ static ag_status read_line(reader *r, const char *p, const char *e)
         r->nvn++;
         return AG_OK;
     }
-    while (kl == 6 && memcmp(k, "mtllib", 6) == 0 && !r->allow_external) {
-        /* The reader never opens a material library, but an upload that names one depends
-         * on another file: refused, so the user knows it was not read. */
-        while (p < e && is_space(*p))
-            p++;
-        while (e > p && is_space(e[-1]))
-            e--;
-        if (p == e)
-            break; /* names nothing */
-        char where[40];
-        snprintf(where, sizeof where, "line %ld: mtllib", r->line);
-        return ag_external_ref_refuse(r->err, r->line, where, p, (size_t)(e - p));
-    }
-    /* Other statements (usemtl, mtllib, s, l, p, vp, curves...) are accepted and ignored,
-     * but control characters mark binary data, not text. */
+    /* Other statements (usemtl, mtllib, s, l, p, vp, curves...) are accepted and ignored:
+     * materials do not shape the mesh, and the reader opens no file (an upload's mtllib may
+     * name any path of the server). Control characters mark binary data, not text. */
     for (const char *c = k; c < e; c++) {
         unsigned char u = (unsigned char)*c;
         if ((u < 0x20 && !is_space((char)u)) || u == 0x7f) {
@@ -539,7 +525,6 @@ ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_opt
     r.yup = opt->up != AG_UP_Z;
     r.max_v = opt->max_vertices ? opt->max_vertices : DEFAULT_MAX_VERTICES;
     r.max_t = opt->max_triangles ? opt->max_triangles : DEFAULT_MAX_TRIANGLES;
-    r.allow_external = opt->allow_external_files;
     r.cur_comp = -1;
     r.nogroup_comp = -1;
     r.m = ag_mesh_create();
@@ -677,12 +662,6 @@ ag_status ag_obj_read_file(const char *path, const ag_obj_read_options *opt, ag_
                            ag_error *err)
 {
     *out = NULL;
-    /* A file the local caller named: its material library lies next to it on the same disk. */
-    ag_obj_read_options local = {0};
-    if (opt)
-        local = *opt;
-    local.allow_external_files = 1;
-    opt = &local;
     ag_filemap fm;
     ag_status st = ag_filemap_open(path, &fm, err);
     if (st != AG_OK)

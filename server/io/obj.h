@@ -2,8 +2,8 @@
  *
  * Reading: `v x y z [w | r g b]` (extras ignored), `f` (polygons fan-triangulated from
  * their first vertex; v, v/vt, v//vn, v/vt/vn; negative indices relative to the vertices
- * defined so far), `g` and `o` start a group, `usemtl`, `mtllib` (see
- * allow_external_files), `vt`, `vn`, `s`, `l`, `p`, `#` comments, CRLF, blank lines, trailing blanks and `\` line continuations are
+ * defined so far), `g` and `o` start a group, `usemtl`, `mtllib` (materials
+ * are not read: the library is never opened, whoever the caller), `vt`, `vn`, `s`, `l`, `p`, `#` comments, CRLF, blank lines, trailing blanks and `\` line continuations are
  * accepted; other statement keywords are ignored.
  *
  * Groups and components: one component per group, in the order of the groups' first faces.
@@ -50,11 +50,6 @@ typedef struct {
      * (the reader then returns AG_ERR_CANCELLED). May be NULL. */
     int (*progress)(void *user, double fraction);
     void *user;
-    /* 0 (the default): an `mtllib` line fails with AG_ERR_EXTERNAL_REF naming the library and
-     * its line, since the input depends on a file that is not read (external_ref.h). 1: it is
-     * accepted and ignored. The reader never opens any file but the one it is given either way;
-     * ag_obj_read_file always accepts it (the library lies next to the caller's file). */
-    int allow_external_files;
 } ag_obj_read_options;
 
 ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_options *opt,

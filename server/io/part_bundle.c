@@ -670,8 +670,8 @@ static ag_status read_part(json_t *o, size_t pi, const bterm *terms, size_t nter
     double box[6];
     char what[96];
     snprintf(what, sizeof what, "%s.box", where);
-    ag_status st = read_box(json_object_get(o, "box"), box, -AG_PART_BUNDLE_MAX_COORD,
-                            AG_PART_BUNDLE_MAX_COORD, what, err);
+    ag_status st = read_box(json_object_get(o, "box"), box, -AG_PART_MAX_COORD,
+                            AG_PART_MAX_COORD, what, err);
     if (st)
         return st;
 

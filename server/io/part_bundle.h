@@ -26,7 +26,6 @@
 #define AG_PART_BUNDLE_MAX_NODES 1000000
 #define AG_PART_BUNDLE_MAX_TRIANGLES 50000000
 #define AG_PART_BUNDLE_MAX_ATTRS 256
-#define AG_PART_BUNDLE_MAX_COORD 1e7 /* metres: |box coordinates| */
 
 /* The bundle text of n parts; *out malloc'd, NUL-terminated. */
 ag_status ag_part_bundle_write(const ag_part *const *parts, size_t n, char **out, size_t *len,

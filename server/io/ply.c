@@ -242,6 +242,32 @@ static ag_status parse_header(const uint8_t *data, size_t len, ply_header *h, ag
     return AG_OK;
 }
 
+ag_status ag_ply_check_header(const uint8_t *data, size_t len, ag_error *err)
+{
+    ply_header h;
+    ag_status st = parse_header(data, len, &h, err);
+    if (st != AG_OK)
+        return st;
+    /* every row of an element with properties takes bytes: its fixed part (binary), or a
+     * character and a separator per value (ASCII, the last value of the file without one) */
+    size_t remaining = len - h.data_start;
+    uint64_t room = (uint64_t)remaining + (h.format == FMT_ASCII), need = 0;
+    for (size_t i = 0; i < h.nelements && st == AG_OK; i++) {
+        const ply_element *el = &h.elements[i];
+        uint64_t row = h.format == FMT_ASCII ? 2 * (uint64_t)el->nprops : el->row_bytes;
+        if (!row)
+            continue;
+        if (el->count > room / row || (need += el->count * row) > room)
+            st = ag_error_set(err, AG_ERR_PARSE, 0,
+                              "the header declares %llu %s rows of at least %llu bytes, more "
+                              "than the %zu bytes of data after the header hold",
+                              (unsigned long long)el->count, el->name, (unsigned long long)row,
+                              remaining);
+    }
+    header_free(&h);
+    return st;
+}
+
 int ag_ply_has_faces(const uint8_t *data, size_t len)
 {
     ply_header h;

@@ -22,6 +22,13 @@
 
 ag_status ag_ply_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag_error *err);
 
+/* Checks that data begins with a header this reader accepts (magic, format, elements,
+ * properties, end_header alone on its line) whose elements' rows fit the bytes after it,
+ * refusing it with AG_ERR_PARSE naming the line or element otherwise. A mesh read through
+ * assimp is checked first: assimp 5.2 loops without end on a header it should refuse, and
+ * spends seconds and gigabytes on a count of rows that the data cannot hold. */
+ag_status ag_ply_check_header(const uint8_t *data, size_t len, ag_error *err);
+
 /* Whether data is a PLY whose header declares a face element with at least one face (a
  * mesh rather than a point cloud). */
 int ag_ply_has_faces(const uint8_t *data, size_t len);

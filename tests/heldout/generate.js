@@ -210,6 +210,28 @@ export function readObj(file) {
   return { v, f };
 }
 
+// An extrusion's OBJ as z-up points, triangles per group (component) and each vertex's id
+// welded at 1e-6 m: what sweep.js and the held-out tests check extrusions on.
+export function readExtrusion(file) {
+  const text = fs.readFileSync(file, 'utf8');
+  const yup = /^# archgram:.*y up/m.test(text);
+  const v = [], groups = new Map();
+  let g = '';
+  for (const line of text.split('\n')) {
+    const t = line.trim().split(/\s+/);
+    if (t[0] === 'v') { const [x, y, z] = t.slice(1, 4).map(Number); v.push(yup ? [x, -z, y] : [x, y, z]); }
+    else if (t[0] === 'g' || t[0] === 'o') g = t.slice(1).join(' ');
+    else if (t[0] === 'f') {
+      const p = t.slice(1).map((s) => parseInt(s, 10) - 1);
+      if (!groups.has(g)) groups.set(g, []);
+      for (let k = 1; k + 1 < p.length; k++) groups.get(g).push([p[0], p[k], p[k + 1]]);
+    }
+  }
+  const ids = new Map();
+  const weld = v.map((p) => { const k = p.map((x) => Math.round(x * 1e6)).join(','); if (!ids.has(k)) ids.set(k, ids.size); return ids.get(k); });
+  return { v, weld, groups };
+}
+
 // --- mesh variants ------------------------------------------------------------------------
 export function meshVariants() {
   const out = [];
@@ -349,18 +371,121 @@ export function footprintVariants() {
     add('denhaag-3d', { ...doc, features: mapRings((r) => r.map(([x, y]) => [x, y, 0.7])) });
     add('denhaag-properties-stripped', { ...doc, features: feats.map((ft) => ({ ...ft, properties: {} })) });
   }
+  heldoutShapes(add, fc, poly, sq);
   const cj = path.join(SHARED, 'footprints_denhaag_lod2/DenHaag_01.city.json');
   if (fs.existsSync(cj)) out.push({ family: 'footprints', variant: 'cityjson-denhaag', ext: 'city.json', copy: cj });
+  return out;
+}
+
+// Shapes of round 2: holes touching the outer ring, courtyards, spikes and 1e-7 m runs,
+// repeated vertices, 1 mm edges, L/U/T/H turned by odd angles at UTM and web-mercator
+// offsets, MultiPolygons with touching parts. Each carries `polys` (its polygons as meant:
+// rings without the closing corner, outer first, relative to `origin`) and `height`, which
+// sweep.js checks the output against (base area, roof bounds, CGAL's skeleton for hip).
+const ringArea = (r) => r.reduce((a, p, i) => { const q = r[(i + 1) % r.length]; return a + p[0] * q[1] - q[0] * p[1]; }, 0) / 2;
+const ccw = (r) => (ringArea(r) > 0 ? r : r.slice().reverse());
+const turn = (r, deg) => { const a = deg * Math.PI / 180, c = Math.cos(a), s = Math.sin(a); return r.map(([x, y]) => [c * x - s * y, s * x + c * y]); };
+const close = (r) => [...r, r[0]];
+export const SHAPES = {
+  L: [[0, 0], [20, 0], [20, 8], [8, 8], [8, 18], [0, 18]],
+  U: [[0, 0], [24, 0], [24, 16], [17, 16], [17, 6], [7, 6], [7, 16], [0, 16]],
+  T: [[0, 0], [8, 0], [8, 10], [16, 10], [16, 16], [-8, 16], [-8, 10], [0, 10]],
+  H: [[0, 0], [6, 0], [6, 7], [14, 7], [14, 0], [20, 0], [20, 20], [14, 20], [14, 13], [6, 13], [6, 20], [0, 20]],
+};
+function heldoutShapes(add, fc, poly, sq) {
+  const open = (r) => r.slice(0, -1);
+  // polys: [[outer, ...holes]] in local metres; coordinates written at `origin` + local
+  const shape = (variant, polys, origin, { write, multi, height = 9 } = {}) => {
+    const at = (r) => close(r.map(([x, y]) => [x + origin[0], y + origin[1]]));
+    const rings = (p) => p.map((r, k) => at(k ? ccw(r).reverse() : ccw(r)));
+    const doc = write ? write(at) : multi ? fc([{ type: 'Feature', properties: { height }, geometry: { type: 'MultiPolygon', coordinates: polys.map(rings) } }])
+      : fc(polys.map((p) => poly(rings(p), { height })));
+    add(variant, doc, { polys: polys.map((p) => p.map(ccw).map((r, k) => (k ? r.slice().reverse() : r))), origin, height });
+  };
+  const rd = [85000, 445000], utm = [500000, 5.8e6], merc = [2e7, 2e7 * 0.33];
+  const O = open(sq(0, 0, 30, 30));
+  // a hole whose corner is an outer corner, and one whose corner lies on an outer edge
+  shape('hole-touches-outer-corner', [[O, [[0, 0], [10, 4], [4, 10]]]], rd);
+  shape('hole-touches-outer-edge', [[O, [[15, 0], [20, 6], [10, 6]]]], rd);
+  shape('two-holes-touching-each-other', [[O, [[5, 5], [15, 5], [15, 15], [5, 15]], [[15, 15], [25, 15], [25, 25], [15, 25]]]], rd);
+  const yard = [];
+  for (let i = 0; i < 4; i++) for (let j = 0; j < 4; j++) yard.push(open(sq(4 + 14 * i, 4 + 14 * j, 8, 8)));
+  shape('courtyards-16', [[open(sq(0, 0, 60, 60)), ...yard]], rd);
+  shape('courtyards-16-utm', [[open(sq(0, 0, 60, 60)), ...yard]], utm);
+  // a spike out and back (no area: cleaned), and one 1e-7 m wide
+  const spike = (w) => [[0, 0], [20, 0], [20, 10], [10 + w, 10], [10, 25], [10 - w, 10], [0, 10]];
+  shape('spike-out-zero-width', [[spike(0)]], rd, { write: (at) => fc([poly([at(spike(0))])]) });
+  shape('spike-1e-7-wide', [[spike(1e-7)]], rd);
+  // a front edge of 200 corners, each 1e-7 m off the line
+  const run = [[0, 0], ...Array.from({ length: 199 }, (_, i) => [0.1 * (i + 1), (i % 2 ? 1 : -1) * 1e-7]), [20, 0], [20, 10], [0, 10]];
+  shape('nearly-collinear-1e-7', [[run]], rd);
+  shape('nearly-collinear-1e-7-utm', [[run]], utm);
+  const dup = [[0, 0], [0, 0], [20, 0], [20, 0], [20, 0], [20, 10], [0, 10], [0, 10]];
+  shape('duplicate-vertices', [[open(sq(0, 0, 20, 10))]], rd, { write: (at) => fc([poly([at(dup)])]) });
+  shape('closing-vertex-repeated', [[open(sq(0, 0, 20, 10))]], rd, { write: (at) => { const r = at(open(sq(0, 0, 20, 10))); return fc([poly([[...r, r[0], r[0]]])]); } });
+  // outer clockwise with a counter-clockwise hole: both reversed
+  shape('cw-outer-ccw-hole', [[O, open(sq(10, 10, 10, 10))]], rd, { write: (at) => fc([poly([at(O).reverse(), at(open(sq(10, 10, 10, 10)))])]) });
+  // 1 mm edges next to 40 m ones: a chamfered corner and a 1 mm jog
+  shape('chamfer-1mm', [[[[0, 0], [39.999, 0], [40, 0.001], [40, 12], [0, 12]]]], rd);
+  shape('jog-1mm', [[[[0, 0], [40, 0], [40, 12], [20, 12], [20, 12.001], [0, 12.001]]]], rd);
+  for (const [name, deg, o] of [['L', 17, rd], ['U', 33.3, rd], ['T', 71, utm], ['H', 123.4, utm], ['L', 201, merc], ['H', 299.9, merc]])
+    shape(`${name}-rot${deg}-${o === rd ? 'rd' : o === utm ? 'utm' : 'mercator'}`, [[turn(SHAPES[name], deg)]], o);
+  shape('U-rot33-cw', [[turn(SHAPES.U, 33)]], rd, { write: (at) => fc([poly([at(turn(SHAPES.U, 33)).reverse()])]) });
+  // MultiPolygons: parts meeting at a corner, sharing a whole edge, sharing part of an edge
+  shape('multipolygon-corner-touch', [[open(sq(0, 0, 10, 10))], [open(sq(10, 10, 10, 10))]], rd, { multi: true });
+  shape('multipolygon-shared-edge', [[open(sq(0, 0, 20, 10))]], rd, { write: (at) => fc([{ type: 'Feature', properties: { height: 9 }, geometry: { type: 'MultiPolygon', coordinates: [[at(open(sq(0, 0, 10, 10)))], [at(open(sq(10, 0, 10, 10)))]] } }]) });
+  shape('multipolygon-partial-edge', [[[[0, 0], [10, 0], [10, 2], [18, 2], [18, 8], [10, 8], [10, 10], [0, 10]]]], rd, { write: (at) => fc([{ type: 'Feature', properties: { height: 9 }, geometry: { type: 'MultiPolygon', coordinates: [[at(open(sq(0, 0, 10, 10)))], [at(open(sq(10, 2, 8, 6)))]] } }]) });
+  shape('features-corner-touch-utm', [[turn(SHAPES.L, 17)], [turn(SHAPES.L, 17).map(([x, y]) => [-x, -y])]], utm);
+}
+
+// --- plans: per-edge profiles, dormers, chimneys (archgram extrude --plan) ------------------
+// Each carries `polys` as footprints do (corners of loop 0 and holes at z = 0) and `rise`:
+// how far above the footprint its profiles can take the roof.
+export function planVariants() {
+  const out = [];
+  const add = (variant, plan, extra) => out.push({ family: 'plan', variant, ext: 'json', data: JSON.stringify(plan), ...extra });
+  const profiles = {
+    steep: { points: [[0, 0], [0, 6], [1, 8]] },
+    wall: [[0, 0], [0, 6]],
+    overhang: [[0, 0], [0, 6], [-0.5, 6.2], [3, 9.7]],
+    lean: [[0, 0], [0, 6], [-0.6, 7], [2, 9]],
+    dormer: [[0, 0], [0, 1.5], [1, 2.5]],
+    chimney: [[0, 0], [0, 3]],
+  };
+  const withOrigin = (pts, o) => pts.map(([x, y]) => [x + o[0], y + o[1]]);
+  const P = (variant, loops, edgeProfiles, o, extra = {}) => {
+    const plan = { profiles, default_profile: 'steep', loops: loops.map((r, k) => (k === 0 ? { points: withOrigin(r, o), profiles: edgeProfiles } : withOrigin(r, o))), ...extra };
+    add(variant, plan, { polys: [loops], origin: o, rise: 10 + (extra.steps ? 3 : 0) });
+  };
+  const box = [[0, 0], [12, 0], [12, 8], [0, 8]];
+  P('box-steep-wall-overhang', [box], ['steep', 'wall', 'overhang', 'wall'], [0, 0]);
+  P('box-lean-all', [box], ['lean', 'lean', 'lean', 'lean'], [0, 0]);
+  P('L-rot17-mixed-utm', [ccw(turn(SHAPES.L, 17))], ['steep', 'overhang', 'wall', 'lean', 'steep', 'overhang'], [500000, 5.8e6]);
+  P('U-mixed', [ccw(SHAPES.U)], ['overhang', 'steep', 'wall', 'steep', 'lean', 'steep', 'wall', 'steep'], [0, 0]);
+  P('H-overhang-all-mercator', [ccw(turn(SHAPES.H, 123.4))], Array(12).fill('overhang'), [2e7, 6.6e6]);
+  P('courtyard-overhang', [[[0, 0], [30, 0], [30, 30], [0, 30]], [[10, 10], [10, 20], [20, 20], [20, 10]]], ['overhang', 'steep', 'overhang', 'steep'], [85000, 445000]);
+  P('box-dormers', [box], ['steep', 'wall', 'steep', 'wall'], [0, 0], {
+    steps: [{ name: 'd1', edge: 0, relative: 0.3, height: 6.8, width: 2, depth: 1, profile: 'dormer' },
+      { name: 'd2', edge: 0, relative: 0.7, height: 6.8, width: 2, depth: 1, profile: 'dormer' }] });
+  P('box-chimney-forced', [box], ['steep', 'wall', 'steep', 'wall'], [85000, 445000], {
+    steps: [{ name: 'c', edge: 2, relative: 0.6, height: 7, profile: 'chimney', points: [[-0.4, -0.6], [0.4, -0.6], [0.4, 0.3], [-0.4, 0.3]] }] });
+  P('box-offset-event-gables', [box], ['steep', 'wall', 'steep', 'wall'], [0, 0], {
+    offsets: [{ height: 6, outside: 0.4, edges: [{ edge: 1, disabled: true }, { edge: 3, disabled: true }] }] });
+  // two parts meeting corner to corner across a 0.5 m gap, both with a 0.5 m soffit: the
+  // soffits run into each other head-on (the MultiPolygon with corner-touching parts under
+  // a style with soffits falls back for the same reason)
+  out.push({ family: 'plan', variant: 'diagonal-parts-soffits-collide', ext: 'json', polys: [[box.map(([x, y]) => [x * 10 / 12, y * 10 / 8])], [[[10.5, 10.5], [20, 10.5], [20, 20], [10.5, 20]]]], origin: [0, 0], rise: 10,
+    data: JSON.stringify({ profiles: { o: [[0, 0], [0, 9], [-0.5, 9], [2.5, 12]] }, default_profile: 'o', loops: [[[0, 0], [10, 0], [10, 10], [0, 10]], [[10.5, 10.5], [20, 10.5], [20, 20], [10.5, 20]]] }) });
   return out;
 }
 
 // --- point clouds -----------------------------------------------------------------------------
 // A building's surface sampled: four walls, a flat roof, windows recessed 0.2 m (holes in the
 // front wall with a back plane), and ground points around it.
-export function cloudPoints({ ground = true, building = true, seed = 3, step = 0.25 } = {}) {
+export function cloudPoints({ ground = true, building = true, seed = 3, step = 0.25, windows = true } = {}) {
   const r = rng(seed), P = [];
   const j = () => (r() - 0.5) * 0.01;
-  const inWindow = (x, z) => { for (let c = 0; c < 4; c++) for (let k = 0; k < 3; k++) { const x0 = 2 + c * 4.5, z0 = 1 + k * 2.8; if (x > x0 && x < x0 + 1.5 && z > z0 && z < z0 + 1.6) return true; } return false; };
+  const inWindow = (x, z) => { if (!windows) return false; for (let c = 0; c < 4; c++) for (let k = 0; k < 3; k++) { const x0 = 2 + c * 4.5, z0 = 1 + k * 2.8; if (x > x0 && x < x0 + 1.5 && z > z0 && z < z0 + 1.6) return true; } return false; };
   if (building) {
     for (let x = 0; x <= 20; x += step) for (let z = 0; z <= 9; z += step) {
       if (inWindow(x, z)) P.push([x + j(), 0.2 + j(), z + j(), 6]); else P.push([x + j(), j(), z + j(), 6]);
@@ -433,11 +558,80 @@ export function cloudVariants() {
   add('ply-cloud-all-same-point', 'ply', ply(Array.from({ length: 500 }, () => [1, 2, 3, 6]), false), {});
   add('ply-cloud-collinear', 'ply', ply(Array.from({ length: 500 }, (_, i) => [i * 0.05, 0, 0, 6]), false), {});
   add('las-empty', 'las', las([[0, 0, 0, 2]], {}).subarray(0, 227), { expectError: true });
+  cloudRound2(add, P, ply);
   return out;
 }
 
+// the box around points as a LAS file stores them (each coordinate on its scale's grid)
+const lasBox = (pts, scale = 0.001, off = [0, 0, 0]) => {
+  const q = pts.map((p) => [0, 1, 2].map((k) => Math.round((p[k] - off[k]) / scale) * scale + off[k]));
+  return [[0, 1, 2].map((k) => Math.min(...q.map((p) => p[k]))), [0, 1, 2].map((k) => Math.max(...q.map((p) => p[k])))];
+};
+// Clouds of round 2: every LAS version with every point format it defines (0-3 in all,
+// 6-8 in 1.4), formats it must refuse, extreme scales and offsets, shuffled, duplicated,
+// turned and noisy clouds, binary PLY with doubles and extra properties, and a plain box
+// building whose planes are known (four walls, the roof, the ground: 6). Each carries the
+// facts sweep.js checks: `points`, `bbox` ([min, max] as stored), `planes`, or `refuse`
+// (a pattern the refusal must match).
+function cloudRound2(add, P, ply) {
+  const rd = [85000, 445000, 0];
+  const at = (pts, o) => pts.map(([x, y, z, c]) => [x + o[0], y + o[1], z + o[2], c]);
+  const S = at(P, rd);
+  for (const [minor, format] of [[2, 0], [3, 0], [3, 2], [3, 3], [4, 0], [4, 1], [4, 2], [4, 3]])
+    add(`las1.${minor}-pf${format}-box-check`, 'las', las(S, { minor, format, offset: rd }), { points: P.length, bbox: lasBox(S, 0.001, rd) });
+  const small = at(P.slice(0, 200), rd);
+  const patch = (buf, f) => { const b = Buffer.from(buf); f(b); return b; };
+  add('las-pf11-undefined', 'las', patch(las(small, { minor: 4, format: 6, offset: rd }), (b) => { b[104] = 11; }), { expectError: true, refuse: 'point format 11' });
+  add('las-laz-bit-no-vlr', 'las', patch(las(small, { format: 1, offset: rd }), (b) => { b[104] = 0x81; }), { expectError: true, refuse: 'LAZ|LASzip' });
+  add('las-record-too-short', 'las', patch(las(small, { format: 3, offset: rd }), (b) => { b.writeUInt16LE(20, 105); }), { expectError: true, refuse: 'record' });
+  add('las-version-2.0', 'las', patch(las(small, { format: 0, offset: rd }), (b) => { b[24] = 2; b[25] = 0; }), { expectError: true, refuse: 'version|2\\.0' });
+  add('las-count-beyond-file', 'las', patch(las(small, { format: 0, offset: rd }), (b) => { b.writeUInt32LE(1e9, 107); }), { expectError: true, refuse: 'point|record|bytes' });
+  const far = at(P, [1e9, -1e9, 1000]);
+  add('las-offset-1e9', 'las', las(far, { offset: [1e9, -1e9, 1000] }), { points: P.length, bbox: lasBox(far, 0.001, [1e9, -1e9, 1000]) });
+  add('las-scale-1-utm', 'las', las(at(P, [500000, 5.8e6, 0]), { scale: 1, offset: [500000, 5.8e6, 0] }), { points: P.length, bbox: lasBox(at(P, [500000, 5.8e6, 0]), 1, [500000, 5.8e6, 0]) });
+  add('las-scale-1e-4-utm', 'las', las(at(P, [500000, 5.8e6, 0]), { scale: 1e-4, offset: [500000, 5.8e6, 0] }), { points: P.length, bbox: lasBox(at(P, [500000, 5.8e6, 0]), 1e-4, [500000, 5.8e6, 0]) });
+  const r = rng(17);
+  const shuffled = shuffle(S, r);
+  add('las-shuffled-rd', 'las', las(shuffled, { offset: rd }), { points: P.length, bbox: lasBox(S, 0.001, rd) });
+  const dup = [...S, ...S];
+  add('las-duplicated-rd', 'las', las(dup, { offset: rd, format: 1 }), { points: dup.length, bbox: lasBox(S, 0.001, rd) });
+  const a = 23 * Math.PI / 180;
+  const turned = at(P.map(([x, y, z, c]) => [Math.cos(a) * x - Math.sin(a) * y, Math.sin(a) * x + Math.cos(a) * y, z, c]), rd);
+  add('las-rotated-23-rd', 'las', las(turned, { offset: rd, minor: 4, format: 6 }), { points: P.length, bbox: lasBox(turned, 0.001, rd) });
+  // 2 % noise in a 60 m box, and five outliers a kilometre off (a bird, a multipath return)
+  const noisy = [...S, ...Array.from({ length: Math.round(P.length * 0.02) }, () => [rd[0] - 20 + 60 * r(), rd[1] - 20 + 50 * r(), 30 * r(), 1]),
+    ...Array.from({ length: 5 }, (_, i) => [rd[0] + 1000 + i, rd[1] - 1000, 300 + i, 7])];
+  add('las-noise-outliers-rd', 'las', las(noisy, { offset: rd }), { points: noisy.length, bbox: lasBox(noisy, 0.001, rd) });
+  const G = cloudPoints({ building: false });
+  add('las1.4-pf7-only-ground-rd', 'las', las(at(G, rd), { minor: 4, format: 7, offset: rd }), { points: G.length, bbox: lasBox(at(G, rd), 0.001, rd) });
+  // a box building (no windows) on its ground: exactly six planes
+  const box = cloudPoints({ windows: false });
+  add('las-box-6-planes', 'las', las(at(box, rd), { offset: rd }), { points: box.length, bbox: lasBox(at(box, rd), 0.001, rd), planes: 6 });
+  add('las-box-6-planes-duplicated', 'las', las(at([...box, ...box], rd), { offset: rd }), { points: 2 * box.length, bbox: lasBox(at(box, rd), 0.001, rd), planes: 6 });
+  add('las-box-6-planes-rot23', 'las', las(box.map(([x, y, z, c]) => [Math.cos(a) * x - Math.sin(a) * y, Math.sin(a) * x + Math.cos(a) * y, z, c]), {}), { points: box.length, planes: 6 });
+  // binary PLY: doubles at UTM with extra per-point properties, and big-endian floats
+  const plyBinary = (pts, { le = true, dbl = true } = {}) => {
+    const h = ['ply', `format binary_${le ? 'little' : 'big'}_endian 1.0`, 'comment from a scanner', `element vertex ${pts.length}`,
+      ...['x', 'y', 'z'].map((c) => `property ${dbl ? 'double' : 'float'} ${c}`), 'property ushort intensity', 'property uchar return_number', 'property double gps_time', 'property uchar classification', 'end_header'];
+    const cs = dbl ? 8 : 4, rec = 3 * cs + 2 + 1 + 8 + 1;
+    const b = Buffer.alloc(rec * pts.length);
+    pts.forEach((p, i) => {
+      let o = i * rec;
+      for (let k = 0; k < 3; k++, o += cs) dbl ? (le ? b.writeDoubleLE(p[k], o) : b.writeDoubleBE(p[k], o)) : (le ? b.writeFloatLE(p[k], o) : b.writeFloatBE(p[k], o));
+      le ? b.writeUInt16LE(1234, o) : b.writeUInt16BE(1234, o); b[o + 2] = 1;
+      le ? b.writeDoubleLE(i * 1e-3, o + 3) : b.writeDoubleBE(i * 1e-3, o + 3); b[o + 11] = p[3];
+    });
+    return Buffer.concat([Buffer.from(h.join('\n') + '\n'), b]);
+  };
+  const box3 = (pts) => [[0, 1, 2].map((k) => Math.min(...pts.map((p) => p[k]))), [0, 1, 2].map((k) => Math.max(...pts.map((p) => p[k])))];
+  const U = at(P, [500000, 5.8e6, 0]);
+  add('ply-binary-double-utm-extra', 'ply', plyBinary(U), { points: U.length, bbox: box3(U) });
+  const F = P.map((p) => p.map(Math.fround));
+  add('ply-binary-be-float-extra', 'ply', plyBinary(F, { le: false, dbl: false }), { points: F.length, bbox: box3(F) });
+}
+
 export function allVariants() {
-  return [...meshVariants(), ...footprintVariants(), ...cloudVariants()];
+  return [...meshVariants(), ...footprintVariants(), ...planVariants(), ...cloudVariants()];
 }
 
 if (process.argv[1] && path.resolve(process.argv[1]) === fileURLToPath(import.meta.url)) {
@@ -450,7 +644,8 @@ if (process.argv[1] && path.resolve(process.argv[1]) === fileURLToPath(import.me
     if (v.copy) fs.copyFileSync(v.copy, file); else fs.writeFileSync(file, v.data);
     const m = v.base ? measure(v.base.v, v.base.f) : null;
     manifest.push({ family: v.family, variant: v.variant, file, expectError: !!v.expectError, scale: v.scale || 1, dupArea: !!v.dupArea, points: v.points,
-      area: m && m.area, extent: m && m.extent });
+      area: m && m.area, extent: m && m.extent, polys: v.polys, origin: v.origin, height: v.height, rise: v.rise,
+      bbox: v.bbox, planes: v.planes, refuse: v.refuse });
   }
   fs.writeFileSync(path.join(dir, 'manifest.json'), JSON.stringify(manifest, null, 1));
   console.log(`${manifest.length} inputs in ${dir}`);

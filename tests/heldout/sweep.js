@@ -8,6 +8,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { spawnSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
+import { readExtrusion } from './generate.js';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const args = process.argv.slice(2);
@@ -123,6 +124,82 @@ function sweepMesh(m, work) {
   record(m, 'part-compose', r.verdict === 'ok' ? 'ok' : r.verdict === 'error' ? 'precise-error' : `BUG:${r.verdict}`, r.out);
 }
 
+const ringArea = (r) => r.reduce((a, p, i) => { const q = r[(i + 1) % r.length]; return a + p[0] * q[1] - q[0] * p[1]; }, 0) / 2;
+
+// Independent checks of an extrusion: every group a closed 2-manifold (each welded directed
+// edge once, its reverse once, no degenerate triangle), the base (faces down at the lowest z)
+// of the footprint's area, no vertex beyond `reach` of the footprint's box or above `top`.
+// Returns '' when all hold, else what failed.
+function checkExtrusion(file, m, { reach, top, origin }) {
+  const { v, weld, groups } = readExtrusion(file);
+  const fails = [];
+  let zmin = Infinity, zmax = -Infinity, base = 0;
+  for (const [g, T] of groups) {
+    const use = new Map();
+    let bad = 0;
+    for (const t of T) {
+      const w = t.map((i) => weld[i]);
+      if (w[0] === w[1] || w[1] === w[2] || w[0] === w[2]) { bad++; continue; }
+      for (let k = 0; k < 3; k++) { const key = `${w[k]},${w[(k + 1) % 3]}`; use.set(key, (use.get(key) || 0) + 1); }
+    }
+    let open = 0;
+    for (const [key, n] of use) { const [a, b] = key.split(','); if (n !== 1 || use.get(`${b},${a}`) !== 1) open++; }
+    if (bad || open) fails.push(`group ${g}: ${bad} degenerate triangles, ${open} directed edges not used once each way`);
+    for (const t of T) for (const i of t) { zmin = Math.min(zmin, v[i][2]); zmax = Math.max(zmax, v[i][2]); }
+  }
+  for (const T of groups.values()) for (const t of T) {
+    const [A, B, C] = t.map((i) => v[i]);
+    if (![A, B, C].every((p) => p[2] < zmin + 1e-6)) continue;
+    const a = ((B[0] - A[0]) * (C[1] - A[1]) - (B[1] - A[1]) * (C[0] - A[0])) / 2;
+    base -= a; // faces down are clockwise seen from above
+  }
+  if (!m.polys) return { fails, zmax, zmin };
+  const want = m.polys.reduce((a, p) => a + p.reduce((b, r, k) => b + (k ? -1 : 1) * Math.abs(ringArea(r)), 0), 0);
+  if (!(Math.abs(base - want) <= 1e-4 * want + 0.01)) fails.push(`base area ${base.toFixed(4)} m², the footprint's ${want.toFixed(4)} m²`);
+  if (!(zmax <= top + 1e-3) || Math.abs(zmin) > 1e-6) fails.push(`heights ${zmin.toFixed(4)}..${zmax.toFixed(4)} m, at most 0..${top.toFixed(3)} m expected`);
+  const lo = [Infinity, Infinity], hi = [-Infinity, -Infinity];
+  for (const p of m.polys) for (const r of p) for (const q of r) for (let k = 0; k < 2; k++) { lo[k] = Math.min(lo[k], q[k] + m.origin[k] - origin[k]); hi[k] = Math.max(hi[k], q[k] + m.origin[k] - origin[k]); }
+  let out = 0;
+  for (const p of v) for (let k = 0; k < 2; k++) out = Math.max(out, lo[k] - p[k], p[k] - hi[k]);
+  if (!(out <= reach + 1e-3)) fails.push(`a vertex ${out.toFixed(3)} m outside the footprint's box (at most ${reach} m expected)`);
+  return { fails, zmax, zmin };
+}
+// the smallest half side of the polygons' boxes: no roof rises above its inradius over it
+function halfSide(polys) {
+  return Math.max(...polys.map((p) => { const xs = p[0].map((q) => q[0]), ys = p[0].map((q) => q[1]); return Math.min(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys)) / 2; }));
+}
+
+// the largest box diagonal of the polygons: a roof whose other edges are vertical (a gable,
+// a chimney's sides) can rise over the whole width
+function diagonal(polys) {
+  return Math.max(...polys.map((p) => { const xs = p[0].map((q) => q[0]), ys = p[0].map((q) => q[1]); return Math.hypot(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys)); }));
+}
+
+// CGAL's straight skeleton (../shared/tools/cgal_skeleton, built by make into build/oracle):
+// the highest 45-degree rise over the polygons, or null when it is not built.
+const ORACLE = path.join(here, '../../build/oracle/cgal_skeleton');
+let oracleNoted = false;
+function oracleRise(m, work) {
+  if (!fs.existsSync(ORACLE)) {
+    if (!oracleNoted) console.log(`(${ORACLE} not built: the hip roofs are not compared with CGAL's skeleton)`);
+    oracleNoted = true;
+    return null;
+  }
+  const L = [];
+  m.polys.forEach((p, i) => {
+    L.push(`P part${i}`);
+    for (const r of p) { L.push(`L ${r.length}`); for (const q of r) L.push(`${q[0]} ${q[1]}`); }
+    L.push('E');
+  });
+  const txt = path.join(work, 'oracle.txt');
+  fs.writeFileSync(txt, L.join('\n') + '\n');
+  const r = spawnSync(ORACLE, ['--exact', txt], { encoding: 'utf8', timeout: 60000 });
+  const lines = (r.stdout || '').split('\n').filter((l) => l.startsWith('part'));
+  const notOk = lines.find((l) => l.split(',')[6] !== 'ok');
+  if (lines.length !== m.polys.length || notOk) return { error: `not compared (${notOk ? notOk.split(',')[6] : (r.stdout || r.stderr).trim()})` };
+  return { rise: Math.max(...lines.map((l) => Number(l.split(',')[7]))) };
+}
+
 function sweepFootprints(m, work) {
   const f = m.file;
   const outObj = path.join(work, 'city.obj'), rep = path.join(work, 'report.json');
@@ -134,19 +211,124 @@ function sweepFootprints(m, work) {
   }
   const d = readObjMesh(outObj);
   const ok = d.triangles > 0 && d.extent.every(Number.isFinite);
-  record(m, 'extrude', ok ? 'ok' : 'BUG:empty-result', `${d.triangles} triangles, extents ${d.extent.map((x) => x.toFixed(1)).join('x')}; ${r.out.split('\n').slice(-1)[0]}`);
+  const summary = `${d.triangles} triangles, extents ${d.extent.map((x) => x.toFixed(1)).join('x')}; ${r.out.split('\n').slice(-1)[0]}`;
+  if (!ok) return record(m, 'extrude', 'BUG:empty-result', summary);
+  const report = JSON.parse(fs.readFileSync(rep, 'utf8'));
+  const fell = report.fallbacks.length || report.failed.length;
+  // hip: walls to the height, then 45 degrees; no part of it leaves the footprint's box
+  const c = checkExtrusion(outObj, m, { reach: 0, top: (m.height || 0) + (m.polys ? halfSide(m.polys) : 0), origin: report.origin || [0, 0] });
+  let verdict = c.fails.length ? 'BUG:wrong-result' : fell ? 'WARN:fallback' : 'ok';
+  let note = c.fails.length ? c.fails.join('; ') : summary;
+  if (!c.fails.length && m.polys && !fell) {
+    const o = oracleRise(m, work);
+    if (o && o.error) note += `; CGAL: ${o.error.split('\n')[0]}`;
+    else if (o && Math.abs(c.zmax - m.height - o.rise) > 1e-3) { verdict = 'BUG:wrong-result'; note = `roof rise ${(c.zmax - m.height).toFixed(4)} m, CGAL's skeleton ${o.rise.toFixed(4)} m`; }
+    else if (o) note += `; rise ${o.rise.toFixed(3)} m as CGAL's`;
+  }
+  record(m, 'extrude', verdict, note);
+  if (m.polys) sweepMixedStyle(m, work);
+}
+
+// per-edge profiles from a style's rules: vertical walls north, a 0.5 m soffit and 45°
+// south, steep (63°) or the soffit elsewhere; reach: the soffit mitred (2.5x), top: the
+// steep slope over the whole footprint
+const MIXED = { name: 'mixed', height: 9, seed: 7, profiles: { steep: [[0.5, 1]], wall: [[0, 1]], over: [[-0.5, 0], [2.5, 3]] },
+  rules: [{ orientation: 'north', profiles: 'wall' }, { orientation: 'south', profiles: 'over' }, { profiles: { steep: 0.6, over: 0.4 } }] };
+function sweepMixedStyle(m, work) {
+  const style = path.join(work, 'mixed.json'), outObj = path.join(work, 'mixed.obj'), rep = path.join(work, 'mixed-report.json');
+  fs.writeFileSync(style, JSON.stringify(MIXED));
+  const r = run(['extrude', m.file, '--style', style, '--out', outObj, '--report', rep]);
+  if (r.verdict !== 'ok') return record(m, 'extrude-mixed', r.verdict === 'error' ? 'BUG:rejected-valid' : `BUG:${r.verdict}`, r.out);
+  const report = JSON.parse(fs.readFileSync(rep, 'utf8'));
+  const c = checkExtrusion(outObj, m, { reach: 2.5 * 0.5, top: m.height + 2 * (diagonal(m.polys) + 0.5), origin: report.origin || [0, 0] });
+  const fell = report.fallbacks.length || report.failed.length;
+  record(m, 'extrude-mixed', c.fails.length ? 'BUG:wrong-result' : fell ? 'WARN:fallback' : 'ok', c.fails.length ? c.fails.join('; ') : r.out.split('\n').slice(-1)[0]);
+}
+
+// a plan with per-edge profiles, steps and offset events: the shell is checked like a
+// footprint's, with the reach its overhangs (mitred up to 2.5x) and steps allow
+function sweepPlan(m, work) {
+  const outObj = path.join(work, 'plan.obj');
+  const r = run(['extrude', '--plan', m.file, '--out', outObj]);
+  // every plan here is valid: an error (a refusal, or a building that is not good) is a bug
+  if (r.verdict !== 'ok') return record(m, 'extrude-plan', r.verdict === 'error' ? 'BUG:rejected-valid' : `BUG:${r.verdict}`, r.out.split('\n').filter((l) => /not good|: /.test(l)).slice(-2).join(' | '));
+  const c = checkExtrusion(outObj, m, { reach: 2.5 * 0.6 + 1, top: 7 + 2 * (diagonal(m.polys) + 0.6) + 3, origin: [0, 0] });
+  record(m, 'extrude-plan', c.fails.length ? 'BUG:wrong-result' : 'ok', c.fails.length ? c.fails.join('; ') : r.out.split('\n').slice(-1)[0]);
+}
+
+// A segmented PLY as archgram writes it (binary little endian, `comment offset`): the
+// absolute points of each segment.
+function readSegments(file) {
+  const b = fs.readFileSync(file);
+  const end = b.indexOf('end_header\n') + 11;
+  const head = b.subarray(0, end).toString().split('\n');
+  const off = (head.find((l) => l.startsWith('comment offset')) || 'comment offset 0 0 0').split(' ').slice(2).map(Number);
+  const size = { char: 1, uchar: 1, short: 2, ushort: 2, int: 4, uint: 4, float: 4, double: 8 };
+  const at = {};
+  let rec = 0;
+  for (const l of head.filter((x) => x.startsWith('property '))) { const [, type, name] = l.split(' '); at[name] = [rec, type]; rec += size[type]; }
+  const n = Number(head.find((l) => l.startsWith('element vertex')).split(' ')[2]);
+  const get = (o, [k, type]) => (type === 'float' ? b.readFloatLE(o + k) : type === 'double' ? b.readDoubleLE(o + k) : b.readInt32LE(o + k));
+  const seg = new Map();
+  for (let i = 0; i < n; i++) {
+    const o = end + i * rec, s = get(o, at.segment);
+    if (!seg.has(s)) seg.set(s, []);
+    seg.get(s).push(['x', 'y', 'z'].map((c, k) => get(o, at[c]) + off[k]));
+  }
+  return seg;
+}
+// the planes of cloudPoints' box building (turned by `deg` about z, moved by `o`) as
+// [normal, d]: the ground and the roof, four walls
+function boxPlanes(deg, o) {
+  const a = deg * Math.PI / 180, c = Math.cos(a), s = Math.sin(a);
+  const wall = (nx, ny, x, y) => { const n = [c * nx - s * ny, s * nx + c * ny, 0]; const p = [c * x - s * y + o[0], s * x + c * y + o[1]]; return [n, n[0] * p[0] + n[1] * p[1]]; };
+  return [[[0, 0, 1], o[2]], [[0, 0, 1], o[2] + 9], wall(0, 1, 0, 0), wall(0, 1, 0, 10), wall(1, 0, 0, 0), wall(1, 0, 20, 0)];
+}
+// each known plane has one segment holding most of its points, all of which lie on it
+function checkPlanes(file, planes) {
+  const seg = readSegments(file);
+  const dist = (p, [n, d]) => Math.abs(n[0] * p[0] + n[1] * p[1] + n[2] * p[2] - d);
+  const fails = [], found = [];
+  planes.forEach((pl, k) => {
+    let best = null;
+    for (const [id, P] of seg) {
+      if (id < 0) continue;
+      const on = P.filter((p) => dist(p, pl) < 0.05).length;
+      if (!best || on > best.on) best = { id, on, all: P.length };
+    }
+    const onPlane = [...seg.values()].flat().filter((p) => dist(p, pl) < 0.02).length;
+    if (!best || best.on < 0.8 * best.all || best.on < 0.6 * onPlane) fails.push(`plane ${k}: no segment holds it (best: segment ${best && best.id}, ${best && best.on} of its ${best && best.all} points on it, the plane has ${onPlane})`);
+    else found.push(best.id);
+  });
+  if (new Set(found).size !== found.length) fails.push(`two planes in one segment (${found})`);
+  const small = [...seg].filter(([id]) => id >= 0 && !found.includes(id));
+  return { fails, note: `${planes.length} planes found as segments ${found.join(',')}; ${small.length} more segments of ${small.reduce((a, [, P]) => a + P.length, 0)} points` };
 }
 
 function sweepCloud(m, work) {
   const f = m.file;
   let r = run(['info', f, '--json']);
-  if (m.expectError) return errorStep(m, 'info', r, f);
+  if (m.expectError) {
+    if (m.refuse && r.verdict === 'error' && !new RegExp(m.refuse, 'i').test(r.out)) return record(m, 'info', 'UNHELPFUL', `refused, but not naming /${m.refuse}/: ${r.out}`);
+    return errorStep(m, 'info', r, f);
+  }
   if (r.verdict !== 'ok') return record(m, 'info', r.verdict === 'error' ? 'BUG:rejected-valid' : `BUG:${r.verdict}`, r.out);
   let info = null; try { info = JSON.parse(r.out.slice(r.out.indexOf('{'))); } catch { /* text */ }
   const n = info && (info.points ?? info.count);
-  record(m, 'info', m.points && n !== undefined && n !== m.points ? 'BUG:wrong-count' : 'ok', `points ${n}`);
-  r = run(['segment', f, '--out', path.join(work, 'seg.ply')]);
-  record(m, 'segment', r.verdict === 'ok' ? 'ok' : r.verdict === 'error' ? (precise(r.out, f) ? 'precise-error' : 'UNHELPFUL') : `BUG:${r.verdict}`, r.out);
+  let verdict = m.points && n !== undefined && n !== m.points ? 'BUG:wrong-count' : 'ok', note = `points ${n}`;
+  if (m.bbox && info) {
+    const off = [0, 1, 2].flatMap((k) => [info.min[k] - m.bbox[0][k], info.max[k] - m.bbox[1][k]]).map(Math.abs);
+    const tol = 1e-6 * (1 + Math.max(...m.bbox[1].map(Math.abs)));
+    if (!(Math.max(...off) <= tol)) { verdict = 'BUG:wrong-bbox'; note += `; box ${JSON.stringify([info.min, info.max])}, stored ${JSON.stringify(m.bbox)}`; }
+    else note += '; box as stored';
+  }
+  record(m, 'info', verdict, note);
+  const seg = path.join(work, 'seg.ply');
+  r = run(['segment', f, '--out', seg]);
+  if (r.verdict === 'ok' && m.planes) {
+    const c = checkPlanes(seg, boxPlanes(/rot23/.test(m.variant) ? 23 : 0, /rot23/.test(m.variant) ? [0, 0, 0] : [85000, 445000, 0]));
+    record(m, 'segment', c.fails.length ? 'BUG:wrong-result' : 'ok', c.fails.length ? c.fails.join('; ') : c.note);
+  } else record(m, 'segment', r.verdict === 'ok' ? 'ok' : r.verdict === 'error' ? (precise(r.out, f) ? 'precise-error' : 'UNHELPFUL') : `BUG:${r.verdict}`, r.out);
   r = run(['proceduralize', f, '--out', path.join(work, 'p')]);
   record(m, 'proceduralize', r.verdict === 'ok' ? 'ok' : r.verdict === 'error' ? (precise(r.out, f) ? 'precise-error' : 'UNHELPFUL') : `BUG:${r.verdict}`, r.out);
   if (r.verdict === 'ok') {
@@ -170,9 +352,13 @@ for (const m of manifest) {
   fs.mkdirSync(work, { recursive: true });
   if (m.family === 'mesh') sweepMesh(m, work);
   else if (m.family === 'footprints') sweepFootprints(m, work);
+  else if (m.family === 'plan') sweepPlan(m, work);
   else sweepCloud(m, work);
 }
 fs.writeFileSync(path.join(dir, 'sweep.json'), JSON.stringify(rows, null, 1));
 const problems = rows.filter((r) => /^(BUG|UNHELPFUL)/.test(r.verdict));
+const table = {};
+for (const r of rows) { const k = r.verdict.replace(/:.*/, ''); (table[r.family] ??= {})[k] = (table[r.family][k] || 0) + 1; }
+for (const [fam, t] of Object.entries(table)) console.log(`${fam}\t${Object.entries(t).map(([k, n]) => `${k} ${n}`).join(', ')}`);
 console.log(`\n${rows.length} steps, ${problems.length} problems`);
 process.exit(problems.length ? 1 : 0);

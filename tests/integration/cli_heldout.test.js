@@ -9,7 +9,7 @@ import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import { REPO, tempDir, removeDir } from './harness.js';
-import { building, measure, offset, rotZ, plyText, stlBinary, gltf, objText, cloudPoints, las } from '../heldout/generate.js';
+import { building, measure, offset, rotZ, plyText, stlBinary, gltf, objText, cloudPoints, las, readExtrusion } from '../heldout/generate.js';
 
 const CLI = process.env.ARCHGRAM ? path.resolve(process.env.ARCHGRAM) : path.join(REPO, 'build', 'archgram');
 const run = (...args) => spawnSync(CLI, args, { encoding: 'utf8', timeout: 60000 });
@@ -146,6 +146,42 @@ test('cut: a tile in a local site frame (coordinates near 0, 0) is refused as de
     assert.match(r.stderr, /plain\.las: --ground class, but no point has classification 2/);
     r = run('cut', plain, '--footprints', fp, '--out', path.join(dir, 'd'), '--metres', '--ground', 'plane');
     assert.equal(r.status, 0, r.stderr);
+  } finally {
+    removeDir(dir);
+  }
+});
+
+test('extrude: a footprint with a spike a few micrometres wide builds as styled, closed, with its base area', () => {
+  const dir = tempDir();
+  try {
+    // a 20 x 10 m block at RD with a 15 m spike: 2e-7 m wide (removed by validation), 4e-6
+    // and 1e-5 m (kept; thinner than the building check's probe near the tip)
+    for (const w of [2e-7, 4e-6, 1e-5]) {
+      const ring = [[0, 0], [20, 0], [20, 10], [10 + w / 2, 10], [10, 25], [10 - w / 2, 10], [0, 10], [0, 0]].map(([x, y]) => [x + 85000, y + 445000]);
+      const fp = path.join(dir, `spike-${w}.geojson`);
+      fs.writeFileSync(fp, JSON.stringify({ type: 'FeatureCollection', features: [{ type: 'Feature', properties: { height: 9 }, geometry: { type: 'Polygon', coordinates: [ring] } }] }));
+      const out = path.join(dir, `spike-${w}.obj`), rep = path.join(dir, `spike-${w}.json`);
+      const r = run('extrude', fp, '--style', 'hip', '--out', out, '--report', rep);
+      assert.equal(r.status, 0, r.stdout + r.stderr);
+      const report = JSON.parse(fs.readFileSync(rep, 'utf8'));
+      assert.equal(report.succeeded, 1, `${w}: ${r.stdout}${r.stderr}`);
+      assert.deepEqual(report.fallbacks, [], `${w}: ${r.stderr}`);
+      const { v, weld, groups } = readExtrusion(out);
+      const T = [...groups.values()].flat();
+      const use = new Map();
+      for (const t of T) for (let k = 0; k < 3; k++) { const key = `${weld[t[k]]},${weld[t[(k + 1) % 3]]}`; use.set(key, (use.get(key) || 0) + 1); }
+      for (const [key, n] of use) {
+        const [a, b] = key.split(',');
+        assert.ok(a !== b && n === 1 && use.get(`${b},${a}`) === 1, `${w}: edge ${key} used ${n} times, its reverse ${use.get(`${b},${a}`)}`);
+      }
+      let base = 0;
+      for (const t of T) {
+        const [A, B, C] = t.map((i) => v[i]);
+        if (Math.max(A[2], B[2], C[2]) < 1e-9) base -= ((B[0] - A[0]) * (C[1] - A[1]) - (B[1] - A[1]) * (C[0] - A[0])) / 2;
+      }
+      assert.ok(Math.abs(base - 200) <= 15 * w / 2 + 1e-6, `${w}: base ${base} m²`);
+      assert.ok(Math.max(...v.map((p) => p[2])) <= 9 + 5 + 1e-6, `${w}: a roof above the block's 45° rise`);
+    }
   } finally {
     removeDir(dir);
   }

@@ -111,3 +111,42 @@ test('bad bundles and bad arguments are refused and write nothing', () => {
     removeDir(dir);
   }
 });
+
+// A georeferenced model (web-mercator reaches 2e7 m): the part it saves is the same file
+// `part info` and `part compose` read; past the bound every bundle reader keeps, save refuses
+// naming the coordinate and writes nothing.
+test('a part saved 2e7 m from the origin reads back and composes; past 1e8 m save refuses', () => {
+  const dir = tempDir();
+  try {
+    const origin = [2.0e7, -1.5e7, 40];
+    const win = { ww: 1.2, wh: 1.8, frame: 0.08, mullions: 1, origin };
+    const a = proceduralized(dir, 'a', { cols: 2, rows: 1, ...win });
+    const b = proceduralized(dir, 'b', { cols: 3, rows: 1, ...win, ww: 1.6 });
+    const bundle = path.join(dir, 'far.agpart');
+    let r = run('part', 'save', a.out, '--node', String(a.nodeOf(a.slots[0])), '--name', 'far', '--out', bundle);
+    assert.equal(r.status, 0, r.stderr);
+    const doc = JSON.parse(fs.readFileSync(bundle, 'utf8'));
+    // the box is where the window stood, checked against the wall's own slot
+    doc.parts[0].box.forEach((x, i) => assert.ok(Math.abs(x - a.slots[0][i]) < 1e-6, `box[${i}] ${x}`));
+    r = run('part', 'info', bundle, '--json');
+    assert.equal(r.status, 0, r.stderr);
+    assert.equal(JSON.parse(r.stdout)[0].visible, 7);
+    const out = path.join(dir, 'b2');
+    r = run('part', 'compose', b.out, '--part', bundle, '--target', String(b.nodeOf(b.slots[1])),
+      '--mode', 'replace', '--scope', 'rule', '--out', out);
+    assert.equal(r.status, 0, r.stderr);
+    const tree = JSON.parse(fs.readFileSync(path.join(out, 'tree.json'), 'utf8'));
+    const inSlot = (nd, s) => nd.box.every((x, i) => (i < 3 ? x >= s[i] - 1e-6 : x <= s[i] + 1e-6));
+    for (const s of b.slots)
+      assert.equal(tree.nodes.filter((nd) => nd.kind === 'component' && inSlot(nd, s)).length, 7);
+
+    const c = proceduralized(dir, 'c', { cols: 2, rows: 1, ...win, origin: [1.5e8, 0, 0] });
+    const refused = path.join(dir, 'beyond.agpart');
+    r = run('part', 'save', c.out, '--node', String(c.nodeOf(c.slots[0])), '--name', 'beyond', '--out', refused);
+    assert.equal(r.status, 1, r.stderr);
+    assert.match(r.stderr, /box: min x = 150000000\.9 m is beyond the \+-1e\+08 m a part can hold/);
+    assert.equal(fs.existsSync(refused), false);
+  } finally {
+    removeDir(dir);
+  }
+});

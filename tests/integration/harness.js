@@ -664,13 +664,15 @@ export function facadeObj(cols = 6, rows = 4, wall = [15, 13]) {
 // window is a casing holding four frame bars of width `frame`, a glass pane and `mullions`
 // mullions, every piece its own group; `front` is the window's front face (0.1: set into the
 // 0.3 m wall, hidden by its face; below 0: standing proud of it, in view from the front).
+// `origin` moves the whole wall (a georeferenced model far from 0).
 // Returns the text and each window's box (slots).
-export function windowWallObj({ cols, rows, ww, wh, frame, mullions, front = 0.1 }) {
+export function windowWallObj({ cols, rows, ww, wh, frame, mullions, front = 0.1, origin = [0, 0, 0] }) {
   const out = [];
   let nv = 0, n = 0;
+  const at = (p, a) => p + origin[a];
   const box = (a, b) => {
     out.push(`g piece_${n++}`);
-    for (let i = 0; i < 8; i++) out.push(`v ${i & 1 ? b[0] : a[0]} ${i & 2 ? b[1] : a[1]} ${i & 4 ? b[2] : a[2]}`);
+    for (let i = 0; i < 8; i++) out.push(`v ${at(i & 1 ? b[0] : a[0], 0)} ${at(i & 2 ? b[1] : a[1], 1)} ${at(i & 4 ? b[2] : a[2], 2)}`);
     const faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     for (const [p, q, r, s] of faces) out.push(`f ${nv + p + 1} ${nv + q + 1} ${nv + r + 1}`, `f ${nv + p + 1} ${nv + r + 1} ${nv + s + 1}`);
     nv += 8;
@@ -691,7 +693,7 @@ export function windowWallObj({ cols, rows, ww, wh, frame, mullions, front = 0.1
         const c = u + frame + (ww - 2 * frame) * (k + 1) / (mullions + 1);
         box([c - 0.025, v0 + 0.03, w + frame], [c + 0.025, v0 + 0.13, w + wh - frame]);
       }
-      slots.push([u, v0, w, u + ww, v1, w + wh]);
+      slots.push([u, v0, w, u + ww, v1, w + wh].map((x, k) => at(x, k % 3)));
     }
   }
   return { obj: out.join('\n') + '\n', slots };

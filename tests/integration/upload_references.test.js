@@ -1,7 +1,8 @@
-// Uploads never read the server's files: a glTF, GLB, Collada, FBX or OBJ that names another
-// file (by absolute or relative path, or file: URI) fails its import job with a 422
+// Uploads never read the server's files: a glTF, GLB, Collada or FBX that names another file
+// (by absolute or relative path, or file: URI) fails its import job with a 422
 // external-reference problem naming it, and no model is stored; inline data: URIs still
-// import. The CLI, reading the user's own file, resolves the same references next to it.
+// import; an OBJ's mtllib is ignored (the mesh imports, the library is not opened). The CLI,
+// reading the user's own file, resolves the same references next to it.
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
@@ -131,11 +132,35 @@ describe('uploads never read the server\'s files', () => {
     await refused(gltf2(DATA_URI, { image: '../textures/wall.png' }), 'gltf', '../textures/wall.png', 'gltf image');
   });
 
-  it('an OBJ mtllib → 422 naming the library and its line', async () => {
-    const e = await refused(obj('/etc/passwd'), 'obj', '/etc/passwd', 'obj mtllib');
-    assert.match(e.detail, /\bline 2: mtllib\b/);
-    // the 1-based line travels as the problem's element (or line) member
-    assert.equal(e.line ?? e.element, 2, JSON.stringify(e));
+  // The probe: a file whose access time lies before its change time, which the kernel
+  // (relatime) moves forward on the next read of it. The test reads it once itself to show the
+  // probe sees a read; the server's import must leave it where it was.
+  function accessProbe(name) {
+    const file = path.join(dir, name);
+    fs.writeFileSync(file, 'newmtl probe\nKd 1 0 0\n');
+    const reset = () => fs.utimesSync(file, new Date('2001-01-01T00:00:00Z'), new Date());
+    const atime = () => fs.statSync(file).atimeMs;
+    reset();
+    const before = atime();
+    fs.readFileSync(file);
+    assert.notEqual(atime(), before, 'the probe must see a read (access times recorded here)');
+    reset();
+    return { file, untouched: () => atime() === before };
+  }
+
+  it('an OBJ mtllib is ignored: the mesh imports and the named file is never opened', async () => {
+    const probe = accessProbe('lib.mtl');
+    const rel = path.relative(d.dir, probe.file); // from the daemon's working folder: ../..
+    for (const [what, lib] of [['absolute', probe.file], ['relative', rel],
+      ['etc/passwd', '../../etc/passwd'], ['absolute system file', '/etc/passwd']]) {
+      const job = await upload(d, obj(lib), { name: `mtllib ${what}`, format: 'obj' });
+      const done = await waitJob(d, job.id);
+      assert.equal(done.status, 'succeeded', `${what}: ${JSON.stringify(done)}`);
+      const m = (await http(d, 'GET', done.result.href)).json;
+      assert.equal(m.stats.triangles, 1, what);
+      assert.equal(m.stats.vertices, 3, what);
+      assert.ok(probe.untouched(), `${what}: the server read ${probe.file}`);
+    }
   });
 
   it('a Collada file with an external image → 422 naming it', async () => {

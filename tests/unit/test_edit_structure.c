@@ -36,6 +36,7 @@ typedef struct {
     double wall_thick_err;      /* largest relative error of a wall's thickness */
     double min_gap;             /* smallest gap between two windows of one facade (< 0: overlap) */
     double period;              /* the front windows' column period (mean) */
+    double period_err;          /* largest relative error of a column spacing to BB_PERIOD */
     double ext[3];              /* the whole building's extents (building frame) */
     size_t open_edges;
 } bb_measure;
@@ -169,6 +170,8 @@ static bb_measure measure(const ag_mesh *m, const bb_options *o, const bb_groups
     r.front_cols = distinct(cols, nf, 0.05);
     r.front_rows = distinct(zs, nf, 0.05);
     r.period = r.front_cols > 1 ? (cols[r.front_cols - 1] - cols[0]) / (r.front_cols - 1) : 0;
+    for (size_t i = 1; i < r.front_cols; i++)
+        r.period_err = fmax(r.period_err, fabs((cols[i] - cols[i - 1]) / BB_PERIOD - 1));
     (void)front_y;
     free(cols);
     free(xs);
@@ -265,7 +268,7 @@ static void expect_original(const bb_measure *r, const bb_options *o, const char
     if (r->front != o->cols * o->rows || r->right != o->side_cols * o->rows ||
         r->left != o->left_cols * o->rows || r->doors != 1 || r->win_size_err > 0.01 ||
         r->door_size_err > 0.01 || r->wall_thick_err > 0.01 || r->open_edges ||
-        !(r->min_gap > 0))
+        !(r->min_gap > 0) || r->period_err > 0.01)
         fail_msg("%s %s: the original structure is not there", o->name, what);
 }
 
@@ -278,15 +281,15 @@ static void expect_stretched(const bb_measure *r, const bb_options *o, const cha
              r->front == cols * o->rows && r->right == o->side_cols * o->rows &&
              r->left == o->left_cols * o->rows && r->doors == 1 && r->win_size_err <= 0.01 &&
              r->door_size_err <= 0.01 && r->wall_thick_err <= 0.01 && r->open_edges == 0 &&
-             r->min_gap > 0;
+             r->min_gap > 0 && r->period_err <= 0.01;
     if (!ok)
         fail_msg("%s %s: front %zu (%zu columns x %zu rows) want %u or %u columns x %u, right %zu "
                  "want %u, left %zu want %u, doors %zu, window size error %.4f, door %.4f, wall "
-                 "thickness error %.4f, gap %.3f, open edges %zu",
+                 "thickness error %.4f, gap %.3f, open edges %zu, spacing error %.4f",
                  o->name, what, r->front, cols, r->front_rows, 2 * o->cols, 2 * o->cols - 1,
                  o->rows, r->right, o->side_cols * o->rows, r->left, o->left_cols * o->rows,
                  r->doors, r->win_size_err, r->door_size_err, r->wall_thick_err, r->min_gap,
-                 r->open_edges);
+                 r->open_edges, r->period_err);
 }
 
 static const bb_options variants[] = {
@@ -301,6 +304,16 @@ static const bb_options variants[] = {
     {"proud, UTM, turned", 6, 3, 3, 0, BB_PROUD, 0.3, 2, 684321.0, 5403210.0, 412.0, 0, 0},
     {"flush, jittered", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 2e-7, 0},
     {"proud 5 x 2, jittered", 5, 2, 4, 0, BB_PROUD, 0.3, 0, 0, 0, 0, 2e-7, 0},
+    /* windows and their mirror images alternating: two interleaved patterns per facade */
+    {"recessed, handed", 6, 3, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0, 1},
+    {"flush, handed", 6, 3, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0, 1},
+    {"proud, handed", 6, 3, 3, 0, BB_PROUD, 0, 0, 0, 0, 0, 0, 1},
+    {"proud, handed, overhang, turned", 6, 2, 3, 2, BB_PROUD, 0.3, 1, 0, 0, 0, 0, 1},
+    /* an odd count: 3 windows and 2 mirror images taking turns */
+    {"flush, handed 5 x 2", 5, 2, 3, 0, BB_FLUSH, 0, 0, 0, 0, 0, 0, 1},
+    {"recessed, handed 5 x 2", 5, 2, 3, 0, BB_RECESSED, 0, 0, 0, 0, 0, 0, 1},
+    {"proud, handed 5 x 2, overhang, turned", 5, 2, 3, 2, BB_PROUD, 0.3, 3, 0, 0, 0, 0, 1},
+
 };
 
 /* One variant through every edit, each on the service's path (the model kept, no read-back)

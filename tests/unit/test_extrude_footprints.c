@@ -144,6 +144,87 @@ static void test_shared_edges_dissolved(void **state)
     ag_footprints_free(f);
 }
 
+/* A MultiPolygon of n x n unit squares of two triangles each, with its feature id. */
+static char *tin_doc(int n, const char *id)
+{
+    size_t cap = 256 + (size_t)n * n * 140, len = 0;
+    char *d = malloc(cap);
+    assert_non_null(d);
+    len += (size_t)snprintf(d, cap, "{\"type\": \"FeatureCollection\", \"features\": [{\"type\": "
+                            "\"Feature\", \"id\": \"%s\", \"properties\": {}, \"geometry\": "
+                            "{\"type\": \"MultiPolygon\", \"coordinates\": [", id);
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++) {
+            int x = 85000 + i, y = 446000 + j;
+            len += (size_t)snprintf(d + len, cap - len,
+                                    "%s[[[%d,%d],[%d,%d],[%d,%d],[%d,%d]]],[[[%d,%d],[%d,%d],[%d,%d],"
+                                    "[%d,%d]]]",
+                                    i || j ? "," : "", x, y, x + 1, y, x + 1, y + 1, x, y, x, y,
+                                    x + 1, y + 1, x, y + 1, x, y);
+        }
+    snprintf(d + len, cap - len, "]}}]}");
+    return d;
+}
+
+/* Dissolving looks at the corners between an edge's ends only, within a budget: a 40 x 40
+ * triangulated square dissolves into its outline, one of 180 x 180 (64 800 parts, past the
+ * budget) is refused naming the feature instead of taking minutes. A polygon of 20 000 holes
+ * keeps them all, each turned clockwise. */
+static void test_large_footprints_bounded(void **state)
+{
+    (void)state;
+    char *doc = tin_doc(40, "tin40");
+    ag_footprints *f = NULL;
+    ag_error err = {0};
+    if (ag_footprints_read_buffer(doc, strlen(doc), NULL, &f, &err) != AG_OK)
+        fail_msg("%s", err.text);
+    free(doc);
+    assert_int_equal(f->n, 1);
+    assert_int_equal(f->items[0].nloops, 1);
+    assert_non_null(strstr(f->items[0].fixes, "3200 parts sharing"));
+    double area = 0;
+    const double *xy = f->items[0].loops[0];
+    size_t n = f->items[0].sizes[0];
+    for (size_t i = 0, j = n - 1; i < n; j = i++)
+        area += xy[2 * j] * xy[2 * i + 1] - xy[2 * i] * xy[2 * j + 1];
+    assert_true(fabs(area / 2 - 1600) < 1e-6);
+    assert_int_equal(n, 4 * 40); /* the outline keeps every grid corner on it */
+    ag_footprints_free(f);
+
+    doc = tin_doc(180, "tin180");
+    f = NULL;
+    assert_int_equal(ag_footprints_read_buffer(doc, strlen(doc), NULL, &f, &err),
+                     AG_ERR_TOO_LARGE);
+    assert_null(f);
+    free(doc);
+    assert_int_equal(err.element, 1);
+    if (!strstr(err.text, "feature 0: its 64800 parts share too many corners"))
+        fail_msg("%s", err.text);
+
+    size_t holes = 20000, cap = 128 + holes * 120, len = 0;
+    doc = malloc(cap);
+    assert_non_null(doc);
+    len += (size_t)snprintf(doc, cap, "{\"type\": \"Feature\", \"properties\": {}, "
+                            "\"geometry\": {\"type\": \"Polygon\", \"coordinates\": "
+                            "[[[85000,446000],[105000,446000],[105000,446001],[85000,446001]]");
+    for (size_t h = 0; h < holes; h++)
+        len += (size_t)snprintf(doc + len, cap - len, ",[[%zu.25,446000.25],[%zu.75,446000.25],"
+                                "[%zu.75,446000.75]]", 85000 + h, 85000 + h, 85000 + h);
+    snprintf(doc + len, cap - len, "]}}");
+    if (ag_footprints_read_buffer(doc, strlen(doc), NULL, &f, &err) != AG_OK)
+        fail_msg("%s", err.text);
+    free(doc);
+    assert_int_equal(f->items[0].nloops, holes + 1);
+    for (size_t h = 1; h <= holes; h++) {
+        const double *r = f->items[0].loops[h];
+        assert_int_equal(f->items[0].sizes[h], 3);
+        /* clockwise: negative signed area */
+        double a2 = (r[2] - r[0]) * (r[5] - r[1]) - (r[4] - r[0]) * (r[3] - r[1]);
+        assert_true(a2 < 0);
+    }
+    ag_footprints_free(f);
+}
+
 /* Rings in the wrong orientation are reversed and reported; a self-crossing ring is
  * refused with the edges named; a symmetric bow tie (no area) likewise. */
 static void test_orientation_and_refusals(void **state)
@@ -308,6 +389,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ogc_valid_accepted),
         cmocka_unit_test(test_shared_edges_dissolved),
+        cmocka_unit_test(test_large_footprints_bounded),
         cmocka_unit_test(test_orientation_and_refusals),
         cmocka_unit_test(test_heights_from_properties),
         cmocka_unit_test(test_cityjson_named),

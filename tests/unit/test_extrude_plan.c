@@ -50,6 +50,33 @@ static void test_cleaning(void **state)
     ag_plan_free(p);
 }
 
+/* A spike no wider than the building check's probe (1e-7 of the plan's size, 3 µm here)
+ * is removed, a wider one kept: the plan's corners and area say which. */
+static void test_thin_spike_removed(void **state)
+{
+    (void)state;
+    const double widths[] = {2e-7, 2e-6, 2e-5};
+    for (int k = 0; k < 3; k++) {
+        double h = widths[k] / 2;
+        const double xy[] = {0, 0, 20, 0, 20, 10, 10 + h, 10, 10, 25, 10 - h, 10, 0, 10};
+        ag_plan *p = one_loop(xy, 7);
+        ag_plan_fixes fx = {0};
+        assert_int_equal(ag_plan_validate(p, &fx, NULL, NULL), AG_OK);
+        double area = ag_plan_loop_area(&p->loops[0]);
+        if (k < 2) {
+            assert_true(has_fix(&fx, AG_PLAN_FIX_SPIKE, 4));
+            assert_int_equal(p->loops[0].n, 4);
+            assert_true(fabs(area - 200) < 1e-9);
+        } else {
+            assert_false(has_fix(&fx, AG_PLAN_FIX_SPIKE, -2));
+            assert_int_equal(p->loops[0].n, 7);
+            assert_true(fabs(area - (200 + 15 * h)) < 1e-9);
+        }
+        ag_plan_fixes_free(&fx);
+        ag_plan_free(p);
+    }
+}
+
 static void test_collinear_kept_with_other_profile(void **state)
 {
     (void)state;
@@ -248,6 +275,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cleaning),
+        cmocka_unit_test(test_thin_spike_removed),
         cmocka_unit_test(test_collinear_kept_with_other_profile),
         cmocka_unit_test(test_orientation),
         cmocka_unit_test(test_reversal_keeps_edge_profiles),

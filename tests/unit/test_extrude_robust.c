@@ -418,6 +418,58 @@ static size_t big_shape(int comb, size_t n, double *xy)
 /* Stars and combs of 100 to 2000 corners: closed 2-manifolds by the independent check
  * (a 2,000-corner star once passed the shell's own check with a duplicated edge), and
  * where the oracle is built, as high as CGAL's roofs. */
+/* Area of the triangles at z = 0 facing down: the building's base, seen from above. */
+static double base_area(const ag_mesh *m)
+{
+    double a = 0;
+    for (size_t t = 0; t < m->ntris; t++) {
+        const double *p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = &m->pos[3 * m->tri[3 * t + k]];
+        if (fabs(p[0][2]) + fabs(p[1][2]) + fabs(p[2][2]) > 1e-12)
+            continue;
+        a -= ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0])) / 2;
+    }
+    return a;
+}
+
+/* A 15 m spike off a 20 x 10 m block, from 2e-7 m to 2 mm wide at its base (the held-out
+ * sweep's footprints): spikes no wider than the building check's probe are removed by
+ * validation, wider ones are swept; either way the building is good, closed at 1e-9 m,
+ * inside its footprint, with the footprint's base area (the spike's counted when kept). */
+static void test_thin_spikes(void **state)
+{
+    (void)state;
+    const double half[] = {1e-7, 3e-7, 1e-6, 2e-6, 5e-6, 1e-5, 1e-3};
+    const ag_profile_point walls45[] = {{0, 0}, {0, 9}, {1, 10}};
+    const ag_profile_point shallow[] = {{0, 0}, {0, 1}, {10, 2}};
+    const ag_profile_point *prof[] = {walls45, shallow};
+    for (size_t w = 0; w < sizeof half / sizeof *half; w++)
+        for (int k = 0; k < 2; k++) {
+            const double xy[] = {0, 0, 20, 0, 20, 10, 10 + half[w], 10, 10, 25, 10 - half[w], 10, 0, 10};
+            ag_plan *p = ag_plan_create();
+            assert_int_equal(ag_plan_add_profile(p, "r", prof[k], 3, NULL, NULL, NULL), AG_OK);
+            assert_int_equal(ag_plan_add_loop(p, xy, 7, NULL, NULL), AG_OK);
+            ag_mesh *m = ag_mesh_create();
+            ag_extrude_result r;
+            ag_error err = {0};
+            assert_int_equal(ag_extrude_plan(p, m, -1, &r, NULL, &err), AG_OK);
+            if (!ag_extrude_result_ok(&r))
+                fail_msg("spike %g m wide, profile %d: not good: %s", 2 * half[w], k, r.defect);
+            char why[200];
+            if (!xc_closed_manifold(m, -1, 1e-9, why, sizeof why))
+                fail_msg("spike %g m wide, profile %d: %s", 2 * half[w], k, why);
+            const double *loops[1] = {xy};
+            size_t sizes[1] = {7};
+            assert_true(xc_outside(m, -1, loops, sizes, 1, -1e-9) < 1e-9);
+            double spike = 15 * half[w], want = 200 + spike, got = base_area(m);
+            if (!(fabs(got - want) < 1e-9 || fabs(got - 200) <= spike + 1e-9))
+                fail_msg("spike %g m wide, profile %d: base %.12g m², footprint %.12g", 2 * half[w], k, got, want);
+            ag_mesh_free(m);
+            ag_plan_free(p);
+        }
+}
+
 static void test_large_footprints(void **state)
 {
     (void)state;
@@ -635,6 +687,7 @@ int main(void)
         cmocka_unit_test(test_denhaag_every_style),
         cmocka_unit_test(test_denhaag_against_cgal),
         cmocka_unit_test(test_large_footprints),
+        cmocka_unit_test(test_thin_spikes),
         cmocka_unit_test(test_budgets),
         cmocka_unit_test(test_batch_budget_falls_back),
         cmocka_unit_test(test_plan_falls_back),

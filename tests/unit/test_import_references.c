@@ -1,6 +1,7 @@
 /* Uploads never read another file: every way a format can name one (glTF 2 buffers and images
- * by URI, a GLB's extra buffer, glTF 1 buffers, Collada images, FBX textures, OBJ mtllib) is
- * refused with AG_ERR_EXTERNAL_REF naming the reference, and inline data: URIs still import.
+ * by URI, a GLB's extra buffer, glTF 1 buffers, Collada images, FBX textures) is refused with
+ * AG_ERR_EXTERNAL_REF naming the reference, inline data: URIs still import, and an OBJ's
+ * mtllib is ignored: the mesh imports and the library is not opened.
  *
  * The references point at a real file holding a valid triangle buffer, so an importer that
  * read it would succeed; an inotify watch on its folder checks independently that nothing
@@ -332,7 +333,6 @@ static const struct {
     {GLTF1_BINARY_BUFFER, AG_FORMAT_GLB, "binary glTF 1 buffer"},
     {DAE_IMAGE, AG_FORMAT_DAE, "Collada image"},
     {FBX_TEXTURE, AG_FORMAT_FBX, "FBX texture"},
-    {OBJ_MTLLIB, AG_FORMAT_OBJ, "OBJ mtllib"},
 };
 
 static blob make(kind k, const char *ref)
@@ -404,7 +404,37 @@ static void test_every_reference_is_refused(void **state)
             free(b.data);
             checked++;
         }
-    assert_int_equal(checked, 56);
+    assert_int_equal(checked, 49);
+}
+
+/* An OBJ's material library, wherever it points (the valid buffer in the watched folder
+ * included), is ignored by an upload: the mesh imports and nothing there is opened. */
+static void test_obj_mtllib_is_ignored(void **state)
+{
+    (void)state;
+    char abs_ref[PATH_MAX + 16], file_ref[PATH_MAX + 32];
+    snprintf(abs_ref, sizeof abs_ref, "%s/tri.bin", dir);
+    snprintf(file_ref, sizeof file_ref, "file://%s/tri.bin", dir);
+    const char *refs[] = {"/etc/passwd", "../../etc/passwd", abs_ref, "tri.bin", file_ref};
+    for (size_t r = 0; r < sizeof refs / sizeof refs[0]; r++) {
+        blob b = make(OBJ_MTLLIB, refs[r]);
+        for (int sniffed = 0; sniffed < 2; sniffed++) {
+            int wd, fd = watch_open(&wd);
+            ag_mesh *m = NULL;
+            ag_error e = {0};
+            ag_status st = ag_import_buffer((const uint8_t *)b.data, b.len,
+                                            sniffed ? AG_FORMAT_UNKNOWN : AG_FORMAT_OBJ, NULL,
+                                            &m, &e);
+            int n = opened(fd);
+            if (st != AG_OK)
+                fail_msg("mtllib \"%s\": status %d, %s", refs[r], st, e.text);
+            assert_int_equal(m->ntris, 1);
+            ag_mesh_free(m);
+            if (n != 0)
+                fail_msg("mtllib \"%s\": %d opens in the referenced folder", refs[r], n);
+        }
+        free(b.data);
+    }
 }
 
 /* Allowed (the CLI, reading the user's own file): the references resolve and import. The
@@ -436,7 +466,7 @@ static void test_allowed_references_resolve(void **state)
         ag_mesh_free(m);
         free(b.data);
     }
-    /* textures and material libraries are accepted and not read */
+    /* textures (and material libraries, ignored for uploads too) are accepted and not read */
     const kind named[] = {GLTF2_IMAGE, DAE_IMAGE, FBX_TEXTURE, OBJ_MTLLIB};
     const ag_format fmts[] = {AG_FORMAT_GLTF, AG_FORMAT_DAE, AG_FORMAT_FBX, AG_FORMAT_OBJ};
     for (size_t i = 0; i < sizeof named / sizeof named[0]; i++) {
@@ -526,6 +556,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_every_reference_is_refused),
+        cmocka_unit_test(test_obj_mtllib_is_ignored),
         cmocka_unit_test(test_allowed_references_resolve),
         cmocka_unit_test(test_inline_data_imports),
         cmocka_unit_test(test_sandbox_refuses_what_the_scan_misses),

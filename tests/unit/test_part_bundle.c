@@ -323,6 +323,72 @@ static void test_cyclic_and_bad_names(void **state)
     expect_refused(j, AG_ERR_INVALID, "parts[0]", "root");
 }
 
+/* A copy of P[0] moved by (dx, 0, 0): its box and its axiom's box. */
+static ag_part *moved(double dx)
+{
+    ag_part *p = NULL;
+    ag_error err = {0};
+    if (ag_part_copy(P[0], &p, &err))
+        fail_msg("copy: %s", err.text);
+    p->box.min[0] += dx;
+    p->box.max[0] += dx;
+    p->grammar->axiom.box.min[0] += dx;
+    p->grammar->axiom.box.max[0] += dx;
+    return p;
+}
+
+/* What the writer writes the reader reads: a part saved 2e7 m from the origin (web-mercator)
+ * reads back where it stood; one past AG_PART_MAX_COORD is refused by the writer, naming the
+ * coordinate, and by the reader, whichever wrote it. */
+static void test_far_box_round_trips_or_is_refused(void **state)
+{
+    (void)state;
+    assert_true(AG_PART_MAX_COORD >= 1e8);
+    ag_part *far = moved(2e7);
+    char *text = NULL;
+    size_t len = 0;
+    ag_error err = {0};
+    if (ag_part_bundle_write((const ag_part *const *)&far, 1, &text, &len, &err))
+        fail_msg("write: %s", err.text);
+    ag_part **parts = NULL;
+    size_t n = 0;
+    if (ag_part_bundle_read(text, len, &parts, &n, &err))
+        fail_msg("read: %s", err.text);
+    assert_int_equal(n, 1);
+    /* independently of the code: P[0]'s box plus the offset, to the last bit the text holds */
+    assert_true(fabs(parts[0]->box.min[0] - (P[0]->box.min[0] + 2e7)) < 1e-8);
+    assert_true(fabs(parts[0]->box.max[0] - (P[0]->box.max[0] + 2e7)) < 1e-8);
+    assert_true(parts[0]->box.min[0] > 1e7);
+    ag_part_bundle_free(parts, n);
+
+    /* the same bundle with its box moved past the bound is refused on reading */
+    json_error_t je;
+    json_t *j = json_loadb(text, len, 0, &je);
+    assert_non_null(j);
+    json_t *box = json_object_get(json_array_get(json_object_get(j, "parts"), 0), "box");
+    json_array_set_new(box, 3, json_real(1.5e8));
+    char *bad = json_dumps(j, 0);
+    assert_int_equal(ag_part_bundle_read(bad, strlen(bad), &parts, &n, &err), AG_ERR_INVALID);
+    assert_non_null(strstr(err.text, "parts[0].box[3]"));
+    free(bad);
+    json_decref(j);
+    free(text);
+    ag_part_free(far);
+
+    /* past the bound, saving is refused before anything is written, naming the coordinate */
+    ag_part *beyond = moved(1.5e8);
+    text = NULL;
+    assert_int_equal(ag_part_validate(beyond, &err), AG_ERR_INVALID);
+    assert_int_equal(ag_part_bundle_write((const ag_part *const *)&beyond, 1, &text, &len, &err),
+                     AG_ERR_INVALID);
+    assert_null(text);
+    char want[64];
+    snprintf(want, sizeof want, "box: min x = %.15g m", P[0]->box.min[0] + 1.5e8);
+    if (!strstr(err.text, want) || !strstr(err.text, "beyond"))
+        fail_msg("%s (wanted '%s')", err.text, want);
+    ag_part_free(beyond);
+}
+
 static void test_absurd_sizes(void **state)
 {
     (void)state;
@@ -637,6 +703,7 @@ int main(void)
         cmocka_unit_test(test_bad_terminal_obj),
         cmocka_unit_test(test_cyclic_and_bad_names),
         cmocka_unit_test(test_absurd_sizes),
+        cmocka_unit_test(test_far_box_round_trips_or_is_refused),
         cmocka_unit_test(test_mutations),
         cmocka_unit_test(test_write_file_leaves_nothing),
         cmocka_unit_test(test_entry_text),

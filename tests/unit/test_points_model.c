@@ -324,6 +324,106 @@ static void test_paste_turns_to_the_target(void **state)
     ag_cloud_free(c);
 }
 
+/* The proxy label name of node n (its placement's terminal), "" for invisible nodes. */
+static const char *proxy_name(const ag_pointmodel *pm, int32_t n)
+{
+    const ag_tnode *x = &pm->em->proc->tree->nodes[n];
+    const ag_mesh *m = pm->em->proc->mesh;
+    if (x->kind != AG_NODE_COMPONENT || x->component < 0 || m->component_group[x->component] < 0)
+        return "";
+    return m->group_names[m->component_group[x->component]];
+}
+
+/* Every visible node of a but those `gone` (NULL: none) has its id in b, on the same box and
+ * placing the same terminal; returns how many. */
+static size_t ids_kept(const ag_pointmodel *a, const ag_pointmodel *b, const uint8_t *gone,
+                       const char *what)
+{
+    const ag_splittree *ta = a->em->proc->tree, *tb = b->em->proc->tree;
+    size_t kept = 0;
+    for (size_t n = 0; n < ta->nnodes; n++) {
+        if (ta->nodes[n].kind != AG_NODE_COMPONENT || (gone && gone[n]))
+            continue;
+        if (n >= tb->nnodes || tb->nodes[n].kind != AG_NODE_COMPONENT)
+            fail_msg("%s: node %zu (%s) lost its id", what, n, proxy_name(a, (int32_t)n));
+        for (int k = 0; k < 3; k++)
+            if (fabs(ta->nodes[n].box.min[k] - tb->nodes[n].box.min[k]) > 1e-6 ||
+                fabs(ta->nodes[n].box.max[k] - tb->nodes[n].box.max[k]) > 1e-6)
+                fail_msg("%s: node %zu names another box", what, n);
+        if (strcmp(proxy_name(a, (int32_t)n), proxy_name(b, (int32_t)n)))
+            fail_msg("%s: node %zu placed %s, now %s", what, n, proxy_name(a, (int32_t)n),
+                     proxy_name(b, (int32_t)n));
+        kept++;
+    }
+    return kept;
+}
+
+/* A point edit keeps the ids of the nodes it leaves alone (issue 14 §4), in its result and in
+ * the state the service keeps (read back through the grammar text): a window removed is dead,
+ * every other visible node has its id, box and terminal. */
+static void test_point_edits_keep_ids(void **state)
+{
+    (void)state;
+    ag_gen_building_options o = {.points = 60000, .width = 12, .depth = 8, .height = 7,
+                                 .ridge = -1, .cols = 3, .rows = 2, .seed = 43};
+    ag_cloud *c = building(&o);
+    ag_proceduralize_cloud_result *r = proceduralize(c);
+    ag_points_state st0 = {0};
+    ag_error e;
+    if (ag_points_state_make(r->model, &st0, &e) != AG_OK)
+        fail_msg("state: %s", e.text);
+    ag_pointmodel *pm = st0.pm; /* as the service holds it */
+    const ag_splittree *t = pm->em->proc->tree;
+    int32_t win = window_node(pm, 1, 1.2 + 0.2, 1.5 + 0.2);
+    assert_true(win > 0);
+    uint8_t *gone = calloc(t->nnodes, 1);
+    gone[win] = 1;
+    int32_t nodes[1] = {win};
+    ag_edit_op rm = {.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = nodes};
+    ag_pointmodel *out = NULL;
+    if (ag_pointedit_apply(pm, &rm, NULL, &out, NULL, &e) != AG_OK)
+        fail_msg("remove: %s", e.text);
+    size_t visible = 0;
+    for (size_t n = 0; n < t->nnodes; n++)
+        visible += t->nodes[n].kind == AG_NODE_COMPONENT;
+    ag_points_state st = {0};
+    if (ag_points_state_make(out, &st, &e) != AG_OK)
+        fail_msg("state after the remove: %s", e.text);
+    if (ag_pointedit_keep_ids(st.pm, pm, &rm, &e) != AG_OK)
+        fail_msg("keep ids: %s", e.text);
+    assert_int_equal(ids_kept(pm, st.pm, gone, "remove a window, read back"), visible - 1);
+    const ag_splittree *t1 = st.pm->em->proc->tree;
+    assert_true((size_t)win >= t1->nnodes || t1->nodes[win].kind != AG_NODE_COMPONENT);
+    /* and a second edit on the state so kept: another window removed */
+    int32_t win2 = window_node(st.pm, 1, 1.2 + 0.2, 1.5 + 0.2);
+    assert_true(win2 > 0 && win2 != win);
+    uint8_t *gone2 = calloc(t1->nnodes, 1);
+    gone2[win2] = 1;
+    nodes[0] = win2;
+    ag_pointmodel *out2 = NULL;
+    if (ag_pointedit_apply(st.pm, &rm, NULL, &out2, NULL, &e) != AG_OK)
+        fail_msg("second remove: %s", e.text);
+    ag_points_state st2 = {0};
+    if (ag_points_state_make(out2, &st2, &e) != AG_OK)
+        fail_msg("state after the second remove: %s", e.text);
+    if (ag_pointedit_keep_ids(st2.pm, st.pm, &rm, &e) != AG_OK)
+        fail_msg("keep ids: %s", e.text);
+    assert_int_equal(ids_kept(st.pm, st2.pm, gone2, "remove another window"), visible - 2);
+    gone[win2] = 1;
+    assert_int_equal(ids_kept(pm, st2.pm, gone, "both removes"), visible - 2);
+    /* what the state derives is the model less the two windows: its placements */
+    assert_int_equal(st2.pm->nplacements, pm->nplacements - 2);
+    ag_points_state_clear(&st2);
+    ag_pointmodel_free(out2);
+    free(gone2);
+    ag_points_state_clear(&st);
+    ag_pointmodel_free(out);
+    free(gone);
+    ag_points_state_clear(&st0);
+    ag_proceduralize_cloud_free(r);
+    ag_cloud_free(c);
+}
+
 static void test_bad_ops(void **state)
 {
     (void)state;
@@ -396,6 +496,7 @@ int main(void)
         cmocka_unit_test(test_proceduralize_and_read_back),
         cmocka_unit_test(test_resize_doubles_the_windows_at_the_density),
         cmocka_unit_test(test_paste_turns_to_the_target),
+        cmocka_unit_test(test_point_edits_keep_ids),
         cmocka_unit_test(test_bad_ops),
         cmocka_unit_test(test_hard_clouds),
     };

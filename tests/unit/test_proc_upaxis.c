@@ -29,16 +29,19 @@ static void test_generated_buildings(void **state)
 {
     (void)state;
     static const double shapes[3][3] = {{12, 9, 8}, {9, 8, 52}, {60, 30, 7}};
+    /* plan turns about up, degrees: aligned, and four azimuths in every quadrant's range */
+    static const double turns[] = {0, 23, 45, 107, 200};
+    const int nturns = (int)(sizeof turns / sizeof *turns);
     size_t n = 0, undecided = 0;
     for (int sh = 0; sh < 3; sh++)
         for (int roof = 0; roof < 3; roof++)
             for (int ground = 0; ground < 2; ground++)
-                for (int turn = 0; turn < 2; turn++)
+                for (int turn = 0; turn < nturns; turn++)
                     for (int frame = 0; frame < 3; frame++)
                         for (int yup = 0; yup < 2; yup++) {
                             building_spec s = {.w = shapes[sh][0], .d = shapes[sh][1],
                                                .h = shapes[sh][2], .roof = roof,
-                                               .ground = ground, .turn = turn ? 23 : 0,
+                                               .ground = ground, .turn = turns[turn],
                                                .frame = frame, .yup = yup,
                                                .window_depth = (n % 3) * 0.1 - 0.1};
                             for (int one = 0; one < 2; one++) {
@@ -49,11 +52,12 @@ static void test_generated_buildings(void **state)
                                 int ambiguous = roof == ROOF_FLAT && !ground && !turn &&
                                                 frame == FRAME_LOCAL;
                                 if (ev.axis != want && !(ambiguous && ev.axis == 0))
-                                    fail_msg("shape %d roof %s ground %d turn %d frame %s %s: "
+                                    fail_msg("shape %d roof %s ground %d turn %g frame %s %s: "
                                              "decided %d (score %.3f; y base %.3f vertical "
                                              "%.3f origin %.3f; z base %.3f vertical %.3f "
                                              "origin %.3f)",
-                                             sh, roof_name[roof], ground, turn, frame_name[frame],
+                                             sh, roof_name[roof], ground, turns[turn],
+                                             frame_name[frame],
                                              yup ? "y up" : "z up", ev.axis, ev.score,
                                              ev.cue[0].base, ev.cue[0].vertical, ev.cue[0].origin,
                                              ev.cue[1].base, ev.cue[1].vertical, ev.cue[1].origin);
@@ -209,7 +213,7 @@ static void test_real_buildings(void **state)
         const char *dir;
         ag_up_axis want;
     } sets[] = {{SHARED "/lod3_ingolstadt/obj", AG_UP_Z}, {SHARED "/meshes_0ad", AG_UP_Y}};
-    size_t n = 0, by_content = 0;
+    size_t n = 0, by_content = 0, turned = 0, wrong = 0;
     for (size_t k = 0; k < 2; k++) {
         DIR *d = opendir(sets[k].dir);
         if (!d) {
@@ -244,14 +248,37 @@ static void test_real_buildings(void **state)
                               e->d_name, dec.evidence.score);
             by_content += dec.basis == AG_UP_BY_CONTENT;
             n++;
+            /* the same building written the other way up (m is z up now): y-up Ingolstadt,
+             * z-up 0 A.D., decided by the content alone */
+            int want_other = sets[k].want == AG_UP_Z ? 1 : 2;
+            if (want_other == 1)
+                for (size_t v = 0; v < m->nverts; v++) {
+                    double y = m->pos[3 * v + 1];
+                    m->pos[3 * v + 1] = m->pos[3 * v + 2];
+                    m->pos[3 * v + 2] = -y;
+                }
+            ag_upaxis_evidence ev;
+            assert_int_equal(ag_upaxis_decide(m, &ev, NULL), AG_OK);
+            if (ev.axis != want_other && ++wrong)
+                print_message("WRONG: %s written %s up: decided %d (score %.3f; y base %.3f top %.3f "
+                         "vertical %.3f origin %.3f extent %.2f; z base %.3f top %.3f vertical "
+                         "%.3f origin %.3f extent %.2f)",
+                         e->d_name, want_other == 1 ? "y" : "z", ev.axis, ev.score,
+                         ev.cue[0].base, ev.cue[0].top, ev.cue[0].vertical, ev.cue[0].origin,
+                         ev.cue[0].extent, ev.cue[1].base, ev.cue[1].top, ev.cue[1].vertical,
+                         ev.cue[1].origin, ev.cue[1].extent);
+            turned++;
             ag_mesh_free(m);
             free(text);
         }
         closedir(d);
     }
-    print_message("real buildings: %zu, every one with its true up axis, %zu by the content\n", n,
-                  by_content);
+    print_message("real buildings: %zu, every one with its true up axis, %zu by the content; "
+                  "%zu written the other way up, every one decided right\n",
+                  n, by_content, turned);
     assert_true(n >= 49);
+    assert_int_equal(turned, n);
+    assert_int_equal(wrong, 0);
     assert_true(by_content + 2 >= n);
 }
 

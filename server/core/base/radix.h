@@ -30,6 +30,18 @@ static inline uint64_t ag_radix_key_double(double x)
     return u >> 63 ? ~u : u | (1ull << 63);
 }
 
+/* The key of a cell (x, y, z) of grid level `level`: the cell grids hash their cells so. */
+static inline uint64_t ag_radix_cell_key(int level, int64_t x, int64_t y, int64_t z)
+{
+    uint64_t h = (uint64_t)level * 0x9E3779B97F4A7C15ULL;
+    h ^= (uint64_t)x * 0xBF58476D1CE4E5B9ULL;
+    h = (h ^ (h >> 31)) * 0x94D049BB133111EBULL;
+    h ^= (uint64_t)y * 0xD6E8FEB86659FD93ULL;
+    h = (h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ULL;
+    h ^= (uint64_t)z * 0x94D049BB133111EBULL;
+    return h ^ (h >> 32);
+}
+
 /* Sorts a[0..n) by key, stably. Needs n records of scratch: AG_ERR_NOMEM when it cannot get
  * them (a is then unchanged). */
 ag_status ag_radix_sort(ag_radix_item *a, size_t n);

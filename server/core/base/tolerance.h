@@ -33,12 +33,14 @@
  * label and, by default, a terminal. 2e-4 of a 20 m building is 4 mm: near-exact copies a
  * person sees as one element (windows modelled by hand a few millimetres apart, or set into
  * facades a fraction of a degree apart) share a label; a window a centimetre larger does
- * not. The default is capped by AG_PROC_LABEL_TOLERANCE_MAX, so sharing a terminal never
- * moves a surface by more than that on large sites (fidelity reports what it did move). */
+ * not. The default is capped by AG_PROC_LABEL_TOLERANCE_MAX metres, in the model's unit
+ * (core/proc/units.h: a millimetre model's cap is 5 units), so sharing a terminal never moves
+ * a surface by more than that on large sites (fidelity reports what it did move). */
 #define AG_PROC_LABEL_TOLERANCE 2e-4
 #define AG_PROC_LABEL_TOLERANCE_MAX 0.005
 /* Label: copies whose orientations about the up axis differ (beyond quarter turns) share a
- * label when that turn moves their plan corners by at most this (metres): a facade a degree
+ * label when that turn moves their plan corners by at most this (metres, in the model's unit
+ * as the cap above): a facade a degree
  * or two off square holds the same windows; a window on a facade turned further is set
  * otherwise and labelled apart (no terminal could serve both anyway). */
 #define AG_PROC_LABEL_TURN_MOVE 0.02
@@ -240,6 +242,11 @@
 #define AG_VERIFY_MITRE 2.5
 /* ... plus this fraction of the plan's size (and its point tolerance) of slack. */
 #define AG_VERIFY_REACH_REL 1e-6
+/* How far behind a face the building check probes its winding, relative to the
+ * building's size. Validation removes spikes no wider than this: the probe of a wall
+ * would lie beyond the spike's other wall, and the shell welds the corners of narrower
+ * ones (delta1 apart) into one edge used twice. */
+#define AG_VERIFY_WINDING_PROBE 1e-7
 
 /* A face whose Newell normal (twice its area, m²) is shorter than this has no area and
  * is not triangulated. */

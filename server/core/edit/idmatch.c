@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "rebuild.h"
 
 static ag_status nomem(ag_error *err)
@@ -84,34 +85,127 @@ static double match_tolerance(const ag_proceduralize_result *r)
     return 2 * tol;
 }
 
-/* The nearest old node of a fresh node's kind and label within the tolerance, among the
- * candidates offered to it one by one. */
+/* A fresh node and an old node it may take the id of. */
 typedef struct {
-    const ag_splittree *O;
-    const ag_proceduralize_result *old;
-    const uint8_t *taken;
-    const ag_tnode *x;
-    const char *name;
-    int32_t best;
-    double bd;
-} nearest;
+    int32_t f, o;
+    uint8_t shape;  /* 1: their components have as many triangles (one terminal's) */
+    uint8_t holder; /* 1: the old node's holder is what the fresh node's holder matched */
+    double d;       /* box_distance */
+    double overlap; /* their boxes' common volume over the larger volume */
+} candidate;
 
-static nearest nearest_start(const ag_proceduralize_result *old, const uint8_t *taken,
-                             const ag_tnode *x, const char *name, double tol)
+/* The more alike first: the same terminal, the nearer box, the larger overlap, held by the
+ * match of the fresh node's holder; then the old id, then the fresh node, so that ties
+ * (boxes that coincide) are decided the same way whatever order either tree lists them in. */
+static int by_likeness(const void *pa, const void *pb)
 {
-    return (nearest){old->tree, old, taken, x, name, -1, tol};
+    const candidate *a = pa, *b = pb;
+    if (a->shape != b->shape)
+        return a->shape > b->shape ? -1 : 1;
+    if (a->d != b->d)
+        return a->d < b->d ? -1 : 1;
+    if (a->overlap != b->overlap)
+        return a->overlap > b->overlap ? -1 : 1;
+    if (a->holder != b->holder)
+        return a->holder > b->holder ? -1 : 1;
+    if (a->o != b->o)
+        return a->o < b->o ? -1 : 1;
+    return (a->f > b->f) - (a->f < b->f);
 }
 
-static void nearest_offer(nearest *s, int32_t o)
+static double overlap_share(const ag_box *a, const ag_box *b)
 {
-    const ag_tnode *y = &s->O->nodes[o];
-    if (s->taken[o] || y->kind != s->x->kind || strcmp(name_of(s->old, y), s->name))
+    double v = 1;
+    for (int k = 0; k < 3; k++)
+        v *= fmax(0, fmin(a->max[k], b->max[k]) - fmax(a->min[k], b->min[k]));
+    double big = fmax(ag_box_volume(a), ag_box_volume(b));
+    return big > 0 ? v / big : 1;
+}
+
+/* The candidates of one round of matching, and what both trees are. */
+typedef struct {
+    const ag_proceduralize_result *old, *fresh;
+    double tol;
+    int32_t *f2o;
+    uint8_t *taken;
+    candidate *c;
+    size_t n, cap;
+} rounds;
+
+/* The mean of a component's triangle corners, from its box's lower corner (0 when it has
+ * none): with its triangle count, what tells two terminals on one box apart (a window and its
+ * mirror image, a pane and the wall it fills). */
+static void corner_mean(const ag_proceduralize_result *r, const ag_tnode *x, double out[3])
+{
+    const ag_labels *L = r->labels;
+    const ag_mesh *m = r->mesh;
+    out[0] = out[1] = out[2] = 0;
+    if (!L || x->component < 0 || (size_t)x->component >= L->ncomponents)
         return;
-    double d = box_distance(&s->x->box, &y->box);
-    if (d <= s->bd) {
-        s->bd = d;
-        s->best = o;
+    uint32_t a = L->tri_start[x->component], b = L->tri_start[x->component + 1];
+    for (uint32_t i = a; i < b; i++)
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 3; k++)
+                out[k] += m->pos[3 * m->tri[3 * L->tris[i] + c] + k];
+    for (int k = 0; k < 3 && b > a; k++)
+        out[k] = out[k] / (3.0 * (b - a)) - x->box.min[k];
+}
+
+/* Do old node y and fresh node x place one terminal (the same triangle count, the same
+ * corner mean within tol)? */
+static int same_shape(const rounds *R, const ag_tnode *x, const ag_tnode *y)
+{
+    const ag_labels *FL = R->fresh->labels, *OL = R->old->labels;
+    if (x->component < 0 || y->component < 0 || (size_t)x->component >= FL->ncomponents ||
+        (size_t)y->component >= OL->ncomponents)
+        return x->component < 0 && y->component < 0;
+    if (FL->ntris[x->component] != OL->ntris[y->component])
+        return 0;
+    double p[3], q[3];
+    corner_mean(R->fresh, x, p);
+    corner_mean(R->old, y, q);
+    return fabs(p[0] - q[0]) <= R->tol && fabs(p[1] - q[1]) <= R->tol &&
+           fabs(p[2] - q[2]) <= R->tol;
+}
+
+/* Old node o for fresh node f, when it is free, of f's kind and label name, on f's box (and
+ * of its shape when `shaped`). */
+static ag_status offer(rounds *R, int32_t f, int32_t o, int shaped)
+{
+    const ag_splittree *O = R->old->tree, *F = R->fresh->tree;
+    const ag_tnode *x = &F->nodes[f], *y = &O->nodes[o];
+    if (R->taken[o] || y->kind != x->kind || strcmp(name_of(R->old, y), name_of(R->fresh, x)))
+        return AG_OK;
+    double d = box_distance(&x->box, &y->box);
+    if (!(d <= R->tol))
+        return AG_OK;
+    int shape = same_shape(R, x, y);
+    if (shaped && !shape)
+        return AG_OK;
+    if (AG_ARRAY_RESERVE(R->c, R->cap, R->n + 1))
+        return AG_ERR_NOMEM;
+    int32_t hf = holder(F, f), ho = holder(O, o);
+    R->c[R->n++] = (candidate){f,
+                               o,
+                               (uint8_t)shape,
+                               hf >= 0 && R->f2o[hf] >= 0 ? R->f2o[hf] == ho : hf < 0 && ho < 0,
+                               d,
+                               overlap_share(&x->box, &y->box)};
+    return AG_OK;
+}
+
+/* The round's candidates taken best first, each node once. */
+static void settle(rounds *R)
+{
+    qsort(R->c, R->n, sizeof *R->c, by_likeness);
+    for (size_t i = 0; i < R->n; i++) {
+        const candidate *c = &R->c[i];
+        if (R->f2o[c->f] < 0 && !R->taken[c->o]) {
+            R->f2o[c->f] = c->o;
+            R->taken[c->o] = 1;
+        }
     }
+    R->n = 0;
 }
 
 /* The holder an old node is bucketed under, or -1 when it may not be matched. */
@@ -120,20 +214,24 @@ static int32_t bucket_of(const ag_splittree *O, const uint8_t *changed, size_t n
     return matchable(&O->nodes[n]) && !(changed && changed[n]) ? holder(O, (int32_t)n) : -1;
 }
 
-/* f2o: per fresh node, the old node it matches (-1). */
+/* f2o: per fresh node, the old node it matches (-1). Every choice is made among all the
+ * candidates of a round at once (rounds.settle), never by the order nodes come in. */
 static ag_status match(const ag_proceduralize_result *old, const ag_proceduralize_result *fresh,
                        const uint8_t *changed, int32_t *f2o)
 {
     const ag_splittree *O = old->tree, *F = fresh->tree;
     size_t no = O->nnodes, nf = F->nnodes;
-    double tol = fmax(match_tolerance(old), match_tolerance(fresh));
     /* old nodes that may be matched, bucketed by their holder */
     uint32_t *start = calloc(no + 2, sizeof *start);
     int32_t *list = malloc((no + 1) * sizeof *list);
     int32_t *queue = malloc((nf + 1) * sizeof *queue);
+    uint32_t *depth = calloc(nf + 1, sizeof *depth);
     uint8_t *taken = calloc(no + 1, 1);
+    keyed *k = NULL;
+    rounds R = {old, fresh, fmax(match_tolerance(old), match_tolerance(fresh)), f2o, taken,
+                NULL, 0, 0};
     ag_status st = AG_OK;
-    if (!start || !list || !queue || !taken) {
+    if (!start || !list || !queue || !depth || !taken) {
         st = AG_ERR_NOMEM;
         goto done;
     }
@@ -161,31 +259,37 @@ static ag_status match(const ag_proceduralize_result *old, const ag_proceduraliz
         goto done;
     f2o[0] = 0;
     taken[0] = 1;
-    /* top-down, so a node's holder is matched (or not) before it */
+    /* breadth first, one round per depth, so a node's holder is matched (or not) before it;
+     * of the same shape only, since which of two coincident boxes holds the other depends on
+     * the order they came in (the other shapes wait for the round below) */
     size_t qh = 0, qt = 0;
     queue[qt++] = 0;
     while (qh < qt) {
-        int32_t f = queue[qh++];
-        for (int32_t c = F->nodes[f].first_child; c >= 0 && qt < nf; c = F->nodes[c].next_sibling)
-            queue[qt++] = c;
-        const ag_tnode *x = &F->nodes[f];
-        if (f == 0 || !matchable(x))
-            continue;
-        int32_t h = holder(F, f);
-        if (h < 0 || f2o[h] < 0)
-            continue;
-        nearest near = nearest_start(old, taken, x, name_of(fresh, x), tol);
-        for (uint32_t i = start[f2o[h]]; i < start[f2o[h] + 1]; i++)
-            nearest_offer(&near, list[i]);
-        if (near.best >= 0) {
-            f2o[f] = near.best;
-            taken[near.best] = 1;
+        size_t level = qh;
+        for (; qh < qt && depth[queue[qh]] == depth[queue[level]]; qh++) {
+            int32_t f = queue[qh];
+            for (int32_t c = F->nodes[f].first_child; c >= 0 && qt < nf;
+                 c = F->nodes[c].next_sibling) {
+                depth[c] = depth[f] + 1;
+                queue[qt++] = c;
+            }
+            const ag_tnode *x = &F->nodes[f];
+            if (f == 0 || !matchable(x))
+                continue;
+            int32_t h = holder(F, f);
+            if (h < 0 || f2o[h] < 0)
+                continue;
+            for (uint32_t i = start[f2o[h]]; i < start[f2o[h] + 1] && !st; i++)
+                st = offer(&R, f, list[i], 1);
         }
+        if (st)
+            goto done;
+        settle(&R);
     }
     /* a node whose holder is new (nested in a node the change made, such as a joined one)
-     * or held otherwise now: the same label on the same box anywhere, nearest first */
+     * or held otherwise now: the same label on the same box anywhere, in one round */
     size_t nl = 0;
-    keyed *k = malloc((no + 1) * sizeof *k);
+    k = malloc((no + 1) * sizeof *k);
     if (!k) {
         st = AG_ERR_NOMEM;
         goto done;
@@ -194,21 +298,18 @@ static ag_status match(const ag_proceduralize_result *old, const ag_proceduraliz
         if (!taken[n] && matchable(&O->nodes[n]) && !(changed && changed[n]))
             k[nl++] = (keyed){O->nodes[n].box.min[0], (int32_t)n};
     qsort(k, nl, sizeof *k, by_x);
-    for (size_t q = 0; q < qt; q++) {
+    for (size_t q = 0; q < qt && !st; q++) {
         int32_t f = queue[q];
         const ag_tnode *x = &F->nodes[f];
         if (f == 0 || f2o[f] >= 0 || !matchable(x))
             continue;
-        nearest near = nearest_start(old, taken, x, name_of(fresh, x), tol);
-        for (size_t i = first_at_or_above(k, nl, x->box.min[0] - tol);
-             i < nl && k[i].x <= x->box.min[0] + tol; i++)
-            nearest_offer(&near, k[i].n);
-        if (near.best >= 0) {
-            f2o[f] = near.best;
-            taken[near.best] = 1;
-        }
+        for (size_t i = first_at_or_above(k, nl, x->box.min[0] - R.tol);
+             i < nl && k[i].x <= x->box.min[0] + R.tol && !st; i++)
+            st = offer(&R, f, k[i].n, 0);
     }
-    free(k);
+    if (st)
+        goto done;
+    settle(&R);
     /* an intermediate split node follows the chain end below it */
     for (size_t f = 1; f < nf; f++) {
         const ag_tnode *x = &F->nodes[f];
@@ -222,9 +323,12 @@ static ag_status match(const ag_proceduralize_result *old, const ag_proceduraliz
         }
     }
 done:
+    free(k);
+    free(R.c);
     free(start);
     free(list);
     free(queue);
+    free(depth);
     free(taken);
     return st;
 }

@@ -9,7 +9,13 @@
  * visible ancestor, or the root) matched; an intermediate split node follows the chain end it
  * leads to. A node nothing matched so (nested now in a node the change made, a joined one)
  * then takes the old node of the same kind and label name on the same box anywhere, the
- * nearest. Old nodes marked `changed` (what the change removed or replaced) are never
+ * nearest. Each of those steps weighs all its candidates at once, the more alike first: the
+ * same terminal (triangle count and where its triangles lie in the box: a window and its
+ * mirror image on one box are told apart), the nearer box, the larger overlap, held by the
+ * match of the new node's holder, then the old id; so boxes that coincide are assigned the
+ * same way whatever order either tree lists them in. Under the holder only nodes of the same
+ * terminal match (which of two coincident boxes holds the other depends on that order).
+ * Old nodes marked `changed` (what the change removed or replaced) are never
  * matched. New nodes nothing matched are appended after every old id, old nodes
  * nothing matched are dead, so an id never names another node than it did. The renumbered
  * tree is rebuilt from the new model (rebuild.h): the same components, labels and geometry,

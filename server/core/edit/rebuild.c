@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "../base/tolerance.h"
+#include "../proc/adjacency.h"
 #include "resize.h"
 
 static ag_status nomem(ag_error *err)
@@ -420,7 +421,7 @@ static ag_status finish(ag_mesh *mesh, ag_labels *L, ag_splittree *t, int with_r
     if (!st)
         st = labels_complete(L, mesh, t);
     if (!st)
-        st = ag_splittree_adjacency(t);
+        st = ag_splittree_adjacency_update(t, NULL); /* only the changed nodes' pairs found again */
     if (st) {
         st = nomem(err);
         goto fail;
@@ -504,6 +505,7 @@ ag_status ag_rebuild(const ag_proceduralize_result *in, ag_splittree *t, int32_t
         memcpy(L->variant_deviation, OL->variant_deviation,
                OL->nvariants * sizeof *L->variant_deviation);
     L->exact_copies = OL->exact_copies;
+    L->units = OL->units; /* a resize changes sizes, not the unit */
     /* tolerances follow the model's size */
     double od = ag_box_diagonal(&ot->nodes[0].box), nd = ag_box_diagonal(&t->nodes[0].box);
     double scale = od > 0 && nd > 0 ? nd / od : 1;

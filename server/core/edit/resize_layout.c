@@ -16,7 +16,8 @@
  *                    count keep their size, cells of the same count their share of the new
  *                    box, except along an axis that is thin for them (they keep their size
  *                    and are spaced out); patterns of one parent whose lattices
- *                    interleave (the pieces of composite windows) share one lattice; new cells
+ *                    interleave (the pieces of composite windows, windows alternating with
+ *                    their mirror images) share one lattice, placed as one; new cells
  *                    copy the cell at their place in the old grid, cells no new cell copies go
  *
  * A node of the copy keeps its index (its id); copies are appended, removed nodes become
@@ -544,6 +545,7 @@ done:
 /* A grid pattern's layout along one axis. */
 typedef struct {
     uint32_t n, k;   /* old and new count */
+    uint32_t kset;   /* the new count of the set it leads (lattice_set) */
     double p, pn;    /* old and new period */
     double w, wn;    /* old and new cell size */
     double o, on;    /* old and new min of the first cell */
@@ -556,19 +558,55 @@ typedef struct {
     int grid;              /* a complete axis-aligned grid: laid out by periods */
     axis_layout ax[3];
     ag__resize_map map;    /* otherwise: its cells follow this map */
+    ag_box nb;             /* its new box */
+    ag_box cont;           /* what holds it (its holder's box, grown to hold nb) */
+    int thin[3];           /* its cells are thin along the axis */
 } pattern_layout;
 
+/* Along one axis, the patterns that share a lattice laid out by the first of them (the
+ * pieces of composite windows, windows and their mirror images alternating): where the
+ * count changes they are placed as one, so that the set stays centred and inside what holds
+ * it (each pattern alone is off-centre by its offset in the set). */
+#define LATTICE_SET_MAX 8
+typedef struct {
+    ag_box nb;     /* the union of their new boxes */
+    ag_box cont;   /* the union of what holds them */
+    double lo, hi; /* the lowest and highest old min of their first cells */
+    uint32_t cells; /* of all members along the axis */
+    size_t m, rank; /* members; the rank of the pattern being laid out (by first cell) */
+    /* alternating: members whose cells lie apart and take turns (a window, its mirror
+     * image, the window again: 3 and 2 cells), counted as one sequence of cells; d: the
+     * members' offsets from lo by rank */
+    int alternating;
+    double d[LATTICE_SET_MAX];
+} lattice_set;
+
+/* Cells of the member of rank q when an alternating set holds `cells` cells in all. */
+static uint32_t member_cells(const lattice_set *set, uint32_t cells, size_t q)
+{
+    return (uint32_t)((cells - q + set->m - 1) / set->m);
+}
+
+/* The extent of an alternating set of `cells` cells at period pn, cells w long. */
+static double set_span(const lattice_set *set, uint32_t cells, double pn, double w)
+{
+    return (double)((cells - 1) / set->m) * pn + set->d[(cells - 1) % set->m] + w;
+}
+
 /* Along axis a, the pattern's new count and period from its stretch f, unless a reference
- * pattern ref (interleaved with it, same count, period and stretch) fixes them. */
-static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const ag_box *cont,
+ * pattern ref (interleaved with it: the same period and stretch) fixes them; set: the
+ * patterns it is the reference of, itself included. An alternating set is counted as one
+ * sequence of cells (kset), which its members take turns in. */
+static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const lattice_set *set,
                         int a, int thin, const axis_layout *ref)
 {
-    uint32_t k = x->n;
+    int alt = set->alternating;
+    uint32_t n = alt ? set->cells : x->n, k = n;
     if (ref) {
-        k = ref->k;
+        k = ref->kset;
     } else if (L->structural && !thin) { /* thin elements are spaced out, never added */
         for (int it = 0; it < PATTERN_MAX_STEPS; it++) {
-            double r = x->f * x->n / k;
+            double r = x->f * n / k;
             if (r > L->s->split_ratio && k < PATTERN_MAX_COUNT)
                 k *= 2;
             else if (r < L->s->join_ratio && k > 1)
@@ -577,8 +615,12 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const ag
                 break;
         }
     }
-    x->k = k;
-    if (ref && ref->k != ref->n) { /* cells of a new count keep their size and offset */
+    int changed = k != n;
+    if (alt && k < set->m)
+        k = (uint32_t)set->m; /* every member keeps a cell */
+    x->kset = k;
+    x->k = alt ? member_cells(set, k, set->rank) : k;
+    if (ref && changed) { /* cells of a new count keep their size and offset */
         x->pn = ref->pn;
         x->wn = x->w;
         x->on = ref->on + (x->o - ref->o);
@@ -586,37 +628,47 @@ static void layout_axis(const lay *L, axis_layout *x, const ag_box *nb, const ag
         x->pn = ref->pn;
         x->wn = thin ? x->w : x->w * x->pn / x->p;
         x->on = ref->on + (x->o - ref->o) * x->pn / x->p;
-    } else if (k == x->n) {
+    } else if (!changed) {
         /* the count stays: the cells span the pattern's new box (thin ones spaced out) */
         x->wn = thin ? x->w : x->w * x->f;
-        x->pn = (ag_box_extent(nb, a) - x->wn) / (k - 1);
+        x->pn = (ag_box_extent(nb, a) - x->wn) / (x->k - 1);
         x->on = nb->min[a];
     } else {
         /* the pattern's length in periods; the cells keep their size (a facade stretched 2x
          * holds twice the windows at the original size and spacing, 1.9x slightly closer) */
-        x->pn = x->f * x->n * x->p / k;
+        x->pn = x->f * n * x->p / k;
         x->wn = x->w;
         /* k periods span one spacing more than the stretched cells did: the cells stay inside
          * what holds the pattern, one fewer when they would not fit (a facade of 6 windows
          * stretched twice as long with less than half a spacing at its ends holds 11) */
-        double room = ag_box_extent(cont, a) + L->eps;
-        while (k > 1 && (k - 1) * x->pn + x->wn > room)
-            k--;
-        x->k = k;
-        double span = (k - 1) * x->pn + x->wn;
-        x->on = ag_box_centre_axis(nb, a) - 0.5 * span;
-        if (x->on + span > cont->max[a])
-            x->on = cont->max[a] - span;
-        if (x->on < cont->min[a])
-            x->on = cont->min[a];
+        const ag_box *cont = &set->cont;
+        double room = ag_box_extent(cont, a) + L->eps, spread = set->hi - set->lo, span;
+        if (alt) {
+            while (k > set->m && set_span(set, k, x->pn, x->wn) > room)
+                k--;
+            span = set_span(set, k, x->pn, x->wn);
+        } else {
+            while (k > 1 && (k - 1) * x->pn + x->wn + spread > room)
+                k--;
+            span = (k - 1) * x->pn + x->wn + spread;
+        }
+        x->kset = k;
+        x->k = alt ? member_cells(set, k, set->rank) : k;
+        double lo = ag_box_centre_axis(&set->nb, a) - 0.5 * span;
+        if (lo + span > cont->max[a])
+            lo = cont->max[a] - span;
+        if (lo < cont->min[a])
+            lo = cont->min[a];
+        x->on = lo + (x->o - set->lo);
     }
 }
 
-/* Do two patterns' lattices interleave along an axis (same count, period and stretch, first
- * cells less than a period apart)? */
+/* Do two patterns' lattices interleave along an axis (counts at most one apart, the same
+ * period and stretch, first cells less than a period apart)? */
 static int interleaved(const axis_layout *x, const axis_layout *y, double tol)
 {
-    return x->lattice && y->lattice && x->n == y->n && fabs(x->p - y->p) <= tol &&
+    return x->lattice && y->lattice && x->n + 1 >= y->n && y->n + 1 >= x->n &&
+           fabs(x->p - y->p) <= tol &&
            fabs(x->f - y->f) <= 1e-9 * fmax(1, fabs(x->f)) && fabs(x->o - y->o) < x->p - tol;
 }
 
@@ -809,6 +861,69 @@ static void place_cells(lay *L, const pattern_layout *pl, int depth)
     free(cells);
 }
 
+/* The pattern whose lattice pattern i follows along axis a: the first earlier one
+ * interleaved with it, followed to the one that follows none; i itself when none. */
+static size_t lattice_root(const pattern_layout *pl, size_t i, int a, double tol)
+{
+    for (size_t j = 0; j < i; j++)
+        if (pl[j].grid && pl[j].ax[a].lattice && interleaved(&pl[j].ax[a], &pl[i].ax[a], tol))
+            return lattice_root(pl, j, a, tol);
+    return i;
+}
+
+static int member_of(const pattern_layout *pl, size_t j, size_t r, int a, double tol)
+{
+    return j == r || (pl[j].grid && pl[j].ax[a].lattice && lattice_root(pl, j, a, tol) == r);
+}
+
+/* The set of patterns that follow pattern r's lattice along axis a, as pattern i sees it.
+ * Members whose cells lie apart (each in its own place in the period: windows and their
+ * mirror images) alternate when the member of rank q holds ceil((cells - q) / m) cells; a
+ * set whose counts differ and do not alternate gives *ok = 0 (each pattern goes alone). */
+static lattice_set lattice_set_of(const pattern_layout *pl, size_t n, size_t r, size_t i,
+                                  int a, double tol, int *ok)
+{
+    lattice_set set = {.nb = pl[r].nb, .cont = pl[r].cont, .lo = pl[r].ax[a].o,
+                       .hi = pl[r].ax[a].o};
+    int differ = 0;
+    double w = 0;
+    for (size_t j = r; j < n; j++) {
+        if (!member_of(pl, j, r, a, tol))
+            continue;
+        ag_box_extend_box(&set.nb, &pl[j].nb);
+        ag_box_extend_box(&set.cont, &pl[j].cont);
+        set.lo = fmin(set.lo, pl[j].ax[a].o);
+        set.hi = fmax(set.hi, pl[j].ax[a].o);
+        set.cells += pl[j].ax[a].n;
+        differ |= pl[j].ax[a].n != pl[r].ax[a].n;
+        w = fmax(w, pl[j].ax[a].w);
+        set.m++;
+    }
+    *ok = !differ;
+    if (set.m < 2 || set.m > LATTICE_SET_MAX)
+        return set;
+    int apart = 1, regular = 1;
+    for (size_t j = r; j < n; j++) {
+        if (!member_of(pl, j, r, a, tol))
+            continue;
+        size_t q = 0; /* its rank: the members whose first cell comes before */
+        for (size_t h = r; h < n; h++)
+            q += h != j && member_of(pl, h, r, a, tol) &&
+                 (pl[h].ax[a].o < pl[j].ax[a].o || (pl[h].ax[a].o == pl[j].ax[a].o && h < j));
+        set.d[q] = pl[j].ax[a].o - set.lo;
+        regular = regular && pl[j].ax[a].n == member_cells(&set, set.cells, q);
+        if (j == i)
+            set.rank = q;
+    }
+    for (size_t q = 0; q < set.m; q++) {
+        double next = q + 1 < set.m ? set.d[q + 1] : pl[r].ax[a].p;
+        apart = apart && next - set.d[q] >= w - tol;
+    }
+    set.alternating = apart && regular;
+    *ok = *ok || set.alternating;
+    return set;
+}
+
 static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
 {
     ag_splittree *t = L->nt;
@@ -818,12 +933,14 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
         return;
     }
     double tol = t->tol > 0 ? t->tol : L->eps;
+    /* each pattern's old lattice, new box and holder */
     for (size_t i = 0; i < n; i++) {
         int32_t P = pats[i];
         pattern_layout *x = &pl[i];
         x->node = P;
         ag_box ob = oldb(L, P), nb = t->nodes[P].box;
         x->map = ag__resize_map_between(&ob, &nb);
+        x->nb = nb;
         const ag_tnode *pn = &t->nodes[P];
         const ag_pattern *pp = pn->pattern >= 0 && (size_t)pn->pattern < t->npatterns
                                    ? &t->patterns[pn->pattern]
@@ -841,10 +958,8 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
         while (holder > 0 && t->nodes[holder].kind != AG_NODE_COMPONENT)
             holder = t->nodes[holder].parent;
         ag_box cont = holder >= 0 ? t->nodes[holder].box : nb;
-        for (int a = 0; a < 3; a++) { /* a pattern already past its holder keeps its own box */
-            cont.min[a] = fmin(cont.min[a], nb.min[a]);
-            cont.max[a] = fmax(cont.max[a], nb.max[a]);
-        }
+        ag_box_extend_box(&cont, &nb); /* a pattern already past its holder keeps its own box */
+        x->cont = cont;
         ag_box cb = oldb(L, first);
         double e[3], emax = 0;
         ag_box_extents(&cb, e);
@@ -856,21 +971,33 @@ static void layout_patterns(lay *L, const int32_t *pats, size_t n, int depth)
             ax->k = ax->n;
             ax->w = e[a];
             ax->o = cb.min[a];
+            x->thin[a] = e[a] < L->s->thin_ratio * emax;
             double span = ag_box_extent(&ob, a);
             ax->lattice = ax->n >= 2 && span > AG_EDIT_FLAT;
             if (!ax->lattice)
                 continue;
             ax->p = (span - ax->w) / (ax->n - 1);
             ax->f = x->map.s[a];
-            if (!(ax->p > AG_EDIT_FLAT) || !(ax->f > AG_EDIT_MIN_RATIO) || !isfinite(ax->f)) {
+            if (!(ax->p > AG_EDIT_FLAT) || !(ax->f > AG_EDIT_MIN_RATIO) || !isfinite(ax->f))
                 ax->lattice = 0;
+        }
+    }
+    /* the new lattices, a shared one from the pattern that leads it */
+    for (size_t i = 0; i < n; i++) {
+        if (!pl[i].grid)
+            continue;
+        for (int a = 0; a < 3; a++) {
+            axis_layout *ax = &pl[i].ax[a];
+            if (!ax->lattice)
                 continue;
+            size_t r = lattice_root(pl, i, a, tol);
+            int ok;
+            lattice_set set = lattice_set_of(pl, n, r, i, a, tol, &ok);
+            if (!ok) { /* counts that differ and do not alternate: alone */
+                r = i;
+                set = (lattice_set){.nb = pl[i].nb, .cont = pl[i].cont, .lo = ax->o, .hi = ax->o};
             }
-            const axis_layout *ref = NULL;
-            for (size_t j = 0; j < i && !ref; j++)
-                if (pl[j].grid && interleaved(&pl[j].ax[a], ax, tol))
-                    ref = &pl[j].ax[a];
-            layout_axis(L, ax, &nb, &cont, a, e[a] < L->s->thin_ratio * emax, ref);
+            layout_axis(L, ax, &pl[i].nb, &set, a, pl[i].thin[a], r < i ? &pl[r].ax[a] : NULL);
         }
     }
     for (size_t i = 0; i < n && !L->st; i++)

@@ -395,8 +395,11 @@ static void add_fix(ag_plan_fixes *f, ag_plan_fix_kind kind, long loop, long cor
 }
 
 /* Removes duplicate, collinear and spike corners of one loop; `orig` maps the kept
- * corners back to input indices for the messages. */
-static void clean_loop(ag_plan_loop *l, long li, long *orig, double d2, ag_plan_fixes *fx)
+ * corners back to input indices for the messages. A spike is removed while it is no wider
+ * than `narrow` (AG_VERIFY_WINDING_PROBE): its two walls could neither stay apart in the
+ * shell nor be told apart by the building check. */
+static void clean_loop(ag_plan_loop *l, long li, long *orig, double d2, double narrow,
+                       ag_plan_fixes *fx)
 {
     int changed = 1;
     while (changed && l->n >= 3) {
@@ -415,7 +418,7 @@ static void clean_loop(ag_plan_loop *l, long li, long *orig, double d2, ag_plan_
                 double cr = abx * bcy - aby * bcx, dt = abx * bcx + aby * bcy;
                 /* distance of b from the line ac, relative to the shorter edge */
                 double h = fabs(cr) / (lab > lbc ? lab : lbc);
-                if (h <= d2 && dt < 0) {
+                if (h <= narrow && dt < 0) {
                     kind = AG_PLAN_FIX_SPIKE;
                     why = "spike (the boundary turns back on itself) removed";
                 } else if (h <= d2 && l->profile[pi] == l->profile[i]) {
@@ -795,7 +798,8 @@ ag_status ag_plan_validate(ag_plan *p, ag_plan_fixes *fixes, double *extent, ag_
     if (extent)
         *extent = ext;
     double mag = fmax(fmax(fabs(lo[0]), fabs(hi[0])), fmax(fabs(lo[1]), fabs(hi[1])));
-    double d2 = ag_extrude_tolerances(ext, mag).point;
+    ag_extrude_tol tol = ag_extrude_tolerances(ext, mag);
+    double d2 = tol.point;
 
     long **orig = calloc(p->nloops, sizeof *orig);
     long *oloop = malloc((p->nloops ? p->nloops : 1) * sizeof *oloop);
@@ -816,7 +820,7 @@ ag_status ag_plan_validate(ag_plan *p, ag_plan_fixes *fixes, double *extent, ag_
         }
         for (size_t j = 0; j < l->n; j++)
             orig[i][j] = (long)j;
-        clean_loop(l, (long)i, orig[i], d2, fixes);
+        clean_loop(l, (long)i, orig[i], d2, AG_VERIFY_WINDING_PROBE * tol.size + d2, fixes);
         if (l->n < 3 || fabs(ag_plan_loop_area(l)) <= d2 * ext) {
             /* a loop without area that crosses itself is a bow tie, not nothing */
             if (l->n >= 3 && (st = check_crossings(p, orig, oloop, (long)i, err)) != AG_OK)

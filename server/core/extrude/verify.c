@@ -231,8 +231,6 @@ static int within(const ag_plan *plan, double x, double y, double allowed, doubl
  * grid-aligned roof exactly; a probe counts as overlapping only when two rays of
  * different leans agree, so a graze within rounding of an edge cannot make a defect. */
 
-/* How far behind a face its probe lies, relative to the building's size. */
-#define AG_VERIFY_WINDING_PROBE 1e-7
 /* Faces whose inscribed circle is so small that the probe would lie closer than this
  * (relative to the building's size) are slivers with no inside to probe. */
 #define AG_VERIFY_WINDING_THIN 1e-10
@@ -425,6 +423,17 @@ static long winding_along(const vtri *T, vgrid *g, const double *q, double dx, d
     return w;
 }
 
+/* The winding number at q, `eps` behind the middle of face f (normal nrm of length len),
+ * along two rays of different leans; 1 when they disagree (a graze within rounding). */
+static long probe_winding(const vtri *T, vgrid *g, const vtri *f, const double *nrm,
+                          double len, double eps, double *q)
+{
+    for (int d = 0; d < 3; d++)
+        q[d] = f->a[d] + 0.3311 * f->e1[d] + 0.3552 * f->e2[d] - eps * nrm[d] / len;
+    long w = winding_along(T, g, q, 0.0123456789, 0.00713286);
+    return w != 1 && winding_along(T, g, q, -0.00871234, 0.0151112) == w ? w : 1;
+}
+
 /* 1 when the shell winds once just inside each of its faces; else 0 with why. */
 static int winds_once(const ag_mesh *m, size_t t0, size_t t1, double tol, double size,
                       char *why, size_t nwhy)
@@ -482,10 +491,14 @@ static int winds_once(const ag_mesh *m, size_t t0, size_t t1, double tol, double
         if (!(eps > AG_VERIFY_WINDING_THIN * size))
             continue; /* a sliver too thin to probe */
         double q[3];
-        for (int d = 0; d < 3; d++)
-            q[d] = f->a[d] + 0.3311 * f->e1[d] + 0.3552 * f->e2[d] - eps * nrm[d] / len;
-        long w = winding_along(T, &g, q, 0.0123456789, 0.00713286);
-        if (w != 1 && winding_along(T, &g, q, -0.00871234, 0.0151112) == w) {
+        long w = probe_winding(T, &g, f, nrm, len, eps, q);
+        /* a wedge thinner than the probe (a spike a few micrometres wide near its tip)
+         * puts the probe beyond its other wall: probed again much closer, an overlap still
+         * winds twice and a face turned inside out still winds 0 */
+        double near = fmax(1e-3 * eps, AG_VERIFY_WINDING_THIN * size);
+        if (w != 1 && near < eps)
+            w = probe_winding(T, &g, f, nrm, len, near, q);
+        if (w != 1) {
             snprintf(why, nwhy, "the building overlaps itself near (%.3f, %.3f, %.3f): it winds "
                      "%ld times there (parts swept through each other)", q[0] + o[0],
                      q[1] + o[1], q[2] + o[2], w);

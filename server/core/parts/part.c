@@ -159,6 +159,14 @@ ag_status ag_part_validate(const ag_part *p, ag_error *err)
     for (int a = 0; a < 3; a++)
         if (!isfinite(p->box.min[a]) || !isfinite(p->box.max[a]) || p->box.max[a] < p->box.min[a])
             return ag_error_set(err, AG_ERR_INVALID, 0, "box: not a finite box");
+    for (int k = 0; k < 6; k++) {
+        double v = k < 3 ? p->box.min[k] : p->box.max[k - 3];
+        if (fabs(v) > AG_PART_MAX_COORD)
+            return ag_error_set(err, AG_ERR_INVALID, 0,
+                                "box: %s %c = %.15g m is beyond the +-%g m a part can hold "
+                                "(move the model nearer its origin)",
+                                k < 3 ? "min" : "max", "xyz"[k % 3], v, AG_PART_MAX_COORD);
+    }
     if (p->facing < 0 || p->facing > 3)
         return ag_error_set(err, AG_ERR_INVALID, 0, "facing: %d is not 0..3", p->facing);
     for (size_t i = 0; i < p->nnodes; i++) {

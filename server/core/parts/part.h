@@ -83,9 +83,15 @@ ag_status ag_part_add_attr(ag_part *p, const char *key, const char *value);
 int32_t ag_part_root_rule(const ag_part *p);
 /* Quarter turns the part's axiom applies its root rule with (0..3). */
 int ag_part_root_rot(const ag_part *p);
+/* The largest |coordinate| of a part's box, in metres: beyond every projected CRS in use
+ * (web-mercator reaches 2e7 m), so a part saved from a georeferenced model keeps its place.
+ * Saving checks it (ag_part_validate) and the bundle reader refuses more, so whatever is
+ * written reads back. */
+#define AG_PART_MAX_COORD 1e8
+
 /* Checks a part's own consistency: the grammar is resolved, the axiom is exactly one
- * application of the root rule, every terminal has geometry, the box is finite, nodes are in
- * range. Names the offending element. */
+ * application of the root rule, every terminal has geometry, the box is finite and within
+ * AG_PART_MAX_COORD, nodes are in range. Names the offending element. */
 ag_status ag_part_validate(const ag_part *p, ag_error *err);
 
 #endif

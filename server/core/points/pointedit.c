@@ -7,6 +7,7 @@
 
 #include "../base/array.h"
 #include "../base/tolerance.h"
+#include "../edit/idmatch.h"
 
 static ag_status copy_terminal(ag_pointmodel *dst, const ag_pointmodel_terminal *t,
                                size_t *index, ag_error *err)
@@ -114,6 +115,53 @@ static int32_t lookup_edit(void *user, const char *group, const double legs[3], 
             p++;
     }
     return best;
+}
+
+/* Per node of t: 1 for what op removes or replaces (the nodes it names and what they hold),
+ * which no node of the result may take the id of; NULL when it names none (or out of memory:
+ * then nothing is excluded, and the boxes alone decide). */
+static uint8_t *replaced_by(const ag_splittree *t, const ag_edit_op *op)
+{
+    int replaces = op->kind == AG_EDIT_REMOVE || op->kind == AG_EDIT_JOIN ||
+                   (op->kind == AG_EDIT_PASTE && op->placement == AG_EDIT_REPLACE);
+    if (!replaces || !t->nnodes)
+        return NULL;
+    uint8_t *mark = calloc(t->nnodes, 1);
+    if (!mark)
+        return NULL;
+    size_t named = op->kind == AG_EDIT_PASTE ? 1 : op->nnodes;
+    for (size_t i = 0; i < named; i++) {
+        int32_t n = op->kind == AG_EDIT_PASTE ? op->node : op->nodes[i];
+        if (n > 0 && (size_t)n < t->nnodes)
+            mark[n] = 1;
+    }
+    /* what a marked node holds: a parent comes before its children in no fixed order, so
+     * walk up from every node */
+    for (size_t n = 1; n < t->nnodes; n++)
+        for (int32_t p = t->nodes[n].parent; p > 0 && !mark[n]; p = t->nodes[p].parent)
+            if (mark[p])
+                mark[n] = 1;
+    return mark;
+}
+
+ag_status ag_pointedit_keep_ids(ag_pointmodel *made, const ag_pointmodel *before,
+                                const ag_edit_op *op, ag_error *err)
+{
+    if (!made->em || !before || !before->em)
+        return AG_OK;
+    uint8_t *changed = op ? replaced_by(before->em->proc->tree, op) : NULL;
+    ag_proceduralize_result *r = NULL;
+    ag_status st = ag_idmatch_renumber(before->em->proc, made->em->proc, changed,
+                                       &made->em->opt.patterns, &r, NULL, err);
+    free(changed);
+    if (st || !r)
+        return st;
+    ag_edit_model *em = NULL;
+    if ((st = ag_edit_model_wrap(r, &made->em->opt, &em, err)))
+        return st;
+    ag_edit_model_free(made->em);
+    made->em = em;
+    return AG_OK;
 }
 
 ag_status ag_pointedit_apply(const ag_pointmodel *pm, const ag_edit_op *op,

@@ -10,7 +10,8 @@
  *   come along), the copied node turned by quarter turns to face the way the paste node faces;
  * - split, remove; join keeps its placements (a joined node is a union of placements).
  * An op names nodes of the model's tree (pm->em->proc->tree), as ops on meshes do. The result
- * is a new model, built; a caller that keeps only the grammar reads it back through its
+ * is a new model, built (its nodes numbered afresh: ag_pointedit_keep_ids gives the state
+ * read back from it the ids of the nodes the op left alone); a caller that keeps only the grammar reads it back through its
  * grammar text (app/points_state.h) so that its node ids are the ones a reload gives. */
 #ifndef AG_POINTEDIT_H
 #define AG_POINTEDIT_H
@@ -24,6 +25,13 @@
 ag_status ag_pointedit_apply(const ag_pointmodel *pm, const ag_edit_op *op,
                              const ag_pointmodel *source, ag_pointmodel **out,
                              ag_edit_report *rep, ag_error *err);
+
+/* made (built) numbered as `before` numbers the nodes made keeps (core/edit/idmatch.h): the
+ * build numbers every node afresh. op (may be NULL): the edit that made it, whose removed and
+ * replaced nodes no new node takes the id of. Only the proxy's tree is renumbered: made's
+ * grammar is the matched one then, so take the grammar text from made before. */
+ag_status ag_pointedit_keep_ids(ag_pointmodel *made, const ag_pointmodel *before,
+                                const ag_edit_op *op, ag_error *err);
 
 /* A deep copy of a model's terminals and placements (not built). */
 ag_status ag_pointedit_copy(const ag_pointmodel *pm, ag_pointmodel **out, ag_error *err);

@@ -487,6 +487,7 @@ typedef struct {
                      shortcut */
     int no_rotation;
     int nomem;
+    double turn_move; /* AG_PROC_LABEL_TURN_MOVE in the model's unit */
     int64_t sa_of; /* label_pass: the (exemplar, turn) whose oriented soup sa holds, -1 */
     unsigned checks_left; /* surface comparisons the current component may still make */
 } lctx;
@@ -524,13 +525,14 @@ static int compare(lctx *x, size_t na, size_t nb, double tol, int fast, double *
 }
 
 /* Whether c's orientation is close enough to e's, beyond quarter turns, for one label: the
- * turn between them moves c's plan corners by at most AG_PROC_LABEL_TURN_MOVE. */
-static int turn_close(const frame *e, const frame *c)
+ * turn between them moves c's plan corners by at most AG_PROC_LABEL_TURN_MOVE (move, in the
+ * model's unit). */
+static int turn_close(const frame *e, const frame *c, double move)
 {
     double d = fmod(fabs(c->phi - e->phi), M_PI / 2);
     if (d > M_PI / 4)
         d = M_PI / 2 - d;
-    return 0.5 * hypot(c->ext[0], c->ext[1]) * d <= AG_PROC_LABEL_TURN_MOVE;
+    return 0.5 * hypot(c->ext[0], c->ext[1]) * d <= move;
 }
 
 /* Labels: every component against the exemplars of the labels in its bucket and the
@@ -578,7 +580,7 @@ static long label_pass(lctx *x, const uint32_t *comps, size_t n, double tol)
                     uint32_t e = L->exemplar[l];
                     if (fast ? L->ntris[e] != L->ntris[c] : !areas_close(x, e, c))
                         continue;
-                    if (!turn_close(&F[e], &F[c]))
+                    if (!turn_close(&F[e], &F[c], x->turn_move))
                         continue;
                     for (int k = 0; k < nk && found < 0; k++) {
                         if (!extents_match(F[e].ext, dc, k, tol))
@@ -772,14 +774,6 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
     L->diagonal = ag_box_diagonal(&all);
     if (!(L->diagonal > 0))
         L->diagonal = 0;
-    double scale = L->diagonal > 0 ? L->diagonal : 1.0;
-    L->tol = o.tolerance * scale;
-    if (capped && L->tol > AG_PROC_LABEL_TOLERANCE_MAX)
-        L->tol = AG_PROC_LABEL_TOLERANCE_MAX;
-    L->exact_copies = o.exact_copies != 0;
-    L->exact = fmin(o.exact * scale, L->tol);
-    L->share = o.exact_copies ? L->exact : L->tol;
-
     for (size_t c = 0; c < nc; c++)
         L->box[c] = ag_box_empty();
     for (size_t t = 0; t < m->ntris; t++) {
@@ -793,6 +787,21 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
         if (L->ntris[c] > maxt)
             maxt = L->ntris[c];
     }
+    /* the tolerances meant in metres are taken in the file's unit, so a model exported in
+     * millimetres gets the labels of the same model in metres */
+    if (o.metres_per_unit > 0)
+        L->units = ag_units_given(o.metres_per_unit);
+    else if (ag_units_decide(&all, L->box, nc, &L->units) < 0)
+        goto fail;
+    double scale = L->diagonal > 0 ? L->diagonal : 1.0;
+    L->tol = o.tolerance * scale;
+    if (capped && L->tol > AG_PROC_LABEL_TOLERANCE_MAX / L->units.metres_per_unit)
+        L->tol = AG_PROC_LABEL_TOLERANCE_MAX / L->units.metres_per_unit;
+    L->exact_copies = o.exact_copies != 0;
+    L->exact = fmin(o.exact * scale, L->tol);
+    L->share = o.exact_copies ? L->exact : L->tol;
+    x.turn_move = AG_PROC_LABEL_TURN_MOVE / L->units.metres_per_unit;
+
     {
         uint32_t *fill = malloc((nc + 1) * sizeof *fill);
         if (!fill)

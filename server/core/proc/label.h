@@ -29,11 +29,14 @@
 
 #include "../mesh.h"
 #include "../status.h"
+#include "units.h"
 
 typedef struct {
     /* labels (and shared terminals): relative to the model diagonal; 0 = the default,
-     * AG_PROC_LABEL_TOLERANCE of the diagonal but at most AG_PROC_LABEL_TOLERANCE_MAX metres */
+     * AG_PROC_LABEL_TOLERANCE of the diagonal but at most AG_PROC_LABEL_TOLERANCE_MAX metres
+     * (in the model's unit, see units.h) */
     double tolerance;
+    double metres_per_unit; /* the model's unit: 1 or 0.001; 0 = decided from the content */
     double exact;     /* exact copies: relative to the model diagonal; 0 = 1e-7 */
     int no_rotation;  /* non-zero: neither turns, orientations nor mirror images match */
     int exact_copies; /* non-zero: terminals are shared by exact copies only */
@@ -66,6 +69,7 @@ typedef struct {
                                    placed terminal, as the labeling certified it */
 
     double diagonal;     /* of the model */
+    ag_units units;      /* the model's length unit, as given or decided (units.h) */
     double tol;          /* absolute label tolerance */
     double exact;        /* absolute tolerance of exact copies: what the split tree, rules
                             and patterns compare with, so only shared terminals move surfaces */

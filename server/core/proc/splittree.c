@@ -9,6 +9,7 @@
 #include "../base/radix.h"
 #include "../base/search.h"
 #include "../base/tolerance.h"
+#include "adjacency.h"
 
 void ag_splittree_free(ag_splittree *t)
 {
@@ -17,6 +18,7 @@ void ag_splittree_free(ag_splittree *t)
     free(t->nodes);
     free(t->comp_node);
     free(t->adj);
+    free(t->adj_seen);
     free(t->rule_count);
     free(t->rule_rep);
     free(t->patterns);
@@ -47,6 +49,7 @@ ag_splittree *ag_splittree_copy(const ag_splittree *t)
     c->cap = c->nodes ? t->nnodes : 0;
     c->comp_node = dup_array(t->comp_node, t->ncomponents, sizeof *t->comp_node, &fail);
     c->adj = dup_array(t->adj, 2 * t->nadj, sizeof *t->adj, &fail);
+    c->adj_seen = dup_array(t->adj_seen, t->adj_nseen, sizeof *t->adj_seen, &fail);
     c->rule_count = dup_array(t->rule_count, t->nrules, sizeof *t->rule_count, &fail);
     c->rule_rep = dup_array(t->rule_rep, t->nrules, sizeof *t->rule_rep, &fail);
     c->patterns = dup_array(t->patterns, t->npatterns, sizeof *t->patterns, &fail);
@@ -312,202 +315,6 @@ static int cmp_volc(const void *a, const void *b)
     return x->c < y->c ? -1 : x->c > y->c;
 }
 
-static uint64_t gkey(int level, int64_t x, int64_t y, int64_t z)
-{
-    uint64_t h = (uint64_t)level * 0x9E3779B97F4A7C15ULL;
-    h ^= (uint64_t)x * 0xBF58476D1CE4E5B9ULL;
-    h = (h ^ (h >> 31)) * 0x94D049BB133111EBULL;
-    h ^= (uint64_t)y * 0xD6E8FEB86659FD93ULL;
-    h = (h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ULL;
-    h ^= (uint64_t)z * 0x94D049BB133111EBULL;
-    return h ^ (h >> 32);
-}
-
-/* Adjacency: every pair of visible boxes that meet within the tolerance, found with a grid
- * per size class instead of a sweep along one axis (a sweep compares every box with all
- * those it overlaps along x: on a facade facing x, or a block of buildings in rows, that is
- * most pairs). Each box, grown by the tolerance, is registered on the finest of halving
- * grid levels whose cell is not smaller than its largest extent, so it covers at most 2
- * cells per axis there, and is found from every box of its level or a finer one through the
- * cells that box covers on the coarser level. A pair is reported from one cell only (the
- * one holding the lower corner of the overlap of the grown boxes), so each pair costs a
- * few hash look-ups whatever the layout: O(n log n) in all, the final sort included. */
-#define ADJ_MAX_LEVELS 40
-
-typedef struct {
-    int level;
-    int64_t lo[3], hi[3]; /* the cells the grown box covers on its level */
-} adj_reg;
-
-static void adj_cells(const double o[3], double h, const double lo[3], const double hi[3],
-                      int64_t clo[3], int64_t chi[3])
-{
-    for (int a = 0; a < 3; a++) {
-        clo[a] = (int64_t)floor((lo[a] - o[a]) / h);
-        chi[a] = (int64_t)floor((hi[a] - o[a]) / h);
-    }
-}
-
-ag_status ag_splittree_adjacency(ag_splittree *t)
-{
-    free(t->adj);
-    t->adj = NULL;
-    t->nadj = 0;
-    size_t nv = 0;
-    for (size_t i = 0; i < t->nnodes; i++)
-        nv += t->nodes[i].kind == AG_NODE_COMPONENT;
-    if (nv < 2)
-        return AG_OK;
-    double tol = t->tol;
-    uint32_t *node = malloc(nv * sizeof *node);
-    uint32_t *rank = malloc(nv * sizeof *rank);
-    ag_radix_item *ord = malloc(nv * sizeof *ord);
-    int *level = malloc(nv * sizeof *level);
-    ag_radix_item *ent = NULL, *pairs = NULL;
-    ag_radix_index cells = {0};
-    size_t nent = 0, npairs = 0, cap_pairs = 0;
-    ag_status st = AG_ERR_NOMEM;
-    if (!node || !rank || !ord || !level)
-        goto done;
-    /* the sweep order of the boxes (by lower x, then node): the order pairs are listed in */
-    size_t k = 0;
-    for (size_t i = 0; i < t->nnodes; i++)
-        if (t->nodes[i].kind == AG_NODE_COMPONENT)
-            node[k++] = (uint32_t)i;
-    for (size_t i = 0; i < nv; i++) {
-        ord[i].key = ag_radix_key_double(t->nodes[node[i]].box.min[0]);
-        ord[i].val = (uint32_t)i;
-    }
-    if (ag_radix_sort(ord, nv))
-        goto done;
-    for (size_t r = 0; r < nv; r++)
-        rank[ord[r].val] = (uint32_t)r;
-
-    /* the grid levels, halving: a cell of level 0 is as large as the largest grown box */
-    double o[3] = {INFINITY, INFINITY, INFINITY}, top = 0, bottom = INFINITY;
-    for (size_t i = 0; i < nv; i++) {
-        const ag_box *b = &t->nodes[node[i]].box;
-        double e = 0;
-        for (int a = 0; a < 3; a++) {
-            o[a] = fmin(o[a], b->min[a] - tol);
-            e = fmax(e, b->max[a] - b->min[a] + 2 * tol);
-        }
-        top = fmax(top, e);
-        bottom = fmin(bottom, e);
-    }
-    if (!(top > 0))
-        top = 1;
-    if (!(bottom > 0))
-        bottom = top * ldexp(1, -ADJ_MAX_LEVELS);
-    double h[ADJ_MAX_LEVELS];
-    int nlevels = 1;
-    h[0] = top;
-    while (nlevels < ADJ_MAX_LEVELS && h[nlevels - 1] / 2 >= bottom) {
-        h[nlevels] = h[nlevels - 1] / 2;
-        nlevels++;
-    }
-    int used[ADJ_MAX_LEVELS] = {0};
-    size_t cap_ent = 0;
-    for (size_t i = 0; i < nv; i++) {
-        const ag_box *b = &t->nodes[node[i]].box;
-        double lo[3], hi[3], e = 0;
-        for (int a = 0; a < 3; a++) {
-            lo[a] = b->min[a] - tol;
-            hi[a] = b->max[a] + tol;
-            e = fmax(e, hi[a] - lo[a]);
-        }
-        int l = 0;
-        while (l + 1 < nlevels && h[l + 1] >= e)
-            l++;
-        level[i] = l;
-        used[l] = 1;
-        int64_t clo[3], chi[3];
-        adj_cells(o, h[l], lo, hi, clo, chi);
-        for (int64_t x = clo[0]; x <= chi[0]; x++)
-            for (int64_t y = clo[1]; y <= chi[1]; y++)
-                for (int64_t z = clo[2]; z <= chi[2]; z++) {
-                    if (AG_ARRAY_RESERVE(ent, cap_ent, nent + 1))
-                        goto done;
-                    ent[nent].key = gkey(l, x, y, z);
-                    ent[nent++].val = (uint32_t)i;
-                }
-    }
-    if (ag_radix_sort(ent, nent) || ag_radix_index_build(&cells, ent, nent))
-        goto done;
-
-    for (size_t i = 0; i < nv; i++) {
-        const ag_box *a = &t->nodes[node[i]].box;
-        double lo[3], hi[3];
-        for (int ax = 0; ax < 3; ax++) {
-            lo[ax] = a->min[ax] - tol;
-            hi[ax] = a->max[ax] + tol;
-        }
-        for (int l = 0; l <= level[i]; l++) {
-            if (!used[l])
-                continue;
-            int64_t clo[3], chi[3];
-            adj_cells(o, h[l], lo, hi, clo, chi);
-            for (int64_t x = clo[0]; x <= chi[0]; x++)
-                for (int64_t y = clo[1]; y <= chi[1]; y++)
-                    for (int64_t z = clo[2]; z <= chi[2]; z++) {
-                        uint64_t key = gkey(l, x, y, z);
-                        size_t e = ag_radix_index_find(&cells, key);
-                        for (; e < nent && ent[e].key == key; e++) {
-                            uint32_t j = ent[e].val;
-                            /* boxes of one level meet from the later one */
-                            if (level[j] != l || (l == level[i] && j >= i))
-                                continue;
-                            const ag_box *b = &t->nodes[node[j]].box;
-                            if (!ag_box_meets_axis(a, b, 0, tol) ||
-                                !ag_box_meets_axis(a, b, 1, tol) ||
-                                !ag_box_meets_axis(a, b, 2, tol))
-                                continue;
-                            /* the pair's own cell: the one holding the overlap's corner */
-                            double c[3];
-                            for (int ax = 0; ax < 3; ax++)
-                                c[ax] = fmax(lo[ax], b->min[ax] - tol);
-                            if ((int64_t)floor((c[0] - o[0]) / h[l]) != x ||
-                                (int64_t)floor((c[1] - o[1]) / h[l]) != y ||
-                                (int64_t)floor((c[2] - o[2]) / h[l]) != z)
-                                continue;
-                            if (AG_ARRAY_RESERVE(pairs, cap_pairs, npairs + 1))
-                                goto done;
-                            uint32_t ri = rank[i], rj = rank[j];
-                            pairs[npairs].key = ri < rj ? (uint64_t)ri << 32 | rj
-                                                        : (uint64_t)rj << 32 | ri;
-                            pairs[npairs++].val = 0;
-                        }
-                    }
-        }
-    }
-    ag_radix_index_free(&cells);
-    free(ent);
-    ent = NULL;
-    if (ag_radix_sort(pairs, npairs))
-        goto done;
-    /* the pairs in sweep order, two node indices each, the smaller first */
-    if (npairs && !(t->adj = malloc(2 * npairs * sizeof *t->adj)))
-        goto done;
-    for (size_t p = 0; p < npairs; p++) {
-        if (p > 0 && pairs[p].key == pairs[p - 1].key)
-            continue; /* a hash collision of two cells lists a pair twice */
-        uint32_t x = node[ord[pairs[p].key >> 32].val], y = node[ord[pairs[p].key & 0xffffffffu].val];
-        t->adj[2 * t->nadj] = x < y ? x : y;
-        t->adj[2 * t->nadj + 1] = x < y ? y : x;
-        t->nadj++;
-    }
-    st = AG_OK;
-done:
-    ag_radix_index_free(&cells);
-    free(node);
-    free(rank);
-    free(ord);
-    free(level);
-    free(ent);
-    free(pairs);
-    return st;
-}
-
 /* Spatial index of visible nodes for the parent search: a box is registered in the cells it
  * covers on the finest of three grid levels where it covers at most 64 cells (boxes larger
  * than that are kept in a short list). A query looks at the cell holding the centre of the
@@ -589,7 +396,7 @@ static int gi_add(gindex *g, const ag_box *b, int32_t node)
                         return -1;
                     if (AG_ARRAY_RESERVE(g->ent, g->capent, g->nent + 1))
                         return -1;
-                    uint64_t key = gkey(l, x, y, z);
+                    uint64_t key = ag_radix_cell_key(l, x, y, z);
                     gcell *c = gi_slot(g, key);
                     if (c->head < 0) {
                         c->key = key;
@@ -679,7 +486,7 @@ ag_status ag_splittree_build(const ag_mesh *m, const ag_labels *L, ag_splittree 
             if (l < GI_LEVELS) {
                 if (!gi.cap)
                     continue;
-                uint64_t key = gkey(l, (int64_t)floor((ctr[0] - gi.o[0]) / gi.h[l]),
+                uint64_t key = ag_radix_cell_key(l, (int64_t)floor((ctr[0] - gi.o[0]) / gi.h[l]),
                                     (int64_t)floor((ctr[1] - gi.o[1]) / gi.h[l]),
                                     (int64_t)floor((ctr[2] - gi.o[2]) / gi.h[l]));
                 gcell *cell = gi_slot(&gi, key);

@@ -51,13 +51,22 @@ typedef struct {
     int32_t node;       /* the PATTERN node */
 } ag_pattern;
 
+/* A node as the adjacency last saw it: its box, and whether it was visible. */
+typedef struct {
+    ag_box box;
+    uint8_t visible;
+} ag_adj_seen;
+
 typedef struct {
     size_t nnodes, cap;
     ag_tnode *nodes;
     size_t ncomponents;
     int32_t *comp_node; /* per component: its visible node, -1 for components without triangles */
     size_t nadj;
-    uint32_t *adj;      /* nadj pairs of visible nodes whose boxes touch or overlap */
+    uint32_t *adj;      /* nadj pairs of visible nodes whose boxes meet (adjacency.h) */
+    size_t adj_nseen;
+    ag_adj_seen *adj_seen; /* what adj was found for (adjacency.h); NULL: unknown */
+    double adj_tol;        /* the tolerance it was found with */
     size_t nrules;
     uint32_t *rule_count; /* per rule: visible nodes in the class */
     int32_t *rule_rep;    /* per rule: its representative node */
@@ -104,8 +113,6 @@ ag_status ag_splittree_hang(ag_splittree *t, int32_t parent, int32_t node);
  * split suffices keeps its second as a split that keeps everything). Pattern cells have no
  * chain. */
 ag_status ag_splittree_rechain(ag_splittree *t, int32_t end);
-/* Recomputes the adjacency of visible nodes (pairs whose boxes touch or overlap). */
-ag_status ag_splittree_adjacency(ag_splittree *t);
 /* A deep copy (NULL when out of memory). */
 ag_splittree *ag_splittree_copy(const ag_splittree *t);
 ag_splittree_stats ag_splittree_stats_of(const ag_splittree *t);

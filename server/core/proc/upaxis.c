@@ -26,6 +26,15 @@
 /* Differences of the vertical share below this are noise of plans aligned with the axes
  * (roof ridges along one axis favour it by up to about a tenth on the 0 A.D. meshes). */
 #define VERTICAL_DEAD_ZONE 0.15
+/* The roof cue counts only where sloped surfaces (normals neither along the axis nor across
+ * it) make at least this share of the area. */
+#define ROOF_MIN_SHARE 0.02
+/* The roof cue decides alone when one axis's sloped surfaces face one way by at least
+ * ROOF_CLEAR and by at least ROOF_RATIO times the other's: a clear roof. Less than that
+ * (shallow or few roofs, battered walls facing one way along a horizontal axis) leaves the
+ * decision to the score. */
+#define ROOF_CLEAR 0.1
+#define ROOF_RATIO 2.0
 /* The origin cue needs both horizontal centres within this many half extents of 0. */
 #define ORIGIN_CENTRED 0.15
 
@@ -133,7 +142,7 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
     }
 
     /* vertical share per axis */
-    double area = 0, aligned[3] = {0, 0, 0};
+    double area = 0, aligned[3] = {0, 0, 0}, sloped[3] = {0, 0, 0}, facing[3] = {0, 0, 0};
     uint8_t *used = calloc(m->nverts + 1, 1);
     if (!used)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory deciding the up axis");
@@ -151,8 +160,12 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
         area += l;
         for (int a = 0; a < 3; a++) {
             double c = fabs(n[a]) / l;
-            if (c < PERPENDICULAR || c > PARALLEL)
+            if (c < PERPENDICULAR || c > PARALLEL) {
                 aligned[a] += l;
+            } else {
+                sloped[a] += fabs(n[a]);
+                facing[a] += n[a];
+            }
         }
     }
 
@@ -195,6 +208,10 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
         if (c->base < 0)
             c->base = fmin(c->base + EAVES, 0);
         c->vertical = area > 0 ? aligned[a] / area : 0;
+        /* sign-free: a file's winding may face every surface inwards */
+        c->roof = sloped[a] > 0 && area - aligned[a] >= ROOF_MIN_SHARE * area
+                      ? fabs(facing[a]) / sloped[a]
+                      : 0;
         double half[3];
         for (int k = 0; k < 3; k++)
             half[k] = ext[k] > 0 ? ext[k] / 2 : 1;
@@ -222,6 +239,15 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
     }
 
     const ag_upaxis_cues *y = &ev->cue[0], *z = &ev->cue[1];
+    for (int a = 1; a < 3; a++) {
+        const ag_upaxis_cues *c = &ev->cue[a - 1], *o = &ev->cue[2 - a];
+        if (c->roof >= ROOF_CLEAR && c->roof >= ROOF_RATIO * o->roof) {
+            ev->roof = 1;
+            ev->axis = a;
+            ev->score = a == 2 ? 1 : -1;
+            return AG_OK;
+        }
+    }
     double dv = z->vertical - y->vertical;
     double vertical = dv > VERTICAL_DEAD_ZONE ? dv - VERTICAL_DEAD_ZONE
                       : dv < -VERTICAL_DEAD_ZONE ? dv + VERTICAL_DEAD_ZONE

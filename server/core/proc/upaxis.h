@@ -21,6 +21,16 @@
  *                  lower than AG_UPAXIS_MIN_HEIGHT is not up when the other is at least that
  *                  tall (a lone facade slab lies down on no base). Decides alone, after the
  *                  map coordinates.
+ *   roof           roofs shed water: a building's sloped surfaces (normals neither along the
+ *                  axis nor across it) face one way along the up axis, while along a
+ *                  horizontal axis they face both ways (the two sides of a ridge) and cancel:
+ *                  per axis, |sum of the normals' components| / sum of their sizes over the
+ *                  sloped surfaces, 0..1 (sign-free, so a file whose winding faces inwards says
+ *                  the same; 0 when sloped surfaces are under 2 % of the area). A clear roof
+ *                  (at least 0.1, and twice the other axis's) decides alone, after the storey:
+ *                  the base cue is fooled by one flat wall closing an open building at one
+ *                  end of a horizontal axis (a stoa's back wall looks like a floor), the roof
+ *                  cue is not.
  *   origin         models kept in their own frame (game and CAD assets) have the origin on the
  *                  ground at the centre of the plan: the two horizontal axes are centred on 0
  *                  and the up axis is not.
@@ -43,6 +53,7 @@ typedef struct {
     double base;     /* support at the low end less support at the high end, -1..1 */
     double top;      /* the high end's support, 0..1 (base = bottom - top) */
     double vertical; /* share of the area perpendicular or parallel to the axis, 0..1 */
+    double roof;     /* how one way the sloped surfaces face along the axis, 0..1 */
     double extent;   /* the model's extent along the axis, metres */
     double origin;   /* how far the axis's centre is above the origin, in half extents,
                         when the two other axes are centred on the origin (else 0), 0..1 */
@@ -52,6 +63,7 @@ typedef struct {
     int axis;             /* 1 = y, 2 = z; 0 when the content decides nothing */
     int georeferenced;    /* the map-coordinate cue decided */
     int storey;           /* the storey cue decided */
+    int roof;             /* the roof cue decided */
     double score;         /* > 0 for z, < 0 for y */
     double centre[3];     /* of the bounding box, as read */
     ag_upaxis_cues cue[2]; /* [0] for y, [1] for z */
