@@ -20,6 +20,7 @@
 #include "core/parts/part.h"
 #include "core/proc/adjacency.h"
 #include "core/proc/grammar.h"
+#include "edit_targets.h"
 
 static double now_ms(void)
 {
@@ -134,30 +135,6 @@ static void run_op(ag_edit_model **em, const ag_edit_op *op, const char *what)
     *em = out;
 }
 
-/* A window (small visible box on a facade) and the largest wall of t. */
-static void pick(const ag_splittree *t, int32_t w[2], int32_t *wall)
-{
-    double wall_area = 0;
-    w[0] = w[1] = *wall = -1;
-    for (size_t n = 0; n < t->nnodes; n++) {
-        const ag_box *b = &t->nodes[n].box;
-        if (t->nodes[n].kind != AG_NODE_COMPONENT)
-            continue;
-        double dx = b->max[0] - b->min[0], dz = b->max[2] - b->min[2];
-        if (dx < 2 && dz < 3 && dx > 0.5 && b->max[1] - b->min[1] < 1) {
-            if (w[0] < 0)
-                w[0] = (int32_t)n;
-            else if (w[1] < 0 && t->nodes[n].label == t->nodes[w[0]].label &&
-                     fabs(b->min[1] - t->nodes[w[0]].box.min[1]) < 1e-6)
-                w[1] = (int32_t)n;
-        }
-        if (dx * dz > wall_area && b->max[1] - b->min[1] < 1) {
-            wall_area = dx * dz;
-            *wall = (int32_t)n;
-        }
-    }
-}
-
 static void edit_ops(void)
 {
     ag_gen_facade_options go = {.cols = 40, .rows = 20, .side_cols = 30, .back = 1, .left = 1,
@@ -176,7 +153,7 @@ static void edit_ops(void)
     for (int k = 0; k < 6; k++) {
         const ag_splittree *t = em->proc->tree;
         int32_t w[2], wall;
-        pick(t, w, &wall);
+        bench_pick_windows_and_wall(t, w, &wall);
         if (w[0] < 0 || w[1] < 0 || wall < 0) {
             printf("no wall or windows to edit\n");
             break;
@@ -327,7 +304,7 @@ static void compositions(void)
     for (int k = 0; k < 3; k++) {
         const ag_splittree *t = em->proc->tree;
         int32_t w[2], wall;
-        pick(t, w, &wall);
+        bench_pick_windows_and_wall(t, w, &wall);
         if (w[0] < 0 || w[1] < 0)
             break;
         ag_edit_op op = {.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = &w[0]};

@@ -32,6 +32,7 @@
 #include "io/obj.h"
 #include "store/db.h"
 #include "store/models.h"
+#include "edit_targets.h"
 
 #define SHARED AG_REPO_DIR "/../shared/data"
 
@@ -357,25 +358,8 @@ static size_t same_ids(const ag_splittree *a, const ag_splittree *b, size_t *vis
 static void run_structural(const char *name, const ag_model_state *st)
 {
     const ag_splittree *t = st->em->proc->tree;
-    int32_t wall = -1, w[2] = {-1, -1};
-    double wall_area = 0;
-    for (size_t n = 0; n < t->nnodes; n++) {
-        const ag_box *b = &t->nodes[n].box;
-        if (t->nodes[n].kind != AG_NODE_COMPONENT)
-            continue;
-        double dx = b->max[0] - b->min[0], dz = b->max[2] - b->min[2];
-        if (dx < 2 && dz < 3 && dx > 0.5 && b->max[1] - b->min[1] < 1) {
-            if (w[0] < 0)
-                w[0] = (int32_t)n;
-            else if (w[1] < 0 && t->nodes[n].label == t->nodes[w[0]].label &&
-                     fabs(b->min[1] - t->nodes[w[0]].box.min[1]) < 1e-6)
-                w[1] = (int32_t)n;
-        }
-        if (dx * dz > wall_area && b->max[1] - b->min[1] < 1) {
-            wall_area = dx * dz;
-            wall = (int32_t)n;
-        }
-    }
+    int32_t wall, w[2];
+    bench_pick_windows_and_wall(t, w, &wall);
     if (wall < 0 || w[0] < 0 || w[1] < 0) {
         printf("%-28s no wall or windows to edit\n", name);
         return;

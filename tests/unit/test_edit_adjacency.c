@@ -23,36 +23,8 @@
 #include "core/parts/part.h"
 #include "core/proc/adjacency.h"
 #include "core/proc/grammar.h"
+#include "adjacency_check.h"
 #include "random_fixture.h"
-
-static int meets(const ag_box *a, const ag_box *b, double tol)
-{
-    for (int k = 0; k < 3; k++)
-        if (a->min[k] > b->max[k] + tol || b->min[k] > a->max[k] + tol)
-            return 0;
-    return 1;
-}
-
-/* t's pairs are every meeting pair of its visible boxes, by node index, each once */
-static void check_brute_force(const ag_splittree *t, const char *what)
-{
-    size_t k = 0;
-    for (size_t i = 0; i < t->nnodes; i++) {
-        if (t->nodes[i].kind != AG_NODE_COMPONENT)
-            continue;
-        for (size_t j = i + 1; j < t->nnodes; j++) {
-            if (t->nodes[j].kind != AG_NODE_COMPONENT ||
-                !meets(&t->nodes[i].box, &t->nodes[j].box, t->tol))
-                continue;
-            if (k >= t->nadj || t->adj[2 * k] != i || t->adj[2 * k + 1] != j)
-                fail_msg("%s: pair %zu %zu missing or out of place (at %zu of %zu)", what, i, j,
-                         k, t->nadj);
-            k++;
-        }
-    }
-    if (k != t->nadj)
-        fail_msg("%s: %zu pairs listed, %zu meet", what, t->nadj, k);
-}
 
 /* the pairs found from scratch are t's, in the same order */
 static void check_oracle(const ag_splittree *t, const char *what)
@@ -253,7 +225,7 @@ static void run_sequence(uint64_t seed, const ag_gen_facade_options *go, int nop
     if (ag_edit_model_create(m, NULL, &em, &err))
         fail_msg("proceduralize: %s", err.text);
     ag_mesh_free(m);
-    check_brute_force(em->proc->tree, "proceduralized");
+    adjacency_check_brute_force(em->proc->tree, "proceduralized");
     for (int k = 0; k < nops; k++) {
         int kind = (int)(next_random(&s) % 6);
         char what[96];
@@ -263,7 +235,7 @@ static void run_sequence(uint64_t seed, const ag_gen_facade_options *go, int nop
         char label[160];
         snprintf(label, sizeof label, "seed %llu op %d: %s", (unsigned long long)seed, k, what);
         const ag_splittree *before = em->proc->tree, *after = out->proc->tree;
-        check_brute_force(after, label);
+        adjacency_check_brute_force(after, label);
         check_oracle(after, label);
         int scratch = replay_from_scratch(before, after);
         size_t ch = changed_nodes(before, after);

@@ -19,42 +19,13 @@
 #include "core/base/box.h"
 #include "core/proc/adjacency.h"
 #include "core/proc/splittree.h"
+#include "adjacency_check.h"
 #include "random_fixture.h"
-
-static int meets(const ag_box *a, const ag_box *b, double tol)
-{
-    for (int k = 0; k < 3; k++)
-        if (a->min[k] > b->max[k] + tol || b->min[k] > a->max[k] + tol)
-            return 0;
-    return 1;
-}
-
-/* t's listed pairs are every meeting pair of visible boxes, in order, each once */
-static void check_pairs(const ag_splittree *t)
-{
-    size_t k = 0;
-    for (size_t i = 0; i < t->nnodes; i++) {
-        if (t->nodes[i].kind != AG_NODE_COMPONENT)
-            continue;
-        for (size_t j = i + 1; j < t->nnodes; j++) {
-            if (t->nodes[j].kind != AG_NODE_COMPONENT ||
-                !meets(&t->nodes[i].box, &t->nodes[j].box, t->tol))
-                continue;
-            if (k >= t->nadj)
-                fail_msg("pair %zu %zu missing (only %zu listed)", i, j, t->nadj);
-            if (t->adj[2 * k] != i || t->adj[2 * k + 1] != j)
-                fail_msg("pair %zu: %u %u listed, %zu %zu expected", k, t->adj[2 * k],
-                         t->adj[2 * k + 1], i, j);
-            k++;
-        }
-    }
-    assert_int_equal(k, t->nadj);
-}
 
 static void check(ag_splittree *t)
 {
     assert_int_equal(ag_splittree_adjacency(t), AG_OK);
-    check_pairs(t);
+    adjacency_check_brute_force(t, "adjacency");
 }
 
 static ag_splittree *tree(double tol)
@@ -265,7 +236,7 @@ static void test_update_after_random_changes(void **state)
                 t->tol = t->tol > 0 ? 2 * t->tol : 1e-3; /* the model grew: its tolerance too */
             int scratch = -1;
             assert_int_equal(ag_splittree_adjacency_update(t, &scratch), AG_OK);
-            check_pairs(t);
+            adjacency_check_brute_force(t, "adjacency");
             /* the same pairs as from scratch, in the same order */
             ag_splittree *f = ag_splittree_copy(t);
             assert_non_null(f);
@@ -294,13 +265,13 @@ static void test_update_without_state(void **state)
     int scratch = -1;
     assert_int_equal(ag_splittree_adjacency_update(t, &scratch), AG_OK);
     assert_int_equal(scratch, 1);
-    check_pairs(t);
+    adjacency_check_brute_force(t, "adjacency");
     /* unchanged since: nothing searched, the same pairs */
     size_t n = t->nadj;
     assert_int_equal(ag_splittree_adjacency_update(t, &scratch), AG_OK);
     assert_int_equal(scratch, 0);
     assert_int_equal(t->nadj, n);
-    check_pairs(t);
+    adjacency_check_brute_force(t, "adjacency");
     ag_splittree_free(t);
 }
 

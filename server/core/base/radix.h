@@ -30,6 +30,19 @@ static inline uint64_t ag_radix_key_double(double x)
     return u >> 63 ? ~u : u | (1ull << 63);
 }
 
+/* v's lowest 21 bits spread to every third bit: three of them interleaved make a Morton
+ * (z-order) key, which sorts nearby points next to each other. */
+static inline uint64_t ag_radix_morton_spread(uint64_t v)
+{
+    v &= 0x1fffffULL;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+}
+
 /* The key of a cell (x, y, z) of grid level `level`: the cell grids hash their cells so. */
 static inline uint64_t ag_radix_cell_key(int level, int64_t x, int64_t y, int64_t z)
 {

@@ -4,24 +4,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/radix.h"
 #include "../extrude/keysort.h"
 #include "rng.h"
 
 #define DEFAULT_SEED 0x6c6f642d6f726465ull /* "lod-orde" */
 #define BITS 21                            /* per axis: three of them fit a 64-bit code */
 #define LEVELS (BITS + 1)                  /* level BITS: the finest cells */
-
-/* The bits of v (21 of them) spread to every third bit. */
-static uint64_t spread(uint64_t v)
-{
-    v &= 0x1fffffull;
-    v = (v | v << 32) & 0x1f00000000ffffull;
-    v = (v | v << 16) & 0x1f0000ff0000ffull;
-    v = (v | v << 8) & 0x100f00f00f00f00full;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-    v = (v | v << 2) & 0x1249249249249249ull;
-    return v;
-}
 
 static uint32_t quantize(double v, double lo, double scale)
 {
@@ -56,9 +45,9 @@ ag_status ag_lod_order(const ag_cloud *c, uint64_t seed, uint32_t *order, ag_err
     ag_rng_seed(&rng, seed ? seed : DEFAULT_SEED);
     for (size_t i = 0; i < n; i++) {
         const double *p = c->xyz + 3 * i;
-        uint64_t code = spread(quantize(p[0], lo[0], scale)) |
-                        spread(quantize(p[1], lo[1], scale)) << 1 |
-                        spread(quantize(p[2], lo[2], scale)) << 2;
+        uint64_t code = ag_radix_morton_spread(quantize(p[0], lo[0], scale)) |
+                        ag_radix_morton_spread(quantize(p[1], lo[1], scale)) << 1 |
+                        ag_radix_morton_spread(quantize(p[2], lo[2], scale)) << 2;
         cells[i] = (ag_keyed){code, (uint32_t)i};
         key[i] = ag_rng_next(&rng);
         level[i] = LEVELS; /* below the finest level: a point sharing its finest cell */

@@ -247,18 +247,6 @@ typedef struct {
     size_t nfound, cap_found;
 } adj_bvh;
 
-/* v's lowest 21 bits spread to every third bit. */
-static uint64_t spread3(uint64_t v)
-{
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffULL;
-    v = (v | v << 16) & 0x1f0000ff0000ffULL;
-    v = (v | v << 8) & 0x100f00f00f00f00fULL;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-    v = (v | v << 2) & 0x1249249249249249ULL;
-    return v;
-}
-
 static ag_status bvh_build(adj_bvh *h, const ag_splittree *t, size_t nv)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -287,7 +275,7 @@ static ag_status bvh_build(adj_bvh *h, const ag_splittree *t, size_t nv)
         for (int a = 0; a < 3; a++) {
             double c = 0.5 * (t->nodes[n].box.min[a] + t->nodes[n].box.max[a]);
             double u = hi[a] > lo[a] ? (c - lo[a]) / (hi[a] - lo[a]) : 0;
-            code |= spread3((uint64_t)(fmin(fmax(u, 0), 1) * 2097151.0)) << a;
+            code |= ag_radix_morton_spread((uint64_t)(fmin(fmax(u, 0), 1) * 2097151.0)) << a;
         }
         ord[k].key = code;
         ord[k++].val = (uint32_t)n;
