@@ -86,7 +86,8 @@ static double update_ms(const ag_splittree *before, const ag_splittree *after, i
         ag_status s = ag_splittree_adjacency_update(c, &scratch);
         double ms = now_ms() - a;
         *scratch_out = scratch;
-        *same = !s && c->nadj == f->nadj && !memcmp(c->adj, f->adj, 2 * f->nadj * sizeof *f->adj);
+        *same = !s && c->nadj == f->nadj &&
+                (!f->nadj || !memcmp(c->adj, f->adj, 2 * f->nadj * sizeof *f->adj));
         ag_splittree_free(c);
         ag_splittree_free(b);
         if (s || !*same) {

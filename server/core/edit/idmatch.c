@@ -197,7 +197,8 @@ static ag_status offer(rounds *R, int32_t f, int32_t o, int shaped)
 /* The round's candidates taken best first, each node once. */
 static void settle(rounds *R)
 {
-    qsort(R->c, R->n, sizeof *R->c, by_likeness);
+    if (R->n) /* R->c is NULL until a candidate is added; qsort must not see it */
+        qsort(R->c, R->n, sizeof *R->c, by_likeness);
     for (size_t i = 0; i < R->n; i++) {
         const candidate *c = &R->c[i];
         if (R->f2o[c->f] < 0 && !R->taken[c->o]) {
