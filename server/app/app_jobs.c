@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include "../core/extrude/style.h"
+#include "../core/proc/units.h"
 #include "../io/cloud_import.h"
 #include "../io/import.h"
 #include "../store/pointclouds.h"
@@ -54,9 +55,15 @@ ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_impor
 }
 
 ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
-                                    const int64_t *if_match, int exact, const json_t *cloud_options,
-                                    int64_t *job, ag_error *err)
+                                    const int64_t *if_match,
+                                    const ag_app_mesh_proc_options *mesh,
+                                    const json_t *cloud_options, int64_t *job, ag_error *err)
 {
+    int exact = mesh && mesh->exact;
+    double metres_per_unit = 0;
+    if (mesh && mesh->unit && ag_units_named(mesh->unit, &metres_per_unit))
+        return ag_error_set(err, AG_ERR_INVALID, 0, "\"unit\": the length unit of the mesh, "
+                            AG_UNITS_NAMES " (or left out: decided from the content)");
     int64_t current;
     ag_status s = ag_app_query_version(app, model, &current, err);
     if (s != AG_OK)
@@ -78,6 +85,11 @@ ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t
                             "\"exact\": model %lld is a point cloud; its terminals are consensus "
                             "models of each label's members, exact is an option of meshes",
                             (long long)model);
+    if (cloud && metres_per_unit > 0)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "\"unit\": model %lld is a point cloud, read in metres; unit is an "
+                            "option of meshes",
+                            (long long)model);
     ag_pointcloud_info info;
     if (cloud && (s = ag_pointclouds_info(db, model, &info, err)) != AG_OK)
         return s;
@@ -94,6 +106,7 @@ ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t
                         .user = who->user,
                         .u.proceduralize = {.model = model, .base = current,
                                             .author = (char *)who->name, .exact = exact != 0,
+                                            .metres_per_unit = metres_per_unit,
                                             .cloud = options}};
     s = submit(app, &jp, NULL, job, err);
     free(options);

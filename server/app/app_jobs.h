@@ -21,12 +21,18 @@ ag_status ag_app_jobs_check_extrude(const ag_extrude_job *p, ag_error *err);
 ag_status ag_app_jobs_import(ag_app *app, const ag_identity *who, const ag_import_job *p,
                              int64_t *job, ag_error *err);
 /* Proceduralizing a model at its current version, the op authored by who; if_match (NULL:
- * none; -1: any) must be the current version (AG_ERR_STALE otherwise); exact: terminals
- * shared by exact copies only; cloud: a point cloud's options (app/points_proc_options.h;
- * NULL: none; refused for a mesh). */
+ * none; -1: any) must be the current version (AG_ERR_STALE otherwise); mesh: a mesh's
+ * options (terminals shared by exact copies only, the length unit; refused for a cloud);
+ * cloud: a point cloud's options (app/points_proc_options.h; NULL: none; refused for a
+ * mesh). */
+typedef struct {
+    int exact;
+    const char *unit; /* core/proc/units.h ag_units_named; NULL: decided from the content */
+} ag_app_mesh_proc_options;
+
 ag_status ag_app_jobs_proceduralize(ag_app *app, const ag_identity *who, int64_t model,
-                                    const int64_t *if_match, int exact, const json_t *cloud,
-                                    int64_t *job, ag_error *err);
+                                    const int64_t *if_match, const ag_app_mesh_proc_options *mesh,
+                                    const json_t *cloud, int64_t *job, ag_error *err);
 /* Segmenting a point cloud model at its current version (app/usecase_segment.h), the op
  * authored by who; body: {"threshold", "coarse_threshold", "cluster_tolerance": fractions of
  * the diagonal, "recompute_normals": bool}, each optional (AG_ERR_INVALID naming a bad or

@@ -34,9 +34,9 @@ char *ag_job_params_encode(const ag_job_params *p)
     }
     case AG_JOB_PROCEDURALIZE: {
         const ag_proceduralize_job *q = &p->u.proceduralize;
-        j = json_pack("{s:I, s:I, s:s, s:b, s:s?}", "model", (json_int_t)q->model, "base",
-                      (json_int_t)q->base, "author", q->author, "exact", q->exact != 0, "cloud",
-                      q->cloud);
+        j = json_pack("{s:I, s:I, s:s, s:b, s:f, s:s?}", "model", (json_int_t)q->model, "base",
+                      (json_int_t)q->base, "author", q->author, "exact", q->exact != 0,
+                      "metres_per_unit", q->metres_per_unit, "cloud", q->cloud);
         break;
     }
     case AG_JOB_EXTRUDE: {
@@ -114,6 +114,8 @@ ag_status ag_job_params_decode(const char *kind, const char *json, ag_job_params
         q->model = json_integer_value(m);
         q->base = json_integer_value(b);
         q->exact = json_is_true(x);
+        /* absent in the jobs of earlier versions: decided from the content */
+        q->metres_per_unit = json_number_value(json_object_get(o, "metres_per_unit"));
         bad = !json_is_integer(m) || !json_is_integer(b) || q->model <= 0 || q->base <= 0 ||
               take(o, "author", 1, &q->author) | take(o, "cloud", 0, &q->cloud);
     } else if (strcmp(kind, "segment") == 0) {

@@ -28,12 +28,13 @@ typedef struct {
 } ag_import_job;
 
 /* A model at version base → proceduralized, by author; exact: terminals shared by exact
- * copies only (every instance derives as it was). */
+ * copies only (every instance derives as it was); metres_per_unit: core/proc/units.h. */
 typedef struct {
     int64_t model;
     int64_t base;
     char *author;
     int exact;
+    double metres_per_unit; /* the mesh's length unit as the request named it; 0 = decided */
     char *cloud; /* a point cloud's options (app/points_proc_options.h) as JSON text, or NULL */
 } ag_proceduralize_job;
 

@@ -22,6 +22,7 @@ static ag_status run(void *services, ag_jobctx *ctx, int64_t job, const ag_job_p
     ag_usecase_proceduralize_params up = {
         .max_triangles = ag_work_limits_resolved(env.limits).max_triangles};
     up.label.exact_copies = pj->exact;
+    up.label.metres_per_unit = pj->metres_per_unit;
     if (s == AG_OK && cloud)
         s = ag_cloud_pipeline_proceduralize ? ag_cloud_pipeline_proceduralize(&w.ws, pj->cloud, err)
                                             : ag_cloud_pipeline_missing(pj->model, "proceduralize",

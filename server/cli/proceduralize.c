@@ -1,4 +1,4 @@
-/* archgram proceduralize IN --out DIR [--up auto|y|z] [--tolerance REL] [--exact]
+/* archgram proceduralize IN --out DIR [--up auto|y|z] [--unit U] [--tolerance REL] [--exact]
  *                          [--keep-groups]
  *
  * The proceduralize use case (app/usecase_proceduralize.h) from a mesh file into a folder
@@ -12,8 +12,8 @@
 #include "commands.h"
 
 #define USAGE                                                                                 \
-    "usage: archgram proceduralize IN --out DIR [--up auto|y|z] [--tolerance REL] [--exact]\n" \
-    "                              [--keep-groups]\n"
+    "usage: archgram proceduralize IN --out DIR [--up auto|y|z] [--unit U] [--tolerance REL]\n" \
+    "                              [--exact] [--keep-groups]\n"
 
 static int usage(void)
 {
@@ -39,6 +39,11 @@ int ag_cli_proceduralize(int argc, char **argv)
                 fputs("archgram: --up takes auto, y or z\n", stderr);
                 return 2;
             }
+        } else if (!strcmp(argv[i], "--unit")) {
+            if (++i >= argc || ag_units_named(argv[i], &p.label.metres_per_unit)) {
+                fputs("archgram: --unit takes " AG_UNITS_NAMES "\n", stderr);
+                return 2;
+            }
         } else if (!strcmp(argv[i], "--tolerance")) {
             char *e;
             if (++i >= argc || (p.label.tolerance = strtod(argv[i], &e), *e) ||
@@ -54,6 +59,9 @@ int ag_cli_proceduralize(int argc, char **argv)
             fputs(USAGE
                   "  --up auto|y|z    the file's up axis (auto: the format's, else the "
                   "content's)\n"
+                  "  --unit U         the length unit of the file's coordinates: " AG_UNITS_NAMES
+                  "\n                   (default: metres or millimetres, decided from the "
+                  "content; FBX is read in m)\n"
                   "  --tolerance REL  labels and shared terminals, relative to the diagonal "
                   "(default 2e-4, at most 5 mm)\n"
                   "  --exact          share terminals between exact copies only: every "

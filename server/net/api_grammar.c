@@ -33,40 +33,37 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
 {
     ag_error err;
     ag_error_clear(&err);
-    /* an empty body, {} or {"exact": true|false}; any other member goes to the app, which
-     * knows a point cloud's options (app/points_proc_options.h) */
-    int exact = 0;
-    json_t *cloud = NULL;
+    /* an empty body, {} or a mesh's {"exact": true|false, "unit": "mm"}; any other member
+     * goes to the app, which knows a point cloud's options (app/points_proc_options.h) */
+    ag_app_mesh_proc_options mesh = {0};
+    json_t *cloud = NULL, *body = NULL;
     if (r->body_len) {
-        json_t *body;
         ag_status s = ag_request_json(r, &body, &err);
         if (s != AG_OK)
             return ag_reply_problem(r, s, &err);
-        const char *key = NULL, *bad = NULL;
+        const char *key = NULL;
         json_t *v;
         json_object_foreach(body, key, v) {
-            if (!strcmp(key, "exact") && json_is_boolean(v)) {
-                exact = json_is_true(v);
-            } else if (strcmp(key, "exact")) {
+            if (!strcmp(key, "exact")) {
+                if (!json_is_boolean(v)) {
+                    ag_error_set(&err, AG_ERR_INVALID, 0, "\"exact\" takes true or false");
+                    break;
+                }
+                mesh.exact = json_is_true(v);
+            } else if (!strcmp(key, "unit")) {
+                /* not a string: no unit's name, which the app refuses naming the units */
+                mesh.unit = json_is_string(v) ? json_string_value(v) : "";
+            } else {
                 if (!cloud)
                     cloud = json_object();
                 json_object_set(cloud, key, v);
-            } else {
-                bad = key;
-                break;
             }
         }
-        if (bad && !strcmp(bad, "exact"))
-            ag_error_set(&err, AG_ERR_INVALID, 0, "\"exact\" takes true or false");
-        else if (bad)
-            ag_error_set(&err, AG_ERR_INVALID, 0, "\"%s\" is not an option of proceduralize",
-                         bad);
-        if (bad) {
+        if (err.code != AG_OK) {
             json_decref(cloud);
             json_decref(body);
             return ag_reply_problem(r, AG_ERR_INVALID, &err);
         }
-        json_decref(body);
     }
     int64_t current, base;
     ag_status s = ag_app_query_version(r->cfg->app, r->ids[0], &current, &err);
@@ -74,9 +71,10 @@ enum MHD_Result ag_api_model_proceduralize(ag_request *r)
         s = if_match(r, 0, current, &base, &err);
     int64_t job = 0;
     if (s == AG_OK)
-        s = ag_app_jobs_proceduralize(r->cfg->app, &r->who, r->ids[0], &current, exact, cloud,
+        s = ag_app_jobs_proceduralize(r->cfg->app, &r->who, r->ids[0], &current, &mesh, cloud,
                                       &job, &err);
     json_decref(cloud);
+    json_decref(body); /* after the job took mesh.unit */
     if (s != AG_OK)
         return ag_reply_problem(r, s, &err);
     return ag_reply_new_job(r, s, job, &err);

@@ -59,3 +59,30 @@ test('--exact shares terminals between exact copies only and derives the input b
     removeDir(dir);
   }
 });
+
+test('--unit names the file\'s length unit: reported as the request\'s, the tolerance cap follows it; a bad name is a usage error', () => {
+  const dir = tempDir();
+  try {
+    // the facade in centimetres: its size does not tell (taken as metres unless named)
+    const obj = path.join(dir, 'facade_cm.obj');
+    fs.writeFileSync(obj, facadeObj(4, 2).replace(/^v (\S+) (\S+) (\S+)/gm,
+      (_, x, y, z) => `v ${x * 100} ${y * 100} ${z * 100}`));
+    const decided = path.join(dir, 'd'), named = path.join(dir, 'n');
+    assert.equal(run('proceduralize', obj, '--out', decided).status, 0);
+    const r = run('proceduralize', obj, '--out', named, '--unit', 'cm');
+    assert.equal(r.status, 0, r.stderr);
+    const d = summary(decided).labeling, n = summary(named).labeling;
+    assert.equal(d.units.decided, 'content');
+    assert.equal(n.units.unit, 'cm');
+    assert.equal(n.units.metres_per_unit, 0.01);
+    assert.equal(n.units.decided, 'request');
+    assert.match(r.stdout, /units cm, request/);
+    // the cap of 5 mm is 0.5 cm: never more than that in the file's unit
+    assert.ok(n.tolerance <= 0.5 + 1e-12, JSON.stringify(n));
+    const bad = run('proceduralize', obj, '--out', path.join(dir, 'bad'), '--unit', 'yd');
+    assert.equal(bad.status, 2);
+    assert.match(bad.stderr, /--unit takes m, dm, cm, mm, ft or in/);
+  } finally {
+    removeDir(dir);
+  }
+});

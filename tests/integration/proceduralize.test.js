@@ -277,17 +277,19 @@ describe('proceduralization over REST and websockets', () => {
     assert.equal((await getModel()).version, model.version);
   });
 
-  it('the body takes exact (a boolean) and nothing else; exact copies derive the input back', async () => {
+  it('the body takes exact (a boolean) and unit (a length unit) and nothing else; exact copies derive the input back', async () => {
     const m = await importModel(d, facadeObj(3, 2), { name: 'exact' });
     for (const [body, detail] of [[{ exact: 'yes' }, '"exact" takes true or false'],
-      [{ tolerance: 1 }, '"tolerance" is not an option of proceduralize']]) {
+      [{ tolerance: 1 }, '"tolerance" is not an option of proceduralize'],
+      [{ unit: 'yd' }, '"unit": the length unit of the mesh, m, dm, cm, mm, ft or in (or left out: decided from the content)'],
+      [{ unit: 5 }, '"unit": the length unit of the mesh, m, dm, cm, mm, ft or in (or left out: decided from the content)']]) {
       const r = await http(d, 'POST', `/api/v1/models/${m.id}/proceduralize`, { body });
       assert.ok(r.status >= 400 && r.status < 500, r.text);
       assert.equal(r.headers.get('content-type'), 'application/problem+json');
       assert.equal(r.json.detail, detail);
     }
     assert.equal((await getModel(m.id)).version, m.version, 'a refused request stores nothing');
-    const r = await http(d, 'POST', `/api/v1/models/${m.id}/proceduralize`, { body: { exact: true } });
+    const r = await http(d, 'POST', `/api/v1/models/${m.id}/proceduralize`, { body: { exact: true, unit: 'm' } });
     assert.equal(r.status, 202, r.text);
     const job = await waitJob(d, r.json.id);
     assert.equal(job.status, 'succeeded', JSON.stringify(job));

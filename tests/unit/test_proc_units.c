@@ -229,12 +229,36 @@ static void test_decision(void **state)
     assert_true(u.given);
 }
 
+/* A unit a person names: each name gives its size and reads back as given with that name;
+ * anything else is refused. */
+static void test_named(void **state)
+{
+    (void)state;
+    static const char *names[] = {"m", "dm", "cm", "mm", "ft", "in"};
+    static const double metres[] = {1, 0.1, 0.01, 0.001, 0.3048, 0.0254};
+    for (int i = 0; i < 6; i++) {
+        double m = 0;
+        assert_int_equal(ag_units_named(names[i], &m), 0);
+        assert_true(m == metres[i]);
+        ag_units u = ag_units_given(m);
+        assert_string_equal(u.name, names[i]);
+        assert_true(u.metres_per_unit == metres[i] && u.given);
+    }
+    double m = 7;
+    assert_int_equal(ag_units_named("yd", &m), -1);
+    assert_int_equal(ag_units_named("", &m), -1);
+    assert_int_equal(ag_units_named("MM", &m), -1);
+    assert_int_equal(ag_units_named(NULL, &m), -1);
+    assert_true(m == 7);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_small_building_at_every_scale),
         cmocka_unit_test(test_capped_building_at_every_scale),
         cmocka_unit_test(test_decision),
+        cmocka_unit_test(test_named),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -36,7 +36,8 @@ typedef struct {
      * AG_PROC_LABEL_TOLERANCE of the diagonal but at most AG_PROC_LABEL_TOLERANCE_MAX metres
      * (in the model's unit, see units.h) */
     double tolerance;
-    double metres_per_unit; /* the model's unit: 1 or 0.001; 0 = decided from the content */
+    double metres_per_unit; /* the model's unit (units.h ag_units_named); 0 = decided from the
+                             * content (metres or millimetres) */
     double exact;     /* exact copies: relative to the model diagonal; 0 = 1e-7 */
     int no_rotation;  /* non-zero: neither turns, orientations nor mirror images match */
     int exact_copies; /* non-zero: terminals are shared by exact copies only */

@@ -1,6 +1,7 @@
 #include "units.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 static int by_value(const void *a, const void *b)
 {
@@ -8,13 +9,31 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The units a person may name: the metric ones and the two of US and UK building plans. */
+static const struct {
+    const char *name;
+    double metres;
+} named[] = {{"m", 1.0},     {"dm", 0.1},     {"cm", 0.01},
+             {"mm", 0.001},  {"ft", 0.3048},  {"in", 0.0254}};
+
+int ag_units_named(const char *name, double *metres_per_unit)
+{
+    for (size_t i = 0; name && i < sizeof named / sizeof *named; i++)
+        if (strcmp(name, named[i].name) == 0) {
+            *metres_per_unit = named[i].metres;
+            return 0;
+        }
+    return -1;
+}
+
 ag_units ag_units_given(double metres_per_unit)
 {
     ag_units u = {.metres_per_unit = 1.0, .name = "m", .given = 1};
-    if (metres_per_unit == 0.001) {
-        u.metres_per_unit = 0.001;
-        u.name = "mm";
-    }
+    for (size_t i = 0; i < sizeof named / sizeof *named; i++)
+        if (metres_per_unit == named[i].metres) {
+            u.metres_per_unit = named[i].metres;
+            u.name = named[i].name;
+        }
     return u;
 }
 
