@@ -26,9 +26,6 @@ static const char *kind_name(int k)
     }
 }
 
-/* A dead node's box: it keeps only its id (the stored model keeps nothing else of it). */
-static const ag_box no_box;
-
 static json_t *box_json(const ag_box *b)
 {
     json_t *a = json_array();
@@ -137,13 +134,18 @@ static json_t *served(const ag_edit_model *em, int with_nodes)
         json_array_append_new(nodes, o);
         int dead = x->kind == AG_NODE_DEAD;
         live += !dead;
+        if (o && dead) { /* only its id: see the header */
+            json_object_set_new(o, "id", json_integer((json_int_t)n));
+            json_object_set_new(o, "kind", json_string(kind_name(x->kind)));
+            continue;
+        }
         if (o) {
             json_object_set_new(o, "id", json_integer((json_int_t)n));
             json_object_set_new(o, "parent",
-                                !dead && x->parent >= 0 ? json_integer(x->parent) : json_null());
-            json_object_set_new(o, "children", dead ? json_array() : children_json(t, x));
+                                x->parent >= 0 ? json_integer(x->parent) : json_null());
+            json_object_set_new(o, "children", children_json(t, x));
             json_object_set_new(o, "kind", json_string(kind_name(x->kind)));
-            json_object_set_new(o, "box", box_json(dead ? &no_box : &x->box));
+            json_object_set_new(o, "box", box_json(&x->box));
             json_object_set_new(o, "visible", json_boolean(x->kind == AG_NODE_COMPONENT));
         }
         const ag_pattern *p = dead ? NULL : pattern_of(t, x);
@@ -367,18 +369,21 @@ static void out_node(text_out *o, const ag_proceduralize_result *r, size_t n)
     int dead = x->kind == AG_NODE_DEAD;
     OUT_LIT(o, "{\"id\":");
     out_int(o, (long long)n);
+    if (dead) { /* only its id: after many edits most of a tree's ids are dead ones */
+        OUT_LIT(o, ",\"kind\":\"dead\"}");
+        return;
+    }
     OUT_LIT(o, ",\"parent\":");
-    if (!dead && x->parent >= 0)
+    if (x->parent >= 0)
         out_int(o, x->parent);
     else
         OUT_LIT(o, "null");
     OUT_LIT(o, ",\"children\":[");
-    if (!dead)
-        for (int32_t c = x->first_child; c >= 0; c = t->nodes[c].next_sibling) {
-            if (c != x->first_child)
-                OUT_LIT(o, ",");
-            out_int(o, c);
-        }
+    for (int32_t c = x->first_child; c >= 0; c = t->nodes[c].next_sibling) {
+        if (c != x->first_child)
+            OUT_LIT(o, ",");
+        out_int(o, c);
+    }
     OUT_LIT(o, "],\"kind\":\"");
     const char *k = kind_name(x->kind);
     out_str(o, k, strlen(k));
@@ -386,19 +391,19 @@ static void out_node(text_out *o, const ag_proceduralize_result *r, size_t n)
     for (int a = 0; a < 6; a++) {
         if (a)
             OUT_LIT(o, ",");
-        out_real(o, dead ? 0 : a < 3 ? x->box.min[a] : x->box.max[a - 3]);
+        out_real(o, a < 3 ? x->box.min[a] : x->box.max[a - 3]);
     }
     OUT_LIT(o, "],\"visible\":");
     if (x->kind == AG_NODE_COMPONENT)
         OUT_LIT(o, "true");
     else
         OUT_LIT(o, "false");
-    const ag_pattern *p = dead ? NULL : pattern_of(t, x);
+    const ag_pattern *p = pattern_of(t, x);
     char fallback[32];
     OUT_LIT(o, ",\"label\":");
     out_name(o, x->kind == AG_NODE_COMPONENT ? label_of(r, x, fallback) : NULL);
     OUT_LIT(o, ",\"rule\":");
-    out_name(o, rule_name(r, dead ? -1 : p ? p->rule : x->rule));
+    out_name(o, rule_name(r, p ? p->rule : x->rule));
     OUT_LIT(o, ",\"terminal\":");
     out_name(o, x->kind == AG_NODE_COMPONENT ? terminal_name(r, x) : NULL);
     OUT_LIT(o, ",\"component\":");
@@ -425,7 +430,10 @@ char *ag_model_tree_served_text(const ag_edit_model *em)
     }
     const ag_splittree *t = em->proc->tree;
     text_out o = {0};
-    out_reserve(&o, 256 * t->nnodes + strlen(tail) + 64);
+    size_t dead = 0;
+    for (size_t n = 0; n < t->nnodes; n++)
+        dead += t->nodes[n].kind == AG_NODE_DEAD;
+    out_reserve(&o, 256 * (t->nnodes - dead) + 32 * dead + strlen(tail) + 64);
     OUT_LIT(&o, "{\"root\":0,\"nodes\":[");
     for (size_t n = 0; n < t->nnodes && !o.fail; n++) {
         if (n)

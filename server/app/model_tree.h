@@ -6,7 +6,8 @@
  * are all these indices, and a workspace keeps what it needs to rebuild the same edit model
  * (app/model_state.h), so the numbering survives a reload. Nodes that proceduralization
  * removed while it restructured the tree (cells moved under a pattern) keep their index: the
- * served tree lists them as kind "dead" with no parent and no children, so nodes[i].id == i.
+ * served tree lists them as {"id","kind":"dead"} and nothing more (after many edits most ids
+ * are dead ones: listed whole they were most of the text), so nodes[i].id == i.
  *
  * A visible node's label is the group of its component in the model's mesh, which names
  * labels as the model's grammar does (app/model_state.h); rules are the edit model's grammar

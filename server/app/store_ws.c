@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "../io/edit_op_json.h"
 #include "../io/meshblob.h"
@@ -144,6 +145,7 @@ ag_status ag__store_ws_put_grammar(ag_db *db, int64_t model, int64_t version, co
 typedef struct {
     const ag_edit_model *em;
     char *tree;
+    double tree_ms, mesh_ms; /* printing the tree, encoding the mesh */
     pthread_t printer;
     int threaded;
     uint8_t *blob;
@@ -152,10 +154,19 @@ typedef struct {
     ag_status mesh_status;
 } encoded_state;
 
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
 static void *print_tree(void *arg)
 {
     encoded_state *e = arg;
+    double t0 = now_ms();
     e->tree = ag_model_kept_tree_text(e->em); /* a reload gives this model back */
+    e->tree_ms = now_ms() - t0;
     return NULL;
 }
 
@@ -166,7 +177,9 @@ static void encode_state(const ag_model_state *st, encoded_state *e, ag_error *e
     e->threaded = pthread_create(&e->printer, NULL, print_tree, e) == 0;
     if (!e->threaded)
         print_tree(e);
+    double t0 = now_ms();
     e->mesh_status = encode_mesh(st->em->proc->mesh, &e->blob, &e->blob_len, &e->stats, err);
+    e->mesh_ms = now_ms() - t0;
 }
 
 /* The tree text, once printed. */
@@ -401,18 +414,28 @@ static ag_status commit_change(ag_store_ws *w, ag_model_state *st, json_t *body,
     }
     ag_seq_txn t;
     int dup = 0;
+    double t_begin = now_ms();
     ag_status s = ag__store_ws_begin(w, "edited", 1, &t, &dup, err);
     if (s != AG_OK || dup) {
         encoded_clear(&e);
         return s;
     }
+    double t_locked = now_ms();
     s = ag_states_keep(t.db, w->o.model, t.version - 1, err);
     if (s == AG_OK)
         s = write_state(t.db, w->o.model, t.version, st, &e, summary, 1, err);
+    double t_tree = e.tree_ms, t_mesh = e.mesh_ms;
     encoded_clear(&e);
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
         s = ag_grammars_put_terminal(t.db, w->o.model, st->terms.path[i], st->terms.obj[i],
                                      st->terms.len[i], err);
+    /* the commit's stages up to here, for the op log (bench/parts reads them) */
+    json_t *report = json_object_get(body, "report");
+    if (s == AG_OK && json_is_object(report))
+        json_object_set_new(report, "commit",
+                            json_pack("{s:f, s:f, s:f, s:f}", "tree_ms", t_tree, "mesh_ms",
+                                      t_mesh, "lock_ms", t_locked - t_begin, "writes_ms",
+                                      now_ms() - t_locked));
     int64_t v = t.version;
     if (s == AG_OK)
         s = ag_sequencer_commit(&t, w->o.author, w->o.cid, body, err);

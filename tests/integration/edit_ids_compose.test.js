@@ -106,7 +106,9 @@ describe('ids held by another client survive resize, paste, a proceduralized com
     const paste = await A.request({ type: 'op', base: t1.version, cid: 'paste', op: { kind: 'paste', source: [w5.id], target: w6.id, placement: 'replace', fit: 'derive' } }, reply('paste'), 60000);
     assert.equal(paste.type, 'ack', JSON.stringify(paste));
     const t2 = await tree(b.id);
-    assert.equal(t2.nodes[w6.id].kind, 'dead');
+    // the replaced window keeps its id, served as the id alone; every id still indexes nodes
+    assert.deepEqual(t2.nodes[w6.id], { id: w6.id, kind: 'dead' });
+    t2.nodes.forEach((n, i) => assert.equal(n.id, i));
     keptAlone(t1, t2, below(t1, w6.id), 'paste');
     stillHeld(t2, 'paste');
 
@@ -119,6 +121,7 @@ describe('ids held by another client survive resize, paste, a proceduralized com
     assert.equal(report.state, 'proceduralized', JSON.stringify(report));
     assert.match(report.fallback, /node/);
     const t3 = await tree(b.id);
+    t3.nodes.forEach((n, i) => assert.ok(n.id === i && (n.kind !== 'dead' || Object.keys(n).length === 2), JSON.stringify(n)));
     const kept = keptAlone(t2, t3, new Set(), 'compose (proceduralized)');
     assert.equal(kept, t2.nodes.filter((n) => n.visible).length);
     const added = t3.nodes.filter((n) => n.visible && !(t2.nodes[n.id]?.visible));

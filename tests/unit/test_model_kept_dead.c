@@ -3,7 +3,8 @@
  * every id where it was (each node of the same kind, live nodes with the same links and box),
  * the dead nodes cost the text almost nothing, a node added after the reload takes an id past
  * every old one (ids are never reused), and the same model written in format 3 (every dead
- * node a whole record, as stores from before keep it) still reloads the same. */
+ * node a whole record, as stores from before keep it) still reloads the same; the served tree
+ * lists each dead node as its id alone. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -18,6 +19,7 @@
 #include <sodium.h>
 
 #include "app/model_kept.h"
+#include "app/model_tree.h"
 #include "core/edit/edit.h"
 #include "core/proc/proceduralize.h"
 #include "edit_building_fixture.h"
@@ -210,10 +212,72 @@ static void many_dead_nodes_keep_their_ids(void **state)
     ag_mesh_free(m);
 }
 
+/* The served tree of the same model: nodes[i].id == i for every id, each dead node exactly
+ * {"id":i,"kind":"dead"} (as the tree says, read independently of the printer), every live
+ * node whole with the links of the tree, and the dead nodes a few bytes each. */
+static void served_dead_nodes_are_their_ids_only(void **state)
+{
+    (void)state;
+    size_t nv;
+    ag_mesh *m = bb_generate(&bb_id_variants(&nv)[0]);
+    ag_edit_model *em = NULL;
+    ag_error err = {0};
+    assert_int_equal(ag_edit_model_create(m, NULL, &em, &err), AG_OK);
+    ag_splittree *t = em->proc->tree;
+    size_t live_before = t->nnodes - count_dead(t);
+    char *small = ag_model_tree_served_text(em);
+    assert_non_null(small);
+    for (size_t i = 0; i < EXTRA_DEAD; i++)
+        assert_true(ag_splittree_add_node(t, AG_NODE_DEAD) >= 0);
+    char *text = ag_model_tree_served_text(em);
+    assert_non_null(text);
+    /* 100,000 more dead ids: at most 32 bytes each ({"id":123456,"kind":"dead"}, and a comma) */
+    if (strlen(text) > strlen(small) + 32 * (size_t)EXTRA_DEAD)
+        fail_msg("the served tree grew by %zu bytes for %d dead nodes",
+                 strlen(text) - strlen(small), EXTRA_DEAD);
+    json_t *doc = json_loads(text, 0, NULL);
+    assert_non_null(doc);
+    json_t *nodes = json_object_get(doc, "nodes");
+    assert_int_equal(json_array_size(nodes), t->nnodes);
+    size_t live = 0;
+    for (size_t i = 0; i < t->nnodes; i++) {
+        json_t *jn = json_array_get(nodes, i);
+        assert_int_equal(json_integer_value(json_object_get(jn, "id")), (json_int_t)i);
+        const char *kind = json_string_value(json_object_get(jn, "kind"));
+        assert_non_null(kind);
+        if (t->nodes[i].kind == AG_NODE_DEAD) {
+            assert_string_equal(kind, "dead");
+            assert_int_equal(json_object_size(jn), 2);
+            continue;
+        }
+        live++;
+        assert_true(strcmp(kind, "dead") != 0);
+        json_t *parent = json_object_get(jn, "parent");
+        assert_int_equal(json_is_null(parent) ? -1 : json_integer_value(parent),
+                         t->nodes[i].parent);
+        size_t nc = 0;
+        for (int32_t c = t->nodes[i].first_child; c >= 0; c = t->nodes[c].next_sibling)
+            assert_int_equal(json_integer_value(json_array_get(json_object_get(jn, "children"),
+                                                               nc++)),
+                             c);
+        assert_int_equal(json_array_size(json_object_get(jn, "children")), nc);
+        assert_int_equal(json_array_size(json_object_get(jn, "box")), 6);
+    }
+    assert_int_equal(live, live_before);
+    assert_int_equal(json_integer_value(json_object_get(json_object_get(doc, "stats"), "nodes")),
+                     (json_int_t)live);
+    json_decref(doc);
+    free(text);
+    free(small);
+    ag_edit_model_free(em);
+    ag_mesh_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(many_dead_nodes_keep_their_ids),
+        cmocka_unit_test(served_dead_nodes_are_their_ids_only),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
