@@ -454,7 +454,19 @@ static void bench_compose(const ag_proceduralize_result *r, const ag_part *p, in
            ms[0]);
 }
 
-int main(void)
+/* Which parts run: all, or those named in the arguments (core, save, compose, search), so a
+ * profile can look at one. */
+static int runs_part(int argc, char **argv, const char *name)
+{
+    if (argc < 2)
+        return 1;
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], name))
+            return 1;
+    return 0;
+}
+
+int main(int argc, char **argv)
 {
     ag_heap_keep_large_blocks(); /* as archgramd runs */
     /* every box its own component: 1720 windows of 9 boxes on three facades, a blank back */
@@ -478,6 +490,7 @@ int main(void)
     picks k = pick(r->tree);
     int32_t rep = k.rep, big = k.big, leaf = k.leaf, side = k.side;
     ag_part *small = NULL, *facade = NULL;
+    if (runs_part(argc, argv, "core")) {
     bench_save(r, rep, "a window piece (most repeated)", &small);
     bench_save(r, big, "a facade with its windows", &facade);
     bench_compose(r, small, rep, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE, "window piece into its rule");
@@ -486,6 +499,7 @@ int main(void)
     bench_compose(r, small, leaf, AG_COMPOSE_FILL, AG_COMPOSE_NODE, "window piece filling a wall");
     bench_compose(r, facade, leaf, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, "facade onto the blank wall");
     bench_compose(r, facade, side, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, "facade onto a narrower wall");
+    }
     ag_part_free(small);
     ag_part_free(facade);
     ag_proceduralize_result_free(r);
@@ -493,13 +507,19 @@ int main(void)
     service sv;
     service_open(&sv, m);
     picks sk = service_picks(&sv);
-    int64_t piece = service_save(&sv, sk.rep, "a window piece (most repeated)");
-    int64_t facade_part = service_save(&sv, sk.big, "a facade with its windows");
-    service_compose(&sv, piece, 0, "replace", "rule", "window piece into its rule");
-    service_compose(&sv, piece, 0, "replace", "node", "window piece into one node");
-    service_compose(&sv, facade_part, 2, "replace", "node", "facade onto the blank wall");
-    service_compose(&sv, piece, 2, "fill", "node", "window piece filling a wall");
-    bench_search(&sv);
+    int compose = runs_part(argc, argv, "compose");
+    if (compose || runs_part(argc, argv, "save")) {
+        int64_t piece = service_save(&sv, sk.rep, "a window piece (most repeated)");
+        int64_t facade_part = service_save(&sv, sk.big, "a facade with its windows");
+        if (compose) {
+            service_compose(&sv, piece, 0, "replace", "rule", "window piece into its rule");
+            service_compose(&sv, piece, 0, "replace", "node", "window piece into one node");
+            service_compose(&sv, facade_part, 2, "replace", "node", "facade onto the blank wall");
+            service_compose(&sv, piece, 2, "fill", "node", "window piece filling a wall");
+        }
+    }
+    if (runs_part(argc, argv, "search"))
+        bench_search(&sv);
     service_close(&sv);
     ag_mesh_free(m);
     return 0;

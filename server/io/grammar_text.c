@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "../core/base/array.h"
+#include "numtext.h"
 
 /* ---- printing --------------------------------------------------------------------------- */
 
@@ -43,13 +44,28 @@ static void sput(sbuf *s, const char *fmt, ...)
     }
 }
 
+/* "%.12g" (numtext's, byte for byte and many times faster: a facade part prints ~100k). */
 static void num(char *b, size_t cap, double v)
 {
     if (v == 0)
         v = 0; /* no "-0" */
-    snprintf(b, cap, "%.12g", v);
-    if (!strcmp(b, "-0"))
-        snprintf(b, cap, "0");
+    char t[AG_NUMTEXT_MAX];
+    ag_numtext_double_g(t, v, 12);
+    snprintf(b, cap, "%s", strcmp(t, "-0") ? t : "0");
+}
+
+/* Appends n bytes (no format: the numbers are the bulk of a large grammar's text). */
+static void sput_bytes(sbuf *s, const char *text, size_t n)
+{
+    if (s->oom)
+        return;
+    if (s->len + n + 1 > s->cap && AG_ARRAY_RESERVE_MORE(s->buf, s->cap, s->len, n + 1)) {
+        s->oom = 1;
+        return;
+    }
+    memcpy(s->buf + s->len, text, n);
+    s->len += n;
+    s->buf[s->len] = '\0';
 }
 
 static void put_nums(sbuf *s, const double *v, int n, const char *sep)
@@ -57,7 +73,9 @@ static void put_nums(sbuf *s, const double *v, int n, const char *sep)
     char b[40];
     for (int i = 0; i < n; i++) {
         num(b, sizeof b, v[i]);
-        sput(s, "%s%s", i ? sep : "", b);
+        if (i)
+            sput_bytes(s, sep, strlen(sep));
+        sput_bytes(s, b, strlen(b));
     }
 }
 

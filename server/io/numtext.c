@@ -155,13 +155,21 @@ size_t ag_numtext_double(char *out, double v)
     return n;
 }
 
-size_t ag_numtext_double_g15(char *out, double v)
+/* What snprintf "%.*g" writes with prec (1 to 15) digits: plain notation, printf's own
+ * decision, for decimal exponents from -4 to below prec. */
+static size_t printf_g(char *out, double v, int prec)
 {
+    int n = snprintf(out, AG_NUMTEXT_MAX, "%.*g", prec, v);
+    return n > 0 ? (size_t)n : 0;
+}
+
+size_t ag_numtext_double_g(char *out, double v, int prec)
+{
+    if (prec < 1 || prec > 15)
+        return printf_g(out, v, prec < 1 ? 1 : 17);
     double a = fabs(v);
-    if (!(a >= 1e-4 && a < 1e15)) { /* exponent notation, zero, NaN and inf: printf's */
-        int n = snprintf(out, AG_NUMTEXT_MAX, "%.15g", v);
-        return n > 0 ? (size_t)n : 0;
-    }
+    if (!(a >= 1e-4 && a < pow10_double[prec + 6])) /* exponent notation, zero, NaN, inf */
+        return printf_g(out, v, prec);
     uint64_t bits;
     memcpy(&bits, &a, sizeof bits);
     int be = (int)(bits >> 52); /* a >= 1e-4: normal */
@@ -170,26 +178,22 @@ size_t ag_numtext_double_g15(char *out, double v)
     /* x = floor(log10(a)), estimated; a wrong estimate gives digits out of [1e14, 1e15)
      * below and goes to printf */
     int x = (int)floor(log10(a));
-    int s = 14 - x; /* a * 10^s has 15 digits before the point */
-    if (s < 0 || s > 18) {
-        int n = snprintf(out, AG_NUMTEXT_MAX, "%.15g", v);
-        return n > 0 ? (size_t)n : 0;
-    }
+    int s = prec - 1 - x; /* a * 10^s has prec digits before the point */
+    if (s < 0 || s > 18)
+        return printf_g(out, v, prec);
     u128 q = (u128)m * pow10_u64[s]; /* < 2^53 * 10^18 < 2^113 */
     u128 rem = q & (((u128)1 << sh) - 1), half = (u128)1 << (sh - 1);
     uint64_t d = (uint64_t)(q >> sh);
-    int below = d < pow10_u64[14]; /* the estimate was one too high */
+    int below = d < pow10_u64[prec - 1]; /* the estimate was one too high */
     if (rem > half)
         d++;
-    if (rem == half || below || d >= pow10_u64[15]) {
+    if (rem == half || below || d >= pow10_u64[prec])
         /* a tie (the rounding mode decides), the estimate off next to a power of ten, or
          * rounding up to the next power of ten */
-        int n = snprintf(out, AG_NUMTEXT_MAX, "%.15g", v);
-        return n > 0 ? (size_t)n : 0;
-    }
+        return printf_g(out, v, prec);
     char dg[24];
-    ag_numtext_u64(dg, d); /* 15 digits */
-    int nd = 15;
+    ag_numtext_u64(dg, d); /* prec digits */
+    int nd = prec;
     while (nd > 1 && dg[nd - 1] == '0')
         nd--;
     size_t n = 0;
@@ -214,4 +218,9 @@ size_t ag_numtext_double_g15(char *out, double v)
     }
     out[n] = '\0';
     return n;
+}
+
+size_t ag_numtext_double_g15(char *out, double v)
+{
+    return ag_numtext_double_g(out, v, 15);
 }

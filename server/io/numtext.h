@@ -26,6 +26,8 @@ size_t ag_numtext_double(char *out, double v);
  * by the rounding mode), go to snprintf itself. For writers of large JSON files (jansson's
  * REAL_PRECISION(15) prints "%.15g"), where snprintf takes most of the time. */
 size_t ag_numtext_double_g15(char *out, double v);
+/* The same for prec digits, 1 to 15 ("%.*g"; the grammar text prints "%.12g"). */
+size_t ag_numtext_double_g(char *out, double v, int prec);
 /* Writes v in decimal to out (AG_NUMTEXT_MAX bytes) with a NUL; returns the length. */
 size_t ag_numtext_u64(char *out, uint64_t v);
 

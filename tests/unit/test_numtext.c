@@ -210,7 +210,8 @@ static void test_round_trip(void **state_)
            "longer than printf's shortest\n", checked, plain);
 }
 
-/* ag_numtext_double_g15 prints what "%.15g" prints, byte for byte */
+/* ag_numtext_double_g15 prints what "%.15g" prints, byte for byte; ag_numtext_double_g
+ * what "%.*g" prints at every precision from 1 to 15 (the grammar text's is 12) */
 static size_t g15_checked;
 static void check_g15(double v)
 {
@@ -219,6 +220,12 @@ static void check_g15(double v)
     snprintf(b, sizeof b, "%.15g", v);
     if (strcmp(a, b) || n != strlen(b))
         fail_msg("%.17g: \"%s\" instead of printf's \"%s\"", v, a, b);
+    for (int prec = 1; prec <= 15; prec++) {
+        n = ag_numtext_double_g(a, v, prec);
+        snprintf(b, sizeof b, "%.*g", prec, v);
+        if (strcmp(a, b) || n != strlen(b))
+            fail_msg("%.17g at %d digits: \"%s\" instead of printf's \"%s\"", v, prec, a, b);
+    }
     g15_checked++;
 }
 
