@@ -356,6 +356,62 @@ static void test_pile_of_duplicates(void **state)
     ag_cloud_free(c);
 }
 
+/* A cloud written twice over (exact copies, copies 1e-9 m off, each point next to its copy)
+ * segments as the cloud itself: every copy in its original's segment, the same segments and
+ * labels, each segment twice its points. Buildings recessed, proud, turned and at UTM. */
+static void test_copies_change_nothing(void **state)
+{
+    (void)state;
+    const ag_gen_building_options variants[] = {
+        {.points = 30000, .seed = 5},
+        {.points = 30000, .window = AG_GEN_WINDOW_PROUD, .rotation = 23, .seed = 6},
+        {.points = 30000, .window = AG_GEN_WINDOW_FLUSH, .origin = {500000, 5.8e6, 0}, .seed = 7},
+    };
+    for (size_t v = 0; v < sizeof variants / sizeof *variants; v++) {
+        ag_cloud *one;
+        assert_int_equal(ag_gen_building(&variants[v], &one, NULL), AG_OK);
+        ag_segment_cloud_result *ro;
+        assert_int_equal(ag_segment_cloud_run(one, NULL, &ro, NULL), AG_OK);
+        size_t n = one->n;
+        for (int how = 0; how < 3; how++) {
+            ag_cloud *two = ag_cloud_create();
+            assert_int_equal(ag_cloud_resize(two, 2 * n, NULL), AG_OK);
+            two->offset[0] = one->offset[0];
+            two->offset[1] = one->offset[1];
+            two->offset[2] = one->offset[2];
+            /* where point i and its copy are */
+            size_t first[2] = {0, n}, step = 1;
+            if (how == 2) {
+                first[1] = 1;
+                step = 2;
+            }
+            for (size_t i = 0; i < n; i++)
+                for (int k = 0; k < 3; k++) {
+                    double x = one->xyz[3 * i + k];
+                    two->xyz[3 * (first[0] + step * i) + k] = x;
+                    two->xyz[3 * (first[1] + step * i) + k] = how == 1 ? x + 1e-9 : x;
+                }
+            ag_segment_cloud_result *rt;
+            assert_int_equal(ag_segment_cloud_run(two, NULL, &rt, NULL), AG_OK);
+            assert_int_equal(rt->nsegments, ro->nsegments);
+            assert_int_equal(rt->nplanes, ro->nplanes);
+            assert_int_equal(rt->nlabels, ro->nlabels);
+            for (size_t i = 0; i < n; i++) {
+                assert_int_equal(rt->segment[first[0] + step * i], ro->segment[i]);
+                assert_int_equal(rt->segment[first[1] + step * i], ro->segment[i]);
+                assert_int_equal(rt->label[first[1] + step * i], ro->label[i]);
+            }
+            for (size_t s = 0; s < ro->nsegments; s++)
+                assert_int_equal(rt->segments[s].count, 2 * ro->segments[s].count);
+            assert_non_null(two->normals); /* the copies got their original's normals */
+            ag_segment_cloud_free(rt);
+            ag_cloud_free(two);
+        }
+        ag_segment_cloud_free(ro);
+        ag_cloud_free(one);
+    }
+}
+
 static void test_cgal_building(void **state)
 {
     (void)state;
@@ -399,6 +455,7 @@ int main(void)
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_hard_cases),
         cmocka_unit_test(test_pile_of_duplicates),
+        cmocka_unit_test(test_copies_change_nothing),
         cmocka_unit_test(test_cgal_building),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -8,6 +8,7 @@
 #include "../base/kdtree.h"
 #include "../base/tolerance.h"
 #include "cluster.h"
+#include "coincident.h"
 #include "group.h"
 #include "normals.h"
 
@@ -358,6 +359,64 @@ static ag_status alloc_result(size_t n, ag_segment_cloud_result **out, ag_error 
     return AG_OK;
 }
 
+/* Segments the distinct points of c (rep[i]: the first copy of point i, ndistinct of them)
+ * and gives every copy its original's segment and piece in r (allocated for all of c). */
+static ag_status segment_distinct(ag_cloud *c, const ag_segment_cloud_options *o,
+                                  const uint32_t *rep, size_t ndistinct,
+                                  ag_segment_cloud_result *r, ag_error *err)
+{
+    size_t n = c->n;
+    uint32_t *keep = malloc((ndistinct ? ndistinct : 1) * sizeof *keep);
+    uint32_t *at = malloc(n * sizeof *at); /* a distinct point's index in the subset */
+    if (!keep || !at) {
+        free(keep);
+        free(at);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    size_t m = 0;
+    for (size_t i = 0; i < n; i++)
+        if (rep[i] == i) {
+            at[i] = (uint32_t)m;
+            keep[m++] = (uint32_t)i;
+        }
+    ag_cloud *sub = NULL;
+    ag_segment_cloud_result *rs = NULL;
+    ag_status st = ag_cloud_subset(c, keep, m, &sub, err);
+    if (st == AG_OK)
+        st = ag_segment_cloud_run(sub, o, &rs, err);
+    if (st == AG_OK && !c->normals && sub->normals) {
+        st = ag_cloud_add_normals(c, err); /* the cloud keeps the normals it lacked */
+        if (st == AG_OK)
+            for (size_t i = 0; i < n; i++)
+                memcpy(c->normals + 3 * i, sub->normals + 3 * (size_t)at[rep[i]],
+                       3 * sizeof *c->normals);
+    }
+    if (st == AG_OK) {
+        for (size_t i = 0; i < n; i++) {
+            r->segment[i] = rs->segment[at[rep[i]]];
+            r->piece[i] = rs->piece[at[rep[i]]];
+        }
+        r->npieces = rs->npieces;
+        r->nsegments = rs->nsegments;
+        r->ncoarse = rs->ncoarse;
+        r->diagonal = rs->diagonal;
+        r->spacing = rs->spacing;
+        r->coarse_threshold = rs->coarse_threshold;
+        r->fine_threshold = rs->fine_threshold;
+        r->cluster_tolerance = rs->cluster_tolerance;
+        memcpy(r->seconds, rs->seconds, sizeof r->seconds);
+        memcpy(r->cpu_seconds, rs->cpu_seconds, sizeof r->cpu_seconds);
+        /* a run gives planes first, then clusters; the rebuild counts and labels them over
+         * every copy */
+        st = finish(c, r, rs->nplanes, err);
+    }
+    ag_segment_cloud_free(rs);
+    ag_cloud_free(sub);
+    free(keep);
+    free(at);
+    return st;
+}
+
 ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
                                ag_segment_cloud_result **out, ag_error *err)
 {
@@ -395,20 +454,44 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
 
     double t = ag_clock_seconds(), tc = ag_clock_thread_cpu_seconds();
     ag_kdtree *tree = NULL;
-    float *variation = malloc(n * sizeof *variation);
-    uint32_t *graph = malloc(n * (size_t)k * sizeof *graph);
-    int32_t *plane_of = malloc(n * sizeof *plane_of);
-    uint32_t *idx = malloc(n * sizeof *idx);
+    float *variation = NULL;
+    uint32_t *graph = NULL, *idx = NULL;
+    int32_t *plane_of = NULL;
     ag_plane_list planes = {0}, coarse_planes = {0};
     ag_cloud view = *c; /* the cloud as the segmentation sees it (its normals) */
     view.normals = NULL;
+    st = ag_kdtree_build(c->xyz, NULL, n, &tree, err);
+    if (st != AG_OK)
+        goto done;
+    {
+        /* copies of a point would halve every neighbourhood and zero the spacing: the
+         * distinct points are segmented and each copy takes its original's answer */
+        uint32_t *rep = malloc(n * sizeof *rep);
+        size_t distinct = n;
+        st = rep ? ag_coincident_points(tree, c->xyz, n, AG_COINCIDENT_TOLERANCE, rep,
+                                        &distinct, err)
+                 : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        if (st == AG_OK && distinct < n) {
+            ag_kdtree_free(tree);
+            tree = NULL;
+            double index_seconds = ag_clock_seconds() - t;
+            double index_cpu = ag_clock_thread_cpu_seconds() - tc;
+            st = segment_distinct(c, &o, rep, distinct, r, err);
+            r->seconds[AG_SEGMENT_CLOUD_INDEX] += index_seconds;
+            r->cpu_seconds[AG_SEGMENT_CLOUD_INDEX] += index_cpu;
+        }
+        free(rep);
+        if (st != AG_OK || distinct < n)
+            goto done;
+    }
+    variation = malloc(n * sizeof *variation);
+    graph = malloc(n * (size_t)k * sizeof *graph);
+    plane_of = malloc(n * sizeof *plane_of);
+    idx = malloc(n * sizeof *idx);
     if (!variation || !graph || !plane_of || !idx) {
         st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         goto done;
     }
-    st = ag_kdtree_build(c->xyz, NULL, n, &tree, err);
-    if (st != AG_OK)
-        goto done;
     r->seconds[AG_SEGMENT_CLOUD_INDEX] = ag_clock_seconds() - t;
     r->cpu_seconds[AG_SEGMENT_CLOUD_INDEX] = ag_clock_thread_cpu_seconds() - tc;
 

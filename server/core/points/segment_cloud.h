@@ -10,6 +10,8 @@
  * chimney and a church; the options' zero value means the defaults. A region of interest
  * can be segmented again at a finer granularity (ag_segment_cloud_refine), replacing only
  * the segments inside it. Deterministic: the random choices come from a seeded generator.
+ * Copies of a point (closer than AG_COINCIDENT_TOLERANCE) are segmented once and take their
+ * original's segment: a cloud written twice over gives the segments of the cloud itself.
  * The seconds of each stage are reported. Segments list their members (CSR) for the stages
  * that come after (consensus models, split tree). */
 #ifndef AG_POINTS_SEGMENT_CLOUD_H
