@@ -73,8 +73,8 @@ static size_t vm_size(void)
     return (size_t)pages * (size_t)sysconf(_SC_PAGESIZE);
 }
 
-static void child(int fd, const uint8_t *data, size_t len, ag_format fmt, ag_up_axis up,
-                  size_t cap, double seconds, pid_t parent)
+static void child(int fd, const uint8_t *data, size_t len, ag_format fmt,
+                  const ag_import_options *caller, size_t cap, double seconds, pid_t parent)
 {
     /* never outlive the parent (it would hold the service's sockets), nor the deadline's
      * worth of processor time should the parent stop watching */
@@ -97,8 +97,12 @@ static void child(int fd, const uint8_t *data, size_t len, ag_format fmt, ag_up_
         setrlimit(RLIMIT_AS, &rl);
     }
     reply_head h = {.magic = REPLY_MAGIC};
-    /* no progress (it writes the parent's store), no files */
-    ag_import_options o = {.up = up, .up_decision = &h.up};
+    /* no progress (it writes the parent's store); files beside the main one only when the
+     * caller allows them (the command line's own files, never an upload's) */
+    ag_import_options o = {.up = caller ? caller->up : AG_UP_DEFAULT,
+                           .up_decision = &h.up,
+                           .allow_external_files = caller && caller->allow_external_files,
+                           .source_path = caller ? caller->source_path : NULL};
     ag_mesh *m = NULL;
     ag_error err;
     ag_error_clear(&err);
@@ -137,7 +141,7 @@ ag_status ag_import_sandbox_read(const uint8_t *data, size_t len, ag_format fmt,
     }
     if (pid == 0) {
         close(fds[0]);
-        child(fds[1], data, len, fmt, opt ? opt->up : AG_UP_DEFAULT, cap, seconds, parent);
+        child(fds[1], data, len, fmt, opt, cap, seconds, parent);
     }
     close(fds[1]);
     /* read the reply until the child closes the pipe, within the deadline */
@@ -203,8 +207,9 @@ ag_status ag_import_sandbox_read(const uint8_t *data, size_t len, ag_format fmt,
             /* it died before answering: the file took the importer down */
             if (WIFSIGNALED(status))
                 s = ag_error_set(err, AG_ERR_PARSE, 0,
-                                 "the importer failed on this file (signal %d)",
-                                 WTERMSIG(status));
+                                 "the importer crashed on this file (%s): the file is "
+                                 "malformed or uses what the importer cannot read",
+                                 strsignal(WTERMSIG(status)));
             else
                 s = ag_error_set(err, AG_ERR_INTERNAL, 0,
                                  "the importer stopped without an answer (exit %d)",

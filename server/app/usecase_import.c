@@ -82,7 +82,7 @@ ag_status ag_usecase_import_read(const ag_mesh_source *src, int (*progress)(void
                                   .user = user,
                                   .allow_external_files = src->own_file,
                                   .source_path = src->own_file ? src->path : NULL};
-        s = src->sandbox_seconds > 0 && !src->own_file && format != AG_FORMAT_OBJ
+        s = format != AG_FORMAT_OBJ
                 ? ag_import_sandbox_read(data, len, format, &iopt, src->sandbox_seconds, mesh,
                                          err)
                 : ag_import_buffer(data, len, format, &iopt, mesh, err);

@@ -27,9 +27,10 @@ typedef struct {
     /* Non-zero for a person's own file (the CLI): the files it refers to (an OBJ's mtllib, a
      * glTF's buffers) are read from next to it. Zero (uploads): no other file is ever read. */
     int own_file;
-    /* > 0: a format read by assimp (anything but OBJ) is read in a child process that is
-     * killed after this many seconds (app/import_sandbox.h): what the service does with
-     * uploads. 0: in this process (the CLI). */
+    /* A format read by assimp (anything but OBJ) is always read in a child process
+     * (app/import_sandbox.h), so that a file that crashes assimp is refused rather than taking
+     * the program down; > 0: the child is killed after this many seconds (the service's
+     * uploads), 0: no deadline (the CLI). */
     double sandbox_seconds;
 } ag_mesh_source;
 

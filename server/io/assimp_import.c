@@ -374,8 +374,9 @@ ag_status ag_assimp_import_buffer(const uint8_t *data, size_t len, ag_format fmt
         return ag_error_set(err, AG_ERR_EMPTY, 0, "empty file");
     if (fmt == AG_FORMAT_PLY) {
         /* assimp 5.2 loops forever on a PLY header without an end_header line (one glued to
-         * the line before it is enough): archgram's own reader checks the header first */
-        ag_status st = ag_ply_check_header(data, len, err);
+         * the line before it is enough), aborts on a face without corners and makes faces up
+         * from a file cut short: archgram's own reader checks the file first */
+        ag_status st = ag_ply_check_mesh(data, len, err);
         if (st)
             return st;
     }

@@ -408,7 +408,47 @@ typedef struct {
     ply_header h;
     ag_cloud *c;
     ag_error *err;
+    /* ag_ply_check_mesh: the vertex count faces' corners index into; 0: corners unchecked */
+    int check_corners;
+    uint64_t vertices;
 } reader;
+
+/* Whether el's list pr holds a face's corners (the names PLY writers use). */
+static int is_corner_list(const reader *r, const ply_element *el, const ply_prop *pr)
+{
+    return r->check_corners && !strcmp(el->name, "face") &&
+           (!strcmp(pr->name, "vertex_indices") || !strcmp(pr->name, "vertex_index"));
+}
+
+/* A face without corners or with one outside the vertex list: AG_ERR_PARSE naming the face
+ * (and the line, for ASCII), as the importer would otherwise abort or read past its arrays on
+ * it. (One or two corners make a point or a line, which the importer drops.) */
+static ag_status no_corners_problem(reader *r, uint64_t face, size_t line)
+{
+    if (line)
+        return ag_error_set(r->err, AG_ERR_PARSE, (long)line,
+                            "line %zu: face %llu has no corners", line,
+                            (unsigned long long)face + 1);
+    return ag_error_set(r->err, AG_ERR_PARSE, (long)face + 1, "face %llu has no corners",
+                        (unsigned long long)face + 1);
+}
+
+static ag_status corner_problem(reader *r, uint64_t face, double index, size_t line)
+{
+    char where[48] = "";
+    if (line)
+        snprintf(where, sizeof where, "line %zu: ", line);
+    return ag_error_set(r->err, AG_ERR_PARSE, line ? (long)line : (long)face + 1,
+                        "%sface %llu names vertex %.17g, but the vertices are numbered 0 to "
+                        "%llu",
+                        where, (unsigned long long)face + 1, index,
+                        (unsigned long long)r->vertices - 1);
+}
+
+static int corner_ok(const reader *r, double index)
+{
+    return index >= 0 && index < (double)r->vertices && index == floor(index);
+}
 
 /* Decides where each vertex property goes and creates the cloud's properties. */
 static ag_status plan_vertex(reader *r, ply_element *v)
@@ -509,6 +549,16 @@ static ag_status read_binary(reader *r, ply_element *el, size_t *pos, int store_
                                     "%s row %llu: list '%s' claims %lld items, more than the data "
                                     "holds",
                                     el->name, (unsigned long long)row + 1, pr->name, (long long)n);
+            if (is_corner_list(r, el, pr)) {
+                if (n == 0)
+                    return no_corners_problem(r, row, 0);
+                for (int64_t j = 0; j < n; j++) {
+                    ag_bytes_load(value, p + (size_t)j * item, item, big);
+                    double index = value_to_double(value, pr->type);
+                    if (!corner_ok(r, index))
+                        return corner_problem(r, row, index, 0);
+                }
+            }
             p += (size_t)n * item;
         }
     }
@@ -568,6 +618,9 @@ static ag_status read_ascii(reader *r, ply_element *el, ascii_cursor *cur, int s
                                     "line %zu: list '%s' claims %lld items, more than the data "
                                     "holds",
                                     cur->line, pr->name, (long long)n);
+            int corners = is_corner_list(r, el, pr);
+            if (corners && n == 0)
+                return no_corners_problem(r, row, cur->line);
             for (int64_t j = 0; j < n; j++) {
                 t = next_token(cur, tok);
                 if (t)
@@ -578,6 +631,8 @@ static ag_status read_ascii(reader *r, ply_element *el, ascii_cursor *cur, int s
                     return ag_error_set(r->err, AG_ERR_PARSE, (long)cur->line,
                                         "line %zu: '%.40s' is not a valid %s in list '%s'",
                                         cur->line, tok, ag_scalar_name(pr->type), pr->name);
+                if (corners && !corner_ok(r, value_to_double(value, pr->type)))
+                    return corner_problem(r, row, value_to_double(value, pr->type), cur->line);
             }
         }
     }
@@ -587,7 +642,7 @@ static ag_status read_ascii(reader *r, ply_element *el, ascii_cursor *cur, int s
 ag_status ag_ply_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag_error *err)
 {
     *out = NULL;
-    reader r = {data, len, {0}, NULL, err};
+    reader r = {data, len, {0}, NULL, err, 0, 0};
     ag_status st = parse_header(data, len, &r.h, err);
     if (st != AG_OK)
         return st;
@@ -651,6 +706,26 @@ ag_status ag_ply_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag
     }
     *out = r.c;
     return AG_OK;
+}
+
+ag_status ag_ply_check_mesh(const uint8_t *data, size_t len, ag_error *err)
+{
+    ag_status st = ag_ply_check_header(data, len, err);
+    if (st != AG_OK)
+        return st;
+    reader r = {data, len, {0}, NULL, err, 1, 0};
+    if ((st = parse_header(data, len, &r.h, err)) != AG_OK)
+        return st;
+    for (size_t i = 0; i < r.h.nelements; i++)
+        if (!strcmp(r.h.elements[i].name, "vertex"))
+            r.vertices = r.h.elements[i].count;
+    size_t pos = r.h.data_start;
+    ascii_cursor cur = {data + pos, data + len, r.h.header_lines + 1};
+    for (size_t i = 0; st == AG_OK && i < r.h.nelements; i++)
+        st = r.h.format == FMT_ASCII ? read_ascii(&r, &r.h.elements[i], &cur, 0)
+                                     : read_binary(&r, &r.h.elements[i], &pos, 0);
+    header_free(&r.h);
+    return st;
 }
 
 /* ---- the writer ------------------------------------------------------------------------ */

@@ -29,6 +29,14 @@ ag_status ag_ply_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag
  * spends seconds and gigabytes on a count of rows that the data cannot hold. */
 ag_status ag_ply_check_header(const uint8_t *data, size_t len, ag_error *err);
 
+/* ag_ply_check_header, then every row of every element read (none stored): the data must
+ * hold every row the header declares, and each face (a `face` element's `vertex_indices` or
+ * `vertex_index` list) must have corners, each a vertex of the file (one or two corners are
+ * a point or a line, which the mesh reader drops). A mesh read through assimp is checked so
+ * first: assimp aborts on a face of no corners and makes faces up from a file cut short.
+ * AG_ERR_PARSE names the line (ASCII) or the face. */
+ag_status ag_ply_check_mesh(const uint8_t *data, size_t len, ag_error *err);
+
 /* Whether data is a PLY whose header declares a face element with at least one face (a
  * mesh rather than a point cloud). */
 int ag_ply_has_faces(const uint8_t *data, size_t len);

@@ -27,6 +27,33 @@ test('a malformed file fails with file:line: message and exit 1', () => {
   assert.match(r.stderr, new RegExp(`${file.replace(/[.*+?^${}()|[\]\\]/g, '\\$&')}:5: face index`));
 });
 
+// assimp aborts on a PLY face without corners and segfaults on a Collada scene that instances
+// itself: the CLI reads such files as the service does (in a child process, after its own PLY
+// check), so every command that reads a mesh refuses them with a message and exit 1.
+test('a file that would crash the importer fails with file: message and exit 1', () => {
+  const dir = tempDir();
+  try {
+    const ply = path.join(dir, 'no_corners.ply');
+    fs.writeFileSync(ply, 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n' +
+      'property float y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\n' +
+      'end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n0\n');
+    const dae = path.join(REPO, 'tests', 'data', 'import_sandbox', 'recursive_scene.dae');
+    const cases = [[ply, /no_corners\.ply:14: face 2 has no corners/],
+      [dae, /recursive_scene\.dae: the importer crashed on this file/]];
+    for (const [file, want] of cases) {
+      for (const args of [['info', file], ['convert', file, path.join(dir, 'out.glb')],
+        ['proceduralize', file, '--out', path.join(dir, 'out')]]) {
+        const r = run(...args);
+        assert.equal(r.signal, null, `${args.join(' ')}: killed by ${r.signal}`);
+        assert.equal(r.status, 1, `${args.join(' ')}: ${r.stderr}`);
+        assert.match(r.stderr, want, args.join(' '));
+      }
+    }
+  } finally {
+    removeDir(dir);
+  }
+});
+
 test('convert writes a GLB that starts with the glTF header, and an OBJ that reads back the same', () => {
   const dir = tempDir();
   try {

@@ -251,6 +251,108 @@ static void test_ply_header_checked_before_assimp(void **state)
     assert_non_null(strstr(err.text, "line 9: unknown header keyword '0'"));
 }
 
+/* A PLY of the four corners of a unit square and the faces given (each: its corner count,
+ * then its corners), in format fmt (0 ascii, 1 little-endian, 2 big-endian); cut: bytes
+ * dropped from the end. Returns the length written into out. */
+static size_t square_ply(int fmt, const int *faces, size_t nfaces, size_t cut, uint8_t *out)
+{
+    static const char *const names[] = {"ascii", "binary_little_endian", "binary_big_endian"};
+    int n = sprintf((char *)out,
+                    "ply\nformat %s 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face %zu\nproperty list uchar int vertex_indices\n"
+                    "end_header\n",
+                    names[fmt], nfaces);
+    uint8_t *p = out + n;
+    static const float xyz[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    for (int v = 0; v < 4; v++)
+        for (int a = 0; a < 3; a++) {
+            if (!fmt) {
+                p += sprintf((char *)p, a < 2 ? "%g " : "%g\n", xyz[v][a]);
+                continue;
+            }
+            uint8_t b[4];
+            memcpy(b, &xyz[v][a], 4);
+            for (int k = 0; k < 4; k++)
+                *p++ = b[fmt == 1 ? k : 3 - k]; /* a little-endian host */
+        }
+    const int *f = faces;
+    for (size_t i = 0; i < nfaces; i++) {
+        int count = *f++;
+        if (!fmt)
+            p += sprintf((char *)p, "%d", count);
+        else
+            *p++ = (uint8_t)count;
+        for (int j = 0; j < count; j++, f++) {
+            if (!fmt) {
+                p += sprintf((char *)p, " %d", *f);
+                continue;
+            }
+            uint8_t b[4];
+            memcpy(b, f, 4);
+            for (int k = 0; k < 4; k++)
+                *p++ = b[fmt == 1 ? k : 3 - k];
+        }
+        if (!fmt)
+            *p++ = '\n';
+    }
+    return (size_t)(p - out) - cut;
+}
+
+/* The faces are checked before assimp sees them: a face without corners made assimp abort
+ * (an assertion in its triangulation), a file cut inside its face list made it invent
+ * triangles, an index past the vertices was its own validation's message. Each is now
+ * refused naming the face (binary) or the line (ASCII), in every encoding. */
+static void test_ply_faces_checked_before_assimp(void **state)
+{
+    (void)state;
+    static const int good[] = {3, 0, 1, 2, 3, 0, 2, 3};
+    static const int no_corners[] = {3, 0, 1, 2, 0};
+    static const int past_end[] = {3, 0, 1, 2, 3, 0, 2, 9};
+    static const int negative[] = {3, 0, 1, 2, 3, -1, 2, 3};
+    static const int a_line[] = {3, 0, 1, 2, 2, 0, 2, 3, 0, 2, 3};
+    static const struct {
+        const int *faces;
+        size_t nfaces, cut;
+        int tris;              /* when it imports */
+        const char *want[2];   /* ASCII, binary message parts; NULL: imports */
+        long element[2];       /* ASCII line, binary face */
+    } cases[] = {
+        {good, 2, 0, 2, {NULL, NULL}, {0, 0}},
+        {a_line, 3, 0, 2, {NULL, NULL}, {0, 0}}, /* one or two corners: dropped, as before */
+        {no_corners, 2, 0, 0, {"line 15: face 2 has no corners", "face 2 has no corners"}, {15, 2}},
+        {past_end, 2, 0, 0,
+         {"line 15: face 2 names vertex 9, but the vertices are numbered 0 to 3",
+          "face 2 names vertex 9, but the vertices are numbered 0 to 3"},
+         {15, 2}},
+        {negative, 2, 0, 0, {"face 2 names vertex -1", "face 2 names vertex -1"}, {15, 2}},
+        /* the last index cut away */
+        {good, 2, 2, 0, {"the data ends inside list 'vertex_indices'", "list 'vertex_indices'"},
+         {15, 0}},
+    };
+    uint8_t buf[1024];
+    for (int fmt = 0; fmt < 3; fmt++)
+        for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+            size_t len = square_ply(fmt, cases[i].faces, cases[i].nfaces, cases[i].cut, buf);
+            ag_mesh *m = (ag_mesh *)1;
+            ag_error err = {0};
+            ag_status st = ag_import_buffer(buf, len, AG_FORMAT_PLY, NULL, &m, &err);
+            const char *want = cases[i].want[fmt > 0];
+            if (!want) {
+                if (st != AG_OK)
+                    fail_msg("format %d case %zu: %s", fmt, i, err.text);
+                assert_int_equal(m->ntris, cases[i].tris);
+                ag_mesh_free(m);
+                continue;
+            }
+            if (st != AG_ERR_PARSE || !strstr(err.text, want))
+                fail_msg("format %d case %zu: status %d, %s", fmt, i, st, err.text);
+            if (cases[i].element[fmt > 0] && err.element != cases[i].element[fmt > 0])
+                fail_msg("format %d case %zu: element %ld, not %ld", fmt, i, err.element,
+                         cases[i].element[fmt > 0]);
+            assert_null(m);
+        }
+}
+
 static void test_derived_glb_reads_back(void **state)
 {
     (void)state;
@@ -289,6 +391,7 @@ int main(void)
         cmocka_unit_test(test_collada_z_up),
         cmocka_unit_test(test_garbage_is_an_error),
         cmocka_unit_test(test_ply_header_checked_before_assimp),
+        cmocka_unit_test(test_ply_faces_checked_before_assimp),
         cmocka_unit_test(test_derived_glb_reads_back),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -2,7 +2,7 @@
  * in this process; a file assimp takes far longer over (one polygon of 32 000 corners, which its
  * triangulation takes quadratic time over: about 10 s) stops at the deadline with
  * AG_ERR_DEADLINE and leaves no child behind; progress asking to stop cancels; the
- * importer's own refusals come through with their message. */
+ * importer's own refusals come through with their message, and its crashes as a refusal. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -149,12 +149,34 @@ static void progress_cancels_and_refusals_come_through(void **state)
     free(data);
 }
 
+/* A Collada scene that instances itself (a node holding an instance_node of its own scene)
+ * takes assimp down with a segmentation fault: read in the child, it is a refusal of the file
+ * and the reader goes on (what the command line, reading every file so, relies on). */
+static void a_crash_of_the_importer_is_a_refusal(void **state)
+{
+    (void)state;
+    size_t len = 0;
+    char *data = read_fixture("import_sandbox/recursive_scene.dae", &len);
+    ag_import_options plain = {0};
+    ag_mesh *m = (ag_mesh *)1;
+    ag_error err;
+    ag_status s = ag_import_sandbox_read((const uint8_t *)data, len, AG_FORMAT_DAE, &plain, 0,
+                                         &m, &err);
+    assert_int_equal(s, AG_ERR_PARSE);
+    assert_null(m);
+    if (!strstr(err.text, "the importer crashed on this file"))
+        fail_msg("%s", err.text);
+    no_children();
+    free(data);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(the_same_mesh_as_in_process),
         cmocka_unit_test(a_file_slower_than_the_deadline_stops_there),
         cmocka_unit_test(progress_cancels_and_refusals_come_through),
+        cmocka_unit_test(a_crash_of_the_importer_is_a_refusal),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
