@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/clock.h"
 #include "../base/tolerance.h"
 #include "../edit/rebuild.h"
 
@@ -925,6 +926,7 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
     int32_t *stack = NULL;
     ag_proceduralize_result comb = {0};
     ag_status st = AG_OK;
+    double t0 = ag_clock_ms(), t1;
     if (dcomps_make(derived, &g.d)) {
         st = nomem(err);
         goto done;
@@ -950,6 +952,8 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
         g.sites[g.nsites++] = op->target;
     }
     rep->sites = g.nsites;
+    t1 = ag_clock_ms();
+    rep->components_ms = t1 - t0;
     /* removals */
     if (!(X = ag_splittree_copy(T)) || !(gone = calloc(T->nnodes + 1, 1)) ||
         !(g.hang = malloc((g.nsites + 1) * sizeof *g.hang)) ||
@@ -980,14 +984,22 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
     unlink_dead(X);
     for (size_t n = 0; n < T->nnodes; n++)
         gone[n] = X->nodes[n].kind == AG_NODE_DEAD;
+    t0 = ag_clock_ms();
+    rep->removal_ms = t0 - t1;
     if ((st = pair_components(&g, X, gone, rep, err)))
         goto done;
+    t1 = ag_clock_ms();
+    rep->pair_ms = t1 - t0;
     if ((st = assign_sites(&g, T, err)) ||
         (st = classify(&g, err)))
         goto done;
+    t0 = ag_clock_ms();
+    rep->classify_ms = t0 - t1;
     if ((st = insert_new(&g, X, err)))
         goto done;
     rep->added = g.nnew;
+    t1 = ag_clock_ms();
+    rep->insert_ms = t1 - t0;
     if ((st = combined_input(&g, X, &comb, err)))
         goto done;
     X = NULL; /* comb.tree */
@@ -1000,7 +1012,10 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
     }
     for (size_t v = 0; v < t->nnodes; v++)
         source[v] = (int32_t)v;
+    t0 = ag_clock_ms();
+    rep->input_ms = t0 - t1;
     st = ag_rebuild(&comb, t, source, popt, out, err);
+    rep->rebuild_ms = ag_clock_ms() - t0;
 done:
     ag_mesh_free(comb.mesh);
     ag_labels_free(comb.labels);
