@@ -250,7 +250,15 @@ typedef struct {
     char fallback[200];
     double compose_ms, state_ms; /* the rewrite, the new state */
     double tree_ms, mesh_ms, writes_ms; /* the commit: tree text, mesh blob, store writes */
+    /* the new state: terminals, grammar text, read back, edit model; inside the graft */
+    double st[4], gr[7];
 } op_state;
+
+static const char *const state_names[4] = {"terminals_ms", "text_ms", "read_back_ms",
+                                           "model_ms"};
+static const char *const graft_names[7] = {"components_ms", "removal_ms", "pair_ms",
+                                           "classify_ms",   "insert_ms",  "input_ms",
+                                           "rebuild_ms"};
 
 static void read_state(void *user, const ag_op_row *row)
 {
@@ -266,6 +274,11 @@ static void read_state(void *user, const ag_op_row *row)
     o->tree_ms = json_number_value(json_object_get(c, "tree_ms"));
     o->mesh_ms = json_number_value(json_object_get(c, "mesh_ms"));
     o->writes_ms = json_number_value(json_object_get(c, "writes_ms"));
+    json_t *ss = json_object_get(r, "state_stages");
+    for (int k = 0; k < 4; k++)
+        o->st[k] = json_number_value(json_object_get(ss, state_names[k]));
+    for (int k = 0; k < 7; k++)
+        o->gr[k] = json_number_value(json_object_get(json_object_get(ss, "graft"), graft_names[k]));
     snprintf(o->fallback, sizeof o->fallback, "%s", fb ? fb : "");
     json_decref(b);
 }
@@ -274,6 +287,7 @@ static void service_compose(service *sv, int64_t part, int which, const char *mo
                             const char *scope, const char *what)
 {
     double pv[RUNS], op[RUNS], rw[RUNS], ns[RUNS], rest[RUNS], tr[RUNS], mb[RUNS], wr[RUNS];
+    double st[4][RUNS], gr[7][RUNS];
     int grafted = 0;
     char fallback[200] = "";
     json_t *rep = NULL;
@@ -315,6 +329,10 @@ static void service_compose(service *sv, int64_t part, int which, const char *mo
         tr[i] = os.tree_ms;
         mb[i] = os.mesh_ms;
         wr[i] = os.writes_ms;
+        for (int k = 0; k < 4; k++)
+            st[k][i] = os.st[k];
+        for (int k = 0; k < 7; k++)
+            gr[k][i] = os.gr[k];
         if (!os.grafted)
             snprintf(fallback, sizeof fallback, "%s", os.fallback);
     }
@@ -331,6 +349,12 @@ static void service_compose(service *sv, int64_t part, int which, const char *mo
     printf("                the commit: tree text %.1f ms (beside the mesh blob), mesh blob "
            "%.1f ms, store writes %.1f ms (then the sequenced commit)\n",
            median(tr, RUNS), median(mb, RUNS), median(wr, RUNS));
+    printf("                the new state: terminals %.1f ms, grammar text %.1f ms, read back "
+           "%.1f ms, edit model %.1f ms (graft: components %.1f, removal %.1f, pairing %.1f, "
+           "classes %.1f, insertion %.1f, rebuild input %.1f, rebuild %.1f ms)\n",
+           median(st[0], RUNS), median(st[1], RUNS), median(st[2], RUNS), median(st[3], RUNS),
+           median(gr[0], RUNS), median(gr[1], RUNS), median(gr[2], RUNS), median(gr[3], RUNS),
+           median(gr[4], RUNS), median(gr[5], RUNS), median(gr[6], RUNS));
     /* removed nodes keep their ids (dead in the tree): what every later op carries */
     size_t nodes = 0, dead = 0;
     service_picks_sized(sv, &nodes, &dead);

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/base/clock.h"
 #include "../io/grammar_text.h"
 #include "model_kept.h"
 
@@ -185,13 +186,19 @@ ag_status ag_model_state_from_grammar_ex(ag_grammar *g, size_t max_triangles,
                                          ag_model_state *out, ag_error *err)
 {
     memset(out, 0, sizeof *out);
+    ag_model_state_times *tm = &out->times;
     ag_grammar *back = NULL;
     long col = 0;
     ag_error e;
     ag_error_clear(&e);
+    double t0 = ag_clock_ms();
     ag_status s = ag_terminals_collect(g, &out->terms, err);
+    double t1 = ag_clock_ms();
+    tm->terminals_ms = t1 - t0;
     if (s == AG_OK)
         s = ag_grammar_text_print(g, &out->text, &out->text_len, err);
+    t0 = ag_clock_ms();
+    tm->text_ms = t0 - t1;
     if (s == AG_OK &&
         (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms,
                          max_triangles ? max_triangles : AG_GRAMMAR_MAX_TRIANGLES, &back,
@@ -205,11 +212,14 @@ ag_status ag_model_state_from_grammar_ex(ag_grammar *g, size_t max_triangles,
                              e.element, col, e.text);
     }
     ag_grammar_free(back);
+    t1 = ag_clock_ms();
+    tm->read_back_ms = t1 - t0;
     if (s == AG_OK && !out->derived->ntris)
         s = ag_error_set(err, AG_ERR_EMPTY, 0, "the grammar derives no geometry");
     if (s == AG_OK)
         s = make ? make(user, out->derived, &out->em, err)
                  : ag_model_state_reload(out->derived, &out->em, err);
+    tm->model_ms = ag_clock_ms() - t1;
     if (s != AG_OK)
         ag_model_state_clear(out);
     return s;

@@ -24,12 +24,21 @@
 /* Derivations larger than this are refused (AG_ERR_TOO_LARGE). */
 #define AG_GRAMMAR_MAX_TRIANGLES ((size_t)20000000)
 
+/* Where making a state from a grammar spent its time (ag_model_state_from_grammar_ex). */
+typedef struct {
+    double terminals_ms; /* the terminals collected with their OBJ text */
+    double text_ms;      /* the grammar printed */
+    double read_back_ms; /* the text parsed, its terminals loaded and derived */
+    double model_ms;     /* the edit model made (the maker, or proceduralized) */
+} ag_model_state_times;
+
 typedef struct {
     char *text;            /* the grammar, NUL-terminated */
     size_t text_len;
     ag_terminal_set terms; /* the terminals the text names (made states) */
     ag_mesh *derived;      /* what the text derives (with the terminals as kept) */
     ag_edit_model *em;     /* the edit model; em->proc->mesh is the model's mesh */
+    ag_model_state_times times; /* made from a grammar: its stages */
 } ag_model_state;
 
 void ag_model_state_clear(ag_model_state *s);

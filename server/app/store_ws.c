@@ -489,6 +489,19 @@ static ag_status save_edit(ag_store_ws *w, ag_model_state *st, const ag_edit_out
     return s;
 }
 
+/* The new state's stages, for the op log (bench/parts reads them): the grammar's terminals,
+ * text and read-back, the edit model made, and inside it the graft's stages. */
+static json_t *state_stages(const ag_model_state *st, const ag_graft_report *g)
+{
+    const ag_model_state_times *t = &st->times;
+    return json_pack("{s:f, s:f, s:f, s:f, s:{s:f, s:f, s:f, s:f, s:f, s:f, s:f}}",
+                     "terminals_ms", t->terminals_ms, "text_ms", t->text_ms, "read_back_ms",
+                     t->read_back_ms, "model_ms", t->model_ms, "graft", "components_ms",
+                     g->components_ms, "removal_ms", g->removal_ms, "pair_ms", g->pair_ms,
+                     "classify_ms", g->classify_ms, "insert_ms", g->insert_ms, "input_ms",
+                     g->input_ms, "rebuild_ms", g->rebuild_ms);
+}
+
 static ag_status save_composed(ag_workspace *ws, ag_model_state *st, const ag_compose_outcome *o,
                                ag_error *err)
 {
@@ -501,6 +514,7 @@ static ag_status save_composed(ag_workspace *ws, ag_model_state *st, const ag_co
     if (report) {
         json_object_set_new(report, "compose_ms", json_real(o->compose_ms));
         json_object_set_new(report, "state_ms", json_real(o->state_ms));
+        json_object_set_new(report, "state_stages", state_stages(st, &o->graft));
     }
     if (!report || !body || !summary || !w->target ||
         json_object_set_new(body, "version", json_integer((json_int_t)o->part->version)) ||

@@ -200,7 +200,8 @@ ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_para
                             .report = out->report,
                             .load_ms = out->load_ms,
                             .compose_ms = out->compose_ms,
-                            .state_ms = out->state_ms};
+                            .state_ms = out->state_ms,
+                            .graft = out->graft};
     return ag_workspace_save_composed(ws, &st, &o, err);
 }
 

@@ -28,6 +28,7 @@
 
 #include "../core/edit/edit.h"
 #include "../core/parts/compose.h"
+#include "../core/parts/graft.h"
 #include "../core/parts/part.h"
 #include "../core/points/cloud.h"
 #include "../core/points/pointmodel.h"
@@ -91,6 +92,7 @@ typedef struct {
     const ag_part *part;          /* its name and version */
     ag_compose_report report;
     double load_ms, compose_ms, state_ms; /* reading; the rewrite; the new state */
+    ag_graft_report graft; /* the graft (report.grafted) with its stages' times */
 } ag_compose_outcome;
 
 typedef struct {

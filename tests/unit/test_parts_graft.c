@@ -608,6 +608,136 @@ static void test_generated_facade(void **state)
     }
 }
 
+/* a and b are one model exactly: the grammar's text byte for byte, the tree node for node
+ * (links, classes, boxes bit for bit), the mesh vertex for vertex. */
+static void same_model(const ag_edit_model *a, const ag_edit_model *b, const char *what)
+{
+    ag_error err = {0};
+    char *ta = NULL, *tb = NULL;
+    size_t la = 0, lb = 0;
+    if (ag_grammar_text_print(a->proc->grammar, &ta, &la, &err) ||
+        ag_grammar_text_print(b->proc->grammar, &tb, &lb, &err))
+        fail_msg("%s: print: %s", what, err.text);
+    if (la != lb || memcmp(ta, tb, la) != 0)
+        fail_msg("%s: the grammars differ", what);
+    free(ta);
+    free(tb);
+    const ag_splittree *x = a->proc->tree, *y = b->proc->tree;
+    assert_int_equal(x->nnodes, y->nnodes);
+    assert_int_equal(x->ncomponents, y->ncomponents);
+    assert_int_equal(x->nrules, y->nrules);
+    assert_int_equal(x->npatterns, y->npatterns);
+    for (size_t n = 0; n < x->nnodes; n++) {
+        const ag_tnode *p = &x->nodes[n], *q = &y->nodes[n];
+        if (p->kind != q->kind || p->parent != q->parent || p->first_child != q->first_child ||
+            p->next_sibling != q->next_sibling || p->component != q->component ||
+            p->label != q->label || p->variant != q->variant || p->rule != q->rule ||
+            (p->kind != AG_NODE_DEAD && memcmp(&p->box, &q->box, sizeof p->box) != 0))
+            fail_msg("%s: node %zu differs (kind %d %d, parent %d %d, first %d %d, next %d %d, "
+                     "component %d %d, label %d %d, variant %d %d, rule %d %d, box x %.17g %.17g)",
+                     what, n, p->kind, q->kind, p->parent, q->parent, p->first_child,
+                     q->first_child, p->next_sibling, q->next_sibling, p->component,
+                     q->component, p->label, q->label, p->variant, q->variant, p->rule, q->rule,
+                     p->box.min[0], q->box.min[0]);
+    }
+    const ag_mesh *m = a->proc->mesh, *k = b->proc->mesh;
+    assert_int_equal(m->nverts, k->nverts);
+    assert_int_equal(m->ntris, k->ntris);
+    assert_int_equal(m->ncomponents, k->ncomponents);
+    assert_memory_equal(m->pos, k->pos, 3 * m->nverts * sizeof *m->pos);
+    assert_memory_equal(m->tri, k->tri, 3 * m->ntris * sizeof *m->tri);
+    assert_memory_equal(m->tri_component, k->tri_component, m->ntris * sizeof *m->tri_component);
+}
+
+/* The visible node whose rule class is the largest (the first such). */
+static int32_t most_repeated(const ag_splittree *t)
+{
+    int32_t rep = -1;
+    size_t best = 0;
+    for (size_t i = 1; i < t->nnodes; i++) {
+        const ag_tnode *n = &t->nodes[i];
+        if (n->kind == AG_NODE_COMPONENT && n->rule >= 0 && t->rule_count[n->rule] > best) {
+            best = t->rule_count[n->rule];
+            rep = (int32_t)i;
+        }
+    }
+    return rep;
+}
+
+/* One composition by the graft alone (the service's fast path), without the slow path. */
+static ag_edit_model *graft_op(const ag_edit_model *em, const ag_part *part, int32_t target,
+                               int mode, int scope, const char *what)
+{
+    ag_compose_op op = {.target = target, .mode = mode, .scope = scope};
+    ag_grammar *g = NULL;
+    ag_compose_report crep;
+    ag_error err = {0};
+    ag_mesh *d = NULL;
+    ag_proceduralize_result *r = NULL;
+    ag_edit_model *out = NULL;
+    if (ag_compose(em->proc, part, &op, &g, &crep, &err) || ag_grammar_derive(g, NULL, &d, &err) ||
+        ag_graft_compose(em->proc, &op, d, &em->opt.patterns, &r, NULL, &err) ||
+        ag_edit_model_wrap(r, &em->opt, &out, &err))
+        fail_msg("%s: %s", what, err.text);
+    /* the state a store keeps (mesh and tree text) rebuilt in full is this model exactly */
+    char *text = ag_model_kept_tree_text(out);
+    assert_non_null(text);
+    ag_edit_model *back = NULL;
+    if (ag_model_kept_reload(out->proc->mesh, text, &back, &err))
+        fail_msg("%s: reload: %s", what, err.text);
+    same_model(out, back, what);
+    ag_edit_model_free(back);
+    free(text);
+    ag_mesh_free(d);
+    ag_grammar_free(g);
+    return out;
+}
+
+/* The fast path's state after several ops in a row equals the full rebuild's (the kept state
+ * reloaded) after each, and an op undone and done again (from the state kept before it, as
+ * undo restores it) gives the same model exactly: nothing of an op stays behind in the model
+ * it started from. */
+static void test_graft_state_is_the_rebuilds(void **state)
+{
+    (void)state;
+    ag_gen_facade_options go = {.cols = 6, .rows = 4, .side_cols = 4, .left = 1, .bars = 3,
+                                .no_groups = 1, .annex = 1};
+    ag_mesh *m = NULL;
+    assert_int_equal(ag_gen_facade(&go, &m, NULL), AG_OK);
+    ag_edit_model *em = model_of(m);
+    const ag_splittree *t = em->proc->tree;
+    int32_t rep = most_repeated(t), big = -1;
+    size_t best_sub = 0;
+    for (size_t i = 1; i < t->nnodes; i++) {
+        size_t sub = t->nodes[i].kind == AG_NODE_COMPONENT ? visible_under(t, (int32_t)i) : 0;
+        if (sub > best_sub) {
+            best_sub = sub;
+            big = (int32_t)i;
+        }
+    }
+    assert_true(rep > 0 && big > 0);
+    ag_part *piece = save_node(em->proc, rep, "window piece");
+    ag_edit_model *a = graft_op(em, piece, rep, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE, "rule");
+    /* as the service picks: the most repeated node of the current model */
+    int32_t other = most_repeated(a->proc->tree);
+    assert_true(other > 0);
+    ag_edit_model *b = graft_op(a, piece, other, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, "node");
+    ag_edit_model *c = graft_op(b, piece, big, AG_COMPOSE_INSERT, AG_COMPOSE_NODE, "insert");
+    /* c undone, then b undone: composing b's op again from a gives b */
+    ag_edit_model *b2 = graft_op(a, piece, other, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, "redo");
+    same_model(b2, b, "b done again");
+    ag_edit_model *c2 = graft_op(b2, piece, big, AG_COMPOSE_INSERT, AG_COMPOSE_NODE, "redo c");
+    same_model(c2, c, "c done again");
+    ag_edit_model_free(c2);
+    ag_edit_model_free(b2);
+    ag_edit_model_free(c);
+    ag_edit_model_free(b);
+    ag_edit_model_free(a);
+    ag_part_free(piece);
+    ag_edit_model_free(em);
+    ag_mesh_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -622,6 +752,7 @@ int main(void)
         cmocka_unit_test(test_rule_scope_terminal),
         cmocka_unit_test(test_pattern_target),
         cmocka_unit_test(test_generated_facade),
+        cmocka_unit_test(test_graft_state_is_the_rebuilds),
         cmocka_unit_test(test_refuses_what_does_not_pair),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

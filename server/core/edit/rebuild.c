@@ -430,11 +430,15 @@ static ag_status finish(ag_mesh *mesh, ag_labels *L, ag_splittree *t, int with_r
         rebase_turns(L, t);
     if (with_rules && (st = rules_and_patterns(t, popt, err)))
         goto fail;
-    /* a dead node names nothing (its old rule, pattern or component may be out of range now) */
+    /* a dead node names nothing (its old rule, pattern or component may be out of range now),
+     * nor links to any node (a chain a new pattern replaced keeps its links otherwise): it is
+     * the node a reload of the kept tree makes */
     for (size_t n = 0; with_rules && n < t->nnodes; n++)
         if (t->nodes[n].kind == AG_NODE_DEAD) {
-            t->nodes[n].rule = t->nodes[n].pattern = t->nodes[n].component = -1;
-            t->nodes[n].label = t->nodes[n].variant = -1;
+            ag_tnode *x = &t->nodes[n];
+            x->rule = x->pattern = x->component = -1;
+            x->label = x->variant = -1;
+            x->parent = x->first_child = x->last_child = x->next_sibling = -1;
         }
     if (with_rules && (st = tree_components(t, mesh->ncomponents))) {
         st = nomem(err);

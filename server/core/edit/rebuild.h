@@ -24,7 +24,9 @@
 #include "../status.h"
 
 /* The edited tree t (taken) with per-node sources (taken, malloc'd, t->nnodes entries) over
- * input in, with patterns found by popt (NULL: defaults). */
+ * input in, with patterns found by popt (NULL: defaults). When every node is its own source t
+ * may be in->tree itself (a node's source is read before the node changes; in->tree is then
+ * the result's, or freed). */
 ag_status ag_rebuild(const ag_proceduralize_result *in, ag_splittree *t, int32_t *source,
                      const ag_patterns_options *popt, ag_proceduralize_result **out,
                      ag_error *err);

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/clock.h"
 #include "../base/tolerance.h"
 #include "../edit/rebuild.h"
 
@@ -336,11 +337,16 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
     const ag_labels *L = g->in->labels;
     size_t nk = 0;
     int32_t *kept = malloc((T->ncomponents + 1) * sizeof *kept);
+    /* the kept boxes side by side: the search reads them, not the tree's scattered nodes */
+    ag_box *kbox = malloc((T->ncomponents + 1) * sizeof *kbox);
     uint8_t *used = calloc(T->ncomponents + 1, 1);
     uint8_t *paired = calloc(g->d.nc + 1, 1);
     cellhash h = {0};
     ag_status st = AG_OK;
-    if (!kept || !used || !paired || cellhash_init(&h, T->ncomponents)) {
+    /* cells four tolerances wide: a box's min +- q meets at most two per axis (one mostly),
+     * not three */
+    double cs = 4 * g->q;
+    if (!kept || !kbox || !used || !paired || cellhash_init(&h, T->ncomponents)) {
         st = nomem(err);
         goto done;
     }
@@ -351,8 +357,9 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
             continue;
         const ag_box *b = &T->nodes[n].box;
         kept[nk] = (int32_t)c;
-        cellhash_add(&h, cell_key(cell_of(b->min[0], g->q), cell_of(b->min[1], g->q),
-                                  cell_of(b->min[2], g->q)),
+        kbox[nk] = *b;
+        cellhash_add(&h, cell_key(cell_of(b->min[0], cs), cell_of(b->min[1], cs),
+                                  cell_of(b->min[2], cs)),
                      (int32_t)nk);
         nk++;
     }
@@ -373,10 +380,11 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
         const ag_box *b = &g->d.box[c];
         int64_t lo[3], hi[3];
         for (int a = 0; a < 3; a++) {
-            lo[a] = cell_of(b->min[a] - g->q, g->q);
-            hi[a] = cell_of(b->min[a] + g->q, g->q);
+            lo[a] = cell_of(b->min[a] - g->q, cs);
+            hi[a] = cell_of(b->min[a] + g->q, cs);
         }
-        /* the best candidate: the same triangle count, then the same label group */
+        /* the best candidate: the same triangle count, then the same label group, then the
+         * first component (coincident copies pair in their order, however the cells fall) */
         int32_t best = -1, best_score = -1;
         int32_t grp = D->component_group ? D->component_group[c] : -1;
         int32_t glab = grp >= 0 && (size_t)grp < D->ngroups ? group_label[grp] : -1;
@@ -386,12 +394,12 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
                     for (int32_t e = h.head[cell_key(x, y, z) & (h.cap - 1)]; e >= 0;
                          e = h.next[e]) {
                         int32_t kc = kept[e];
-                        if (used[kc] || !same_box(&T->nodes[T->comp_node[kc]].box, b, g->q))
+                        if (used[kc] || !same_box(&kbox[e], b, g->q))
                             continue;
                         int score = (L->tri_start[kc + 1] - L->tri_start[kc]) ==
                                     dcomp_ntris(&g->d, c);
                         score += glab >= 0 && glab == L->label[kc] ? 2 : 0;
-                        if (score > best_score) {
+                        if (score > best_score || (score == best_score && kc < best)) {
                             best_score = score;
                             best = kc;
                         }
@@ -450,6 +458,7 @@ static ag_status pair_components(graft *g, const ag_splittree *X, const uint8_t 
             g->nd[k++] = (uint32_t)c;
 done:
     free(kept);
+    free(kbox);
     free(used);
     free(paired);
     cellhash_free(&h);
@@ -925,6 +934,7 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
     int32_t *stack = NULL;
     ag_proceduralize_result comb = {0};
     ag_status st = AG_OK;
+    double t0 = ag_clock_ms(), t1;
     if (dcomps_make(derived, &g.d)) {
         st = nomem(err);
         goto done;
@@ -950,6 +960,8 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
         g.sites[g.nsites++] = op->target;
     }
     rep->sites = g.nsites;
+    t1 = ag_clock_ms();
+    rep->components_ms = t1 - t0;
     /* removals */
     if (!(X = ag_splittree_copy(T)) || !(gone = calloc(T->nnodes + 1, 1)) ||
         !(g.hang = malloc((g.nsites + 1) * sizeof *g.hang)) ||
@@ -980,27 +992,40 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
     unlink_dead(X);
     for (size_t n = 0; n < T->nnodes; n++)
         gone[n] = X->nodes[n].kind == AG_NODE_DEAD;
+    t0 = ag_clock_ms();
+    rep->removal_ms = t0 - t1;
     if ((st = pair_components(&g, X, gone, rep, err)))
         goto done;
+    t1 = ag_clock_ms();
+    rep->pair_ms = t1 - t0;
     if ((st = assign_sites(&g, T, err)) ||
         (st = classify(&g, err)))
         goto done;
+    t0 = ag_clock_ms();
+    rep->classify_ms = t0 - t1;
     if ((st = insert_new(&g, X, err)))
         goto done;
     rep->added = g.nnew;
+    t1 = ag_clock_ms();
+    rep->insert_ms = t1 - t0;
     if ((st = combined_input(&g, X, &comb, err)))
         goto done;
     X = NULL; /* comb.tree */
-    ag_splittree *t = ag_splittree_copy(comb.tree);
-    int32_t *source = t ? malloc((t->nnodes + 1) * sizeof *source) : NULL;
+    /* every node is its own source, so the rebuild edits the combined tree itself rather
+     * than a copy of it: it reads a node's source before it changes that node (rebuild.h) */
+    ag_splittree *t = comb.tree;
+    int32_t *source = malloc((t->nnodes + 1) * sizeof *source);
     if (!source) {
-        ag_splittree_free(t);
         st = nomem(err);
         goto done;
     }
     for (size_t v = 0; v < t->nnodes; v++)
         source[v] = (int32_t)v;
+    t0 = ag_clock_ms();
+    rep->input_ms = t0 - t1;
     st = ag_rebuild(&comb, t, source, popt, out, err);
+    comb.tree = NULL; /* the rebuild's (its result's, or freed) */
+    rep->rebuild_ms = ag_clock_ms() - t0;
 done:
     ag_mesh_free(comb.mesh);
     ag_labels_free(comb.labels);

@@ -36,6 +36,10 @@ typedef struct {
     size_t kept;    /* visible nodes kept (their ids unchanged) */
     size_t removed; /* visible nodes removed */
     size_t added;   /* components the part brought (new nodes) */
+    /* where the graft spent its time (ms): the derivation's components measured, the tree
+     * copied with the sites removed, the components paired, the new ones classified (sites,
+     * labels, variants), inserted, the rebuild's input made, the rebuild */
+    double components_ms, removal_ms, pair_ms, classify_ms, insert_ms, input_ms, rebuild_ms;
 } ag_graft_report;
 
 ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_op *op,
