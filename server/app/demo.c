@@ -79,22 +79,6 @@ static char *spool_street(ag_error *err)
 
 /* --- demo parts ----------------------------------------------------------------------------- */
 
-/* The visible node of the most repeated rule: a window of the row house, a column of the
- * tower. */
-static int32_t most_repeated(const ag_splittree *t)
-{
-    int32_t best = -1;
-    size_t count = 1;
-    for (size_t i = 0; i < t->nnodes; i++) {
-        const ag_tnode *n = &t->nodes[i];
-        if (n->kind == AG_NODE_COMPONENT && n->rule >= 0 && t->rule_count[n->rule] > count) {
-            count = t->rule_count[n->rule];
-            best = (int32_t)i;
-        }
-    }
-    return best;
-}
-
 /* The pattern holding the most nodes: the row house's grid of windows. */
 static int32_t largest_pattern(const ag_splittree *t)
 {
@@ -140,10 +124,10 @@ typedef struct {
 } demo_part;
 
 static const demo_part demo_parts[] = {
-    {0, most_repeated, "Framed window", "A window of the row house: a frame of four bars", {"window", "frame", "demo"}, 3},
+    {0, ag_splittree_most_repeated, "Framed window", "A window of the row house: a frame of four bars", {"window", "frame", "demo"}, 3},
     {0, largest_pattern, "Row of windows", "The row house's grid of twelve windows", {"window", "facade", "demo"}, 3},
     {0, door_sized, "Front door", "The row house's door: a frame and its leaf", {"door", "demo"}, 2},
-    {1, most_repeated, "Column", "A column of the octagonal tower", {"column", "demo"}, 2},
+    {1, ag_splittree_most_repeated, "Column", "A column of the octagonal tower", {"column", "demo"}, 2},
 };
 
 /* The model's edit state once a job has proceduralized it (polled, at most a minute). */

@@ -649,21 +649,6 @@ static void same_model(const ag_edit_model *a, const ag_edit_model *b, const cha
     assert_memory_equal(m->tri_component, k->tri_component, m->ntris * sizeof *m->tri_component);
 }
 
-/* The visible node whose rule class is the largest (the first such). */
-static int32_t most_repeated(const ag_splittree *t)
-{
-    int32_t rep = -1;
-    size_t best = 0;
-    for (size_t i = 1; i < t->nnodes; i++) {
-        const ag_tnode *n = &t->nodes[i];
-        if (n->kind == AG_NODE_COMPONENT && n->rule >= 0 && t->rule_count[n->rule] > best) {
-            best = t->rule_count[n->rule];
-            rep = (int32_t)i;
-        }
-    }
-    return rep;
-}
-
 /* One composition by the graft alone (the service's fast path), without the slow path. */
 static ag_edit_model *graft_op(const ag_edit_model *em, const ag_part *part, int32_t target,
                                int mode, int scope, const char *what)
@@ -706,7 +691,7 @@ static void test_graft_state_is_the_rebuilds(void **state)
     assert_int_equal(ag_gen_facade(&go, &m, NULL), AG_OK);
     ag_edit_model *em = model_of(m);
     const ag_splittree *t = em->proc->tree;
-    int32_t rep = most_repeated(t), big = -1;
+    int32_t rep = ag_splittree_most_repeated(t), big = -1;
     size_t best_sub = 0;
     for (size_t i = 1; i < t->nnodes; i++) {
         size_t sub = t->nodes[i].kind == AG_NODE_COMPONENT ? visible_under(t, (int32_t)i) : 0;
@@ -719,7 +704,7 @@ static void test_graft_state_is_the_rebuilds(void **state)
     ag_part *piece = save_node(em->proc, rep, "window piece");
     ag_edit_model *a = graft_op(em, piece, rep, AG_COMPOSE_REPLACE, AG_COMPOSE_RULE, "rule");
     /* as the service picks: the most repeated node of the current model */
-    int32_t other = most_repeated(a->proc->tree);
+    int32_t other = ag_splittree_most_repeated(a->proc->tree);
     assert_true(other > 0);
     ag_edit_model *b = graft_op(a, piece, other, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, "node");
     ag_edit_model *c = graft_op(b, piece, big, AG_COMPOSE_INSERT, AG_COMPOSE_NODE, "insert");

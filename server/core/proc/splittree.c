@@ -88,6 +88,20 @@ int32_t ag_splittree_chain_end(const ag_splittree *t, int32_t n)
     return n;
 }
 
+int32_t ag_splittree_most_repeated(const ag_splittree *t)
+{
+    int32_t best = -1;
+    size_t count = 1;
+    for (size_t i = 0; i < t->nnodes; i++) {
+        const ag_tnode *n = &t->nodes[i];
+        if (n->kind == AG_NODE_COMPONENT && n->rule >= 0 && t->rule_count[n->rule] > count) {
+            count = t->rule_count[n->rule];
+            best = (int32_t)i;
+        }
+    }
+    return best;
+}
+
 static int32_t new_node(ag_splittree *t, int kind)
 {
     if (t->nnodes >= INT32_MAX || AG_ARRAY_RESERVE(t->nodes, t->cap, t->nnodes + 1))

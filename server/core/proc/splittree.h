@@ -92,6 +92,9 @@ void ag_splittree_free(ag_splittree *t);
 ag_box ag_splittree_child_box(const ag_box *parent, const double pivot[3], int octant);
 /* The node that a child slot leads to: follows intermediate split nodes. */
 int32_t ag_splittree_chain_end(const ag_splittree *t, int32_t n);
+/* The first visible node of the rule with the most instances (at least two): a window of a
+ * facade, what a part is typically saved from; -1 when no rule repeats. */
+int32_t ag_splittree_most_repeated(const ag_splittree *t);
 /* Adds one or two split nodes under `parent` ending in a node with box `box`; returns the last
  * node's index (with kind `kind`) or -1 when out of memory. */
 int32_t ag_splittree_insert(ag_splittree *t, int32_t parent, const ag_box *box, int kind);
