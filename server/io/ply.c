@@ -242,19 +242,17 @@ static ag_status parse_header(const uint8_t *data, size_t len, ply_header *h, ag
     return AG_OK;
 }
 
-ag_status ag_ply_check_header(const uint8_t *data, size_t len, ag_error *err)
+/* Whether the rows h declares fit the bytes after it (see ag_ply_check_header). */
+static ag_status check_rows_fit(const ply_header *h, size_t len, ag_error *err)
 {
-    ply_header h;
-    ag_status st = parse_header(data, len, &h, err);
-    if (st != AG_OK)
-        return st;
+    ag_status st = AG_OK;
     /* every row of an element with properties takes bytes: its fixed part (binary), or a
      * character and a separator per value (ASCII, the last value of the file without one) */
-    size_t remaining = len - h.data_start;
-    uint64_t room = (uint64_t)remaining + (h.format == FMT_ASCII), need = 0;
-    for (size_t i = 0; i < h.nelements && st == AG_OK; i++) {
-        const ply_element *el = &h.elements[i];
-        uint64_t row = h.format == FMT_ASCII ? 2 * (uint64_t)el->nprops : el->row_bytes;
+    size_t remaining = len - h->data_start;
+    uint64_t room = (uint64_t)remaining + (h->format == FMT_ASCII), need = 0;
+    for (size_t i = 0; i < h->nelements && st == AG_OK; i++) {
+        const ply_element *el = &h->elements[i];
+        uint64_t row = h->format == FMT_ASCII ? 2 * (uint64_t)el->nprops : el->row_bytes;
         if (!row)
             continue;
         if (el->count > room / row || (need += el->count * row) > room)
@@ -264,6 +262,16 @@ ag_status ag_ply_check_header(const uint8_t *data, size_t len, ag_error *err)
                               (unsigned long long)el->count, el->name, (unsigned long long)row,
                               remaining);
     }
+    return st;
+}
+
+ag_status ag_ply_check_header(const uint8_t *data, size_t len, ag_error *err)
+{
+    ply_header h;
+    ag_status st = parse_header(data, len, &h, err);
+    if (st != AG_OK)
+        return st;
+    st = check_rows_fit(&h, len, err);
     header_free(&h);
     return st;
 }
@@ -710,12 +718,14 @@ ag_status ag_ply_read_buffer(const uint8_t *data, size_t len, ag_cloud **out, ag
 
 ag_status ag_ply_check_mesh(const uint8_t *data, size_t len, ag_error *err)
 {
-    ag_status st = ag_ply_check_header(data, len, err);
+    reader r = {data, len, {0}, NULL, err, 1, 0};
+    ag_status st = parse_header(data, len, &r.h, err);
     if (st != AG_OK)
         return st;
-    reader r = {data, len, {0}, NULL, err, 1, 0};
-    if ((st = parse_header(data, len, &r.h, err)) != AG_OK)
+    if ((st = check_rows_fit(&r.h, len, err)) != AG_OK) {
+        header_free(&r.h);
         return st;
+    }
     for (size_t i = 0; i < r.h.nelements; i++)
         if (!strcmp(r.h.elements[i].name, "vertex"))
             r.vertices = r.h.elements[i].count;
