@@ -1,5 +1,6 @@
 #include "model_state.h"
 
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -139,8 +140,31 @@ static ag_status regroup(ag_proceduralize_result *r, ag_error *err)
     return AG_OK;
 }
 
+/* The work done beside the read-back's proceduralization, on a thread of its own. */
+typedef struct {
+    ag_model_state_beside fn;
+    void *user;
+    const ag_mesh *derived;
+    ag_status status;
+    ag_error err;
+} beside_work;
+
+static void *run_beside(void *arg)
+{
+    beside_work *b = arg;
+    b->status = b->fn(b->user, b->derived, &b->err);
+    return NULL;
+}
+
 ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_state *out,
                               ag_error *err)
+{
+    return ag_model_state_make_beside(made, flags, NULL, NULL, out, err);
+}
+
+ag_status ag_model_state_make_beside(ag_edit_model **made, unsigned flags,
+                                     ag_model_state_beside beside, void *user,
+                                     ag_model_state *out, ag_error *err)
 {
     memset(out, 0, sizeof *out);
     ag_edit_model *m = *made;
@@ -158,11 +182,30 @@ ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_sta
                          "the grammar does not read back (line %ld, column %ld): %s", e.element,
                          col, e.text);
     ag_grammar_free(back);
+    beside_work bw = {.fn = beside, .user = user, .derived = out->derived};
+    pthread_t thread;
+    /* the derivation is only read from here on: the reload and the work beside share it */
+    int threaded = s == AG_OK && beside && (flags & AG_MODEL_READ_BACK) &&
+                   pthread_create(&thread, NULL, run_beside, &bw) == 0;
+    if (s == AG_OK && beside && !threaded) { /* before *made is moved: a failure keeps it */
+        run_beside(&bw);
+        s = bw.status;
+        bw.status = AG_OK;
+        if (s != AG_OK && err)
+            *err = bw.err;
+    }
     if (s == AG_OK && (flags & AG_MODEL_READ_BACK)) {
         s = ag_model_state_reload(out->derived, &out->em, err);
     } else if (s == AG_OK && (s = regroup(m->proc, err)) == AG_OK) {
         out->em = m;
         *made = NULL;
+    }
+    if (threaded)
+        pthread_join(thread, NULL);
+    if (s == AG_OK && beside && bw.status != AG_OK) {
+        s = bw.status;
+        if (err)
+            *err = bw.err;
     }
     if (s != AG_OK)
         ag_model_state_clear(out);

@@ -53,6 +53,15 @@ enum { AG_MODEL_READ_BACK = 1 };
 ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_state *out,
                               ag_error *err);
 
+/* Work on a state's derivation (read only) that needs nothing of its edit model. */
+typedef ag_status (*ag_model_state_beside)(void *user, const ag_mesh *derived, ag_error *err);
+/* ag_model_state_make that also runs beside on the derivation, with AG_MODEL_READ_BACK on a
+ * thread of its own while the derivation is proceduralized (the two share no state), else
+ * before *made is moved; a failure of beside is the call's (*made then stays the caller's). */
+ag_status ag_model_state_make_beside(ag_edit_model **made, unsigned flags,
+                                     ag_model_state_beside beside, void *user,
+                                     ag_model_state *out, ag_error *err);
+
 /* The state of a model given as a grammar (a composition's result, resolved, terminals with
  * geometry): the grammar itself printed with its terminals (g's terminal paths are set as
  * they will be kept), checked to read back, and the edit model of what it derives, so the

@@ -20,6 +20,18 @@ static int on_stage(void *user, ag_stage stage)
     return ag_workspace_progress(user, stage_start[stage], ag_proceduralize_stage_name(stage));
 }
 
+typedef struct {
+    const ag_mesh *input;
+    double tol;
+    ag_fidelity *out;
+} fidelity_check;
+
+static ag_status check_fidelity(void *user, const ag_mesh *derived, ag_error *err)
+{
+    fidelity_check *c = user;
+    return ag_grammar_fidelity(c->input, derived, c->tol, c->out, err);
+}
+
 ag_status ag_usecase_proceduralize_run(ag_workspace *ws, const ag_usecase_proceduralize_params *p,
                                        ag_usecase_proceduralize_result *out, ag_error *err)
 {
@@ -58,11 +70,12 @@ ag_status ag_usecase_proceduralize_run(ag_workspace *ws, const ag_usecase_proced
         goto done;
     }
     /* verify: the grammar printed, read back with its terminals as they will be kept,
-     * derived, proceduralized anew (the saved tree) and compared with the input */
+     * derived, proceduralized anew (the saved tree) and, meanwhile, compared with the input */
     double t0 = now();
-    if ((s = ag_model_state_make(&made, AG_MODEL_READ_BACK, &st, err)) != AG_OK ||
-        (s = ag_grammar_fidelity(r->mesh, st.derived, AG_PROC_VERIFY_FACTOR * r->labels->tol, &o.fidelity, err)) !=
-            AG_OK)
+    fidelity_check fc = {.input = r->mesh, .tol = AG_PROC_VERIFY_FACTOR * r->labels->tol,
+                         .out = &o.fidelity};
+    if ((s = ag_model_state_make_beside(&made, AG_MODEL_READ_BACK, check_fidelity, &fc, &st,
+                                        err)) != AG_OK)
         goto done;
     o.seconds[AG_STAGE_VERIFY] = now() - t0;
     if (o.fidelity.unmatched && !(p && p->save_unfaithful)) {

@@ -344,12 +344,70 @@ static void an_old_tree_is_renumbered_and_sessions_are_kept(void **state)
     unlink(side);
 }
 
+/* What the work beside a state's read-back saw, and what it answers. */
+typedef struct {
+    const ag_mesh *seen;
+    size_t triangles;
+    int fail;
+} beside_probe;
+
+static ag_status probe_beside(void *user, const ag_mesh *derived, ag_error *err)
+{
+    beside_probe *p = user;
+    p->seen = derived;
+    p->triangles = derived->ntris;
+    return p->fail ? ag_error_set(err, AG_ERR_INTERNAL, 0, "the probe refused %zu triangles",
+                                  derived->ntris)
+                   : AG_OK;
+}
+
+/* Work beside the read-back (the proceduralization's fidelity check) sees the state's own
+ * derivation, with or without read-back, and its failure is the state's, nothing kept. */
+static void work_beside_the_read_back_sees_the_derivation(void **state)
+{
+    (void)state;
+    ag_error err;
+    ag_mesh *m = NULL;
+    assert_int_equal(ag_gen_facade(&(ag_gen_facade_options){.cols = 5, .rows = 3}, &m, &err),
+                     AG_OK);
+    for (int fail = 0; fail < 2; fail++) {
+        for (unsigned flags = 0; flags <= AG_MODEL_READ_BACK; flags++) {
+            ag_proceduralize_result *r = NULL;
+            assert_int_equal(ag_proceduralize_run(m, NULL, &r, &err), AG_OK);
+            ag_edit_model *made = NULL;
+            assert_int_equal(ag_edit_model_wrap(r, NULL, &made, &err), AG_OK);
+            beside_probe p = {.fail = fail};
+            ag_model_state st;
+            ag_error_clear(&err);
+            ag_status s = ag_model_state_make_beside(&made, flags, probe_beside, &p, &st, &err);
+            assert_non_null(p.seen);
+            if (fail) {
+                assert_int_equal(s, AG_ERR_INTERNAL);
+                assert_non_null(strstr(err.text, "the probe refused"));
+                assert_null(st.em);
+                assert_null(st.derived);
+                assert_non_null(made); /* still the caller's */
+            } else {
+                assert_int_equal(s, AG_OK);
+                assert_ptr_equal(p.seen, st.derived);
+                assert_int_equal(p.triangles, st.derived->ntris);
+                assert_true(p.triangles > 0);
+                assert_non_null(st.em);
+            }
+            ag_model_state_clear(&st);
+            ag_edit_model_free(made);
+        }
+    }
+    ag_mesh_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(one_numbering_survives_every_reload),
         cmocka_unit_test(a_stored_tree_that_is_not_json_is_refused),
         cmocka_unit_test(an_old_tree_is_renumbered_and_sessions_are_kept),
+        cmocka_unit_test(work_beside_the_read_back_sees_the_derivation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
