@@ -44,6 +44,22 @@ void ag_edit_session_reset(ag_edit_state *st)
         st->points_free(st->points);
     st->points = NULL;
     st->points_free = NULL;
+    ag_trace_free(st->trace);
+    st->trace = NULL;
+}
+
+ag_status ag_edit_session_trace(ag_edit_state *st, const ag_trace **trace, ag_error *err)
+{
+    *trace = NULL;
+    if (!st->em)
+        return ag_error_set(err, AG_ERR_INTERNAL, 0, "no model is loaded to trace");
+    if (!st->trace) {
+        ag_status s = ag_trace_build(st->em->proc->grammar, 0, &st->trace, err);
+        if (s != AG_OK)
+            return s;
+    }
+    *trace = st->trace;
+    return AG_OK;
 }
 
 static void entry_free(entry *e)

@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "../core/edit/edit.h"
+#include "../core/parts/trace.h"
 #include "../core/status.h"
 #include "../store/db.h"
 
@@ -32,6 +33,9 @@ typedef struct {
      * state (reset, replace, eviction) by points_free */
     void *points;
     void (*points_free)(void *points);
+    /* em's derivation traced (core/parts/trace.h), made by the first part save or
+     * composition of this version and kept for the next ones */
+    ag_trace *trace;
 } ag_edit_state;
 
 ag_edit_sessions *ag_edit_sessions_create(void);
@@ -53,5 +57,7 @@ ag_status ag_edit_session_hold(ag_edit_sessions *reg, int64_t model, ag_edit_sta
 void ag_edit_session_replace(ag_edit_state *state, int64_t version, ag_edit_model *em);
 /* Forgets the loaded model (e.g. after a restore). */
 void ag_edit_session_reset(ag_edit_state *state);
+/* The borrowed state's trace, made when it has none yet (it goes with em). */
+ag_status ag_edit_session_trace(ag_edit_state *state, const ag_trace **trace, ag_error *err);
 
 #endif

@@ -90,6 +90,14 @@ static ag_status open_models(ag_workspace *ws, const ag_edit_op_origin *from, ag
     return AG_OK;
 }
 
+static ag_status model_trace(ag_workspace *ws, const ag_trace **trace, ag_error *err)
+{
+    ag_store_ws *w = (ag_store_ws *)ws;
+    if (!w->target)
+        return ag_error_set(err, AG_ERR_INTERNAL, 0, "no model is open to trace");
+    return ag_edit_session_trace(w->target, trace, err);
+}
+
 /* --- writing --------------------------------------------------------------------------- */
 
 /* A mesh as the store keeps it: the meshblob and the stats JSON (both malloc'd). */
@@ -740,6 +748,7 @@ static const ag_workspace_ops store_ops = {
     .open_part = open_part,
     .save_part = save_part,
     .save_composed = save_composed,
+    .model_trace = model_trace,
     .add_cloud = ag__store_ws_add_cloud,
     .input_cloud = ag__store_ws_input_cloud,
     .save_segmentation = ag__store_ws_save_segmentation,

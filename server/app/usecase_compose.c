@@ -48,7 +48,10 @@ static ag_status compose_grammar(ag_workspace *ws, const ag_usecase_compose_para
               : own > AG_USECASE_COMPOSE_MAX_TRIANGLES ? own
                                                        : AG_USECASE_COMPOSE_MAX_TRIANGLES;
     t0 = now_ms();
-    s = ag_compose(em->proc, part, &p->op, g, &out->report, err);
+    const ag_trace *trace = NULL;
+    s = ag_workspace_model_trace(ws, &trace, err);
+    if (s == AG_OK)
+        s = ag_compose_traced(em->proc, trace, part, &p->op, g, &out->report, err);
     out->compose_ms = now_ms() - t0;
     return s;
 }

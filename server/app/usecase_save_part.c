@@ -58,7 +58,9 @@ ag_status ag_usecase_save_part_run(ag_workspace *ws, const ag_usecase_save_part_
     if ((s = saved_node(em, p, &node, err)) != AG_OK)
         return s;
     ag_part *part = NULL;
-    if ((s = ag_part_extract(em->proc, node, p->meta, &part, err)) != AG_OK)
+    const ag_trace *trace = NULL;
+    if ((s = ag_workspace_model_trace(ws, &trace, err)) != AG_OK ||
+        (s = ag_part_extract_traced(em->proc, trace, node, p->meta, &part, err)) != AG_OK)
         return s;
     out->save_ms = now_ms() - t0;
     out->node = node;

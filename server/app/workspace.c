@@ -82,6 +82,12 @@ ag_status ag_workspace_save_segmentation(ag_workspace *ws, const ag_cloud_state 
                                       : unsupported("save a segmentation", err);
 }
 
+ag_status ag_workspace_model_trace(ag_workspace *ws, const ag_trace **trace, ag_error *err)
+{
+    *trace = NULL;
+    return ws->ops->model_trace ? ws->ops->model_trace(ws, trace, err) : AG_OK;
+}
+
 ag_status ag_workspace_open_part(ag_workspace *ws, const ag_part_ref *ref, const ag_part **part,
                                  ag_error *err)
 {

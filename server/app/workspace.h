@@ -120,6 +120,10 @@ typedef struct {
      * cleared); exactly one of proc and edit is given. */
     ag_status (*save)(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
                       const ag_edit_outcome *edit, ag_error *err);
+    /* The derivation trace (core/parts/trace.h) of the model open_models gave, kept with it
+     * for the next save or composition of the same version; without it (NULL), *trace = NULL
+     * and the caller traces. */
+    ag_status (*model_trace)(ag_workspace *ws, const ag_trace **trace, ag_error *err);
     /* The part a composition brings; the workspace's until close. */
     ag_status (*open_part)(ag_workspace *ws, const ag_part_ref *ref, const ag_part **part,
                            ag_error *err);
@@ -180,6 +184,7 @@ ag_status ag_workspace_open_models(ag_workspace *ws, const ag_edit_op_origin *fr
                                    int64_t *source_version, ag_error *err);
 ag_status ag_workspace_save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
                             const ag_edit_outcome *edit, ag_error *err);
+ag_status ag_workspace_model_trace(ag_workspace *ws, const ag_trace **trace, ag_error *err);
 ag_status ag_workspace_open_part(ag_workspace *ws, const ag_part_ref *ref, const ag_part **part,
                                  ag_error *err);
 ag_status ag_workspace_save_part(ag_workspace *ws, ag_part *part, const ag_part_outcome *o,

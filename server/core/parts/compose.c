@@ -386,6 +386,13 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
                      const ag_compose_op *op, ag_grammar **out, ag_compose_report *rep,
                      ag_error *err)
 {
+    return ag_compose_traced(target, NULL, part, op, out, rep, err);
+}
+
+ag_status ag_compose_traced(const ag_proceduralize_result *target, const ag_trace *trace,
+                            const ag_part *part, const ag_compose_op *op, ag_grammar **out,
+                            ag_compose_report *rep, ag_error *err)
+{
     *out = NULL;
     ag_compose_report local;
     if (!rep)
@@ -402,13 +409,14 @@ ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
         return st;
     const ag_grammar *g = target->grammar;
     const ag_splittree *tree = target->tree;
-    ag_trace *t = NULL;
+    ag_trace *own = NULL; /* the trace made here, when none is given */
     ag_grammar *W = NULL;
     uint8_t *below = NULL;
     ag_grule fitted = {0}, tmp = {0};
     namemap map = {0};
-    if ((st = ag_trace_build(g, 0, &t, err)))
+    if (!trace && (st = ag_trace_build(g, 0, &own, err)))
         return st;
+    const ag_trace *t = trace ? trace : own;
     ag_trace_site site;
     if ((st = ag_trace_find_node(t, g, target, op->target, &site, err)))
         goto done;
@@ -782,6 +790,6 @@ done:
     map_free(&map);
     free(below);
     ag_grammar_free(W);
-    ag_trace_free(t);
+    ag_trace_free(own);
     return st;
 }

@@ -75,5 +75,9 @@ typedef struct {
 ag_status ag_compose(const ag_proceduralize_result *target, const ag_part *part,
                      const ag_compose_op *op, ag_grammar **out, ag_compose_report *rep,
                      ag_error *err);
+/* ag_compose with target->grammar's trace (trace.h) given, NULL: traced here. */
+ag_status ag_compose_traced(const ag_proceduralize_result *target, const ag_trace *trace,
+                            const ag_part *part, const ag_compose_op *op, ag_grammar **out,
+                            ag_compose_report *rep, ag_error *err);
 
 #endif

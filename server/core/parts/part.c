@@ -364,19 +364,27 @@ done:
 ag_status ag_part_extract(const ag_proceduralize_result *r, int32_t node, const ag_part_meta *meta,
                           ag_part **out, ag_error *err)
 {
+    return ag_part_extract_traced(r, NULL, node, meta, out, err);
+}
+
+ag_status ag_part_extract_traced(const ag_proceduralize_result *r, const ag_trace *trace,
+                                 int32_t node, const ag_part_meta *meta, ag_part **out,
+                                 ag_error *err)
+{
     *out = NULL;
     ag_status st = ag_part_check_meta(meta, err);
     if (st)
         return st;
     if ((st = ag_place_check_node(r, node, "node", err)))
         return st;
-    ag_trace *t = NULL;
-    if ((st = ag_trace_build(r->grammar, 0, &t, err)))
+    ag_trace *own = NULL; /* the trace made here, when none is given */
+    if (!trace && (st = ag_trace_build(r->grammar, 0, &own, err)))
         return st;
+    const ag_trace *t = trace ? trace : own;
     ag_trace_site site;
     ag_part *p = calloc(1, sizeof *p);
     if (!p) {
-        ag_trace_free(t);
+        ag_trace_free(own);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
     p->version = 1;
@@ -411,11 +419,11 @@ ag_status ag_part_extract(const ag_proceduralize_result *r, int32_t node, const 
         ag_error_set(err, st, 0, "out of memory");
         goto fail;
     }
-    ag_trace_free(t);
+    ag_trace_free(own);
     *out = p;
     return AG_OK;
 fail:
-    ag_trace_free(t);
+    ag_trace_free(own);
     ag_part_free(p);
     return st;
 }

@@ -18,6 +18,7 @@
 
 #include "../mesh.h"
 #include "../proc/proceduralize.h"
+#include "trace.h"
 #include "../status.h"
 
 #define AG_PART_NAME_MAX 200
@@ -69,6 +70,11 @@ typedef struct {
 /* Saves node `node` of r (node ids of r->tree; r->grammar is r's exported grammar) as a part. */
 ag_status ag_part_extract(const ag_proceduralize_result *r, int32_t node, const ag_part_meta *meta,
                           ag_part **out, ag_error *err);
+/* ag_part_extract with r->grammar's trace (trace.h) given, NULL: traced here. A caller that
+ * keeps a model traces it once for every save and composition of that version. */
+ag_status ag_part_extract_traced(const ag_proceduralize_result *r, const ag_trace *trace,
+                                 int32_t node, const ag_part_meta *meta, ag_part **out,
+                                 ag_error *err);
 void ag_part_free(ag_part *p);
 /* A deep copy (its grammar resolved again). */
 ag_status ag_part_copy(const ag_part *p, ag_part **out, ag_error *err);
