@@ -613,7 +613,9 @@ static ag_status save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcom
 {
     ag_folder_ws *w = (ag_folder_ws *)ws;
     double t0 = now();
-    ag_status s = write_model(w, st, err);
+    ag_status s = ag_model_state_checked(st, err);
+    if (s == AG_OK)
+        s = write_model(w, st, err);
     double write_s = now() - t0;
     if (s == AG_OK) {
         char path[4200];

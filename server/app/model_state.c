@@ -13,6 +13,7 @@ void ag_model_state_clear(ag_model_state *s)
 {
     if (!s)
         return;
+    ag_model_state_checked(s, NULL); /* a check still running is waited for */
     free(s->text);
     ag_terminals_set_clear(&s->terms);
     ag_mesh_free(s->derived);
@@ -140,6 +141,95 @@ static ag_status regroup(ag_proceduralize_result *r, ag_error *err)
     return AG_OK;
 }
 
+/* out's text of grammar g (its terminals collected in out->terms), checked to read back:
+ * the text parsed with the terminals as they will be kept and derived (out->derived). */
+static ag_status print_and_read_back(const ag_grammar *g, ag_model_state *out, ag_error *err)
+{
+    ag_grammar *back = NULL;
+    long col = 0;
+    ag_error e;
+    ag_error_clear(&e);
+    ag_status s = ag_grammar_text_print(g, &out->text, &out->text_len, err);
+    if (s == AG_OK &&
+        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms,
+                         AG_GRAMMAR_MAX_TRIANGLES, &back, &out->derived, &e, &col)) != AG_OK)
+        s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
+                         "the grammar does not read back (line %ld, column %ld): %s", e.element,
+                         col, e.text);
+    ag_grammar_free(back);
+    return s;
+}
+
+/* out's terminals (g's paths set as they will be kept), text and read-back. */
+static ag_status read_back(ag_grammar *g, ag_model_state *out, ag_error *err)
+{
+    ag_status s = ag_terminals_collect(g, &out->terms, err);
+    return s == AG_OK ? print_and_read_back(g, out, err) : s;
+}
+
+/* A read-back check running beside the caller (ag_model_state_start). */
+struct ag_model_state_check {
+    pthread_t thread;
+    const ag_grammar *grammar;
+    ag_model_state *out;
+    ag_status status;
+    ag_error err;
+};
+
+static void *run_check(void *arg)
+{
+    struct ag_model_state_check *c = arg;
+    ag_error_clear(&c->err);
+    c->status = print_and_read_back(c->grammar, c->out, &c->err);
+    return NULL;
+}
+
+ag_status ag_model_state_start(ag_edit_model **made, unsigned flags, ag_model_state *out,
+                               ag_error *err)
+{
+    if (flags & AG_MODEL_READ_BACK)
+        return ag_model_state_make(made, flags, out, err);
+    memset(out, 0, sizeof *out);
+    ag_edit_model *m = *made;
+    ag_status s = regroup(m->proc, err);
+    if (s == AG_OK) /* sets the grammar's terminal paths: before anything reads it beside */
+        s = ag_terminals_collect(m->proc->grammar, &out->terms, err);
+    if (s != AG_OK) {
+        ag_terminals_set_clear(&out->terms);
+        return s;
+    }
+    struct ag_model_state_check *c = calloc(1, sizeof *c);
+    out->em = m;
+    *made = NULL;
+    if (c) {
+        /* the check reads the grammar only; the caller reads the tree and the mesh */
+        c->grammar = m->proc->grammar;
+        c->out = out;
+        if (pthread_create(&c->thread, NULL, run_check, c) == 0) {
+            out->check = c;
+            return AG_OK;
+        }
+        free(c);
+    }
+    if ((s = print_and_read_back(m->proc->grammar, out, err)) != AG_OK)
+        ag_model_state_clear(out);
+    return s;
+}
+
+ag_status ag_model_state_checked(ag_model_state *st, ag_error *err)
+{
+    struct ag_model_state_check *c = st->check;
+    if (!c)
+        return AG_OK;
+    pthread_join(c->thread, NULL);
+    st->check = NULL;
+    ag_status s = c->status;
+    if (s != AG_OK && err)
+        *err = c->err;
+    free(c);
+    return s;
+}
+
 /* The work done beside the read-back's proceduralization, on a thread of its own. */
 typedef struct {
     ag_model_state_beside fn;
@@ -168,20 +258,7 @@ ag_status ag_model_state_make_beside(ag_edit_model **made, unsigned flags,
 {
     memset(out, 0, sizeof *out);
     ag_edit_model *m = *made;
-    ag_grammar *back = NULL;
-    long col = 0;
-    ag_error e;
-    ag_error_clear(&e);
-    ag_status s = ag_terminals_collect(m->proc->grammar, &out->terms, err);
-    if (s == AG_OK)
-        s = ag_grammar_text_print(m->proc->grammar, &out->text, &out->text_len, err);
-    if (s == AG_OK &&
-        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms,
-                         AG_GRAMMAR_MAX_TRIANGLES, &back, &out->derived, &e, &col)) != AG_OK)
-        s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
-                         "the grammar does not read back (line %ld, column %ld): %s", e.element,
-                         col, e.text);
-    ag_grammar_free(back);
+    ag_status s = read_back(m->proc->grammar, out, err);
     beside_work bw = {.fn = beside, .user = user, .derived = out->derived};
     pthread_t thread;
     /* the derivation is only read from here on: the reload and the work beside share it */

@@ -39,6 +39,7 @@ typedef struct {
     ag_mesh *derived;      /* what the text derives (with the terminals as kept) */
     ag_edit_model *em;     /* the edit model; em->proc->mesh is the model's mesh */
     ag_model_state_times times; /* made from a grammar: its stages */
+    struct ag_model_state_check *check; /* a read-back check still running (ag_model_state_start) */
 } ag_model_state;
 
 void ag_model_state_clear(ag_model_state *s);
@@ -52,6 +53,18 @@ enum { AG_MODEL_READ_BACK = 1 };
  * mesh's groups renamed to the grammar's label names. */
 ag_status ag_model_state_make(ag_edit_model **made, unsigned flags, ag_model_state *out,
                               ag_error *err);
+
+/* ag_model_state_make without AG_MODEL_READ_BACK whose check runs on: *made is moved into out
+ * at once (its mesh's groups renamed) while the grammar is printed, read back and derived on a
+ * thread of its own, so the caller can encode the model meanwhile. text, terms and derived
+ * are out's only after ag_model_state_checked says AG_OK, and out stays where it is until
+ * then (the check writes into it); with AG_MODEL_READ_BACK (which needs the derivation
+ * first) it is ag_model_state_make. */
+ag_status ag_model_state_start(ag_edit_model **made, unsigned flags, ag_model_state *out,
+                               ag_error *err);
+/* Waits for a started check: AG_OK when the grammar reads back (at once for a state made any
+ * other way), else its problem (the state keeps its edit model; clear it). */
+ag_status ag_model_state_checked(ag_model_state *st, ag_error *err);
 
 /* Work on a state's derivation (read only) that needs nothing of its edit model. */
 typedef ag_status (*ag_model_state_beside)(void *user, const ag_mesh *derived, ag_error *err);

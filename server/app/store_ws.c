@@ -409,23 +409,32 @@ static ag_status save_proc(ag_store_ws *w, ag_model_state *st, const ag_proc_out
 
 /* Commits a structural change of the model (an edit, a composition): the state before and
  * after are kept for undo, st is stored with the version the op raises, body is logged. */
+static char *change_summary(const char *source, const char *kind, const ag_model_state *st);
+
 static ag_status commit_change(ag_store_ws *w, ag_model_state *st, json_t *body,
-                               const char *summary, ag_error *err)
+                               const char *source, const char *kind, ag_error *err)
 {
-    /* encoded before the sequencer's lock is taken: it serializes every model's changes */
+    /* encoded before the sequencer's lock is taken: it serializes every model's changes;
+     * meanwhile the grammar's read-back check may still be running (ag_model_state_start) */
     encoded_state e;
     encode_state(st, &e, err);
-    if (e.mesh_status != AG_OK) {
-        ag_status s = e.mesh_status;
+    ag_status s = e.mesh_status;
+    if (s == AG_OK)
+        s = ag_model_state_checked(st, err);
+    char *summary = s == AG_OK ? change_summary(source, kind, st) : NULL;
+    if (s == AG_OK && !summary)
+        s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    if (s != AG_OK) {
         encoded_clear(&e);
         return s;
     }
     ag_seq_txn t;
     int dup = 0;
     double t_begin = now_ms();
-    ag_status s = ag__store_ws_begin(w, "edited", 1, &t, &dup, err);
+    s = ag__store_ws_begin(w, "edited", 1, &t, &dup, err);
     if (s != AG_OK || dup) {
         encoded_clear(&e);
+        free(summary);
         return s;
     }
     double t_locked = now_ms();
@@ -434,6 +443,7 @@ static ag_status commit_change(ag_store_ws *w, ag_model_state *st, json_t *body,
         s = write_state(t.db, w->o.model, t.version, st, &e, summary, 1, err);
     double t_tree = e.tree_ms, t_mesh = e.mesh_ms;
     encoded_clear(&e);
+    free(summary);
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)
         s = ag_grammars_put_terminal(t.db, w->o.model, st->terms.path[i], st->terms.obj[i],
                                      st->terms.len[i], err);
@@ -481,19 +491,17 @@ static ag_status save_edit(ag_store_ws *w, ag_model_state *st, const ag_edit_out
         json_object_set_new(report, "edit_ms", json_real(o->edit_ms));
     if (report && o->source_version) /* the version of the source model whose nodes were copied */
         json_object_set_new(report, "source_version", json_integer((json_int_t)o->source_version));
-    char *summary =
-        change_summary("edit", json_string_value(json_object_get(w->o.op, "kind")), st);
     ag_status s = AG_OK;
-    if (!report || !body || !summary) {
+    if (!report || !body) {
         json_decref(report);
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     } else if (json_object_set_new(body, "report", report) != 0) {
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
     if (s == AG_OK)
-        s = commit_change(w, st, body, summary, err);
+        s = commit_change(w, st, body, "edit",
+                          json_string_value(json_object_get(w->o.op, "kind")), err);
     json_decref(body);
-    free(summary);
     return s;
 }
 
@@ -517,22 +525,20 @@ static ag_status save_composed(ag_workspace *ws, ag_model_state *st, const ag_co
     /* logged: the op as sent, with the part version it used and the composition's report */
     json_t *report = ag_usecase_compose_report_json(o);
     json_t *body = json_deep_copy(w->o.op);
-    char *summary = change_summary("compose", "compose", st);
     ag_status s = AG_OK;
     if (report) {
         json_object_set_new(report, "compose_ms", json_real(o->compose_ms));
         json_object_set_new(report, "state_ms", json_real(o->state_ms));
         json_object_set_new(report, "state_stages", state_stages(st, &o->graft));
     }
-    if (!report || !body || !summary || !w->target ||
+    if (!report || !body || !w->target ||
         json_object_set_new(body, "version", json_integer((json_int_t)o->part->version)) ||
         json_object_set(body, "report", report))
         s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     if (s == AG_OK)
-        s = commit_change(w, st, body, summary, err);
+        s = commit_change(w, st, body, "compose", "compose", err);
     json_decref(report);
     json_decref(body);
-    free(summary);
     ag_model_state_clear(st);
     return s;
 }
@@ -575,9 +581,12 @@ static ag_status save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcom
                       const ag_edit_outcome *edit, ag_error *err)
 {
     ag_store_ws *w = (ag_store_ws *)ws;
-    ag_status s = proc ? save_proc(w, st, proc, err)
-                : edit && w->target ? save_edit(w, st, edit, err)
-                                    : ag_error_set(err, AG_ERR_INTERNAL, 0, "nothing to save");
+    /* an edit's read-back check is waited for in its commit, after the model is encoded */
+    ag_status s = proc ? ag_model_state_checked(st, err) : AG_OK;
+    if (s == AG_OK)
+        s = proc                  ? save_proc(w, st, proc, err)
+            : edit && w->target ? save_edit(w, st, edit, err)
+                                : ag_error_set(err, AG_ERR_INTERNAL, 0, "nothing to save");
     ag_model_state_clear(st);
     return s;
 }

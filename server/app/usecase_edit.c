@@ -53,7 +53,7 @@ ag_status ag_usecase_edit_run(ag_workspace *ws, const ag_usecase_edit_params *p,
         return s;
     op.source = source ? source->proc : NULL;
     if ((s = ag_edit_apply_ex(em, &op, 0, &made, &out->report, err)) != AG_OK ||
-        (s = ag_model_state_make(&made, ws->ops->state_flags, &st, err)) != AG_OK)
+        (s = ag_model_state_start(&made, ws->ops->state_flags, &st, err)) != AG_OK)
         goto done;
     /* instances per label as the saved model names its labels */
     if ((s = ag_edit_report_count_labels(&out->report, st.em->proc->mesh, err)) != AG_OK)

@@ -117,7 +117,9 @@ typedef struct {
                              const ag_edit_model **source, int64_t *source_version,
                              ag_error *err);
     /* Saves a proceduralized or edited model (st is the workspace's afterwards: taken and
-     * cleared); exactly one of proc and edit is given. */
+     * cleared); exactly one of proc and edit is given. A state whose read-back check still
+     * runs (ag_model_state_start) is kept only once ag_model_state_checked says it reads
+     * back. */
     ag_status (*save)(ag_workspace *ws, ag_model_state *st, const ag_proc_outcome *proc,
                       const ag_edit_outcome *edit, ag_error *err);
     /* The derivation trace (core/parts/trace.h) of the model open_models gave, kept with it

@@ -401,6 +401,57 @@ static void work_beside_the_read_back_sees_the_derivation(void **state)
     ag_mesh_free(m);
 }
 
+/* A state whose read-back check runs beside the caller is the state ag_model_state_make makes,
+ * once checked; a grammar that does not read back is refused by the check, with the line. */
+static void a_started_check_is_the_made_state(void **state)
+{
+    (void)state;
+    ag_error err;
+    ag_mesh *m = NULL;
+    assert_int_equal(ag_gen_facade(&(ag_gen_facade_options){.cols = 6, .rows = 3, .left = 1},
+                                   &m, &err),
+                     AG_OK);
+    for (int broken = 0; broken < 2; broken++) {
+        ag_edit_model *a = NULL, *b = NULL;
+        assert_int_equal(ag_edit_model_create(m, NULL, &a, &err), AG_OK);
+        assert_int_equal(ag_edit_model_create(m, NULL, &b, &err), AG_OK);
+        if (broken) { /* a rule name that is no identifier: the text does not parse */
+            free(b->proc->grammar->rules[0].name);
+            b->proc->grammar->rules[0].name = strdup("not a name");
+        }
+        ag_model_state made, started;
+        assert_int_equal(ag_model_state_make(&a, 0, &made, &err), AG_OK);
+        assert_int_equal(ag_model_state_start(&b, 0, &started, &err), AG_OK);
+        assert_null(b); /* moved at once */
+        assert_non_null(started.em);
+        ag_error_clear(&err);
+        ag_status s = ag_model_state_checked(&started, &err);
+        if (broken) {
+            assert_int_equal(s, AG_ERR_INTERNAL);
+            assert_non_null(strstr(err.text, "does not read back"));
+        } else {
+            assert_int_equal(s, AG_OK);
+            assert_int_equal(started.text_len, made.text_len);
+            assert_memory_equal(started.text, made.text, made.text_len);
+            assert_int_equal(started.terms.n, made.terms.n);
+            assert_int_equal(started.derived->ntris, made.derived->ntris);
+            assert_int_equal(started.derived->ncomponents, made.derived->ncomponents);
+            /* checked again: nothing left to wait for */
+            assert_int_equal(ag_model_state_checked(&started, &err), AG_OK);
+        }
+        ag_model_state_clear(&made);
+        ag_model_state_clear(&started);
+    }
+    /* cleared while the check still runs: waited for, nothing leaks */
+    ag_edit_model *c = NULL;
+    assert_int_equal(ag_edit_model_create(m, NULL, &c, &err), AG_OK);
+    ag_model_state running;
+    assert_int_equal(ag_model_state_start(&c, 0, &running, &err), AG_OK);
+    ag_model_state_clear(&running);
+    assert_null(running.check);
+    ag_mesh_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -408,6 +459,7 @@ int main(void)
         cmocka_unit_test(a_stored_tree_that_is_not_json_is_refused),
         cmocka_unit_test(an_old_tree_is_renumbered_and_sessions_are_kept),
         cmocka_unit_test(work_beside_the_read_back_sees_the_derivation),
+        cmocka_unit_test(a_started_check_is_the_made_state),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
