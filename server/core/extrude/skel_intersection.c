@@ -1,6 +1,7 @@
 /* The generalized intersection event (§4.4): the corners arriving at one point are
  * retired, edges passing through it are split, and the edges leaving the point are
- * paired around it into new corners. */
+ * paired around it into new corners. Corners of two parts growing outwards into each other
+ * head-on (eaves of wings set corner to corner) pair the other way round: the parts merge. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -95,6 +96,61 @@ static void apex(const sk *S, const uint32_t *es, size_t n, double spread, doubl
     *lx += d[0];
     *ly += d[1];
     *z = fmax(*z + d[2], S->zcur);
+}
+
+/* Pairs each outgoing ray with the next incoming one counter-clockwise (clockwise when cw)
+ * around the point, nested pairs matched inside out: np pairs (in edge, out edge) into
+ * pairs. The rays leave and arrive in equal numbers. */
+static size_t pair_rays(const sk_ray *rays, size_t nrays, int cw, uint32_t *stack,
+                        uint32_t *pairs, int *nested)
+{
+    long bal = 0, minbal = 0;
+    size_t start = 0;
+    for (size_t i = 0; i < nrays; i++) {
+        bal += rays[cw ? nrays - 1 - i : i].out ? 1 : -1;
+        if (bal < minbal) {
+            minbal = bal;
+            start = i + 1;
+        }
+    }
+    size_t sp = 0, np = 0;
+    *nested = 0;
+    for (size_t j = 0; j < nrays; j++) {
+        size_t k = (start + j) % nrays;
+        const sk_ray *r = &rays[cw ? nrays - 1 - k : k];
+        if (r->out) {
+            if (sp)
+                *nested = 1;
+            stack[sp++] = r->edge;
+        } else if (sp) {
+            pairs[2 * np] = r->edge;
+            pairs[2 * np + 1] = stack[--sp];
+            np++;
+        }
+    }
+    return np;
+}
+
+static int all_outwards(const sk *S, const sk_ray *rays, size_t nrays)
+{
+    for (size_t i = 0; i < nrays; i++)
+        if (!(S->e[rays[i].edge].s < 0))
+            return 0;
+    return 1;
+}
+
+/* Does every pair make again one of the corners arriving at the point? */
+static int pairs_remake_corners(const sk *S, const uint32_t *cs, size_t nc,
+                                const uint32_t *pairs, size_t np)
+{
+    for (size_t p = 0; p < np; p++) {
+        int found = 0;
+        for (size_t i = 0; i < nc && !found; i++)
+            found = S->c[cs[i]].in == pairs[2 * p] && S->c[cs[i]].out == pairs[2 * p + 1];
+        if (!found)
+            return 0;
+    }
+    return 1;
 }
 
 void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
@@ -254,19 +310,10 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
         memmove(&W->rays[1], &W->rays[0], (nrays - 1) * sizeof(sk_ray));
         W->rays[0] = r;
     }
-    /* pair each outgoing sk_ray with the next incoming one counter-clockwise */
-    long bal = 0, minbal = 0;
-    size_t start = 0;
     int nout = 0;
-    for (size_t i = 0; i < nrays; i++) {
-        bal += W->rays[i].out ? 1 : -1;
+    for (size_t i = 0; i < nrays; i++)
         nout += W->rays[i].out;
-        if (bal < minbal) {
-            minbal = bal;
-            start = i + 1;
-        }
-    }
-    if (bal != 0) {
+    if (2 * nout != (int)nrays) {
         ag_error_set(S->err, AG_ERR_INTERNAL, 0,
                      "inconsistent intersection at (%.6f, %.6f, %.6f): %d edges leave, %d arrive",
                      lx + S->ox, ly + S->oy, z, nout, (int)nrays - nout);
@@ -283,20 +330,15 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
         ag__skel_fail(S, AG_ERR_NOMEM);
         return;
     }
-    size_t sp = 0, np = 0;
     int nested = 0;
-    for (size_t j = 0; j < nrays; j++) {
-        sk_ray *r = &W->rays[(start + j) % nrays];
-        if (r->out) {
-            if (sp)
-                nested = 1;
-            stack[sp++] = r->edge;
-        } else if (sp) {
-            pairs[2 * np] = r->edge;
-            pairs[2 * np + 1] = stack[--sp];
-            np++;
-        }
-    }
+    size_t np = pair_rays(W->rays, nrays, 0, stack, pairs, &nested);
+    /* Corners of parts growing into each other head-on (every edge at the point moving
+     * outwards, each arriving corner paired again with its own edges): counter-clockwise
+     * pairing would let them pass through each other. The parts merge: seen from the
+     * outside, which is what shrinks, the pairing turns the other way. */
+    if (W->C.n >= 2 && np == W->C.n && all_outwards(S, W->rays, nrays) &&
+        pairs_remake_corners(S, W->C.arr, W->C.n, pairs, np))
+        np = pair_rays(W->rays, nrays, 1, stack, pairs, &nested);
     if (nested)
         S->stats.irregular++;
     /* a corner that is paired again with the same two edges only touched the others:
