@@ -6,6 +6,7 @@
 
 #include "../base/tolerance.h"
 #include "../proc/gframe.h"
+#include "fit.h"
 
 /* Work limits: columns of an axis, and the new count. */
 #define MAX_COLUMNS 1000000L
@@ -302,6 +303,35 @@ ag_status ag_fit_count_axis(ag_fit_items *items, double S[3], int a, double len,
         if (first[s] < 0)
             first[s] = j;
         last[s] = j;
+    }
+    /* what the new columns hold, refused before it is made past what a fit takes */
+    double total = 0;
+    for (size_t i = 0; i < n; i++) {
+        const ag_fit_item *x = &items->v[i];
+        if (kind[i] == SPANS) {
+            total += cells_of(&x->s);
+            continue;
+        }
+        long j = (long)floor((lo[i] - o + tol) / p);
+        if (kind[i] == IN_COLUMN) {
+            total += first[j] < 0 ? 0 : cells_of(&x->s) * (double)(last[j] - first[j] + 1);
+            continue;
+        }
+        long c = (long)x->s.counts[kk[i]], t0 = -1, t1 = -1;
+        for (long t = j; t < j + c; t++)
+            if (first[t] >= 0) {
+                t0 = t0 < 0 ? first[t] : t0;
+                t1 = last[t];
+            }
+        if (t0 >= 0)
+            total += cells_of(&x->s) / (double)c * (double)(t1 - t0 + 1);
+    }
+    if (total > AG_FIT_MAX_ELEMENTS) {
+        st = ag_error_set(err, AG_ERR_TOO_LARGE, 0,
+                          "the part's %ld columns would become %ld, %.0f nodes (at most "
+                          "%d can be fitted)",
+                          ncols, k, total, AG_FIT_MAX_ELEMENTS);
+        goto keep;
     }
     double ratio = len / S[a], shift = lo2 - m;
     for (size_t i = 0; i < n && !st; i++) {
