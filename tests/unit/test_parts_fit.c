@@ -38,6 +38,9 @@ static ag_grammar *parse_body(unsigned n)
              "  b = split(a, 2.85, 0.05, 1, 1)\n"
              "  P(subdivide(b, 5, 1, 1, 0.7, 0, 0))\n"
              "}\n\n"
+             "rule grid size 23.7 0.16 11.4 {\n"
+             "  C(subdivide(p, 10, 1, 4, 2.5, 0, 3.2))\n"
+             "}\n\n"
              "axiom box 0 0 0 %.17g 0.3 7 {\n"
              "  facade(p)\n"
              "}\n",
@@ -153,6 +156,33 @@ static void test_thin_and_short_rows_keep_counts(void **state)
     ag_grammar_free(g);
 }
 
+/* A grid of 10 x 4 windows (no margins) into 0.77 of its length and half its height: both
+ * axes re-laid, 7 columns (8 at 2.5 m would need 18.7 m of the 18.25) and 2 rows, the
+ * windows' size and periods kept, nothing left to solve. */
+static void test_grid_both_axes(void **state)
+{
+    (void)state;
+    ag_grammar *g = parse_body(10);
+    const ag_grule *r = rule(g, "grid");
+    double size[3] = {0.77 * r->size[0], 0.16, 0.5 * r->size[2]};
+    ag_grule out = {0};
+    ag_fit_report rep;
+    ag_error err = {0};
+    if (ag_fit_body(g, r, size, &out, &rep, &err))
+        fail_msg("fit: %s", err.text);
+    assert_int_equal(rep.columns[0][0], 10);
+    assert_int_equal(rep.columns[0][1], 7);
+    assert_int_equal(rep.columns[2][0], 4);
+    assert_int_equal(rep.columns[2][1], 2);
+    assert_int_equal(rep.equations, 0); /* no solve */
+    const ag_gstmt *s = pattern_of(&out, "C");
+    assert_int_equal(s->counts[0], 7);
+    assert_int_equal(s->counts[2], 2);
+    assert_true(fabs(s->step[0] - 2.5) < 1e-9 && fabs(s->step[2] - 3.2) < 1e-9);
+    free_body(&out);
+    ag_grammar_free(g);
+}
+
 /* A row stretched 30000 times would hold 300000 windows: refused, naming the columns. */
 static void test_too_many_columns(void **state)
 {
@@ -174,6 +204,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_row_of_windows),
         cmocka_unit_test(test_thin_and_short_rows_keep_counts),
+        cmocka_unit_test(test_grid_both_axes),
         cmocka_unit_test(test_too_many_columns),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
