@@ -128,6 +128,31 @@ static void test_row_of_windows(void **state)
     ag_grammar_free(g);
 }
 
+/* Shorter and taller: the columns re-laid along the length, the height left to the solve
+ * (one row: no lattice there), which keeps every coordinate along the length. */
+static void test_row_shorter_and_taller(void **state)
+{
+    (void)state;
+    ag_grammar *g = parse_body(10);
+    const ag_grule *f = rule(g, "facade");
+    double size[3] = {0.77 * f->size[0], 0.3, 8.4};
+    ag_grule out = {0};
+    ag_fit_report rep;
+    ag_error err = {0};
+    if (ag_fit_body(g, f, size, &out, &rep, &err))
+        fail_msg("fit: %s", err.text);
+    assert_int_equal(rep.columns[0][1], 8);
+    assert_int_equal(rep.columns[2][1], 0);
+    assert_true(rep.equations > 0);
+    const ag_gstmt *s = pattern_of(&out, "C");
+    assert_int_equal(s->counts[0], 8);
+    assert_true(fabs(s->step[0] - 2.5) < 1e-9);
+    double x0 = pattern_min_x(&out, s), room = size[0] - (7 * 2.5 + 1.2);
+    assert_true(fabs(x0 - room / 2) < 1e-9);
+    free_body(&out);
+    ag_grammar_free(g);
+}
+
 /* Thin posts are spaced out over a rail twice as long, never added to; two windows are no
  * lattice: the solve keeps their count. */
 static void test_thin_and_short_rows_keep_counts(void **state)
@@ -204,6 +229,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_row_of_windows),
         cmocka_unit_test(test_thin_and_short_rows_keep_counts),
+        cmocka_unit_test(test_row_shorter_and_taller),
         cmocka_unit_test(test_grid_both_axes),
         cmocka_unit_test(test_too_many_columns),
     };
