@@ -39,7 +39,9 @@ ag_status ag_fit_items_push(ag_fit_items *it, const ag_fit_item *x);
 
 /* Along axis a, the body of items (in a box of size S, min corner 0) re-laid for the length
  * `len`: on a lattice, *items holds the new columns, S[a] becomes len and *cols gets the old and
- * new column counts; otherwise nothing changes and cols is {0, 0}. */
+ * new column counts; otherwise nothing changes and cols is {0, 0}. New columns that would hold
+ * more than AG_FIT_MAX_ELEMENTS (fit.h) nodes are refused before they are made:
+ * AG_ERR_TOO_LARGE. */
 ag_status ag_fit_count_axis(ag_fit_items *items, double S[3], int a, double len, double tol,
                             unsigned cols[2], ag_error *err);
 
