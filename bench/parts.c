@@ -490,9 +490,15 @@ static void bench_compose(const ag_proceduralize_result *r, const ag_part *p, in
         ag_grammar_free(g);
     }
     qsort(ms, RUNS, sizeof *ms, cmp);
-    printf("compose %-34s %-7s %-4s %6zu instances: %8.2f ms (min %.2f)\n", what,
+    /* the columns the fit re-counted (core/parts/fitcount.h), when it did */
+    char cols[48] = "";
+    for (int a = 0; a < 3; a++)
+        if (rep.fit.columns[a][1])
+            snprintf(cols + strlen(cols), sizeof cols - strlen(cols), ", columns %u -> %u",
+                     rep.fit.columns[a][0], rep.fit.columns[a][1]);
+    printf("compose %-34s %-7s %-4s %6zu instances: %8.2f ms (min %.2f)%s\n", what,
            ag_compose_mode_name(mode), ag_compose_scope_name(scope), rep.instances, ms[RUNS / 2],
-           ms[0]);
+           ms[0], cols);
 }
 
 /* Which parts run: all, or those named in the arguments (core, save, compose, search), so a

@@ -538,6 +538,152 @@ static void test_bad_ops(void **state)
     ag_part_free(p);
 }
 
+/* b turned by `turn` quarter turns about z (as pf_building turns its building). */
+static ag_box turned_box(const ag_box *b, int turn)
+{
+    ag_box r = {{INFINITY, INFINITY, b->min[2]}, {-INFINITY, -INFINITY, b->max[2]}};
+    for (int i = 0; i < 4; i++) {
+        double x = i & 1 ? b->max[0] : b->min[0], y = i & 2 ? b->max[1] : b->min[1];
+        for (int k = 0; k < (turn & 3); k++) {
+            double t = x;
+            x = -y;
+            y = t;
+        }
+        r.min[0] = fmin(r.min[0], x);
+        r.max[0] = fmax(r.max[0], x);
+        r.min[1] = fmin(r.min[1], y);
+        r.max[1] = fmax(r.max[1], y);
+    }
+    return r;
+}
+
+static int by_min_along(const void *x, const void *y, void *ctx)
+{
+    int u = *(const int *)ctx;
+    double a = ((const ag_box *)x)->min[u], b = ((const ag_box *)y)->min[u];
+    return a < b ? -1 : a > b;
+}
+
+/* The top node above n that is not the root (visible, or a pattern when grid is set). */
+static int32_t top_above(const ag_splittree *t, int32_t n, int grid)
+{
+    int32_t up = n;
+    for (int32_t p = t->nodes[n].parent; p > 0; p = t->nodes[p].parent)
+        if (t->nodes[p].kind == (grid ? AG_NODE_PATTERN : AG_NODE_COMPONENT))
+            up = p;
+    return up;
+}
+
+/* A facade part (A's front wall with two rows of ten windows) replaces B's blank left wall of
+ * `ratio` times its length: the wall holds more or fewer columns of A's window at the window's
+ * own size and spacing (as a resize does), measured on the derived mesh: the casings found by
+ * their boxes, counted (as many as fit in the wall at A's density), their widths and spacing
+ * within 1 %, every piece of the part inside the wall's box, each window's frame bars 0.08
+ * wide. Proud windows stand out of their wall, so no node holds both: there A's grid of
+ * windows replaces B's (two columns as long as the ratio says). */
+static void facade_onto_wall(int depth, int turn_a, int turn_b, double ratio)
+{
+    const unsigned N = 10, rows = 2;
+    int grid = depth == PF_PROUD;
+    pf_options oa = pf_design_a(depth, turn_a, 0, 0);
+    oa.cols = N;
+    oa.rows = rows;
+    double sx = oa.ww + 1.0; /* the fixture's spacing */
+    double Wa = grid ? (N - 1) * sx + oa.ww : 2 * 0.9 + (N - 1) * sx + oa.ww, L = ratio * Wa;
+    ag_mesh *ma;
+    ag_box *sa;
+    size_t nsa;
+    ag_proceduralize_result *ra = building(&oa, &ma, &sa, &nsa);
+    /* the facade: the top node above a window, below the building's root */
+    const ag_splittree *ta = ra->tree;
+    int32_t fnode = pf_node_with_box(ra, &sa[0], TOL);
+    assert_true(fnode > 0);
+    fnode = top_above(ta, fnode, grid);
+    for (size_t s = 0; s < nsa; s++) /* it holds every window */
+        assert_true(pf_inside(&sa[s], &ta->nodes[fnode].box, TOL));
+    ag_part_meta meta = {.name = "row facade", .source = "A"};
+    ag_part *part = NULL;
+    ag_error err = {0};
+    if (ag_part_extract(ra, fnode, &meta, &part, &err))
+        fail_msg("extract: %s", err.text);
+    /* B: as tall as A, its left wall (blank) L long, or its grid of two columns L long */
+    pf_options ob = pf_design_b(depth, turn_b, 0, 0);
+    ob.side_cols = 0;
+    ob.rows = rows;
+    ob.wh = oa.wh;
+    if (grid) {
+        ob.cols = 2;
+        ob.sx = L - ob.ww;
+    } else {
+        ob.sx = L - 1.8 - ob.ww; /* the left wall: 2 * 0.9 + sx + ww */
+    }
+    ag_mesh *mb;
+    ag_box *sb;
+    size_t nsb;
+    ag_proceduralize_result *rb = building(&ob, &mb, &sb, &nsb);
+    double Ht = 1.0 + rows * (ob.wh + 1.2);
+    ag_box left0 = {{0, 0, 0}, {0.3, L, Ht}}, T = turned_box(&left0, turn_b);
+    int32_t target = grid ? top_above(rb->tree, pf_node_with_box(rb, &sb[0], TOL), 1)
+                          : pf_node_with_box(rb, &T, TOL);
+    assert_true(target > 0);
+    if (grid)
+        T = rb->tree->nodes[target].box;
+    ag_compose_report rep;
+    ag_grammar *g = compose(rb, part, target, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, &rep);
+    ag_mesh *d = derive(g);
+    ag_box *cb = pf_component_boxes(d), bounds = ag_mesh_bounds(d);
+    /* the columns at A's density, fewer while they do not fit at A's spacing */
+    unsigned k = (unsigned)lround(N * ratio);
+    while (k > 1 && (k - 1) * sx + oa.ww > L + TOL)
+        k--;
+    print_message("ratio %.2f: %u columns expected\n", ratio, k);
+    int u = along_axis(&T), v = 1 - u;
+    ag_box *cas = malloc((d->ncomponents + 1) * sizeof *cas);
+    size_t ncas = 0, npart = 0;
+    for (size_t c = 0; c < d->ncomponents; c++) {
+        int32_t gi = d->component_group[c];
+        if (gi < 0 || strncmp(d->group_names[gi], "row_facade_", 11))
+            continue;
+        npart++;
+        if (!pf_inside(&cb[c], &T, TOL))
+            fail_msg("a piece of the part lies outside the target's box");
+        double eu = cb[c].max[u] - cb[c].min[u], ev = cb[c].max[v] - cb[c].min[v];
+        double ez = cb[c].max[2] - cb[c].min[2];
+        if (fabs(eu - oa.ww) <= 0.01 * oa.ww && fabs(ez - oa.wh) <= 0.01 * oa.wh &&
+            fabs(ev - 0.16) <= 0.01 * 0.16)
+            cas[ncas++] = cb[c];
+    }
+    assert_int_equal(ncas, k * rows);
+    /* seven pieces per window, and A's wall */
+    assert_int_equal(npart, 7 * k * rows + !grid);
+    qsort_r(cas, ncas, sizeof *cas, by_min_along, &u);
+    /* per column (two casings at one place along the wall): the spacing of A's windows */
+    for (size_t i = 0; i + rows < ncas; i += rows) {
+        double gap = cas[i + rows].min[u] - cas[i].min[u];
+        if (fabs(gap - sx) > 0.01 * sx)
+            fail_msg("columns %zu and %zu are %g apart, not %g", i / rows, i / rows + 1, gap, sx);
+    }
+    for (size_t i = 0; i < ncas; i++) /* each a window of A: frame 0.08, one mullion */
+        check_window(cb, d->ncomponents, &cas[i], oa.frame, oa.mullions, &bounds);
+    free(cas);
+    free(cb);
+    ag_mesh_free(d);
+    ag_grammar_free(g);
+    free(sb);
+    ag_proceduralize_result_free(rb);
+    ag_mesh_free(mb);
+    ag_part_free(part);
+    free(sa);
+    ag_proceduralize_result_free(ra);
+    ag_mesh_free(ma);
+}
+
+static void test_facade_narrower_recessed(void **state) { (void)state; facade_onto_wall(PF_RECESSED, 0, 0, 0.77); }
+static void test_facade_much_narrower_flush(void **state) { (void)state; facade_onto_wall(PF_FLUSH, 0, 0, 0.6); }
+static void test_facade_wider_proud(void **state) { (void)state; facade_onto_wall(PF_PROUD, 0, 0, 1.5); }
+static void test_facade_twice_turned(void **state) { (void)state; facade_onto_wall(PF_RECESSED, 1, 3, 2.0); }
+static void test_facade_narrower_both_turned(void **state) { (void)state; facade_onto_wall(PF_FLUSH, 2, 1, 0.77); }
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -553,6 +699,11 @@ int main(void)
         cmocka_unit_test(test_rule_scope_terminal),
         cmocka_unit_test(test_pattern_target),
         cmocka_unit_test(test_bad_ops),
+        cmocka_unit_test(test_facade_narrower_recessed),
+        cmocka_unit_test(test_facade_much_narrower_flush),
+        cmocka_unit_test(test_facade_wider_proud),
+        cmocka_unit_test(test_facade_twice_turned),
+        cmocka_unit_test(test_facade_narrower_both_turned),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -598,6 +598,33 @@ static void test_generated_facade(void **state)
         ag_edit_model *c = compare(b, facade, leaf, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE, "facade onto the blank wall");
         classes_may_differ = 0;
         resize_works(c);
+        /* the facade onto a narrower facade: fewer columns of its windows (core/parts/fitcount.h),
+         * grafted as the slow path proceduralizes them */
+        int32_t side = -1;
+        size_t best_side = 0;
+        const ag_box *bb = &t->nodes[big].box;
+        for (size_t i = 1; i < t->nnodes; i++) {
+            const ag_box *b2 = &t->nodes[i].box;
+            size_t sub = t->nodes[i].kind == AG_NODE_COMPONENT && (int32_t)i != big
+                             ? visible_under(t, (int32_t)i)
+                             : 0;
+            double w = b2->max[0] - b2->min[0] + b2->max[1] - b2->min[1];
+            if (sub > best_side && w < 0.95 * (bb->max[0] - bb->min[0] + bb->max[1] - bb->min[1])) {
+                best_side = sub;
+                side = (int32_t)i;
+            }
+        }
+        assert_true(side > 0);
+        /* the mesh is the slow path's; two visible nodes may fall in rule classes of other
+         * sizes (as for the blank wall above) */
+        classes_may_differ = 1;
+        ag_edit_model *e = compare(em, facade, side, AG_COMPOSE_REPLACE, AG_COMPOSE_NODE,
+                                   "facade onto a narrower facade");
+        classes_may_differ = 0;
+        /* the side's four columns give way to four of the front's (the same window): as many
+         * components as before, where the front's six columns would add two columns more */
+        assert_int_equal(e->proc->mesh->ncomponents, em->proc->mesh->ncomponents);
+        ag_edit_model_free(e);
         ag_edit_model_free(c);
         ag_edit_model_free(b);
         ag_edit_model_free(a);

@@ -770,14 +770,24 @@ ag_status ag_compose_traced(const ag_proceduralize_result *target, const ag_trac
                           err ? err->text : "");
         goto done;
     }
+    /* the columns the fit re-counted, as "10 -> 8 columns" */
+    char counts[64] = "";
+    for (int a = 0; a < 3; a++)
+        if (rep->fit.columns[a][1]) {
+            size_t at = strlen(counts);
+            snprintf(counts + at, sizeof counts - at, "%s%u -> %u columns", at ? ", " : " (",
+                     rep->fit.columns[a][0], rep->fit.columns[a][1]);
+        }
+    if (counts[0])
+        snprintf(counts + strlen(counts), sizeof counts - strlen(counts), ")");
     snprintf(rep->message, sizeof rep->message,
              "%s '%s' into node %d (scope %s%s%s): %zu instance%s, turned by %d, fitted to "
-             "%.4g x %.4g x %.4g; %zu rules and %zu terminals added, %zu and %zu shared",
+             "%.4g x %.4g x %.4g%s; %zu rules and %zu terminals added, %zu and %zu shared",
              ag_compose_mode_name(op->mode), part->name, (int)op->target,
              ag_compose_scope_name(op->scope), rep->target_rule[0] ? ", rule " : "",
              rep->target_rule, rep->instances, rep->instances == 1 ? "" : "s", 90 * rep->turn,
-             Sk[0], Sk[1], Sk[2], rep->rules_added, rep->terminals_added, rep->rules_shared,
-             rep->terminals_shared);
+             Sk[0], Sk[1], Sk[2], counts, rep->rules_added, rep->terminals_added,
+             rep->rules_shared, rep->terminals_shared);
     *out = W;
     W = NULL;
     st = AG_OK;

@@ -21,7 +21,8 @@
  *   name_2, name_3, ... where they clash. Terminals brought in are labelled "<part>_<label>".
  * - the part is turned by quarter turns from the way it faced in its building to the way the
  *   target faces (ag_place_facing), and fitted into the target's box (or a fill cell) by
- *   fit.h: contacts kept, thin members keep their sizes.
+ *   fit.h: contacts kept, thin members keep their sizes, repeated columns (a facade's
+ *   windows) re-counted at their own size and period (fitcount.h).
  * The result is a new resolved grammar (terminals with geometry) that derives, prints and
  * parses like any other; target and part are not changed. Deterministic: a pure function of
  * the target grammar and tree, the part, the node, the mode and the scope. */

@@ -10,6 +10,7 @@
 #include "../edit/lsq.h"
 #include "../proc/gframe.h"
 #include "../proc/splittree.h"
+#include "fitcount.h"
 #include "gcopy.h"
 
 #define RIGID_RELAXED_WEIGHT 100.0
@@ -106,7 +107,7 @@ static int push(softs *q, soft s)
 static double coord_of(const ag_box *b, int c) { return c < 3 ? b->min[c] : b->max[c - 3]; }
 
 typedef struct {
-    int32_t node;   /* body node, -1 for the body's box */
+    int32_t item;   /* the item it is (a cell of), -1 for the body's box */
     ag_box box;
 } element;
 
@@ -221,6 +222,24 @@ static ag_status emit_pattern(ag_grule *out, const ag_gstmt *s, const element *e
     return st;
 }
 
+/* Every item on its box, by two splits from p (none for the whole box). */
+static ag_status emit_items(ag_grule *out, const ag_fit_items *it, const double size[3],
+                            double tol)
+{
+    ag_status st = AG_OK;
+    for (size_t i = 0; i < it->n && !st; i++) {
+        char a1[24], node[24] = "p";
+        if (!whole_box(&it->v[i].box, size, tol)) {
+            snprintf(a1, sizeof a1, "f%zua", i);
+            snprintf(node, sizeof node, "f%zub", i);
+            st = split_to(out, a1, node, &it->v[i].box);
+        }
+        if (!st)
+            st = ag_gcopy_stmt(out, &it->v[i].s, node, NULL, NULL);
+    }
+    return st;
+}
+
 ag_status ag_fit_body(const ag_grammar *g, const ag_grule *r, const double size[3], ag_grule *out,
                       ag_fit_report *rep, ag_error *err)
 {
@@ -230,7 +249,7 @@ ag_status ag_fit_body(const ag_grammar *g, const ag_grule *r, const double size[
         rep = &local;
     memset(rep, 0, sizeof *rep);
     memcpy(out->size, size, 3 * sizeof *size);
-    const double *S = r->size;
+    const double *S0 = r->size;
     for (int a = 0; a < 3; a++)
         if (!isfinite(size[a]) || size[a] < 0)
             return ag_error_set(err, AG_ERR_INVALID, 0, "the fitted size is not finite");
@@ -238,8 +257,8 @@ ag_status ag_fit_body(const ag_grammar *g, const ag_grule *r, const double size[
     {
         double d = 0, sc = 0;
         for (int a = 0; a < 3; a++) {
-            d = fmax(d, fabs(size[a] - S[a]));
-            sc = fmax(sc, fabs(S[a]));
+            d = fmax(d, fabs(size[a] - S0[a]));
+            sc = fmax(sc, fabs(S0[a]));
         }
         if (d <= 1e-12 * (sc + 1)) {
             for (size_t i = 0; i < r->nstmts; i++)
@@ -251,40 +270,73 @@ ag_status ag_fit_body(const ag_grammar *g, const ag_grule *r, const double size[
     }
     size_t nn = r->nnodes ? r->nnodes : 1;
     ag_box *nb = malloc(nn * sizeof *nb);
-    int32_t *elem_of = malloc(nn * sizeof *elem_of);
-    element *el = malloc((nn + 1) * sizeof *el);
+    ag_fit_items items = {0};
+    element *el = NULL;
     classes c = {0};
     softs q = {0};
     uint32_t *order = NULL, *rows = NULL, *cols = NULL, *col_of = NULL;
     double *vals = NULL, *b = NULL, *x = NULL, *nv = NULL;
-    uint8_t *emitted = NULL;
     size_t *cell0 = NULL;
     ag_lsq *lsq = NULL;
     ag_status st = AG_ERR_NOMEM;
-    if (!nb || !elem_of || !el)
+    if (!nb)
         goto done;
-    nb[0] = (ag_box){{0, 0, 0}, {S[0], S[1], S[2]}};
-    for (size_t i = 0; i < nn; i++)
-        elem_of[i] = -1;
-    size_t ne = 1, cap_el = nn + 1;
-    el[0] = (element){-1, nb[0]};
-    cell0 = malloc((r->nstmts + 1) * sizeof *cell0);
-    if (!cell0)
-        goto done;
+    /* the applications on their nodes' boxes */
+    nb[0] = (ag_box){{0, 0, 0}, {S0[0], S0[1], S0[2]}};
     for (size_t i = 0; i < r->nstmts; i++) {
         const ag_gstmt *s = &r->stmts[i];
-        cell0[i] = 0;
         if (s->kind == AG_GSTMT_SPLIT) {
             nb[s->node_ix] = ag_splittree_child_box(&nb[s->parent_ix], s->v, s->octant);
             continue;
         }
+        ag_fit_item it = {*s, nb[s->node_ix]};
+        if (ag_fit_items_push(&items, &it))
+            goto done;
+    }
+    double diag = sqrt(S0[0] * S0[0] + S0[1] * S0[1] + S0[2] * S0[2]);
+    double diag2 = sqrt(size[0] * size[0] + size[1] * size[1] + size[2] * size[2]);
+    double eps = 1e-7 * (diag > 0 ? diag : 1), tol = 1e-7 * (diag + diag2 + 1e-9);
+    /* counts: repeated columns re-laid at their own period (fitcount.h) */
+    double S[3] = {S0[0], S0[1], S0[2]};
+    for (int a = 0; a < 3; a++)
+        if ((st = ag_fit_count_axis(&items, S, a, size[a], tol, rep->columns[a], err)))
+            goto done;
+    int solve = 0;
+    for (int a = 0; a < 3; a++)
+        solve |= fabs(size[a] - S[a]) > tol;
+    if (!solve) { /* every axis that changed was re-laid: the items are in place */
+        size_t cells = 0;
+        for (size_t i = 0; i < items.n; i++)
+            cells += items.v[i].s.subdivide ? (size_t)items.v[i].s.counts[0] *
+                                                  items.v[i].s.counts[1] * items.v[i].s.counts[2]
+                                            : 1;
+        if (cells > AG_FIT_MAX_ELEMENTS) {
+            st = ag_error_set(err, AG_ERR_TOO_LARGE, 0,
+                              "the part's root would apply %zu nodes (at most %d can be fitted)",
+                              cells, AG_FIT_MAX_ELEMENTS);
+            goto done;
+        }
+        rep->elements = cells;
+        if ((st = emit_items(out, &items, size, tol)))
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        goto done;
+    }
+    st = AG_ERR_NOMEM;
+    /* the elements: the body's box, every single application, every pattern's cells */
+    size_t ne = 1, cap_el = items.n + 1;
+    el = malloc(cap_el * sizeof *el);
+    cell0 = malloc((items.n + 1) * sizeof *cell0);
+    if (!el || !cell0)
+        goto done;
+    el[0] = (element){-1, {{0, 0, 0}, {S[0], S[1], S[2]}}};
+    for (size_t i = 0; i < items.n; i++) {
+        const ag_fit_item *it = &items.v[i];
+        const ag_gstmt *s = &it->s;
+        cell0[i] = ne;
         if (!s->subdivide) {
-            if (elem_of[s->node_ix] >= 0)
-                continue;
             if (ne == cap_el && grow_el(&el, &cap_el))
                 goto done;
-            elem_of[s->node_ix] = (int32_t)ne;
-            el[ne++] = (element){s->node_ix, nb[s->node_ix]};
+            el[ne++] = (element){(int32_t)i, it->box};
             continue;
         }
         /* a pattern: its cells are the members */
@@ -294,14 +346,13 @@ ag_status ag_fit_body(const ag_grammar *g, const ag_grule *r, const double size[
             break;
         }
         ag_gframe_cells gc;
-        ag_gframe_cells_of(s, &nb[s->node_ix], &gc);
-        cell0[i] = ne;
+        ag_gframe_cells_of(s, &it->box, &gc);
         for (uint32_t z = 0; z < s->counts[2]; z++)
             for (uint32_t y = 0; y < s->counts[1]; y++)
-                for (uint32_t x = 0; x < s->counts[0]; x++) {
+                for (uint32_t xx = 0; xx < s->counts[0]; xx++) {
                     if (ne == cap_el && grow_el(&el, &cap_el))
                         goto done;
-                    el[ne++] = (element){s->node_ix, ag_gframe_cell(&gc, x, y, z)};
+                    el[ne++] = (element){(int32_t)i, ag_gframe_cell(&gc, xx, y, z)};
                 }
     }
     if (ne > AG_FIT_MAX_ELEMENTS) {
@@ -311,9 +362,6 @@ ag_status ag_fit_body(const ag_grammar *g, const ag_grule *r, const double size[
         goto done;
     }
     rep->elements = ne - 1;
-    double diag = sqrt(S[0] * S[0] + S[1] * S[1] + S[2] * S[2]);
-    double diag2 = sqrt(size[0] * size[0] + size[1] * size[1] + size[2] * size[2]);
-    double eps = 1e-7 * (diag > 0 ? diag : 1), tol = 1e-7 * (diag + diag2 + 1e-9);
     size_t nc = 6 * ne;
     c.n = nc;
     c.up = malloc(nc * sizeof *c.up);
@@ -452,34 +500,24 @@ ag_status ag_fit_body(const ag_grammar *g, const ag_grule *r, const double size[
         uint32_t rt = find(&c, (uint32_t)i, &o);
         nv[i] = (c.fixed[rt] ? c.val[rt] : x[col_of[rt]]) + o;
     }
-    /* emission: every applied node on its new box, by two splits from p */
+    /* emission: every application on its new box, by two splits from p */
     unsigned fresh = 0;
-    emitted = calloc(ne, 1);
-    if (!emitted)
-        goto done;
     st = AG_OK;
-    for (size_t i = 0; i < r->nstmts && !st; i++) {
-        const ag_gstmt *s = &r->stmts[i];
-        if (s->kind != AG_GSTMT_APPLY)
-            continue;
+    for (size_t i = 0; i < items.n && !st; i++) {
+        const ag_gstmt *s = &items.v[i].s;
         if (s->subdivide) {
             st = emit_pattern(out, s, el, cell0[i], nv, size, tol, &fresh);
             continue;
         }
-        int32_t e = elem_of[s->node_ix];
-        ag_box nbx = new_box(nv, (size_t)e);
+        size_t e = cell0[i];
+        ag_box nbx = new_box(nv, e);
         char node[24] = "p";
         if (!whole_box(&nbx, size, tol)) {
-            /* the node's two splits are emitted once, before its first application */
-            snprintf(node, sizeof node, "f%ub", (unsigned)e);
-            if (!emitted[e]) {
-                char a1[24];
-                snprintf(a1, sizeof a1, "f%ua", (unsigned)e);
-                st = split_to(out, a1, node, &nbx);
-                emitted[e] = 1;
-                if (st)
-                    break;
-            }
+            char a1[24];
+            snprintf(a1, sizeof a1, "f%zua", e);
+            snprintf(node, sizeof node, "f%zub", e);
+            if ((st = split_to(out, a1, node, &nbx)))
+                break;
         }
         st = ag_gcopy_stmt(out, s, node, NULL, NULL);
     }
@@ -490,7 +528,7 @@ done:
         ag_error_set(err, st, 0, "out of memory");
     ag_lsq_free(lsq);
     free(nb);
-    free(elem_of);
+    free(items.v);
     free(el);
     free(c.up);
     free(c.off);
@@ -505,7 +543,6 @@ done:
     free(b);
     free(x);
     free(nv);
-    free(emitted);
     free(cell0);
     return st;
 }

@@ -27,6 +27,8 @@
 typedef struct {
     size_t elements, classes, equations;
     size_t rigid, rigid_relaxed; /* rigid sizes kept exactly / turned soft */
+    unsigned columns[3][2];      /* per axis re-laid by its columns (fitcount.h): the old and
+                                    new column counts; {0, 0} where none */
 } ag_fit_report;
 
 /* Appends to `out` (an empty rule; its size is set to size) the statements of body r (of
