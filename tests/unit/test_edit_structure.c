@@ -489,14 +489,23 @@ static int cmp_window(const void *p, const void *q)
     return x->u < y->u ? -1 : x->u > y->u;
 }
 
-/* The visible node of the front window of column col in the first row: the smallest visible
- * node whose box holds the window's glass centre (world). */
-static int32_t front_window(const ag_edit_model *em, const bb_options *o, unsigned col)
+/* A facade's direction (u) in the building frame: front +x, right +y. */
+static void facade_dir(int facade, double d[2])
+{
+    d[0] = facade ? 0 : 1;
+    d[1] = facade ? 1 : 0;
+}
+
+/* The visible node of the window of column col in the first row of a facade (0 front, 1
+ * right): the smallest visible node whose box holds the window's glass centre (world). */
+static int32_t window_node(const ag_edit_model *em, const bb_options *o, int facade,
+                           unsigned col)
 {
     double fr[2], gl[2], si[2], p[3];
     bb_depths(o->mount, fr, gl, si);
-    bb_to_world(o, BB_MARGIN + col * BB_PERIOD + 0.5 * BB_WIN_W, 0.5 * (gl[0] + gl[1]),
-                BB_ROW0 + 0.5 * BB_WIN_H, p);
+    double u = BB_MARGIN + col * BB_PERIOD + 0.5 * BB_WIN_W, v = 0.5 * (gl[0] + gl[1]);
+    /* the right facade's frame: x = L - v, y = u (edit_building_fixture.h bb_to_building) */
+    bb_to_world(o, facade ? bb_length(o) - v : u, facade ? u : v, BB_ROW0 + 0.5 * BB_WIN_H, p);
     const ag_splittree *t = em->proc->tree;
     int32_t best = -1;
     double bv = INFINITY;
@@ -520,12 +529,14 @@ static int32_t front_window(const ag_edit_model *em, const bb_options *o, unsign
 #define HM_WIDER 1.2
 #define HM_TALLER 0.9
 
-/* Resizes the front window of column col (a left-handed window in an even column, its mirror
- * image in an odd one) 1.2x wider and 0.9x taller in global mode: every window, of both hands
- * and on every facade, has the new size within 1 % on the edited mesh, its hand where it was
- * (the hands still alternate along every row), its depth in the wall as before, inside its
- * facade's wall along it and clear of the other windows, and the count is unchanged. */
-static int resize_one_window(const bb_options *o, unsigned col)
+/* Resizes the window of column col in the first row of a facade (0 front, 1 right; a
+ * left-handed window in an even column, its mirror image in an odd one) 1.2x wider and 0.9x
+ * taller in global mode: every window, of both hands and on every facade, has the new size
+ * within 1 % on the edited mesh, its hand where it was (the hands still alternate along every
+ * row), the side it grew from kept (a mirror image grows the other way), its depth in the wall
+ * as before, inside its facade's wall along it and clear of the other windows, and the count
+ * is unchanged. */
+static int resize_one_window(const bb_options *o, int facade, unsigned col)
 {
     ag_mesh *m = NULL;
     ag_error err = {0};
@@ -536,14 +547,22 @@ static int resize_one_window(const bb_options *o, unsigned col)
     size_t n0, n1;
     hm_window *w0 = measure_windows(em->proc->mesh, o, g.window, &n0);
     qsort(w0, n0, sizeof *w0, cmp_window);
-    int32_t node = front_window(em, o, col);
+    int32_t node = window_node(em, o, facade, col);
     assert_true(node > 0);
+    /* the facade's direction in the world: the axis the window widens along, and whether the
+     * scale, which holds the world min corner, holds the facade's min in its own frame */
+    double d[2], w0o[3], w1o[3];
+    facade_dir(facade, d);
+    bb_to_world(o, 0, 0, 0, w0o);
+    bb_to_world(o, d[0], d[1], 0, w1o);
+    int axis = fabs(w1o[0] - w0o[0]) > fabs(w1o[1] - w0o[1]) ? 0 : 1;
+    int grows_from_min = w1o[axis] > w0o[axis];
     ag_edit_op op = {.kind = AG_EDIT_RESIZE, .node = node, .has_scale = 1, .scale = {1, 1, 1},
                      .mode = AG_EDIT_GLOBAL};
-    op.scale[front_axis(o)] = HM_WIDER;
+    op.scale[axis] = HM_WIDER;
     op.scale[2] = HM_TALLER;
     char what[64];
-    snprintf(what, sizeof what, "window %u resized", col);
+    snprintf(what, sizeof what, "%s window %u resized", facade ? "right" : "front", col);
     ag_edit_model *ed = apply(em, &op, 0, what, o);
     hm_window *w1 = measure_windows(ed->proc->mesh, o, g.window, &n1);
     qsort(w1, n1, sizeof *w1, cmp_window);
@@ -551,9 +570,6 @@ static int resize_one_window(const bb_options *o, unsigned col)
     double want[3] = {(BB_WIN_W + 0.1) * HM_WIDER, w0[0].depth, (BB_WIN_H + 0.08) * HM_TALLER};
     /* the hand of the edited window: even columns left-handed (none when un-handed) */
     int edited_hand = o->handed ? (col & 1 ? 1 : -1) : 0;
-    /* the scale holds the world min corner: the facade's min in its own frame unless the
-     * building's turn points the front against the world axis (a half or three quarter turn) */
-    int grows_from_min = (o->turn & 3) < 2;
     double size_err = 0, depth_moved = 0, anchor_moved = 0, min_gap = INFINITY, outside = 0;
     size_t hands_wrong = 0, row_start = 0, per_facade0[3] = {0}, per_facade1[3] = {0};
     for (size_t i = 0; i < n0; i++) {
@@ -598,19 +614,19 @@ static int resize_one_window(const bb_options *o, unsigned col)
             min_gap = fmin(min_gap, gap);
         }
     }
-    print_message("  %-40s window %u x%.1f wide x%.1f tall: %zu windows (were %zu), size error "
+    print_message("  %-40s %s x%.1f wide x%.1f tall: %zu windows (were %zu), size error "
                   "%.4f, hands wrong %zu, anchor moved %.2g, depth moved %.2g, outside %.2g, gap "
                   "%.3f\n",
-                  o->name, col, HM_WIDER, HM_TALLER, n1, n0, size_err, hands_wrong, anchor_moved,
+                  o->name, what, HM_WIDER, HM_TALLER, n1, n0, size_err, hands_wrong, anchor_moved,
                   depth_moved, outside, min_gap);
     int ok = n1 == n0 && !memcmp(per_facade0, per_facade1, sizeof per_facade0) &&
              size_err <= 0.01 && !hands_wrong && anchor_moved <= 1e-4 && depth_moved <= 1e-4 &&
              outside <= 1e-4 && min_gap > 0;
     if (!ok)
-        print_error("%s window %u resized: %zu windows (were %zu), size error %.4f, %zu with the "
+        print_error("%s %s: %zu windows (were %zu), size error %.4f, %zu with the "
                     "wrong hand, the fixed side moved %.3g, depth moved %.3g, outside its wall "
                     "%.3g, gap %.3f\n",
-                    o->name, col, n1, n0, size_err, hands_wrong, anchor_moved, depth_moved,
+                    o->name, what, n1, n0, size_err, hands_wrong, anchor_moved, depth_moved,
                     outside, min_gap);
     assert_grammar_derives_mesh(ed, what);
     free(w0);
@@ -627,8 +643,9 @@ static void a_window_resize_reaches_every_window(void **state)
     (void)state;
     size_t failed = 0;
     for (size_t i = 0; i < sizeof variants / sizeof *variants; i++)
-        for (unsigned col = 0; col < 2; col++)
-            failed += !resize_one_window(&variants[i], col);
+        for (int facade = 0; facade < (variants[i].side_cols ? 2 : 1); facade++)
+            for (unsigned col = 0; col < 2; col++)
+                failed += !resize_one_window(&variants[i], facade, col);
     if (failed)
         fail_msg("%zu window resizes did not reach every window", failed);
 }
