@@ -407,15 +407,24 @@ typedef struct {
     double along, depth, height; /* extents in the facade frame */
     double v0, v1;               /* the box's depth range along the facade's normal */
     int hand;
-} hm_window;
+} window_measure;
 
-/* The facade's direction in the building frame: front +x, right +y, left -y. */
-static double facade_u(int facade, double x, double y)
+/* A facade's direction (its u) in the building frame: front +x, right +y, left -y. */
+static void facade_dir(int facade, double d[2])
 {
-    return facade == 0 ? x : facade == 1 ? y : -y;
+    d[0] = facade == 0 ? 1 : 0;
+    d[1] = facade == 0 ? 0 : facade == 1 ? 1 : -1;
 }
 
-static hm_window *measure_windows(const ag_mesh *m, const bb_options *o, const char *window,
+/* A point's place along a facade (building frame). */
+static double facade_u(int facade, double x, double y)
+{
+    double d[2];
+    facade_dir(facade, d);
+    return d[0] * x + d[1] * y;
+}
+
+static window_measure *measure_windows(const ag_mesh *m, const bb_options *o, const char *window,
                                   size_t *nw)
 {
     int32_t gw = group_named(m, window);
@@ -443,12 +452,12 @@ static hm_window *measure_windows(const ag_mesh *m, const bb_options *o, const c
         nt[c]++;
     }
     double xmid = 0.5 * bb_length(o);
-    hm_window *w = calloc(nc + 1, sizeof *w);
+    window_measure *w = calloc(nc + 1, sizeof *w);
     size_t k = 0;
     for (size_t c = 0; c < nc; c++) {
         if (!nt[c] || m->component_group[c] != gw)
             continue;
-        hm_window *x = &w[k++];
+        window_measure *x = &w[k++];
         x->box = b[c];
         int along_x = bb_extent(&b[c], 0) > bb_extent(&b[c], 1);
         x->facade = along_x ? 0 : b[c].min[0] > xmid ? 1 : 2;
@@ -473,7 +482,7 @@ static hm_window *measure_windows(const ag_mesh *m, const bb_options *o, const c
 }
 
 /* A window's row: the nearest of the rows its bottom (the sill's) started on. */
-static long window_row(const hm_window *x)
+static long window_row(const window_measure *x)
 {
     return lround((x->box.min[2] + 0.08 - BB_ROW0) / BB_FLOOR);
 }
@@ -481,19 +490,12 @@ static long window_row(const hm_window *x)
 /* Windows ordered by facade, row, then place along the facade. */
 static int cmp_window(const void *p, const void *q)
 {
-    const hm_window *x = p, *y = q;
+    const window_measure *x = p, *y = q;
     if (x->facade != y->facade)
         return x->facade - y->facade;
     if (window_row(x) != window_row(y))
         return window_row(x) < window_row(y) ? -1 : 1;
     return x->u < y->u ? -1 : x->u > y->u;
-}
-
-/* A facade's direction (u) in the building frame: front +x, right +y. */
-static void facade_dir(int facade, double d[2])
-{
-    d[0] = facade ? 0 : 1;
-    d[1] = facade ? 1 : 0;
 }
 
 /* The visible node of the window of column col in the first row of a facade (0 front, 1
@@ -526,8 +528,8 @@ static int32_t window_node(const ag_edit_model *em, const bb_options *o, int fac
     return best;
 }
 
-#define HM_WIDER 1.2
-#define HM_TALLER 0.9
+#define WINDOW_WIDER 1.2
+#define WINDOW_TALLER 0.9
 
 /* Resizes the window of column col in the first row of a facade (0 front, 1 right; a
  * left-handed window in an even column, its mirror image in an odd one) 1.2x wider and 0.9x
@@ -545,7 +547,7 @@ static int resize_one_window(const bb_options *o, int facade, unsigned col)
         fail_msg("%s: proceduralize: %s", o->name, err.text);
     bb_groups g = find_groups(em->proc->mesh, o);
     size_t n0, n1;
-    hm_window *w0 = measure_windows(em->proc->mesh, o, g.window, &n0);
+    window_measure *w0 = measure_windows(em->proc->mesh, o, g.window, &n0);
     qsort(w0, n0, sizeof *w0, cmp_window);
     int32_t node = window_node(em, o, facade, col);
     assert_true(node > 0);
@@ -559,15 +561,17 @@ static int resize_one_window(const bb_options *o, int facade, unsigned col)
     int grows_from_min = w1o[axis] > w0o[axis];
     ag_edit_op op = {.kind = AG_EDIT_RESIZE, .node = node, .has_scale = 1, .scale = {1, 1, 1},
                      .mode = AG_EDIT_GLOBAL};
-    op.scale[axis] = HM_WIDER;
-    op.scale[2] = HM_TALLER;
+    op.scale[axis] = WINDOW_WIDER;
+    op.scale[2] = WINDOW_TALLER;
     char what[64];
     snprintf(what, sizeof what, "%s window %u resized", facade ? "right" : "front", col);
     ag_edit_model *ed = apply(em, &op, 0, what, o);
-    hm_window *w1 = measure_windows(ed->proc->mesh, o, g.window, &n1);
+    window_measure *w1 = measure_windows(ed->proc->mesh, o, g.window, &n1);
     qsort(w1, n1, sizeof *w1, cmp_window);
 
-    double want[3] = {(BB_WIN_W + 0.1) * HM_WIDER, w0[0].depth, (BB_WIN_H + 0.08) * HM_TALLER};
+    /* a window's box: the frame and the sill 5 cm past it on each side, 8 cm under it */
+    double want[3] = {(BB_WIN_W + 0.1) * WINDOW_WIDER, w0[0].depth,
+                      (BB_WIN_H + 0.08) * WINDOW_TALLER};
     /* the hand of the edited window: even columns left-handed (none when un-handed) */
     int edited_hand = o->handed ? (col & 1 ? 1 : -1) : 0;
     double size_err = 0, depth_moved = 0, anchor_moved = 0, min_gap = INFINITY, outside = 0;
@@ -581,7 +585,7 @@ static int resize_one_window(const bb_options *o, int facade, unsigned col)
         assert_int_equal(w0[i].hand, o->handed ? ((i - row_start) & 1 ? 1 : -1) : 0);
     }
     for (size_t i = 0; i < n1; i++) {
-        const hm_window *x = &w1[i];
+        const window_measure *x = &w1[i];
         per_facade1[x->facade]++;
         double e[3] = {x->along, x->depth, x->height};
         for (int a = 0; a < 3; a++)
@@ -617,8 +621,8 @@ static int resize_one_window(const bb_options *o, int facade, unsigned col)
     print_message("  %-40s %s x%.1f wide x%.1f tall: %zu windows (were %zu), size error "
                   "%.4f, hands wrong %zu, anchor moved %.2g, depth moved %.2g, outside %.2g, gap "
                   "%.3f\n",
-                  o->name, what, HM_WIDER, HM_TALLER, n1, n0, size_err, hands_wrong, anchor_moved,
-                  depth_moved, outside, min_gap);
+                  o->name, what, WINDOW_WIDER, WINDOW_TALLER, n1, n0, size_err, hands_wrong,
+                  anchor_moved, depth_moved, outside, min_gap);
     int ok = n1 == n0 && !memcmp(per_facade0, per_facade1, sizeof per_facade0) &&
              size_err <= 0.01 && !hands_wrong && anchor_moved <= 1e-4 && depth_moved <= 1e-4 &&
              outside <= 1e-4 && min_gap > 0;
