@@ -9,7 +9,8 @@
  * front (the root and the front wall) and squeezed back. Every result is checked on its mesh
  * alone: windows and doors are counted by group and position, their sizes and the walls'
  * thicknesses measured, every element must still be closed, and the grammar must derive the
- * mesh exactly (fidelity). */
+ * mesh exactly (fidelity). A global resize of one window (either hand) reaches every window:
+ * both hands on every facade get its new size, the mirror images growing the other way. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -392,6 +393,267 @@ static void run_variant(const bb_options *o)
     ag_mesh_free(m);
 }
 
+/* ---- a global resize of one window ------------------------------------------------------ */
+
+/* The windows of a mesh as a window resize checks them: per window its box in the building
+ * frame, its facade (0 front, 1 right, 2 left), its place along the facade (u, increasing
+ * along the facade's own direction) and its hand: the sign of its triangles' mean centroid
+ * along u from its box's centre (the handle is the only part off the centre: -1 on the left,
+ * +1 on the right, 0 for a window without one). */
+typedef struct {
+    bb_part box;
+    int facade;
+    double u;  /* the box's min along the facade's direction */
+    double along, depth, height; /* extents in the facade frame */
+    double v0, v1;               /* the box's depth range along the facade's normal */
+    int hand;
+} window_measure;
+
+/* A facade's direction (its u) in the building frame: front +x, right +y, left -y. */
+static void facade_dir(int facade, double d[2])
+{
+    d[0] = facade == 0 ? 1 : 0;
+    d[1] = facade == 0 ? 0 : facade == 1 ? 1 : -1;
+}
+
+/* A point's place along a facade (building frame). */
+static double facade_u(int facade, double x, double y)
+{
+    double d[2];
+    facade_dir(facade, d);
+    return d[0] * x + d[1] * y;
+}
+
+static window_measure *measure_windows(const ag_mesh *m, const bb_options *o, const char *window,
+                                  size_t *nw)
+{
+    int32_t gw = group_named(m, window);
+    size_t nc = m->ncomponents;
+    bb_part *b = calloc(nc + 1, sizeof *b);
+    double *cx = calloc(nc + 1, sizeof *cx), *cy = calloc(nc + 1, sizeof *cy);
+    size_t *nt = calloc(nc + 1, sizeof *nt);
+    for (size_t c = 0; c < nc; c++)
+        for (int a = 0; a < 3; a++) {
+            b[c].min[a] = INFINITY;
+            b[c].max[a] = -INFINITY;
+        }
+    for (size_t t = 0; t < m->ntris; t++) {
+        uint32_t c = m->tri_component[t];
+        for (int k = 0; k < 3; k++) {
+            double q[3];
+            bb_to_frame(o, &m->pos[3 * m->tri[3 * t + k]], q);
+            for (int a = 0; a < 3; a++) {
+                b[c].min[a] = fmin(b[c].min[a], q[a]);
+                b[c].max[a] = fmax(b[c].max[a], q[a]);
+            }
+            cx[c] += q[0] / 3;
+            cy[c] += q[1] / 3;
+        }
+        nt[c]++;
+    }
+    double xmid = 0.5 * bb_length(o);
+    window_measure *w = calloc(nc + 1, sizeof *w);
+    size_t k = 0;
+    for (size_t c = 0; c < nc; c++) {
+        if (!nt[c] || m->component_group[c] != gw)
+            continue;
+        window_measure *x = &w[k++];
+        x->box = b[c];
+        int along_x = bb_extent(&b[c], 0) > bb_extent(&b[c], 1);
+        x->facade = along_x ? 0 : b[c].min[0] > xmid ? 1 : 2;
+        double u0 = facade_u(x->facade, b[c].min[0], b[c].min[1]),
+               u1 = facade_u(x->facade, b[c].max[0], b[c].max[1]);
+        x->u = fmin(u0, u1);
+        x->along = bb_extent(&b[c], along_x ? 0 : 1);
+        x->depth = bb_extent(&b[c], along_x ? 1 : 0);
+        x->height = bb_extent(&b[c], 2);
+        x->v0 = b[c].min[along_x ? 1 : 0];
+        x->v1 = b[c].max[along_x ? 1 : 0];
+        double mu = facade_u(x->facade, cx[c] / nt[c], cy[c] / nt[c]);
+        double off = mu - 0.5 * (u0 + u1);
+        x->hand = fabs(off) < 1e-3 * x->along ? 0 : off < 0 ? -1 : 1;
+    }
+    free(b);
+    free(cx);
+    free(cy);
+    free(nt);
+    *nw = k;
+    return w;
+}
+
+/* A window's row: the nearest of the rows its bottom (the sill's) started on. */
+static long window_row(const window_measure *x)
+{
+    return lround((x->box.min[2] + 0.08 - BB_ROW0) / BB_FLOOR);
+}
+
+/* Windows ordered by facade, row, then place along the facade. */
+static int cmp_window(const void *p, const void *q)
+{
+    const window_measure *x = p, *y = q;
+    if (x->facade != y->facade)
+        return x->facade - y->facade;
+    if (window_row(x) != window_row(y))
+        return window_row(x) < window_row(y) ? -1 : 1;
+    return x->u < y->u ? -1 : x->u > y->u;
+}
+
+/* The visible node of the window of column col in the first row of a facade (0 front, 1
+ * right): the smallest visible node whose box holds the window's glass centre (world). */
+static int32_t window_node(const ag_edit_model *em, const bb_options *o, int facade,
+                           unsigned col)
+{
+    double fr[2], gl[2], si[2], p[3];
+    bb_depths(o->mount, fr, gl, si);
+    double u = BB_MARGIN + col * BB_PERIOD + 0.5 * BB_WIN_W, v = 0.5 * (gl[0] + gl[1]);
+    /* the right facade's frame: x = L - v, y = u (edit_building_fixture.h bb_to_building) */
+    bb_to_world(o, facade ? bb_length(o) - v : u, facade ? u : v, BB_ROW0 + 0.5 * BB_WIN_H, p);
+    const ag_splittree *t = em->proc->tree;
+    int32_t best = -1;
+    double bv = INFINITY;
+    for (size_t n = 1; n < t->nnodes; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        if (x->kind != AG_NODE_COMPONENT)
+            continue;
+        int in = 1;
+        for (int a = 0; a < 3 && in; a++)
+            in = x->box.min[a] <= p[a] && p[a] <= x->box.max[a];
+        double v = ag_box_extent(&x->box, 0) * ag_box_extent(&x->box, 1) *
+                   ag_box_extent(&x->box, 2);
+        if (in && v < bv) {
+            bv = v;
+            best = (int32_t)n;
+        }
+    }
+    return best;
+}
+
+#define WINDOW_WIDER 1.2
+#define WINDOW_TALLER 0.9
+
+/* Resizes the window of column col in the first row of a facade (0 front, 1 right; a
+ * left-handed window in an even column, its mirror image in an odd one) 1.2x wider and 0.9x
+ * taller in global mode: every window, of both hands and on every facade, has the new size
+ * within 1 % on the edited mesh, its hand where it was (the hands still alternate along every
+ * row), the side it grew from kept (a mirror image grows the other way), its depth in the wall
+ * as before, inside its facade's wall along it and clear of the other windows, and the count
+ * is unchanged. */
+static int resize_one_window(const bb_options *o, int facade, unsigned col)
+{
+    ag_mesh *m = NULL;
+    ag_error err = {0};
+    ag_edit_model *em = bb_service_model(o, &m, &err);
+    if (!em)
+        fail_msg("%s: proceduralize: %s", o->name, err.text);
+    bb_groups g = find_groups(em->proc->mesh, o);
+    size_t n0, n1;
+    window_measure *w0 = measure_windows(em->proc->mesh, o, g.window, &n0);
+    qsort(w0, n0, sizeof *w0, cmp_window);
+    int32_t node = window_node(em, o, facade, col);
+    assert_true(node > 0);
+    /* the facade's direction in the world: the axis the window widens along, and whether the
+     * scale, which holds the world min corner, holds the facade's min in its own frame */
+    double d[2], w0o[3], w1o[3];
+    facade_dir(facade, d);
+    bb_to_world(o, 0, 0, 0, w0o);
+    bb_to_world(o, d[0], d[1], 0, w1o);
+    int axis = fabs(w1o[0] - w0o[0]) > fabs(w1o[1] - w0o[1]) ? 0 : 1;
+    int grows_from_min = w1o[axis] > w0o[axis];
+    ag_edit_op op = {.kind = AG_EDIT_RESIZE, .node = node, .has_scale = 1, .scale = {1, 1, 1},
+                     .mode = AG_EDIT_GLOBAL};
+    op.scale[axis] = WINDOW_WIDER;
+    op.scale[2] = WINDOW_TALLER;
+    char what[64];
+    snprintf(what, sizeof what, "%s window %u resized", facade ? "right" : "front", col);
+    ag_edit_model *ed = apply(em, &op, 0, what, o);
+    window_measure *w1 = measure_windows(ed->proc->mesh, o, g.window, &n1);
+    qsort(w1, n1, sizeof *w1, cmp_window);
+
+    /* a window's box: the frame and the sill 5 cm past it on each side, 8 cm under it */
+    double want[3] = {(BB_WIN_W + 0.1) * WINDOW_WIDER, w0[0].depth,
+                      (BB_WIN_H + 0.08) * WINDOW_TALLER};
+    /* the hand of the edited window: even columns left-handed (none when un-handed) */
+    int edited_hand = o->handed ? (col & 1 ? 1 : -1) : 0;
+    double size_err = 0, depth_moved = 0, anchor_moved = 0, min_gap = INFINITY, outside = 0;
+    size_t hands_wrong = 0, row_start = 0, per_facade0[3] = {0}, per_facade1[3] = {0};
+    for (size_t i = 0; i < n0; i++) {
+        per_facade0[w0[i].facade]++;
+        if (i == 0 || w0[i - 1].facade != w0[i].facade ||
+            window_row(&w0[i - 1]) != window_row(&w0[i]))
+            row_start = i;
+        /* the measure itself: the original's hands alternate along every row */
+        assert_int_equal(w0[i].hand, o->handed ? ((i - row_start) & 1 ? 1 : -1) : 0);
+    }
+    for (size_t i = 0; i < n1; i++) {
+        const window_measure *x = &w1[i];
+        per_facade1[x->facade]++;
+        double e[3] = {x->along, x->depth, x->height};
+        for (int a = 0; a < 3; a++)
+            size_err = fmax(size_err, fabs(e[a] / want[a] - 1));
+        /* its place in its row: even places left-handed, odd ones right (un-handed: 0) */
+        if (i == 0 || w1[i - 1].facade != x->facade || window_row(&w1[i - 1]) != window_row(x))
+            row_start = i;
+        int hand = o->handed ? ((i - row_start) & 1 ? 1 : -1) : 0;
+        hands_wrong += x->hand != hand;
+        if (i < n0 && w0[i].facade == x->facade) {
+            depth_moved = fmax(depth_moved, fmax(fabs(x->v0 - w0[i].v0), fabs(x->v1 - w0[i].v1)));
+            /* the edited window grew from its world min: a window of its hand kept that side
+             * in the facade's frame, a mirror image the other side (it grew the other way) */
+            int keep_min = (x->hand == edited_hand) == grows_from_min;
+            double a1 = keep_min ? x->u : x->u + x->along,
+                   a0 = keep_min ? w0[i].u : w0[i].u + w0[i].along;
+            anchor_moved = fmax(anchor_moved, fabs(a1 - a0));
+        }
+        /* inside its facade's wall along the facade (front 0..L, right 0..D, left -D..0)
+         * and in height */
+        double lo = x->facade == 2 ? -bb_depth(o) : 0,
+               hi = lo + (x->facade ? bb_depth(o) : bb_length(o));
+        outside = fmax(outside, fmax(fmax(lo - x->u, x->u + x->along - hi), 0));
+        outside = fmax(outside, fmax(x->box.max[2] - bb_height(o), -x->box.min[2]));
+        for (size_t j = 0; j < i; j++) {
+            const bb_part *y = &w1[j].box;
+            double gap = -INFINITY;
+            for (int a = 0; a < 3; a++)
+                gap = fmax(gap, fmax(y->min[a] - x->box.max[a], x->box.min[a] - y->max[a]));
+            min_gap = fmin(min_gap, gap);
+        }
+    }
+    print_message("  %-40s %s x%.1f wide x%.1f tall: %zu windows (were %zu), size error "
+                  "%.4f, hands wrong %zu, anchor moved %.2g, depth moved %.2g, outside %.2g, gap "
+                  "%.3f\n",
+                  o->name, what, WINDOW_WIDER, WINDOW_TALLER, n1, n0, size_err, hands_wrong,
+                  anchor_moved, depth_moved, outside, min_gap);
+    int ok = n1 == n0 && !memcmp(per_facade0, per_facade1, sizeof per_facade0) &&
+             size_err <= 0.01 && !hands_wrong && anchor_moved <= 1e-4 && depth_moved <= 1e-4 &&
+             outside <= 1e-4 && min_gap > 0;
+    if (!ok)
+        print_error("%s %s: %zu windows (were %zu), size error %.4f, %zu with the "
+                    "wrong hand, the fixed side moved %.3g, depth moved %.3g, outside its wall "
+                    "%.3g, gap %.3f\n",
+                    o->name, what, n1, n0, size_err, hands_wrong, anchor_moved, depth_moved,
+                    outside, min_gap);
+    assert_grammar_derives_mesh(ed, what);
+    free(w0);
+    free(w1);
+    ag_edit_model_free(ed);
+    ag_edit_model_free(em);
+    ag_mesh_free(m);
+    return ok;
+}
+
+/* Every variant measured (its figures printed) before the test fails on any. */
+static void a_window_resize_reaches_every_window(void **state)
+{
+    (void)state;
+    size_t failed = 0;
+    for (size_t i = 0; i < sizeof variants / sizeof *variants; i++)
+        for (int facade = 0; facade < (variants[i].side_cols ? 2 : 1); facade++)
+            for (unsigned col = 0; col < 2; col++)
+                failed += !resize_one_window(&variants[i], facade, col);
+    if (failed)
+        fail_msg("%zu window resizes did not reach every window", failed);
+}
+
 static void every_variant_keeps_its_structure(void **state)
 {
     (void)state;
@@ -403,6 +665,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(every_variant_keeps_its_structure),
+        cmocka_unit_test(a_window_resize_reaches_every_window),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -79,6 +79,7 @@ void ag_edit_resize_solver_free(ag_edit_resize_solver *s)
     ag__resize_system_free(&s->sys);
     free(s->edit);
     free(s->edit_turn);
+    free(s->edit_mirror);
     free(s->level);
     free(s->held);
     free(s->old);
@@ -93,25 +94,57 @@ int ag_edit_resize_solver_matches(const ag_edit_resize_solver *s, const ag_edit_
     return !s->has_region || !memcmp(&op->region, &s->region, sizeof op->region);
 }
 
+/* The labeling's record of component c (label.h): a mirror image of its label's exemplar
+ * (x -> -x in the exemplar's frame) and the quarter turns after that; 0 for a component the
+ * labels do not hold. */
+static int label_mirror(const ag_labels *L, int32_t c, int *turns)
+{
+    *turns = 0;
+    if (!L || c < 0 || (size_t)c >= L->ncomponents)
+        return 0;
+    *turns = L->rot ? L->rot[c] & 3 : 0;
+    return L->mirror ? L->mirror[c] != 0 : 0;
+}
+
 /* The edited units: the op's node (a split node stands for the node its chain ends in), and in
- * global mode every visible node of its rule with the quarter turns from the op's node to it. */
+ * global mode every visible node of its rule with the quarter turns from the op's node to it,
+ * and every mirror image of it: a node of its label of the other hand (a handed window's twin
+ * is another rule of the same label, so only the labeling knows them for one element). The
+ * labeling records a member as its label's exemplar E mirrored or not, then turned: R^a M^p E
+ * (M: x -> -x). For the op's node R^a M^p E and a member R^b M^q E with q != p, the member is
+ * R^b M^q (R^a M^p)^-1 = R^(a+b) M applied to the op's node: its change is the op's node's
+ * reflected along x, then turned a + b quarter turns. */
 static void gather_edited(ag_edit_resize_solver *s, const ag_edit_op *op)
 {
     const ag_splittree *t = s->in->tree;
+    const ag_labels *L = s->in->labels;
     int32_t n = op->node;
     if (t->nodes[n].kind == AG_NODE_SPLIT)
         n = ag_splittree_chain_end(t, n);
     s->edit[s->nedit] = n;
+    s->edit_mirror[s->nedit] = 0;
     s->edit_turn[s->nedit++] = 0;
     const ag_tnode *en = &t->nodes[n];
-    if (op->mode == AG_EDIT_GLOBAL && en->kind == AG_NODE_COMPONENT && en->rule >= 0) {
-        for (size_t k = 0; k < t->nnodes; k++) {
-            const ag_tnode *x = &t->nodes[k];
-            if ((int32_t)k == n || x->kind != AG_NODE_COMPONENT || x->rule != en->rule)
-                continue;
-            s->edit[s->nedit] = (int32_t)k;
-            s->edit_turn[s->nedit++] = (x->rule_rot - en->rule_rot) & 3;
+    if (op->mode != AG_EDIT_GLOBAL || en->kind != AG_NODE_COMPONENT || en->rule < 0)
+        return;
+    int ea, ep = label_mirror(L, en->component, &ea);
+    for (size_t k = 0; k < t->nnodes; k++) {
+        const ag_tnode *x = &t->nodes[k];
+        if ((int32_t)k == n || x->kind != AG_NODE_COMPONENT)
+            continue;
+        int xb = 0, xq = x->label >= 0 && x->label == en->label
+                             ? label_mirror(L, x->component, &xb)
+                             : ep; /* another label: never a mirror image */
+        if (x->rule == en->rule) {
+            s->edit_mirror[s->nedit] = 0;
+            s->edit_turn[s->nedit] = (x->rule_rot - en->rule_rot) & 3;
+        } else if (xq != ep) {
+            s->edit_mirror[s->nedit] = 1;
+            s->edit_turn[s->nedit] = (ea + xb) & 3;
+        } else {
+            continue;
         }
+        s->edit[s->nedit++] = (int32_t)k;
     }
 }
 
@@ -225,7 +258,8 @@ ag_status ag_edit_resize_solver_create(const ag_proceduralize_result *in, const 
     s->frame_node = -1;
     s->edit = malloc((t->nnodes + 1) * sizeof *s->edit);
     s->edit_turn = malloc((t->nnodes + 1) * sizeof *s->edit_turn);
-    if (!s->edit || !s->edit_turn) {
+    s->edit_mirror = malloc(t->nnodes + 1);
+    if (!s->edit || !s->edit_turn || !s->edit_mirror) {
         ag_edit_resize_solver_free(s);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
@@ -269,9 +303,15 @@ ag_status ag_edit_resize_solver_create(const ag_proceduralize_result *in, const 
     return AG_OK;
 }
 
-/* Turns box deltas (dmin, dmax) by k quarter turns about +z. */
-static void turn_delta(int k, double dmin[3], double dmax[3])
+/* Reflects box deltas (dmin, dmax) along x when mirror is set, then turns them by k quarter
+ * turns about +z: a mirror image's min side moves as the original's max side does. */
+static void turn_delta(int k, int mirror, double dmin[3], double dmax[3])
 {
+    if (mirror) {
+        double x0 = -dmax[0];
+        dmax[0] = -dmin[0];
+        dmin[0] = x0;
+    }
     for (int i = 0; i < (k & 3); i++) {
         double nx0 = -dmax[1], nx1 = -dmin[1], ny0 = dmin[0], ny1 = dmax[0];
         dmin[0] = nx0;
@@ -318,7 +358,7 @@ ag_status ag__resize_solve_level(ag_edit_resize_solver *s, const ag_edit_op *op,
             double d0[3], d1[3];
             memcpy(d0, dmin, sizeof d0);
             memcpy(d1, dmax, sizeof d1);
-            turn_delta(s->edit_turn[e], d0, d1);
+            turn_delta(s->edit_turn[e], s->edit_mirror[e], d0, d1);
             for (int a = 0; a < 3; a++) {
                 tb.min[a] += d0[a];
                 tb.max[a] += d1[a];

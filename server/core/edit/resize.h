@@ -3,7 +3,9 @@
  * 1. Units: the boxes the equations move are the visible nodes and the patterns (a pattern is
  *    one box whose cells are its lattice periods; an edited cell opens its pattern).
  * 2. The edited level: the op's node, and in global mode every visible node of its rule
- *    (turned by their quarter turns), each with a target box kept inside its nearest visible
+ *    (turned by their quarter turns) and every mirror image of it (a node of its label of the
+ *    other hand, as the labeling recorded it: reflected, then turned, so a handed window's
+ *    twin grows the other way), each with a target box kept inside its nearest visible
  *    ancestor (a window never leaves its wall); around them, breadth-first over the units'
  *    adjacency, the units with the same nearest visible ancestor (local mode: only those
  *    meeting the region). The root is resized like any node: its target is the frame of every

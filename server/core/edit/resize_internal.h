@@ -157,6 +157,8 @@ struct ag_edit_resize_solver {
     size_t nedit;
     int32_t *edit;            /* edited units (the op's node's unit first) */
     int *edit_turn;           /* quarter turns from the op's node to each edited node */
+    uint8_t *edit_mirror;     /* per edited node: a mirror image of the op's node (reflected
+                                 along x, then turned by edit_turn) */
     int32_t frame_node;       /* the level's frame: the edited units' visible ancestor (or the
                                  root), -1 when the level has none */
     size_t nunits;
