@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "app/model_kept.h"
 #include "app/points_state.h"
 #include "core/base/uf.h"
 #include "core/points/gen_building.h"
@@ -334,6 +335,19 @@ static const char *proxy_name(const ag_pointmodel *pm, int32_t n)
     return m->group_names[m->component_group[x->component]];
 }
 
+/* The terminal node n places (its component's variant: a terminal of the model), NULL for
+ * invisible nodes. */
+static const ag_pointmodel_terminal *placed(const ag_pointmodel *pm, int32_t n)
+{
+    const ag_tnode *x = &pm->em->proc->tree->nodes[n];
+    const ag_labels *L = pm->em->proc->labels;
+    if (x->kind != AG_NODE_COMPONENT || x->component < 0 ||
+        (size_t)x->component >= L->ncomponents)
+        return NULL;
+    int32_t v = L->variant[x->component];
+    return v >= 0 && (size_t)v < pm->nterminals ? &pm->terminals[v] : NULL;
+}
+
 /* Every visible node of a but those `gone` (NULL: none) has its id in b, on the same box and
  * placing the same terminal; returns how many. */
 static size_t ids_kept(const ag_pointmodel *a, const ag_pointmodel *b, const uint8_t *gone,
@@ -350,9 +364,12 @@ static size_t ids_kept(const ag_pointmodel *a, const ag_pointmodel *b, const uin
             if (fabs(ta->nodes[n].box.min[k] - tb->nodes[n].box.min[k]) > 1e-6 ||
                 fabs(ta->nodes[n].box.max[k] - tb->nodes[n].box.max[k]) > 1e-6)
                 fail_msg("%s: node %zu names another box", what, n);
-        if (strcmp(proxy_name(a, (int32_t)n), proxy_name(b, (int32_t)n)))
-            fail_msg("%s: node %zu placed %s, now %s", what, n, proxy_name(a, (int32_t)n),
-                     proxy_name(b, (int32_t)n));
+        const ag_pointmodel_terminal *pa = placed(a, (int32_t)n), *pb = placed(b, (int32_t)n);
+        if (!pa || !pb || pa->points->n != pb->points->n ||
+            fabs(pa->size[0] - pb->size[0]) + fabs(pa->size[1] - pb->size[1]) +
+                    fabs(pa->size[2] - pb->size[2]) > 1e-9)
+            fail_msg("%s: node %zu placed %zu points, now %zu", what, n,
+                     pa ? pa->points->n : 0, pb ? pb->points->n : 0);
         kept++;
     }
     return kept;
@@ -416,6 +433,86 @@ static void test_point_edits_keep_ids(void **state)
     ag_points_state_clear(&st2);
     ag_pointmodel_free(out2);
     free(gone2);
+    ag_points_state_clear(&st);
+    ag_pointmodel_free(out);
+    free(gone);
+    ag_points_state_clear(&st0);
+    ag_proceduralize_cloud_free(r);
+    ag_cloud_free(c);
+}
+
+/* The state kept as the store keeps it (its text, its terminals and its kept tree) reads back
+ * numbered as it was saved, and a second edit of what was read back keeps the ids again: the
+ * service's round trip between two ops and over a restart (app/store_ws_points.c). */
+static void test_point_ids_survive_reload(void **state)
+{
+    (void)state;
+    ag_gen_building_options o = {.points = 60000, .width = 12, .depth = 8, .height = 7,
+                                 .ridge = -1, .cols = 3, .rows = 2, .seed = 43};
+    ag_cloud *c = building(&o);
+    ag_proceduralize_cloud_result *r = proceduralize(c);
+    ag_points_state st0 = {0};
+    ag_error e;
+    if (ag_points_state_make(r->model, &st0, &e) != AG_OK)
+        fail_msg("state: %s", e.text);
+    ag_pointmodel *pm = st0.pm;
+    const ag_splittree *t = pm->em->proc->tree;
+    size_t visible = 0;
+    for (size_t n = 0; n < t->nnodes; n++)
+        visible += t->nodes[n].kind == AG_NODE_COMPONENT;
+    int32_t win = window_node(pm, 1, 1.2 + 0.2, 1.5 + 0.2);
+    assert_true(win > 0);
+    uint8_t *gone = calloc(t->nnodes, 1);
+    gone[win] = 1;
+    int32_t nodes[1] = {win};
+    ag_edit_op rm = {.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = nodes};
+    ag_pointmodel *out = NULL;
+    if (ag_pointedit_apply(pm, &rm, NULL, &out, NULL, &e) != AG_OK)
+        fail_msg("remove: %s", e.text);
+    ag_points_state st = {0};
+    if (ag_points_state_make(out, &st, &e) != AG_OK ||
+        ag_pointedit_keep_ids(st.pm, pm, &rm, &e) != AG_OK)
+        fail_msg("state after the remove: %s", e.text);
+    /* stored and read back */
+    char *kept = ag_model_kept_tree_text(st.pm->em);
+    assert_non_null(kept);
+    ag_pointmodel *back = NULL;
+    long col = 0;
+    if (ag_points_state_read(st.text, st.text_len, ag_terminals_set_lookup, &st.terms, &back,
+                             &e, &col) != AG_OK ||
+        ag_points_state_reload_kept(back, kept, &e) != AG_OK)
+        fail_msg("read back: %s", e.text);
+    assert_int_equal(ids_kept(pm, back, gone, "read back with its kept tree"), visible - 1);
+    /* without the kept tree, the text numbers the nodes afresh: what the service served */
+    ag_pointmodel *plain = NULL;
+    if (ag_points_state_read(st.text, st.text_len, ag_terminals_set_lookup, &st.terms, &plain,
+                             &e, &col) != AG_OK)
+        fail_msg("read back: %s", e.text);
+    const ag_splittree *tp = plain->em->proc->tree;
+    assert_true((size_t)win < tp->nnodes && tp->nodes[win].kind == AG_NODE_COMPONENT);
+    /* a second edit of what was read back: another window removed, the ids kept again */
+    int32_t win2 = window_node(back, 1, 1.2 + 0.2, 1.5 + 0.2);
+    assert_true(win2 > 0 && win2 != win);
+    nodes[0] = win2;
+    ag_pointmodel *out2 = NULL;
+    if (ag_pointedit_apply(back, &rm, NULL, &out2, NULL, &e) != AG_OK)
+        fail_msg("second remove: %s", e.text);
+    ag_points_state st2 = {0};
+    if (ag_points_state_make(out2, &st2, &e) != AG_OK ||
+        ag_pointedit_keep_ids(st2.pm, back, &rm, &e) != AG_OK)
+        fail_msg("state after the second remove: %s", e.text);
+    gone[win2] = 1;
+    assert_int_equal(ids_kept(pm, st2.pm, gone, "both removes, read back between"), visible - 2);
+    assert_int_equal(st2.pm->nplacements, pm->nplacements - 2);
+    /* a stored tree that is not one over the model is refused, never trusted */
+    char *other = ag_model_kept_tree_text(pm->em);
+    assert_int_equal(ag_points_state_reload_kept(plain, other, &e), AG_ERR_PARSE);
+    free(other);
+    ag_points_state_clear(&st2);
+    ag_pointmodel_free(out2);
+    ag_pointmodel_free(plain);
+    ag_pointmodel_free(back);
+    free(kept);
     ag_points_state_clear(&st);
     ag_pointmodel_free(out);
     free(gone);
@@ -497,6 +594,7 @@ int main(void)
         cmocka_unit_test(test_resize_doubles_the_windows_at_the_density),
         cmocka_unit_test(test_paste_turns_to_the_target),
         cmocka_unit_test(test_point_edits_keep_ids),
+        cmocka_unit_test(test_point_ids_survive_reload),
         cmocka_unit_test(test_bad_ops),
         cmocka_unit_test(test_hard_clouds),
     };

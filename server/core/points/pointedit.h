@@ -33,6 +33,20 @@ ag_status ag_pointedit_apply(const ag_pointmodel *pm, const ag_edit_op *op,
 ag_status ag_pointedit_keep_ids(ag_pointmodel *made, const ag_pointmodel *before,
                                 const ag_edit_op *op, ag_error *err);
 
+/* The model ag_pointedit_keep_ids numbers lists its components in the order of their ids, not
+ * of pm's placements, so a tree kept from it (app/model_kept.h) does not fit the proxy a
+ * reload of pm's grammar builds. kept: an edit model read from such a tree over that proxy;
+ * pm's placements are put in kept's component order (placement k the one whose box, terminal
+ * and turn kept's component k has) and *mesh is the proxy in that order, over which the tree
+ * reads as it was kept. AG_ERR_PARSE when a component of kept has no placement of pm. */
+ag_status ag_pointedit_kept_order(ag_pointmodel *pm, const ag_edit_model *kept, ag_mesh **mesh,
+                                  ag_error *err);
+
+/* pm, whose edit model was made from a kept tree over its proxy (app/model_kept.h), with the
+ * proxy's groups named after its labels ("L<label + 1>") as the model ag_pointedit_keep_ids
+ * made and kept names them: the next edit matches nodes by those names. */
+ag_status ag_pointedit_name_groups(ag_pointmodel *pm, ag_error *err);
+
 /* A deep copy of a model's terminals and placements (not built). */
 ag_status ag_pointedit_copy(const ag_pointmodel *pm, ag_pointmodel **out, ag_error *err);
 
