@@ -213,8 +213,10 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
     /* an edit's state numbered as the model it edited: the nodes it left alone keep their ids
      * (issue 14 §4), and the tree kept with the state gives them back on a reload */
     ag_status s = AG_OK;
-    if (edit && edit->op && w->points)
-        s = ag_pointedit_keep_ids(st->pm, w->points, edit->op, err);
+    if (edit && edit->op && w->points) {
+        ag_edit_op local = ag_usecase_points_local_op(w->points, edit->op);
+        s = ag_pointedit_keep_ids(st->pm, w->points, &local, w->points_source, err);
+    }
     if (s != AG_OK) {
         ag_points_state_clear(st);
         return s;

@@ -406,7 +406,7 @@ static void test_point_edits_keep_ids(void **state)
     ag_points_state st = {0};
     if (ag_points_state_make(out, &st, &e) != AG_OK)
         fail_msg("state after the remove: %s", e.text);
-    if (ag_pointedit_keep_ids(st.pm, pm, &rm, &e) != AG_OK)
+    if (ag_pointedit_keep_ids(st.pm, pm, &rm, NULL, &e) != AG_OK)
         fail_msg("keep ids: %s", e.text);
     assert_int_equal(ids_kept(pm, st.pm, gone, "remove a window, read back"), visible - 1);
     const ag_splittree *t1 = st.pm->em->proc->tree;
@@ -423,7 +423,7 @@ static void test_point_edits_keep_ids(void **state)
     ag_points_state st2 = {0};
     if (ag_points_state_make(out2, &st2, &e) != AG_OK)
         fail_msg("state after the second remove: %s", e.text);
-    if (ag_pointedit_keep_ids(st2.pm, st.pm, &rm, &e) != AG_OK)
+    if (ag_pointedit_keep_ids(st2.pm, st.pm, &rm, NULL, &e) != AG_OK)
         fail_msg("keep ids: %s", e.text);
     assert_int_equal(ids_kept(st.pm, st2.pm, gone2, "remove another window"), visible - 2);
     gone[win2] = 1;
@@ -471,7 +471,7 @@ static void test_point_ids_survive_reload(void **state)
         fail_msg("remove: %s", e.text);
     ag_points_state st = {0};
     if (ag_points_state_make(out, &st, &e) != AG_OK ||
-        ag_pointedit_keep_ids(st.pm, pm, &rm, &e) != AG_OK)
+        ag_pointedit_keep_ids(st.pm, pm, &rm, NULL, &e) != AG_OK)
         fail_msg("state after the remove: %s", e.text);
     /* stored and read back */
     char *kept = ag_model_kept_tree_text(st.pm->em);
@@ -499,7 +499,7 @@ static void test_point_ids_survive_reload(void **state)
         fail_msg("second remove: %s", e.text);
     ag_points_state st2 = {0};
     if (ag_points_state_make(out2, &st2, &e) != AG_OK ||
-        ag_pointedit_keep_ids(st2.pm, back, &rm, &e) != AG_OK)
+        ag_pointedit_keep_ids(st2.pm, back, &rm, NULL, &e) != AG_OK)
         fail_msg("state after the second remove: %s", e.text);
     gone[win2] = 1;
     assert_int_equal(ids_kept(pm, st2.pm, gone, "both removes, read back between"), visible - 2);

@@ -185,16 +185,82 @@ static uint8_t *replaced_by(const ag_splittree *t, const ag_edit_op *op)
     return mark;
 }
 
+/* The op as a point model runs it: the point-cloud split ratio and thin share unless it sets
+ * its own, a paste's source the other model's proxy. */
+static ag_edit_op point_op(const ag_edit_op *op, const ag_pointmodel *pm,
+                           const ag_pointmodel *source)
+{
+    ag_edit_op o = *op;
+    if (!o.split_ratio)
+        o.split_ratio = AG_POINTS_SPLIT_RATIO;
+    if (!o.thin_share)
+        o.thin_share = AG_POINTS_THIN_SHARE;
+    o.source = source && source != pm && source->em ? source->em->proc : NULL;
+    return o;
+}
+
+/* r moved by d (its mesh and its nodes' boxes; pivots are relative to the parent's box). */
+static void shift_result(ag_proceduralize_result *r, const double d[3])
+{
+    if (!d[0] && !d[1] && !d[2])
+        return;
+    for (size_t v = 0; v < r->mesh->nverts; v++)
+        for (int a = 0; a < 3; a++)
+            r->mesh->pos[3 * v + a] += d[a];
+    for (size_t n = 0; n < r->tree->nnodes; n++)
+        for (int a = 0; a < 3; a++) {
+            r->tree->nodes[n].box.min[a] += d[a];
+            r->tree->nodes[n].box.max[a] += d[a];
+        }
+}
+
+/* What op makes of before on its tree (core/edit: the nodes it keeps at their ids with the
+ * boxes it gives them, a resize's rule-mates moved with its node, copies appended, removed
+ * nodes dead), in made's coordinates: where made's nodes are looked for. *out NULL when the
+ * tree edit refuses what the proxy's edit made (then before's own boxes are matched). */
+static ag_status expected_model(const ag_pointmodel *made, const ag_pointmodel *before,
+                                const ag_edit_op *op, const ag_pointmodel *source,
+                                ag_edit_model **out, ag_error *err)
+{
+    *out = NULL;
+    ag_edit_op o = point_op(op, before, source);
+    ag_error e;
+    ag_error_clear(&e);
+    ag_status st = ag_edit_apply_ex(before->em, &o, 0, out, NULL, &e);
+    if (st == AG_ERR_NOMEM || st == AG_ERR_CANCELLED) {
+        if (err)
+            *err = e;
+        return st;
+    }
+    if (st) {
+        *out = NULL;
+        return AG_OK;
+    }
+    double d[3];
+    for (int a = 0; a < 3; a++)
+        d[a] = before->offset[a] - made->offset[a];
+    shift_result((*out)->proc, d);
+    return AG_OK;
+}
+
 ag_status ag_pointedit_keep_ids(ag_pointmodel *made, const ag_pointmodel *before,
-                                const ag_edit_op *op, ag_error *err)
+                                const ag_edit_op *op, const ag_pointmodel *source,
+                                ag_error *err)
 {
     if (!made->em || !before || !before->em)
         return AG_OK;
-    uint8_t *changed = op ? replaced_by(before->em->proc->tree, op) : NULL;
+    ag_edit_model *expected = NULL;
+    ag_status st = op ? expected_model(made, before, op, source, &expected, err) : AG_OK;
+    if (st)
+        return st;
+    /* matched against where the op put every node; without that, against before's boxes,
+     * with what the op removes or replaces kept out */
+    uint8_t *changed = op && !expected ? replaced_by(before->em->proc->tree, op) : NULL;
     ag_proceduralize_result *r = NULL;
-    ag_status st = ag_idmatch_renumber(before->em->proc, made->em->proc, changed,
-                                       &made->em->opt.patterns, &r, NULL, err);
+    st = ag_idmatch_renumber(expected ? expected->proc : before->em->proc, made->em->proc,
+                             changed, &made->em->opt.patterns, &r, NULL, err);
     free(changed);
+    ag_edit_model_free(expected);
     if (st || !r)
         return st;
     ag_edit_model *em = NULL;
@@ -344,12 +410,7 @@ ag_status ag_pointedit_apply(const ag_pointmodel *pm, const ag_edit_op *op,
         ag_edit_report_clear(rep);
     if (!pm->em || (source && !source->em))
         return ag_error_set(err, AG_ERR_INVALID, 0, "the model is not built");
-    ag_edit_op o = *op;
-    if (!o.split_ratio)
-        o.split_ratio = AG_POINTS_SPLIT_RATIO;
-    if (!o.thin_share)
-        o.thin_share = AG_POINTS_THIN_SHARE;
-    o.source = source && source != pm ? source->em->proc : NULL;
+    ag_edit_op o = point_op(op, pm, source);
     const ag_proceduralize_result *in = pm->em->proc;
     ag_mesh *mesh = NULL;
     ag_status st;

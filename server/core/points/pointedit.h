@@ -27,11 +27,17 @@ ag_status ag_pointedit_apply(const ag_pointmodel *pm, const ag_edit_op *op,
                              ag_edit_report *rep, ag_error *err);
 
 /* made (built) numbered as `before` numbers the nodes made keeps (core/edit/idmatch.h): the
- * build numbers every node afresh. op (may be NULL): the edit that made it, whose removed and
- * replaced nodes no new node takes the id of. Only the proxy's tree is renumbered: made's
- * grammar is the matched one then, so take the grammar text from made before. */
+ * build numbers every node afresh. op (may be NULL; in before's coordinates, as
+ * ag_pointedit_apply was given it, with the paste's source model `source`, NULL: before): the
+ * edit that made it. A node op did not remove keeps its id, also when op moved or resized it:
+ * made's nodes are matched against the tree op makes of before's on the tree (core/edit/edit.h:
+ * kept nodes at their ids with their new boxes, a resize's rule-mates moved with its node,
+ * copies appended, removed nodes dead), each new node of made given an id after all of those.
+ * Only the proxy's tree is renumbered: made's grammar is the matched one then, so take the
+ * grammar text from made before. */
 ag_status ag_pointedit_keep_ids(ag_pointmodel *made, const ag_pointmodel *before,
-                                const ag_edit_op *op, ag_error *err);
+                                const ag_edit_op *op, const ag_pointmodel *source,
+                                ag_error *err);
 
 /* The model ag_pointedit_keep_ids numbers lists its components in the order of their ids, not
  * of pm's placements, so a tree kept from it (app/model_kept.h) does not fit the proxy a
