@@ -1,8 +1,10 @@
 // A point model's edits keep the ids of the nodes they leave alone (issue 14 §4), as mesh
 // edits do: after a remove over REST and one over the websocket every other node of GET …/tree
 // has its id, kind and box, the removed window is dead, an op naming a kept id edits that node,
-// and a restart of the daemon serves the same tree and an op after it names the same nodes. The windows are
-// found by their boxes in the test's own building (points_building.js), never by archgram's ids.
+// and a restart of the daemon serves the same tree and an op after it names the same nodes; a
+// resize of one window, which resizes every window of its rule, keeps every node at its id
+// (the windows with their new boxes), and undo and redo keep them too. The windows are found by
+// their boxes in the test's own building (points_building.js), never by archgram's ids.
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
 import { http, removeDir, startDaemon, tempDir, waitJob, WsClient } from './harness.js';
@@ -51,7 +53,7 @@ describe('point model edits keep node ids', () => {
     return r.json;
   };
 
-  let t0, t1, t2;
+  let t0, t1, t2, t3;
   const removed = new Set();
 
   it('a remove over REST keeps every other node at its id', async () => {
@@ -103,9 +105,38 @@ describe('point model edits keep node ids', () => {
     const w = glassOf(t0, 3);
     await op({ kind: 'remove', nodes: [w.id] }, 'rm-3');
     removed.add(w.id);
-    const t3 = await tree();
+    t3 = await tree();
     assert.equal(assertKept(t0, t3, removed, 'after a restart and a third remove'), components(t0) - 3);
     assert.equal(glassOf(t3, 3), undefined, 'window 3 is gone');
     assert.ok(Math.abs(t3.nodes[t3.root].box[0] - ORIGIN[0]) < 0.1, 'the model stays where it is');
+  });
+
+  it('a resize of a window keeps every node at its id, its rule-mates with their new boxes; undo and redo keep them', async () => {
+    const left = [0, 2, 4, 5, 7, 8, 9].map((w) => glassOf(t3, w));
+    left.forEach((w, i) => assert.ok(w, `window ${i}`));
+    const grow = (b) => [b[0], b[1], b[2], b[3] + 0.1, b[4], b[5] + 0.1];
+    const w7 = glassOf(t3, 7);
+    await op({ kind: 'resize', node: w7.id, box: grow(w7.box) }, 'grow-7');
+    const t4 = await tree();
+    // every window, the one resized and those of its rule, is at its id with its new box
+    for (const w of left) {
+      const m = t4.nodes[w.id];
+      assert.ok(m && m.kind === 'component', `window node ${w.id} lost its id (${JSON.stringify(m)})`);
+      assert.ok(near(m.box, grow(w.box), 1e-3), `window node ${w.id} has box ${JSON.stringify(m.box)}, not ${JSON.stringify(grow(w.box))}`);
+    }
+    // and so is every other node: a resize removes nothing
+    let kept = 0;
+    for (const n of t3.nodes) {
+      if (n.kind !== 'component') continue;
+      assert.equal(t4.nodes[n.id]?.kind, 'component', `node ${n.id} is no component after the resize`);
+      kept++;
+    }
+    assert.equal(kept, components(t3));
+    assert.equal(components(t4), components(t3));
+    // undo brings the tree before the resize back, ids and boxes; redo the resized one
+    await op({ kind: 'undo' }, 'undo-grow');
+    assert.deepEqual((await tree()).nodes, t3.nodes);
+    await op({ kind: 'redo' }, 'redo-grow');
+    assert.deepEqual((await tree()).nodes, t4.nodes);
   });
 });
