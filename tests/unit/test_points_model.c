@@ -441,6 +441,129 @@ static void test_point_edits_keep_ids(void **state)
     ag_cloud_free(c);
 }
 
+/* Every visible node of a has its id in b, visible, its box within `far` of its old one (no node
+ * takes the id of one elsewhere); returns how many. */
+static size_t ids_kept_near(const ag_pointmodel *a, const ag_pointmodel *b, double far,
+                            const char *what)
+{
+    const ag_splittree *ta = a->em->proc->tree, *tb = b->em->proc->tree;
+    size_t kept = 0;
+    for (size_t n = 0; n < ta->nnodes; n++) {
+        if (ta->nodes[n].kind != AG_NODE_COMPONENT)
+            continue;
+        if (n >= tb->nnodes || tb->nodes[n].kind != AG_NODE_COMPONENT)
+            fail_msg("%s: node %zu (%s) lost its id", what, n, proxy_name(a, (int32_t)n));
+        for (int k = 0; k < 3; k++)
+            if (fabs(ta->nodes[n].box.min[k] - tb->nodes[n].box.min[k]) > far ||
+                fabs(ta->nodes[n].box.max[k] - tb->nodes[n].box.max[k]) > far)
+                fail_msg("%s: node %zu moved %g m on axis %d", what, n,
+                         fmax(fabs(ta->nodes[n].box.min[k] - tb->nodes[n].box.min[k]),
+                              fabs(ta->nodes[n].box.max[k] - tb->nodes[n].box.max[k])),
+                         k);
+        kept++;
+    }
+    return kept;
+}
+
+static int box_near(const ag_box *a, const ag_box *b, double eps)
+{
+    for (int k = 0; k < 3; k++)
+        if (fabs(a->min[k] - b->min[k]) > eps || fabs(a->max[k] - b->max[k]) > eps)
+            return 0;
+    return 1;
+}
+
+/* op applied to pm, read back as the service keeps it and numbered after pm. */
+static void edit_kept(ag_pointmodel *pm, const ag_edit_op *op, ag_points_state *st,
+                      ag_pointmodel **out)
+{
+    ag_error e;
+    if (ag_pointedit_apply(pm, op, NULL, out, NULL, &e) != AG_OK)
+        fail_msg("edit: %s", e.text);
+    if (ag_points_state_make(*out, st, &e) != AG_OK ||
+        ag_pointedit_keep_ids(st->pm, pm, op, NULL, &e) != AG_OK)
+        fail_msg("state after the edit: %s", e.text);
+}
+
+/* A node an edit changed but did not remove keeps its id (issue 14 §4), found where the edit
+ * put it: a resized window and the front windows of its rule, resized with it, keep their ids
+ * with their new boxes; a split window keeps its id with its lower half, and its upper half is
+ * a new node after every old id. */
+static void test_moved_nodes_keep_ids(void **state)
+{
+    (void)state;
+    ag_gen_building_options o = {.points = 60000, .width = 12, .depth = 8, .height = 7,
+                                 .ridge = -1, .cols = 3, .rows = 2, .seed = 43};
+    ag_cloud *c = building(&o);
+    ag_proceduralize_cloud_result *r = proceduralize(c);
+    ag_points_state st0 = {0};
+    ag_error e;
+    if (ag_points_state_make(r->model, &st0, &e) != AG_OK)
+        fail_msg("state: %s", e.text);
+    ag_pointmodel *pm = st0.pm;
+    const ag_splittree *t = pm->em->proc->tree;
+    size_t visible = 0;
+    for (size_t n = 0; n < t->nnodes; n++)
+        visible += t->nodes[n].kind == AG_NODE_COMPONENT;
+    int32_t win = window_node(pm, 1, 1.2 + 0.2, 1.5 + 0.2);
+    assert_true(win > 0);
+    const ag_tnode *w = &t->nodes[win];
+    ag_box asked = w->box;
+    asked.max[0] += 0.1;
+    asked.max[2] += 0.1;
+    ag_edit_op grow = {.kind = AG_EDIT_RESIZE, .node = win, .has_box = 1, .box = asked};
+    ag_points_state st = {0};
+    ag_pointmodel *out = NULL;
+    edit_kept(pm, &grow, &st, &out);
+    assert_int_equal(ids_kept_near(pm, st.pm, 0.2, "resize a window"), visible);
+    const ag_splittree *t1 = st.pm->em->proc->tree;
+    assert_true(box_near(&t1->nodes[win].box, &asked, 1e-3));
+    /* the front windows of its rule went with it, each at its id */
+    size_t mates = 0;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        if ((int32_t)n == win || x->kind != AG_NODE_COMPONENT || x->rule != w->rule ||
+            fabs((x->box.max[1] - x->box.min[1]) - (w->box.max[1] - w->box.min[1])) > 1e-3 ||
+            fabs((x->box.max[0] - x->box.min[0]) - (w->box.max[0] - w->box.min[0])) > 1e-3)
+            continue;
+        ag_box want = x->box;
+        want.max[0] += 0.1;
+        want.max[2] += 0.1;
+        if (!box_near(&t1->nodes[n].box, &want, 1e-3))
+            fail_msg("window node %zu was not resized with node %d", n, win);
+        mates++;
+    }
+    print_message("window node %d resized with %zu of its rule\n", win, mates);
+    assert_true(mates >= 2);
+    /* a split of that window at its middle: the lower half keeps its id, the upper one is new */
+    const ag_box wb = t1->nodes[win].box;
+    double mid = (wb.min[0] + wb.max[0]) / 2;
+    ag_edit_op split = {.kind = AG_EDIT_SPLIT, .node = win, .axis = 0, .at = mid};
+    ag_points_state st2 = {0};
+    ag_pointmodel *out2 = NULL;
+    edit_kept(st.pm, &split, &st2, &out2);
+    assert_int_equal(ids_kept_near(st.pm, st2.pm, wb.max[0] - mid + 1e-3, "split a window"),
+                     visible);
+    const ag_splittree *t2 = st2.pm->em->proc->tree;
+    ag_box lower = wb, upper = wb;
+    lower.max[0] = upper.min[0] = mid;
+    assert_true(box_near(&t2->nodes[win].box, &lower, 1e-3));
+    size_t uppers = 0;
+    for (size_t n = 0; n < t2->nnodes; n++)
+        if (t2->nodes[n].kind == AG_NODE_COMPONENT && box_near(&t2->nodes[n].box, &upper, 1e-3)) {
+            assert_true(n >= t1->nnodes);
+            uppers++;
+        }
+    assert_int_equal(uppers, 1);
+    ag_points_state_clear(&st2);
+    ag_pointmodel_free(out2);
+    ag_points_state_clear(&st);
+    ag_pointmodel_free(out);
+    ag_points_state_clear(&st0);
+    ag_proceduralize_cloud_free(r);
+    ag_cloud_free(c);
+}
+
 /* The state kept as the store keeps it (its text, its terminals and its kept tree) reads back
  * numbered as it was saved, and a second edit of what was read back keeps the ids again: the
  * service's round trip between two ops and over a restart (app/store_ws_points.c). */
@@ -595,6 +718,7 @@ int main(void)
         cmocka_unit_test(test_paste_turns_to_the_target),
         cmocka_unit_test(test_point_edits_keep_ids),
         cmocka_unit_test(test_point_ids_survive_reload),
+        cmocka_unit_test(test_moved_nodes_keep_ids),
         cmocka_unit_test(test_bad_ops),
         cmocka_unit_test(test_hard_clouds),
     };
