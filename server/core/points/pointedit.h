@@ -11,8 +11,9 @@
  * - split, remove; join keeps its placements (a joined node is a union of placements).
  * An op names nodes of the model's tree (pm->em->proc->tree), as ops on meshes do. The result
  * is a new model, built (its nodes numbered afresh: ag_pointedit_keep_ids gives the state
- * read back from it the ids of the nodes the op left alone); a caller that keeps only the grammar reads it back through its
- * grammar text (app/points_state.h) so that its node ids are the ones a reload gives. */
+ * read back from it the ids of every node the op did not remove, moved or resized ones too); a
+ * caller that keeps only the grammar reads it back through its grammar text
+ * (app/points_state.h) so that its node ids are the ones a reload gives. */
 #ifndef AG_POINTEDIT_H
 #define AG_POINTEDIT_H
 
