@@ -53,7 +53,7 @@ describe('point model edits keep node ids', () => {
     return r.json;
   };
 
-  let t0, t1, t2, t3;
+  let t0, t1, t2, t3, t4;
   const removed = new Set();
 
   it('a remove over REST keeps every other node at its id', async () => {
@@ -117,7 +117,7 @@ describe('point model edits keep node ids', () => {
     const grow = (b) => [b[0], b[1], b[2], b[3] + 0.1, b[4], b[5] + 0.1];
     const w7 = glassOf(t3, 7);
     await op({ kind: 'resize', node: w7.id, box: grow(w7.box) }, 'grow-7');
-    const t4 = await tree();
+    t4 = await tree();
     // every window, the one resized and those of its rule, is at its id with its new box
     for (const w of left) {
       const m = t4.nodes[w.id];
@@ -138,5 +138,23 @@ describe('point model edits keep node ids', () => {
     assert.deepEqual((await tree()).nodes, t3.nodes);
     await op({ kind: 'redo' }, 'redo-grow');
     assert.deepEqual((await tree()).nodes, t4.nodes);
+  });
+
+  it('a resize of the whole building past a metre of its origin keeps every node at its id', async () => {
+    // the model is kept local to a whole metre below its lower corner: growing the building a
+    // metre towards -x moves that origin, and the ids follow the nodes there too
+    const root = t4.nodes[t4.root];
+    const box = [root.box[0] - 1, ...root.box.slice(1)];
+    await op({ kind: 'resize', node: 'root', box }, 'grow-west');
+    const t5 = await tree();
+    assert.ok(near(t5.nodes[t5.root].box, box, 1e-3), `the root has box ${JSON.stringify(t5.nodes[t5.root].box)}`);
+    for (const n of t4.nodes) {
+      if (n.kind !== 'component') continue;
+      const m = t5.nodes[n.id];
+      assert.equal(m?.kind, 'component', `node ${n.id} is no component after the resize (${JSON.stringify(m)})`);
+      // stretched by 17/16 at most, moved by a metre at most: never another node's place
+      assert.ok(m.box.every((v, i) => Math.abs(v - n.box[i]) <= 1.001), `node ${n.id} went from ${JSON.stringify(n.box)} to ${JSON.stringify(m.box)}`);
+    }
+    assert.equal(components(t5), components(t4));
   });
 });
