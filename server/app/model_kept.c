@@ -175,10 +175,8 @@ static char *kept_text(const ag_edit_model *em)
     return out;
 }
 
-char *ag_model_kept_tree_text(const ag_edit_model *em)
+char *ag_model_kept_join(const char *served, const ag_edit_model *em)
 {
-    /* the served part keeps its own (shorter) printing; the kept member is exact */
-    char *served = ag_model_tree_served_text(em);
     char *kept = served ? kept_text(em) : NULL;
     char *out = NULL;
     size_t n = served ? strlen(served) : 0;
@@ -195,8 +193,16 @@ char *ag_model_kept_tree_text(const ag_edit_model *em)
             out[at] = '\0';
         }
     }
-    free(served);
     free(kept);
+    return out;
+}
+
+char *ag_model_kept_tree_text(const ag_edit_model *em)
+{
+    /* the served part keeps its own (shorter) printing; the kept member is exact */
+    char *served = ag_model_tree_served_text(em);
+    char *out = ag_model_kept_join(served, em);
+    free(served);
     return out;
 }
 

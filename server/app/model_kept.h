@@ -32,6 +32,10 @@
  * of memory. */
 char *ag_model_kept_tree_text(const ag_edit_model *em);
 
+/* served (a served tree's text, an object: a point model's is in the input's coordinates)
+ * with em's kept member added (malloc'd); NULL when out of memory. */
+char *ag_model_kept_join(const char *served, const ag_edit_model *em);
+
 /* The served tree of a stored tree text (malloc'd): the text without its kept member (all of
  * it when it keeps none); NULL when out of memory. */
 char *ag_model_kept_served_text(const char *tree_text);

@@ -3,8 +3,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/points/pointedit.h"
 #include "../io/grammar_text.h"
 #include "../io/point_terminals.h"
+#include "model_kept.h"
 
 void ag_points_state_clear(ag_points_state *s)
 {
@@ -120,4 +122,30 @@ ag_status ag_points_state_make(ag_pointmodel *made, ag_points_state *out, ag_err
     if (st != AG_OK)
         ag_points_state_clear(out);
     return st;
+}
+
+ag_status ag_points_state_reload_kept(ag_pointmodel *pm, const char *tree_text, ag_error *err)
+{
+    if (!tree_text || !pm->em)
+        return AG_OK;
+    /* read once over the proxy the text gives, to learn the kept order of the placements,
+     * then over the proxy in that order */
+    ag_edit_model *em = NULL;
+    ag_mesh *ordered = NULL;
+    ag_status st = ag_model_kept_reload(pm->em->proc->mesh, tree_text, &em, err);
+    if (st == AG_ERR_NOT_FOUND)
+        return AG_OK;
+    if (st == AG_OK)
+        st = ag_pointedit_kept_order(pm, em, &ordered, err);
+    ag_edit_model_free(em);
+    em = NULL;
+    if (st == AG_OK)
+        st = ag_model_kept_reload(ordered, tree_text, &em, err);
+    ag_mesh_free(ordered);
+    if (st != AG_OK)
+        return st;
+    em->opt = pm->em->opt; /* a point model's options, as its build set them */
+    ag_edit_model_free(pm->em);
+    pm->em = em;
+    return ag_pointedit_name_groups(pm, err);
 }

@@ -5,7 +5,9 @@
  * The text's axiom box is in the input's coordinate system (RD New, UTM: the cloud's offset
  * added back), terminal points are local to their boxes; a reload moves the model to a local
  * origin again (ag_cloud_choose_origin). A state is always read back (the text printed, parsed
- * and derived), so the ids of its tree are those the next load gives. */
+ * and derived), so the ids of its tree are those the next load gives; an edit's state is then
+ * numbered as the model it edited numbers the nodes it left alone (ag_pointedit_keep_ids), and
+ * the store keeps that tree with the text (app/model_kept.h) for a reload to give it back. */
 #ifndef AG_POINTS_STATE_H
 #define AG_POINTS_STATE_H
 
@@ -34,6 +36,12 @@ ag_status ag_points_state_make(ag_pointmodel *made, ag_points_state *out, ag_err
  * naming the terminal. */
 ag_status ag_points_state_read(const char *text, size_t len, ag_terminal_lookup lookup,
                                void *user, ag_pointmodel **out, ag_error *err, long *col);
+
+/* pm (read from its text) with the tree a store kept beside that text (tree_text, the stored
+ * tree: app/model_kept.h), so that its nodes have the ids the saved state gave them. A tree
+ * that keeps none (stored before point models kept theirs, or tree_text NULL) leaves pm as
+ * the text numbers it; one that is not a tree over pm's proxy: AG_ERR_PARSE. */
+ag_status ag_points_state_reload_kept(ag_pointmodel *pm, const char *tree_text, ag_error *err);
 
 /* The grammar text of a built model with its axiom in the input's coordinates (terminal paths
  * as the grammar has them). */

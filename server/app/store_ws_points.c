@@ -9,11 +9,14 @@
  * version names are released with each save), and a new empty mesh file per saved state, so that the grammar describes the
  * model exactly while that state is current (store/grammars.h) and undo, redo and restore
  * bring a version's grammar back with its states (store/states.h). Nothing is cached: a model
- * is read back from its text each time (the ids of its tree are those the text gives). */
+ * is read back from its text each time, numbered by the tree stored with the text: an edit
+ * keeps the ids of the nodes it left alone (issue 14 §4), and its tree is stored with what
+ * rebuilds that numbering (app/model_kept.h), so a reload, undo, redo and restore give it. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/points/pointedit.h"
 #include "../io/edit_op_json.h"
 #include "../io/meshblob.h"
 #include "../store/grammars.h"
@@ -22,6 +25,7 @@
 #include "../store/pointclouds.h"
 #include "../store/states.h"
 #include "edit_ops.h"
+#include "model_kept.h"
 #include "model_tree.h"
 #include "points_state.h"
 #include "points_summary.h"
@@ -58,7 +62,7 @@ ag_status ag_store_ws_read_point_model(ag_db *db, int64_t model, const char *fie
     ag_grammar_row g;
     ag_error e;
     ag_error_clear(&e);
-    if ((s = ag_grammars_current(db, model, 0, &g, &e)) == AG_ERR_NOT_FOUND)
+    if ((s = ag_grammars_current(db, model, 1, &g, &e)) == AG_ERR_NOT_FOUND)
         return ag_error_set(err, AG_ERR_NOT_PROCEDURALIZED, 0,
                             "%s%smodel %lld is not proceduralized: structural edits need a "
                             "grammar (POST /api/v1/models/%lld/proceduralize)",
@@ -71,6 +75,13 @@ ag_status ag_store_ws_read_point_model(ag_db *db, int64_t model, const char *fie
     ag__store_ws_terminals ts = {db, model};
     long col = 0;
     s = ag_points_state_read(g.text, g.text_len, ag__store_ws_terminal_lookup, &ts, pm, &e, &col);
+    /* numbered as the state was saved: the ids an edit kept, not those the text gives */
+    if (s == AG_OK)
+        s = ag_points_state_reload_kept(*pm, g.tree_json, &e);
+    if (s != AG_OK) {
+        ag_pointmodel_free(*pm);
+        *pm = NULL;
+    }
     ag_grammars_row_clear(&g);
     if (s != AG_OK) /* what the store saved does not read back: not the caller's fault */
         s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
@@ -144,8 +155,11 @@ static ag_status put_points_state(ag_db *db, int64_t model, int64_t version,
     json_t *tree = ag_model_tree_served(st->pm->em);
     if (tree)
         ag_points_summary_shift_tree(tree, st->pm->offset);
-    tree_text = tree ? json_dumps(tree, JSON_COMPACT | JSON_REAL_PRECISION(12)) : NULL;
+    char *served = tree ? json_dumps(tree, JSON_COMPACT | JSON_REAL_PRECISION(12)) : NULL;
     json_decref(tree);
+    /* with what gives a reload this numbering (app/model_kept.h) */
+    tree_text = served ? ag_model_kept_join(served, st->pm->em) : NULL;
+    free(served);
     ag_status s = empty && tree_text ? ag_meshblob_encode(empty, &mesh, &mesh_len) : AG_ERR_NOMEM;
     ag_mesh_free(empty);
     if (s != AG_OK)
@@ -196,6 +210,17 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
                                    ag_error *err)
 {
     ag_store_ws *w = (ag_store_ws *)ws;
+    /* an edit's state numbered as the model it edited: the nodes it left alone keep their ids
+     * (issue 14 §4), and the tree kept with the state gives them back on a reload */
+    ag_status s = AG_OK;
+    if (edit && edit->op && w->points) {
+        ag_edit_op local = ag_usecase_points_local_op(w->points, edit->op);
+        s = ag_pointedit_keep_ids(st->pm, w->points, &local, w->points_source, err);
+    }
+    if (s != AG_OK) {
+        ag_points_state_clear(st);
+        return s;
+    }
     json_t *summary_json = proc ? ag_points_summary_proc(st, proc, NULL)
                                 : edit ? ag_points_summary_edit(st, edit) : NULL;
     char *summary = summary_json ? json_dumps(summary_json, JSON_COMPACT | JSON_PRESERVE_ORDER |
@@ -203,7 +228,7 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
                                  : NULL;
     json_decref(summary_json);
     json_t *body = logged_op(w, st, proc, edit);
-    ag_status s = summary && body ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    s = summary && body ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     ag_seq_txn t;
     int dup = 0;
     /* a proceduralization is the job's (no client id); an edit is the client's op */
@@ -229,10 +254,11 @@ ag_status ag__store_ws_save_points(ag_workspace *ws, ag_points_state *st,
 
 /* ---- live drag ------------------------------------------------------------------------------ */
 
-/* The point model a model's edit session keeps for drags, with the grammar text it was read
- * from: a text names its terminals by their content, so the same text is the same model. */
+/* The point model a model's edit session keeps for drags, with the grammar text and stored
+ * tree it was read from: a text names its terminals by their content, so the same text is the
+ * same model, and the same tree numbers it the same. */
 typedef struct {
-    char *text;
+    char *text, *tree;
     size_t len;
     ag_pointmodel *pm;
 } kept_points;
@@ -243,6 +269,7 @@ static void kept_points_free(void *p)
     if (!k)
         return;
     free(k->text);
+    free(k->tree);
     ag_pointmodel_free(k->pm);
     free(k);
 }
@@ -253,7 +280,7 @@ static ag_status drag_model(const ag_store_env *env, int64_t model, ag_edit_stat
                             kept_points **out, int64_t *version, ag_error *err)
 {
     ag_grammar_row g;
-    ag_status s = ag_grammars_current(env->db, model, 0, &g, err);
+    ag_status s = ag_grammars_current(env->db, model, 1, &g, err);
     if (s == AG_ERR_NOT_FOUND) /* not proceduralized, or no such model: the reader says which */
         return ag_store_ws_read_point_model(env->db, model, "", &(ag_pointmodel *){NULL}, version,
                                             err);
@@ -261,7 +288,8 @@ static ag_status drag_model(const ag_store_env *env, int64_t model, ag_edit_stat
         return s;
     *version = g.model_version;
     kept_points *k = held->points;
-    if (k && k->len == g.text_len && !memcmp(k->text, g.text, g.text_len)) {
+    if (k && k->len == g.text_len && !memcmp(k->text, g.text, g.text_len) &&
+        !strcmp(k->tree ? k->tree : "", g.tree_json ? g.tree_json : "")) {
         ag_grammars_row_clear(&g);
         *out = k;
         return AG_OK;
@@ -272,7 +300,9 @@ static ag_status drag_model(const ag_store_env *env, int64_t model, ag_edit_stat
     }
     k->text = g.text;
     k->len = g.text_len;
+    k->tree = g.tree_json;
     g.text = NULL;
+    g.tree_json = NULL;
     ag_grammars_row_clear(&g);
     int64_t v = 0;
     if ((s = ag_store_ws_read_point_model(env->db, model, "", &k->pm, &v, err)) != AG_OK) {

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "app/model_kept.h"
 #include "app/points_state.h"
 #include "core/base/uf.h"
 #include "core/points/gen_building.h"
@@ -334,6 +335,19 @@ static const char *proxy_name(const ag_pointmodel *pm, int32_t n)
     return m->group_names[m->component_group[x->component]];
 }
 
+/* The terminal node n places (its component's variant: a terminal of the model), NULL for
+ * invisible nodes. */
+static const ag_pointmodel_terminal *placed(const ag_pointmodel *pm, int32_t n)
+{
+    const ag_tnode *x = &pm->em->proc->tree->nodes[n];
+    const ag_labels *L = pm->em->proc->labels;
+    if (x->kind != AG_NODE_COMPONENT || x->component < 0 ||
+        (size_t)x->component >= L->ncomponents)
+        return NULL;
+    int32_t v = L->variant[x->component];
+    return v >= 0 && (size_t)v < pm->nterminals ? &pm->terminals[v] : NULL;
+}
+
 /* Every visible node of a but those `gone` (NULL: none) has its id in b, on the same box and
  * placing the same terminal; returns how many. */
 static size_t ids_kept(const ag_pointmodel *a, const ag_pointmodel *b, const uint8_t *gone,
@@ -350,9 +364,12 @@ static size_t ids_kept(const ag_pointmodel *a, const ag_pointmodel *b, const uin
             if (fabs(ta->nodes[n].box.min[k] - tb->nodes[n].box.min[k]) > 1e-6 ||
                 fabs(ta->nodes[n].box.max[k] - tb->nodes[n].box.max[k]) > 1e-6)
                 fail_msg("%s: node %zu names another box", what, n);
-        if (strcmp(proxy_name(a, (int32_t)n), proxy_name(b, (int32_t)n)))
-            fail_msg("%s: node %zu placed %s, now %s", what, n, proxy_name(a, (int32_t)n),
-                     proxy_name(b, (int32_t)n));
+        const ag_pointmodel_terminal *pa = placed(a, (int32_t)n), *pb = placed(b, (int32_t)n);
+        if (!pa || !pb || pa->points->n != pb->points->n ||
+            fabs(pa->size[0] - pb->size[0]) + fabs(pa->size[1] - pb->size[1]) +
+                    fabs(pa->size[2] - pb->size[2]) > 1e-9)
+            fail_msg("%s: node %zu placed %zu points, now %zu", what, n,
+                     pa ? pa->points->n : 0, pb ? pb->points->n : 0);
         kept++;
     }
     return kept;
@@ -389,7 +406,7 @@ static void test_point_edits_keep_ids(void **state)
     ag_points_state st = {0};
     if (ag_points_state_make(out, &st, &e) != AG_OK)
         fail_msg("state after the remove: %s", e.text);
-    if (ag_pointedit_keep_ids(st.pm, pm, &rm, &e) != AG_OK)
+    if (ag_pointedit_keep_ids(st.pm, pm, &rm, NULL, &e) != AG_OK)
         fail_msg("keep ids: %s", e.text);
     assert_int_equal(ids_kept(pm, st.pm, gone, "remove a window, read back"), visible - 1);
     const ag_splittree *t1 = st.pm->em->proc->tree;
@@ -406,7 +423,7 @@ static void test_point_edits_keep_ids(void **state)
     ag_points_state st2 = {0};
     if (ag_points_state_make(out2, &st2, &e) != AG_OK)
         fail_msg("state after the second remove: %s", e.text);
-    if (ag_pointedit_keep_ids(st2.pm, st.pm, &rm, &e) != AG_OK)
+    if (ag_pointedit_keep_ids(st2.pm, st.pm, &rm, NULL, &e) != AG_OK)
         fail_msg("keep ids: %s", e.text);
     assert_int_equal(ids_kept(st.pm, st2.pm, gone2, "remove another window"), visible - 2);
     gone[win2] = 1;
@@ -416,6 +433,244 @@ static void test_point_edits_keep_ids(void **state)
     ag_points_state_clear(&st2);
     ag_pointmodel_free(out2);
     free(gone2);
+    ag_points_state_clear(&st);
+    ag_pointmodel_free(out);
+    free(gone);
+    ag_points_state_clear(&st0);
+    ag_proceduralize_cloud_free(r);
+    ag_cloud_free(c);
+}
+
+/* Every visible node of a has its id in b, visible, its box within `far` of its old one (no node
+ * takes the id of one elsewhere); returns how many. */
+static size_t ids_kept_near(const ag_pointmodel *a, const ag_pointmodel *b, double far,
+                            const char *what)
+{
+    const ag_splittree *ta = a->em->proc->tree, *tb = b->em->proc->tree;
+    size_t kept = 0;
+    for (size_t n = 0; n < ta->nnodes; n++) {
+        if (ta->nodes[n].kind != AG_NODE_COMPONENT)
+            continue;
+        if (n >= tb->nnodes || tb->nodes[n].kind != AG_NODE_COMPONENT)
+            fail_msg("%s: node %zu (%s) lost its id", what, n, proxy_name(a, (int32_t)n));
+        for (int k = 0; k < 3; k++)
+            if (fabs(ta->nodes[n].box.min[k] - tb->nodes[n].box.min[k]) > far ||
+                fabs(ta->nodes[n].box.max[k] - tb->nodes[n].box.max[k]) > far)
+                fail_msg("%s: node %zu moved %g m on axis %d", what, n,
+                         fmax(fabs(ta->nodes[n].box.min[k] - tb->nodes[n].box.min[k]),
+                              fabs(ta->nodes[n].box.max[k] - tb->nodes[n].box.max[k])),
+                         k);
+        kept++;
+    }
+    return kept;
+}
+
+static int box_near(const ag_box *a, const ag_box *b, double eps)
+{
+    for (int k = 0; k < 3; k++)
+        if (fabs(a->min[k] - b->min[k]) > eps || fabs(a->max[k] - b->max[k]) > eps)
+            return 0;
+    return 1;
+}
+
+/* op applied to pm, read back as the service keeps it and numbered after pm. */
+static void edit_kept(ag_pointmodel *pm, const ag_edit_op *op, ag_points_state *st,
+                      ag_pointmodel **out)
+{
+    ag_error e;
+    if (ag_pointedit_apply(pm, op, NULL, out, NULL, &e) != AG_OK)
+        fail_msg("edit: %s", e.text);
+    if (ag_points_state_make(*out, st, &e) != AG_OK ||
+        ag_pointedit_keep_ids(st->pm, pm, op, NULL, &e) != AG_OK)
+        fail_msg("state after the edit: %s", e.text);
+}
+
+/* A node an edit changed but did not remove keeps its id (issue 14 §4), found where the edit
+ * put it: a resized window and the front windows of its rule, resized with it, keep their ids
+ * with their new boxes; a split window keeps its id with its lower half, and its upper half is
+ * a new node after every old id; a join replaces what it joins and leaves the rest. */
+static void test_moved_nodes_keep_ids(void **state)
+{
+    (void)state;
+    ag_gen_building_options o = {.points = 60000, .width = 12, .depth = 8, .height = 7,
+                                 .ridge = -1, .cols = 3, .rows = 2, .seed = 43};
+    ag_cloud *c = building(&o);
+    ag_proceduralize_cloud_result *r = proceduralize(c);
+    ag_points_state st0 = {0};
+    ag_error e;
+    if (ag_points_state_make(r->model, &st0, &e) != AG_OK)
+        fail_msg("state: %s", e.text);
+    ag_pointmodel *pm = st0.pm;
+    const ag_splittree *t = pm->em->proc->tree;
+    size_t visible = 0;
+    for (size_t n = 0; n < t->nnodes; n++)
+        visible += t->nodes[n].kind == AG_NODE_COMPONENT;
+    int32_t win = window_node(pm, 1, 1.2 + 0.2, 1.5 + 0.2);
+    assert_true(win > 0);
+    const ag_tnode *w = &t->nodes[win];
+    ag_box asked = w->box;
+    asked.max[0] += 0.1;
+    asked.max[2] += 0.1;
+    ag_edit_op grow = {.kind = AG_EDIT_RESIZE, .node = win, .has_box = 1, .box = asked};
+    ag_points_state st = {0};
+    ag_pointmodel *out = NULL;
+    edit_kept(pm, &grow, &st, &out);
+    assert_int_equal(ids_kept_near(pm, st.pm, 0.2, "resize a window"), visible);
+    const ag_splittree *t1 = st.pm->em->proc->tree;
+    assert_true(box_near(&t1->nodes[win].box, &asked, 1e-3));
+    /* the front windows of its rule went with it, each at its id */
+    size_t mates = 0;
+    for (size_t n = 0; n < t->nnodes; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        if ((int32_t)n == win || x->kind != AG_NODE_COMPONENT || x->rule != w->rule ||
+            fabs((x->box.max[1] - x->box.min[1]) - (w->box.max[1] - w->box.min[1])) > 1e-3 ||
+            fabs((x->box.max[0] - x->box.min[0]) - (w->box.max[0] - w->box.min[0])) > 1e-3)
+            continue;
+        ag_box want = x->box;
+        want.max[0] += 0.1;
+        want.max[2] += 0.1;
+        if (!box_near(&t1->nodes[n].box, &want, 1e-3))
+            fail_msg("window node %zu was not resized with node %d", n, win);
+        mates++;
+    }
+    print_message("window node %d resized with %zu of its rule\n", win, mates);
+    assert_true(mates >= 2);
+    /* a split of that window at its middle: the lower half keeps its id, the upper one is new */
+    const ag_box wb = t1->nodes[win].box;
+    double mid = (wb.min[0] + wb.max[0]) / 2;
+    ag_edit_op split = {.kind = AG_EDIT_SPLIT, .node = win, .axis = 0, .at = mid};
+    ag_points_state st2 = {0};
+    ag_pointmodel *out2 = NULL;
+    edit_kept(st.pm, &split, &st2, &out2);
+    assert_int_equal(ids_kept_near(st.pm, st2.pm, wb.max[0] - mid + 1e-3, "split a window"),
+                     visible);
+    const ag_splittree *t2 = st2.pm->em->proc->tree;
+    ag_box lower = wb, upper = wb;
+    lower.max[0] = upper.min[0] = mid;
+    assert_true(box_near(&t2->nodes[win].box, &lower, 1e-3));
+    size_t uppers = 0;
+    for (size_t n = 0; n < t2->nnodes; n++)
+        if (t2->nodes[n].kind == AG_NODE_COMPONENT && box_near(&t2->nodes[n].box, &upper, 1e-3)) {
+            assert_true(n >= t1->nnodes);
+            uppers++;
+        }
+    assert_int_equal(uppers, 1);
+    /* a join of the lower half and the next window of its row: a point join keeps its
+     * placements, which come back as new nodes (the joined ones are replaced); every other node
+     * keeps its id and box */
+    int32_t next = -1;
+    for (size_t n = 0; n < t2->nnodes; n++) {
+        const ag_tnode *x = &t2->nodes[n];
+        if ((int32_t)n != win && x->kind == AG_NODE_COMPONENT &&
+            fabs((x->box.max[0] - x->box.min[0]) - (wb.max[0] - wb.min[0])) < 1e-3 &&
+            fabs(x->box.min[2] - lower.min[2]) < 1e-3 &&
+            fabs(x->box.min[1] - lower.min[1]) < 1e-3 && x->box.min[0] > lower.max[0] &&
+            (next < 0 || x->box.min[0] < t2->nodes[next].box.min[0]))
+            next = (int32_t)n;
+    }
+    assert_true(next > 0);
+    int32_t sel[2] = {win, next};
+    ag_box was[2] = {t2->nodes[win].box, t2->nodes[next].box};
+    ag_edit_op join = {.kind = AG_EDIT_JOIN, .nnodes = 2, .nodes = sel};
+    ag_points_state st3 = {0};
+    ag_pointmodel *out3 = NULL;
+    edit_kept(st2.pm, &join, &st3, &out3);
+    const ag_splittree *t3 = st3.pm->em->proc->tree;
+    uint8_t *joined = calloc(t2->nnodes, 1);
+    joined[win] = joined[next] = 1;
+    assert_int_equal(ids_kept(st2.pm, st3.pm, joined, "join two windows"), visible + 1 - 2);
+    for (int k = 0; k < 2; k++) {
+        assert_int_not_equal(t3->nodes[sel[k]].kind, AG_NODE_COMPONENT);
+        size_t found = 0;
+        for (size_t n = t2->nnodes; n < t3->nnodes; n++)
+            found += t3->nodes[n].kind == AG_NODE_COMPONENT &&
+                     box_near(&t3->nodes[n].box, &was[k], 1e-6);
+        assert_int_equal(found, 1);
+    }
+    free(joined);
+    ag_points_state_clear(&st3);
+    ag_pointmodel_free(out3);
+    ag_points_state_clear(&st2);
+    ag_pointmodel_free(out2);
+    ag_points_state_clear(&st);
+    ag_pointmodel_free(out);
+    ag_points_state_clear(&st0);
+    ag_proceduralize_cloud_free(r);
+    ag_cloud_free(c);
+}
+
+/* The state kept as the store keeps it (its text, its terminals and its kept tree) reads back
+ * numbered as it was saved, and a second edit of what was read back keeps the ids again: the
+ * service's round trip between two ops and over a restart (app/store_ws_points.c). */
+static void test_point_ids_survive_reload(void **state)
+{
+    (void)state;
+    ag_gen_building_options o = {.points = 60000, .width = 12, .depth = 8, .height = 7,
+                                 .ridge = -1, .cols = 3, .rows = 2, .seed = 43};
+    ag_cloud *c = building(&o);
+    ag_proceduralize_cloud_result *r = proceduralize(c);
+    ag_points_state st0 = {0};
+    ag_error e;
+    if (ag_points_state_make(r->model, &st0, &e) != AG_OK)
+        fail_msg("state: %s", e.text);
+    ag_pointmodel *pm = st0.pm;
+    const ag_splittree *t = pm->em->proc->tree;
+    size_t visible = 0;
+    for (size_t n = 0; n < t->nnodes; n++)
+        visible += t->nodes[n].kind == AG_NODE_COMPONENT;
+    int32_t win = window_node(pm, 1, 1.2 + 0.2, 1.5 + 0.2);
+    assert_true(win > 0);
+    uint8_t *gone = calloc(t->nnodes, 1);
+    gone[win] = 1;
+    int32_t nodes[1] = {win};
+    ag_edit_op rm = {.kind = AG_EDIT_REMOVE, .nnodes = 1, .nodes = nodes};
+    ag_pointmodel *out = NULL;
+    if (ag_pointedit_apply(pm, &rm, NULL, &out, NULL, &e) != AG_OK)
+        fail_msg("remove: %s", e.text);
+    ag_points_state st = {0};
+    if (ag_points_state_make(out, &st, &e) != AG_OK ||
+        ag_pointedit_keep_ids(st.pm, pm, &rm, NULL, &e) != AG_OK)
+        fail_msg("state after the remove: %s", e.text);
+    /* stored and read back */
+    char *kept = ag_model_kept_tree_text(st.pm->em);
+    assert_non_null(kept);
+    ag_pointmodel *back = NULL;
+    long col = 0;
+    if (ag_points_state_read(st.text, st.text_len, ag_terminals_set_lookup, &st.terms, &back,
+                             &e, &col) != AG_OK ||
+        ag_points_state_reload_kept(back, kept, &e) != AG_OK)
+        fail_msg("read back: %s", e.text);
+    assert_int_equal(ids_kept(pm, back, gone, "read back with its kept tree"), visible - 1);
+    /* without the kept tree, the text numbers the nodes afresh: what the service served */
+    ag_pointmodel *plain = NULL;
+    if (ag_points_state_read(st.text, st.text_len, ag_terminals_set_lookup, &st.terms, &plain,
+                             &e, &col) != AG_OK)
+        fail_msg("read back: %s", e.text);
+    const ag_splittree *tp = plain->em->proc->tree;
+    assert_true((size_t)win < tp->nnodes && tp->nodes[win].kind == AG_NODE_COMPONENT);
+    /* a second edit of what was read back: another window removed, the ids kept again */
+    int32_t win2 = window_node(back, 1, 1.2 + 0.2, 1.5 + 0.2);
+    assert_true(win2 > 0 && win2 != win);
+    nodes[0] = win2;
+    ag_pointmodel *out2 = NULL;
+    if (ag_pointedit_apply(back, &rm, NULL, &out2, NULL, &e) != AG_OK)
+        fail_msg("second remove: %s", e.text);
+    ag_points_state st2 = {0};
+    if (ag_points_state_make(out2, &st2, &e) != AG_OK ||
+        ag_pointedit_keep_ids(st2.pm, back, &rm, NULL, &e) != AG_OK)
+        fail_msg("state after the second remove: %s", e.text);
+    gone[win2] = 1;
+    assert_int_equal(ids_kept(pm, st2.pm, gone, "both removes, read back between"), visible - 2);
+    assert_int_equal(st2.pm->nplacements, pm->nplacements - 2);
+    /* a stored tree that is not one over the model is refused, never trusted */
+    char *other = ag_model_kept_tree_text(pm->em);
+    assert_int_equal(ag_points_state_reload_kept(plain, other, &e), AG_ERR_PARSE);
+    free(other);
+    ag_points_state_clear(&st2);
+    ag_pointmodel_free(out2);
+    ag_pointmodel_free(plain);
+    ag_pointmodel_free(back);
+    free(kept);
     ag_points_state_clear(&st);
     ag_pointmodel_free(out);
     free(gone);
@@ -497,6 +752,8 @@ int main(void)
         cmocka_unit_test(test_resize_doubles_the_windows_at_the_density),
         cmocka_unit_test(test_paste_turns_to_the_target),
         cmocka_unit_test(test_point_edits_keep_ids),
+        cmocka_unit_test(test_point_ids_survive_reload),
+        cmocka_unit_test(test_moved_nodes_keep_ids),
         cmocka_unit_test(test_bad_ops),
         cmocka_unit_test(test_hard_clouds),
     };

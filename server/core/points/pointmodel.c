@@ -257,7 +257,7 @@ static void legs_of(const double size[3], double L[3])
         L[a] = size[a] > FLAT ? size[a] : 1;
 }
 
-static ag_status proxy_mesh(const ag_pointmodel *pm, ag_mesh **out, ag_error *err)
+ag_status ag_pointmodel_proxy_mesh(const ag_pointmodel *pm, ag_mesh **out, ag_error *err)
 {
     ag_mesh *m = ag_mesh_create();
     ag_status st = m ? ag_mesh_reserve(m, 4 * pm->nplacements, 4 * pm->nplacements)
@@ -383,7 +383,7 @@ ag_status ag_pointmodel_build(ag_pointmodel *pm, ag_error *err)
     if (!r)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     double t0 = ag_clock_seconds(), c0 = ag_clock_thread_cpu_seconds();
-    ag_status st = proxy_mesh(pm, &r->mesh, err);
+    ag_status st = ag_pointmodel_proxy_mesh(pm, &r->mesh, err);
     if (!st)
         st = proxy_labels(pm, &r->labels, err);
     if (!st)

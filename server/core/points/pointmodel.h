@@ -86,6 +86,10 @@ ag_status ag_pointmodel_add_placement(ag_pointmodel *pm, int32_t terminal, const
  * for terminal t; their sizes the terminals' own). */
 ag_status ag_pointmodel_build(ag_pointmodel *pm, ag_error *err);
 
+/* The proxy mesh ag_pointmodel_build makes: a tetrahedron per placement (component i places
+ * placement i), in a group per terminal ("L<t + 1>"). */
+ag_status ag_pointmodel_proxy_mesh(const ag_pointmodel *pm, ag_mesh **out, ag_error *err);
+
 /* The grammar of a built model (pm->em->proc->grammar) and which of its terminals is which of
  * the model's: term[g] = model terminal of grammar terminal g (malloc'd). */
 ag_status ag_pointmodel_grammar_terminals(const ag_pointmodel *pm, int32_t **term,
