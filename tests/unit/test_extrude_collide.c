@@ -24,28 +24,42 @@
 
 typedef struct {
     double x0, y0, x1, y1; /* axis-aligned before the turn */
+    int walled_top;        /* its top edge a plain wall (no overhang), the others eaves */
 } square;
 
-/* Wall to 9 m, the soffit OVERHANG out, a roof rising 3 m over 3 m inwards. */
-static void add_profile(ag_plan *p)
+/* Profile 0: wall to 9 m, the soffit OVERHANG out, a roof rising 3 m over 3 m inwards;
+ * profile 1: a wall going on up (a gable or party wall). */
+static void add_profiles(ag_plan *p)
 {
-    const ag_profile_point pts[] = {{0, 0}, {0, 9}, {-OVERHANG, 9}, {2.5, 12}};
+    const ag_profile_point eaves[] = {{0, 0}, {0, 9}, {-OVERHANG, 9}, {2.5, 12}};
+    const ag_profile_point wall[] = {{0, 0}, {0, 9}, {0, 12}};
     ag_error err = {0};
-    if (ag_plan_add_profile(p, "eaves", pts, 4, NULL, NULL, &err))
+    if (ag_plan_add_profile(p, "eaves", eaves, 4, NULL, NULL, &err) ||
+        ag_plan_add_profile(p, "wall", wall, 3, NULL, NULL, &err))
         fail_msg("profile: %s", err.text);
 }
 
+/* A square grown by the overhang on its eaves' sides. */
+static square grown(const square *q)
+{
+    return (square){q->x0 - OVERHANG, q->y0 - OVERHANG, q->x1 + OVERHANG,
+                    q->y1 + (q->walled_top ? 0 : OVERHANG), 0};
+}
+
 /* The area of the union of the squares grown by the overhang (they overlap pairwise in
- * small squares only, never three at one spot, in the cases below). */
+ * small rectangles only, never three at one spot, in the cases below). */
 static double grown_union_area(const square *s, size_t n)
 {
     double a = 0;
-    for (size_t i = 0; i < n; i++)
-        a += (s[i].x1 - s[i].x0 + 2 * OVERHANG) * (s[i].y1 - s[i].y0 + 2 * OVERHANG);
+    for (size_t i = 0; i < n; i++) {
+        square g = grown(&s[i]);
+        a += (g.x1 - g.x0) * (g.y1 - g.y0);
+    }
     for (size_t i = 0; i < n; i++)
         for (size_t j = i + 1; j < n; j++) {
-            double w = fmin(s[i].x1, s[j].x1) - fmax(s[i].x0, s[j].x0) + 2 * OVERHANG;
-            double h = fmin(s[i].y1, s[j].y1) - fmax(s[i].y0, s[j].y0) + 2 * OVERHANG;
+            square p = grown(&s[i]), q = grown(&s[j]);
+            double w = fmin(p.x1, q.x1) - fmax(p.x0, q.x0);
+            double h = fmin(p.y1, q.y1) - fmax(p.y0, q.y0);
             if (w > 0 && h > 0)
                 a -= w * h;
         }
@@ -74,7 +88,7 @@ static double build(const square *s, size_t n, double turn, double ox, double oy
                     const char *what)
 {
     ag_plan *p = ag_plan_create();
-    add_profile(p);
+    add_profiles(p);
     ag_error err = {0};
     double c = cos(turn), sn = sin(turn);
     for (size_t k = 0; k < n; k++) {
@@ -85,7 +99,8 @@ static double build(const square *s, size_t n, double turn, double ox, double oy
             xy[2 * i] = ox + c * corners[2 * i] - sn * corners[2 * i + 1];
             xy[2 * i + 1] = oy + sn * corners[2 * i] + c * corners[2 * i + 1];
         }
-        if (ag_plan_add_loop(p, xy, 4, NULL, &err))
+        const int32_t profiles[4] = {0, 0, q->walled_top ? 1 : 0, 0};
+        if (ag_plan_add_loop(p, xy, 4, profiles, &err))
             fail_msg("%s: loop: %s", what, err.text);
     }
     ag_mesh *m = ag_mesh_create();
@@ -145,7 +160,7 @@ static void two_squares_meeting_corner_to_corner_merge(void **state)
     const double gaps[] = {0.2, 0.5, 0.8};
     for (size_t g = 0; g < 3; g++) {
         double a = 10 + gaps[g];
-        const square s[] = {{0, 0, 10, 10}, {a, a, 20, 20}};
+        const square s[] = {{0, 0, 10, 10, 0}, {a, a, 20, 20, 0}};
         char name[64];
         snprintf(name, sizeof name, "two squares %g m apart", gaps[g]);
         run_case(name, s, 2);
@@ -156,13 +171,30 @@ static void two_squares_meeting_corner_to_corner_merge(void **state)
 static void squares_around_one_merge(void **state)
 {
     (void)state;
-    const square three[] = {{0, 0, 10, 10}, {10.5, 10.5, 20, 20}, {-9.5, 10.5, -0.5, 20}};
+    const square three[] = {{0, 0, 10, 10, 0}, {10.5, 10.5, 20, 20, 0}, {-9.5, 10.5, -0.5, 20, 0}};
     run_case("three squares", three, 3);
-    const square four[] = {{0, 0, 10, 10},
-                           {10.5, 10.5, 20, 20},
-                           {-9.5, 10.5, -0.5, 20},
-                           {10.5, -9.5, 20, -0.5}};
+    const square four[] = {{0, 0, 10, 10, 0},
+                           {10.5, 10.5, 20, 20, 0},
+                           {-9.5, 10.5, -0.5, 20, 0},
+                           {10.5, -9.5, 20, -0.5, 0}};
     run_case("four squares", four, 4);
+}
+
+/* A square whose top is a plain wall: its top right corner slides out along that wall while
+ * the eaves of a square set off diagonally come at it; they meet head-on at a wall. The old
+ * pairing let them pass through each other and still called the building closed (the roof
+ * covered the overlap twice). */
+static void eaves_meeting_a_wall_corner_merge(void **state)
+{
+    (void)state;
+    const double offs[] = {0.1, 0.2, 0.3};
+    for (size_t k = 0; k < 3; k++) {
+        double d = offs[k];
+        const square s[] = {{0, 0, 10, 10, 1}, {10 + 2 * d, 10 + d, 20, 20, 0}};
+        char name[80];
+        snprintf(name, sizeof name, "eaves meeting a wall corner, %g m off", d);
+        run_case(name, s, 2);
+    }
 }
 
 int main(void)
@@ -170,6 +202,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(two_squares_meeting_corner_to_corner_merge),
         cmocka_unit_test(squares_around_one_merge),
+        cmocka_unit_test(eaves_meeting_a_wall_corner_merge),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

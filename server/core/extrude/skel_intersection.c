@@ -1,7 +1,7 @@
 /* The generalized intersection event (§4.4): the corners arriving at one point are
  * retired, edges passing through it are split, and the edges leaving the point are
- * paired around it into new corners. Corners of two parts growing outwards into each other
- * head-on (eaves of wings set corner to corner) pair the other way round: the parts merge. */
+ * paired around it into new corners. Corners of two parts growing into each other head-on
+ * (eaves of wings set corner to corner) pair the other way round: the parts merge. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -131,12 +131,29 @@ static size_t pair_rays(const sk_ray *rays, size_t nrays, int cw, uint32_t *stac
     return np;
 }
 
-static int all_outwards(const sk *S, const sk_ray *rays, size_t nrays)
+/* Does corner k, at the point now, move into corner i's inside just above it? Each of i's
+ * edges e: k's distance into e's side grows at n_e . v_k - s_e (both start at the point). A
+ * convex corner's inside is on the inner side of both edges, a reflex one's of either. */
+static int moves_into(const sk *S, uint32_t i, uint32_t k)
 {
-    for (size_t i = 0; i < nrays; i++)
-        if (!(S->e[rays[i].edge].s < 0))
-            return 0;
-    return 1;
+    const sk_corner *ci = &S->c[i], *ck = &S->c[k];
+    const sk_edge *a = &S->e[ci->in], *b = &S->e[ci->out];
+    double ra = a->nx * ck->vx + a->ny * ck->vy - a->s;
+    double rb = b->nx * ck->vx + b->ny * ck->vy - b->s;
+    double turn = ag__skel_edx(a) * ag__skel_edy(b) - ag__skel_edy(a) * ag__skel_edx(b);
+    const double eps = 1e3 * AG_EXTRUDE_MIN_RATE;
+    return turn > 0 ? ra > eps && rb > eps : ra > eps || rb > eps;
+}
+
+/* Does a corner arriving at the point go on into another's inside (parts growing into each
+ * other, which are to merge rather than pass through each other)? */
+static int corners_run_into(const sk *S, const uint32_t *cs, size_t nc)
+{
+    for (size_t i = 0; i < nc; i++)
+        for (size_t k = 0; k < nc; k++)
+            if (i != k && moves_into(S, cs[i], cs[k]))
+                return 1;
+    return 0;
 }
 
 /* Does every pair make again one of the corners arriving at the point? */
@@ -332,12 +349,12 @@ void ag__skel_intersection(sk *S, ag_event *evs, size_t n)
     }
     int nested = 0;
     size_t np = pair_rays(W->rays, nrays, 0, stack, pairs, &nested);
-    /* Corners of parts growing into each other head-on (every edge at the point moving
-     * outwards, each arriving corner paired again with its own edges): counter-clockwise
+    /* Corners of parts growing into each other head-on (each arriving corner paired again
+     * with its own edges, one of them going on into another's inside): counter-clockwise
      * pairing would let them pass through each other. The parts merge: seen from the
-     * outside, which is what shrinks, the pairing turns the other way. */
-    if (W->C.n >= 2 && np == W->C.n && all_outwards(S, W->rays, nrays) &&
-        pairs_remake_corners(S, W->C.arr, W->C.n, pairs, np))
+     * outside, which is what shrinks there, the pairing turns the other way. */
+    if (W->C.n >= 2 && np == W->C.n && pairs_remake_corners(S, W->C.arr, W->C.n, pairs, np) &&
+        corners_run_into(S, W->C.arr, W->C.n))
         np = pair_rays(W->rays, nrays, 1, stack, pairs, &nested);
     if (nested)
         S->stats.irregular++;
