@@ -485,6 +485,27 @@ static void edit_kept(ag_pointmodel *pm, const ag_edit_op *op, ag_points_state *
         fail_msg("state after the edit: %s", e.text);
 }
 
+/* The building both id tests edit: proceduralized, its state made, its visible nodes counted,
+ * and the id of a first-floor window of its front. */
+static int32_t ids_building(ag_cloud **c, ag_proceduralize_cloud_result **r, ag_points_state *st0,
+                            size_t *visible)
+{
+    ag_gen_building_options o = {.points = 60000, .width = 12, .depth = 8, .height = 7,
+                                 .ridge = -1, .cols = 3, .rows = 2, .seed = 43};
+    *c = building(&o);
+    *r = proceduralize(*c);
+    ag_error e;
+    if (ag_points_state_make((*r)->model, st0, &e) != AG_OK)
+        fail_msg("state: %s", e.text);
+    const ag_splittree *t = st0->pm->em->proc->tree;
+    *visible = 0;
+    for (size_t n = 0; n < t->nnodes; n++)
+        *visible += t->nodes[n].kind == AG_NODE_COMPONENT;
+    int32_t win = window_node(st0->pm, 1, 1.2 + 0.2, 1.5 + 0.2);
+    assert_true(win > 0);
+    return win;
+}
+
 /* A node an edit changed but did not remove keeps its id (issue 14 §4), found where the edit
  * put it: a resized window and the front windows of its rule, resized with it, keep their ids
  * with their new boxes; a split window keeps its id with its lower half, and its upper half is
@@ -492,21 +513,13 @@ static void edit_kept(ag_pointmodel *pm, const ag_edit_op *op, ag_points_state *
 static void test_moved_nodes_keep_ids(void **state)
 {
     (void)state;
-    ag_gen_building_options o = {.points = 60000, .width = 12, .depth = 8, .height = 7,
-                                 .ridge = -1, .cols = 3, .rows = 2, .seed = 43};
-    ag_cloud *c = building(&o);
-    ag_proceduralize_cloud_result *r = proceduralize(c);
+    ag_cloud *c = NULL;
+    ag_proceduralize_cloud_result *r = NULL;
     ag_points_state st0 = {0};
-    ag_error e;
-    if (ag_points_state_make(r->model, &st0, &e) != AG_OK)
-        fail_msg("state: %s", e.text);
+    size_t visible = 0;
+    int32_t win = ids_building(&c, &r, &st0, &visible);
     ag_pointmodel *pm = st0.pm;
     const ag_splittree *t = pm->em->proc->tree;
-    size_t visible = 0;
-    for (size_t n = 0; n < t->nnodes; n++)
-        visible += t->nodes[n].kind == AG_NODE_COMPONENT;
-    int32_t win = window_node(pm, 1, 1.2 + 0.2, 1.5 + 0.2);
-    assert_true(win > 0);
     const ag_tnode *w = &t->nodes[win];
     ag_box asked = w->box;
     asked.max[0] += 0.1;
@@ -605,21 +618,14 @@ static void test_moved_nodes_keep_ids(void **state)
 static void test_point_ids_survive_reload(void **state)
 {
     (void)state;
-    ag_gen_building_options o = {.points = 60000, .width = 12, .depth = 8, .height = 7,
-                                 .ridge = -1, .cols = 3, .rows = 2, .seed = 43};
-    ag_cloud *c = building(&o);
-    ag_proceduralize_cloud_result *r = proceduralize(c);
+    ag_cloud *c = NULL;
+    ag_proceduralize_cloud_result *r = NULL;
     ag_points_state st0 = {0};
-    ag_error e;
-    if (ag_points_state_make(r->model, &st0, &e) != AG_OK)
-        fail_msg("state: %s", e.text);
+    size_t visible = 0;
+    int32_t win = ids_building(&c, &r, &st0, &visible);
     ag_pointmodel *pm = st0.pm;
     const ag_splittree *t = pm->em->proc->tree;
-    size_t visible = 0;
-    for (size_t n = 0; n < t->nnodes; n++)
-        visible += t->nodes[n].kind == AG_NODE_COMPONENT;
-    int32_t win = window_node(pm, 1, 1.2 + 0.2, 1.5 + 0.2);
-    assert_true(win > 0);
+    ag_error e;
     uint8_t *gone = calloc(t->nnodes, 1);
     gone[win] = 1;
     int32_t nodes[1] = {win};
