@@ -65,7 +65,7 @@ typedef struct {
     int turn;               /* quarter turns from the part's facing to the target's */
     double fitted[3];       /* the size the part was fitted to (its own axes) */
     ag_fit_report fit;
-    char message[256];
+    char message[512];
     /* how a service made the new model from the composed grammar (app/usecase_compose.h;
      * ag_compose leaves them 0): 1 when the part was grafted into the model's tree
      * (graft.h), else its derivation was proceduralized, for the reason in fallback */
