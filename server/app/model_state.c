@@ -107,36 +107,10 @@ static ag_status derive_text(const char *text, size_t len, ag_terminal_lookup lo
     return s;
 }
 
-/* r's mesh with its components grouped by the labels of r, named "L<n>" as the grammar export
- * names them (in place: the vertices and triangles stay as they are). */
+/* r's mesh grouped by r's labels, named as the grammar export names them. */
 static ag_status regroup(ag_proceduralize_result *r, ag_error *err)
 {
-    ag_mesh *m = r->mesh;
-    const ag_labels *L = r->labels;
-    int32_t *group = L->nlabels ? malloc(L->nlabels * sizeof *group) : NULL;
-    ag_status s = group || !L->nlabels ? AG_OK : AG_ERR_NOMEM;
-    for (size_t l = 0; s == AG_OK && l < L->nlabels; l++)
-        group[l] = -1;
-    if (s == AG_OK) {
-        for (size_t g = 0; g < m->ngroups; g++)
-            free(m->group_names[g]);
-        m->ngroups = 0;
-    }
-    for (size_t c = 0; s == AG_OK && c < m->ncomponents; c++) {
-        int32_t l = c < L->ncomponents ? L->label[c] : -1;
-        int valid = l >= 0 && (size_t)l < L->nlabels;
-        if (valid && group[l] < 0) {
-            char name[32];
-            size_t g;
-            snprintf(name, sizeof name, "L%d", l + 1);
-            if ((s = ag_mesh_add_group(m, name, &g)) == AG_OK)
-                group[l] = (int32_t)g;
-        }
-        if (s == AG_OK)
-            m->component_group[c] = valid ? group[l] : -1;
-    }
-    free(group);
-    if (s != AG_OK)
+    if (ag_labels_name_groups(r->mesh, r->labels) != AG_OK)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory naming the labels");
     return AG_OK;
 }

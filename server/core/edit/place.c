@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../base/array.h"
+#include "../base/hash.h"
 #include "../base/tolerance.h"
 
 void ag_place_identity(ag_place_map *m)
@@ -229,14 +230,6 @@ struct ag_place_builder {
     size_t vcap;
 };
 
-static uint64_t hash_str(const char *s)
-{
-    uint64_t h = 1469598103934665603ULL;
-    for (; *s; s++)
-        h = (h ^ (unsigned char)*s) * 1099511628211ULL;
-    return h;
-}
-
 ag_place_builder *ag_place_builder_create(void)
 {
     ag_place_builder *b = calloc(1, sizeof *b);
@@ -272,7 +265,7 @@ static ag_status group_index(ag_place_builder *b, const char *name, int32_t *out
         for (size_t i = 0; i < nc; i++)
             ns[i] = -1;
         for (size_t g = 0; g < b->m->ngroups; g++) {
-            size_t i = hash_str(b->m->group_names[g]) & (nc - 1);
+            size_t i = ag_hash_text(b->m->group_names[g]) & (nc - 1);
             while (ns[i] >= 0)
                 i = (i + 1) & (nc - 1);
             ns[i] = (int32_t)g;
@@ -281,7 +274,7 @@ static ag_status group_index(ag_place_builder *b, const char *name, int32_t *out
         b->gslot = ns;
         b->gcap = nc;
     }
-    size_t i = hash_str(name) & (b->gcap - 1);
+    size_t i = ag_hash_text(name) & (b->gcap - 1);
     while (b->gslot[i] >= 0) {
         if (!strcmp(b->m->group_names[b->gslot[i]], name)) {
             *out = b->gslot[i];

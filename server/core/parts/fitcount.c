@@ -4,8 +4,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/hash.h"
 #include "../base/tolerance.h"
 #include "../proc/gframe.h"
+#include "../proc/weld.h"
 #include "fit.h"
 
 /* Work limits: columns of an axis, and the new count. */
@@ -115,22 +117,7 @@ static uint64_t mix(uint64_t h, uint64_t x)
     return h;
 }
 
-static uint64_t finish(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
 static uint64_t quant(double x, double q) { return (uint64_t)(int64_t)llround(x / q); }
-
-static uint64_t text_hash(const char *s)
-{
-    uint64_t h = 1469598103934665603ull;
-    for (; s && *s; s++)
-        h = (h ^ (unsigned char)*s) * 1099511628211ull;
-    return h;
-}
 
 /* What one application puts in its column: callee, turn, kind, counts across the axis (kk:
  * the lattice vector that makes the columns, -1 for none), its cell's place in the column and
@@ -138,7 +125,7 @@ static uint64_t text_hash(const char *s)
 static uint64_t content_hash(const ag_fit_item *x, int a, int kk, double rel, const ag_box *cell,
                              double q)
 {
-    uint64_t h = mix(text_hash(x->s.callee), (uint64_t)x->s.rot);
+    uint64_t h = mix(ag_hash_text(x->s.callee), (uint64_t)x->s.rot);
     h = mix(h, (uint64_t)x->s.subdivide);
     for (int k = 0; k < 3; k++)
         h = mix(h, k == kk ? 0 : x->s.subdivide ? x->s.counts[k] : 1);
@@ -149,7 +136,7 @@ static uint64_t content_hash(const ag_fit_item *x, int a, int kk, double rel, co
             h = mix(h, quant(x->box.min[b], q));
             h = mix(h, quant(x->box.max[b], q));
         }
-    return finish(h);
+    return ag__mix64(h);
 }
 
 /* Not thin along a (resize's thin test, AG_EDIT_THIN_RATIO): a window's glass, not a mullion. */

@@ -364,38 +364,9 @@ ag_status ag_pointedit_kept_order(ag_pointmodel *pm, const ag_edit_model *kept, 
 
 ag_status ag_pointedit_name_groups(ag_pointmodel *pm, ag_error *err)
 {
-    if (!pm->em)
-        return AG_OK;
-    ag_mesh *m = pm->em->proc->mesh;
-    const ag_labels *L = pm->em->proc->labels;
-    int32_t *group_of = malloc((L->nlabels + 1) * sizeof *group_of);
-    if (!group_of)
+    if (pm->em && ag_labels_name_groups(pm->em->proc->mesh, pm->em->proc->labels) != AG_OK)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    for (size_t l = 0; l < L->nlabels; l++)
-        group_of[l] = -1;
-    for (size_t g = 0; g < m->ngroups; g++)
-        free(m->group_names[g]);
-    m->ngroups = 0;
-    ag_status st = AG_OK;
-    for (size_t c = 0; c < m->ncomponents && !st; c++) {
-        int32_t lab = c < L->ncomponents ? L->label[c] : -1;
-        if (lab < 0 || (size_t)lab >= L->nlabels) {
-            m->component_group[c] = -1;
-            continue;
-        }
-        if (group_of[lab] < 0) {
-            char name[32];
-            size_t gi;
-            snprintf(name, sizeof name, "L%d", lab + 1);
-            if ((st = ag_mesh_add_group(m, name, &gi)))
-                st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-            else
-                group_of[lab] = (int32_t)gi;
-        }
-        m->component_group[c] = group_of[lab];
-    }
-    free(group_of);
-    return st;
+    return AG_OK;
 }
 
 ag_status ag_pointedit_apply(const ag_pointmodel *pm, const ag_edit_op *op,

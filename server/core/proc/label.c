@@ -2,6 +2,7 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -860,4 +861,34 @@ fail:
     free(list);
     ag_labels_free(L);
     return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling");
+}
+
+ag_status ag_labels_name_groups(ag_mesh *m, const ag_labels *L)
+{
+    int32_t *group_of = malloc((L->nlabels + 1) * sizeof *group_of);
+    if (!group_of)
+        return AG_ERR_NOMEM;
+    for (size_t l = 0; l < L->nlabels; l++)
+        group_of[l] = -1;
+    for (size_t g = 0; g < m->ngroups; g++)
+        free(m->group_names[g]);
+    m->ngroups = 0;
+    ag_status st = AG_OK;
+    for (size_t c = 0; c < m->ncomponents && st == AG_OK; c++) {
+        int32_t lab = c < L->ncomponents ? L->label[c] : -1;
+        if (lab < 0 || (size_t)lab >= L->nlabels) {
+            m->component_group[c] = -1;
+            continue;
+        }
+        if (group_of[lab] < 0) {
+            char name[32];
+            size_t gi;
+            snprintf(name, sizeof name, "L%d", lab + 1);
+            if ((st = ag_mesh_add_group(m, name, &gi)) == AG_OK)
+                group_of[lab] = (int32_t)gi;
+        }
+        m->component_group[c] = group_of[lab];
+    }
+    free(group_of);
+    return st;
 }

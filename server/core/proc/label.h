@@ -84,6 +84,11 @@ ag_status ag_label_components(const ag_mesh *m, const ag_label_options *opt, ag_
                               ag_error *err);
 void ag_labels_free(ag_labels *l);
 
+/* m's components grouped by their labels in L, each group named "L<label + 1>" as the
+ * grammar export names its labels; components without a label in no group. In place: the
+ * vertices and triangles stay as they are. AG_ERR_NOMEM when out of memory. */
+ag_status ag_labels_name_groups(ag_mesh *m, const ag_labels *L);
+
 /* Rotates (x, y) by k quarter turns counter-clockwise about +z. */
 void ag_label_rotate(int k, double *x, double *y);
 
