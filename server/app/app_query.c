@@ -143,22 +143,49 @@ ag_status ag_app_query_job(ag_app *app, int64_t job, json_t **view, int *finishe
     return *view ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
 }
 
-/* The model's current grammar with its tree, in the numbering ops name: a tree stored in an
- * older one is rebuilt (loading the model's edit model) before it is served. */
+/* The served tree (malloc'd) of the model's current grammar g, in the numbering ops name: a
+ * tree stored in an older one is rebuilt (loading the model's edit model) before it is
+ * served, and a bare one (an edit's, app/model_kept.h) is printed from the model's edit model,
+ * once per version (ag_edit_session_served). */
 static ag_status current_tree(ag_app *app, ag_db *db, int64_t id, ag_grammar_row *g,
-                              ag_error *err)
+                              char **served, ag_error *err)
 {
-    ag_status s = ag_grammars_current(db, id, 1, g, err);
-    if (s != AG_OK || g->tree_numbering == AG_MODEL_TREE_NUMBERING)
-        return s;
-    ag_grammars_row_clear(g);
-    ag_store_env env;
-    ag_edit_state *st = NULL;
-    if ((s = ag__app_env(app, &env, err)) != AG_OK ||
-        (s = ag_edit_session_acquire(env.sessions, db, id, &st, err)) != AG_OK)
-        return s;
-    ag_edit_session_release(env.sessions, st);
-    return ag_grammars_current(db, id, 1, g, err);
+    *served = NULL;
+    /* a version that comes while the edit model is loaded is read again: at most a few */
+    for (int tries = 0; tries < 4; tries++) {
+        ag_status s = ag_grammars_current(db, id, 1, g, err);
+        if (s != AG_OK)
+            return s;
+        int renumber = g->tree_numbering != AG_MODEL_TREE_NUMBERING;
+        if (!renumber && ag_model_kept_serves(g->tree_json)) {
+            if ((*served = ag_model_kept_served_text(g->tree_json)))
+                return AG_OK;
+            ag_grammars_row_clear(g);
+            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        }
+        ag_store_env env;
+        ag_edit_state *st = NULL;
+        if ((s = ag__app_env(app, &env, err)) != AG_OK ||
+            (s = ag_edit_session_acquire(env.sessions, db, id, &st, err)) != AG_OK) {
+            ag_grammars_row_clear(g);
+            return s;
+        }
+        const char *text = NULL;
+        if (!renumber && st->version == g->model_version) {
+            s = ag_edit_session_served(st, &text, err);
+            if (s == AG_OK && !(*served = strdup(text)))
+                s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        }
+        ag_edit_session_release(env.sessions, st);
+        if (s == AG_OK && *served)
+            return AG_OK;
+        ag_grammars_row_clear(g); /* renumbered, or changed meanwhile: read again */
+        if (s != AG_OK)
+            return s;
+    }
+    return ag_error_set(err, AG_ERR_BUSY, 0,
+                        "model %lld kept changing while its tree was read; ask again",
+                        (long long)id);
 }
 
 ag_status ag_app_query_tree(ag_app *app, int64_t id, char **json, size_t *len,
@@ -167,16 +194,11 @@ ag_status ag_app_query_tree(ag_app *app, int64_t id, char **json, size_t *len,
     *json = NULL;
     DB_OR_RETURN(db, app, err);
     ag_grammar_row g;
-    ag_status s = current_tree(app, db, id, &g, err);
+    char *served = NULL;
+    ag_status s = current_tree(app, db, id, &g, &served, err);
     if (s != AG_OK)
         return s;
-    /* The stored tree is an object; the model, its version and the summary go in front, and
-     * what it keeps to reload the model (app/model_kept.h) is not served. */
-    char *served = ag_model_kept_served_text(g.tree_json);
-    if (!served) {
-        ag_grammars_row_clear(&g);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
+    /* The served tree is an object; the model, its version and the summary go in front. */
     const char *tree = served;
     while (*tree == ' ')
         tree++;
@@ -345,11 +367,12 @@ ag_status ag_app_query_glb(ag_app *app, int64_t id, int (*fresh)(void *user, con
     ag_grammar_row g;
     ag_error e;
     ag_error_clear(&e);
-    ag_status s = current_tree(app, db, id, &g, &e);
+    ag_status s = ag_grammars_current(db, id, 0, &g, &e);
     int proceduralized = s == AG_OK;
     int64_t blob_id = 0;
     if (proceduralized) {
         blob_id = g.mesh_blob;
+        ag_grammars_row_clear(&g);
     } else if (s == AG_ERR_NOT_FOUND) {
         ag_model_row row;
         if ((s = ag_models_get(db, id, &row, err)) != AG_OK)
@@ -363,22 +386,28 @@ ag_status ag_app_query_glb(ag_app *app, int64_t id, int (*fresh)(void *user, con
     }
     /* The geometry changes only with a new mesh file, so its id is a strong validator. */
     snprintf(out->etag, sizeof out->etag, "\"mesh-%lld\"", (long long)blob_id);
-    if (fresh && fresh(user, out->etag)) {
-        if (proceduralized)
-            ag_grammars_row_clear(&g);
+    if (fresh && fresh(user, out->etag))
         return AG_OK;
+    /* the components' nodes and labels from the served tree (a version may have come since:
+     * the mesh is then that version's) */
+    char *served = NULL;
+    if (proceduralized) {
+        if ((s = current_tree(app, db, id, &g, &served, err)) != AG_OK)
+            return s;
+        blob_id = g.mesh_blob;
+        ag_grammars_row_clear(&g);
+        snprintf(out->etag, sizeof out->etag, "\"mesh-%lld\"", (long long)blob_id);
     }
     ag_mesh *mesh = NULL;
     ag_glb_component_meta *meta = NULL;
     char *labels = NULL;
     s = load_mesh(db, blob_id, &mesh, err);
     if (s == AG_OK && proceduralized)
-        s = ag_model_tree_component_meta(g.tree_json, mesh->ncomponents, &meta, &labels, err);
+        s = ag_model_tree_component_meta(served, mesh->ncomponents, &meta, &labels, err);
     if (s == AG_OK)
         s = meta ? ag_glb_write_meta(mesh, meta, mesh->ncomponents, &out->data, &out->len, err)
                  : ag_glb_write(mesh, &out->data, &out->len, err);
-    if (proceduralized)
-        ag_grammars_row_clear(&g);
+    free(served);
     ag_mesh_free(mesh);
     free(meta);
     free(labels);

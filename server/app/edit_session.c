@@ -46,6 +46,19 @@ void ag_edit_session_reset(ag_edit_state *st)
     st->points_free = NULL;
     ag_trace_free(st->trace);
     st->trace = NULL;
+    free(st->served);
+    st->served = NULL;
+}
+
+ag_status ag_edit_session_served(ag_edit_state *st, const char **text, ag_error *err)
+{
+    *text = NULL;
+    if (!st->em)
+        return ag_error_set(err, AG_ERR_INTERNAL, 0, "no model is loaded to describe");
+    if (!st->served && !(st->served = ag_model_tree_served_text(st->em)))
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory describing the model");
+    *text = st->served;
+    return AG_OK;
 }
 
 ag_status ag_edit_session_trace(ag_edit_state *st, const ag_trace **trace, ag_error *err)

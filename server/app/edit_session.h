@@ -36,6 +36,9 @@ typedef struct {
     /* em's derivation traced (core/parts/trace.h), made by the first part save or
      * composition of this version and kept for the next ones */
     ag_trace *trace;
+    /* em's served tree text (app/model_tree.h), printed when first asked for: edits store
+     * their tree bare (app/model_kept.h), so every reader of this version shares one print */
+    char *served;
 } ag_edit_state;
 
 ag_edit_sessions *ag_edit_sessions_create(void);
@@ -59,5 +62,9 @@ void ag_edit_session_replace(ag_edit_state *state, int64_t version, ag_edit_mode
 void ag_edit_session_reset(ag_edit_state *state);
 /* The borrowed state's trace, made when it has none yet (it goes with em). */
 ag_status ag_edit_session_trace(ag_edit_state *state, const ag_trace **trace, ag_error *err);
+
+/* The borrowed state's served tree text (ag_model_tree_served_text of em), printed when it
+ * has none yet (it goes with em): AG_ERR_NOMEM when out of memory. */
+ag_status ag_edit_session_served(ag_edit_state *state, const char **text, ag_error *err);
 
 #endif

@@ -185,8 +185,9 @@ char *ag_model_kept_join(const char *served, const ag_edit_model *em)
         if ((out = malloc(n + kn + 16))) {
             memcpy(out, served, n - 1);
             size_t at = n - 1;
-            memcpy(out + at, ",\"kept\":", 8);
-            at += 8;
+            int empty = served[0] == '{' && at == 1; /* "{}": the kept member alone */
+            memcpy(out + at, ",\"kept\":" + empty, 8 - (size_t)empty);
+            at += 8 - (size_t)empty;
             memcpy(out + at, kept, kn);
             at += kn;
             out[at++] = '}';
@@ -204,6 +205,20 @@ char *ag_model_kept_tree_text(const ag_edit_model *em)
     char *out = ag_model_kept_join(served, em);
     free(served);
     return out;
+}
+
+char *ag_model_kept_bare_text(const ag_edit_model *em)
+{
+    return ag_model_kept_join("{}", em);
+}
+
+#define BARE_START "{\"kept\":{\"format\":"
+
+int ag_model_kept_serves(const char *tree_text)
+{
+    while (*tree_text == ' ')
+        tree_text++;
+    return strncmp(tree_text, BARE_START, strlen(BARE_START)) != 0;
 }
 
 #define KEPT_MEMBER ",\"kept\":{\"format\":"
@@ -468,10 +483,32 @@ static int get_real(reader *R, const json_t *k, const char *key, double *out)
     return 1;
 }
 
-ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_edit_model **em,
-                               ag_error *err)
+/* What a kept member holds: the split tree and the classes labeling gave the components. */
+typedef struct {
+    ag_splittree *t;
+    ag_rebuild_classes classes;
+} kept_parts;
+
+static void kept_parts_free(kept_parts *kp)
 {
-    *em = NULL;
+    ag_splittree_free(kp->t);
+    free((void *)kp->classes.label);
+    free((void *)kp->classes.variant);
+    free((void *)kp->classes.rot);
+    free((void *)kp->classes.vrot);
+    free((void *)kp->classes.variant_label);
+    free((void *)kp->classes.mirror);
+    free((void *)kp->classes.turn);
+    free((void *)kp->classes.variant_deviation);
+    memset(kp, 0, sizeof *kp);
+}
+
+/* The kept member of tree_text read and checked; ncomponents, when not SIZE_MAX, is the
+ * number of components of the mesh it must fit. */
+static ag_status read_kept(const char *tree_text, size_t ncomponents, kept_parts *out,
+                           ag_error *err)
+{
+    memset(out, 0, sizeof *out);
     json_error_t je;
     json_t *doc = json_loads(tree_text, 0, &je);
     if (!doc)
@@ -508,7 +545,7 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
              get_real(&R, k, "label_tol", &classes.tol) && get_real(&R, k, "exact", &classes.exact) &&
              get_real(&R, k, "share", &classes.share) &&
              get_count(&R, k, "exact_copies", 1, &exact_copies);
-    if (ok && ncomp != mesh->ncomponents)
+    if (ok && ncomponents != SIZE_MAX && ncomp != ncomponents)
         ok = bad(&R, "it names another number of components than the mesh has");
     if (ok && !(data = malloc(blen + 1)))
         R.st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory"), ok = 0;
@@ -600,27 +637,45 @@ ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_ed
     classes.turn = turn;
     classes.variant_deviation = deviation;
     classes.exact_copies = (int)exact_copies;
-    ag_mesh *m = NULL;
-    if (!st && !(m = ag_mesh_clone(mesh)))
-        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    out->t = t;
+    out->classes = classes;
+    if (st)
+        kept_parts_free(out);
+    return st;
+}
+
+ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_edit_model **em,
+                               ag_error *err)
+{
+    *em = NULL;
+    kept_parts kp;
+    ag_status st = read_kept(tree_text, mesh->ncomponents, &kp, err);
+    if (st)
+        return st;
+    ag_mesh *m = ag_mesh_clone(mesh);
     ag_proceduralize_result *r = NULL;
-    if (!st) {
-        st = ag_rebuild_finish(m, t, &classes, &r, err); /* takes m and t */
-        m = NULL;
-        t = NULL;
+    if (!m)
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    else {
+        st = ag_rebuild_finish(m, kp.t, &kp.classes, &r, err); /* takes m and the tree */
+        kp.t = NULL;
     }
     ag_proceduralize_options opt = {.segment.keep_groups = 1}; /* as ag_edit_model_create */
     if (!st && (st = ag_edit_model_wrap(r, &opt, em, err)))
         ag_proceduralize_result_free(r);
-    ag_mesh_free(m);
-    ag_splittree_free(t);
-    free(label);
-    free(variant);
-    free(rot);
-    free(vrot);
-    free(vlabel);
-    free(mirror);
-    free(turn);
-    free(deviation);
+    kept_parts_free(&kp);
     return st;
+}
+
+ag_status ag_model_kept_tree(const char *tree_text, ag_splittree **tree, ag_error *err)
+{
+    *tree = NULL;
+    kept_parts kp;
+    ag_status st = read_kept(tree_text, SIZE_MAX, &kp, err);
+    if (st)
+        return st;
+    *tree = kp.t;
+    kp.t = NULL;
+    kept_parts_free(&kp);
+    return AG_OK;
 }

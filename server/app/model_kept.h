@@ -20,7 +20,14 @@
  * deviation. Format 3, which wrote dead nodes whole, is still read. Binary, because the tree is written
  * with every edit: numbers exactly, a 200k-triangle building's in milliseconds. A kept member
  * that does not describe a tree over the mesh is refused (AG_ERR_PARSE naming what is wrong),
- * never trusted. */
+ * never trusted.
+ *
+ * An edit's or a composition's version is stored bare: {"kept":{...}} alone, without the
+ * served tree. Printing the served tree is most of writing a large model's tree, and it is
+ * asked for far less often than edits are made (and shared by every client when it is), so
+ * the service makes it from the edit model when it is first asked for (app/edit_session.h,
+ * ag_edit_session_served) and a rebase reads the boxes it compares from the kept member
+ * (ag_model_kept_tree). ag_model_kept_serves tells the two kinds of stored text apart. */
 #ifndef AG_MODEL_KEPT_H
 #define AG_MODEL_KEPT_H
 
@@ -31,6 +38,13 @@
 /* The stored tree text of em (malloc'd): the served tree with the kept member; NULL when out
  * of memory. */
 char *ag_model_kept_tree_text(const ag_edit_model *em);
+
+/* The bare stored tree text of em (malloc'd): its kept member alone; NULL when out of
+ * memory. */
+char *ag_model_kept_bare_text(const ag_edit_model *em);
+
+/* Whether a stored tree text holds the served tree (else it is bare: the kept member alone). */
+int ag_model_kept_serves(const char *tree_text);
 
 /* served (a served tree's text, an object: a point model's is in the input's coordinates)
  * with em's kept member added (malloc'd); NULL when out of memory. */
@@ -45,5 +59,9 @@ char *ag_model_kept_served_text(const char *tree_text);
  * when it is not one over this mesh. */
 ag_status ag_model_kept_reload(const ag_mesh *mesh, const char *tree_text, ag_edit_model **em,
                                ag_error *err);
+
+/* The split tree a stored tree text keeps (malloc'd; checked as a reload checks it, without a
+ * mesh to fit): AG_ERR_NOT_FOUND when it keeps none, AG_ERR_PARSE when it is not valid. */
+ag_status ag_model_kept_tree(const char *tree_text, ag_splittree **tree, ag_error *err);
 
 #endif

@@ -452,6 +452,26 @@ char *ag_model_tree_served_text(const ag_edit_model *em)
     return o.p;
 }
 
+json_t *ag_model_tree_boxes(const ag_splittree *t)
+{
+    json_t *nodes = json_array();
+    json_t *tree = nodes ? json_pack("{s:o}", "nodes", nodes) : NULL;
+    for (size_t n = 0; tree && n < t->nnodes; n++) {
+        const ag_tnode *x = &t->nodes[n];
+        json_t *j = json_pack("{s:I, s:s}", "id", (json_int_t)n, "kind", kind_name(x->kind));
+        if (j && x->kind != AG_NODE_DEAD)
+            json_object_set_new(j, "box",
+                                json_pack("[f,f,f,f,f,f]", x->box.min[0], x->box.min[1],
+                                          x->box.min[2], x->box.max[0], x->box.max[1],
+                                          x->box.max[2]));
+        if (!j || json_array_append_new(nodes, j)) {
+            json_decref(tree);
+            tree = NULL;
+        }
+    }
+    return tree;
+}
+
 json_t *ag_model_tree_folder_stats(const ag_edit_model *em)
 {
     const ag_splittree *t = em->proc->tree;

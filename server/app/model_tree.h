@@ -50,6 +50,10 @@ ag_status ag_model_tree_check_node(const ag_edit_model *em, int32_t id, const ch
 /* The served tree as compact text (malloc'd), or NULL when out of memory. */
 char *ag_model_tree_served_text(const ag_edit_model *em);
 
+/* Of t's nodes only what a served tree says of their kind and box: {"nodes":[{"id","kind",
+ * "box"}]} (dead ones {"id","kind"}), numbered as the served tree; NULL when out of memory. */
+json_t *ag_model_tree_boxes(const ag_splittree *t);
+
 /* A stored tree (text) read for mesh.glb (ag_glb_write_meta): *meta has ncomponents entries
  * (label NULL / node -1 where the tree says nothing); the labels point into *labels, a
  * malloc'd block the caller frees after use. AG_ERR_PARSE for a tree that is not one. */

@@ -7,6 +7,7 @@
 
 #include "../store/ops.h"
 #include "../store/states.h"
+#include "model_kept.h"
 #include "model_tree.h"
 
 /* --- the ops that came since the base ------------------------------------------------------ */
@@ -192,7 +193,19 @@ static int map_op(json_t *op, int64_t model, const json_t *ta, const json_t *tb,
     return 1;
 }
 
-/* The served tree kept with version v, parsed; NULL when none was kept in today's numbering. */
+/* The nodes' kinds and boxes of a bare stored tree (app/model_kept.h), as a served tree has
+ * them; NULL when it keeps no valid tree. */
+static json_t *kept_boxes(const char *tree_text)
+{
+    ag_splittree *t = NULL;
+    if (ag_model_kept_tree(tree_text, &t, NULL) != AG_OK)
+        return NULL;
+    json_t *tree = ag_model_tree_boxes(t);
+    ag_splittree_free(t);
+    return tree;
+}
+
+/* The served tree kept with version v, parsed (a bare one's boxes); NULL when none was kept in today's numbering. */
 static json_t *tree_of(ag_db *db, int64_t model, int64_t v, ag_status *s, ag_error *err)
 {
     ag_state_row row = {0};
@@ -200,7 +213,8 @@ static json_t *tree_of(ag_db *db, int64_t model, int64_t v, ag_status *s, ag_err
     *s = ag_states_get(db, model, v, &row, &e);
     json_t *tree = NULL;
     if (*s == AG_OK && row.tree_json && row.tree_numbering == AG_MODEL_TREE_NUMBERING)
-        tree = json_loads(row.tree_json, 0, NULL);
+        tree = ag_model_kept_serves(row.tree_json) ? json_loads(row.tree_json, 0, NULL)
+                                                   : kept_boxes(row.tree_json);
     else if (*s != AG_OK && *s != AG_ERR_NOT_FOUND && err)
         *err = e;
     if (*s == AG_ERR_NOT_FOUND)

@@ -152,6 +152,7 @@ ag_status ag__store_ws_put_grammar(ag_db *db, int64_t model, int64_t version, co
  * (and while the mesh is written); the two need nothing of each other. */
 typedef struct {
     const ag_edit_model *em;
+    int bare; /* the tree stored bare: the kept member alone (app/model_kept.h) */
     char *tree;
     double tree_ms, mesh_ms; /* printing the tree, encoding the mesh */
     pthread_t printer;
@@ -173,15 +174,17 @@ static void *print_tree(void *arg)
 {
     encoded_state *e = arg;
     double t0 = now_ms();
-    e->tree = ag_model_kept_tree_text(e->em); /* a reload gives this model back */
+    /* a reload gives this model back */
+    e->tree = e->bare ? ag_model_kept_bare_text(e->em) : ag_model_kept_tree_text(e->em);
     e->tree_ms = now_ms() - t0;
     return NULL;
 }
 
-static void encode_state(const ag_model_state *st, encoded_state *e, ag_error *err)
+static void encode_state(const ag_model_state *st, int bare, encoded_state *e, ag_error *err)
 {
     memset(e, 0, sizeof *e);
     e->em = st->em;
+    e->bare = bare;
     e->threaded = pthread_create(&e->printer, NULL, print_tree, e) == 0;
     if (!e->threaded)
         print_tree(e);
@@ -231,7 +234,7 @@ ag_status ag__store_ws_put_state(ag_db *db, int64_t model, int64_t version,
                                  ag_error *err)
 {
     encoded_state e;
-    encode_state(st, &e, err);
+    encode_state(st, 0, &e, err);
     ag_status s = write_state(db, model, version, st, &e, summary_json, keep, err);
     encoded_clear(&e);
     return s;
@@ -415,9 +418,10 @@ static ag_status commit_change(ag_store_ws *w, ag_model_state *st, json_t *body,
                                const char *source, const char *kind, ag_error *err)
 {
     /* encoded before the sequencer's lock is taken: it serializes every model's changes;
-     * meanwhile the grammar's read-back check may still be running (ag_model_state_start) */
+     * meanwhile the grammar's read-back check may still be running (ag_model_state_start);
+     * the tree is stored bare, served from the edit model kept for the next edit when asked */
     encoded_state e;
-    encode_state(st, &e, err);
+    encode_state(st, 1, &e, err);
     ag_status s = e.mesh_status;
     if (s == AG_OK)
         s = ag_model_state_checked(st, err);
