@@ -7,7 +7,8 @@
  *   served tree byte for byte (a restart serves what the running service served);
  * - the tree a rebase reads from the bare text (ag_model_kept_tree, ag_model_tree_boxes) maps
  *   every node as the served tree itself does, read with the rebase's own matcher;
- * - a bare text cut short, or one that keeps nothing, is refused. */
+ * - a bare text cut short, one whose data is not base64, or one that keeps nothing, is
+ *   refused. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -157,6 +158,23 @@ static void bad_bare_texts_are_refused(void **state)
     assert_null(back);
     assert_false(ag_model_kept_serves(cut_text)); /* bare still: refused, not served as {} */
     free(cut_text);
+    /* not base64: a character outside the alphabet, padding inside, a length that is no
+     * multiple of four */
+    size_t at = (size_t)(strstr(bare, "\"data\":\"") + 8 + 16 - bare);
+    for (int b = 0; b < 3; b++) {
+        char *broken = NULL;
+        if (b < 2) {
+            broken = strdup(bare);
+            broken[at] = b == 0 ? '*' : '=';
+        } else {
+            assert_true(asprintf(&broken, "%.*sA%s", (int)at, bare, bare + at) > 0);
+        }
+        assert_int_equal(ag_model_kept_tree(broken, &t, &err), AG_ERR_PARSE);
+        if (!strstr(err.text, "base64"))
+            fail_msg("case %d: %s", b, err.text);
+        assert_null(t);
+        free(broken);
+    }
     free(bare);
     ag_edit_model_free(em);
     ag_mesh_free(m);
