@@ -3,7 +3,7 @@
 // drag previews (solved with the kept factorization, never stored); prints op→ack,
 // op→broadcast (to B) and preview→room (to B) times. Then the same committed ops on the
 // generated 20k- and 200k-triangle buildings of bench/edit (written by `build/bench/edit
-// --write-obj`), and split, remove, paste and join there. Target: an op reaches
+// --write-obj`), the tree served after them, and split, remove, paste and join there. Target: an op reaches
 // the other clients ≤ 50 ms after it is sent at 200k.
 // Prints figures; not a test.
 import fs from 'node:fs';
@@ -168,6 +168,21 @@ try {
     await committedOps(model, A, B, version, 'demo building');
   }
 
+  // An op stores its tree bare (app/model_kept.h): the first GET …/tree after it prints the
+  // served tree from the edit model, and every later reader of that version shares the print.
+  async function treeAfterOps(m, label) {
+    const times = [];
+    let bytes = 0;
+    for (let i = 0; i < 2; i++) {
+      const t0 = performance.now();
+      const r = await http(d, 'GET', `/api/v1/models/${m.id}/tree`);
+      times.push(performance.now() - t0);
+      if (r.status !== 200) throw new Error(`GET tree: ${r.status} ${r.text}`);
+      bytes = r.text.length;
+    }
+    console.log(`edit ws ${label}: GET …/tree after the ops ${times[0].toFixed(1)} ms (printed from the edit model), again ${times[1].toFixed(1)} ms (${(bytes / 1e6).toFixed(1)} MB)`);
+  }
+
   // the generated buildings, uploaded z-up and proceduralized
   const bench = path.join(path.dirname(DAEMON), 'bench', 'edit');
   for (const size of SIZES) {
@@ -188,6 +203,7 @@ try {
       const v = (await GA.request({ type: 'hello', model: g.id, user: 'a' }, 'welcome')).version;
       await GB.request({ type: 'hello', model: g.id, user: 'b' }, 'welcome');
       await committedOps(g, GA, GB, v, `generated ${size} (${g.stats.triangles} triangles)`);
+      await treeAfterOps(g, `generated ${size}`);
       const now = (await http(d, 'GET', `/api/v1/models/${g.id}`)).json.version;
       await structuralOps(g, GA, GB, now, `generated ${size}`);
     } finally {
