@@ -355,12 +355,13 @@ static void service_compose(service *sv, int64_t part, int which, const char *mo
         if (!os.grafted)
             snprintf(fallback, sizeof fallback, "%s", os.fallback);
     }
+    double first = op[0]; /* before median sorts op */
     printf("service compose %-34s %-7s %-4s %6lld instances: preview %8.2f ms, op %8.2f ms "
            "(the case's first %.2f ms; in the op: rewrite %.1f ms, new state %.1f ms, commit and the rest %.1f ms; "
            "in the preview: loading %.1f ms, rewrite %.1f ms, derivation %.1f ms; the op's new "
            "state grafted in %d of %d runs%s%s)\n",
            what, mode, scope, (long long)json_integer_value(json_object_get(rep, "instances")),
-           median(pv, RUNS), median(op, RUNS), op[0], median(rw, RUNS), median(ns, RUNS),
+           median(pv, RUNS), median(op, RUNS), first, median(rw, RUNS), median(ns, RUNS),
            median(rest, RUNS), json_real_value(json_object_get(rep, "load_ms")),
            json_real_value(json_object_get(rep, "compose_ms")),
            json_real_value(json_object_get(rep, "state_ms")), grafted, RUNS,
