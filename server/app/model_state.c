@@ -145,27 +145,6 @@ static ag_status read_back(ag_grammar *g, ag_model_state *out, ag_error *err)
                       : s;
 }
 
-/* Which part of two meshes differs ("" when they are the same, byte for byte). */
-static const char *mesh_difference(const ag_mesh *a, const ag_mesh *b)
-{
-    if (a->nverts != b->nverts || a->ntris != b->ntris)
-        return "the vertex or triangle counts";
-    if (a->ncomponents != b->ncomponents || a->ngroups != b->ngroups)
-        return "the component or group counts";
-    if (memcmp(a->pos, b->pos, 3 * a->nverts * sizeof *a->pos))
-        return "the vertices";
-    if (memcmp(a->tri, b->tri, 3 * a->ntris * sizeof *a->tri) ||
-        memcmp(a->tri_component, b->tri_component, a->ntris * sizeof *a->tri_component))
-        return "the triangles";
-    if (memcmp(a->component_group, b->component_group,
-               a->ncomponents * sizeof *a->component_group))
-        return "the components' groups";
-    for (size_t i = 0; i < a->ngroups; i++)
-        if (strcmp(a->group_names[i], b->group_names[i]))
-            return "the group names";
-    return "";
-}
-
 /* A read-back check running beside the caller (ag_model_state_start,
  * ag_model_state_from_grammar_start). */
 struct ag_model_state_check {
@@ -190,7 +169,7 @@ static void *run_check(void *arg)
     ag_mesh *back = NULL;
     c->status = print_and_read_back(c->grammar, &out->terms, c->max_triangles, &out->text,
                                     &out->text_len, c->expect ? &back : &out->derived, &c->err);
-    const char *diff = c->status == AG_OK && c->expect ? mesh_difference(c->expect, back) : "";
+    const char *diff = c->status == AG_OK && c->expect ? ag_mesh_difference(c->expect, back) : "";
     if (*diff)
         c->status = ag_error_set(&c->err, AG_ERR_INTERNAL, 0,
                                  "the grammar read back derives another mesh than the grammar "
