@@ -596,7 +596,9 @@ static ag_status save_composed(ag_workspace *ws, ag_model_state *st, const ag_co
                                ag_error *err)
 {
     ag_folder_ws *w = (ag_folder_ws *)ws;
-    ag_status s = write_model(w, st, err);
+    ag_status s = ag_model_state_checked(st, err); /* the composition's read-back */
+    if (s == AG_OK)
+        s = write_model(w, st, err);
     if (s == AG_OK) {
         char path[4200];
         snprintf(path, sizeof path, "%s/summary.json", w->o.out_dir);

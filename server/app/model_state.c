@@ -115,18 +115,20 @@ static ag_status regroup(ag_proceduralize_result *r, ag_error *err)
     return AG_OK;
 }
 
-/* out's text of grammar g (its terminals collected in out->terms), checked to read back:
- * the text parsed with the terminals as they will be kept and derived (out->derived). */
-static ag_status print_and_read_back(const ag_grammar *g, ag_model_state *out, ag_error *err)
+/* Grammar g printed (*text) and read back: the text parsed with the terminals of terms and
+ * derived (*derived, at most max_triangles); a text that does not is AG_ERR_INTERNAL. */
+static ag_status print_and_read_back(const ag_grammar *g, const ag_terminal_set *terms,
+                                     size_t max_triangles, char **text, size_t *len,
+                                     ag_mesh **derived, ag_error *err)
 {
     ag_grammar *back = NULL;
     long col = 0;
     ag_error e;
     ag_error_clear(&e);
-    ag_status s = ag_grammar_text_print(g, &out->text, &out->text_len, err);
+    ag_status s = ag_grammar_text_print(g, text, len, err);
     if (s == AG_OK &&
-        (s = derive_text(out->text, out->text_len, ag_terminals_set_lookup, &out->terms,
-                         AG_GRAMMAR_MAX_TRIANGLES, &back, &out->derived, &e, &col)) != AG_OK)
+        (s = derive_text(*text, *len, ag_terminals_set_lookup, (void *)terms, max_triangles,
+                         &back, derived, &e, &col)) != AG_OK)
         s = ag_error_set(err, s == AG_ERR_NOMEM ? s : AG_ERR_INTERNAL, 0,
                          "the grammar does not read back (line %ld, column %ld): %s", e.element,
                          col, e.text);
@@ -138,14 +140,22 @@ static ag_status print_and_read_back(const ag_grammar *g, ag_model_state *out, a
 static ag_status read_back(ag_grammar *g, ag_model_state *out, ag_error *err)
 {
     ag_status s = ag_terminals_collect(g, &out->terms, err);
-    return s == AG_OK ? print_and_read_back(g, out, err) : s;
+    return s == AG_OK ? print_and_read_back(g, &out->terms, AG_GRAMMAR_MAX_TRIANGLES, &out->text,
+                                            &out->text_len, &out->derived, err)
+                      : s;
 }
 
-/* A read-back check running beside the caller (ag_model_state_start). */
+/* A read-back check running beside the caller (ag_model_state_start,
+ * ag_model_state_from_grammar_start). */
 struct ag_model_state_check {
     pthread_t thread;
     const ag_grammar *grammar;
+    ag_grammar *owned;     /* the grammar when the check has it to itself: freed after */
+    const ag_mesh *expect; /* the derivation the state keeps: the text must derive it (or
+                              NULL: what the text derives is kept) */
+    size_t max_triangles;
     ag_model_state *out;
+    double ms;
     ag_status status;
     ag_error err;
 };
@@ -153,9 +163,35 @@ struct ag_model_state_check {
 static void *run_check(void *arg)
 {
     struct ag_model_state_check *c = arg;
+    ag_model_state *out = c->out;
+    double t0 = ag_clock_ms();
     ag_error_clear(&c->err);
-    c->status = print_and_read_back(c->grammar, c->out, &c->err);
+    ag_mesh *back = NULL;
+    c->status = print_and_read_back(c->grammar, &out->terms, c->max_triangles, &out->text,
+                                    &out->text_len, c->expect ? &back : &out->derived, &c->err);
+    const char *diff = c->status == AG_OK && c->expect ? ag_mesh_difference(c->expect, back) : "";
+    if (*diff)
+        c->status = ag_error_set(&c->err, AG_ERR_INTERNAL, 0,
+                                 "the grammar read back derives another mesh than the grammar "
+                                 "made: %s differ",
+                                 diff);
+    ag_mesh_free(back);
+    c->ms = ag_clock_ms() - t0;
     return NULL;
+}
+
+/* Starts c on out (c->out set here): AG_OK once it runs, else c is freed and the caller
+ * checks on its own thread. */
+static int check_started(struct ag_model_state_check *c, ag_model_state *out)
+{
+    if (!c)
+        return 0;
+    c->out = out;
+    if (pthread_create(&c->thread, NULL, run_check, c) == 0) {
+        out->check = c;
+        return 1;
+    }
+    return 0;
 }
 
 ag_status ag_model_state_start(ag_edit_model **made, unsigned flags, ag_model_state *out,
@@ -175,17 +211,15 @@ ag_status ag_model_state_start(ag_edit_model **made, unsigned flags, ag_model_st
     struct ag_model_state_check *c = calloc(1, sizeof *c);
     out->em = m;
     *made = NULL;
-    if (c) {
-        /* the check reads the grammar only; the caller reads the tree and the mesh */
+    if (c) { /* the check reads the grammar only; the caller reads the tree and the mesh */
         c->grammar = m->proc->grammar;
-        c->out = out;
-        if (pthread_create(&c->thread, NULL, run_check, c) == 0) {
-            out->check = c;
+        c->max_triangles = AG_GRAMMAR_MAX_TRIANGLES;
+        if (check_started(c, out))
             return AG_OK;
-        }
         free(c);
     }
-    if ((s = print_and_read_back(m->proc->grammar, out, err)) != AG_OK)
+    if ((s = print_and_read_back(m->proc->grammar, &out->terms, AG_GRAMMAR_MAX_TRIANGLES,
+                                 &out->text, &out->text_len, &out->derived, err)) != AG_OK)
         ag_model_state_clear(out);
     return s;
 }
@@ -197,9 +231,11 @@ ag_status ag_model_state_checked(ag_model_state *st, ag_error *err)
         return AG_OK;
     pthread_join(c->thread, NULL);
     st->check = NULL;
+    st->times.check_ms = c->ms;
     ag_status s = c->status;
     if (s != AG_OK && err)
         *err = c->err;
+    ag_grammar_free(c->owned);
     free(c);
     return s;
 }
@@ -314,6 +350,73 @@ ag_status ag_model_state_from_grammar_ex(ag_grammar *g, size_t max_triangles,
         s = make ? make(user, out->derived, &out->em, err)
                  : ag_model_state_reload(out->derived, &out->em, err);
     tm->model_ms = ag_clock_ms() - t1;
+    if (s != AG_OK)
+        ag_model_state_clear(out);
+    return s;
+}
+
+/* g's terminals given the geometry their kept text (terms) reads as, so that g derives what
+ * the kept grammar does. */
+static ag_status load_kept_terminals(ag_grammar *g, const ag_terminal_set *terms, ag_error *err)
+{
+    ag_status s = AG_OK;
+    for (size_t i = 0; i < g->nterminals && s == AG_OK; i++) {
+        ag_gterminal *t = &g->terminals[i];
+        size_t k = 0;
+        while (k < terms->n && strcmp(terms->path[k], t->path))
+            k++;
+        s = k < terms->n ? ag_terminals_load_buffer(t, terms->obj[k], terms->len[k], err)
+                         : ag_error_set(err, AG_ERR_INTERNAL, 0,
+                                        "terminal '%s' was not collected", t->name);
+    }
+    return s;
+}
+
+ag_status ag_model_state_from_grammar_start(ag_grammar **grammar, size_t max_triangles,
+                                            ag_model_state_maker make, void *user,
+                                            ag_model_state *out, ag_error *err)
+{
+    memset(out, 0, sizeof *out);
+    ag_model_state_times *tm = &out->times;
+    ag_grammar *g = *grammar;
+    size_t max = max_triangles ? max_triangles : AG_GRAMMAR_MAX_TRIANGLES;
+    double t0 = ag_clock_ms();
+    ag_status s = ag_terminals_collect(g, &out->terms, err);
+    if (s == AG_OK)
+        s = load_kept_terminals(g, &out->terms, err);
+    if (s == AG_OK)
+        ag_grammar_text_round(g);
+    double t1 = ag_clock_ms();
+    tm->terminals_ms = t1 - t0;
+    ag_grammar_derive_options dopt = {.max_triangles = max};
+    if (s == AG_OK && (s = ag_grammar_derive(g, &dopt, &out->derived, err)) == AG_ERR_TOO_LARGE)
+        ag_error_set(err, s, 0, "the grammar derives more than %zu triangles", max);
+    t0 = ag_clock_ms();
+    tm->read_back_ms = t0 - t1;
+    if (s == AG_OK && !out->derived->ntris)
+        s = ag_error_set(err, AG_ERR_EMPTY, 0, "the grammar derives no geometry");
+    struct ag_model_state_check *c = s == AG_OK ? calloc(1, sizeof *c) : NULL;
+    if (c) { /* the check has the grammar to itself; it and the maker only read the derivation */
+        *c = (struct ag_model_state_check){
+            .grammar = g, .owned = g, .expect = out->derived, .max_triangles = max};
+        if (check_started(c, out))
+            *grammar = NULL;
+        else
+            free(c);
+    }
+    if (s == AG_OK && !out->check) { /* no thread: checked here, before the model is made */
+        struct ag_model_state_check here = {
+            .grammar = g, .expect = out->derived, .max_triangles = max, .out = out};
+        run_check(&here);
+        if ((s = here.status) != AG_OK && err)
+            *err = here.err;
+        tm->check_ms = here.ms;
+        t0 = ag_clock_ms();
+    }
+    if (s == AG_OK)
+        s = make ? make(user, out->derived, &out->em, err)
+                 : ag_model_state_reload(out->derived, &out->em, err);
+    tm->model_ms = ag_clock_ms() - t0;
     if (s != AG_OK)
         ag_model_state_clear(out);
     return s;

@@ -28,8 +28,10 @@
 typedef struct {
     double terminals_ms; /* the terminals collected with their OBJ text */
     double text_ms;      /* the grammar printed */
-    double read_back_ms; /* the text parsed, its terminals loaded and derived */
+    double read_back_ms; /* the text parsed, its terminals loaded and derived (a started
+                            state: the grammar itself derived, the text read back beside) */
     double model_ms;     /* the edit model made (the maker, or proceduralized) */
+    double check_ms;     /* a started state: the read-back check beside (once checked) */
 } ag_model_state_times;
 
 typedef struct {
@@ -91,6 +93,18 @@ typedef ag_status (*ag_model_state_maker)(void *user, const ag_mesh *derived, ag
 ag_status ag_model_state_from_grammar_ex(ag_grammar *g, size_t max_triangles,
                                          ag_model_state_maker make, void *user,
                                          ag_model_state *out, ag_error *err);
+
+/* ag_model_state_from_grammar_ex whose read-back runs beside the maker: g (its terminals
+ * given the geometry their kept text reads as) is derived at once and that derivation given
+ * to make, while a thread prints g, reads the text back and checks that it derives the same
+ * mesh, byte for byte (if not, the check is AG_ERR_INTERNAL naming what differs). The
+ * check takes *g (*g = NULL; it frees it; where no thread can start it runs first and *g
+ * stays the caller's). As for ag_model_state_start, text and terms are out's only after
+ * ag_model_state_checked says AG_OK, and out stays where it is until then; clearing out
+ * waits for the check. */
+ag_status ag_model_state_from_grammar_start(ag_grammar **g, size_t max_triangles,
+                                            ag_model_state_maker make, void *user,
+                                            ag_model_state *out, ag_error *err);
 
 /* OBJ text of the terminal kept under path: AG_OK with *obj malloc'd, AG_ERR_NOT_FOUND when
  * there is none. */

@@ -165,8 +165,10 @@ ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_par
      * numbered as that reload numbers it, so only one that keeps the tree takes the graft */
     int graft = !(ws->ops->state_flags & AG_MODEL_READ_BACK);
     graft_maker gm = {.model = em, .op = &p->op, .out = out};
-    s = over_budget(ag_model_state_from_grammar_ex(g, budget, graft ? make_grafted : NULL,
-                                                   &gm, st, err),
+    /* the maker takes the grammar's own derivation while its text is read back beside: the
+     * state is checked (ag_model_state_checked) before it is kept */
+    s = over_budget(ag_model_state_from_grammar_start(&g, budget, graft ? make_grafted : NULL,
+                                                      &gm, st, err),
                     budget, err);
     ag_grammar_free(g);
     out->state_ms = now_ms() - t0;

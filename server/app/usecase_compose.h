@@ -46,7 +46,9 @@ typedef struct {
 ag_status ag_usecase_compose_run(ag_workspace *ws, const ag_usecase_compose_params *p,
                                  ag_usecase_compose_result *out, ag_error *err);
 
-/* The composition without saving: *st receives the state the run would save (clear it). */
+/* The composition without saving: *st receives the state the run would save (clear it),
+ * its read-back check still running (app/model_state.h ag_model_state_from_grammar_start):
+ * its text and terms are its own once ag_model_state_checked says AG_OK. */
 ag_status ag_usecase_compose_make(ag_workspace *ws, const ag_usecase_compose_params *p,
                                   ag_model_state *st, ag_usecase_compose_result *out,
                                   ag_error *err);

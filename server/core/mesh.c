@@ -282,3 +282,23 @@ fail:
     ag_mesh_free(c);
     return NULL;
 }
+
+const char *ag_mesh_difference(const ag_mesh *a, const ag_mesh *b)
+{
+    if (a->nverts != b->nverts || a->ntris != b->ntris)
+        return "the vertex or triangle counts";
+    if (a->ncomponents != b->ncomponents || a->ngroups != b->ngroups)
+        return "the component or group counts";
+    if (a->nverts && memcmp(a->pos, b->pos, 3 * a->nverts * sizeof *a->pos))
+        return "the vertices";
+    if (a->ntris && (memcmp(a->tri, b->tri, 3 * a->ntris * sizeof *a->tri) ||
+                     memcmp(a->tri_component, b->tri_component, a->ntris * sizeof *a->tri_component)))
+        return "the triangles";
+    if (a->ncomponents && memcmp(a->component_group, b->component_group,
+               a->ncomponents * sizeof *a->component_group))
+        return "the components' groups";
+    for (size_t i = 0; i < a->ngroups; i++)
+        if (strcmp(a->group_names[i], b->group_names[i]))
+            return "the group names";
+    return "";
+}

@@ -63,4 +63,8 @@ void ag_mesh_compact_components(ag_mesh *m);
 /* Deep copy. */
 ag_mesh *ag_mesh_clone(const ag_mesh *m);
 
+/* Which part of two meshes differs, compared byte for byte (counts, vertices, triangles,
+ * components, group names): "" when they are the same. */
+const char *ag_mesh_difference(const ag_mesh *a, const ag_mesh *b);
+
 #endif

@@ -152,6 +152,46 @@ ag_status ag_grammar_text_print(const ag_grammar *g, char **out, size_t *len, ag
     return AG_OK;
 }
 
+/* v as its printed text reads back (num's digits through strtod, as number() reads them). */
+static void round_num(double *v, int n)
+{
+    char t[AG_NUMTEXT_MAX];
+    for (int i = 0; i < n; i++) {
+        ag_numtext_double_g(t, v[i], 12);
+        double x = strtod(t, NULL);
+        v[i] = x == 0 ? 0 : x; /* "-0" prints as 0 */
+    }
+}
+
+static void round_body(ag_grule *r)
+{
+    for (size_t i = 0; i < r->nstmts; i++) {
+        ag_gstmt *t = &r->stmts[i];
+        if (t->kind == AG_GSTMT_SPLIT)
+            round_num(t->v, 3);
+        else if (t->subdivide == 2)
+            for (int k = 0; k < t->nvec; k++)
+                round_num(t->vec[k], 3);
+        else if (t->subdivide)
+            round_num(t->step, 3);
+    }
+}
+
+void ag_grammar_text_round(ag_grammar *g)
+{
+    for (size_t i = 0; i < g->nterminals; i++)
+        round_num(g->terminals[i].size, 3);
+    for (size_t i = 0; i < g->nrules; i++) {
+        round_num(g->rules[i].size, 3);
+        round_body(&g->rules[i]);
+    }
+    if (g->has_axiom) {
+        round_num(g->axiom.box.min, 3);
+        round_num(g->axiom.box.max, 3);
+        round_body(&g->axiom);
+    }
+}
+
 /* ---- parsing ---------------------------------------------------------------------------- */
 
 enum { TK_EOF, TK_IDENT, TK_NUM, TK_STR, TK_PUNCT };

@@ -19,6 +19,10 @@ ag_status ag_grammar_text_parse(const char *text, size_t len, ag_grammar **out, 
 /* *out is malloc'd and NUL-terminated; *len excludes the NUL. */
 ag_status ag_grammar_text_print(const ag_grammar *g, char **out, size_t *len, ag_error *err);
 
+/* Sets every number of g to what its text reads back as (printed, then parsed), so that g
+ * derives what its printed text does. */
+void ag_grammar_text_round(ag_grammar *g);
+
 /* Reads a whole file (limit 64 MiB). */
 ag_status ag_grammar_text_read_file(const char *path, ag_grammar **out, ag_error *err, long *col);
 
