@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "core/mesh.h"
+#include "core/parts/part.h"
 #include "core/proc/proceduralize.h"
 #include "edit_fixture.h"
 #include "mesh_measure_fixture.h"
@@ -227,6 +228,29 @@ static inline int pf_inside(const ag_box *in, const ag_box *out, double tol)
 static inline int pf_same_box(const ag_box *x, const ag_box *y, double tol)
 {
     return pf_inside(x, y, tol) && pf_inside(y, x, tol);
+}
+
+/* The window `which` of building o saved as a part ("sash window" from "A"); *slot (may be
+ * NULL) gets the window's slot. */
+static inline ag_part *pf_window_part(const pf_options *o, int which, ag_box *slot)
+{
+    ag_box *slots;
+    size_t ns;
+    ag_mesh *m = pf_building(o, &slots, &ns);
+    ag_proceduralize_result *r = pf_proc(m);
+    int32_t node = pf_node_with_box(r, &slots[which], 1e-6);
+    assert_true(node > 0);
+    ag_part_meta meta = {.name = "sash window", .source = "A"};
+    ag_part *p = NULL;
+    ag_error err = {0};
+    if (ag_part_extract(r, node, &meta, &p, &err))
+        fail_msg("extract: %s", err.text);
+    if (slot)
+        *slot = slots[which];
+    free(slots);
+    ag_proceduralize_result_free(r);
+    ag_mesh_free(m);
+    return p;
 }
 
 /* Window design A (the part): 1.2 x 1.8, frame 0.08, one mullion. Design B (the target's):

@@ -23,26 +23,6 @@
 
 #define TOL 1e-6
 
-/* The window `which` of building a as a part. */
-static ag_part *window_part(const pf_options *a, int which)
-{
-    ag_box *slots;
-    size_t ns;
-    ag_mesh *m = pf_building(a, &slots, &ns);
-    ag_proceduralize_result *r = pf_proc(m);
-    int32_t node = pf_node_with_box(r, &slots[which], TOL);
-    assert_true(node > 0);
-    ag_part_meta meta = {.name = "sash window", .source = "A"};
-    ag_part *p = NULL;
-    ag_error err = {0};
-    if (ag_part_extract(r, node, &meta, &p, &err))
-        fail_msg("extract: %s", err.text);
-    free(slots);
-    ag_proceduralize_result_free(r);
-    ag_mesh_free(m);
-    return p;
-}
-
 /* The maker the store's composition uses: the part grafted into the model's tree, else the
  * derivation proceduralized. */
 typedef struct {
@@ -161,7 +141,7 @@ static void test_replace_node_and_rule(void **state)
 {
     (void)state;
     pf_options a = pf_design_a(PF_RECESSED, 0, 0, 0);
-    ag_part *part = window_part(&a, 0);
+    ag_part *part = pf_window_part(&a, 0, NULL);
     for (int turn = 0; turn < 4; turn += 3) {
         /* turned and far from the origin: the numbers need all their printed digits */
         pf_options b = pf_design_b(PF_RECESSED, turn, turn ? 512345.678 : 0,
@@ -177,7 +157,7 @@ static void test_insert_and_fill(void **state)
 {
     (void)state;
     pf_options a = pf_design_a(PF_FLUSH, 0, 0, 0), b = pf_design_b(PF_RECESSED, 0, 0, 0);
-    ag_part *part = window_part(&a, 2);
+    ag_part *part = pf_window_part(&a, 2, NULL);
     ag_box wall = back_wall(&b);
     compare_paths(&b, part, &wall, AG_COMPOSE_FILL, AG_COMPOSE_NODE);
     compare_paths(&b, part, &wall, AG_COMPOSE_INSERT, AG_COMPOSE_NODE);
@@ -209,7 +189,7 @@ static void test_text_that_does_not_read_back_is_refused(void **state)
 {
     (void)state;
     pf_options a = pf_design_a(PF_RECESSED, 0, 0, 0), b = pf_design_b(PF_RECESSED, 0, 0, 0);
-    ag_part *part = window_part(&a, 0);
+    ag_part *part = pf_window_part(&a, 0, NULL);
     for (int beside = 0; beside < 2; beside++) {
         ag_mesh *m;
         ag_grammar *g = composed(&b, part, &m);
@@ -242,7 +222,7 @@ static void test_clear_while_checking_and_budget(void **state)
 {
     (void)state;
     pf_options a = pf_design_a(PF_RECESSED, 0, 0, 0), b = pf_design_b(PF_RECESSED, 0, 0, 0);
-    ag_part *part = window_part(&a, 0);
+    ag_part *part = pf_window_part(&a, 0, NULL);
     ag_mesh *m;
     ag_grammar *g = composed(&b, part, &m);
     ag_model_state st;

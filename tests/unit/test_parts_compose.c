@@ -21,24 +21,16 @@
 
 static ag_part *save_window(const pf_options *o, int which)
 {
-    ag_box *slots;
-    size_t ns;
-    ag_mesh *m = pf_building(o, &slots, &ns);
-    ag_proceduralize_result *r = pf_proc(m);
-    int32_t node = pf_node_with_box(r, &slots[which], TOL);
-    assert_true(node > 0);
-    ag_part_meta meta = {.name = "sash window", .source = "A"};
-    ag_part *p = NULL;
+    ag_box slot;
+    ag_part *p = pf_window_part(o, which, &slot);
     ag_error err = {0};
-    if (ag_part_extract(r, node, &meta, &p, &err))
-        fail_msg("extract: %s", err.text);
     /* the part's grammar derives the window as it stood: 1 casing, 4 bars, glass, mullions */
     ag_mesh *d = NULL;
     assert_int_equal(ag_grammar_derive(p->grammar, NULL, &d, &err), AG_OK);
     ag_box *cb = pf_component_boxes(d);
     size_t inside = 0;
     for (size_t c = 0; c < d->ncomponents; c++)
-        inside += pf_inside(&cb[c], &slots[which], TOL);
+        inside += pf_inside(&cb[c], &slot, TOL);
     assert_int_equal(d->ncomponents, 6 + o->mullions);
     assert_int_equal(inside, d->ncomponents);
     free(cb);
@@ -51,9 +43,6 @@ static ag_part *save_window(const pf_options *o, int which)
     assert_int_equal(p->nodes[0].kind, AG_NODE_COMPONENT);
     for (int a = 0; a < 3; a++) /* the root spans the part's box */
         assert_true(p->nodes[0].box[a] == 0 && p->nodes[0].box[a + 3] == 1);
-    free(slots);
-    ag_proceduralize_result_free(r);
-    ag_mesh_free(m);
     return p;
 }
 
