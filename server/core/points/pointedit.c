@@ -163,7 +163,7 @@ static int32_t lookup_edit(void *user, const char *group, const double legs[3], 
  * then nothing is excluded, and the boxes alone decide). */
 static uint8_t *replaced_by(const ag_splittree *t, const ag_edit_op *op)
 {
-    int replaces = op->kind == AG_EDIT_REMOVE || op->kind == AG_EDIT_JOIN ||
+    int replaces = op->kind == AG_EDIT_REMOVE ||
                    (op->kind == AG_EDIT_PASTE && op->placement == AG_EDIT_REPLACE);
     if (!replaces || !t->nnodes)
         return NULL;
@@ -250,7 +250,12 @@ ag_status ag_pointedit_keep_ids(ag_pointmodel *made, const ag_pointmodel *before
     if (!made->em || !before || !before->em)
         return AG_OK;
     ag_edit_model *expected = NULL;
-    ag_status st = op ? expected_model(made, before, op, source, &expected, err) : AG_OK;
+    /* a join keeps its placements where they were (a point model has no joined terminal:
+     * lookup_edit reads a joined group back as its members), so they are matched where
+     * before had them, not at the union the tree edit gives the joined node */
+    ag_status st = op && op->kind != AG_EDIT_JOIN
+                       ? expected_model(made, before, op, source, &expected, err)
+                       : AG_OK;
     if (st)
         return st;
     /* matched against where the op put every node; without that, against before's boxes,
