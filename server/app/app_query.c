@@ -143,14 +143,19 @@ ag_status ag_app_query_job(ag_app *app, int64_t job, json_t **view, int *finishe
     return *view ? AG_OK : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
 }
 
-/* The served tree (malloc'd) of the model's current grammar g, in the numbering ops name: a
- * tree stored in an older one is rebuilt (loading the model's edit model) before it is
+/* What a reader makes of the served tree text: called while the text is valid, with the
+ * grammar row it belongs to (the text is not kept). */
+typedef ag_status (*served_reader)(void *user, const ag_grammar_row *g, const char *tree,
+                                   ag_error *err);
+
+/* The served tree of the model's current grammar g, handed to `read`, in the numbering ops
+ * name: a tree stored in an older one is rebuilt (loading the model's edit model) before it is
  * served, and a bare one (an edit's, app/model_kept.h) is printed from the model's edit model,
- * once per version (ag_edit_session_served). */
+ * once per version (ag_edit_session_served), and read in place there. On success g holds the
+ * row the tree was read from (the caller clears it). */
 static ag_status current_tree(ag_app *app, ag_db *db, int64_t id, ag_grammar_row *g,
-                              char **served, ag_error *err)
+                              served_reader read, void *user, ag_error *err)
 {
-    *served = NULL;
     /* a version that comes while the edit model is loaded is read again: at most a few */
     for (int tries = 0; tries < 4; tries++) {
         ag_status s = ag_grammars_current(db, id, 1, g, err);
@@ -158,10 +163,13 @@ static ag_status current_tree(ag_app *app, ag_db *db, int64_t id, ag_grammar_row
             return s;
         int renumber = g->tree_numbering != AG_MODEL_TREE_NUMBERING;
         if (!renumber && ag_model_kept_serves(g->tree_json)) {
-            if ((*served = ag_model_kept_served_text(g->tree_json)))
-                return AG_OK;
-            ag_grammars_row_clear(g);
-            return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            char *text = ag_model_kept_served_text(g->tree_json);
+            s = text ? read(user, g, text, err)
+                     : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+            free(text);
+            if (s != AG_OK)
+                ag_grammars_row_clear(g);
+            return s;
         }
         ag_store_env env;
         ag_edit_state *st = NULL;
@@ -171,13 +179,11 @@ static ag_status current_tree(ag_app *app, ag_db *db, int64_t id, ag_grammar_row
             return s;
         }
         const char *text = NULL;
-        if (!renumber && st->version == g->model_version) {
-            s = ag_edit_session_served(st, &text, err);
-            if (s == AG_OK && !(*served = strdup(text)))
-                s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        }
+        int current = !renumber && st->version == g->model_version;
+        if (current && (s = ag_edit_session_served(st, &text, err)) == AG_OK)
+            s = read(user, g, text, err);
         ag_edit_session_release(env.sessions, st);
-        if (s == AG_OK && *served)
+        if (s == AG_OK && current)
             return AG_OK;
         ag_grammars_row_clear(g); /* renumbered, or changed meanwhile: read again */
         if (s != AG_OK)
@@ -188,35 +194,47 @@ static ag_status current_tree(ag_app *app, ag_db *db, int64_t id, ag_grammar_row
                         (long long)id);
 }
 
+/* GET …/tree: the served tree, an object, with the model, its version and the summary in
+ * front of its members. */
+typedef struct {
+    int64_t id;
+    char *json;
+    size_t len;
+} tree_document;
+
+static ag_status tree_document_of(void *user, const ag_grammar_row *g, const char *tree,
+                                  ag_error *err)
+{
+    tree_document *d = user;
+    while (*tree == ' ')
+        tree++;
+    if (*tree != '{')
+        return ag_error_set(err, AG_ERR_INTERNAL, 0, "the stored split tree cannot be served");
+    int n = asprintf(&d->json, "{\"model\":%lld,\"version\":%lld,\"summary\":%s%s%s",
+                     (long long)d->id, (long long)g->model_version, g->summary_json,
+                     tree[1] == '}' ? "" : ",", tree + 1);
+    if (n < 0) {
+        d->json = NULL;
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    d->len = (size_t)n;
+    return AG_OK;
+}
+
 ag_status ag_app_query_tree(ag_app *app, int64_t id, char **json, size_t *len,
                             int64_t *version, ag_error *err)
 {
     *json = NULL;
     DB_OR_RETURN(db, app, err);
     ag_grammar_row g;
-    char *served = NULL;
-    ag_status s = current_tree(app, db, id, &g, &served, err);
+    tree_document d = {.id = id};
+    ag_status s = current_tree(app, db, id, &g, tree_document_of, &d, err);
     if (s != AG_OK)
         return s;
-    /* The served tree is an object; the model, its version and the summary go in front. */
-    const char *tree = served;
-    while (*tree == ' ')
-        tree++;
-    char *out = NULL;
-    int n = -1;
-    if (*tree == '{')
-        n = asprintf(&out, "{\"model\":%lld,\"version\":%lld,\"summary\":%s%s%s", (long long)id,
-                     (long long)g.model_version, g.summary_json, tree[1] == '}' ? "" : ",",
-                     tree + 1);
     *version = g.model_version;
     ag_grammars_row_clear(&g);
-    int is_object = *tree == '{';
-    free(served);
-    if (n < 0)
-        return ag_error_set(err, is_object ? AG_ERR_NOMEM : AG_ERR_INTERNAL, 0,
-                            "the stored split tree cannot be served");
-    *json = out;
-    *len = (size_t)n;
+    *json = d.json;
+    *len = d.len;
     return AG_OK;
 }
 
@@ -334,6 +352,18 @@ ag_status ag_app_query_plan(ag_app *app, int64_t id, json_t **doc, int64_t *vers
     return ag_error_set(err, AG_ERR_BUSY, 0, "the model kept changing while its plan was read");
 }
 
+/* mesh.glb: the served tree copied, read after the mesh is loaded. */
+static ag_status copy_served(void *user, const ag_grammar_row *g, const char *tree,
+                             ag_error *err)
+{
+    (void)g;
+    char **out = user;
+    free(*out); /* a version that came meanwhile: its tree replaces this one */
+    if (!(*out = strdup(tree)))
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    return AG_OK;
+}
+
 /* --- geometry ---------------------------------------------------------------------------- */
 
 static ag_status load_mesh(ag_db *db, int64_t blob_id, ag_mesh **mesh, ag_error *err)
@@ -392,7 +422,7 @@ ag_status ag_app_query_glb(ag_app *app, int64_t id, int (*fresh)(void *user, con
      * the mesh is then that version's) */
     char *served = NULL;
     if (proceduralized) {
-        if ((s = current_tree(app, db, id, &g, &served, err)) != AG_OK)
+        if ((s = current_tree(app, db, id, &g, copy_served, &served, err)) != AG_OK)
             return s;
         blob_id = g.mesh_blob;
         ag_grammars_row_clear(&g);
