@@ -360,11 +360,19 @@ ag_status ag_model_state_from_grammar_ex(ag_grammar *g, size_t max_triangles,
 static ag_status load_kept_terminals(ag_grammar *g, const ag_terminal_set *terms, ag_error *err)
 {
     ag_status s = AG_OK;
+    /* terms was collected from g in its order: each search starts where the last one ended,
+     * so a grammar's terminals are found in one pass, not one scan each */
+    size_t from = 0;
     for (size_t i = 0; i < g->nterminals && s == AG_OK; i++) {
         ag_gterminal *t = &g->terminals[i];
-        size_t k = 0;
-        while (k < terms->n && strcmp(terms->path[k], t->path))
-            k++;
+        size_t k = terms->n, tries = 0;
+        for (size_t j = from; tries < terms->n; tries++, j = j + 1 < terms->n ? j + 1 : 0)
+            if (!strcmp(terms->path[j], t->path)) {
+                k = j;
+                break;
+            }
+        if (k < terms->n)
+            from = k;
         s = k < terms->n ? ag_terminals_load_buffer(t, terms->obj[k], terms->len[k], err)
                          : ag_error_set(err, AG_ERR_INTERNAL, 0,
                                         "terminal '%s' was not collected", t->name);
