@@ -108,11 +108,22 @@ ag_status ag_mesh_add_component(ag_mesh *m, int32_t group, size_t *index)
 
 ag_box ag_mesh_bounds(const ag_mesh *m)
 {
+    /* ag_box_extend_point's comparisons (a NaN never wins either), in six scalars and
+     * without branches: every commit of an edit summarizes its mesh, twice as fast so */
     ag_box b = ag_box_empty();
+    double x0 = b.min[0], y0 = b.min[1], z0 = b.min[2], x1 = b.max[0], y1 = b.max[1],
+           z1 = b.max[2];
     size_t n = 3 * m->ntris;
-    for (size_t i = 0; i < n; i++)
-        ag_box_extend_point(&b, m->pos + 3 * (size_t)m->tri[i]);
-    return b;
+    for (size_t i = 0; i < n; i++) {
+        const double *p = m->pos + 3 * (size_t)m->tri[i];
+        x0 = p[0] < x0 ? p[0] : x0;
+        x1 = p[0] > x1 ? p[0] : x1;
+        y0 = p[1] < y0 ? p[1] : y0;
+        y1 = p[1] > y1 ? p[1] : y1;
+        z0 = p[2] < z0 ? p[2] : z0;
+        z1 = p[2] > z1 ? p[2] : z1;
+    }
+    return (ag_box){{x0, y0, z0}, {x1, y1, z1}};
 }
 
 void ag_mesh_component_triangle_counts(const ag_mesh *m, size_t *counts)
