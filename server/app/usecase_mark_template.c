@@ -33,7 +33,7 @@ ag_status ag_usecase_mark_template(ag_workspace *ws, int32_t segment, const doub
                                  "template_segment", (json_int_t)tm.template_segment, "label",
                                  (json_int_t)tm.label, "positions", (json_int_t)tm.positions,
                                  "copies", (json_int_t)tm.copies, "copy_boxes", copies,
-                                 "segments", (json_int_t)st.seg->nsegments, "labels",
+                                 "segments", (json_int_t)ag_segment_cloud_in_use(st.seg), "labels",
                                  (json_int_t)st.seg->nlabels, "seconds",
                                  ag_clock_seconds() - t0)
                      : NULL;
