@@ -76,8 +76,8 @@ json_t *ag_cloud_state_segmentation(const ag_segment_cloud_result *r, int with_r
     return j;
 }
 
-static const char *const FIGURES[] = {"segments", "planes", "clusters", "pieces", "labels",
-                                      "unsegmented", NULL};
+static const char *const FIGURES[] = {"segments", "segment_ids", "planes", "clusters", "pieces",
+                                      "labels", "unsegmented", NULL};
 
 json_t *ag_cloud_state_stats_segmented(json_t *stats, const json_t *seg)
 {

@@ -39,8 +39,11 @@ export class CloudEditor {
     // {model, points, shown, budget, offset, segmented, segments, labels} of what is on screen
     this.info = null;
     editor.signals.modelOpened.add(() => this.reset());
-    // segments are renumbered by every segmentation: a picked id would name another segment
-    editor.signals.pointsChanged.add(() => this.setSegment(null));
+    // ROI refinement and template marking keep every segment's id (a segment they empty is
+    // gone, its id unused); a new segmentation numbers afresh: a picked id would name another
+    editor.signals.pointsChanged.add((model, kind) => {
+      if (kind !== OP.segment_roi && kind !== OP.mark_template) this.setSegment(null);
+    });
   }
 
   get active() {
