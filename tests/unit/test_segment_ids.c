@@ -5,7 +5,8 @@
  * points inside. After template marking every point outside the template and its copies
  * keeps its segment, every segment keeps its label, and the template and its copies get the
  * ids and the label after all there were. A read-back with each id's kind is the same
- * segmentation, id for id. */
+ * segmentation, id for id. The point pipeline with an ROI that empties segments (their ids
+ * unused) still builds its model from every segment with points. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -17,6 +18,7 @@
 #include <string.h>
 
 #include "core/points/gen_building.h"
+#include "core/points/proceduralize_cloud.h"
 #include "core/points/segment_cloud.h"
 #include "core/points/template_mark.h"
 
@@ -253,11 +255,47 @@ static void template_marking_keeps_every_id_and_label(void **state)
     ag_cloud_free(c);
 }
 
+static void the_pipeline_takes_unused_ids(void **state)
+{
+    (void)state;
+    ag_gen_building_options go = {.points = 40000, .seed = 9};
+    ag_cloud *c;
+    ag_error e;
+    assert_int_equal(ag_gen_building(&go, &c, &e), AG_OK);
+    const int32_t *window = ag_cloud_find(c, "window")->values;
+    /* the ROI: window 7 and a little wall around it, so its reveals are wholly inside */
+    ag_box roi = ag_box_empty();
+    for (size_t i = 0; i < c->n; i++)
+        if (window[i] == 7)
+            ag_box_extend_point(&roi, c->xyz + 3 * i);
+    for (int a = 0; a < 3; a++) {
+        roi.min[a] -= 0.3;
+        roi.max[a] += 0.3;
+    }
+    ag_proceduralize_cloud_options o = {.rois = &roi, .nrois = 1};
+    ag_proceduralize_cloud_result *r;
+    if (ag_proceduralize_cloud_run(c, &o, &r, &e) != AG_OK)
+        fail_msg("%s", e.text);
+    size_t unused = 0, used = 0;
+    for (size_t s = 0; s < r->seg->nsegments; s++) {
+        if (r->seg->segments[s].count)
+            used++;
+        else
+            unused += r->seg->segments[s].label == -1;
+    }
+    assert_true(unused > 0); /* the ROI emptied segments, and their ids stayed unused */
+    assert_int_equal(ag_segment_cloud_in_use(r->seg), used);
+    assert_true(r->model->nplacements > 0);
+    ag_proceduralize_cloud_free(r);
+    ag_cloud_free(c);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(roi_refinement_keeps_the_ids_outside),
         cmocka_unit_test(template_marking_keeps_every_id_and_label),
+        cmocka_unit_test(the_pipeline_takes_unused_ids),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
