@@ -405,6 +405,12 @@ describe('point clouds in the service', () => {
         }
       }
       assert.ok(inside > 0);
+      // the GLB's figures are the segments with points and the ids, as the report's
+      const extras = parseGlb((await http(d, 'GET', `/api/v1/models/${id}/points.glb?budget=100`)).body).json.nodes[0].extras;
+      assert.equal(extras.segments, r1.op.report.segments);
+      assert.equal(extras.segment_ids, ids1);
+      assert.equal(extras.segments, new Set(s1.props.segment.filter((s) => s >= 0)).size);
+
       // template: the wall around the window at column 1, row 1 (the wall kept its id); its
       // copies are the other windows
       const t = await send(A, 'tmpl-1', { kind: 'mark_template', segment: wall, box: around(1, 1, 1.2, 1.35, 0.5) });
