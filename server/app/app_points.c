@@ -45,6 +45,26 @@ static ag_status read_points(ag_db *db, int64_t id, unsigned what, const char *c
     return s;
 }
 
+/* Segments with points (ids below seg->nsegments may be unused: segment_cloud.h). */
+static size_t segments_in_use(const ag_pointcloud_segmentation *seg)
+{
+    uint8_t *seen = calloc(seg->nsegments + 1, 1);
+    if (!seen || !seg->segment) {
+        free(seen);
+        return seg->nsegments; /* out of memory: the ids, an upper bound */
+    }
+    size_t used = 0;
+    for (size_t i = 0; i < seg->n; i++) {
+        int32_t sg = seg->segment[i];
+        if (sg >= 0 && (size_t)sg < seg->nsegments && !seen[sg]) {
+            seen[sg] = 1;
+            used++;
+        }
+    }
+    free(seen);
+    return used;
+}
+
 /* The ETag of what a read shows: the points never change, the segmentation has its id, the
  * normals come once. */
 static void etag_of(char *buf, size_t len, const char *what, const ag_pointcloud_info *info,
@@ -200,12 +220,13 @@ ag_status ag_app_points_glb(ag_app *app, int64_t id, size_t budget,
                 ca[i] = (float)ag_cloud_get(cls, order[i]);
             attrs[nattrs++] = (ag_points_glb_attribute){"_CLASSIFICATION", ca};
         }
-        extras = json_pack("{s:I, s:I, s:I, s:I, s:[f,f,f], s:b, s:I, s:I}", "model",
+        extras = json_pack("{s:I, s:I, s:I, s:I, s:[f,f,f], s:b, s:I, s:I, s:I}", "model",
                            (json_int_t)id, "points", (json_int_t)info.points, "shown",
                            (json_int_t)k, "budget", (json_int_t)budget, "offset",
                            info.offset[0], info.offset[1], info.offset[2], "segmented",
-                           seg.segment != NULL, "segments", (json_int_t)seg.nsegments,
-                           "labels", (json_int_t)seg.nlabels);
+                           seg.segment != NULL, "segments", (json_int_t)segments_in_use(&seg),
+                           "segment_ids", (json_int_t)seg.nsegments, "labels",
+                           (json_int_t)seg.nlabels);
         if (!extras)
             s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }

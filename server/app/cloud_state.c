@@ -46,14 +46,20 @@ json_t *ag_cloud_state_segmentation(const ag_segment_cloud_result *r, int with_r
     for (size_t i = 0; i < r->n; i++)
         none += r->segment[i] < 0;
     json_t *j = json_pack("{s:I, s:I, s:I, s:I, s:I, s:I, s:I, s:f, s:f}", "points",
-                          (json_int_t)r->n, "segments", (json_int_t)r->nsegments, "planes",
+                          (json_int_t)r->n, "segments", (json_int_t)ag_segment_cloud_in_use(r),
+                          "planes",
                           (json_int_t)r->nplanes, "clusters", (json_int_t)r->nclusters,
                           "pieces", (json_int_t)r->npieces, "labels", (json_int_t)r->nlabels,
                           "unsegmented", (json_int_t)none, "diagonal",
                           isfinite(r->diagonal) ? r->diagonal : 0.0, "spacing",
                           isfinite(r->spacing) ? r->spacing : 0.0);
-    if (!j || !with_run)
+    if (!j)
+        return NULL;
+    /* ids below it may be in use; the next new segment gets it */
+    json_object_set_new(j, "segment_ids", json_integer((json_int_t)r->nsegments));
+    if (!with_run)
         return j;
+
     json_object_set_new(j, "coarse_threshold", json_real(r->coarse_threshold));
     json_object_set_new(j, "fine_threshold", json_real(r->fine_threshold));
     json_object_set_new(j, "cluster_tolerance", json_real(r->cluster_tolerance));
@@ -70,8 +76,8 @@ json_t *ag_cloud_state_segmentation(const ag_segment_cloud_result *r, int with_r
     return j;
 }
 
-static const char *const FIGURES[] = {"segments", "planes", "clusters", "pieces", "labels",
-                                      "unsegmented", NULL};
+static const char *const FIGURES[] = {"segments", "segment_ids", "planes", "clusters", "pieces",
+                                      "labels", "unsegmented", NULL};
 
 json_t *ag_cloud_state_stats_segmented(json_t *stats, const json_t *seg)
 {

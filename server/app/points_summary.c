@@ -90,7 +90,7 @@ json_t *ag_points_summary_proc(const ag_points_state *st, const ag_points_outcom
     json_object_set_new(j, "segment_seconds", segs);
 
     json_t *js = json_object();
-    json_object_set_new(js, "segments", json_integer((json_int_t)sg->nsegments));
+    json_object_set_new(js, "segments", json_integer((json_int_t)ag_segment_cloud_in_use(sg)));
     json_object_set_new(js, "planes", json_integer((json_int_t)sg->nplanes));
     json_object_set_new(js, "clusters", json_integer((json_int_t)sg->nclusters));
     json_object_set_new(js, "elements", json_integer((json_int_t)sg->nelements));

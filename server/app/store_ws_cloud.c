@@ -120,6 +120,8 @@ static ag_status read_cloud(ag_store_ws *w, int with_properties, int need_segmen
                                 .piece = seg.piece,
                                 .nsegments = seg.nsegments,
                                 .nplanes = seg.nplanes,
+                                .kind = seg.kind,
+                                .nlabels = seg.nlabels,
                                 .npieces = seg.npieces,
                                 .spacing = seg.spacing};
     s = ag_segment_cloud_restore(st->cloud, &ids, &st->seg, err);

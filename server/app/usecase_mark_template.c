@@ -33,10 +33,12 @@ ag_status ag_usecase_mark_template(ag_workspace *ws, int32_t segment, const doub
                                  "template_segment", (json_int_t)tm.template_segment, "label",
                                  (json_int_t)tm.label, "positions", (json_int_t)tm.positions,
                                  "copies", (json_int_t)tm.copies, "copy_boxes", copies,
-                                 "segments", (json_int_t)st.seg->nsegments, "labels",
+                                 "segments", (json_int_t)ag_segment_cloud_in_use(st.seg), "labels",
                                  (json_int_t)st.seg->nlabels, "seconds",
                                  ag_clock_seconds() - t0)
                      : NULL;
+        if (rep) /* ids below it may be in use; the next new segment gets it */
+            json_object_set_new(rep, "segment_ids", json_integer((json_int_t)st.seg->nsegments));
         s = rep ? ag_workspace_save_segmentation(
                       ws, &st, &(ag_segment_outcome){"mark_template", rep}, err)
                 : ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");

@@ -82,7 +82,7 @@ ag_status ag_usecase_points_proceduralize_run(ag_workspace *ws,
         goto done;
     }
     const ag_segment_cloud_result *sg = r->seg;
-    out->segments = sg->nsegments;
+    out->segments = ag_segment_cloud_in_use(sg);
     out->planes = sg->nplanes;
     out->clusters = sg->nclusters;
     out->elements = sg->nelements;

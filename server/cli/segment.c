@@ -184,7 +184,7 @@ int ag_cli_segment(int argc, char **argv)
         if (as_json) {
             json_t *j = json_object(), *sec = json_object();
             json_object_set_new(j, "points", json_integer((json_int_t)r->n));
-            json_object_set_new(j, "segments", json_integer((json_int_t)r->nsegments));
+            json_object_set_new(j, "segments", json_integer((json_int_t)ag_segment_cloud_in_use(r)));
             json_object_set_new(j, "planes", json_integer((json_int_t)r->nplanes));
             json_object_set_new(j, "clusters", json_integer((json_int_t)r->nclusters));
             json_object_set_new(j, "pieces", json_integer((json_int_t)r->npieces));

@@ -386,6 +386,7 @@ void ag_pointcloud_segmentation_clear(ag_pointcloud_segmentation *s)
     free(s->segment);
     free(s->label);
     free(s->piece);
+    free(s->kind);
     free(s->summary_json);
     memset(s, 0, sizeof *s);
 }
@@ -426,13 +427,20 @@ ag_status ag_pointclouds_put_segmentation(ag_db *db, int64_t model, int64_t vers
     if (r->npieces > most)
         most = r->npieces;
     unsigned width = ag_cloudblob_id_width((int64_t)most);
+    uint8_t *kinds = malloc(r->nsegments + 1); /* each id's kind (migration 0012) */
+    if (!kinds)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory storing a segmentation");
+    for (size_t k = 0; k < r->nsegments; k++)
+        kinds[k] = (uint8_t)r->segments[k].kind;
     sqlite3_stmt *st;
     if ((s = ag_db_prepared(db, &st,
                             "INSERT INTO pointcloud_segmentations (model_id, version, segments, "
-                            "planes, pieces, labels, spacing, id_width, summary) "
-                            "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                            err)) != AG_OK)
+                            "planes, pieces, labels, spacing, id_width, summary, kinds) "
+                            "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                            err)) != AG_OK) {
+        free(kinds);
         return s;
+    }
     sqlite3_bind_int64(st, 1, model);
     sqlite3_bind_int64(st, 2, version);
     sqlite3_bind_int64(st, 3, (sqlite3_int64)r->nsegments);
@@ -442,7 +450,10 @@ ag_status ag_pointclouds_put_segmentation(ag_db *db, int64_t model, int64_t vers
     sqlite3_bind_double(st, 7, r->spacing);
     sqlite3_bind_int(st, 8, (int)width);
     sqlite3_bind_text(st, 9, summary_json ? summary_json : "{}", -1, SQLITE_STATIC);
-    if ((s = ag_db_step_done(db, st, "storing a segmentation", err)) != AG_OK)
+    sqlite3_bind_blob64(st, 10, kinds, r->nsegments, SQLITE_STATIC);
+    s = ag_db_step_done(db, st, "storing a segmentation", err);
+    free(kinds);
+    if (s != AG_OK)
         return s;
     int64_t id = sqlite3_last_insert_rowid(ag_db_handle(db));
     size_t chunk = info.chunk_points;
@@ -510,7 +521,8 @@ ag_status ag_pointclouds_get_segmentation(ag_db *db, const ag_pointcloud_info *i
     sqlite3_stmt *st;
     ag_status s = ag_db_prepared(db, &st,
                                  "SELECT version, segments, planes, pieces, labels, spacing, "
-                                 "id_width, summary FROM pointcloud_segmentations WHERE id = ?",
+                                 "id_width, summary, kinds FROM pointcloud_segmentations "
+                                 "WHERE id = ?",
                                  err);
     if (s != AG_OK)
         return s;
@@ -529,8 +541,21 @@ ag_status ag_pointclouds_get_segmentation(ag_db *db, const ag_pointcloud_info *i
         out->spacing = sqlite3_column_double(st, 5);
         width = (unsigned)sqlite3_column_int(st, 6);
         out->summary_json = ag_db_column_dup(st, 7, NULL, &nomem);
+        if (sqlite3_column_type(st, 8) != SQLITE_NULL) { /* NULL: stored before 0012 */
+            const void *k = sqlite3_column_blob(st, 8);
+            size_t len = (size_t)sqlite3_column_bytes(st, 8);
+            if (len != out->nsegments)
+                s = ag_error_set(err, AG_ERR_INTERNAL, 0,
+                                 "segmentation %lld has %zu kinds for %zu segments",
+                                 (long long)info->segmentation, len, out->nsegments);
+            else if (!(out->kind = malloc(len + 1)))
+                nomem = 1;
+            else if (len)
+                memcpy(out->kind, k, len);
+        }
         if (nomem)
             s = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+
     } else if (rc == SQLITE_DONE) {
         s = ag_error_set(err, AG_ERR_NOT_FOUND, 0, "model %lld is not segmented",
                          (long long)info->model);

@@ -70,7 +70,10 @@ typedef struct {
     int64_t version; /* the model version that made it */
     size_t n;
     int32_t *segment, *label, *piece; /* n each, malloc'd */
+    uint8_t *kind; /* nsegments (each id's ag_segment_cloud_kind), malloc'd; NULL for one
+                    * stored before migration 0012: the ids below nplanes are planes */
     size_t nsegments, nplanes, npieces, nlabels;
+
     double spacing;
     char *summary_json; /* malloc'd */
 } ag_pointcloud_segmentation;

@@ -390,18 +390,33 @@ describe('point clouds in the service', () => {
         const v = [s1.props.x, s1.props.y, s1.props.z][k][i] + so[k] - off[k];
         return v >= roi[k] - 1e-6 && v <= roi[3 + k] + 1e-6;
       });
-      // outside the box every point keeps the segment it shared with the others
-      const map = new Map();
+      // outside the box every point keeps its segment id; inside, the new segments have ids
+      // after every id there was
+      const ids0 = r1.op.report.segments_before, ids1 = r1.op.report.segment_ids;
+      assert.equal(ids0, Math.max(...s0.props.segment) + 1);
+      assert.ok(ids1 > ids0, JSON.stringify(r1.op.report));
+      let inside = 0;
       for (let i = 0; i < s1.n; i++) {
-        if (inBox(i) || s0.props.segment[i] < 0) continue;
-        const was = s0.props.segment[i], now = s1.props.segment[i];
-        if (!map.has(was)) map.set(was, now);
-        assert.equal(map.get(was), now, `point ${i} outside the box changed segment`);
+        if (!inBox(i)) {
+          assert.equal(s1.props.segment[i], s0.props.segment[i], `point ${i} outside the box changed segment`);
+        } else if (s1.props.segment[i] >= 0) {
+          assert.ok(s1.props.segment[i] >= ids0, `point ${i} inside the box is in old segment ${s1.props.segment[i]}`);
+          inside++;
+        }
       }
-      // template: the wall around the window at column 1, row 1; its copies are the other windows
-      const wall1 = s1.props.segment[s0.props.segment.indexOf(wall)];
-      const t = await send(A, 'tmpl-1', { kind: 'mark_template', segment: wall1, box: around(1, 1, 1.2, 1.35, 0.5) });
+      assert.ok(inside > 0);
+      // the GLB's figures are the segments with points and the ids, as the report's
+      const extras = parseGlb((await http(d, 'GET', `/api/v1/models/${id}/points.glb?budget=100`)).body).json.nodes[0].extras;
+      assert.equal(extras.segments, r1.op.report.segments);
+      assert.equal(extras.segment_ids, ids1);
+      assert.equal(extras.segments, new Set(s1.props.segment.filter((s) => s >= 0)).size);
+
+      // template: the wall around the window at column 1, row 1 (the wall kept its id); its
+      // copies are the other windows
+      const t = await send(A, 'tmpl-1', { kind: 'mark_template', segment: wall, box: around(1, 1, 1.2, 1.35, 0.5) });
       const rep = t.op.report;
+      assert.equal(rep.template_segment, ids1); // the next id, read back from the store's ids
+
       assert.ok(rep.copies >= 13, JSON.stringify(rep));
       const hit = new Set();
       for (const cb of rep.copy_boxes) {
@@ -421,6 +436,19 @@ describe('point clouds in the service', () => {
       const labelled = new Set();
       for (let i = 0; i < s2.n; i++) if (s2.props.label[i] === rep.label) labelled.add(s2.props.segment[i]);
       assert.equal(labelled.size, rep.copies + 1);
+      // every other point keeps its segment and its label; the marked ones have the new ids
+      const label1 = new Map();
+      for (let i = 0; i < s1.n; i++) if (s1.props.segment[i] >= 0) label1.set(s1.props.segment[i], s1.props.label[i]);
+      for (let i = 0; i < s2.n; i++) {
+        if (s2.props.segment[i] >= ids1) {
+          assert.equal(s1.props.segment[i], wall, `point ${i} came to the template from segment ${s1.props.segment[i]}`);
+          assert.equal(s2.props.label[i], rep.label);
+        } else {
+          assert.equal(s2.props.segment[i], s1.props.segment[i], `point ${i} changed segment`);
+          if (s2.props.segment[i] >= 0 && s2.props.segment[i] !== wall) assert.equal(s2.props.label[i], label1.get(s2.props.segment[i]), `the label of segment ${s2.props.segment[i]}`);
+        }
+      }
+
       console.log(`# template marking through the service: ${rep.copies} copies of ${rep.template_points} points from ${rep.positions} positions`);
       // the log has both, with their reports
       const log = (await http(d, 'GET', `/api/v1/models/${id}/ops`)).json.items;

@@ -8,9 +8,14 @@
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
 import { http, removeDir, startDaemon, tempDir, waitJob, WsClient } from './harness.js';
+import { parsePly } from './clouds.js';
 import { buildingPly, glassOf, ORIGIN, windowBox } from './points_building.js';
 
 const box6 = (s) => s.split(',').map(Number);
+const offsetOf = (ply) => {
+  const c = ply.comments.find((x) => x.startsWith('offset'));
+  return c ? c.split(' ').slice(1).map(Number) : [0, 0, 0];
+};
 const near = (a, b, eps = 1e-6) => a.length === b.length && a.every((v, i) => Math.abs(v - b[i]) <= eps);
 
 // Every component of `before` but those in `gone` is at its id in `after` with its kind and box.
@@ -156,6 +161,99 @@ describe('point model edits keep node ids', () => {
       assert.ok(m.box.every((v, i) => Math.abs(v - n.box[i]) <= 1.001), `node ${n.id} went from ${JSON.stringify(n.box)} to ${JSON.stringify(m.box)}`);
     }
     assert.equal(components(t5), components(t4));
+  });
+});
+
+// A cloud's segment ids (issue 14 §4, before any proceduralization): segment_roi keeps the id
+// of every segment with points outside its box, a restart serves the same ids from the store
+// (each id's kind with them), and a mark_template after it keeps every id and label, its
+// template at the next id; undo brings the ids before it back.
+describe('cloud segment ids survive segment_roi, a restart and mark_template', () => {
+  let d;
+  let id;
+  const dir = tempDir();
+  before(async () => {
+    d = await startDaemon({ dir });
+  });
+  after(async () => {
+    if (d) { try { await d.stop(); } finally { await d.kill(); } }
+    removeDir(dir);
+  });
+  const op = async (body, cid) => {
+    const v = (await http(d, 'GET', `/api/v1/models/${id}`)).json.version;
+    const r = await http(d, 'POST', `/api/v1/models/${id}/ops`, { body: { op: body, cid }, headers: { 'If-Match': `"${v}"` }, timeout: 120000 });
+    assert.equal(r.status, 200, r.text.slice(0, 400));
+    return r.json;
+  };
+  const ply = async () => {
+    const r = await http(d, 'GET', `/api/v1/models/${id}/points.ply`, { timeout: 60000 });
+    assert.equal(r.status, 200, r.text.slice(0, 300));
+    return parsePly(r.body);
+  };
+  const logged = async (kind) => (await http(d, 'GET', `/api/v1/models/${id}/ops`)).json.items.filter((e) => e.op.kind === kind).at(-1);
+
+  it('keeps every id', async () => {
+    const q = new URLSearchParams({ name: 'house', format: 'ply' });
+    const up = await http(d, 'POST', `/api/v1/models?${q}`, { body: buildingPly(60000).bytes, headers: { 'Content-Type': 'application/octet-stream' }, timeout: 120000 });
+    assert.equal(up.status, 202, up.text);
+    id = (await waitJob(d, up.json.id, { timeout: 120000 })).result.model;
+    const sj = await http(d, 'POST', `/api/v1/models/${id}/segment`, { body: {} });
+    assert.equal(sj.status, 202, sj.text);
+    assert.equal((await waitJob(d, sj.json.id, { timeout: 120000 })).status, 'succeeded');
+    const off = (await http(d, 'GET', `/api/v1/models/${id}`)).json.stats.offset;
+    const local = (b) => box6(b).map((v, k) => v - off[k % 3]);
+    const s0 = await ply();
+    const at = (s, i) => [s.props.x[i], s.props.y[i], s.props.z[i]].map((v, k) => v + offsetOf(s)[k] - off[k]);
+    const inside = (b, s, i) => at(s, i).every((v, k) => v >= b[k] - 1e-6 && v <= b[3 + k] + 1e-6);
+    // the front wall: the segment most of the points at y = 0 are in
+    const count = new Map();
+    for (let i = 0; i < s0.n; i++) {
+      const s = s0.props.segment[i];
+      if (s >= 0 && Math.abs(at(s0, i)[1] - (ORIGIN[1] - off[1])) < 0.01) count.set(s, (count.get(s) ?? 0) + 1);
+    }
+    const wall = [...count.entries()].sort((a, b) => b[1] - a[1])[0][0];
+    // ROI: window 7 and the wall around it, finer
+    const roi = local(windowBox(7, 0.6));
+    await op({ kind: 'segment_roi', box: roi, threshold: 0.005 }, 'roi');
+    const r1 = (await logged('segment_roi')).op.report;
+    assert.equal(r1.segments_before, Math.max(...s0.props.segment) + 1);
+    const s1 = await ply();
+    let fresh = 0;
+    for (let i = 0; i < s1.n; i++) {
+      if (!inside(roi, s1, i)) assert.equal(s1.props.segment[i], s0.props.segment[i], `point ${i} outside the ROI changed segment`);
+      else if (s1.props.segment[i] >= 0) { assert.ok(s1.props.segment[i] >= r1.segments_before, `point ${i} inside the ROI is in old segment ${s1.props.segment[i]}`); fresh++; }
+    }
+    assert.ok(fresh > 0, 'the ROI made new segments');
+    // a restart serves the same ids and labels
+    await d.stop();
+    d = await startDaemon({ dir, db: d.db });
+    const s1b = await ply();
+    assert.deepEqual(s1b.props.segment, s1.props.segment);
+    assert.deepEqual(s1b.props.label, s1.props.label);
+    // a template on the wall around window 1, by the wall's id from before the ROI
+    const rep = (await op({ kind: 'mark_template', segment: wall, box: local(windowBox(1, 0.5)) }, 'tmpl')).report ?? (await logged('mark_template')).op.report;
+    assert.equal(rep.template_segment, r1.segment_ids, JSON.stringify(rep));
+    assert.ok(rep.copies >= 1, JSON.stringify(rep));
+    const s2 = await ply();
+    const label1 = new Map();
+    for (let i = 0; i < s1.n; i++) if (s1.props.segment[i] >= 0) label1.set(s1.props.segment[i], s1.props.label[i]);
+    let marked = 0;
+    for (let i = 0; i < s2.n; i++) {
+      const s = s2.props.segment[i];
+      if (s >= r1.segment_ids) {
+        assert.equal(s1.props.segment[i], wall, `point ${i} of the template or a copy was not the wall's`);
+        assert.equal(s2.props.label[i], rep.label);
+        marked++;
+      } else {
+        assert.equal(s, s1.props.segment[i], `point ${i} changed segment`);
+        if (s >= 0 && s !== wall) assert.equal(s2.props.label[i], label1.get(s), `segment ${s} changed label`);
+      }
+    }
+    assert.ok(marked >= rep.template_points);
+    console.log(`# cloud segment ids: ROI ${r1.segments_before} → ${r1.segment_ids} ids (${r1.segments} segments), kept outside it, over a restart and a template with ${rep.copies} copies`);
+    // undo brings the ids of before the template back
+    await op({ kind: 'undo' }, 'undo-tmpl');
+    assert.deepEqual((await ply()).props.segment, s1.props.segment);
   });
 });
 

@@ -129,7 +129,8 @@ static void clouds_come_back_in_every_chunking(void **state)
     }
 }
 
-/* A segmentation of n points with s segments (the first half planes). */
+/* A segmentation of n points with s segments (the second half planes: planes need not be
+ * the first ids). */
 static ag_segment_cloud_result *fake_segmentation(size_t n, size_t s, int shift)
 {
     ag_segment_cloud_result *r = calloc(1, sizeof *r);
@@ -145,6 +146,9 @@ static ag_segment_cloud_result *fake_segmentation(size_t n, size_t s, int shift)
     }
     r->nsegments = s;
     r->nplanes = s / 2;
+    r->segments = calloc(s, sizeof *r->segments);
+    for (size_t k = 0; k < s; k++)
+        r->segments[k].kind = k >= s - s / 2 ? AG_SEGMENT_CLOUD_PLANE : AG_SEGMENT_CLOUD_CLUSTERED;
     r->npieces = 2 * s;
     r->nlabels = (s + 2) / 3;
     r->spacing = 0.125;
@@ -181,7 +185,11 @@ static void assert_current(ag_db *db, int64_t model, const ag_segment_cloud_resu
     assert_memory_equal(s.segment, want->segment, want->n * sizeof(int32_t));
     assert_memory_equal(s.label, want->label, want->n * sizeof(int32_t));
     assert_memory_equal(s.piece, want->piece, want->n * sizeof(int32_t));
+    assert_non_null(s.kind); /* each id's kind */
+    for (size_t k = 0; k < want->nsegments; k++)
+        assert_int_equal(s.kind[k], want->segments[k].kind);
     ag_pointcloud_segmentation_clear(&s);
+
 }
 
 static void keep(ag_db *db, int64_t model, int64_t version)
@@ -291,6 +299,42 @@ static void a_segmentation_of_another_cloud_is_refused(void **state)
     close_temp_db(db, path);
 }
 
+/* A segmentation stored before each id had its kind (migration 0012: kinds NULL) reads back
+ * without kinds, for the reader to take the ids below planes as the planes; kinds that do
+ * not cover every id are refused by the schema. */
+static void a_segmentation_stored_before_kinds_reads_without_them(void **state)
+{
+    (void)state;
+    char *path;
+    ag_db *db = open_temp_db(&path);
+    ag_cloud *c = make_cloud(60, 2);
+    uint32_t lod[60];
+    int64_t model = a_model(db, "pointcloud");
+    put_cloud(db, model, c, 0, lod);
+    ag_segment_cloud_result *r = fake_segmentation(60, 6, 1);
+    put_seg(db, model, 1, r);
+    sqlite3 *h = ag_db_handle(db);
+    assert_int_equal(sqlite3_exec(h, "UPDATE pointcloud_segmentations SET kinds = x'0001'",
+                                  NULL, NULL, NULL) & 0xff,
+                     SQLITE_CONSTRAINT);
+    assert_int_equal(sqlite3_exec(h, "UPDATE pointcloud_segmentations SET kinds = NULL", NULL,
+                                  NULL, NULL),
+                     SQLITE_OK);
+    ag_pointcloud_info info;
+    ag_pointcloud_segmentation s;
+    ag_error err;
+    assert_int_equal(ag_pointclouds_info(db, model, &info, &err), AG_OK);
+    assert_int_equal(ag_pointclouds_get_segmentation(db, &info, 1, &s, &err), AG_OK);
+    assert_null(s.kind);
+    assert_int_equal(s.nsegments, 6);
+    assert_int_equal(s.nplanes, 3);
+    assert_memory_equal(s.segment, r->segment, 60 * sizeof(int32_t));
+    ag_pointcloud_segmentation_clear(&s);
+    ag_segment_cloud_free(r);
+    ag_cloud_free(c);
+    close_temp_db(db, path);
+}
+
 /* A point grammar saved as a new version, with the terminals it brings, and its state kept. */
 static int64_t save_points(ag_db *db, int64_t model, int64_t base, const char *text,
                            const char *const *paths)
@@ -381,6 +425,8 @@ int main(void)
         cmocka_unit_test(clouds_come_back_in_every_chunking),
         cmocka_unit_test(segmentations_follow_the_states),
         cmocka_unit_test(a_segmentation_of_another_cloud_is_refused),
+        cmocka_unit_test(a_segmentation_stored_before_kinds_reads_without_them),
+
         cmocka_unit_test(terminals_go_when_no_version_names_them),
     };
     return cmocka_run_group_tests_name("pointclouds_store", tests, NULL, NULL);

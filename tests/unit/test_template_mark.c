@@ -200,10 +200,21 @@ static void bad_marks_are_refused(void **state)
     assert_int_equal(ag_template_mark(c, &r, 0, far_lo, far_hi, &rep, &e), AG_ERR_INVALID);
     assert_non_null(strstr(e.text, "holds 0 points"));
     assert_int_equal(r->nsegments, nseg); /* nothing changed */
-    /* a box around the whole segment: the template is all of it, no room to slide */
+    /* a box around the whole segment: the template is all of it, no room to slide; it gets
+     * the next id and segment 0, left without points, is gone (its id is not reused) */
+    size_t in_use = ag_segment_cloud_in_use(r);
     assert_int_equal(ag_template_mark(c, &r, 0, lo, hi, &rep, &e), AG_OK);
     assert_int_equal(rep.copies, 0);
-    assert_int_equal(r->nsegments, nseg);
+    assert_int_equal(rep.template_segment, (int32_t)nseg);
+    assert_int_equal(r->nsegments, nseg + 1);
+    assert_int_equal(ag_segment_cloud_in_use(r), in_use);
+    assert_int_equal(r->segments[0].count, 0);
+    assert_int_equal(r->segments[0].label, -1);
+    ag_template_mark_report_clear(&rep);
+    /* an id without points is refused, saying so */
+    assert_int_equal(ag_template_mark(c, &r, 0, lo, hi, &rep, &e), AG_ERR_INVALID);
+    assert_non_null(strstr(e.text, "has no points"));
+
     ag_template_mark_report_clear(&rep);
     ag_segment_cloud_free(r);
     ag_cloud_free(c);

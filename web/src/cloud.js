@@ -36,11 +36,15 @@ export class CloudEditor {
     this.tool = null;
     this.view = 'derived'; // of a proceduralized cloud; an unproceduralized one has only its input
     this.procTemplates = []; // boxes in the cloud's coordinates (the offset added)
-    // {model, points, shown, budget, offset, segmented, segments, labels} of what is on screen
+    // {model, points, shown, budget, offset, segmented, segments, segment_ids, labels} of what
+    // is on screen (ids below segment_ids may be in use)
     this.info = null;
     editor.signals.modelOpened.add(() => this.reset());
-    // segments are renumbered by every segmentation: a picked id would name another segment
-    editor.signals.pointsChanged.add(() => this.setSegment(null));
+    // ROI refinement and template marking keep every segment's id (a segment they empty is
+    // gone, its id unused); a new segmentation numbers afresh: a picked id would name another
+    editor.signals.pointsChanged.add((model, kind) => {
+      if (kind !== OP.segment_roi && kind !== OP.mark_template) this.setSegment(null);
+    });
   }
 
   get active() {
@@ -129,7 +133,7 @@ export class CloudEditor {
   setInfo(info) {
     this.info = info;
     // a segment id of the previous segmentation means nothing in a new one
-    if (!info?.segmented || (this.segment !== null && this.segment >= (info.segments ?? 0))) this.setSegment(null);
+    if (!info?.segmented || (this.segment !== null && this.segment >= (info.segment_ids ?? info.segments ?? 0))) this.setSegment(null);
     this.signals.infoChanged.dispatch(info);
   }
 

@@ -27,7 +27,7 @@ export class Editor {
       historyChanged: new Signal(),
       jobChanged: new Signal(),        // job (or null when the panel should clear)
       meshChanged: new Signal(),       // model: its mesh was replaced (proceduralize, grammar edit)
-      pointsChanged: new Signal(),     // model: a point cloud's segmentation changed (segment ops, undo)
+      pointsChanged: new Signal(),     // model, op kind: a point cloud's segmentation changed (segment ops, undo)
       treeChanged: new Signal(),       // split tree (SplitTree or null)
       grammarChanged: new Signal(),    // grammar {text, version} (or null)
       procJobChanged: new Signal(),    // proceduralize job of the open model (or null)
@@ -188,7 +188,7 @@ export class Editor {
       this.selected.clear();
       this.signals.meshChanged.dispatch(this.model);
     }
-    if (resegmented) this.signals.pointsChanged.dispatch(this.model);
+    if (resegmented) this.signals.pointsChanged.dispatch(this.model, op.kind);
   }
 
   // Fresh figures of the open model (e.g. re-read after its mesh changed).

@@ -285,7 +285,8 @@ ag_status ag_proceduralize_cloud_run(ag_cloud *c, const ag_proceduralize_cloud_o
             goto fail;
         }
         for (size_t s = 0; s < sg->nsegments; s++)
-            lstart[sg->segments[s].label + 1]++;
+            if (sg->segments[s].label >= 0) /* not an id an ROI left unused */
+                lstart[sg->segments[s].label + 1]++;
         for (size_t l = 0; l < nl; l++)
             lstart[l + 1] += lstart[l];
         {
@@ -299,7 +300,8 @@ ag_status ag_proceduralize_cloud_run(ag_cloud *c, const ag_proceduralize_cloud_o
             }
             memcpy(fill, lstart, (nl + 1) * sizeof *fill);
             for (size_t s = 0; s < sg->nsegments; s++)
-                lseg[fill[sg->segments[s].label]++] = (uint32_t)s;
+                if (sg->segments[s].label >= 0)
+                    lseg[fill[sg->segments[s].label]++] = (uint32_t)s;
             free(fill);
         }
         /* labels merged: two or more elements (repetitions); never planes (two walls of one

@@ -181,53 +181,82 @@ int ag_segment_cloud_similar(const ag_segment_cloud_item *a, const ag_segment_cl
     return 1;
 }
 
+size_t ag_segment_cloud_in_use(const ag_segment_cloud_result *r)
+{
+    return r->nplanes + r->nclusters + r->nelements;
+}
+
+ag_segment_cloud_spec ag_segment_cloud_spec_of(const ag_segment_cloud_item *it)
+{
+    /* an element keeps its host and shares a label with the elements it shared one with */
+    int el = it->kind == AG_SEGMENT_CLOUD_ELEMENT;
+    return (ag_segment_cloud_spec){it->kind, el ? it->host : -1, el ? it->label : -1,
+                                   el ? it->box : ag_box_empty()};
+}
+
+static void *dup_of(const void *p, size_t bytes, int *nomem)
+{
+    void *q = malloc(bytes ? bytes : 1);
+    if (!q)
+        *nomem = 1;
+    else if (p && bytes)
+        memcpy(q, p, bytes);
+    return q;
+}
+
+ag_status ag_segment_cloud_clone(const ag_segment_cloud_result *r,
+                                 ag_segment_cloud_result **out, ag_error *err)
+{
+    *out = NULL;
+    ag_segment_cloud_result *o = malloc(sizeof *o);
+    if (!o)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    *o = *r;
+    int nomem = 0;
+    size_t nm = r->member_start ? r->member_start[r->nsegments] : 0;
+    o->segment = dup_of(r->segment, r->n * sizeof *r->segment, &nomem);
+    o->label = dup_of(r->label, r->n * sizeof *r->label, &nomem);
+    o->piece = dup_of(r->piece, r->n * sizeof *r->piece, &nomem);
+    o->segments = dup_of(r->segments, r->nsegments * sizeof *r->segments, &nomem);
+    o->member_start = r->member_start ? dup_of(r->member_start,
+                                               (r->nsegments + 1) * sizeof *r->member_start,
+                                               &nomem)
+                                      : NULL;
+    o->members = r->members ? dup_of(r->members, nm * sizeof *r->members, &nomem) : NULL;
+    if (nomem) {
+        ag_segment_cloud_free(o);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    *out = o;
+    return AG_OK;
+}
+
+
 ag_status ag_segment_cloud_rebuild(const ag_cloud *c, ag_segment_cloud_result *r,
                                    const ag_segment_cloud_spec *spec, size_t nspec,
                                    ag_error *err)
 {
-    /* new ids: non-empty ids, planes then clusters then elements, each in id order */
+    /* every id keeps its number; the ids without points stay as unused entries */
     size_t *count = calloc(nspec + 1, sizeof *count);
-    int32_t *map = malloc((nspec + 1) * sizeof *map);
-    if (!count || !map) {
-        free(count);
-        free(map);
+    if (!count)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
     for (size_t i = 0; i < r->n; i++)
         if (r->segment[i] >= 0) {
             if ((size_t)r->segment[i] >= nspec) {
                 free(count);
-                free(map);
                 return ag_error_set(err, AG_ERR_INTERNAL, 0, "point %zu has segment %d of %zu",
                                     i + 1, (int)r->segment[i], nspec);
             }
             count[r->segment[i]]++;
         }
-    int32_t next = 0;
     size_t per_kind[3] = {0, 0, 0};
-    for (int kind = AG_SEGMENT_CLOUD_PLANE; kind <= AG_SEGMENT_CLOUD_ELEMENT; kind++)
-        for (size_t s = 0; s < nspec; s++)
-            if ((int)spec[s].kind == kind) {
-                map[s] = count[s] ? next++ : -1;
-                per_kind[kind] += count[s] > 0;
-            }
-    free(count);
-    for (size_t i = 0; i < r->n; i++)
-        if (r->segment[i] >= 0)
-            r->segment[i] = map[r->segment[i]];
-    r->nsegments = (size_t)next;
+    for (size_t s = 0; s < nspec; s++)
+        if (count[s] && (unsigned)spec[s].kind <= AG_SEGMENT_CLOUD_ELEMENT)
+            per_kind[spec[s].kind]++;
+    r->nsegments = nspec;
     r->nplanes = per_kind[AG_SEGMENT_CLOUD_PLANE];
     r->nclusters = per_kind[AG_SEGMENT_CLOUD_CLUSTERED];
     r->nelements = per_kind[AG_SEGMENT_CLOUD_ELEMENT];
-    /* what each new id was */
-    int32_t *old_of = malloc((r->nsegments + 1) * sizeof *old_of);
-    if (!old_of) {
-        free(map);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
-    for (size_t s = 0; s < nspec; s++)
-        if (map[s] >= 0)
-            old_of[map[s]] = (int32_t)s;
     ag_status st = build_members(r, err);
     if (st == AG_OK) {
         free(r->segments);
@@ -247,9 +276,8 @@ ag_status ag_segment_cloud_rebuild(const ag_cloud *c, ag_segment_cloud_result *r
         for (size_t i = 0; i < r->n; i++) {
             int32_t sg = r->segment[i];
             int32_t p = sg < 0 ? -1
-                        : spec[old_of[sg]].kind == AG_SEGMENT_CLOUD_ELEMENT
-                            ? (int32_t)r->npieces + sg
-                            : r->piece[i];
+                        : spec[sg].kind == AG_SEGMENT_CLOUD_ELEMENT ? (int32_t)r->npieces + sg
+                                                                    : r->piece[i];
             if (p < 0 || (size_t)p >= np) {
                 r->piece[i] = -1;
                 continue;
@@ -262,19 +290,27 @@ ag_status ag_segment_cloud_rebuild(const ag_cloud *c, ag_segment_cloud_result *r
     }
     free(pmap);
     /* descriptions: hosts (planes, clusters) before the elements that use their frames */
-    for (size_t s = 0; st == AG_OK && s < r->nsegments; s++) {
-        const ag_segment_cloud_spec *sp = &spec[old_of[s]];
-        ag_segment_cloud_item *it = &r->segments[s];
-        it->kind = sp->kind;
-        it->host = sp->kind == AG_SEGMENT_CLOUD_ELEMENT && sp->host >= 0 &&
-                           (size_t)sp->host < nspec
-                       ? map[sp->host]
-                       : -1;
-        describe(c, r->members + r->member_start[s], r->member_start[s + 1] - r->member_start[s],
-                 it, it->host >= 0 ? &r->segments[it->host] : NULL);
-        if (sp->kind == AG_SEGMENT_CLOUD_ELEMENT && !ag_box_is_empty(&sp->box))
-            ag_box_extend_box(&it->box, &sp->box);
-    }
+    for (int pass = 0; st == AG_OK && pass < 2; pass++)
+        for (size_t s = 0; s < r->nsegments; s++) {
+            const ag_segment_cloud_spec *sp = &spec[s];
+            ag_segment_cloud_item *it = &r->segments[s];
+            int el = sp->kind == AG_SEGMENT_CLOUD_ELEMENT;
+            if (el != pass)
+                continue;
+            it->kind = sp->kind;
+            it->host = el && sp->host >= 0 && (size_t)sp->host < nspec && count[sp->host]
+                           ? sp->host
+                           : -1;
+            it->label = -1;
+            it->box = ag_box_empty();
+            if (!count[s])
+                continue; /* an unused id */
+            describe(c, r->members + r->member_start[s],
+                     r->member_start[s + 1] - r->member_start[s], it,
+                     it->host >= 0 ? &r->segments[it->host] : NULL);
+            if (el && !ag_box_is_empty(&sp->box))
+                ag_box_extend_box(&it->box, &sp->box);
+        }
     for (size_t s = 0; st == AG_OK && s < r->nsegments; s++)
         if (r->segments[s].host >= 0)
             ag_box_extend_box(&r->segments[r->segments[s].host].box, &r->segments[s].box);
@@ -291,49 +327,51 @@ ag_status ag_segment_cloud_rebuild(const ag_cloud *c, ag_segment_cloud_result *r
         for (int32_t g = 0; g <= max_group; g++)
             group_label[g] = -1;
         size_t nlabels = 0, nrep = 0;
-        for (size_t s = 0; s < r->nsegments; s++) {
-            ag_segment_cloud_item *it = &r->segments[s];
-            int32_t g = spec[old_of[s]].group;
-            it->label = -1;
-            if (it->kind == AG_SEGMENT_CLOUD_ELEMENT && g >= 0) {
-                if (group_label[g] < 0)
-                    group_label[g] = (int32_t)nlabels++;
-                it->label = group_label[g];
-                continue;
-            }
-            for (size_t l = 0; l < nrep; l++)
-                if (ag_segment_cloud_similar(&r->segments[rep[l]], it, 2 * r->spacing)) {
-                    it->label = r->segments[rep[l]].label;
-                    break;
+        for (int kind = AG_SEGMENT_CLOUD_PLANE; kind <= AG_SEGMENT_CLOUD_ELEMENT; kind++)
+            for (size_t s = 0; s < r->nsegments; s++) {
+                ag_segment_cloud_item *it = &r->segments[s];
+                if ((int)it->kind != kind || !count[s])
+                    continue;
+                int32_t g = spec[s].group;
+                if (it->kind == AG_SEGMENT_CLOUD_ELEMENT && g >= 0) {
+                    if (group_label[g] < 0)
+                        group_label[g] = (int32_t)nlabels++;
+                    it->label = group_label[g];
+                    continue;
                 }
-            if (it->label < 0) {
-                rep[nrep++] = (int32_t)s;
-                it->label = (int32_t)nlabels++;
+                for (size_t l = 0; l < nrep; l++)
+                    if (ag_segment_cloud_similar(&r->segments[rep[l]], it, 2 * r->spacing)) {
+                        it->label = r->segments[rep[l]].label;
+                        break;
+                    }
+                if (it->label < 0) {
+                    rep[nrep++] = (int32_t)s;
+                    it->label = (int32_t)nlabels++;
+                }
             }
-        }
         r->nlabels = nlabels;
         for (size_t i = 0; i < r->n; i++)
             r->label[i] = r->segment[i] >= 0 ? r->segments[r->segment[i]].label : -1;
     }
     free(rep);
     free(group_label);
-    free(old_of);
-    free(map);
+    free(count);
     return st;
 }
 
-/* Segment table, members and labels from r->segment; the nplanes first ids are planes, the
- * rest clusters. */
-static ag_status finish(const ag_cloud *c, ag_segment_cloud_result *r, size_t nplanes,
-                        ag_error *err)
+/* Segment table, members and labels from r->segment; kind[s] gives each id's kind, or (kind
+ * NULL) the nplanes first ids are planes, the rest clusters. */
+static ag_status finish(const ag_cloud *c, ag_segment_cloud_result *r, const uint8_t *kind,
+                        size_t nplanes, ag_error *err)
 {
     size_t ns = r->nsegments;
     ag_segment_cloud_spec *spec = malloc((ns + 1) * sizeof *spec);
     if (!spec)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     for (size_t s = 0; s < ns; s++)
-        spec[s] = (ag_segment_cloud_spec){s < nplanes ? AG_SEGMENT_CLOUD_PLANE
-                                                      : AG_SEGMENT_CLOUD_CLUSTERED,
+        spec[s] = (ag_segment_cloud_spec){kind ? (ag_segment_cloud_kind)kind[s]
+                                          : s < nplanes ? AG_SEGMENT_CLOUD_PLANE
+                                                        : AG_SEGMENT_CLOUD_CLUSTERED,
                                           -1, -1, ag_box_empty()};
     ag_status st = ag_segment_cloud_rebuild(c, r, spec, ns, err);
     free(spec);
@@ -406,9 +444,15 @@ static ag_status segment_distinct(ag_cloud *c, const ag_segment_cloud_options *o
         r->cluster_tolerance = rs->cluster_tolerance;
         memcpy(r->seconds, rs->seconds, sizeof r->seconds);
         memcpy(r->cpu_seconds, rs->cpu_seconds, sizeof r->cpu_seconds);
-        /* a run gives planes first, then clusters; the rebuild counts and labels them over
-         * every copy */
-        st = finish(c, r, rs->nplanes, err);
+        /* the rebuild counts and labels the run's segments over every copy */
+        uint8_t *kind = malloc(rs->nsegments + 1);
+        if (!kind)
+            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+        for (size_t s = 0; kind && s < rs->nsegments; s++)
+            kind[s] = (uint8_t)rs->segments[s].kind;
+        if (st == AG_OK)
+            st = finish(c, r, kind, 0, err);
+        free(kind);
     }
     ag_segment_cloud_free(rs);
     ag_cloud_free(sub);
@@ -446,7 +490,7 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
     *out = r;
     if (n < 3 || !(r->diagonal > 0)) {
         /* nothing to fit: a point, a duplicate pile or no points at all */
-        return finish(c, r, 0, err);
+        return finish(c, r, NULL, 0, err);
     }
     r->fine_threshold = fine * r->diagonal;
     r->coarse_threshold = coarse > 0 ? coarse * r->diagonal : 0;
@@ -675,7 +719,8 @@ ag_status ag_segment_cloud_run(ag_cloud *c, const ag_segment_cloud_options *opt,
     t = ag_clock_seconds();
 
     tc = ag_clock_thread_cpu_seconds();
-    st = finish(c, r, ncomp, err);
+    st = finish(c, r, NULL, ncomp, err); /* the ncomp planes first, then the clusters */
+
     r->seconds[AG_SEGMENT_CLOUD_LABEL] = ag_clock_seconds() - t;
     r->cpu_seconds[AG_SEGMENT_CLOUD_LABEL] = ag_clock_thread_cpu_seconds() - tc;
 
@@ -694,6 +739,44 @@ done:
         *out = NULL;
     }
     return st;
+}
+
+/* After a rebuild numbered the label rule's classes afresh: a class takes the label id that
+ * its first segment of the old ones (ids below old, old_label[s] their labels before) had,
+ * unless a class before took it; the other classes get ids from old_nlabels on. */
+static ag_status keep_label_ids(ag_segment_cloud_result *r, const int32_t *old_label,
+                                size_t old, size_t old_nlabels, ag_error *err)
+{
+    size_t nl = r->nlabels;
+    int32_t *to = malloc((nl + 1) * sizeof *to);
+    uint8_t *taken = calloc(old_nlabels + 1, 1);
+    if (!to || !taken) {
+        free(to);
+        free(taken);
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
+    }
+    for (size_t l = 0; l < nl; l++)
+        to[l] = -1;
+    for (size_t s = 0; s < old && s < r->nsegments; s++) {
+        int32_t l = r->segments[s].label, was = old_label[s];
+        if (l < 0 || to[l] >= 0 || was < 0 || (size_t)was >= old_nlabels || taken[was])
+            continue;
+        to[l] = was;
+        taken[was] = 1;
+    }
+    int32_t next = (int32_t)old_nlabels;
+    for (size_t l = 0; l < nl; l++)
+        if (to[l] < 0)
+            to[l] = next++;
+    for (size_t s = 0; s < r->nsegments; s++)
+        if (r->segments[s].label >= 0)
+            r->segments[s].label = to[r->segments[s].label];
+    for (size_t i = 0; i < r->n; i++)
+        r->label[i] = r->segment[i] >= 0 ? r->segments[r->segment[i]].label : -1;
+    r->nlabels = (size_t)next;
+    free(to);
+    free(taken);
+    return AG_OK;
 }
 
 ag_status ag_segment_cloud_refine(ag_cloud *c, ag_segment_cloud_result *r, const double min[3],
@@ -725,24 +808,22 @@ ag_status ag_segment_cloud_refine(ag_cloud *c, ag_segment_cloud_result *r, const
         free(inside);
         return st;
     }
-    /* old segments keep their ids (minus the points inside), new ones follow; the rebuild
-     * orders them by kind (old planes, new planes, old clusters, new clusters, elements) */
-    size_t old = r->nsegments, nnew = rs->nsegments;
+    /* old segments keep their ids (minus the points inside), new ones follow */
+    size_t old = r->nsegments, nnew = rs->nsegments, old_nlabels = r->nlabels;
     ag_segment_cloud_spec *spec = malloc((old + nnew + 1) * sizeof *spec);
-    if (!spec) {
+    int32_t *old_label = malloc((old + 1) * sizeof *old_label);
+    if (!spec || !old_label) {
+        free(spec);
+        free(old_label);
         ag_cloud_free(sub);
         free(inside);
         ag_segment_cloud_free(rs);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     }
-    for (size_t s = 0; s < old; s++) {
-        const ag_segment_cloud_item *it = &r->segments[s];
-        /* an element keeps its host and shares a label with the elements it shared one with */
-        spec[s] = (ag_segment_cloud_spec){it->kind, it->host,
-                                          it->kind == AG_SEGMENT_CLOUD_ELEMENT ? it->label : -1,
-                                          it->kind == AG_SEGMENT_CLOUD_ELEMENT ? it->box
-                                                                               : ag_box_empty()};
-    }
+    for (size_t s = 0; s < old; s++)
+        old_label[s] = r->segments[s].label;
+    for (size_t s = 0; s < old; s++)
+        spec[s] = ag_segment_cloud_spec_of(&r->segments[s]);
     for (size_t s = 0; s < nnew; s++)
         spec[old + s] = (ag_segment_cloud_spec){rs->segments[s].kind, -1, -1, ag_box_empty()};
     for (size_t j = 0; j < m; j++) {
@@ -754,7 +835,10 @@ ag_status ag_segment_cloud_refine(ag_cloud *c, ag_segment_cloud_result *r, const
     ag_cloud_free(sub);
     ag_segment_cloud_free(rs);
     st = ag_segment_cloud_rebuild(c, r, spec, old + nnew, err);
+    if (st == AG_OK)
+        st = keep_label_ids(r, old_label, old, old_nlabels, err);
     free(spec);
+    free(old_label);
     return st;
 }
 
@@ -768,8 +852,13 @@ ag_status ag_segment_cloud_restore(const ag_cloud *c, const ag_segment_cloud_ids
         return ag_error_set(err, AG_ERR_INVALID, 0,
                             "%zu planes among %zu segments and %zu pieces cannot be",
                             ids->nplanes, ids->nsegments, ids->npieces);
+    for (size_t s = 0; ids->kind && s < ids->nsegments; s++)
+        if (ids->kind[s] > AG_SEGMENT_CLOUD_ELEMENT)
+            return ag_error_set(err, AG_ERR_INVALID, (long)s + 1, "segment %zu has kind %u", s,
+                                (unsigned)ids->kind[s]);
     for (size_t i = 0; i < n; i++) {
         int32_t s = ids->segment[i], p = ids->piece[i];
+
         if (s < -1 || s >= (int32_t)ids->nsegments || p < -1 || p >= (int32_t)ids->npieces ||
             (s < 0) != (p < 0))
             return ag_error_set(err, AG_ERR_INVALID, (long)i + 1,
@@ -786,41 +875,30 @@ ag_status ag_segment_cloud_restore(const ag_cloud *c, const ag_segment_cloud_ids
     r->npieces = ids->npieces;
     r->spacing = ids->spacing;
     r->diagonal = ag_cloud_diagonal(c);
-    st = finish(c, r, ids->nplanes, err);
+    st = finish(c, r, ids->kind, ids->nplanes, err);
     if (st == AG_OK && ids->label) {
-        /* the labels given, checked against their segments and renumbered densely */
-        int32_t *dense = malloc((n + 1) * sizeof *dense);
-        for (size_t s = 0; dense && s < r->nsegments; s++)
+        /* the labels given, checked against their segments, kept as they are */
+        size_t bound = ids->nlabels ? ids->nlabels : n, nlabels = ids->nlabels;
+        for (size_t s = 0; s < r->nsegments; s++)
             r->segments[s].label = -1;
-        if (!dense)
-            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
         for (size_t i = 0; st == AG_OK && i < n; i++) {
             int32_t s = r->segment[i], l = ids->label[i];
-            if ((s < 0) != (l < 0) || l >= (int32_t)n ||
+            if ((s < 0) != (l < 0) || (l >= 0 && (size_t)l >= bound) ||
                 (s >= 0 && r->segments[s].label >= 0 && r->segments[s].label != l))
                 st = ag_error_set(err, AG_ERR_INVALID, (long)i + 1,
                                   "point %zu has label %d, which its segment %d does not have",
                                   i + 1, l, s);
-            else if (s >= 0)
+            else if (s >= 0) {
                 r->segments[s].label = l;
-        }
-        size_t nlabels = 0;
-        for (size_t l = 0; st == AG_OK && l <= n; l++)
-            dense[l] = -1;
-        for (size_t s = 0; st == AG_OK && s < r->nsegments; s++) {
-            int32_t l = r->segments[s].label;
-            if (l < 0) /* a segment without points */
-                continue;
-            if (dense[l] < 0)
-                dense[l] = (int32_t)nlabels++;
-            r->segments[s].label = dense[l];
+                if ((size_t)l + 1 > nlabels)
+                    nlabels = (size_t)l + 1;
+            }
         }
         if (st == AG_OK) {
             r->nlabels = nlabels;
             for (size_t i = 0; i < n; i++)
-                r->label[i] = r->segment[i] >= 0 ? r->segments[r->segment[i]].label : -1;
+                r->label[i] = ids->label[i];
         }
-        free(dense);
     }
     if (st != AG_OK) {
         ag_segment_cloud_free(r);

@@ -100,6 +100,42 @@ static int place_copy(const ag_cloud *c, const uint32_t *mem, size_t m, const do
     return best < INFINITY;
 }
 
+/* Labels after a mark (out, rebuilt from r with the template and its copies at ids old on):
+ * every segment r had keeps its label; the marked one too while it still passes the label
+ * rule with a segment of its label (or has it alone), else it gets one of its own; the
+ * template and its copies one new label, which is returned. Label ids are never reused. */
+static int32_t keep_labels(const ag_segment_cloud_result *r, ag_segment_cloud_result *out,
+                           int32_t marked, size_t old)
+{
+    int32_t fresh = (int32_t)r->nlabels, next = fresh + 1;
+    for (size_t s = 0; s < out->nsegments; s++) {
+        ag_segment_cloud_item *it = &out->segments[s];
+        if (!it->count)
+            it->label = -1;
+        else if (s >= old)
+            it->label = fresh;
+        else
+            it->label = r->segments[s].label;
+    }
+    ag_segment_cloud_item *h = &out->segments[marked];
+    if (h->count) {
+        int alone = 1, similar = 0;
+        for (size_t s = 0; s < old && !similar; s++) {
+            const ag_segment_cloud_item *o = &out->segments[s];
+            if ((int32_t)s == marked || !o->count || o->label != h->label)
+                continue;
+            alone = 0;
+            similar = ag_segment_cloud_similar(h, o, 2 * out->spacing);
+        }
+        if (!alone && !similar)
+            h->label = next++;
+    }
+    out->nlabels = (size_t)next;
+    for (size_t i = 0; i < out->n; i++)
+        out->label[i] = out->segment[i] >= 0 ? out->segments[out->segment[i]].label : -1;
+    return fresh;
+}
+
 ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **rp, int32_t segment,
                            const double min[3], const double max[3],
                            ag_template_mark_report *rep, ag_error *err)
@@ -116,6 +152,10 @@ ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **rp, int3
                             r->nsegments - 1);
     }
     const ag_segment_cloud_item *it = &r->segments[segment];
+    if (!it->count)
+        return ag_error_set(err, AG_ERR_INVALID, 0,
+                            "segment %d has no points: an edit before left its id unused",
+                            segment);
     const uint32_t *mem = r->members + r->member_start[segment];
     size_t m = r->member_start[segment + 1] - r->member_start[segment];
     double slack = 2 * r->spacing;
@@ -166,98 +206,41 @@ ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **rp, int3
             if (group[j] < 0 && inside(c->xyz + 3 * (size_t)mem[j], placed.min, placed.max))
                 group[j] = gid;
     }
-    /* the new segmentation: the template and its copies become segments of the segment's
-     * kind (planes keep the first ids), empty segments are dropped */
+    /* the new segmentation, made on a copy so that r stays as it was on an error: the
+     * template and its copies become segments of the segment's kind with ids after every id
+     * there was; every other segment keeps its id, the marked one what is left of it */
     ag_segment_cloud_result *out = NULL;
-    int32_t *seg = NULL, *piece = NULL, *map = NULL, *pmap = NULL;
-    size_t *count = NULL;
-    size_t k = ntaken, old = r->nsegments, total = old + k, n = c->n;
-    int plane = (size_t)segment < r->nplanes;
-    size_t base = plane ? r->nplanes : old; /* where the new ids go */
+    ag_segment_cloud_spec *spec = NULL;
+    size_t k = ntaken, old = r->nsegments;
+    if (st == AG_OK)
+        st = ag_segment_cloud_clone(r, &out, err);
+    if (st == AG_OK && !(spec = malloc((old + k + 1) * sizeof *spec)))
+        st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     if (st == AG_OK) {
-        seg = malloc((n ? n : 1) * sizeof *seg);
-        piece = malloc((n ? n : 1) * sizeof *piece);
-        map = malloc((total + 1) * sizeof *map);
-        count = calloc(total + 1, sizeof *count);
-        pmap = malloc((r->npieces + k + 1) * sizeof *pmap);
-        if (!seg || !piece || !map || !count || !pmap)
-            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    }
-    if (st == AG_OK) {
-        for (size_t i = 0; i < n; i++) {
-            int32_t s = r->segment[i];
-            seg[i] = s < 0 ? -1 : (size_t)s >= base ? s + (int32_t)k : s;
-            piece[i] = r->piece[i];
-        }
+        for (size_t s = 0; s < old; s++)
+            spec[s] = ag_segment_cloud_spec_of(&r->segments[s]);
+        int el = it->kind == AG_SEGMENT_CLOUD_ELEMENT;
+        for (size_t t = 0; t < k; t++)
+            spec[old + t] = (ag_segment_cloud_spec){it->kind, el ? it->host : -1, -1,
+                                                    ag_box_empty()};
         for (size_t j = 0; j < m; j++)
             if (group[j] >= 0) {
-                seg[mem[j]] = (int32_t)(base + (size_t)group[j]);
-                piece[mem[j]] = (int32_t)(r->npieces + (size_t)group[j]);
+                out->segment[mem[j]] = (int32_t)(old + (size_t)group[j]);
+                out->piece[mem[j]] = (int32_t)(r->npieces + (size_t)group[j]);
             }
-        for (size_t i = 0; i < n; i++)
-            if (seg[i] >= 0)
-                count[seg[i]]++;
-        int32_t next = 0;
-        size_t nplanes = 0, planes_end = r->nplanes + (plane ? k : 0);
-        for (size_t s = 0; s < total; s++) {
-            map[s] = count[s] ? next++ : -1;
-            if (s < planes_end && count[s])
-                nplanes++;
-        }
-        int32_t pn = 0;
-        for (size_t p = 0; p < r->npieces + k; p++)
-            pmap[p] = -1;
-        for (size_t i = 0; i < n; i++) {
-            if (seg[i] < 0)
-                continue;
-            seg[i] = map[seg[i]];
-            if (pmap[piece[i]] < 0)
-                pmap[piece[i]] = pn++;
-            piece[i] = pmap[piece[i]];
-        }
-        ag_segment_cloud_ids ids = {.segment = seg,
-                                    .piece = piece,
-                                    .nsegments = (size_t)next,
-                                    .nplanes = nplanes,
-                                    .npieces = (size_t)pn,
-                                    .spacing = r->spacing};
-        st = ag_segment_cloud_restore(c, &ids, &out, err);
+        out->npieces = r->npieces + k;
+        st = ag_segment_cloud_rebuild(c, out, spec, old + k, err);
     }
     if (st == AG_OK) {
-        /* one new label for the template and its copies, then labels renumbered densely */
-        int32_t fresh = (int32_t)out->nlabels;
-        for (size_t t = 0; t < k; t++) {
-            int32_t s = map[base + t];
-            if (s >= 0)
-                out->segments[s].label = fresh;
-        }
-        int32_t *dense = malloc((out->nlabels + 2) * sizeof *dense);
-        if (!dense) {
-            st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-        } else {
-            for (size_t l = 0; l <= out->nlabels; l++)
-                dense[l] = -1;
-            int32_t nl = 0;
-            for (size_t s = 0; s < out->nsegments; s++) {
-                int32_t l = out->segments[s].label;
-                if (dense[l] < 0)
-                    dense[l] = nl++;
-                out->segments[s].label = dense[l];
-            }
-            out->nlabels = (size_t)nl;
-            for (size_t i = 0; i < n; i++)
-                out->label[i] = out->segment[i] >= 0 ? out->segments[out->segment[i]].label : -1;
-            rep->label = dense[fresh];
-            rep->template_segment = map[base];
-            free(dense);
-        }
+        rep->label = keep_labels(r, out, segment, old);
+        rep->template_segment = (int32_t)old;
     }
     if (st == AG_OK && k > 1 && !(rep->copy = calloc(k - 1, sizeof *rep->copy)))
         st = ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
     size_t copies = 0;
     for (size_t t = 1; st == AG_OK && t < k; t++) {
-        int32_t s = map[base + t];
-        if (s < 0) /* every point of it went to a copy before */
+        size_t s = old + t;
+        if (!out->segments[s].count) /* every point of it went to a copy before */
             continue;
         ag_template_copy *cp = &rep->copy[copies++];
         for (int a = 0; a < 3; a++) {
@@ -282,13 +265,9 @@ ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **rp, int3
         ag_template_mark_report_clear(rep);
     }
     ag_segment_cloud_free(out);
+    free(spec);
     free(u);
     free(group);
     free(matches);
-    free(seg);
-    free(piece);
-    free(map);
-    free(count);
-    free(pmap);
     return st;
 }

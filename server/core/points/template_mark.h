@@ -41,9 +41,14 @@ typedef struct {
 void ag_template_mark_report_clear(ag_template_mark_report *rep);
 
 /* Marks the points of segment `segment` inside the box [min, max] (local coordinates) as a
- * template and labels its copies; r is replaced by the new segmentation (segments and
- * labels renumbered). AG_ERR_INVALID when there is no such segment or the box holds fewer
- * than AG_TEMPLATE_MIN_POINTS of its points (the message says how many it holds). */
+ * template and labels its copies; r is replaced by the new segmentation (left as it was on
+ * an error). Every segment keeps its id and its label, the marked one what is left of it
+ * (its label too while it passes the label rule with another segment of that label, or has
+ * it alone; else a new one); the template and its copies get the ids from r->nsegments on
+ * and one new label (r->nlabels). AG_ERR_INVALID when there is no such segment, it has no
+ * points or the box holds fewer than AG_TEMPLATE_MIN_POINTS of its points (the message says
+ * how many it holds). */
+
 ag_status ag_template_mark(const ag_cloud *c, ag_segment_cloud_result **r, int32_t segment,
                            const double min[3], const double max[3],
                            ag_template_mark_report *rep, ag_error *err);
