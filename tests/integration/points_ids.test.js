@@ -5,6 +5,7 @@
 // resize of one window, which resizes every window of its rule, keeps every node at its id
 // (the windows with their new boxes), and undo and redo keep them too. The windows are found by
 // their boxes in the test's own building (points_building.js), never by archgram's ids.
+// A join keeps every node at its id too (a point model keeps the joined placements as they were).
 import assert from 'node:assert/strict';
 import { after, before, describe, it } from 'node:test';
 import { http, removeDir, startDaemon, tempDir, waitJob, WsClient } from './harness.js';
@@ -162,6 +163,30 @@ describe('point model edits keep node ids', () => {
     }
     assert.equal(components(t5), components(t4));
   });
+
+  // A point model has no joined terminal: a join reads the joined group back as its members'
+  // placements, where they were. So a join removes no node, and every node keeps its id and
+  // box, the two joined windows too; undo gives the same tree back.
+  it('a join on a model of its own keeps every node at its id, the joined windows too', async () => {
+    const q = new URLSearchParams({ name: 'house', format: 'ply' });
+    const up = await http(d, 'POST', `/api/v1/models?${q}`, { body: buildingPly(60000).bytes, headers: { 'Content-Type': 'application/octet-stream' }, timeout: 120000 });
+    assert.equal(up.status, 202, up.text);
+    id = (await waitJob(d, up.json.id, { timeout: 120000 })).result.model;
+    const pj = await http(d, 'POST', `/api/v1/models/${id}/proceduralize`, { body: { templates: [box6(windowBox(2))], auto: false } });
+    assert.equal(pj.status, 202, pj.text);
+    assert.equal((await waitJob(d, pj.json.id, { timeout: 120000 })).status, 'succeeded');
+    const t0 = await tree();
+    const a = glassOf(t0, 0), b = glassOf(t0, 1);
+    assert.ok(a && b, 'windows 0 and 1');
+    await op({ kind: 'join', nodes: [a.id, b.id] }, 'join-0-1');
+    const t1 = await tree();
+    assert.equal(assertKept(t0, t1, new Set(), 'after the join'), components(t0));
+    assert.equal(components(t1), components(t0), 'the join adds no node');
+    assert.equal(glassOf(t1, 0)?.id, a.id);
+    assert.equal(glassOf(t1, 1)?.id, b.id);
+    await op({ kind: 'undo' }, 'undo-join');
+    assert.equal(assertKept(t0, await tree(), new Set(), 'after undo'), components(t0));
+  });
 });
 
 // A cloud's segment ids (issue 14 §4, before any proceduralization): segment_roi keeps the id
@@ -254,53 +279,5 @@ describe('cloud segment ids survive segment_roi, a restart and mark_template', (
     // undo brings the ids of before the template back
     await op({ kind: 'undo' }, 'undo-tmpl');
     assert.deepEqual((await ply()).props.segment, s1.props.segment);
-  });
-});
-
-// A point model has no joined terminal: a join reads the joined group back as its members'
-// placements, where they were. So a join removes no node, and every node keeps its id and box,
-// the two joined windows too; undo gives the same tree back.
-describe('a point model join', () => {
-  let d;
-  let id;
-  const dir = tempDir();
-  before(async () => {
-    d = await startDaemon({ dir });
-  });
-  after(async () => {
-    if (d) { try { await d.stop(); } finally { await d.kill(); } }
-    removeDir(dir);
-  });
-  const tree = async () => {
-    const r = await http(d, 'GET', `/api/v1/models/${id}/tree`);
-    assert.equal(r.status, 200, r.text.slice(0, 300));
-    return r.json;
-  };
-  const op = async (body, cid) => {
-    const v = (await http(d, 'GET', `/api/v1/models/${id}`)).json.version;
-    const r = await http(d, 'POST', `/api/v1/models/${id}/ops`, { body: { op: body, cid }, headers: { 'If-Match': `"${v}"` }, timeout: 120000 });
-    assert.equal(r.status, 200, r.text.slice(0, 400));
-    return r.json;
-  };
-
-  it('keeps every node at its id, the joined windows too', async () => {
-    const q = new URLSearchParams({ name: 'house', format: 'ply' });
-    const up = await http(d, 'POST', `/api/v1/models?${q}`, { body: buildingPly(60000).bytes, headers: { 'Content-Type': 'application/octet-stream' }, timeout: 120000 });
-    assert.equal(up.status, 202, up.text);
-    id = (await waitJob(d, up.json.id, { timeout: 120000 })).result.model;
-    const pj = await http(d, 'POST', `/api/v1/models/${id}/proceduralize`, { body: { templates: [box6(windowBox(2))], auto: false } });
-    assert.equal(pj.status, 202, pj.text);
-    assert.equal((await waitJob(d, pj.json.id, { timeout: 120000 })).status, 'succeeded');
-    const t0 = await tree();
-    const a = glassOf(t0, 0), b = glassOf(t0, 1);
-    assert.ok(a && b, 'windows 0 and 1');
-    await op({ kind: 'join', nodes: [a.id, b.id] }, 'join-0-1');
-    const t1 = await tree();
-    assert.equal(assertKept(t0, t1, new Set(), 'after the join'), components(t0));
-    assert.equal(components(t1), components(t0), 'the join adds no node');
-    assert.equal(glassOf(t1, 0)?.id, a.id);
-    assert.equal(glassOf(t1, 1)?.id, b.id);
-    await op({ kind: 'undo' }, 'undo-join');
-    assert.equal(assertKept(t0, await tree(), new Set(), 'after undo'), components(t0));
   });
 });

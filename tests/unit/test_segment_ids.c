@@ -22,6 +22,7 @@
 #include "core/points/proceduralize_cloud.h"
 #include "core/points/segment_cloud.h"
 #include "core/points/template_mark.h"
+#include "segment_fixture.h"
 
 static int in_box(const double *p, const double lo[3], const double hi[3])
 {
@@ -192,22 +193,6 @@ static void roi_refinement_keeps_the_ids_outside(void **state)
     ag_cloud_free(c);
 }
 
-/* The segment most of the points of truth plane `plane` went to. */
-static int32_t majority(const ag_cloud *c, const int32_t *truth, const ag_segment_cloud_result *r,
-                        int32_t plane)
-{
-    size_t *votes = calloc(r->nsegments + 1, sizeof *votes);
-    int32_t best = -1;
-    for (size_t i = 0; i < c->n; i++)
-        if (truth[i] == plane && r->segment[i] >= 0) {
-            votes[r->segment[i]]++;
-            if (best < 0 || votes[r->segment[i]] > votes[best])
-                best = r->segment[i];
-        }
-    free(votes);
-    return best;
-}
-
 static void template_marking_keeps_every_id_and_label(void **state)
 {
     (void)state;
@@ -226,7 +211,7 @@ static void template_marking_keeps_every_id_and_label(void **state)
     double rlo[3] = {lo[0] + 0.7 * (hi[0] - lo[0]), lo[1] + 0.6 * (hi[1] - lo[1]), lo[2]};
     double rhi[3] = {hi[0], hi[1], lo[2] + 0.6 * (hi[2] - lo[2])};
     assert_int_equal(ag_segment_cloud_refine(c, r, rlo, rhi, NULL, &e), AG_OK);
-    int32_t wall = majority(c, truth, r, 0);
+    int32_t wall = sf_majority(c, truth, r, 0);
     assert_true(wall >= 0);
     /* the box: around the points of front window 7, grown 0.5 m (the wall around it) */
     double tlo[3] = {INFINITY, INFINITY, INFINITY}, thi[3] = {-INFINITY, -INFINITY, -INFINITY};

@@ -18,24 +18,9 @@
 
 #include "core/points/gen_building.h"
 #include "core/points/template_mark.h"
+#include "segment_fixture.h"
 
 #define FRONT_WINDOWS 18 /* 6 x 3 on the front wall: window ids 0..17 */
-
-/* The segment most of the points of truth plane `plane` went to. */
-static int32_t majority(const ag_cloud *c, const int32_t *truth, const ag_segment_cloud_result *r,
-                        int32_t plane)
-{
-    size_t *votes = calloc(r->nsegments + 1, sizeof *votes);
-    int32_t best = -1;
-    for (size_t i = 0; i < c->n; i++)
-        if (truth[i] == plane && r->segment[i] >= 0) {
-            votes[r->segment[i]]++;
-            if (best < 0 || votes[r->segment[i]] > votes[best])
-                best = r->segment[i];
-        }
-    free(votes);
-    return best;
-}
 
 /* The centre of window w (the mean of its points) and the wall's frame in world axes. */
 static void window_centre(const ag_cloud *c, const int32_t *window, int32_t w, double centre[3])
@@ -87,7 +72,7 @@ static void copies_sit_on_the_other_windows(void **state)
         memcpy(window, ag_cloud_find(c, "window")->values, n * sizeof *window);
         ag_segment_cloud_result *r;
         assert_int_equal(ag_segment_cloud_run(c, NULL, &r, &e), AG_OK);
-        int32_t wall = majority(c, truth, r, 0);
+        int32_t wall = sf_majority(c, truth, r, 0);
         assert_true(wall >= 0);
         size_t wall_points = r->member_start[wall + 1] - r->member_start[wall];
         size_t before = r->nsegments;
@@ -169,7 +154,7 @@ static void copies_sit_on_the_other_windows(void **state)
             assert_int_equal(r->label[i],
                              r->segment[i] >= 0 ? r->segments[r->segment[i]].label : -1);
         /* the wall's points are all still there: the rest of the wall plus the group */
-        int32_t left = majority(c, truth, r, 0);
+        int32_t left = sf_majority(c, truth, r, 0);
         assert_true(left >= 0 && r->segments[left].label != rep.label);
         rest = r->member_start[left + 1] - r->member_start[left];
         assert_int_equal(rest + grouped, wall_points);
