@@ -821,6 +821,8 @@ ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_opt
         later.later = 1;
         if (!later.m)
             split = NULL;
+        else
+            reserve_for(&later, (size_t)(end - split));
     }
     if (split) {
         split_read sr = {.first = &r, .later = &later, .data = data, .start = p,
