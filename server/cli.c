@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "app/threads.h"
 #include "app/usecase_import.h"
 #include "cli/commands.h"
 
@@ -113,6 +114,7 @@ int main(int argc, char **argv)
         puts("archgram " ARCHGRAM_VERSION);
         return 0;
     }
+    ag_threads_install(); /* core's and io's parallel parts (a large OBJ read in halves) */
     for (size_t i = 0; i < NCOMMANDS; i++)
         if (!strcmp(argv[1], commands[i].name))
             return commands[i].run(argc - 1, argv + 1);

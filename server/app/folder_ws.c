@@ -15,6 +15,7 @@
 #include "../io/part_bundle.h"
 #include "usecase_compose.h"
 #include "model_tree.h"
+#include "threads.h"
 #include "usecase_import.h"
 
 static double now(void)
@@ -241,17 +242,47 @@ ag_status ag__folder_ws_write_grammar(ag_folder_ws *w, const char *text, size_t 
     return s == AG_OK ? ag__folder_ws_write_file(w, path, text, len, err) : s;
 }
 
-/* grammar.txt, terminals/ and tree.json of st. */
-static ag_status write_model(ag_folder_ws *w, const ag_model_state *st, ag_error *err)
+/* tree.json's text, printed on a thread beside the rest of a save (it reads st only). */
+typedef struct {
+    const ag_model_state *st;
+    char *text;
+    ag_beside thread;
+} tree_text;
+
+static void *print_tree(void *arg)
+{
+    tree_text *t = arg;
+    t->text = ag_model_tree_folder_text(t->st->em); /* the served tree's precision */
+    return NULL;
+}
+
+static void tree_text_start(tree_text *t, const ag_model_state *st)
+{
+    t->st = st;
+    t->text = NULL;
+    ag_beside_start(&t->thread, print_tree, t);
+}
+
+/* grammar.txt, terminals/ and tree.json of st; tree, when given, is tree.json's text
+ * printing beside (waited for and freed here). */
+static ag_status write_model_with(ag_folder_ws *w, const ag_model_state *st, tree_text *beside,
+                                  ag_error *err)
 {
     const char *dir = w->o.out_dir;
     char path[4200];
     ag_status s = ag__folder_ws_write_grammar(w, st->text, st->text_len, &st->terms, err);
     snprintf(path, sizeof path, "%s/tree.json", dir);
-    if (s != AG_OK)
+    char *tree = NULL;
+    if (beside) {
+        ag_beside_join(&beside->thread);
+        tree = beside->text;
+    }
+    if (s != AG_OK) {
+        free(tree);
         return s;
-    /* the served tree's precision (model_tree.c), printed directly */
-    char *tree = ag_model_tree_folder_text(st->em);
+    }
+    if (!beside) /* the served tree's precision (model_tree.c), printed directly */
+        tree = ag_model_tree_folder_text(st->em);
     if (!tree) {
         ag__folder_ws_blame(w, NULL);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory writing %s", path);
@@ -259,6 +290,11 @@ static ag_status write_model(ag_folder_ws *w, const ag_model_state *st, ag_error
     s = ag__folder_ws_write_file(w, path, tree, strlen(tree), err);
     free(tree);
     return s;
+}
+
+static ag_status write_model(ag_folder_ws *w, const ag_model_state *st, ag_error *err)
+{
+    return write_model_with(w, st, NULL, err);
 }
 
 static json_t *vec3(const double *v)
@@ -364,12 +400,11 @@ static char *components_text(const ag_proceduralize_result *r)
 
 /* The proceduralize summary: jansson's dump with the components list put in at its marker. */
 static ag_status write_proc_summary(ag_folder_ws *w, const char *path, json_t *j,
-                                    const ag_proceduralize_result *r, ag_error *err)
+                                    const char *comps, ag_error *err)
 {
     char *rest = j ? json_dumps(j, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(10))
                    : NULL;
-    char *comps = rest ? components_text(r) : NULL;
-    char *at = comps ? strstr(rest, components_at) : NULL;
+    char *at = rest && comps ? strstr(rest, components_at) : NULL;
     ag_status s;
     if (!at) {
         ag__folder_ws_blame(w, NULL);
@@ -390,7 +425,6 @@ static ag_status write_proc_summary(ag_folder_ws *w, const char *path, json_t *j
         free(b.p);
     }
     free(rest);
-    free(comps);
     return s;
 }
 
@@ -615,20 +649,28 @@ static ag_status save(ag_workspace *ws, ag_model_state *st, const ag_proc_outcom
 {
     ag_folder_ws *w = (ag_folder_ws *)ws;
     double t0 = now();
+    char *comps = NULL;
     ag_status s = ag_model_state_checked(st, err);
-    if (s == AG_OK)
-        s = write_model(w, st, err);
+    if (s == AG_OK) {
+        /* tree.json printed beside the components of summary.json and the grammar's files */
+        tree_text tree;
+        tree_text_start(&tree, st);
+        if (proc)
+            comps = components_text(proc->proc);
+        s = write_model_with(w, st, &tree, err);
+    }
     double write_s = now() - t0;
     if (s == AG_OK) {
         char path[4200];
         snprintf(path, sizeof path, "%s/summary.json", w->o.out_dir);
         json_t *j = proc ? proc_summary(w, st, proc, write_s) : edit_summary(st, edit);
         if (proc)
-            s = write_proc_summary(w, path, j, proc->proc, err);
+            s = write_proc_summary(w, path, j, comps, err);
         else
             s = ag__folder_ws_write_json(w, path, j, JSON_INDENT(1) | JSON_REAL_PRECISION(12), err);
         json_decref(j);
     }
+    free(comps);
     ag_model_state_clear(st);
     return s;
 }

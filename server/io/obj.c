@@ -1,5 +1,6 @@
 #include "obj.h"
 
+#include "../core/base/parallel.h"
 #include "filemap.h"
 #include "numtext.h"
 
@@ -241,7 +242,21 @@ typedef struct {
     size_t cap_poly;
     char *joined; /* scratch for lines with '\' continuations */
     size_t cap_joined;
+    char *held_name; /* a group name from a continued line (names point into the input) */
+    /* The later part of a split read (read_part): the counts before it are not known yet,
+     * so its faces keep indices that merge() resolves, and what only a read in turn can
+     * decide (an error, a face mixing absolute and relative indices) stops it: that part
+     * is then read again after the first. */
+    int later;
+    size_t need_v, need_vt, need_vn; /* the most vertices (texture, normal) defined before
+                                        the part that its faces need */
 } reader;
+
+/* A later part's vertex index: an absolute (1-based) index as it is, a relative one as
+ * LATER_LOCAL + LATER_BIAS + its position among the part's own vertices (negative for the
+ * vertices before the part), which merge() resolves. */
+#define LATER_LOCAL 0x80000000u
+#define LATER_BIAS 0x40000000
 
 static ag_status perr(reader *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static ag_status perr(reader *r, const char *fmt, ...)
@@ -367,10 +382,48 @@ static ag_status current_component(reader *r, uint32_t *comp)
     return AG_OK;
 }
 
+/* An index of a later part's face (reader.later): its encoding, what it needs defined
+ * before the part, 0; -1 when only a read in turn can take it. */
+static int later_index(reader *r, long long idx, size_t *v, int *kinds)
+{
+    size_t nv = r->m->nverts;
+    if (idx > 0) {
+        if ((unsigned long long)idx >= LATER_LOCAL)
+            return -1;
+        if ((unsigned long long)idx > nv && (size_t)idx - nv > r->need_v)
+            r->need_v = (size_t)idx - nv;
+        *v = (size_t)idx - 1;
+        *kinds |= 1;
+    } else {
+        if (idx == 0 || nv >= LATER_BIAS || idx < -(long long)LATER_BIAS)
+            return -1;
+        long long local = (long long)nv + idx;
+        if (local < 0 && (size_t)-local > r->need_v)
+            r->need_v = (size_t)-local;
+        *v = LATER_LOCAL + (size_t)(local + LATER_BIAS);
+        *kinds |= 2;
+    }
+    /* one vertex named both ways is equal only once resolved: the dropped degenerate
+     * triangles are decided in turn */
+    return *kinds == 3 ? -1 : 0;
+}
+
+/* A later part's texture or normal index: what it needs before the part, 0; -1 for 0. */
+static int later_count(long long j, size_t count, size_t *need)
+{
+    if (j == 0)
+        return -1;
+    unsigned long long a = j > 0 ? (unsigned long long)j : (unsigned long long)-j;
+    if (a > count && a - count > *need)
+        *need = (size_t)(a - count);
+    return 0;
+}
+
 static ag_status read_face(reader *r, const char *p, const char *e)
 {
     size_t n = 0;
     size_t nv = r->m->nverts;
+    int kinds = 0; /* a later part: 1 absolute indices, 2 relative ones */
     for (;;) {
         while (p < e && is_space(*p))
             p++;
@@ -382,9 +435,12 @@ static ag_status read_face(reader *r, const char *p, const char *e)
         if (parse_long(&p, e, &idx))
             return perr(r, "bad face vertex '%s'", quote(s, e, q, sizeof q));
         size_t v;
-        if (idx == 0)
+        if (r->later) {
+            if (later_index(r, idx, &v, &kinds))
+                return AG_ERR_PARSE;
+        } else if (idx == 0)
             return perr(r, "face index 0 is invalid (OBJ indices start at 1)");
-        if (resolve(idx, nv, &v))
+        else if (resolve(idx, nv, &v))
             return perr(r, "face index %lld out of range (file has %zu vertices so far)", idx,
                         nv);
         /* Optional /vt and /vn parts: checked, then ignored. */
@@ -395,7 +451,10 @@ static ag_status read_face(reader *r, const char *p, const char *e)
                 size_t dummy, count = part == 0 ? r->nvt : r->nvn;
                 if (parse_long(&p, e, &j))
                     return perr(r, "bad face vertex '%s'", quote(s, e, q, sizeof q));
-                if (resolve(j, count, &dummy))
+                if (r->later) {
+                    if (later_count(j, count, part == 0 ? &r->need_vt : &r->need_vn))
+                        return AG_ERR_PARSE;
+                } else if (resolve(j, count, &dummy))
                     return perr(r, "face %s index %lld out of range (file has %zu so far)",
                                 part == 0 ? "texture" : "normal", j, count);
             }
@@ -501,6 +560,223 @@ static ag_status read_line(reader *r, const char *p, const char *e)
     return AG_OK;
 }
 
+/* Reads the lines of [p, end) of data (len bytes in all) into r, counting them on from
+ * *line; progress (NULL for none) is asked each PROGRESS_STEP bytes past *next_progress. */
+static ag_status read_lines(reader *r, const char *data, size_t len, const char *p,
+                            const char *end, long *line, const ag_obj_read_options *progress,
+                            size_t *next_progress)
+{
+    while (p < end) {
+        const char *nl = memchr(p, '\n', (size_t)(end - p));
+        const char *le = nl ? nl : end;
+        ++*line;
+        r->line = *line;
+        const char *q = le;
+        while (q > p && (q[-1] == '\r' || q[-1] == ' ' || q[-1] == '\t'))
+            q--;
+        ag_status st;
+        if (q > p && q[-1] == '\\' && nl) {
+            /* Continuation: join the physical lines (backslash-newline → space). */
+            size_t n = 0;
+            const char *s = p;
+            for (;;) {
+                const char *ne = memchr(s, '\n', (size_t)(end - s));
+                const char *se = ne ? ne : end;
+                const char *t = se;
+                while (t > s && (t[-1] == '\r' || t[-1] == ' ' || t[-1] == '\t'))
+                    t--;
+                int cont = ne && t > s && t[-1] == '\\';
+                size_t piece = (size_t)((cont ? t - 1 : se) - s);
+                if (n + piece + 1 > r->cap_joined) {
+                    size_t ncap = (n + piece + 1) * 2;
+                    char *nj = realloc(r->joined, ncap);
+                    if (!nj)
+                        return nomem(r);
+                    r->joined = nj;
+                    r->cap_joined = ncap;
+                }
+                memcpy(r->joined + n, s, piece);
+                n += piece;
+                r->joined[n++] = ' ';
+                s = ne ? ne + 1 : end;
+                if (!cont)
+                    break;
+                ++*line;
+            }
+            p = s;
+            const char *js = r->joined, *je = r->joined + n;
+            const char *ks = js;
+            while (ks < je && is_space(*ks))
+                ks++;
+            if (je - ks >= 2 && (ks[0] == 'g' || ks[0] == 'o') && is_space(ks[1])) {
+                /* The scratch buffer is reused: keep the group name elsewhere. */
+                char *copy = malloc(n);
+                if (!copy)
+                    return nomem(r);
+                memcpy(copy, js, n);
+                free(r->held_name);
+                r->held_name = copy;
+                js = copy;
+                je = copy + n;
+            }
+            st = read_line(r, js, je);
+        } else {
+            st = read_line(r, p, le);
+            p = nl ? nl + 1 : end;
+        }
+        if (st != AG_OK)
+            return st;
+        if (progress && (size_t)(p - data) >= *next_progress) {
+            *next_progress = (size_t)(p - data) + PROGRESS_STEP;
+            if (progress->progress &&
+                progress->progress(progress->user, (double)(p - data) / (double)len))
+                return ag_error_set(r->err, AG_ERR_CANCELLED, *line, "cancelled at line %ld",
+                                    *line);
+        }
+    }
+    return AG_OK;
+}
+
+static void reader_free(reader *r)
+{
+    free(r->held_name);
+    free(r->comp_of_group);
+    free(r->poly);
+    free(r->joined);
+    map_free(&r->map);
+}
+
+/* Below this many bytes a file is read in one part: a thread costs more than it saves. */
+#define SPLIT_BYTES ((size_t)1 << 20)
+
+/* Where a read in two parts splits [p, end): after the newline ending the first line past
+ * the middle that does not continue (no '\' at its end); NULL when there is none. */
+static const char *split_point(const char *p, const char *end)
+{
+    const char *s = p + (size_t)(end - p) / 2;
+    for (;;) {
+        const char *nl = memchr(s, '\n', (size_t)(end - s));
+        if (!nl || nl + 1 >= end)
+            return NULL;
+        const char *t = nl;
+        while (t > p && (t[-1] == '\r' || t[-1] == ' ' || t[-1] == '\t'))
+            t--;
+        if (!(t > p && t[-1] == '\\'))
+            return nl + 1;
+        s = nl + 1;
+    }
+}
+
+/* The two parts of a split read: the first read as a read in turn reads it, the later one
+ * on its own (reader.later) into a mesh of its own. */
+typedef struct {
+    reader *first, *later;
+    const char *data, *start, *split, *end; /* start: past a byte order mark */
+    size_t len;
+    const ag_obj_read_options *opt;
+    long line;                 /* the first part's last line */
+    size_t next_progress;
+    ag_status first_st, later_st;
+} split_read;
+
+static void read_part(void *ctx, size_t part)
+{
+    split_read *sr = ctx;
+    if (part == 0) {
+        sr->first_st = read_lines(sr->first, sr->data, sr->len, sr->start,
+                                  sr->split, &sr->line, sr->opt, &sr->next_progress);
+    } else {
+        long line = 0;
+        sr->later_st = read_lines(sr->later, sr->data, sr->len, sr->split, sr->end, &line, NULL,
+                                  NULL);
+    }
+}
+/* Appends the later part l to the first part r, as reading on in turn would have made
+ * it: its vertices after r's, its relative indices resolved, its components those its
+ * groups name in r (the first of them, when its faces start before any g/o line, r's
+ * current one). The caller checked l's needs against r's counts. */
+static ag_status merge(reader *r, const reader *l)
+{
+    ag_mesh *m = r->m;
+    const ag_mesh *lm = l->m;
+    size_t nv0 = m->nverts, nt0 = m->ntris;
+    uint32_t *comp = malloc((lm->ncomponents + 1) * sizeof *comp);
+    if (!comp)
+        return nomem(r);
+    ag_status st = AG_OK;
+    for (size_t c = 0; c < lm->ncomponents && st == AG_OK; c++) {
+        if ((long)c != l->nogroup_comp) { /* a group of the later part: resolved as its g line */
+            const char *name = lm->group_names[lm->component_group[c]];
+            r->pend = name;
+            r->pend_len = strlen(name);
+            r->have_pend = 1;
+            r->cur_comp = -1;
+        }
+        st = current_component(r, &comp[c]);
+    }
+    r->have_pend = 0; /* the names were l's */
+    if (st == AG_OK && ag_mesh_reserve(m, nv0 + lm->nverts, nt0 + lm->ntris) != AG_OK)
+        st = nomem(r);
+    if (st == AG_OK) {
+        memcpy(m->pos + 3 * nv0, lm->pos, 3 * lm->nverts * sizeof *lm->pos);
+        for (size_t t = 0; t < lm->ntris; t++) {
+            for (int k = 0; k < 3; k++) {
+                uint32_t v = lm->tri[3 * t + k];
+                m->tri[3 * (nt0 + t) + k] =
+                    v >= LATER_LOCAL
+                        ? (uint32_t)((long long)nv0 + (long long)(v - LATER_LOCAL) - LATER_BIAS)
+                        : v;
+            }
+            m->tri_component[nt0 + t] = comp[lm->tri_component[t]];
+        }
+        m->nverts += lm->nverts;
+        m->ntris += lm->ntris;
+        r->nvt += l->nvt;
+        r->nvn += l->nvn;
+    }
+    free(comp);
+    return st;
+}
+
+/* Whether the later part can be merged: it read to its end, the indices its faces need
+ * before it are defined by the first part, and the counts stay within the limits (else it
+ * is read again in turn, which says what is wrong where). */
+static int mergeable(const split_read *sr)
+{
+    const reader *r = sr->first, *l = sr->later;
+    return sr->later_st == AG_OK && l->need_v <= r->m->nverts && l->need_vt <= r->nvt &&
+           l->need_vn <= r->nvn && r->m->nverts + l->m->nverts <= r->max_v &&
+           r->m->nverts + l->m->nverts < LATER_LOCAL && r->m->ntris + l->m->ntris <= r->max_t;
+}
+
+static void reader_init(reader *r, const ag_obj_read_options *opt, ag_error *err)
+{
+    memset(r, 0, sizeof *r);
+    r->err = err;
+    r->yup = opt->up != AG_UP_Z;
+    r->max_v = opt->max_vertices ? opt->max_vertices : DEFAULT_MAX_VERTICES;
+    r->max_t = opt->max_triangles ? opt->max_triangles : DEFAULT_MAX_TRIANGLES;
+    r->cur_comp = -1;
+    r->nogroup_comp = -1;
+    r->m = ag_mesh_create();
+}
+
+/* Room for about len bytes of lines: a typical OBJ line is ~30 bytes, so len/60 leaves
+ * room for a balanced file. */
+static void reserve_for(reader *r, size_t len)
+{
+    size_t guess_v = len / 60, guess_t = len / 60;
+    if (guess_v > r->max_v)
+        guess_v = r->max_v;
+    if (guess_t > r->max_t)
+        guess_t = r->max_t;
+    if (guess_v > (1u << 24))
+        guess_v = 1u << 24;
+    if (guess_t > (1u << 24))
+        guess_t = 1u << 24;
+    (void)ag_mesh_reserve(r->m, guess_v, guess_t);
+}
+
 ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_options *opt,
                              ag_mesh **out, ag_error *err)
 {
@@ -520,29 +796,11 @@ ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_opt
                             line);
     }
 
-    reader r = {0};
-    r.err = err;
-    r.yup = opt->up != AG_UP_Z;
-    r.max_v = opt->max_vertices ? opt->max_vertices : DEFAULT_MAX_VERTICES;
-    r.max_t = opt->max_triangles ? opt->max_triangles : DEFAULT_MAX_TRIANGLES;
-    r.cur_comp = -1;
-    r.nogroup_comp = -1;
-    r.m = ag_mesh_create();
+    reader r, later = {0};
+    reader_init(&r, opt, err);
     if (!r.m)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory");
-    /* A typical OBJ line is ~30 bytes, so len/60 leaves room for a balanced file. */
-    {
-        size_t guess_v = len / 60, guess_t = len / 60;
-        if (guess_v > r.max_v)
-            guess_v = r.max_v;
-        if (guess_t > r.max_t)
-            guess_t = r.max_t;
-        if (guess_v > (1u << 24))
-            guess_v = 1u << 24;
-        if (guess_t > (1u << 24))
-            guess_t = 1u << 24;
-        (void)ag_mesh_reserve(r.m, guess_v, guess_t);
-    }
+    reserve_for(&r, len);
 
     ag_status st = AG_OK;
     const char *p = data, *end = data + len;
@@ -551,79 +809,41 @@ ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_opt
         p += 3; /* UTF-8 byte order mark */
     size_t next_progress = PROGRESS_STEP;
     long line = 0;
-    /* Group names point into the input; a name from a continued line is copied here. */
-    char *held_name = NULL;
-    while (p < end) {
-        const char *nl = memchr(p, '\n', (size_t)(end - p));
-        const char *le = nl ? nl : end;
-        line++;
-        r.line = line;
-        const char *q = le;
-        while (q > p && (q[-1] == '\r' || q[-1] == ' ' || q[-1] == '\t'))
-            q--;
-        if (q > p && q[-1] == '\\' && nl) {
-            /* Continuation: join the physical lines (backslash-newline → space). */
-            size_t n = 0;
-            const char *s = p;
-            for (;;) {
-                const char *ne = memchr(s, '\n', (size_t)(end - s));
-                const char *se = ne ? ne : end;
-                const char *t = se;
-                while (t > s && (t[-1] == '\r' || t[-1] == ' ' || t[-1] == '\t'))
-                    t--;
-                int cont = ne && t > s && t[-1] == '\\';
-                size_t piece = (size_t)((cont ? t - 1 : se) - s);
-                if (n + piece + 1 > r.cap_joined) {
-                    size_t ncap = (n + piece + 1) * 2;
-                    char *nj = realloc(r.joined, ncap);
-                    if (!nj) {
-                        st = nomem(&r);
-                        goto done;
-                    }
-                    r.joined = nj;
-                    r.cap_joined = ncap;
-                }
-                memcpy(r.joined + n, s, piece);
-                n += piece;
-                r.joined[n++] = ' ';
-                s = ne ? ne + 1 : end;
-                if (!cont)
-                    break;
-                line++;
-            }
-            p = s;
-            const char *js = r.joined, *je = r.joined + n;
-            const char *ks = js;
-            while (ks < je && is_space(*ks))
-                ks++;
-            if (je - ks >= 2 && (ks[0] == 'g' || ks[0] == 'o') && is_space(ks[1])) {
-                /* The scratch buffer is reused: keep the group name elsewhere. */
-                char *copy = malloc(n);
-                if (!copy) {
-                    st = nomem(&r);
-                    goto done;
-                }
-                memcpy(copy, js, n);
-                free(held_name);
-                held_name = copy;
-                js = copy;
-                je = copy + n;
-            }
-            st = read_line(&r, js, je);
-        } else {
-            st = read_line(&r, p, le);
-            p = nl ? nl + 1 : end;
-        }
-        if (st != AG_OK)
+    /* a large file on a machine with threads: its second half read beside the first */
+    size_t split_bytes = opt->split_bytes ? opt->split_bytes : SPLIT_BYTES;
+    const char *split = len >= split_bytes && ag_parallel_threads() > 1
+                            ? split_point(p, end)
+                            : NULL;
+    ag_error later_err;
+    ag_error_clear(&later_err);
+    if (split) {
+        reader_init(&later, opt, &later_err);
+        later.later = 1;
+        if (!later.m)
+            split = NULL;
+        else
+            reserve_for(&later, (size_t)(end - split));
+    }
+    if (split) {
+        split_read sr = {.first = &r, .later = &later, .data = data, .start = p,
+                         .split = split, .end = end, .len = len, .opt = opt,
+                         .next_progress = next_progress};
+        ag_parallel_run(2, read_part, &sr);
+        line = sr.line;
+        next_progress = sr.next_progress;
+        if ((st = sr.first_st) != AG_OK)
             goto done;
-        if ((size_t)(p - data) >= next_progress) {
-            next_progress = (size_t)(p - data) + PROGRESS_STEP;
-            if (opt->progress && opt->progress(opt->user, (double)(p - data) / (double)len)) {
-                st = ag_error_set(err, AG_ERR_CANCELLED, line, "cancelled at line %ld", line);
+        if (mergeable(&sr)) {
+            if ((st = merge(&r, &later)) != AG_OK)
                 goto done;
-            }
+            p = end;
+        } else {
+            p = split; /* read on in turn */
         }
     }
+    st = read_lines(&r, data, len, p, end, &line, opt, &next_progress);
+    if (st != AG_OK)
+        goto done;
     if (opt->progress && opt->progress(opt->user, 1.0)) {
         st = ag_error_set(err, AG_ERR_CANCELLED, line, "cancelled at line %ld", line);
         goto done;
@@ -645,11 +865,9 @@ ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_opt
         goto done;
     }
 done:
-    free(held_name);
-    free(r.comp_of_group);
-    free(r.poly);
-    free(r.joined);
-    map_free(&r.map);
+    reader_free(&r);
+    reader_free(&later);
+    ag_mesh_free(later.m);
     if (st != AG_OK) {
         ag_mesh_free(r.m);
         return st;

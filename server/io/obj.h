@@ -50,6 +50,12 @@ typedef struct {
      * (the reader then returns AG_ERR_CANCELLED). May be NULL. */
     int (*progress)(void *user, double fraction);
     void *user;
+    /* Files of at least this many bytes are read in two parts at once when the program has
+     * threads (core/base/parallel.h): the later half beside the first, merged after it, or
+     * read again after it in turn when only that can tell (an error in it, an index it
+     * cannot resolve alone), so the mesh and every message are a read in turn's.
+     * 0 = 1 MiB. */
+    size_t split_bytes;
 } ag_obj_read_options;
 
 ag_status ag_obj_read_buffer(const char *data, size_t len, const ag_obj_read_options *opt,
