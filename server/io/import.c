@@ -146,9 +146,9 @@ const char *ag_import_up_basis_name(ag_up_basis b)
 
 static json_t *cues_json(const ag_upaxis_cues *c)
 {
-    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:f}", "base", c->base, "top", c->top,
+    return json_pack("{s:f, s:f, s:f, s:f, s:f, s:f, s:f}", "base", c->base, "top", c->top,
                      "vertical", c->vertical, "extent", c->extent, "origin", c->origin, "roof",
-                     c->roof);
+                     c->roof, "roof_strict", c->roof_strict);
 }
 
 json_t *ag_import_up_json(const ag_up_decision *d)

@@ -143,6 +143,7 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
 
     /* vertical share per axis */
     double area = 0, aligned[3] = {0, 0, 0}, sloped[3] = {0, 0, 0}, facing[3] = {0, 0, 0};
+    double strict_sloped[3] = {0, 0, 0}, strict_facing[3] = {0, 0, 0}, strict_area[3] = {0, 0, 0};
     uint8_t *used = calloc(m->nverts + 1, 1);
     if (!used)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory deciding the up axis");
@@ -165,6 +166,14 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
             } else {
                 sloped[a] += fabs(n[a]);
                 facing[a] += n[a];
+                /* the strict reading: a surface upright about the other candidate is that
+                 * axis's wall, so it is no roof for this one (a plan turned off the axes
+                 * makes walls sloped about the horizontal axis) */
+                if (a > 0 && fabs(n[3 - a]) / l >= PERPENDICULAR) {
+                    strict_sloped[a] += fabs(n[a]);
+                    strict_facing[a] += n[a];
+                    strict_area[a] += l;
+                }
             }
         }
     }
@@ -212,6 +221,9 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
         c->roof = sloped[a] > 0 && area - aligned[a] >= ROOF_MIN_SHARE * area
                       ? fabs(facing[a]) / sloped[a]
                       : 0;
+        c->roof_strict = strict_sloped[a] > 0 && strict_area[a] >= ROOF_MIN_SHARE * area
+                             ? fabs(strict_facing[a]) / strict_sloped[a]
+                             : 0;
         double half[3];
         for (int k = 0; k < 3; k++)
             half[k] = ext[k] > 0 ? ext[k] / 2 : 1;
@@ -241,7 +253,8 @@ ag_status ag_upaxis_decide(const ag_mesh *m, ag_upaxis_evidence *ev, ag_error *e
     const ag_upaxis_cues *y = &ev->cue[0], *z = &ev->cue[1];
     for (int a = 1; a < 3; a++) {
         const ag_upaxis_cues *c = &ev->cue[a - 1], *o = &ev->cue[2 - a];
-        if (c->roof >= ROOF_CLEAR && c->roof >= ROOF_RATIO * o->roof) {
+        if (c->roof >= ROOF_CLEAR && c->roof >= ROOF_RATIO * o->roof &&
+            c->roof_strict >= ROOF_CLEAR && c->roof_strict >= ROOF_RATIO * o->roof_strict) {
             ev->roof = 1;
             ev->axis = a;
             ev->score = a == 2 ? 1 : -1;

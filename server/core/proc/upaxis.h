@@ -30,7 +30,10 @@
  *                  (at least 0.1, and twice the other axis's) decides alone, after the storey:
  *                  the base cue is fooled by one flat wall closing an open building at one
  *                  end of a horizontal axis (a stoa's back wall looks like a floor), the roof
- *                  cue is not.
+ *                  cue is not. It must be clear also in its strict reading, which leaves out
+ *                  the surfaces upright about the other candidate: those are that axis's
+ *                  walls, and a plan turned off the coordinate axes makes its walls sloped
+ *                  about the horizontal axis, facing one way where one side has more wall.
  *   origin         models kept in their own frame (game and CAD assets) have the origin on the
  *                  ground at the centre of the plan: the two horizontal axes are centred on 0
  *                  and the up axis is not.
@@ -54,6 +57,7 @@ typedef struct {
     double top;      /* the high end's support, 0..1 (base = bottom - top) */
     double vertical; /* share of the area perpendicular or parallel to the axis, 0..1 */
     double roof;     /* how one way the sloped surfaces face along the axis, 0..1 */
+    double roof_strict; /* the same without the surfaces upright about the other axis */
     double extent;   /* the model's extent along the axis, metres */
     double origin;   /* how far the axis's centre is above the origin, in half extents,
                         when the two other axes are centred on the origin (else 0), 0..1 */
