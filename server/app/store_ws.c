@@ -396,7 +396,9 @@ static ag_status save_proc(ag_store_ws *w, ag_model_state *st, const ag_proc_out
         json_decref(op);
         return s;
     }
-    s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, 0, err);
+    /* kept as a state at once, as an edit keeps its own: the first edit would otherwise copy
+     * this version's rows (the served tree of a large model is megabytes) inside its commit */
+    s = ag__store_ws_put_state(t.db, w->o.model, t.version, st, summary, 1, err);
     if (s == AG_OK)
         s = ag_grammars_clear_terminals(t.db, w->o.model, err);
     for (size_t i = 0; s == AG_OK && i < st->terms.n; i++)

@@ -26,6 +26,7 @@
 #include "core/gen_facade.h"
 #include "io/obj.h"
 #include "store/grammars.h"
+#include "store/states.h"
 #include "file_fixture.h"
 
 static char dir[64];
@@ -102,6 +103,14 @@ static void the_store_and_a_folder_run_the_same_pipeline(void **state)
         live++;
     }
     assert_true(live > 10);
+    /* the proceduralized version is kept as a state when it is written (its tree once, in
+     * the state), so that the first edit's commit copies nothing of it */
+    ag_state_row kept;
+    assert_int_equal(ag_states_get(db, model, 2, &kept, &err), AG_OK);
+    assert_non_null(kept.tree_json);
+    assert_string_equal(kept.tree_json, g.tree_json);
+    assert_string_equal(kept.grammar, g.text);
+    ag_states_row_clear(&kept);
     ag_grammars_row_clear(&g);
     free(folder_text);
 
