@@ -856,6 +856,8 @@ static int32_t *cell_takers(const graft *g, const ag_splittree *X, const ag_spli
     }
     for (size_t s = 0; s < g->nsites; s++)
         take[s] = -1;
+    /* within what the rebuild's pattern check allows, so that the pattern still holds */
+    double tol = fmin(g->q, X->tol > 0 ? X->tol : X->eps);
     for (size_t k = 0; k < mt->nnodes; k++) {
         const ag_tnode *x = &mt->nodes[k];
         if (x->kind != AG_NODE_COMPONENT)
@@ -868,7 +870,7 @@ static int32_t *cell_takers(const graft *g, const ag_splittree *X, const ag_spli
         if (vp >= 0 || g->cell[s] < 0)
             continue;
         tops[s]++;
-        if (same_box(&g->d.box[g->nd[i]], &T->nodes[g->sites[s]].box, g->q))
+        if (same_box(&g->d.box[g->nd[i]], &T->nodes[g->sites[s]].box, tol))
             take[s] = (int32_t)i;
     }
     /* replaced cells per pattern: a pattern only partly replaced holds again only when its
