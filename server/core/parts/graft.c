@@ -827,6 +827,7 @@ nomem_:
     return nomem(err);
 }
 
+/* The number of cells of pattern node p. */
 static uint32_t cells_of(const ag_splittree *t, int32_t p)
 {
     uint32_t n = 0;
@@ -847,11 +848,13 @@ static int32_t *cell_takers(const graft *g, const ag_splittree *X, const ag_spli
     uint32_t *tops = calloc(g->nsites + 1, sizeof *tops);
     uint8_t *broken = calloc(X->nnodes + 1, 1);
     uint32_t *replaced = calloc(X->nnodes + 1, sizeof *replaced);
-    if (!take || !tops || !broken || !replaced) {
+    uint8_t *partial = calloc(X->nnodes + 1, 1); /* per pattern: 1 all cells replaced, 2 not */
+    if (!take || !tops || !broken || !replaced || !partial) {
         free(take);
         free(tops);
         free(broken);
         free(replaced);
+        free(partial);
         return NULL;
     }
     for (size_t s = 0; s < g->nsites; s++)
@@ -885,10 +888,14 @@ static int32_t *cell_takers(const graft *g, const ag_splittree *X, const ag_spli
             continue;
         if (tops[s] != 1 || take[s] < 0 || X->nodes[p].kind != AG_NODE_PATTERN)
             broken[p] = 1;
-        else if (replaced[p] != cells_of(T, p) &&
+        else if (partial[p] != 1 &&
                  (g->nvariant[take[s]] != T->nodes[g->sites[s]].variant ||
-                  g->nrot[take[s]] != T->nodes[g->sites[s]].rot))
-            broken[p] = 1;
+                  g->nrot[take[s]] != T->nodes[g->sites[s]].rot)) {
+            if (!partial[p]) /* counted once per pattern */
+                partial[p] = replaced[p] == cells_of(T, p) ? 1 : 2;
+            if (partial[p] == 2)
+                broken[p] = 1;
+        }
     }
     for (size_t s = 0; s < g->nsites; s++)
         if (g->cell[s] < 0 || broken[g->cell[s]])
@@ -896,6 +903,7 @@ static int32_t *cell_takers(const graft *g, const ag_splittree *X, const ag_spli
     free(tops);
     free(broken);
     free(replaced);
+    free(partial);
     return take;
 }
 
