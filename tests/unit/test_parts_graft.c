@@ -750,6 +750,51 @@ static void test_graft_state_is_the_rebuilds(void **state)
     ag_mesh_free(m);
 }
 
+/* A composition replacing a pattern's cells by copies of one part fitted to them keeps the
+ * pattern: its node stays (not dissolved and found again), its cells in lattice order on their
+ * boxes, the replaced ones new nodes in their cells' places. */
+static void test_cells_keep_their_pattern(void **state)
+{
+    (void)state;
+    ag_gen_facade_options go = {.cols = 6, .rows = 4, .side_cols = 4, .left = 1, .bars = 3,
+                                .no_groups = 1, .annex = 1};
+    ag_mesh *m = NULL;
+    assert_int_equal(ag_gen_facade(&go, &m, NULL), AG_OK);
+    ag_edit_model *em = model_of(m);
+    const ag_splittree *t = em->proc->tree;
+    int32_t rep = ag_splittree_most_repeated(t);
+    assert_true(rep > 0);
+    int32_t pn = t->nodes[rep].parent;
+    assert_true(pn > 0 && t->nodes[pn].kind == AG_NODE_PATTERN);
+    ag_part *piece = save_node(em->proc, rep, "window piece");
+    const int scopes[2] = {AG_COMPOSE_RULE, AG_COMPOSE_NODE};
+    for (int k = 0; k < 2; k++) {
+        int scope = scopes[k];
+        ag_edit_model *a = graft_op(em, piece, rep, AG_COMPOSE_REPLACE, scope, "cells");
+        const ag_splittree *x = a->proc->tree;
+        assert_int_equal(x->nodes[pn].kind, AG_NODE_PATTERN);
+        int32_t c = t->nodes[pn].first_child, y = x->nodes[pn].first_child;
+        size_t fresh = 0;
+        for (; c >= 0 && y >= 0; c = t->nodes[c].next_sibling, y = x->nodes[y].next_sibling) {
+            assert_int_equal(x->nodes[y].kind, AG_NODE_COMPONENT);
+            assert_true(pf_same_box(&x->nodes[y].box, &t->nodes[c].box, TOL));
+            if (c == rep)
+                assert_true((size_t)y >= t->nnodes);
+            fresh += (size_t)y >= t->nnodes;
+        }
+        assert_true(c < 0 && y < 0);
+        /* scope rule replaces every cell of the rule, scope node the target alone */
+        if (scope == AG_COMPOSE_NODE)
+            assert_int_equal(fresh, 1);
+        else
+            assert_true(fresh > 1);
+        ag_edit_model_free(a);
+    }
+    ag_part_free(piece);
+    ag_edit_model_free(em);
+    ag_mesh_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -765,6 +810,7 @@ int main(void)
         cmocka_unit_test(test_pattern_target),
         cmocka_unit_test(test_generated_facade),
         cmocka_unit_test(test_graft_state_is_the_rebuilds),
+        cmocka_unit_test(test_cells_keep_their_pattern),
         cmocka_unit_test(test_refuses_what_does_not_pair),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -307,6 +307,7 @@ typedef struct {
     int32_t *sites;
     size_t nsites;
     int32_t *hang;     /* per site: where its new components hang */
+    int32_t *cell;     /* per site: the pattern node it was a cell of (replace), else -1 */
     /* new components: the derivation's index, their site, label, variant */
     size_t nnew;
     uint32_t *nd;
@@ -321,6 +322,7 @@ static void graft_free(graft *g)
     dcomps_free(&g->d);
     free(g->sites);
     free(g->hang);
+    free(g->cell);
     free(g->nd);
     free(g->nsite);
     free(g->nlabel);
@@ -825,6 +827,121 @@ nomem_:
     return nomem(err);
 }
 
+/* The number of cells of pattern node p. */
+static uint32_t cells_of(const ag_splittree *t, int32_t p)
+{
+    uint32_t n = 0;
+    for (int32_t c = t->nodes[p].first_child; c >= 0; c = t->nodes[c].next_sibling)
+        n++;
+    return n;
+}
+
+/* Per site, the new component that takes the place of the pattern cell the site was (its
+ * box the cell's, the only one of the site's that no other new component holds), else -1.
+ * Only a pattern every one of whose replaced cells is so taken keeps its cells in place: it
+ * then holds as before, and is not dissolved and found again. mt: the new components' own
+ * nesting. */
+static int32_t *cell_takers(const graft *g, const ag_splittree *X, const ag_splittree *mt)
+{
+    const ag_splittree *T = g->in->tree;
+    int32_t *take = malloc((g->nsites + 1) * sizeof *take);
+    uint32_t *tops = calloc(g->nsites + 1, sizeof *tops);
+    uint8_t *broken = calloc(X->nnodes + 1, 1);
+    uint32_t *replaced = calloc(X->nnodes + 1, sizeof *replaced);
+    uint8_t *partial = calloc(X->nnodes + 1, 1); /* per pattern: 1 all cells replaced, 2 not */
+    if (!take || !tops || !broken || !replaced || !partial) {
+        free(take);
+        free(tops);
+        free(broken);
+        free(replaced);
+        free(partial);
+        return NULL;
+    }
+    for (size_t s = 0; s < g->nsites; s++)
+        take[s] = -1;
+    /* within what the rebuild's pattern check allows, so that the pattern still holds */
+    double tol = fmin(g->q, X->tol > 0 ? X->tol : X->eps);
+    for (size_t k = 0; k < mt->nnodes; k++) {
+        const ag_tnode *x = &mt->nodes[k];
+        if (x->kind != AG_NODE_COMPONENT)
+            continue;
+        int32_t vp = x->parent;
+        while (vp >= 0 && mt->nodes[vp].kind != AG_NODE_COMPONENT)
+            vp = mt->nodes[vp].parent;
+        size_t i = (size_t)x->component;
+        int32_t s = g->nsite[i];
+        if (vp >= 0 || g->cell[s] < 0)
+            continue;
+        tops[s]++;
+        if (same_box(&g->d.box[g->nd[i]], &T->nodes[g->sites[s]].box, tol))
+            take[s] = (int32_t)i;
+    }
+    /* replaced cells per pattern: a pattern only partly replaced holds again only when its
+     * new cells repeat its rule, so those must at least be its cells' variant (else it is
+     * dissolved, and its cells are best hung as before) */
+    for (size_t s = 0; s < g->nsites; s++)
+        if (g->cell[s] >= 0)
+            replaced[g->cell[s]]++;
+    for (size_t s = 0; s < g->nsites; s++) {
+        int32_t p = g->cell[s];
+        if (p < 0)
+            continue;
+        if (tops[s] != 1 || take[s] < 0 || X->nodes[p].kind != AG_NODE_PATTERN)
+            broken[p] = 1;
+        else if (partial[p] != 1 &&
+                 (g->nvariant[take[s]] != T->nodes[g->sites[s]].variant ||
+                  g->nrot[take[s]] != T->nodes[g->sites[s]].rot)) {
+            if (!partial[p]) /* counted once per pattern */
+                partial[p] = replaced[p] == cells_of(T, p) ? 1 : 2;
+            if (partial[p] == 2)
+                broken[p] = 1;
+        }
+    }
+    for (size_t s = 0; s < g->nsites; s++)
+        if (g->cell[s] < 0 || broken[g->cell[s]])
+            take[s] = -1;
+    free(tops);
+    free(broken);
+    free(replaced);
+    free(partial);
+    return take;
+}
+
+/* The cells of pattern node p in X in the order they had in in's tree, each replaced cell's
+ * place taken by its new node (placed: per site; site_of: per node of in's tree), so the
+ * lattice order of the pattern is kept; its box spans them again. */
+static void cells_reorder(const graft *g, ag_splittree *X, int32_t p, const int32_t *placed,
+                          const int32_t *site_of)
+{
+    const ag_splittree *T = g->in->tree;
+    ag_tnode *P = &X->nodes[p];
+    int32_t last = -1;
+    P->first_child = P->last_child = -1;
+    for (int32_t c = T->nodes[p].first_child; c >= 0; c = T->nodes[c].next_sibling) {
+        int32_t v = -1;
+        if (X->nodes[c].kind != AG_NODE_DEAD && X->nodes[c].parent == p)
+            v = c;
+        else if (site_of[c] >= 0 && placed[site_of[c]] >= 0)
+            v = placed[site_of[c]];
+        if (v < 0)
+            continue;
+        X->nodes[v].parent = p;
+        X->nodes[v].next_sibling = -1;
+        if (last >= 0)
+            X->nodes[last].next_sibling = v;
+        else
+            P->first_child = v;
+        last = v;
+    }
+    P->last_child = last;
+    if (last < 0)
+        return;
+    ag_box b = X->nodes[P->first_child].box;
+    for (int32_t c = X->nodes[P->first_child].next_sibling; c >= 0; c = X->nodes[c].next_sibling)
+        ag_box_extend_box(&b, &X->nodes[c].box);
+    P->box = b;
+}
+
 /* The new components nested among themselves (the split tree's rule) and inserted into X
  * under their sites' hang nodes. */
 static ag_status insert_new(graft *g, ag_splittree *X, ag_error *err)
@@ -851,7 +968,8 @@ static ag_status insert_new(graft *g, ag_splittree *X, ag_error *err)
     ml.diagonal = L0->diagonal;
     ml.exact = L0->exact;
     ag_splittree *mt = NULL;
-    int32_t *map = NULL;
+    int32_t *map = NULL, *take = NULL, *placed = NULL, *site_of = NULL;
+    uint8_t *done_p = NULL;
     ag_status st = AG_OK;
     if (!ml.box || !ml.ntris || !ml.label || !ml.variant || !ml.vrot) {
         st = nomem(err);
@@ -866,10 +984,13 @@ static ag_status insert_new(graft *g, ag_splittree *X, ag_error *err)
     }
     if ((st = ag_splittree_build(g->D, &ml, &mt, err)))
         goto done;
-    if (!(map = malloc((mt->nnodes + 1) * sizeof *map))) {
+    if (!(map = malloc((mt->nnodes + 1) * sizeof *map)) || !(take = cell_takers(g, X, mt)) ||
+        !(placed = malloc((g->nsites + 1) * sizeof *placed))) {
         st = nomem(err);
         goto done;
     }
+    for (size_t s = 0; s < g->nsites; s++)
+        placed[s] = -1;
     double nest = fmax(X->eps, X->tol);
     for (size_t k = 0; k < mt->nnodes && !st; k++) {
         map[k] = -1;
@@ -881,10 +1002,17 @@ static ag_status insert_new(graft *g, ag_splittree *X, ag_error *err)
             vp = mt->nodes[vp].parent;
         size_t i = (size_t)x->component;
         ag_box b = g->d.box[g->nd[i]];
-        int32_t parent = vp >= 0 && map[vp] >= 0 ? map[vp] : g->hang[g->nsite[i]];
-        parent = holder(X, parent, &b, nest);
+        int32_t s = g->nsite[i], n;
         ag_box_extend_box(&X->nodes[0].box, &b);
-        int32_t n = ag_splittree_insert(X, parent, &b, AG_NODE_COMPONENT);
+        if (vp < 0 && take[s] == (int32_t)i) {
+            /* the cell's place in its pattern: no split chain (the pattern places its cells) */
+            n = ag_splittree_add_node(X, AG_NODE_COMPONENT);
+            placed[s] = n;
+        } else {
+            int32_t parent = vp >= 0 && map[vp] >= 0 ? map[vp] : g->hang[s];
+            parent = holder(X, parent, &b, nest);
+            n = ag_splittree_insert(X, parent, &b, AG_NODE_COMPONENT);
+        }
         if (n < 0) {
             st = nomem(err);
             break;
@@ -898,7 +1026,33 @@ static ag_status insert_new(graft *g, ag_splittree *X, ag_error *err)
         X->comp_node[n0 + i] = n;
         map[k] = n;
     }
+    /* the replaced cells' new nodes into their patterns, in the cells' places */
+    size_t ntaken = 0;
+    for (size_t s = 0; !st && s < g->nsites; s++)
+        ntaken += placed[s] >= 0;
+    if (!st && ntaken) {
+        const ag_splittree *T = g->in->tree;
+        if (!(site_of = malloc((T->nnodes + 1) * sizeof *site_of)) ||
+            !(done_p = calloc(X->nnodes + 1, 1))) {
+            st = nomem(err);
+            goto done;
+        }
+        for (size_t v = 0; v < T->nnodes; v++)
+            site_of[v] = -1;
+        for (size_t s = 0; s < g->nsites; s++)
+            if (placed[s] >= 0)
+                site_of[g->sites[s]] = (int32_t)s;
+        for (size_t s = 0; s < g->nsites; s++)
+            if (placed[s] >= 0 && !done_p[g->cell[s]]) {
+                done_p[g->cell[s]] = 1;
+                cells_reorder(g, X, g->cell[s], placed, site_of);
+            }
+    }
 done:
+    free(take);
+    free(placed);
+    free(site_of);
+    free(done_p);
     free(ml.box);
     free(ml.ntris);
     free(ml.label);
@@ -965,12 +1119,14 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
     /* removals */
     if (!(X = ag_splittree_copy(T)) || !(gone = calloc(T->nnodes + 1, 1)) ||
         !(g.hang = malloc((g.nsites + 1) * sizeof *g.hang)) ||
+        !(g.cell = malloc((g.nsites + 1) * sizeof *g.cell)) ||
         !(stack = malloc((T->nnodes + 1) * sizeof *stack))) {
         st = nomem(err);
         goto done;
     }
     for (size_t s = 0; s < g.nsites; s++) {
         int32_t n = g.sites[s];
+        g.cell[s] = -1;
         if (X->nodes[n].kind == AG_NODE_DEAD) { /* inside a site removed before */
             g.hang[s] = 0;
             continue;
@@ -978,6 +1134,9 @@ ag_status ag_graft_compose(const ag_proceduralize_result *in, const ag_compose_o
         int whole = op->mode == AG_COMPOSE_REPLACE && n != 0;
         if (whole) {
             int32_t p = X->nodes[n].parent;
+            if (X->nodes[n].kind == AG_NODE_COMPONENT && p >= 0 &&
+                X->nodes[p].kind == AG_NODE_PATTERN)
+                g.cell[s] = p;
             while (p > 0 && X->nodes[p].kind != AG_NODE_COMPONENT)
                 p = X->nodes[p].parent;
             g.hang[s] = p < 0 ? 0 : p;
