@@ -215,29 +215,42 @@ size_t ag_rules_max_count(const ag_splittree *t)
 
 /* The visible nodes in an order where every visible node comes after the visible nodes below
  * it: reverse index order when every visible node's nearest visible ancestor has a smaller
- * index (a tree as built, or edited keeping that), else a post-order walk. */
-static int32_t *children_first(const ag_splittree *t, size_t *n_out)
+ * index (a tree as built, or edited keeping that), else a post-order walk. One pass over the
+ * nodes (an edited tree is mostly dead nodes: each pass over them costs more than the live
+ * ones' work) also gives the largest variant of a visible node. */
+static int32_t *children_first(const ag_splittree *t, size_t *n_out, int32_t *maxvariant)
 {
     size_t N = t->nnodes, n = 0;
     int32_t *order = malloc((N + 1) * sizeof *order);
     if (!order)
         return NULL;
     int indexed = 1;
-    for (size_t i = 0; i < N && indexed; i++) {
-        if (t->nodes[i].kind != AG_NODE_COMPONENT)
+    int32_t mv = -1;
+    for (size_t i = 0; i < N; i++) {
+        const ag_tnode *x = &t->nodes[i];
+        if (x->kind != AG_NODE_COMPONENT)
             continue;
-        int32_t p = t->nodes[i].parent;
+        if (x->variant > mv)
+            mv = x->variant;
+        order[n++] = (int32_t)i;
+        if (!indexed)
+            continue;
+        int32_t p = x->parent;
         while (p >= 0 && t->nodes[p].kind != AG_NODE_COMPONENT && t->nodes[p].kind != AG_NODE_ROOT)
             p = t->nodes[p].parent;
         indexed = p < (int32_t)i;
     }
+    *maxvariant = mv;
     if (indexed) {
-        for (size_t i = N; i-- > 0;)
-            if (t->nodes[i].kind == AG_NODE_COMPONENT)
-                order[n++] = (int32_t)i;
+        for (size_t i = 0, j = n; i < j / 2; i++) {
+            int32_t v = order[i];
+            order[i] = order[j - 1 - i];
+            order[j - 1 - i] = v;
+        }
         *n_out = n;
         return order;
     }
+    n = 0;
     /* iterative post-order: a node is emitted once its children are */
     int32_t *stack = malloc((N + 1) * sizeof *stack), *next = malloc((N + 1) * sizeof *next);
     if (!stack || !next) {
@@ -268,52 +281,69 @@ static int32_t *children_first(const ag_splittree *t, size_t *n_out)
     return order;
 }
 
+/* The comparison's scratch, grown to the most children a compared node has (not the tree's
+ * size: most of an edited tree's nodes are dead). */
+typedef struct {
+    int32_t *ca, *cb;
+    uint8_t *used;
+    size_t cap;
+} same_bufs;
+
+static int bufs_reserve(same_bufs *b, same_scratch *sc, size_t n)
+{
+    if (n <= b->cap && b->ca)
+        return 0;
+    size_t cap = b->cap ? b->cap : 16;
+    while (cap < n)
+        cap *= 2;
+    int32_t *ca = realloc(b->ca, cap * sizeof *ca);
+    if (ca)
+        b->ca = ca;
+    int32_t *cb = realloc(b->cb, cap * sizeof *cb);
+    if (cb)
+        b->cb = cb;
+    uint8_t *used = realloc(b->used, cap);
+    if (used)
+        b->used = used;
+    double *lo = realloc(sc->lo, 3 * cap * sizeof *lo);
+    if (lo)
+        sc->lo = lo;
+    double *hi = realloc(sc->hi, 3 * cap * sizeof *hi);
+    if (hi)
+        sc->hi = hi;
+    if (!ca || !cb || !used || !lo || !hi)
+        return -1;
+    b->cap = cap;
+    return 0;
+}
+
 ag_status ag_rules_label(ag_splittree *t, ag_error *err)
 {
     size_t N = t->nnodes;
-    /* per variant: list of rules whose representative has that variant */
+    /* children first, so each comparison is one level deep */
+    size_t norder = 0;
     int32_t maxlabel = -1;
-    for (size_t i = 0; i < N; i++)
-        if (t->nodes[i].variant > maxlabel)
-            maxlabel = t->nodes[i].variant;
-    int32_t *lhead = malloc(((size_t)maxlabel + 2) * sizeof *lhead);
-    int32_t *rnext = malloc((N + 1) * sizeof *rnext);
-    int32_t *ca = malloc((N + 1) * sizeof *ca), *cb = malloc((N + 1) * sizeof *cb);
-    uint8_t *used = malloc(N + 1);
-    same_scratch sc = {malloc((3 * N + 1) * sizeof *sc.lo), malloc((3 * N + 1) * sizeof *sc.hi),
-                       NULL, 0, 0};
+    int32_t *order = children_first(t, &norder, &maxlabel);
+    /* per variant: list of rules whose representative has that variant */
+    int32_t *lhead = order ? malloc(((size_t)maxlabel + 2) * sizeof *lhead) : NULL;
+    int32_t *rnext = malloc((norder + 1) * sizeof *rnext);
+    same_bufs bufs = {0};
+    same_scratch sc = {NULL, NULL, NULL, 0, 0};
     free(t->rule_count);
     free(t->rule_rep);
-    t->rule_count = malloc((N + 1) * sizeof *t->rule_count);
-    t->rule_rep = malloc((N + 1) * sizeof *t->rule_rep);
+    /* a rule has one visible node at least */
+    t->rule_count = malloc((norder + 1) * sizeof *t->rule_count);
+    t->rule_rep = malloc((norder + 1) * sizeof *t->rule_rep);
     t->nrules = 0;
-    if (!lhead || !rnext || !ca || !cb || !used || !t->rule_count || !t->rule_rep || !sc.lo ||
-        !sc.hi) {
-        free(sc.lo);
-        free(sc.hi);
+    if (!order || !lhead || !rnext || !t->rule_count || !t->rule_rep) {
+        free(order);
         free(lhead);
         free(rnext);
-        free(ca);
-        free(cb);
-        free(used);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     }
     for (int32_t l = 0; l <= maxlabel; l++)
         lhead[l] = -1;
-    /* children first, so each comparison is one level deep */
-    size_t norder = 0;
-    int32_t *order = children_first(t, &norder);
-    if (!order) {
-        free(sc.lo);
-        free(sc.hi);
-        free(lhead);
-        free(rnext);
-        free(ca);
-        free(cb);
-        free(used);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
-    }
-    for (size_t oi = 0; oi < norder; oi++) {
+    for (size_t oi = 0; oi < norder && !sc.nomem; oi++) {
         size_t ii = (size_t)order[oi];
         ag_tnode *b = &t->nodes[ii];
         size_t nb = children(t, (int32_t)ii, NULL, 0);
@@ -323,12 +353,18 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
             int32_t a = t->rule_rep[r];
             if (children(t, a, NULL, 0) != nb)
                 continue;
+            if (bufs_reserve(&bufs, &sc, nb)) {
+                sc.nomem = 1;
+                break;
+            }
             int k = (b->rot - t->nodes[a].rot) & 3;
-            if (same(t, a, (int32_t)ii, k, ca, cb, used, nb, &sc)) {
+            if (same(t, a, (int32_t)ii, k, bufs.ca, bufs.cb, bufs.used, nb, &sc)) {
                 found = r;
                 fk = k;
             }
         }
+        if (sc.nomem)
+            break;
         if (found < 0) {
             found = (int32_t)t->nrules++;
             t->rule_rep[found] = (int32_t)ii;
@@ -345,6 +381,13 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     free(sc.lo);
     free(sc.hi);
     free(sc.ent);
+    free(bufs.ca);
+    free(bufs.cb);
+    free(bufs.used);
+    free(lhead);
+    free(rnext);
+    if (sc.nomem)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     /* a pattern repeats its cells' rule */
     for (size_t p = 0; p < t->npatterns; p++) {
         int32_t pn = t->patterns[p].node;
@@ -354,12 +397,5 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
             t->patterns[p].rot = t->nodes[c].rule_rot;
         }
     }
-    free(lhead);
-    free(rnext);
-    free(ca);
-    free(cb);
-    free(used);
-    if (sc.nomem)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     return AG_OK;
 }
