@@ -112,13 +112,8 @@ static uint64_t corner_cell(const double p[3], double cell, const int64_t add[3]
 static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca, int32_t *cb,
                 uint8_t *used, size_t n, same_scratch *sc)
 {
-    size_t na = children(t, a, ca, n), nb = children(t, b, cb, n);
-    assert(na == n && nb == n); /* the caller compared the counts */
-    (void)na;
-    (void)nb;
-    memset(used, 0, n);
     double tol = t->tol;
-    {
+    {   /* the sizes first: most candidates differ there, before their children are walked */
         double ea[3], eb[3];
         ag_box_extents(&t->nodes[a].box, ea);
         ag_box_extents(&t->nodes[b].box, eb);
@@ -127,6 +122,11 @@ static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca,
             fabs(ea[2] - eb[2]) > tol)
             return 0;
     }
+    size_t na = children(t, a, ca, n), nb = children(t, b, cb, n);
+    assert(na == n && nb == n); /* the caller compared the counts */
+    (void)na;
+    (void)nb;
+    memset(used, 0, n);
     if (n <= SAME_INDEX_MIN) {
         for (size_t j = 0; j < n; j++) {
             double blo[3], bhi[3];
@@ -327,6 +327,9 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     /* per variant: list of rules whose representative has that variant */
     int32_t *lhead = order ? malloc(((size_t)maxlabel + 2) * sizeof *lhead) : NULL;
     int32_t *rnext = malloc((norder + 1) * sizeof *rnext);
+    /* per rule: its representative's child count (a candidate with another is no match;
+     * counting a wall's thousands of children once per candidate was most of the work) */
+    size_t *rkids = malloc((norder + 1) * sizeof *rkids);
     same_bufs bufs = {0};
     same_scratch sc = {NULL, NULL, NULL, 0, 0};
     free(t->rule_count);
@@ -335,10 +338,11 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     t->rule_count = malloc((norder + 1) * sizeof *t->rule_count);
     t->rule_rep = malloc((norder + 1) * sizeof *t->rule_rep);
     t->nrules = 0;
-    if (!order || !lhead || !rnext || !t->rule_count || !t->rule_rep) {
+    if (!order || !lhead || !rnext || !rkids || !t->rule_count || !t->rule_rep) {
         free(order);
         free(lhead);
         free(rnext);
+        free(rkids);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     }
     for (int32_t l = 0; l <= maxlabel; l++)
@@ -351,7 +355,7 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
         int fk = 0;
         for (int32_t r = lhead[b->variant]; r >= 0 && found < 0; r = rnext[r]) {
             int32_t a = t->rule_rep[r];
-            if (children(t, a, NULL, 0) != nb)
+            if (rkids[r] != nb)
                 continue;
             if (bufs_reserve(&bufs, &sc, nb)) {
                 sc.nomem = 1;
@@ -369,6 +373,7 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
             found = (int32_t)t->nrules++;
             t->rule_rep[found] = (int32_t)ii;
             t->rule_count[found] = 0;
+            rkids[found] = nb;
             rnext[found] = lhead[b->variant];
             lhead[b->variant] = found;
             fk = 0;
@@ -386,6 +391,7 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     free(bufs.used);
     free(lhead);
     free(rnext);
+    free(rkids);
     if (sc.nomem)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     /* a pattern repeats its cells' rule */
