@@ -104,6 +104,58 @@ static uint64_t corner_cell(const double p[3], double cell, const int64_t add[3]
                          (int64_t)floor(p[2] / cell) + add[2]);
 }
 
+/* Does a box of extents eb have the size of one of extents ea turned by k quarter turns? */
+static int same_size(const double ea[3], const double eb[3], int k, double tol)
+{
+    int odd = k & 1;
+    return !(fabs(ea[odd ? 1 : 0] - eb[0]) > tol || fabs(ea[odd ? 0 : 1] - eb[1]) > tol ||
+             fabs(ea[2] - eb[2]) > tol);
+}
+
+/* A rule's representative as the search for a node's rule first compares it: its child
+ * count, the sum of its children's classes (below), turn and extents. */
+typedef struct {
+    size_t kids;
+    uint64_t sig;
+    double ext[3];
+    uint8_t rot;
+} rule_key;
+
+/* A child's class as same_child compares it before its turn and place: its kind and its rule
+ * (a pattern's: the pattern's rule; none for a pattern out of range). Two nodes whose
+ * children's classes differ as multisets are not the same: the sums of their mixed classes
+ * tell most such pairs apart without the comparison. */
+static uint64_t child_class(const ag_splittree *t, const ag_tnode *x)
+{
+    uint64_t r;
+    if (x->kind == AG_NODE_PATTERN)
+        r = x->pattern >= 0 && (size_t)x->pattern < t->npatterns
+                ? (uint32_t)t->patterns[x->pattern].rule
+                : UINT64_C(1) << 32;
+    else
+        r = (uint32_t)x->rule;
+    uint64_t z = r ^ (uint64_t)x->kind << 40;
+    z = (z ^ (z >> 30)) * UINT64_C(0xbf58476d1ce4e5b9); /* splitmix64's finaliser */
+    z = (z ^ (z >> 27)) * UINT64_C(0x94d049bb133111eb);
+    return z ^ (z >> 31);
+}
+
+/* The number of children of v (as children() counts them) and the sum of their classes. */
+static size_t children_sig(const ag_splittree *t, int32_t v, uint64_t *sig)
+{
+    size_t n = 0;
+    uint64_t s = 0;
+    for (int32_t c = t->nodes[v].first_child; c >= 0; c = t->nodes[c].next_sibling) {
+        int32_t e = ag_splittree_chain_end(t, c);
+        if (e >= 0) {
+            s += child_class(t, &t->nodes[e]);
+            n++;
+        }
+    }
+    *sig = s;
+    return n;
+}
+
 /* Does b match rep a with b = rotate(a, k)? b must also have a's size: a rule is placed scaled
  * to the box it is applied to (its children would move with it) and a pattern's cells are of
  * one size (nodes of one variant have it anyway; an edited model's stretched copies of a
@@ -117,9 +169,7 @@ static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca,
         double ea[3], eb[3];
         ag_box_extents(&t->nodes[a].box, ea);
         ag_box_extents(&t->nodes[b].box, eb);
-        int odd = k & 1;
-        if (fabs(ea[odd ? 1 : 0] - eb[0]) > tol || fabs(ea[odd ? 0 : 1] - eb[1]) > tol ||
-            fabs(ea[2] - eb[2]) > tol)
+        if (!same_size(ea, eb, k, tol))
             return 0;
     }
     size_t na = children(t, a, ca, n), nb = children(t, b, cb, n);
@@ -327,9 +377,9 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     /* per variant: list of rules whose representative has that variant */
     int32_t *lhead = order ? malloc(((size_t)maxlabel + 2) * sizeof *lhead) : NULL;
     int32_t *rnext = malloc((norder + 1) * sizeof *rnext);
-    /* per rule: its representative's child count (a candidate with another is no match;
-     * counting a wall's thousands of children once per candidate was most of the work) */
-    size_t *rkids = malloc((norder + 1) * sizeof *rkids);
+    /* per rule: what same() looks at first of its representative, kept together (an edited
+     * model's stretched copies make many rules of one variant, each node tries them all) */
+    rule_key *rkey = malloc((norder + 1) * sizeof *rkey);
     same_bufs bufs = {0};
     same_scratch sc = {NULL, NULL, NULL, 0, 0};
     free(t->rule_count);
@@ -338,11 +388,11 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     t->rule_count = malloc((norder + 1) * sizeof *t->rule_count);
     t->rule_rep = malloc((norder + 1) * sizeof *t->rule_rep);
     t->nrules = 0;
-    if (!order || !lhead || !rnext || !rkids || !t->rule_count || !t->rule_rep) {
+    if (!order || !lhead || !rnext || !rkey || !t->rule_count || !t->rule_rep) {
         free(order);
         free(lhead);
         free(rnext);
-        free(rkids);
+        free(rkey);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     }
     for (int32_t l = 0; l <= maxlabel; l++)
@@ -350,13 +400,18 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     for (size_t oi = 0; oi < norder && !sc.nomem; oi++) {
         size_t ii = (size_t)order[oi];
         ag_tnode *b = &t->nodes[ii];
-        size_t nb = children(t, (int32_t)ii, NULL, 0);
+        uint64_t sig;
+        size_t nb = children_sig(t, (int32_t)ii, &sig);
+        double eb[3];
+        ag_box_extents(&b->box, eb);
         int32_t found = -1;
         int fk = 0;
         for (int32_t r = lhead[b->variant]; r >= 0 && found < 0; r = rnext[r]) {
-            int32_t a = t->rule_rep[r];
-            if (rkids[r] != nb)
+            const rule_key *q = &rkey[r];
+            if (q->kids != nb || q->sig != sig ||
+                !same_size(q->ext, eb, (b->rot - q->rot) & 3, t->tol))
                 continue;
+            int32_t a = t->rule_rep[r];
             if (bufs_reserve(&bufs, &sc, nb)) {
                 sc.nomem = 1;
                 break;
@@ -373,7 +428,10 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
             found = (int32_t)t->nrules++;
             t->rule_rep[found] = (int32_t)ii;
             t->rule_count[found] = 0;
-            rkids[found] = nb;
+            rkey[found].kids = nb;
+            rkey[found].sig = sig;
+            rkey[found].rot = b->rot;
+            memcpy(rkey[found].ext, eb, sizeof eb);
             rnext[found] = lhead[b->variant];
             lhead[b->variant] = found;
             fk = 0;
@@ -391,7 +449,7 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     free(bufs.used);
     free(lhead);
     free(rnext);
-    free(rkids);
+    free(rkey);
     if (sc.nomem)
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     /* a pattern repeats its cells' rule */
