@@ -329,8 +329,10 @@ static ag_status bvh_query(adj_bvh *h, const ag_splittree *t, uint32_t q)
 }
 
 /* t's pairs without those of a changed node (the others are as they were), merged with the
- * sorted pairs found for the changed nodes (those have a changed node: the two are apart), in
- * one pass over the old pairs. */
+ * sorted pairs found for the changed nodes (those have a changed node: the two are apart).
+ * In place: the kept pairs close up from the front, then the two merge from the back into
+ * the array grown by the found ones (a new array of a few million pairs costs more in fresh
+ * pages than the merge itself). */
 static ag_status merge_found(ag_splittree *t, const uint8_t *changed, ag_radix_item *found,
                              size_t nfound)
 {
@@ -338,32 +340,41 @@ static ag_status merge_found(ag_splittree *t, const uint8_t *changed, ag_radix_i
     for (size_t f = 0; f < nfound; f++) /* a pair of two changed nodes was found from both */
         if (!nf || found[f].key != found[nf - 1].key)
             found[nf++] = found[f];
-    size_t cap = t->nadj + nf;
-    uint32_t *adj = cap ? malloc(2 * cap * sizeof *adj) : NULL;
-    if (cap && !adj)
-        return AG_ERR_NOMEM;
-    const uint32_t *old = t->adj;
-    size_t w = 0, f = 0;
+    uint32_t *adj = t->adj;
+    size_t w = 0;
     for (size_t p = 0; p < t->nadj; p++) {
-        uint32_t a = old[2 * p], b = old[2 * p + 1];
+        uint32_t a = adj[2 * p], b = adj[2 * p + 1];
         if (a >= nn || b >= nn || changed[a] || changed[b])
             continue;
-        uint64_t key = (uint64_t)a << 32 | b;
-        for (; f < nf && found[f].key < key; f++, w++) {
-            adj[2 * w] = (uint32_t)(found[f].key >> 32);
-            adj[2 * w + 1] = (uint32_t)found[f].key;
+        if (w != p) { /* pairs before the first one dropped stay where they are */
+            adj[2 * w] = a;
+            adj[2 * w + 1] = b;
         }
-        adj[2 * w] = a;
-        adj[2 * w + 1] = b;
         w++;
     }
-    for (; f < nf; f++, w++) {
-        adj[2 * w] = (uint32_t)(found[f].key >> 32);
-        adj[2 * w + 1] = (uint32_t)found[f].key;
-    }
-    free(t->adj);
-    t->adj = adj;
     t->nadj = w;
+    if (!nf)
+        return AG_OK;
+    adj = realloc(t->adj, 2 * (w + nf) * sizeof *adj);
+    if (!adj)
+        return AG_ERR_NOMEM;
+    t->adj = adj;
+    size_t k = w, f = nf, o = w + nf;
+    while (f > 0) {
+        uint64_t fk = found[f - 1].key;
+        if (k > 0 && ((uint64_t)adj[2 * (k - 1)] << 32 | adj[2 * (k - 1) + 1]) > fk) {
+            k--;
+            o--;
+            adj[2 * o] = adj[2 * k];
+            adj[2 * o + 1] = adj[2 * k + 1];
+        } else {
+            f--;
+            o--;
+            adj[2 * o] = (uint32_t)(fk >> 32);
+            adj[2 * o + 1] = (uint32_t)fk;
+        }
+    }
+    t->nadj = w + nf;
     return AG_OK;
 }
 
