@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../base/array.h"
 #include "../base/tolerance.h"
 #include "../proc/adjacency.h"
 #include "resize.h"
@@ -19,9 +20,12 @@ static ag_status nomem(ag_error *err)
 /* ---- the mesh ---------------------------------------------------------------------------- */
 
 /* The visible nodes of t in component order: the input's components whose node stays, in
- * their order, then the nodes that place another's component (copies), in index order. */
+ * their order, then the nodes that place another's component (copies), in index order.
+ * comps (ncomps of them) lists t's visible nodes in index order when the caller has them, so
+ * the dead nodes are not looked at again; NULL: they are found here. */
 static int32_t *component_order(const ag_proceduralize_result *in, const ag_splittree *t,
-                                const int32_t *source, size_t *n)
+                                const int32_t *source, const int32_t *comps, size_t ncomps,
+                                size_t *n)
 {
     const ag_splittree *ot = in->tree;
     int32_t *order = malloc((t->nnodes + 1) * sizeof *order);
@@ -41,9 +45,15 @@ static int32_t *component_order(const ag_proceduralize_result *in, const ag_spli
         }
     }
     /* then the nodes that place another node's component (copies, a join's node) */
-    for (size_t v = 0; v < t->nnodes; v++)
-        if (t->nodes[v].kind == AG_NODE_COMPONENT && !taken[v])
-            order[k++] = (int32_t)v;
+    if (comps) {
+        for (size_t i = 0; i < ncomps; i++)
+            if (!taken[comps[i]])
+                order[k++] = comps[i];
+    } else {
+        for (size_t v = 0; v < t->nnodes; v++)
+            if (t->nodes[v].kind == AG_NODE_COMPONENT && !taken[v])
+                order[k++] = (int32_t)v;
+    }
     free(taken);
     *n = k;
     return order;
@@ -140,7 +150,7 @@ ag_status ag_rebuild_mesh(const ag_proceduralize_result *in, const ag_splittree 
 {
     *out = NULL;
     size_t n;
-    int32_t *order = component_order(in, t, source, &n);
+    int32_t *order = component_order(in, t, source, NULL, 0, &n);
     if (!order)
         return nomem(err);
     ag_status st = emit(in, t, source, order, n, out, err);
@@ -280,8 +290,20 @@ static void rebase_turns(ag_labels *L, ag_splittree *t)
 
 /* ---- the tree ---------------------------------------------------------------------------- */
 
-/* Component map of a tree whose visible nodes carry their component. */
-static ag_status tree_components(ag_splittree *t, size_t nc)
+/* The visible nodes of a tree being rebuilt, when known: every visible node (norder, in
+ * component order, each with its own component) and the pattern nodes in index order. The
+ * later stages then look at these instead of every node: an edited tree's nodes are mostly
+ * dead ones. */
+typedef struct {
+    const int32_t *order;
+    size_t norder;
+    const int32_t *pats;
+    size_t npats;
+} live_nodes;
+
+/* Component map of a tree whose visible nodes carry their component (all of them in
+ * live->order when live is given; distinct nodes have distinct components). */
+static ag_status tree_components(ag_splittree *t, size_t nc, const live_nodes *live)
 {
     free(t->comp_node);
     t->ncomponents = nc;
@@ -290,6 +312,14 @@ static ag_status tree_components(ag_splittree *t, size_t nc)
         return AG_ERR_NOMEM;
     for (size_t c = 0; c < nc; c++)
         t->comp_node[c] = -1;
+    if (live) {
+        for (size_t i = 0; i < live->norder; i++) {
+            const ag_tnode *x = &t->nodes[live->order[i]];
+            if (x->kind == AG_NODE_COMPONENT && x->component >= 0 && (size_t)x->component < nc)
+                t->comp_node[x->component] = live->order[i];
+        }
+        return AG_OK;
+    }
     for (size_t n = 0; n < t->nnodes; n++)
         if (t->nodes[n].kind == AG_NODE_COMPONENT && t->nodes[n].component >= 0 &&
             (size_t)t->nodes[n].component < nc)
@@ -385,18 +415,23 @@ static ag_status dissolve(ag_splittree *t, int32_t pn)
 /* Rules found again; patterns that no longer hold dissolved (then rules once more); new
  * repetitions found. */
 static ag_status rules_and_patterns(ag_splittree *t, const ag_patterns_options *popt,
-                                    ag_error *err)
+                                    const live_nodes *live, ag_error *err)
 {
     ag_status st = ag_rules_label(t, err);
     if (st)
         return st;
     int dissolved = 0;
-    for (size_t n = 0; n < t->nnodes; n++)
-        if (t->nodes[n].kind == AG_NODE_PATTERN && !pattern_holds(t, (int32_t)n)) {
-            if ((st = dissolve(t, (int32_t)n)))
+    /* a dissolution only adds split nodes and kills its own pattern's chain: the pattern
+     * nodes listed before are all there are */
+    size_t npn = live ? live->npats : t->nnodes;
+    for (size_t i = 0; i < npn; i++) {
+        int32_t n = live ? live->pats[i] : (int32_t)i;
+        if (t->nodes[n].kind == AG_NODE_PATTERN && !pattern_holds(t, n)) {
+            if ((st = dissolve(t, n)))
                 return nomem(err);
             dissolved = 1;
         }
+    }
     if (dissolved) {
         compact_patterns(t);
         if ((st = ag_rules_label(t, err)))
@@ -411,13 +446,13 @@ static ag_status rules_and_patterns(ag_splittree *t, const ag_patterns_options *
 }
 
 static ag_status finish(ag_mesh *mesh, ag_labels *L, ag_splittree *t, int with_rules,
-                        const ag_patterns_options *popt, ag_proceduralize_result **out,
-                        ag_error *err)
+                        const ag_patterns_options *popt, const live_nodes *live,
+                        ag_proceduralize_result **out, ag_error *err)
 {
     ag_proceduralize_result *r = calloc(1, sizeof *r);
     ag_status st = r ? AG_OK : AG_ERR_NOMEM;
     if (!st)
-        st = tree_components(t, mesh->ncomponents);
+        st = tree_components(t, mesh->ncomponents, live);
     if (!st)
         st = labels_complete(L, mesh, t);
     if (!st)
@@ -428,21 +463,37 @@ static ag_status finish(ag_mesh *mesh, ag_labels *L, ag_splittree *t, int with_r
     }
     if (with_rules)
         rebase_turns(L, t);
-    if (with_rules && (st = rules_and_patterns(t, popt, err)))
+    if (with_rules && (st = rules_and_patterns(t, popt, live, err)))
         goto fail;
     /* a dead node names nothing (its old rule, pattern or component may be out of range now),
      * nor links to any node (a chain a new pattern replaced keeps its links otherwise): it is
-     * the node a reload of the kept tree makes */
-    for (size_t n = 0; with_rules && n < t->nnodes; n++)
-        if (t->nodes[n].kind == AG_NODE_DEAD) {
-            ag_tnode *x = &t->nodes[n];
-            x->rule = x->pattern = x->component = -1;
-            x->label = x->variant = -1;
-            x->parent = x->first_child = x->last_child = x->next_sibling = -1;
+     * the node a reload of the kept tree makes. In the pass that maps the components again
+     * (new patterns moved nodes, none changed its component); a dead node cleared before is
+     * only read. */
+    if (with_rules) {
+        size_t nc = mesh->ncomponents;
+        free(t->comp_node);
+        t->ncomponents = nc;
+        if (!(t->comp_node = malloc((nc + 1) * sizeof *t->comp_node))) {
+            st = nomem(err);
+            goto fail;
         }
-    if (with_rules && (st = tree_components(t, mesh->ncomponents))) {
-        st = nomem(err);
-        goto fail;
+        for (size_t c = 0; c < nc; c++)
+            t->comp_node[c] = -1;
+        for (size_t n = 0; n < t->nnodes; n++) {
+            ag_tnode *x = &t->nodes[n];
+            if (x->kind == AG_NODE_COMPONENT) {
+                if (x->component >= 0 && (size_t)x->component < nc)
+                    t->comp_node[x->component] = (int32_t)n;
+            } else if (x->kind == AG_NODE_DEAD &&
+                       (x->rule != -1 || x->pattern != -1 || x->component != -1 ||
+                        x->label != -1 || x->variant != -1 || x->parent != -1 ||
+                        x->first_child != -1 || x->last_child != -1 || x->next_sibling != -1)) {
+                x->rule = x->pattern = x->component = -1;
+                x->label = x->variant = -1;
+                x->parent = x->first_child = x->last_child = x->next_sibling = -1;
+            }
+        }
     }
     r->mesh = mesh;
     r->labels = L;
@@ -472,15 +523,32 @@ ag_status ag_rebuild(const ag_proceduralize_result *in, ag_splittree *t, int32_t
     const ag_splittree *ot = in->tree;
     ag_mesh *mesh = NULL;
     ag_labels *L = NULL;
-    size_t n = 0;
+    size_t n = 0, ncomps = 0, cap_comps = 0, npats = 0, cap_pats = 0;
+    int32_t *comps = NULL, *pats = NULL, *order = NULL;
     ag_status st = AG_OK;
-    /* the chains from the new boxes */
-    for (size_t v = 1; v < t->nnodes && !st; v++) {
+    /* the chains from the new boxes; the one pass over every node also lists the visible and
+     * the pattern nodes (a rechain adds split nodes only) */
+    for (size_t v = 0; v < t->nnodes && !st; v++) {
         const ag_tnode *x = &t->nodes[v];
-        if ((x->kind == AG_NODE_COMPONENT || x->kind == AG_NODE_PATTERN) && x->parent >= 0)
+        if (x->kind == AG_NODE_COMPONENT)
+            st = AG_ARRAY_RESERVE(comps, cap_comps, ncomps + 1);
+        else if (x->kind == AG_NODE_PATTERN)
+            st = AG_ARRAY_RESERVE(pats, cap_pats, npats + 1);
+        else
+            continue;
+        if (st)
+            break;
+        if (x->kind == AG_NODE_COMPONENT)
+            comps[ncomps++] = (int32_t)v;
+        else
+            pats[npats++] = (int32_t)v;
+        if (v > 0 && x->parent >= 0)
             st = ag_splittree_rechain(t, (int32_t)v);
     }
-    int32_t *order = st ? NULL : component_order(in, t, source, &n);
+    if (!st)
+        order = component_order(in, t, source, comps, ncomps, &n);
+    free(comps);
+    comps = NULL;
     if (!order) {
         st = nomem(err);
         goto fail;
@@ -519,12 +587,16 @@ ag_status ag_rebuild(const ag_proceduralize_result *in, ag_splittree *t, int32_t
     L->share = OL->share * scale;
     t->tol = L->exact;
     t->eps = ot->eps * scale;
-    free(order);
     free(source);
     source = NULL;
-    return finish(mesh, L, t, 1, popt, out, err);
+    live_nodes live = {order, n, pats, npats};
+    st = finish(mesh, L, t, 1, popt, &live, out, err);
+    free(order);
+    free(pats);
+    return st;
 fail:
     free(order);
+    free(pats);
     free(source);
     ag_mesh_free(mesh);
     ag_labels_free(L);
@@ -569,7 +641,7 @@ ag_status ag_rebuild_finish(ag_mesh *mesh, ag_splittree *tree, const ag_rebuild_
     L->exact = c->exact;
     L->share = c->share;
     L->exact_copies = c->exact_copies;
-    return finish(mesh, L, tree, 0, NULL, out, err);
+    return finish(mesh, L, tree, 0, NULL, NULL, out, err);
 }
 
 /* ---- label names ------------------------------------------------------------------------- */

@@ -95,24 +95,26 @@ ag_status ag_splittree_adjacency(ag_splittree *t)
     t->adj = NULL;
     t->nadj = 0;
     forget(t);
+    /* the visible nodes in one pass (an edited tree's are a few among many dead ones) */
     size_t nv = 0;
+    uint32_t *node = malloc((t->nnodes + 1) * sizeof *node);
+    if (!node)
+        return AG_ERR_NOMEM;
     for (size_t i = 0; i < t->nnodes; i++)
-        nv += t->nodes[i].kind == AG_NODE_COMPONENT;
-    if (nv < 2)
+        if (t->nodes[i].kind == AG_NODE_COMPONENT)
+            node[nv++] = (uint32_t)i;
+    if (nv < 2) {
+        free(node);
         return remember(t, 0);
+    }
     double tol = t->tol;
-    uint32_t *node = malloc(nv * sizeof *node);
     int *level = malloc(nv * sizeof *level);
     ag_radix_item *ent = NULL, *pairs = NULL;
     ag_radix_index cells = {0};
     size_t nent = 0, npairs = 0, cap_pairs = 0;
     ag_status st = AG_ERR_NOMEM;
-    if (!node || !level)
+    if (!level)
         goto done;
-    size_t k = 0;
-    for (size_t i = 0; i < t->nnodes; i++)
-        if (t->nodes[i].kind == AG_NODE_COMPONENT)
-            node[k++] = (uint32_t)i;
 
     /* the grid levels, halving: a cell of level 0 is as large as the largest grown box */
     double o[3] = {INFINITY, INFINITY, INFINITY}, top = 0, bottom = INFINITY;
@@ -247,16 +249,16 @@ typedef struct {
     size_t nfound, cap_found;
 } adj_bvh;
 
-static ag_status bvh_build(adj_bvh *h, const ag_splittree *t, size_t nv)
+static ag_status bvh_build(adj_bvh *h, const ag_splittree *t, const uint32_t *vis, size_t nv)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t n = 0; n < t->nnodes; n++)
-        if (t->nodes[n].kind == AG_NODE_COMPONENT)
-            for (int a = 0; a < 3; a++) {
-                double c = 0.5 * (t->nodes[n].box.min[a] + t->nodes[n].box.max[a]);
-                lo[a] = fmin(lo[a], c);
-                hi[a] = fmax(hi[a], c);
-            }
+    for (size_t i = 0; i < nv; i++)
+        for (int a = 0; a < 3; a++) {
+            const ag_box *b = &t->nodes[vis[i]].box;
+            double c = 0.5 * (b->min[a] + b->max[a]);
+            lo[a] = fmin(lo[a], c);
+            hi[a] = fmax(hi[a], c);
+        }
     h->m = 1;
     while (h->m < nv)
         h->m *= 2;
@@ -267,18 +269,16 @@ static ag_status bvh_build(adj_bvh *h, const ag_splittree *t, size_t nv)
         free(ord);
         return AG_ERR_NOMEM;
     }
-    size_t k = 0;
-    for (size_t n = 0; n < t->nnodes; n++) {
-        if (t->nodes[n].kind != AG_NODE_COMPONENT)
-            continue;
+    for (size_t k = 0; k < nv; k++) {
+        const ag_box *b = &t->nodes[vis[k]].box;
         uint64_t code = 0;
         for (int a = 0; a < 3; a++) {
-            double c = 0.5 * (t->nodes[n].box.min[a] + t->nodes[n].box.max[a]);
+            double c = 0.5 * (b->min[a] + b->max[a]);
             double u = hi[a] > lo[a] ? (c - lo[a]) / (hi[a] - lo[a]) : 0;
             code |= ag_radix_morton_spread((uint64_t)(fmin(fmax(u, 0), 1) * 2097151.0)) << a;
         }
         ord[k].key = code;
-        ord[k++].val = (uint32_t)n;
+        ord[k].val = vis[k];
     }
     if (ag_radix_sort(ord, nv)) {
         free(ord);
@@ -329,8 +329,10 @@ static ag_status bvh_query(adj_bvh *h, const ag_splittree *t, uint32_t q)
 }
 
 /* t's pairs without those of a changed node (the others are as they were), merged with the
- * sorted pairs found for the changed nodes (those have a changed node: the two are apart), in
- * one pass over the old pairs. */
+ * sorted pairs found for the changed nodes (those have a changed node: the two are apart).
+ * In place: the kept pairs close up from the front, then the two merge from the back into
+ * the array grown by the found ones (a new array of a few million pairs costs more in fresh
+ * pages than the merge itself). */
 static ag_status merge_found(ag_splittree *t, const uint8_t *changed, ag_radix_item *found,
                              size_t nfound)
 {
@@ -338,45 +340,55 @@ static ag_status merge_found(ag_splittree *t, const uint8_t *changed, ag_radix_i
     for (size_t f = 0; f < nfound; f++) /* a pair of two changed nodes was found from both */
         if (!nf || found[f].key != found[nf - 1].key)
             found[nf++] = found[f];
-    size_t cap = t->nadj + nf;
-    uint32_t *adj = cap ? malloc(2 * cap * sizeof *adj) : NULL;
-    if (cap && !adj)
-        return AG_ERR_NOMEM;
-    const uint32_t *old = t->adj;
-    size_t w = 0, f = 0;
+    uint32_t *adj = t->adj;
+    size_t w = 0;
     for (size_t p = 0; p < t->nadj; p++) {
-        uint32_t a = old[2 * p], b = old[2 * p + 1];
+        uint32_t a = adj[2 * p], b = adj[2 * p + 1];
         if (a >= nn || b >= nn || changed[a] || changed[b])
             continue;
-        uint64_t key = (uint64_t)a << 32 | b;
-        for (; f < nf && found[f].key < key; f++, w++) {
-            adj[2 * w] = (uint32_t)(found[f].key >> 32);
-            adj[2 * w + 1] = (uint32_t)found[f].key;
+        if (w != p) { /* pairs before the first one dropped stay where they are */
+            adj[2 * w] = a;
+            adj[2 * w + 1] = b;
         }
-        adj[2 * w] = a;
-        adj[2 * w + 1] = b;
         w++;
     }
-    for (; f < nf; f++, w++) {
-        adj[2 * w] = (uint32_t)(found[f].key >> 32);
-        adj[2 * w + 1] = (uint32_t)found[f].key;
-    }
-    free(t->adj);
-    t->adj = adj;
     t->nadj = w;
+    if (!nf)
+        return AG_OK;
+    adj = realloc(t->adj, 2 * (w + nf) * sizeof *adj);
+    if (!adj)
+        return AG_ERR_NOMEM;
+    t->adj = adj;
+    size_t k = w, f = nf, o = w + nf;
+    while (f > 0) {
+        uint64_t fk = found[f - 1].key;
+        if (k > 0 && ((uint64_t)adj[2 * (k - 1)] << 32 | adj[2 * (k - 1) + 1]) > fk) {
+            k--;
+            o--;
+            adj[2 * o] = adj[2 * k];
+            adj[2 * o + 1] = adj[2 * k + 1];
+        } else {
+            f--;
+            o--;
+            adj[2 * o] = (uint32_t)(fk >> 32);
+            adj[2 * o + 1] = (uint32_t)fk;
+        }
+    }
+    t->nadj = w + nf;
     return AG_OK;
 }
 
-/* Records the changed nodes and the nodes past the ones recorded (ns of them). */
-static ag_status remember_changed(ag_splittree *t, const uint8_t *changed, size_t ns)
+/* Records the changed nodes (the list of them, nchg) and the nodes past the ones recorded (ns
+ * of them). */
+static ag_status remember_changed(ag_splittree *t, const uint32_t *chg, size_t nchg, size_t ns)
 {
     size_t from = ns < t->nnodes ? ns : t->nnodes;
     ag_status st = remember(t, from);
-    for (size_t n = 0; !st && n < from; n++)
-        if (changed[n]) {
-            t->adj_seen[n].box = t->nodes[n].box;
-            t->adj_seen[n].visible = t->nodes[n].kind == AG_NODE_COMPONENT;
-        }
+    for (size_t i = 0; !st && i < nchg && chg[i] < from; i++) {
+        uint32_t n = chg[i];
+        t->adj_seen[n].box = t->nodes[n].box;
+        t->adj_seen[n].visible = t->nodes[n].kind == AG_NODE_COMPONENT;
+    }
     return st;
 }
 
@@ -388,38 +400,50 @@ ag_status ag_splittree_adjacency_update(ag_splittree *t, int *from_scratch)
         return ag_splittree_adjacency(t);
     size_t nn = t->nnodes, ns = t->adj_nseen, top = nn > ns ? nn : ns, nv = 0, nch = 0;
     uint8_t *changed = calloc(top + 1, 1);
-    if (!changed)
+    /* one pass over the nodes (mostly dead ones in an edited tree) lists what the rest uses:
+     * the visible nodes, and the changed ones (visible ones first in a second list) */
+    uint32_t *vis = malloc((nn + 1) * sizeof *vis), *chg = malloc((top + 1) * sizeof *chg);
+    if (!changed || !vis || !chg) {
+        free(changed);
+        free(vis);
+        free(chg);
         return AG_ERR_NOMEM;
+    }
+    size_t nchg = 0;
     for (size_t n = 0; n < top; n++) {
         int now = n < nn && t->nodes[n].kind == AG_NODE_COMPONENT;
         int then = n < ns && t->adj_seen[n].visible;
         if (now != then ||
             (now && memcmp(&t->adj_seen[n].box, &t->nodes[n].box, sizeof(ag_box)))) {
             changed[n] = 1;
+            chg[nchg++] = (uint32_t)n;
             nch += now;
         }
-        nv += now;
+        if (now)
+            vis[nv++] = (uint32_t)n;
     }
     adj_bvh h = {0};
     ag_status st = AG_OK;
     int whole = nch * ADJ_UPDATE_MAX_SHARE >= nv && nch > 0;
     if (!whole && nch) {
-        st = bvh_build(&h, t, nv);
-        for (size_t n = 0; !st && n < nn; n++)
-            if (changed[n] && t->nodes[n].kind == AG_NODE_COMPONENT)
-                st = bvh_query(&h, t, (uint32_t)n);
+        st = bvh_build(&h, t, vis, nv);
+        for (size_t i = 0; !st && i < nchg; i++)
+            if (chg[i] < nn && t->nodes[chg[i]].kind == AG_NODE_COMPONENT)
+                st = bvh_query(&h, t, chg[i]);
         free(h.bound);
         free(h.leaf);
     }
+    free(vis);
     if (!st && !whole) {
         st = ag_radix_sort(h.found, h.nfound);
         if (!st)
             st = merge_found(t, changed, h.found, h.nfound);
         if (!st)
-            st = remember_changed(t, changed, ns);
+            st = remember_changed(t, chg, nchg, ns);
     }
     free(h.found);
     free(changed);
+    free(chg);
     if (whole && !st)
         return ag_splittree_adjacency(t);
     if (from_scratch && !st)

@@ -599,24 +599,66 @@ static int axis_rows(const ag_splittree *t, inst *g, size_t n, size_t minn, foun
     return fail;
 }
 
+/* The scratch of one parent's instances, grown to the most instances a parent has (not the
+ * tree's size: most of an edited tree's nodes are dead). */
+typedef struct {
+    inst *row, *run;
+    uint32_t *idx;
+    double *tmp;
+    uint8_t *seen;
+    int64_t *ij, *ij2;
+    runkey *rk;
+    size_t cap;
+} scratch;
+
+static int scratch_reserve(scratch *w, size_t n)
+{
+    if (n <= w->cap)
+        return 0;
+    size_t cap = w->cap ? w->cap : 64;
+    while (cap < n)
+        cap *= 2;
+    void *p;
+    if (!(p = realloc(w->row, (cap + 1) * sizeof *w->row)))
+        return -1;
+    w->row = p;
+    if (!(p = realloc(w->run, (cap + 1) * sizeof *w->run)))
+        return -1;
+    w->run = p;
+    if (!(p = realloc(w->idx, (3 * cap + 3) * sizeof *w->idx)))
+        return -1;
+    w->idx = p;
+    if (!(p = realloc(w->tmp, (cap + 1) * sizeof *w->tmp)))
+        return -1;
+    w->tmp = p;
+    if (!(p = realloc(w->seen, cap + 1)))
+        return -1;
+    w->seen = p;
+    if (!(p = realloc(w->ij, (2 * cap + 2) * sizeof *w->ij)))
+        return -1;
+    w->ij = p;
+    if (!(p = realloc(w->ij2, (2 * cap + 2) * sizeof *w->ij2)))
+        return -1;
+    w->ij2 = p;
+    if (!(p = realloc(w->rk, (cap + 1) * sizeof *w->rk)))
+        return -1;
+    w->rk = p;
+    w->cap = cap;
+    return 0;
+}
+
 ag_status ag_patterns_find(ag_splittree *t, const ag_patterns_options *opt, ag_error *err)
 {
     size_t minn = opt && opt->min_instances ? opt->min_instances : 2;
     if (minn < 2)
         minn = 2;
-    size_t N0 = t->nnodes;
-    inst *buf = malloc((N0 + 1) * sizeof *buf);
-    inst *row = malloc((N0 + 1) * sizeof *row);
-    uint32_t *idx = malloc((3 * N0 + 3) * sizeof *idx);
-    double *tmp = malloc((N0 + 1) * sizeof *tmp);
-    uint8_t *seen = malloc(N0 + 1);
+    size_t N0 = t->nnodes, cap_buf = 0;
+    inst *buf = NULL;
+    scratch w = {0};
     uint8_t *moved = calloc(N0 + 1, 1);
-    int64_t *ij = malloc((2 * N0 + 2) * sizeof *ij), *ij2 = malloc((2 * N0 + 2) * sizeof *ij2);
-    runkey *rk = malloc((N0 + 1) * sizeof *rk);
-    inst *run = malloc((N0 + 1) * sizeof *run);
     foundset fs = {0};
     ag_status st = AG_ERR_NOMEM;
-    if (!buf || !row || !idx || !tmp || !seen || !moved || !ij || !ij2 || !rk || !run)
+    if (!moved)
         goto done;
     for (size_t pi = 0; pi < N0; pi++) {
         int kind = t->nodes[pi].kind;
@@ -628,6 +670,8 @@ ag_status ag_patterns_find(ag_splittree *t, const ag_patterns_options *opt, ag_e
             if (e < 0 || t->nodes[e].kind != AG_NODE_COMPONENT || t->nodes[e].rule < 0 ||
                 t->rule_count[t->nodes[e].rule] < minn)
                 continue;
+            if (AG_ARRAY_RESERVE(buf, cap_buf, n + 1))
+                goto done;
             buf[n].rule = t->nodes[e].rule;
             buf[n].rot = t->nodes[e].rule_rot;
             buf[n].node = e;
@@ -636,6 +680,14 @@ ag_status ag_patterns_find(ag_splittree *t, const ag_patterns_options *opt, ag_e
         }
         if (n < minn)
             continue;
+        if (scratch_reserve(&w, n))
+            goto done;
+        inst *row = w.row, *run = w.run;
+        uint32_t *idx = w.idx;
+        double *tmp = w.tmp;
+        uint8_t *seen = w.seen;
+        int64_t *ij = w.ij, *ij2 = w.ij2;
+        runkey *rk = w.rk;
         qsort(buf, n, sizeof *buf, cmp_inst);
         for (size_t i = 0, j; i < n; i = j) {
             for (j = i + 1; j < n && buf[j].rule == buf[i].rule && buf[j].rot == buf[i].rot; j++)
@@ -705,15 +757,15 @@ ag_status ag_patterns_find(ag_splittree *t, const ag_patterns_options *opt, ag_e
     st = AG_OK;
 done:
     free(buf);
-    free(row);
-    free(idx);
-    free(tmp);
-    free(seen);
+    free(w.row);
+    free(w.run);
+    free(w.idx);
+    free(w.tmp);
+    free(w.seen);
+    free(w.ij);
+    free(w.ij2);
+    free(w.rk);
     free(moved);
-    free(ij);
-    free(ij2);
-    free(rk);
-    free(run);
     free(fs.members);
     free(fs.list);
     if (st)

@@ -104,6 +104,58 @@ static uint64_t corner_cell(const double p[3], double cell, const int64_t add[3]
                          (int64_t)floor(p[2] / cell) + add[2]);
 }
 
+/* Does a box of extents eb have the size of one of extents ea turned by k quarter turns? */
+static int same_size(const double ea[3], const double eb[3], int k, double tol)
+{
+    int odd = k & 1;
+    return !(fabs(ea[odd ? 1 : 0] - eb[0]) > tol || fabs(ea[odd ? 0 : 1] - eb[1]) > tol ||
+             fabs(ea[2] - eb[2]) > tol);
+}
+
+/* A rule's representative as the search for a node's rule first compares it: its child
+ * count, the sum of its children's classes (below), turn and extents. */
+typedef struct {
+    size_t kids;
+    uint64_t sig;
+    double ext[3];
+    uint8_t rot;
+} rule_key;
+
+/* A child's class as same_child compares it before its turn and place: its kind and its rule
+ * (a pattern's: the pattern's rule; none for a pattern out of range). Two nodes whose
+ * children's classes differ as multisets are not the same: the sums of their mixed classes
+ * tell most such pairs apart without the comparison. */
+static uint64_t child_class(const ag_splittree *t, const ag_tnode *x)
+{
+    uint64_t r;
+    if (x->kind == AG_NODE_PATTERN)
+        r = x->pattern >= 0 && (size_t)x->pattern < t->npatterns
+                ? (uint32_t)t->patterns[x->pattern].rule
+                : UINT64_C(1) << 32;
+    else
+        r = (uint32_t)x->rule;
+    uint64_t z = r ^ (uint64_t)x->kind << 40;
+    z = (z ^ (z >> 30)) * UINT64_C(0xbf58476d1ce4e5b9); /* splitmix64's finaliser */
+    z = (z ^ (z >> 27)) * UINT64_C(0x94d049bb133111eb);
+    return z ^ (z >> 31);
+}
+
+/* The number of children of v (as children() counts them) and the sum of their classes. */
+static size_t children_sig(const ag_splittree *t, int32_t v, uint64_t *sig)
+{
+    size_t n = 0;
+    uint64_t s = 0;
+    for (int32_t c = t->nodes[v].first_child; c >= 0; c = t->nodes[c].next_sibling) {
+        int32_t e = ag_splittree_chain_end(t, c);
+        if (e >= 0) {
+            s += child_class(t, &t->nodes[e]);
+            n++;
+        }
+    }
+    *sig = s;
+    return n;
+}
+
 /* Does b match rep a with b = rotate(a, k)? b must also have a's size: a rule is placed scaled
  * to the box it is applied to (its children would move with it) and a pattern's cells are of
  * one size (nodes of one variant have it anyway; an edited model's stretched copies of a
@@ -112,21 +164,19 @@ static uint64_t corner_cell(const double p[3], double cell, const int64_t add[3]
 static int same(const ag_splittree *t, int32_t a, int32_t b, int k, int32_t *ca, int32_t *cb,
                 uint8_t *used, size_t n, same_scratch *sc)
 {
+    double tol = t->tol;
+    {   /* the sizes first: most candidates differ there, before their children are walked */
+        double ea[3], eb[3];
+        ag_box_extents(&t->nodes[a].box, ea);
+        ag_box_extents(&t->nodes[b].box, eb);
+        if (!same_size(ea, eb, k, tol))
+            return 0;
+    }
     size_t na = children(t, a, ca, n), nb = children(t, b, cb, n);
     assert(na == n && nb == n); /* the caller compared the counts */
     (void)na;
     (void)nb;
     memset(used, 0, n);
-    double tol = t->tol;
-    {
-        double ea[3], eb[3];
-        ag_box_extents(&t->nodes[a].box, ea);
-        ag_box_extents(&t->nodes[b].box, eb);
-        int odd = k & 1;
-        if (fabs(ea[odd ? 1 : 0] - eb[0]) > tol || fabs(ea[odd ? 0 : 1] - eb[1]) > tol ||
-            fabs(ea[2] - eb[2]) > tol)
-            return 0;
-    }
     if (n <= SAME_INDEX_MIN) {
         for (size_t j = 0; j < n; j++) {
             double blo[3], bhi[3];
@@ -215,29 +265,42 @@ size_t ag_rules_max_count(const ag_splittree *t)
 
 /* The visible nodes in an order where every visible node comes after the visible nodes below
  * it: reverse index order when every visible node's nearest visible ancestor has a smaller
- * index (a tree as built, or edited keeping that), else a post-order walk. */
-static int32_t *children_first(const ag_splittree *t, size_t *n_out)
+ * index (a tree as built, or edited keeping that), else a post-order walk. One pass over the
+ * nodes (an edited tree is mostly dead nodes: each pass over them costs more than the live
+ * ones' work) also gives the largest variant of a visible node. */
+static int32_t *children_first(const ag_splittree *t, size_t *n_out, int32_t *maxvariant)
 {
     size_t N = t->nnodes, n = 0;
     int32_t *order = malloc((N + 1) * sizeof *order);
     if (!order)
         return NULL;
     int indexed = 1;
-    for (size_t i = 0; i < N && indexed; i++) {
-        if (t->nodes[i].kind != AG_NODE_COMPONENT)
+    int32_t mv = -1;
+    for (size_t i = 0; i < N; i++) {
+        const ag_tnode *x = &t->nodes[i];
+        if (x->kind != AG_NODE_COMPONENT)
             continue;
-        int32_t p = t->nodes[i].parent;
+        if (x->variant > mv)
+            mv = x->variant;
+        order[n++] = (int32_t)i;
+        if (!indexed)
+            continue;
+        int32_t p = x->parent;
         while (p >= 0 && t->nodes[p].kind != AG_NODE_COMPONENT && t->nodes[p].kind != AG_NODE_ROOT)
             p = t->nodes[p].parent;
         indexed = p < (int32_t)i;
     }
+    *maxvariant = mv;
     if (indexed) {
-        for (size_t i = N; i-- > 0;)
-            if (t->nodes[i].kind == AG_NODE_COMPONENT)
-                order[n++] = (int32_t)i;
+        for (size_t i = 0, j = n; i < j / 2; i++) {
+            int32_t v = order[i];
+            order[i] = order[j - 1 - i];
+            order[j - 1 - i] = v;
+        }
         *n_out = n;
         return order;
     }
+    n = 0;
     /* iterative post-order: a node is emitted once its children are */
     int32_t *stack = malloc((N + 1) * sizeof *stack), *next = malloc((N + 1) * sizeof *next);
     if (!stack || !next) {
@@ -268,71 +331,107 @@ static int32_t *children_first(const ag_splittree *t, size_t *n_out)
     return order;
 }
 
+/* The comparison's scratch, grown to the most children a compared node has (not the tree's
+ * size: most of an edited tree's nodes are dead). */
+typedef struct {
+    int32_t *ca, *cb;
+    uint8_t *used;
+    size_t cap;
+} same_bufs;
+
+static int bufs_reserve(same_bufs *b, same_scratch *sc, size_t n)
+{
+    if (n <= b->cap && b->ca)
+        return 0;
+    size_t cap = b->cap ? b->cap : 16;
+    while (cap < n)
+        cap *= 2;
+    int32_t *ca = realloc(b->ca, cap * sizeof *ca);
+    if (ca)
+        b->ca = ca;
+    int32_t *cb = realloc(b->cb, cap * sizeof *cb);
+    if (cb)
+        b->cb = cb;
+    uint8_t *used = realloc(b->used, cap);
+    if (used)
+        b->used = used;
+    double *lo = realloc(sc->lo, 3 * cap * sizeof *lo);
+    if (lo)
+        sc->lo = lo;
+    double *hi = realloc(sc->hi, 3 * cap * sizeof *hi);
+    if (hi)
+        sc->hi = hi;
+    if (!ca || !cb || !used || !lo || !hi)
+        return -1;
+    b->cap = cap;
+    return 0;
+}
+
 ag_status ag_rules_label(ag_splittree *t, ag_error *err)
 {
     size_t N = t->nnodes;
-    /* per variant: list of rules whose representative has that variant */
+    /* children first, so each comparison is one level deep */
+    size_t norder = 0;
     int32_t maxlabel = -1;
-    for (size_t i = 0; i < N; i++)
-        if (t->nodes[i].variant > maxlabel)
-            maxlabel = t->nodes[i].variant;
-    int32_t *lhead = malloc(((size_t)maxlabel + 2) * sizeof *lhead);
-    int32_t *rnext = malloc((N + 1) * sizeof *rnext);
-    int32_t *ca = malloc((N + 1) * sizeof *ca), *cb = malloc((N + 1) * sizeof *cb);
-    uint8_t *used = malloc(N + 1);
-    same_scratch sc = {malloc((3 * N + 1) * sizeof *sc.lo), malloc((3 * N + 1) * sizeof *sc.hi),
-                       NULL, 0, 0};
+    int32_t *order = children_first(t, &norder, &maxlabel);
+    /* per variant: list of rules whose representative has that variant */
+    int32_t *lhead = order ? malloc(((size_t)maxlabel + 2) * sizeof *lhead) : NULL;
+    int32_t *rnext = malloc((norder + 1) * sizeof *rnext);
+    /* per rule: what same() looks at first of its representative, kept together (an edited
+     * model's stretched copies make many rules of one variant, each node tries them all) */
+    rule_key *rkey = malloc((norder + 1) * sizeof *rkey);
+    same_bufs bufs = {0};
+    same_scratch sc = {NULL, NULL, NULL, 0, 0};
     free(t->rule_count);
     free(t->rule_rep);
-    t->rule_count = malloc((N + 1) * sizeof *t->rule_count);
-    t->rule_rep = malloc((N + 1) * sizeof *t->rule_rep);
+    /* a rule has one visible node at least */
+    t->rule_count = malloc((norder + 1) * sizeof *t->rule_count);
+    t->rule_rep = malloc((norder + 1) * sizeof *t->rule_rep);
     t->nrules = 0;
-    if (!lhead || !rnext || !ca || !cb || !used || !t->rule_count || !t->rule_rep || !sc.lo ||
-        !sc.hi) {
-        free(sc.lo);
-        free(sc.hi);
+    if (!order || !lhead || !rnext || !rkey || !t->rule_count || !t->rule_rep) {
+        free(order);
         free(lhead);
         free(rnext);
-        free(ca);
-        free(cb);
-        free(used);
+        free(rkey);
         return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     }
     for (int32_t l = 0; l <= maxlabel; l++)
         lhead[l] = -1;
-    /* children first, so each comparison is one level deep */
-    size_t norder = 0;
-    int32_t *order = children_first(t, &norder);
-    if (!order) {
-        free(sc.lo);
-        free(sc.hi);
-        free(lhead);
-        free(rnext);
-        free(ca);
-        free(cb);
-        free(used);
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
-    }
-    for (size_t oi = 0; oi < norder; oi++) {
+    for (size_t oi = 0; oi < norder && !sc.nomem; oi++) {
         size_t ii = (size_t)order[oi];
         ag_tnode *b = &t->nodes[ii];
-        size_t nb = children(t, (int32_t)ii, NULL, 0);
+        uint64_t sig;
+        size_t nb = children_sig(t, (int32_t)ii, &sig);
+        double eb[3];
+        ag_box_extents(&b->box, eb);
         int32_t found = -1;
         int fk = 0;
         for (int32_t r = lhead[b->variant]; r >= 0 && found < 0; r = rnext[r]) {
-            int32_t a = t->rule_rep[r];
-            if (children(t, a, NULL, 0) != nb)
+            const rule_key *q = &rkey[r];
+            if (q->kids != nb || q->sig != sig ||
+                !same_size(q->ext, eb, (b->rot - q->rot) & 3, t->tol))
                 continue;
+            int32_t a = t->rule_rep[r];
+            if (bufs_reserve(&bufs, &sc, nb)) {
+                sc.nomem = 1;
+                break;
+            }
             int k = (b->rot - t->nodes[a].rot) & 3;
-            if (same(t, a, (int32_t)ii, k, ca, cb, used, nb, &sc)) {
+            if (same(t, a, (int32_t)ii, k, bufs.ca, bufs.cb, bufs.used, nb, &sc)) {
                 found = r;
                 fk = k;
             }
         }
+        if (sc.nomem)
+            break;
         if (found < 0) {
             found = (int32_t)t->nrules++;
             t->rule_rep[found] = (int32_t)ii;
             t->rule_count[found] = 0;
+            rkey[found].kids = nb;
+            rkey[found].sig = sig;
+            rkey[found].rot = b->rot;
+            memcpy(rkey[found].ext, eb, sizeof eb);
             rnext[found] = lhead[b->variant];
             lhead[b->variant] = found;
             fk = 0;
@@ -345,6 +444,14 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
     free(sc.lo);
     free(sc.hi);
     free(sc.ent);
+    free(bufs.ca);
+    free(bufs.cb);
+    free(bufs.used);
+    free(lhead);
+    free(rnext);
+    free(rkey);
+    if (sc.nomem)
+        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     /* a pattern repeats its cells' rule */
     for (size_t p = 0; p < t->npatterns; p++) {
         int32_t pn = t->patterns[p].node;
@@ -354,12 +461,5 @@ ag_status ag_rules_label(ag_splittree *t, ag_error *err)
             t->patterns[p].rot = t->nodes[c].rule_rot;
         }
     }
-    free(lhead);
-    free(rnext);
-    free(ca);
-    free(cb);
-    free(used);
-    if (sc.nomem)
-        return ag_error_set(err, AG_ERR_NOMEM, 0, "out of memory while labeling rules");
     return AG_OK;
 }
