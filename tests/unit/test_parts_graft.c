@@ -705,6 +705,16 @@ static ag_edit_model *graft_op(const ag_edit_model *em, const ag_part *part, int
     return out;
 }
 
+/* The model of a small generated facade (every box its own component), its mesh in *m. */
+static ag_edit_model *small_facade_model(ag_mesh **m)
+{
+    ag_gen_facade_options go = {.cols = 6, .rows = 4, .side_cols = 4, .left = 1, .bars = 3,
+                                .no_groups = 1, .annex = 1};
+    *m = NULL;
+    assert_int_equal(ag_gen_facade(&go, m, NULL), AG_OK);
+    return model_of(*m);
+}
+
 /* The fast path's state after several ops in a row equals the full rebuild's (the kept state
  * reloaded) after each, and an op undone and done again (from the state kept before it, as
  * undo restores it) gives the same model exactly: nothing of an op stays behind in the model
@@ -712,11 +722,8 @@ static ag_edit_model *graft_op(const ag_edit_model *em, const ag_part *part, int
 static void test_graft_state_is_the_rebuilds(void **state)
 {
     (void)state;
-    ag_gen_facade_options go = {.cols = 6, .rows = 4, .side_cols = 4, .left = 1, .bars = 3,
-                                .no_groups = 1, .annex = 1};
     ag_mesh *m = NULL;
-    assert_int_equal(ag_gen_facade(&go, &m, NULL), AG_OK);
-    ag_edit_model *em = model_of(m);
+    ag_edit_model *em = small_facade_model(&m);
     const ag_splittree *t = em->proc->tree;
     int32_t rep = ag_splittree_most_repeated(t), big = -1;
     size_t best_sub = 0;
@@ -756,11 +763,8 @@ static void test_graft_state_is_the_rebuilds(void **state)
 static void test_cells_keep_their_pattern(void **state)
 {
     (void)state;
-    ag_gen_facade_options go = {.cols = 6, .rows = 4, .side_cols = 4, .left = 1, .bars = 3,
-                                .no_groups = 1, .annex = 1};
     ag_mesh *m = NULL;
-    assert_int_equal(ag_gen_facade(&go, &m, NULL), AG_OK);
-    ag_edit_model *em = model_of(m);
+    ag_edit_model *em = small_facade_model(&m);
     const ag_splittree *t = em->proc->tree;
     int32_t rep = ag_splittree_most_repeated(t);
     assert_true(rep > 0);

@@ -827,6 +827,15 @@ nomem_:
     return nomem(err);
 }
 
+/* The nearest component above node n of t, else -1. */
+static int32_t component_above(const ag_splittree *t, int32_t n)
+{
+    int32_t p = t->nodes[n].parent;
+    while (p >= 0 && t->nodes[p].kind != AG_NODE_COMPONENT)
+        p = t->nodes[p].parent;
+    return p;
+}
+
 /* The number of cells of pattern node p. */
 static uint32_t cells_of(const ag_splittree *t, int32_t p)
 {
@@ -865,9 +874,7 @@ static int32_t *cell_takers(const graft *g, const ag_splittree *X, const ag_spli
         const ag_tnode *x = &mt->nodes[k];
         if (x->kind != AG_NODE_COMPONENT)
             continue;
-        int32_t vp = x->parent;
-        while (vp >= 0 && mt->nodes[vp].kind != AG_NODE_COMPONENT)
-            vp = mt->nodes[vp].parent;
+        int32_t vp = component_above(mt, (int32_t)k);
         size_t i = (size_t)x->component;
         int32_t s = g->nsite[i];
         if (vp >= 0 || g->cell[s] < 0)
@@ -997,9 +1004,7 @@ static ag_status insert_new(graft *g, ag_splittree *X, ag_error *err)
         const ag_tnode *x = &mt->nodes[k];
         if (x->kind != AG_NODE_COMPONENT)
             continue;
-        int32_t vp = x->parent;
-        while (vp >= 0 && mt->nodes[vp].kind != AG_NODE_COMPONENT)
-            vp = mt->nodes[vp].parent;
+        int32_t vp = component_above(mt, (int32_t)k);
         size_t i = (size_t)x->component;
         ag_box b = g->d.box[g->nd[i]];
         int32_t s = g->nsite[i], n;
