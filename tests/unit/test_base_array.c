@@ -157,8 +157,17 @@ static void test_overflow_and_nomem_keep_array(void **state)
     assert_int_equal(AG_ARRAY_RESERVE_EXACT(a, cap, SIZE_MAX / sizeof *a), AG_ERR_NOMEM);
     assert_ptr_equal(a, keep);
     assert_int_equal(cap, keep_cap);
+    /* a resize of one array of a struct of arrays: refused alike, the array kept */
+    assert_int_equal(AG_ARRAY_RESIZE(a, SIZE_MAX / sizeof *a + 1), AG_ERR_TOO_LARGE);
+    assert_int_equal(AG_ARRAY_RESIZE(a, SIZE_MAX / sizeof *a), AG_ERR_NOMEM);
+    assert_ptr_equal(a, keep);
     for (int i = 0; i < 10; i++)
         assert_true(a[i] == i + 0.5);
+    /* and grown, its contents kept */
+    assert_int_equal(AG_ARRAY_RESIZE(a, 1000), AG_OK);
+    for (int i = 0; i < 10; i++)
+        assert_true(a[i] == i + 0.5);
+    a[999] = 1;
     free(a);
 }
 

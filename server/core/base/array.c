@@ -31,20 +31,28 @@ ag_status ag_array_hash_size(size_t n, size_t *size)
     return AG_OK;
 }
 
-ag_status ag_array_reserve_exact(void **items, size_t *cap, size_t need, size_t elem)
+ag_status ag_array_resize(void **items, size_t n, size_t elem)
 {
-    assert(items && cap && elem > 0);
-    if (need <= *cap)
-        return AG_OK;
+    assert(items && elem > 0);
     size_t bytes;
-    if (ag_array_bytes(need, elem, &bytes))
+    if (ag_array_bytes(n ? n : 1, elem, &bytes))
         return AG_ERR_TOO_LARGE;
     void *p = realloc(*items, bytes);
     if (!p)
         return AG_ERR_NOMEM;
     *items = p;
-    *cap = need;
     return AG_OK;
+}
+
+ag_status ag_array_reserve_exact(void **items, size_t *cap, size_t need, size_t elem)
+{
+    assert(items && cap && elem > 0);
+    if (need <= *cap)
+        return AG_OK;
+    ag_status s = ag_array_resize(items, need, elem);
+    if (s == AG_OK)
+        *cap = need;
+    return s;
 }
 
 ag_status ag_array_capacity(size_t cap, size_t need, size_t elem, size_t *out)

@@ -31,6 +31,9 @@ ag_status ag_array_reserve(void **items, size_t *cap, size_t need, size_t elem);
 ag_status ag_array_reserve_more(void **items, size_t *cap, size_t len, size_t more, size_t elem);
 /* Exactly need elements when the capacity is smaller (no doubling): for a known final size. */
 ag_status ag_array_reserve_exact(void **items, size_t *cap, size_t need, size_t elem);
+/* *items reallocated to exactly n elements (at least one), *items kept when that fails: for
+ * the arrays of a struct that share one capacity (ag_array_capacity). */
+ag_status ag_array_resize(void **items, size_t n, size_t elem);
 
 /* The size of an open-addressing hash table for n keys: a power of two of at least 2 n + 16,
  * so the table is at most half full. AG_ERR_TOO_LARGE when that does not fit a size_t. */
@@ -48,5 +51,6 @@ ag_status ag_array_sum(size_t a, size_t b, size_t *sum);
     ag_array_reserve_more((void **)&(items), &(cap), (len), (more), sizeof *(items))
 #define AG_ARRAY_RESERVE_EXACT(items, cap, need) \
     ag_array_reserve_exact((void **)&(items), &(cap), (need), sizeof *(items))
+#define AG_ARRAY_RESIZE(items, n) ag_array_resize((void **)&(items), (n), sizeof *(items))
 
 #endif

@@ -615,34 +615,15 @@ static int scratch_reserve(scratch *w, size_t n)
 {
     if (n <= w->cap)
         return 0;
-    size_t cap = w->cap ? w->cap : 64;
-    while (cap < n)
-        cap *= 2;
-    void *p;
-    if (!(p = realloc(w->row, (cap + 1) * sizeof *w->row)))
+    /* doubled from 64, as long as the largest array per unit of capacity (rk) fits */
+    size_t cap;
+    if (ag_array_capacity(w->cap ? w->cap : 64, n, sizeof *w->rk, &cap))
         return -1;
-    w->row = p;
-    if (!(p = realloc(w->run, (cap + 1) * sizeof *w->run)))
+    if (AG_ARRAY_RESIZE(w->row, cap + 1) || AG_ARRAY_RESIZE(w->run, cap + 1) ||
+        AG_ARRAY_RESIZE(w->idx, 3 * cap + 3) || AG_ARRAY_RESIZE(w->tmp, cap + 1) ||
+        AG_ARRAY_RESIZE(w->seen, cap + 1) || AG_ARRAY_RESIZE(w->ij, 2 * cap + 2) ||
+        AG_ARRAY_RESIZE(w->ij2, 2 * cap + 2) || AG_ARRAY_RESIZE(w->rk, cap + 1))
         return -1;
-    w->run = p;
-    if (!(p = realloc(w->idx, (3 * cap + 3) * sizeof *w->idx)))
-        return -1;
-    w->idx = p;
-    if (!(p = realloc(w->tmp, (cap + 1) * sizeof *w->tmp)))
-        return -1;
-    w->tmp = p;
-    if (!(p = realloc(w->seen, cap + 1)))
-        return -1;
-    w->seen = p;
-    if (!(p = realloc(w->ij, (2 * cap + 2) * sizeof *w->ij)))
-        return -1;
-    w->ij = p;
-    if (!(p = realloc(w->ij2, (2 * cap + 2) * sizeof *w->ij2)))
-        return -1;
-    w->ij2 = p;
-    if (!(p = realloc(w->rk, (cap + 1) * sizeof *w->rk)))
-        return -1;
-    w->rk = p;
     w->cap = cap;
     return 0;
 }

@@ -343,25 +343,11 @@ static int bufs_reserve(same_bufs *b, same_scratch *sc, size_t n)
 {
     if (n <= b->cap && b->ca)
         return 0;
-    size_t cap = b->cap ? b->cap : 16;
-    while (cap < n)
-        cap *= 2;
-    int32_t *ca = realloc(b->ca, cap * sizeof *ca);
-    if (ca)
-        b->ca = ca;
-    int32_t *cb = realloc(b->cb, cap * sizeof *cb);
-    if (cb)
-        b->cb = cb;
-    uint8_t *used = realloc(b->used, cap);
-    if (used)
-        b->used = used;
-    double *lo = realloc(sc->lo, 3 * cap * sizeof *lo);
-    if (lo)
-        sc->lo = lo;
-    double *hi = realloc(sc->hi, 3 * cap * sizeof *hi);
-    if (hi)
-        sc->hi = hi;
-    if (!ca || !cb || !used || !lo || !hi)
+    size_t cap;
+    if (ag_array_capacity(b->cap ? b->cap : 16, n, 3 * sizeof *sc->lo, &cap) ||
+        AG_ARRAY_RESIZE(b->ca, cap) || AG_ARRAY_RESIZE(b->cb, cap) ||
+        AG_ARRAY_RESIZE(b->used, cap) || AG_ARRAY_RESIZE(sc->lo, 3 * cap) ||
+        AG_ARRAY_RESIZE(sc->hi, 3 * cap))
         return -1;
     b->cap = cap;
     return 0;
